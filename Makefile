@@ -1,0 +1,30 @@
+# Two commands for a fresh machine:
+#   make demo   set up .venv and run the headline scenario
+#   make test   set up .venv and run the tests (what CI runs)
+PY ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+export MUJOCO_GL ?= egl
+
+.PHONY: setup demo test lint bench clean
+
+$(BIN)/headsim: pyproject.toml
+	$(PY) -m venv $(VENV)
+	$(BIN)/pip install -q --upgrade pip
+	$(BIN)/pip install -q -e '.[test]'
+	@touch $@
+
+setup: $(BIN)/headsim
+
+demo: setup
+	$(BIN)/headsim snapshot --out out/snapshot
+
+test: setup
+	$(BIN)/ruff check headsim tests benchmarks
+	$(BIN)/python -m pytest -q
+
+bench: setup
+	$(BIN)/python benchmarks/render_speed.py
+
+clean:
+	rm -rf $(VENV) out
