@@ -21,6 +21,7 @@ demo: setup
 
 test: setup
 	$(BIN)/ruff check headsim tests benchmarks
+	$(BIN)/ruff format --check headsim tests benchmarks
 	$(BIN)/python -m pytest -q
 
 bench: setup
