@@ -1,0 +1,195 @@
+"""Uncalibrated visual servoing from images alone: no focal length, no principal point.
+
+The eye servo drives the eye motor, in whole encoder steps, until the chosen
+camera sees the target at a goal column (the image centre).  Its gain (px per
+encoder step) is measured from the images: a probe move when nothing is known,
+then secant (1-D Broyden) updates after every large enough move.  A gain
+learnt on one target seeds the next.  Every loop is bounded and returns a
+:class:`ServoResult` that says why it ended.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from headsim import names
+from headsim.sim import HeadSim
+from headsim.vision import Detection
+
+Detector = Callable[[np.ndarray], Detection]
+
+
+class ServoOutcome(enum.Enum):
+    CONVERGED = "converged"
+    TARGET_LOST = "target lost"
+    ITERATION_LIMIT = "iteration limit"
+    JOINT_LIMIT = "joint limit"
+
+
+@dataclass(frozen=True)
+class ServoResult:
+    """How a servo ended.
+
+    ``steps``: final eye-motor position, encoder steps; ``uv``: the target's
+    image point there, px; ``residual_px``: ``u - goal_u`` there;
+    ``gain_px_per_step``: the last gain estimate (seed for the next target);
+    ``subpixel_steps``: the fractional step at which u would equal the goal,
+    interpolated with the gain (the image tells more than the encoder);
+    ``renders``: images taken; ``iterations``: moves made.
+    """
+
+    outcome: ServoOutcome
+    steps: int
+    uv: tuple[float, float] | None
+    residual_px: float
+    gain_px_per_step: float | None
+    subpixel_steps: float
+    renders: int
+    iterations: int
+
+    @property
+    def converged(self) -> bool:
+        return self.outcome is ServoOutcome.CONVERGED
+
+
+@dataclass(frozen=True)
+class ServoConfig:
+    """Bounds and tolerances of the eye servo.
+
+    ``tolerance_px``: stop when |u - goal| is within this, or within half the
+    image motion of one encoder step (no whole step can do better).
+    ``probe_steps``: first probe when no gain is known; grown x4 until the
+    image moves ``min_probe_px``.  ``min_secant_steps``: moves shorter than this
+    do not update the gain (centroid pixel-locking would corrupt it).
+    """
+
+    tolerance_px: float = 0.1
+    max_iterations: int = 25
+    probe_steps: int = 16
+    min_probe_px: float = 2.0
+    min_secant_steps: int = 8
+
+
+class EyeServo:
+    """Servo the eye motor so that one camera's target column reaches a goal u."""
+
+    def __init__(self, sim: HeadSim, config: ServoConfig | None = None) -> None:
+        self.sim = sim
+        self.config = config or ServoConfig()
+        low, high = sim.joint_range(names.EYE_MOTOR_JOINT)
+        resolution = sim.settings.encoder_resolution_rad
+        self._step_range = (math.ceil(low / resolution), math.floor(high / resolution))
+        #: Gain per camera, px per encoder step, carried from one target to the next.
+        self.gains: dict[int, float] = {}
+
+    def observe(self, camera: int, detector: Detector) -> Detection:
+        """Render ``camera`` and detect the target in it (one render)."""
+        return detector(self.sim.render(camera))
+
+    def run(
+        self,
+        camera: int,
+        detector: Detector,
+        goal_u: float | None = None,
+        first: Detection | None = None,
+    ) -> ServoResult:
+        """Drive the eye motor until ``camera`` sees the target at ``goal_u`` (image centre).
+
+        ``first``: a detection already made at the current eye position (saves
+        a render).
+        """
+        sim, cfg = self.sim, self.config
+        goal = sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
+        renders = 0
+        steps = sim.eye_encoder_steps()
+        if first is None:
+            first = self.observe(camera, detector)
+            renders += 1
+        if not first.found or first.uv is None:
+            return self._result(ServoOutcome.TARGET_LOST, steps, None, goal, renders, 0, camera)
+        visited: dict[int, tuple[float, float]] = {steps: first.uv}
+        uv = first.uv
+        gain = self.gains.get(camera)
+        probe = cfg.probe_steps
+        for iteration in range(1, cfg.max_iterations + 1):
+            error = uv[0] - goal
+            if gain is not None and abs(error) <= max(cfg.tolerance_px, 0.5 * abs(gain)):
+                return self._result(
+                    ServoOutcome.CONVERGED, steps, uv, goal, renders, iteration - 1, camera, gain
+                )
+            if gain is None:
+                move = probe if steps + probe <= self._step_range[1] else -probe
+            else:
+                move = round(-error / gain) or (-1 if error / gain > 0 else 1)
+            target = steps + move
+            if not self._step_range[0] <= target <= self._step_range[1]:
+                return self._result(
+                    ServoOutcome.JOINT_LIMIT, steps, uv, goal, renders, iteration - 1, camera, gain
+                )
+            if target in visited:
+                # Revisiting a step (pixel locking between neighbours): the best
+                # visited step is as close as whole steps get.
+                best = min(visited, key=lambda s: abs(visited[s][0] - goal))
+                if best != steps:
+                    sim.command_eye_steps(best)
+                    sim.settle()
+                return self._result(
+                    ServoOutcome.CONVERGED,
+                    best,
+                    visited[best],
+                    goal,
+                    renders,
+                    iteration,
+                    camera,
+                    gain,
+                )
+            sim.command_eye_steps(target)
+            sim.settle()
+            detection = self.observe(camera, detector)
+            renders += 1
+            if not detection.found or detection.uv is None:
+                return self._result(
+                    ServoOutcome.TARGET_LOST, target, None, goal, renders, iteration, camera, gain
+                )
+            change = detection.uv[0] - uv[0]
+            if gain is None:
+                if abs(change) >= cfg.min_probe_px:
+                    gain = change / move
+                else:
+                    probe *= 4
+            elif abs(move) >= cfg.min_secant_steps and change != 0.0:
+                gain = change / move
+            steps, uv = target, detection.uv
+            visited[steps] = uv
+        return self._result(
+            ServoOutcome.ITERATION_LIMIT,
+            steps,
+            uv,
+            goal,
+            renders,
+            cfg.max_iterations,
+            camera,
+            gain,
+        )
+
+    def _result(
+        self,
+        outcome: ServoOutcome,
+        steps: int,
+        uv: tuple[float, float] | None,
+        goal: float,
+        renders: int,
+        iterations: int,
+        camera: int,
+        gain: float | None = None,
+    ) -> ServoResult:
+        if gain is not None:
+            self.gains[camera] = gain
+        residual = math.nan if uv is None else uv[0] - goal
+        subpixel = float(steps) if gain is None or uv is None else steps - residual / gain
+        return ServoResult(outcome, steps, uv, residual, gain, subpixel, renders, iterations)
