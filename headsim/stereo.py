@@ -330,7 +330,8 @@ class CameraCalibration:
     ``K`` (3, 3) px and ``dist`` (k1, k2, p1, p2, k3) as OpenCV returns them;
     ``rms_px`` the reprojection RMS of the fit that gave them
     (``calibrateCamera``, or ``stereoCalibrate`` over both cameras when it
-    refined them); ``true_K``, ``true_dist`` the simulator's.
+    refined them); ``true_K``, ``true_dist`` the simulator's;
+    ``image_size`` (width, height) px.
     """
 
     K: np.ndarray
@@ -338,6 +339,7 @@ class CameraCalibration:
     rms_px: float
     true_K: np.ndarray
     true_dist: np.ndarray
+    image_size: tuple[int, int]
 
     @property
     def focal_rel_errors(self) -> tuple[float, float]:
@@ -359,6 +361,18 @@ class CameraCalibration:
     def k1_error(self) -> float:
         """Error of k1, estimate - truth."""
         return float(self.dist[0] - self.true_dist[0])
+
+    @property
+    def centre_ray_yaw_rad(self) -> float:
+        """Horizontal angle of the image centre's ray off the optical axis, rad, + towards x.
+
+        From the calibrated K and distortion; the image centre is
+        ((W - 1) / 2, (H - 1) / 2).  What separates the paper's effective
+        initial direction (Sec. V) from the camera's mount yaw.
+        """
+        width, height = self.image_size
+        centre = np.array([[(width - 1) / 2, (height - 1) / 2]])
+        return math.atan(float(undistort_normalized_points(centre, self.K, self.dist)[0, 0]))
 
 
 @dataclass(frozen=True)
@@ -441,6 +455,7 @@ def _calibrate_camera(
         rms_px=float(rms),
         true_K=np.asarray(true_K, dtype=float),
         true_dist=np.asarray(true_dist, dtype=float),
+        image_size=views.image_sizes[index],
     )
 
 
@@ -488,6 +503,7 @@ def calibrate_stereo(
             rms_px=float(rms),
             true_K=m.true_K,
             true_dist=m.true_dist,
+            image_size=m.image_size,
         )
         for K, d, m in ((K1, d1, mono[0]), (K2, d2, mono[1]))
     ]
@@ -536,7 +552,10 @@ def head_from_cam1_from_eye(initial_direction_rad: float, baseline_m: float) -> 
     """The paper's H (Sec. VI-B): turn by camera 1's initial direction about y_c1, shift D/2.
 
     Camera 1 sits at (-D/2, 0, 0) in H, turned inward (towards +x) by
-    ``initial_direction_rad`` about H's y.
+    ``initial_direction_rad`` about H's y.  That angle must be the optical
+    axis's, i.e. the mount yaw: the Sec. V calibration measures the image
+    centre's ray instead; subtract :attr:`CameraCalibration.centre_ray_yaw_rad`
+    from it first.
     """
     head_from_cam1 = np.eye(4)
     head_from_cam1[:3, :3] = _rotation(1, initial_direction_rad)

@@ -103,7 +103,12 @@ def test_canonical_order_undoes_a_board_seen_from_its_other_end() -> None:
 def _calibration_from_truth(sim: HeadSim) -> stereo.StereoCalibration:
     cams = [
         stereo.CameraCalibration(
-            sim.camera_matrix(i), sim.dist_coeffs(i), 0.0, sim.camera_matrix(i), sim.dist_coeffs(i)
+            sim.camera_matrix(i),
+            sim.dist_coeffs(i),
+            0.0,
+            sim.camera_matrix(i),
+            sim.dist_coeffs(i),
+            (sim.camera_settings(i).width, sim.camera_settings(i).height),
         )
         for i in (0, 1)
     ]
@@ -162,14 +167,16 @@ def test_head_frame_from_extrinsics_is_exact_for_mount_yaws_and_reports_other_of
         np.testing.assert_allclose(
             stereo.head_from_cam1_from_eye(yaw, sim.settings.baseline_m), truth, atol=1e-12
         )
-        # ... and is off by the centre ray's angle when given the effective direction.
+        # ... and is off by the centre ray's angle when given the effective direction,
+        effective = sim.effective_initial_direction(0)
         rotation, _ = stereo.frame_deviation(
-            stereo.head_from_cam1_from_eye(
-                sim.effective_initial_direction(0), sim.settings.baseline_m
-            ),
-            truth,
+            stereo.head_from_cam1_from_eye(effective, sim.settings.baseline_m), truth
         )
-        assert rotation == pytest.approx(abs(sim.effective_initial_direction(0) - yaw), abs=1e-12)
+        assert rotation == pytest.approx(abs(effective - yaw), abs=1e-12)
+        assert rotation > 0.018
+        # ... which the calibrated intrinsics give back.
+        centre_ray = _calibration_from_truth(sim).cam1.centre_ray_yaw_rad
+        assert effective - centre_ray == pytest.approx(yaw, abs=1e-12)
     # A mount pitch tilts camera 1 out of the plane the construction assumes.
     pitched = HeadSettings(cameras=(CameraSettings(mount_pitch_rad=0.02), CameraSettings()))
     with HeadSim("default", pitched) as sim:
