@@ -170,10 +170,18 @@ def model2_jacobian(
     sd2, cd2 = np.sin(gamma2 - alpha2), np.cos(gamma2 - alpha2)
     xc1, xc2 = z * sd1 * sec1, z * sd2 * sec2  # eq. (8) and its Ca2 twin
     # d x_c1 / d(D, alpha1, alpha2, gamma1) and d x_c2 / d(D, alpha1, alpha2, gamma2)
-    dxc1 = (xc1 / baseline, dz[1] * sd1 * sec1 + z * sec1 * (cd1 + sd1 * t1),
-            dz[2] * sd1 * sec1, -z * cd1 * sec1)  # fmt: skip
-    dxc2 = (xc2 / baseline, dz[1] * sd2 * sec2,
-            dz[2] * sd2 * sec2 + z * sec2 * (sd2 * t2 - cd2), z * cd2 * sec2)  # fmt: skip
+    dxc1 = (
+        xc1 / baseline,
+        dz[1] * sd1 * sec1 + z * sec1 * (cd1 + sd1 * t1),
+        dz[2] * sd1 * sec1,
+        -z * cd1 * sec1,
+    )
+    dxc2 = (
+        xc2 / baseline,
+        dz[1] * sd2 * sec2,
+        dz[2] * sd2 * sec2 + z * sec2 * (sd2 * t2 - cd2),
+        z * cd2 * sec2,
+    )
     n = alpha1.shape[0]
     w1, w2 = (np.broadcast_to(np.asarray(w, float), (n,)) for w in (y_weights or (0.5, 0.5)))
     # y_h = w1 q1 x_c1 + w2 q2 x_c2 with q_i = (kx_i / ky_i) v_id / u_id, eqs. (7), (9)-(11)

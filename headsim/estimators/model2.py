@@ -110,9 +110,13 @@ def model2(
         y2 = (r2 * v2d / u2d) * (z * sin2 * sec2)
 
     finite = (
-        np.isfinite(a1) & np.isfinite(a2) & np.isfinite(g1) & np.isfinite(g2)
-        & np.isfinite(uv1).all(axis=1) & np.isfinite(uv2).all(axis=1)
-    )  # fmt: skip
+        np.isfinite(a1)
+        & np.isfinite(a2)
+        & np.isfinite(g1)
+        & np.isfinite(g2)
+        & np.isfinite(uv1).all(axis=1)
+        & np.isfinite(uv2).all(axis=1)
+    )
     small1 = ~(np.abs(u1d) >= min_abs_ud)
     small2 = ~(np.abs(u2d) >= min_abs_ud)
     flags = np.zeros(n, dtype=np.int64)

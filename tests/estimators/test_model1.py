@@ -83,10 +83,12 @@ def test_degenerate_angles_are_flagged():
 
 @pytest.mark.parametrize(
     ("alpha", "baseline", "message"),
-    [([[0.1]], D, r"alpha must be a scalar or have shape \(N,\)"),
-     ([5.0], D, "alpha must be in radians"),
-     ([0.1], 0.0, "baseline must be in metres")],
-)  # fmt: skip
+    [
+        ([[0.1]], D, r"alpha must be a scalar or have shape \(N,\)"),
+        ([5.0], D, "alpha must be in radians"),
+        ([0.1], 0.0, "baseline must be in metres"),
+    ],
+)
 def test_wrong_input_raises(alpha, baseline, message):
     with pytest.raises(ValueError, match=message):
         model1(alpha, baseline)

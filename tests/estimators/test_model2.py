@@ -98,9 +98,17 @@ def test_distorted_cameras_recover_points_in_the_plane_of_the_axes():
     obs = observe(head, points, gamma1=g1, gamma2=g2)
     e1, e2 = (head.effective_initial_directions(v) for v in (cam1.cy, cam2.cy))
     est = model2(
-        obs.alpha1, obs.alpha2, obs.uv1, obs.uv2, D, uv10=(319.5, cam1.cy),
-        uv20=(319.5, cam2.cy), alpha_e=(e1[0], e2[1]), gamma1=g1, gamma2=g2,
-    )  # fmt: skip
+        obs.alpha1,
+        obs.alpha2,
+        obs.uv1,
+        obs.uv2,
+        D,
+        uv10=(319.5, cam1.cy),
+        uv20=(319.5, cam2.cy),
+        alpha_e=(e1[0], e2[1]),
+        gamma1=g1,
+        gamma2=g2,
+    )
     assert obs.valid.all() and est.valid.all()
     np.testing.assert_allclose(est.positions, points, atol=1e-12)
 
@@ -127,8 +135,9 @@ def test_one_small_u_offset_uses_the_other_camera():
     obs = observe(head, points)
     # Ca1's image taken at the step-1 angle itself: P sits on u10, eq. (9) is 0/0.
     uv1 = observe(head, points, gamma1=obs.alpha1).uv1
-    est = model2(obs.alpha1, obs.alpha2, uv1, obs.uv2, D, uv10=CENTRE, uv20=CENTRE,
-                 gamma1=obs.alpha1)  # fmt: skip
+    est = model2(
+        obs.alpha1, obs.alpha2, uv1, obs.uv2, D, uv10=CENTRE, uv20=CENTRE, gamma1=obs.alpha1
+    )
     assert est.valid.all()
     assert all(est.reasons(i) == Flag.SMALL_U1D for i in range(50))
     assert np.isnan(est.y_cam[:, 0]).all() and np.isfinite(est.y_cam[:, 1]).all()
@@ -155,8 +164,15 @@ def test_degenerate_points_are_flagged_without_touching_the_others():
 
 
 def test_zero_sum_of_eye_angles_is_not_converging():
-    est = model2([0.01, 0.0], [-0.01, 0.0], [[400.0, 250.0]] * 2, [[400.0, 250.0]] * 2, D,
-                 uv10=CENTRE, uv20=CENTRE)  # fmt: skip
+    est = model2(
+        [0.01, 0.0],
+        [-0.01, 0.0],
+        [[400.0, 250.0]] * 2,
+        [[400.0, 250.0]] * 2,
+        D,
+        uv10=CENTRE,
+        uv20=CENTRE,
+    )
     assert not est.valid.any()
     assert all(Flag.NOT_CONVERGING in est.reasons(i) for i in range(2))
 
@@ -173,8 +189,13 @@ def test_zero_sum_of_eye_angles_is_not_converging():
     ],
 )
 def test_wrong_shapes_and_units_raise(kwargs, message):
-    args = {"alpha1": [0.1], "alpha2": [0.05], "uv1": [[400.0, 250.0]], "uv2": [[380.0, 250.0]],
-            "baseline": D}  # fmt: skip
+    args = {
+        "alpha1": [0.1],
+        "alpha2": [0.05],
+        "uv1": [[400.0, 250.0]],
+        "uv2": [[380.0, 250.0]],
+        "baseline": D,
+    }
     args.update(kwargs)
     with pytest.raises(ValueError, match=message):
         model2(uv10=CENTRE, uv20=CENTRE, **args)
@@ -194,12 +215,29 @@ def test_quantised_eye_angles_err_as_the_jacobian_predicts():
     assert np.all(np.abs(d1) <= step / 2 + 1e-15) and np.all(np.abs(d2) <= step / 2 + 1e-15)
     np.testing.assert_allclose(obs.alpha1 / step, np.round(obs.alpha1 / step), atol=1e-9)
     e = head.effective_initial_directions()
-    est = model2(obs.alpha1, obs.alpha2, obs.uv1, obs.uv2, D, uv10=CENTRE, uv20=CENTRE,
-                 alpha_e=e, min_abs_ud=20.0)  # fmt: skip
+    est = model2(
+        obs.alpha1,
+        obs.alpha2,
+        obs.uv1,
+        obs.uv2,
+        D,
+        uv10=CENTRE,
+        uv20=CENTRE,
+        alpha_e=e,
+        min_abs_ud=20.0,
+    )
     ok = est.valid
     assert ok.mean() > 0.9
-    jac = model2_jacobian(exact.alpha1, exact.alpha2, exact.alpha2, exact.alpha1,
-                          exact.uv1 - CENTRE, exact.uv2 - CENTRE, D, e)  # fmt: skip
+    jac = model2_jacobian(
+        exact.alpha1,
+        exact.alpha2,
+        exact.alpha2,
+        exact.alpha1,
+        exact.uv1 - CENTRE,
+        exact.uv2 - CENTRE,
+        D,
+        e,
+    )
     predicted = jac[..., 1] * d1[:, None] + jac[..., 2] * d2[:, None]
     residual = (est.positions - points - predicted)[ok]
     # Second order only: the residual is a small fraction of the predicted error.
