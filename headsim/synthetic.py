@@ -134,8 +134,8 @@ class Fixation:
 
     alpha1: (N,) eye angle putting P at column u10 in Ca1; alpha2: (N,) at u20 in
     Ca2.  ``valid`` (N,) is False (angles NaN) where the point cannot be fixated:
-    not finite, behind a camera, beyond the lens's fold, or the two lines of
-    sight would not meet in front (alpha1 + alpha_e1 + alpha2 + alpha_e2 <= 0).
+    not finite, not in front of the baseline (z_h <= 0), a camera would have to
+    turn to +-pi/2 or beyond, or P would image beyond the lens's fold.
     """
 
     alpha1: np.ndarray
@@ -164,7 +164,6 @@ def fixation_angles(head: StereoHead, points_h: ArrayLike) -> Fixation:
         & (p[:, 2] > 0.0)
         & (np.abs(yaw1) < math.pi / 2)
         & (np.abs(yaw2) < math.pi / 2)
-        & (yaw1 + yaw2 > 0.0)
     )
     nan = np.full_like(yaw1, np.nan)
     return Fixation(
