@@ -219,4 +219,4 @@ def model2_covariance(
     if tied_gammas[1]:
         jac[..., 1] += jac[..., 4]
         var[4] = 0.0
-    return np.einsum("nip,p,njp->nij", jac, var, jac)
+    return np.einsum("nip,njp->nij", jac * var, jac)

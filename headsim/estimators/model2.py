@@ -114,8 +114,10 @@ def model2(
         & np.isfinite(a2)
         & np.isfinite(g1)
         & np.isfinite(g2)
-        & np.isfinite(uv1).all(axis=1)
-        & np.isfinite(uv2).all(axis=1)
+        & np.isfinite(u1d)  # column-wise: isfinite(uv).all(axis=1) is 30x slower
+        & np.isfinite(v1d)
+        & np.isfinite(u2d)
+        & np.isfinite(v2d)
     )
     small1 = ~(np.abs(u1d) >= min_abs_ud)
     small2 = ~(np.abs(u2d) >= min_abs_ud)
