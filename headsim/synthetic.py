@@ -283,9 +283,9 @@ def neck_fixation(
     The neck puts P in the plane of the optical axes (y_h = 0, so P images on
     the principal row) and the single eye angle alpha puts P on both target
     columns, i.e. at the crossing of the two effective lines of sight; with
-    equal effective initial directions that crossing is on the Z_h axis.  P's
-    distance from the neck's pitch axis fixes alpha (1-D solve), then theta2
-    and theta1 follow in closed form.  With ``quantised`` only alpha is rounded
+    equal effective initial directions that crossing is on the Z_h axis.  With
+    y_h = 0, |P_h| is the same for every neck pose, so it fixes alpha (1-D
+    solve), then theta2 and theta1 follow in closed form.  With ``quantised`` only alpha is rounded
     to the encoder (the neck angles and the point stay those of the exact
     fixation); quantise the neck yourself with :func:`quantise`.
     """
@@ -298,7 +298,7 @@ def neck_fixation(
     half = head.baseline / 2.0
     h = pw[:, 2] - d1
     rho2 = pw[:, 0] ** 2 + pw[:, 1] ** 2
-    target = rho2 + h * h - a2 * a2  # = |P_h|^2, independent of the neck angles
+    target = rho2 + h * h - a2 * a2  # |P_h|^2 for any neck pose with y_h = 0
 
     def crossing(alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         t1, t2 = np.tan(alpha + e1), np.tan(alpha + e2)
