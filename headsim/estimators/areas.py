@@ -53,7 +53,10 @@ def _table(d11: np.ndarray, d12: np.ndarray, d21: np.ndarray, d22: np.ndarray) -
     return np.where(hits.sum(axis=0) == 1, np.argmax(hits, axis=0) + 1, 0)
 
 
-def _classify(d11, d12, d21, d22, alpha1_gt_alpha2: np.ndarray | bool) -> np.ndarray:
+def _classify(
+    d11: np.ndarray, d12: np.ndarray, d21: np.ndarray, d22: np.ndarray, alpha1_gt_alpha2: bool
+) -> np.ndarray:
+    """Eq. (12) for either order of the reference's eye angles."""
     direct = _table(d11, d12, d21, d22)
     # For alpha1 < alpha2 apply the table to the mirror image: offsets flip sign,
     # cameras and steps swap (Ca1 step j <-> Ca2 step 3-j).
