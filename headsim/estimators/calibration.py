@@ -1,0 +1,177 @@
+"""Calibration of the initial directions alpha_e1, alpha_e2 (Sec. V, eqs. 22-26).
+
+A target at known depth z_h is fixated with Model 2 at n places, giving
+(alpha1, alpha2, z_h) per sample.  With x = tan alpha_e1, y = tan alpha_e2,
+t_i = tan alpha_i and K = D / z_h, eq. (22) tan(alpha1 + alpha_e1) +
+tan(alpha2 + alpha_e2) = K becomes f = a1 x y + a2 x + a3 y + a4 = 0 (23), (24);
+F = sum f_i^2 (25), (26) is minimised with BFGS (quasi-Newton), and the minimum
+certified by a Gauss-Newton step.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.optimize import minimize
+
+from headsim.estimators.result import as_vector, check_angles, check_baseline
+
+__all__ = ["Calibration", "calibrate_initial_directions", "calibration_coefficients"]
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """Result of :func:`calibrate_initial_directions`.
+
+    alpha_e: (2,) the initial directions (alpha_e1, alpha_e2), rad.
+    std_errors: (2,) their standard errors, rad (NaN when n = 2 and no noise model).
+    covariance: (2, 2) rad^2.  residuals: (n,) f_i of eq. (25) at the solution.
+    depth_residuals: (n,) D / (tan a1 + tan a2) - z_h, m.  weighted: whether a
+    noise model weighted the samples.  converged, message: from the optimiser.
+    """
+
+    alpha_e: np.ndarray
+    std_errors: np.ndarray
+    covariance: np.ndarray
+    residuals: np.ndarray
+    depth_residuals: np.ndarray
+    weighted: bool
+    converged: bool
+    message: str
+
+
+def calibration_coefficients(
+    alpha1: np.ndarray, alpha2: np.ndarray, z_h: np.ndarray, baseline: float
+) -> np.ndarray:
+    """Coefficients (n, 4) = (a1, a2, a3, a4) of eq. (24) per sample."""
+    t1, t2, k = np.tan(alpha1), np.tan(alpha2), baseline / z_h
+    return np.stack(
+        [t1 + t2 + t1 * t2 * k, t1 * t2 - t1 * k - 1.0, t1 * t2 - t2 * k - 1.0, k - t1 - t2], -1
+    )
+
+
+def calibrate_initial_directions(
+    alpha1: ArrayLike,
+    alpha2: ArrayLike,
+    z_h: ArrayLike,
+    baseline: float,
+    *,
+    sigma_encoder: float | None = None,
+    sigma_depth: float | None = None,
+    initial: tuple[float, float] = (0.0, 0.0),
+) -> Calibration:
+    """Initial directions from n >= 2 samples of (alpha1, alpha2) (rad) at known depth z_h (m).
+
+    Without a noise model the paper's unweighted F is minimised and the
+    covariance is s^2 (J^T J)^-1 with s^2 = F / (n - 2).  With ``sigma_encoder``
+    (rad, per reading) and/or ``sigma_depth`` (m, per z_h) each f_i is weighted
+    by the inverse of its first-order variance at the solution (one
+    re-weighting pass) and the covariance is (J^T W J)^-1.  Raises ValueError
+    for fewer than two usable samples, non-finite input, or samples that do
+    not separate the two offsets.
+    """
+    a1, a2, z = as_vector(alpha1, "alpha1"), as_vector(alpha2, "alpha2"), as_vector(z_h, "z_h")
+    if not (a1.shape == a2.shape == z.shape):
+        raise ValueError(
+            f"alpha1, alpha2, z_h must have one shape (n,), got {a1.shape}, {a2.shape}, {z.shape}"
+        )
+    if a1.size < 2:
+        raise ValueError(f"calibration needs at least two samples, got {a1.size}")
+    if not (np.isfinite(a1).all() and np.isfinite(a2).all() and np.isfinite(z).all()):
+        raise ValueError("calibration samples must be finite (NaN or inf in alpha1, alpha2 or z_h)")
+    check_angles(a1, "alpha1")
+    check_angles(a2, "alpha2")
+    if not (z > 0.0).all():
+        raise ValueError("z_h must be > 0 m for every sample (a target behind the cameras)")
+    d = check_baseline(baseline)
+    coeffs = calibration_coefficients(a1, a2, z, d)
+    weighted = sigma_encoder is not None or sigma_depth is not None
+    se, sd = float(sigma_encoder or 0.0), float(sigma_depth or 0.0)
+    if weighted and not (se >= 0.0 and sd >= 0.0 and se + sd > 0.0):
+        raise ValueError(f"sigma_encoder, sigma_depth must be >= 0 and not both 0, got {se}, {sd}")
+
+    w = np.ones(a1.size)
+    xy = np.tan(np.asarray(initial, dtype=float))
+    for _ in range(2 if weighted else 1):
+        xy, ok, message = _minimise(coeffs, w, xy)
+        if weighted:
+            w = 1.0 / _residual_variance(a1, a2, z, d, xy, se, sd)
+    f, jac = _residuals(coeffs, xy)
+    jtwj = jac.T @ (w[:, None] * jac)
+    if np.linalg.cond(jtwj) > 1e12:
+        raise ValueError(
+            "the samples do not separate alpha_e1 from alpha_e2 (J^T J is singular): "
+            "place the target at several lateral positions and depths"
+        )
+    cov_xy = np.linalg.inv(jtwj)
+    if not weighted:
+        dof = a1.size - 2
+        cov_xy = cov_xy * (float(f @ f) / dof if dof > 0 else np.nan)
+    to_angle = np.diag(1.0 / (1.0 + xy * xy))  # d atan(x) / dx
+    cov = to_angle @ cov_xy @ to_angle
+    alpha_e = np.arctan(xy)
+    z_model = d / (np.tan(a1 + alpha_e[0]) + np.tan(a2 + alpha_e[1]))
+    return Calibration(
+        alpha_e=alpha_e,
+        std_errors=np.sqrt(np.diag(cov)),
+        covariance=cov,
+        residuals=f,
+        depth_residuals=z_model - z,
+        weighted=weighted,
+        converged=ok,
+        message=message,
+    )
+
+
+def _residuals(coeffs: np.ndarray, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """f_i (n,) of eq. (25) and their Jacobian (n, 2) w.r.t. (x, y)."""
+    x, y = xy
+    a1, a2, a3, a4 = coeffs.T
+    f = a1 * x * y + a2 * x + a3 * y + a4
+    return f, np.stack([a1 * y + a2, a1 * x + a3], axis=-1)
+
+
+def _minimise(coeffs: np.ndarray, w: np.ndarray, start: np.ndarray) -> tuple[np.ndarray, bool, str]:
+    """BFGS on F = sum w_i f_i^2, then certify the minimum with Gauss-Newton.
+
+    BFGS stops with "precision loss" once F no longer changes in floating
+    point; F is a sum of squares, so the Gauss-Newton step at the result
+    measures how far from the minimum that is.  Up to three such steps polish
+    it; converged means the last step is below 1e-13 (tangent of an angle).
+    """
+    scale = 1.0 / float(np.sum(w * np.abs(coeffs[:, 1:3]).sum(axis=1) ** 2))
+
+    def objective(v: np.ndarray) -> tuple[float, np.ndarray]:
+        f, jac = _residuals(coeffs, v)
+        return scale * float(np.sum(w * f * f)), 2.0 * scale * (jac.T @ (w * f))
+
+    res = minimize(
+        objective, start, jac=True, method="BFGS", options={"gtol": 1e-14, "maxiter": 500}
+    )
+    xy = res.x
+    for _ in range(3):
+        f, jac = _residuals(coeffs, xy)
+        try:
+            step = np.linalg.solve(jac.T @ (w[:, None] * jac), -(jac.T @ (w * f)))
+        except np.linalg.LinAlgError:
+            return xy, False, f"{res.message} (singular normal equations)"
+        xy = xy + step
+        if np.max(np.abs(step)) < 1e-13:
+            return xy, True, str(res.message)
+    return xy, False, f"{res.message} (Gauss-Newton polish did not settle)"
+
+
+def _residual_variance(
+    a1: np.ndarray, a2: np.ndarray, z: np.ndarray, d: float, xy: np.ndarray, se: float, sd: float
+) -> np.ndarray:
+    """First-order variance (n,) of f_i from encoder errors (rad) and depth errors (m)."""
+    x, y = xy
+    t1, t2, k = np.tan(a1), np.tan(a2), d / z
+    df_dt1 = (1.0 + t2 * k) * x * y + (t2 - k) * x + t2 * y - 1.0
+    df_dt2 = (1.0 + t1 * k) * x * y + t1 * x + (t1 - k) * y - 1.0
+    df_dk = t1 * t2 * x * y - t1 * x - t2 * y + 1.0
+    var_enc = ((df_dt1 * (1.0 + t1 * t1)) ** 2 + (df_dt2 * (1.0 + t2 * t2)) ** 2) * se**2
+    return var_enc + (df_dk * k * sd / z) ** 2 + math.ulp(1.0)

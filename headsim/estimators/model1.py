@@ -1,0 +1,67 @@
+"""Model 1, the humanoid head with a neck (Sec. II-B, eqs. 2-3), vectorised.
+
+The neck puts P in the plane of the optical axes and on the perpendicular
+bisector of C1C2, the eyes verge on it with encoder reading alpha; then in H
+
+    x_h = y_h = 0,  z_h = D / (2 tan(alpha + alpha_e))      (2)
+
+and p_W = W_T_H p_H with the neck angles, eq. (3) (see ``PositionEstimate.to_world``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from headsim.estimators.errors import model1_covariance
+from headsim.estimators.result import (
+    Flag,
+    PositionEstimate,
+    Uncertainty,
+    as_vector,
+    check_angles,
+    check_baseline,
+)
+
+__all__ = ["model1"]
+
+
+def model1(
+    alpha: ArrayLike,
+    baseline: float,
+    *,
+    alpha_e: float = 0.0,
+    uncertainty: Uncertainty | None = None,
+) -> PositionEstimate:
+    """Positions (N, 3) in H of points fixated with the neck, eq. (2).
+
+    alpha: (N,) eye encoder reading at fixation, rad.  baseline: D, m.
+    alpha_e: the eyes' common initial direction, rad (eq. 2 assumes the two eyes
+    are symmetric; with unequal offsets pass their mean, a first-order value).
+    uncertainty: baseline and encoder errors for the covariance of z_h, or None.
+    Points with alpha + alpha_e <= 0 (lines of sight parallel or diverging) or
+    >= pi/2 are flagged invalid.
+    """
+    a_enc = as_vector(alpha, "alpha")
+    check_angles(a_enc, "alpha")
+    d = check_baseline(baseline)
+    check_angles(np.array([alpha_e]), "alpha_e")
+    a = a_enc + float(alpha_e)
+    finite = np.isfinite(a)
+    flags = np.zeros(a.shape, dtype=np.int64)
+    flags[~finite] |= Flag.NONFINITE
+    flags[finite & ~(a > 0.0)] |= Flag.NOT_CONVERGING
+    flags[finite & ~(a < math.pi / 2)] |= Flag.BEHIND_CAMERA
+    valid = flags == 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = np.where(valid, d / (2.0 * np.tan(a)), np.nan)
+    positions = np.stack([np.zeros_like(z), np.zeros_like(z), z], axis=-1)
+    positions[~valid] = np.nan
+    covariance = None
+    if uncertainty is not None:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            covariance = model1_covariance(a, d, uncertainty)
+        covariance[~valid] = np.nan
+    return PositionEstimate(positions, valid, flags, covariance)
