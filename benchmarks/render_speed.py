@@ -32,12 +32,12 @@ CASES = {
 def time_case(settings: HeadSettings, frames: int) -> dict[str, float]:
     with HeadSim("default", settings) as sim:
         sim.move(eye=0.05)
-        for camera in (0, 1):  # warm-up: GL contexts, shader compilation
+        for camera in (1, 2):  # warm-up: GL contexts, shader compilation
             sim.render(camera)
         times = []
         for i in range(frames):
             start = time.perf_counter()
-            sim.render(i % 2)
+            sim.render(1 + i % 2)
             times.append((time.perf_counter() - start) * 1e3)
     times.sort()
     return {

@@ -75,10 +75,10 @@ def head_frames(sim: HeadSim, calib: stereo.StereoCalibration) -> dict[str, np.n
             sim.settings.cameras[0].mount_yaw_rad, baseline
         ),
         "eye, effective direction": stereo.head_from_cam1_from_eye(
-            sim.effective_initial_direction(0), baseline
+            sim.effective_initial_direction(1), baseline
         ),
         "eye, effective - centre ray": stereo.head_from_cam1_from_eye(
-            sim.effective_initial_direction(0) - calib.cam1.centre_ray_yaw_rad, baseline
+            sim.effective_initial_direction(1) - calib.cam1.centre_ray_yaw_rad, baseline
         ),
         "parallel (yaw 0)": stereo.head_from_cam1_from_eye(0.0, baseline),
         "truth": calib.true_head_from_cam1,

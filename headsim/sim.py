@@ -28,6 +28,7 @@ from headsim.optics import camera_matrix, dist_coeffs, project_points, undistort
 from headsim.render import EyeRenderer
 from headsim.settings import CameraSettings, HeadSettings, SettingsError
 
+#: A camera: 1 or 2 (the paper's Ca1, Ca2) or its MJCF name "cam1"/"cam2".
 CameraId = int | str
 
 
@@ -234,12 +235,12 @@ class HeadSim:
         return {joint: float(self.data.qpos[adr]) for joint, adr in self._qadr.items()}
 
     def camera_index(self, camera: CameraId) -> int:
-        """0 for Ca1, 1 for Ca2, from an index or a camera name."""
-        if camera in (0, 1):
-            return int(camera)
+        """Position in ``settings.cameras`` (0, 1) of camera 1 or 2 (the paper's Ca1, Ca2) or its name."""
+        if isinstance(camera, int) and not isinstance(camera, bool) and camera in (1, 2):
+            return camera - 1
         if camera in names.CAMERAS:
             return names.CAMERAS.index(str(camera))
-        raise SettingsError(f"unknown camera {camera!r}; allowed: 0, 1, {', '.join(names.CAMERAS)}")
+        raise SettingsError(f"unknown camera {camera!r}; allowed: 1, 2, {', '.join(names.CAMERAS)}")
 
     def camera_settings(self, camera: CameraId) -> CameraSettings:
         return self.settings.cameras[self.camera_index(camera)]

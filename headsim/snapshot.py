@@ -27,26 +27,26 @@ def ground_truth(sim: HeadSim) -> dict[str, Any]:
     """Everything the simulator knows, as JSON-ready data (SI units, OpenCV pixels)."""
     cameras = {}
     targets = {}
-    for index, cam in enumerate(names.CAMERAS):
-        settings = sim.settings.cameras[index]
+    for cam in names.CAMERAS:
+        settings = sim.camera_settings(cam)
         cameras[cam] = {
-            "K": sim.camera_matrix(index),
-            "dist_coeffs": sim.dist_coeffs(index),
+            "K": sim.camera_matrix(cam),
+            "dist_coeffs": sim.dist_coeffs(cam),
             "image_size": [settings.width, settings.height],
             "image_centre": list(settings.image_centre),
-            "world_from_camera": sim.world_from_camera(index),
-            "head_from_camera": sim.head_from_camera(index),
-            "effective_initial_direction_rad": sim.effective_initial_direction(index),
+            "world_from_camera": sim.world_from_camera(cam),
+            "head_from_camera": sim.head_from_camera(cam),
+            "effective_initial_direction_rad": sim.effective_initial_direction(cam),
         }
     for body in movable_bodies(sim):
         entry: dict[str, Any] = {
             "world_m": sim.position(body),
             "head_m": sim.position(body, "head"),
         }
-        for index, cam in enumerate(names.CAMERAS):
+        for cam in names.CAMERAS:
             p_cam = sim.position(body, cam)
             entry[f"{cam}_m"] = p_cam
-            entry[f"{cam}_px"] = sim.project(sim.position(body), index)[0] if p_cam[2] > 0 else None
+            entry[f"{cam}_px"] = sim.project(sim.position(body), cam)[0] if p_cam[2] > 0 else None
         targets[body] = entry
     return {
         "joints_true_rad": sim.true_joint_angles(),
@@ -104,7 +104,7 @@ def take_snapshot(
     out = Path(out_dir)
     with HeadSim(scene, settings) as sim:
         sim.move(neck_yaw=neck_yaw, neck_pitch=neck_pitch, eye=eye)
-        images = [sim.render(index) for index in range(2)]
+        images = [sim.render(cam) for cam in names.CAMERAS]
         truth = ground_truth(sim)
         written = {
             cam: write_png_atomic(out / f"{cam}.png", images[i])

@@ -141,9 +141,9 @@ def _board_outline() -> np.ndarray:
 
 def _fully_visible(sim: HeadSim, points_head: np.ndarray, margin_px: float) -> bool:
     """True when both cameras image every point inside the image, on the lens's valid branch."""
-    for index in (0, 1):
+    for index in (1, 2):
         cam = sim.camera_settings(index)
-        p_cam = sim.transform_points(points_head, "head", names.CAMERAS[index])
+        p_cam = sim.transform_points(points_head, "head", names.CAMERAS[index - 1])
         if np.any(p_cam[:, 2] <= 0.05):
             return False
         uv = project_points(p_cam, cam)
@@ -187,7 +187,7 @@ def sample_board_pose(
     cols, rows = CHESSBOARD_PATTERN
     centre_board = np.array([(cols - 1) / 2, (rows - 1) / 2, 0.0]) * CHESSBOARD_SQUARE_M
     outline = _board_outline()
-    cam = sim.camera_settings(0)
+    cam = sim.camera_settings(1)
     half_u, half_v = cam.width / 2 / cam.kx, cam.height / 2 / cam.ky
     for _ in range(max_attempts):
         distance = rng.uniform(lo, hi)
@@ -298,11 +298,11 @@ def chessboard_views(
         sim.set_body_pose(
             names.CHESSBOARD, world_from_board[:3, 3], _quat_from_rotation(world_from_board[:3, :3])
         )
-        detected = [detect_chessboard(sim.render(camera)) for camera in (0, 1)]
+        detected = [detect_chessboard(sim.render(camera)) for camera in (1, 2)]
         if detected[0] is None or detected[1] is None:
             continue
         points_world = object_points @ world_from_board[:3, :3].T + world_from_board[:3, 3]
-        truth = [sim.project(points_world, camera) for camera in (0, 1)]
+        truth = [sim.project(points_world, camera) for camera in (1, 2)]
         kept.append((detected[0], detected[1], truth[0], truth[1], head_from_board))
     sizes = tuple((c.width, c.height) for c in sim.settings.cameras)
     empty = np.zeros((0, len(object_points), 2))
@@ -437,13 +437,13 @@ def rotation_angle(rotation: np.ndarray) -> float:
 def _calibrate_camera(
     views: ChessboardViews, index: int, true_K: np.ndarray, true_dist: np.ndarray
 ) -> CameraCalibration:
-    image_points = views.image_points1 if index == 0 else views.image_points2
+    image_points = views.image_points1 if index == 1 else views.image_points2
     object_list = [views.object_points.astype(np.float32)] * views.count
     image_list = [p.astype(np.float32) for p in image_points]
     rms, K, dist, _, _ = cv2.calibrateCamera(
         object_list,
         image_list,
-        views.image_sizes[index],
+        views.image_sizes[index - 1],
         None,
         None,
         flags=CALIBRATION_FLAGS,
@@ -455,7 +455,7 @@ def _calibrate_camera(
         rms_px=float(rms),
         true_K=np.asarray(true_K, dtype=float),
         true_dist=np.asarray(true_dist, dtype=float),
-        image_size=views.image_sizes[index],
+        image_size=views.image_sizes[index - 1],
     )
 
 
@@ -478,7 +478,7 @@ def calibrate_stereo(
     sim.move(eye=0.0)
     mono = [
         _calibrate_camera(views, index, sim.camera_matrix(index), sim.dist_coeffs(index))
-        for index in (0, 1)
+        for index in (1, 2)
     ]
     flags = CALIBRATION_FLAGS | (
         cv2.CALIB_USE_INTRINSIC_GUESS if refine_intrinsics else cv2.CALIB_FIX_INTRINSIC
@@ -510,7 +510,7 @@ def calibrate_stereo(
     cam2_from_cam1 = np.eye(4)
     cam2_from_cam1[:3, :3] = R
     cam2_from_cam1[:3, 3] = np.asarray(T, dtype=float).ravel()
-    true_cam2_from_cam1 = invert_transform(sim.world_from_camera(1)) @ sim.world_from_camera(0)
+    true_cam2_from_cam1 = invert_transform(sim.world_from_camera(2)) @ sim.world_from_camera(1)
     return StereoCalibration(
         mono1=mono[0],
         mono2=mono[1],
@@ -519,7 +519,7 @@ def calibrate_stereo(
         stereo_rms_px=float(rms),
         cam2_from_cam1=cam2_from_cam1,
         true_cam2_from_cam1=true_cam2_from_cam1,
-        true_head_from_cam1=sim.head_from_camera(0),
+        true_head_from_cam1=sim.head_from_camera(1),
         views=views.count,
         refined=refine_intrinsics,
     )
@@ -662,11 +662,11 @@ def measure_point_stereo(
     detect = detector or marker_detector(target)
     sim.move(eye=0.0)
     uvs = []
-    for index in (0, 1):
+    for index in (1, 2):
         detection = detect(sim.render(index))
         if not detection.found or detection.uv is None:
             raise StereoError(
-                f"{target!r} not found in {names.CAMERAS[index]}: {detection.status.value}"
+                f"{target!r} not found in {names.CAMERAS[index - 1]}: {detection.status.value}"
             )
         uvs.append(detection.uv)
     p_head = triangulate(calib, np.array([uvs[0]]), np.array([uvs[1]]), head_from_cam1)[0]

@@ -35,7 +35,7 @@ def test_servo_centres_the_target_in_each_camera(variant: str, rng) -> None:
                 MARKER,
                 [rng.uniform(-0.1, 0.1), rng.uniform(0.35, 1.2), 0.21 + rng.uniform(-0.05, 0.05)],
             )
-            for index in (0, 1):
+            for index in (1, 2):
                 result = servo.run(index, RED)
                 assert result.outcome is ServoOutcome.CONVERGED
                 # As close as whole encoder steps allow: within half a step's image motion.
@@ -50,14 +50,14 @@ def test_gain_sign_is_learnt_per_camera_and_seeds_the_next_target(rng) -> None:
     with HeadSim("default") as sim:
         servo = EyeServo(sim)
         sim.set_body_pose(MARKER, [0.05, 0.7, 0.21])
-        first = servo.run(0, RED)
+        first = servo.run(1, RED)
         # Turning Ca1 inward moves the image left: negative gain, about -f * step.
         expected = -579.41 * sim.settings.encoder_resolution_rad
         assert first.gain_px_per_step == pytest.approx(expected, rel=0.05)
-        second_camera = servo.run(1, RED)
+        second_camera = servo.run(2, RED)
         assert second_camera.gain_px_per_step == pytest.approx(-expected, rel=0.05)
         sim.set_body_pose(MARKER, [-0.04, 0.9, 0.25])
-        seeded = servo.run(0, RED)
+        seeded = servo.run(1, RED)
         assert seeded.converged
         assert seeded.renders < first.renders + 1  # no probe needed
 
@@ -66,7 +66,7 @@ def test_subpixel_step_interpolates_the_fixation(rng) -> None:
     with HeadSim("default") as sim:
         servo = EyeServo(sim)
         sim.set_body_pose(MARKER, [0.03, 0.8, 0.22])
-        result = servo.run(0, RED)
+        result = servo.run(1, RED)
         # The true eye angle that centres the marker, from the geometry.
         p_eye = sim.position(MARKER, "head") - np.array([-0.075, 0.0, 0.0])
         true_steps = np.arctan2(p_eye[0], p_eye[2]) / sim.settings.encoder_resolution_rad
@@ -77,7 +77,7 @@ def test_subpixel_step_interpolates_the_fixation(rng) -> None:
 def test_lost_target_is_reported() -> None:
     with HeadSim("default") as sim:
         sim.set_body_pose(MARKER, [0.0, -1.0, 0.2])
-        result = EyeServo(sim).run(0, RED)
+        result = EyeServo(sim).run(1, RED)
         assert result.outcome is ServoOutcome.TARGET_LOST
         assert result.renders == 1
         assert np.isnan(result.residual_px)
@@ -86,7 +86,7 @@ def test_lost_target_is_reported() -> None:
 def test_iteration_limit_is_reported() -> None:
     with HeadSim("default") as sim:
         sim.set_body_pose(MARKER, [0.15, 0.5, 0.21])
-        result = EyeServo(sim, ServoConfig(max_iterations=2)).run(0, RED)
+        result = EyeServo(sim, ServoConfig(max_iterations=2)).run(1, RED)
         assert result.outcome is ServoOutcome.ITERATION_LIMIT
         assert result.iterations == 2
         assert abs(result.residual_px) > 0.1
@@ -98,7 +98,7 @@ def test_joint_limit_is_reported() -> None:
         # A target Ca1 sees but could only centre by turning beyond -0.7 rad.
         p_cam1 = np.array([-0.35, 0.0, 1.0])
         sim.set_body_pose(MARKER, sim.transform_points(p_cam1, "cam1", "world")[0])
-        result = EyeServo(sim).run(0, RED)
+        result = EyeServo(sim).run(1, RED)
         assert result.outcome is ServoOutcome.JOINT_LIMIT
         low, _ = sim.joint_range("eye1_yaw")
         assert sim.eye_encoder() >= low

@@ -48,7 +48,7 @@ def test_zoom_scales_both_focal_lengths() -> None:
 
 
 def _render_in_subprocess(backend: str) -> subprocess.CompletedProcess[str]:
-    code = "from headsim.sim import HeadSim\nHeadSim('default').render(0)\nprint('rendered')"
+    code = "from headsim.sim import HeadSim\nHeadSim('default').render(1)\nprint('rendered')"
     env = {**os.environ, "MUJOCO_GL": backend}
     return subprocess.run(
         [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120

@@ -34,8 +34,8 @@ def test_cameras_sit_on_the_baseline_and_turn_inward_with_the_eye_angle() -> Non
     with HeadSim("default", settings) as sim:
         alpha = 0.123
         sim.move(eye=alpha, neck_yaw=0.3, neck_pitch=-0.2)
-        head_from_cam1 = sim.head_from_camera(0)
-        head_from_cam2 = sim.head_from_camera(1)
+        head_from_cam1 = sim.head_from_camera(1)
+        head_from_cam2 = sim.head_from_camera(2)
         np.testing.assert_allclose(head_from_cam1[:3, 3], [-0.1, 0, 0], atol=1e-12)
         np.testing.assert_allclose(head_from_cam2[:3, 3], [0.1, 0, 0], atol=1e-12)
         # Optical axes: Ca1 towards +x, Ca2 towards -x by the same angle.
@@ -58,7 +58,7 @@ def test_one_motor_turns_both_eyes_equally_and_oppositely_under_physics() -> Non
             eye1, eye2 = angles[names.EYE_JOINTS[0]], angles[names.EYE_JOINTS[1]]
             assert abs(eye1 - target) < 1e-6
             assert abs(eye2 - eye1) < 1e-6  # coupled: equal joint angles ...
-            axis1, axis2 = sim.head_from_camera(0)[:3, 2], sim.head_from_camera(1)[:3, 2]
+            axis1, axis2 = sim.head_from_camera(1)[:3, 2], sim.head_from_camera(2)[:3, 2]
             assert abs(axis1[0] + axis2[0]) < 1e-6  # ... that turn the axes oppositely
             assert axis1[0] * target > 0
 
@@ -107,7 +107,7 @@ def test_positions_in_frames_are_consistent(sim: HeadSim) -> None:
         sim.world_from_head() @ np.append(p_head, 1), np.append(p_world, 1), atol=1e-12
     )
     np.testing.assert_allclose(
-        sim.world_from_camera(1) @ np.append(p_cam, 1), np.append(p_world, 1), atol=1e-12
+        sim.world_from_camera(2) @ np.append(p_cam, 1), np.append(p_world, 1), atol=1e-12
     )
     assert p_cam[2] > 0  # in front of the camera
     new = np.array([0.05, 0.8, 0.3])
@@ -122,22 +122,22 @@ def test_effective_initial_direction_adds_the_centre_ray_to_the_mount() -> None:
         # Ca1 inward is +x: a centre right of the principal point adds; Ca2 the opposite.
         expected1 = 0.03 + math.atan((319.5 - 300.0) / cam1.kx)
         expected2 = -0.02 - math.atan((319.5 - 340.0) / cam2.kx)
-        assert sim.effective_initial_direction(0) == pytest.approx(expected1, abs=1e-12)
-        assert sim.effective_initial_direction(1) == pytest.approx(expected2, abs=1e-12)
+        assert sim.effective_initial_direction(1) == pytest.approx(expected1, abs=1e-12)
+        assert sim.effective_initial_direction(2) == pytest.approx(expected2, abs=1e-12)
 
 
 def test_paper_preset_reproduces_the_paper_initial_directions() -> None:
     with HeadSim("default", paper_head()) as sim:
-        assert sim.effective_initial_direction(0) == pytest.approx(0.0578, abs=1e-12)
-        assert sim.effective_initial_direction(1) == pytest.approx(-0.0254, abs=1e-12)
+        assert sim.effective_initial_direction(1) == pytest.approx(0.0578, abs=1e-12)
+        assert sim.effective_initial_direction(2) == pytest.approx(-0.0254, abs=1e-12)
         np.testing.assert_allclose(
-            sim.camera_matrix(0)[:2, :], [[834.83, 0, 303.8], [0, 815.42, 306.3]]
+            sim.camera_matrix(1)[:2, :], [[834.83, 0, 303.8], [0, 815.42, 306.3]]
         )
-        assert sim.dist_coeffs(1)[0] == pytest.approx(-0.30938)
+        assert sim.dist_coeffs(2)[0] == pytest.approx(-0.30938)
 
 
 def test_unknown_names_are_refused_with_the_allowed_values(sim: HeadSim) -> None:
-    with pytest.raises(ValueError, match="unknown camera 'cam3'; allowed: 0, 1, cam1, cam2"):
+    with pytest.raises(ValueError, match="unknown camera 'cam3'; allowed: 1, 2, cam1, cam2"):
         sim.render("cam3")
     with pytest.raises(ValueError, match="unknown frame"):
         sim.position("marker_red", "torso")
@@ -145,3 +145,38 @@ def test_unknown_names_are_refused_with_the_allowed_values(sim: HeadSim) -> None
         sim.position("nothing")
     with pytest.raises(ValueError, match="not a movable"):
         sim.set_body_pose(names.HEAD, [0, 0, 0])
+
+
+def test_eq1_matches_mujocos_head_frame_for_1000_random_neck_angles(rng) -> None:
+    from headsim.kinematics import world_from_head
+
+    settings = HeadSettings(neck_d1_m=0.14, neck_a2_m=0.07)
+    with HeadSim("default", settings) as sim:
+        low_yaw, high_yaw = sim.joint_range(names.NECK_YAW)
+        low_pitch, high_pitch = sim.joint_range(names.NECK_PITCH)
+        worst = 0.0
+        for yaw, pitch in zip(
+            rng.uniform(low_yaw, high_yaw, 1000),
+            rng.uniform(low_pitch, high_pitch, 1000),
+            strict=True,
+        ):
+            sim.move(neck_yaw=float(yaw), neck_pitch=float(pitch), eye=0.0)
+            expected = world_from_head(yaw, pitch, settings.neck_d1_m, settings.neck_a2_m)
+            worst = max(worst, float(np.abs(sim.world_from_head() - expected).max()))
+        assert worst < 1e-9
+
+
+def test_effective_initial_direction_agrees_with_the_forward_model() -> None:
+    from headsim.camera_model import PinholeCamera
+    from headsim.synthetic import effective_initial_direction
+
+    settings = paper_head()
+    with HeadSim("default", settings) as sim:
+        for camera, cam in zip((1, 2), settings.cameras, strict=True):
+            pinhole = PinholeCamera(
+                cam.width, cam.height, cam.kx, cam.ky, *cam.principal, cam.k1, cam.k2
+            )
+            expected = effective_initial_direction(
+                camera, cam.mount_yaw_rad, pinhole, cam.image_centre[0]
+            )
+            assert sim.effective_initial_direction(camera) == pytest.approx(expected, abs=1e-12)

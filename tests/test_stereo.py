@@ -110,9 +110,9 @@ def _calibration_from_truth(sim: HeadSim) -> stereo.StereoCalibration:
             sim.dist_coeffs(i),
             (sim.camera_settings(i).width, sim.camera_settings(i).height),
         )
-        for i in (0, 1)
+        for i in (1, 2)
     ]
-    cam2_from_cam1 = invert_transform(sim.world_from_camera(1)) @ sim.world_from_camera(0)
+    cam2_from_cam1 = invert_transform(sim.world_from_camera(2)) @ sim.world_from_camera(1)
     return stereo.StereoCalibration(
         mono1=cams[0],
         mono2=cams[1],
@@ -121,7 +121,7 @@ def _calibration_from_truth(sim: HeadSim) -> stereo.StereoCalibration:
         stereo_rms_px=0.0,
         cam2_from_cam1=cam2_from_cam1,
         true_cam2_from_cam1=cam2_from_cam1,
-        true_head_from_cam1=sim.head_from_camera(0),
+        true_head_from_cam1=sim.head_from_camera(1),
         views=0,
         refined=False,
     )
@@ -135,7 +135,7 @@ def test_triangulation_with_the_true_calibration_recovers_points_exactly(rng) ->
             [rng.uniform(-0.15, 0.15, 200), rng.uniform(-0.1, 0.1, 200), rng.uniform(0.4, 1.5, 200)]
         )
         p_world = sim.transform_points(p_head, "head", "world")
-        uv1, uv2 = sim.project(p_world, 0), sim.project(p_world, 1)
+        uv1, uv2 = sim.project(p_world, 1), sim.project(p_world, 2)
         inside = np.all((uv1 > 0) & (uv1 < [639, 479]) & (uv2 > 0) & (uv2 < [639, 479]), axis=1)
         assert inside.sum() > 100
         estimate = stereo.triangulate(calib, uv1[inside], uv2[inside])
@@ -158,8 +158,8 @@ def test_undistortion_converges_over_the_whole_image_where_opencv_defaults_do_no
 def test_head_frame_from_extrinsics_is_exact_for_mount_yaws_and_reports_other_offsets() -> None:
     # Paper preset: the mounts are yawed (0.039 / -0.056 rad); H is still exact.
     with HeadSim("default", paper_head()) as sim:
-        truth = sim.head_from_camera(0)
-        cam2_from_cam1 = invert_transform(sim.world_from_camera(1)) @ sim.world_from_camera(0)
+        truth = sim.head_from_camera(1)
+        cam2_from_cam1 = invert_transform(sim.world_from_camera(2)) @ sim.world_from_camera(1)
         built = stereo.head_from_cam1_from_extrinsics(cam2_from_cam1)
         np.testing.assert_allclose(built, truth, atol=1e-12)
         # The paper's construction matches it when given the true mount yaw ...
@@ -168,7 +168,7 @@ def test_head_frame_from_extrinsics_is_exact_for_mount_yaws_and_reports_other_of
             stereo.head_from_cam1_from_eye(yaw, sim.settings.baseline_m), truth, atol=1e-12
         )
         # ... and is off by the centre ray's angle when given the effective direction,
-        effective = sim.effective_initial_direction(0)
+        effective = sim.effective_initial_direction(1)
         rotation, _ = stereo.frame_deviation(
             stereo.head_from_cam1_from_eye(effective, sim.settings.baseline_m), truth
         )
@@ -180,9 +180,9 @@ def test_head_frame_from_extrinsics_is_exact_for_mount_yaws_and_reports_other_of
     # A mount pitch tilts camera 1 out of the plane the construction assumes.
     pitched = HeadSettings(cameras=(CameraSettings(mount_pitch_rad=0.02), CameraSettings()))
     with HeadSim("default", pitched) as sim:
-        cam2_from_cam1 = invert_transform(sim.world_from_camera(1)) @ sim.world_from_camera(0)
+        cam2_from_cam1 = invert_transform(sim.world_from_camera(2)) @ sim.world_from_camera(1)
         rotation, translation = stereo.frame_deviation(
-            stereo.head_from_cam1_from_extrinsics(cam2_from_cam1), sim.head_from_camera(0)
+            stereo.head_from_cam1_from_extrinsics(cam2_from_cam1), sim.head_from_camera(1)
         )
     assert rotation == pytest.approx(0.01, abs=1e-9)  # half the pitch: y is the mean of both
     assert translation < 1e-12

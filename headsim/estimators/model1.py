@@ -32,14 +32,16 @@ def model1(
     alpha: ArrayLike,
     baseline: float,
     *,
-    alpha_e: float = 0.0,
+    alpha_e: float | tuple[float, float] = 0.0,
     uncertainty: Uncertainty | None = None,
 ) -> PositionEstimate:
     """Positions (N, 3) in H of points fixated with the neck, eq. (2).
 
     alpha: (N,) eye encoder reading at fixation, rad.  baseline: D, m.
-    alpha_e: the eyes' common initial direction, rad (eq. 2 assumes the two eyes
-    are symmetric; with unequal offsets pass their mean, a first-order value).
+    alpha_e: the eyes' initial direction, rad.  A scalar is eq. (2) as written
+    (symmetric eyes).  A pair (alpha_e1, alpha_e2) is exact for unequal
+    offsets: one eye angle then centres P where the two lines of sight cross,
+    off the Z_h axis, so z_h and x_h follow eqs. (4)-(5) with alpha1 = alpha2.
     uncertainty: baseline and encoder errors for the covariance of z_h, or None.
     Points with alpha + alpha_e <= 0 (lines of sight parallel or diverging) or
     >= pi/2 are flagged invalid.
@@ -47,8 +49,9 @@ def model1(
     a_enc = as_vector(alpha, "alpha")
     check_angles(a_enc, "alpha")
     d = check_baseline(baseline)
-    check_angles(np.array([alpha_e]), "alpha_e")
-    a = a_enc + float(alpha_e)
+    pair = np.broadcast_to(np.asarray(alpha_e, dtype=float), (2,))
+    check_angles(pair, "alpha_e")
+    a = a_enc + float(pair.mean())
     finite = np.isfinite(a)
     flags = np.zeros(a.shape, dtype=np.int64)
     flags[~finite] |= Flag.NONFINITE
@@ -56,8 +59,10 @@ def model1(
     flags[finite & ~(a < math.pi / 2)] |= Flag.BEHIND_CAMERA
     valid = flags == 0
     with np.errstate(divide="ignore", invalid="ignore"):
-        z = np.where(valid, d / (2.0 * np.tan(a)), np.nan)
-    positions = np.stack([np.zeros_like(z), np.zeros_like(z), z], axis=-1)
+        t1, t2 = np.tan(a_enc + pair[0]), np.tan(a_enc + pair[1])
+        z = np.where(valid, d / (t1 + t2), np.nan)  # = D / (2 tan a) for equal offsets
+        x = np.where(valid, z * t1 - 0.5 * d, np.nan)  # 0 for equal offsets
+    positions = np.stack([x, np.zeros_like(z), z], axis=-1)
     positions[~valid] = np.nan
     covariance = None
     if uncertainty is not None:

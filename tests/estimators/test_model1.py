@@ -106,3 +106,21 @@ def test_covariance_matches_monte_carlo():
         z = model1(a + rng.normal(0.0, unc.encoder, n), 1.0).positions[:, 2] * d
         assert np.std(z) / math.sqrt(ref.covariance[i, 2, 2]) == pytest.approx(1.0, abs=0.10)
     assert np.all(ref.covariance[:, :2, :] == 0.0)
+
+
+def test_unequal_offsets_are_exact_with_the_pair():
+    rng = np.random.default_rng(32)
+    theta1, theta2 = rng.uniform(-1.0, 1.0, 2_000), rng.uniform(-0.5, 0.5, 2_000)
+    points_w = head_to_world(random_points(rng, 2_000), theta1, theta2, D1, A2)
+    head = StereoHead(D, alpha_e1=0.0578, alpha_e2=-0.0254)
+    fix = neck_fixation(head, points_w, D1, A2)
+    ok = fix.valid
+    assert ok.mean() > 0.9
+    exact = model1(fix.alpha[ok], D, alpha_e=(0.0578, -0.0254))
+    truth_h = world_to_head(points_w[ok], fix.theta1[ok], fix.theta2[ok], D1, A2)
+    rel = np.linalg.norm(exact.positions - truth_h, axis=1) / np.linalg.norm(truth_h, axis=1)
+    assert rel.max() < 1e-9
+    assert np.abs(truth_h[:, 0]).max() > 1e-3  # the fixated point is off the Z_h axis
+    # The mean offset in eq. (2) is only first-order right.
+    mean = model1(fix.alpha[ok], D, alpha_e=(0.0578 - 0.0254) / 2)
+    assert np.linalg.norm(mean.positions - truth_h, axis=1).max() > 1e-4
