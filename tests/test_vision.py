@@ -184,6 +184,8 @@ def test_bad_input_names_the_problem() -> None:
         find_marker(image, "pink")
     with pytest.raises(ValueError, match="unknown marker colour 'pink'"):
         find_markers(image, {"thing": "pink"})
+    with pytest.raises(ValueError, match="colours must be a mapping or a sequence"):
+        find_markers(image, "red")
     with pytest.raises(ValueError, match=r"expected an RGB uint8 image \(H, W, 3\)"):
         find_marker(image[..., 0], "red")
     with pytest.raises(ValueError, match="pattern must be at least"):
