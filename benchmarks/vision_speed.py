@@ -33,7 +33,7 @@ OBJECT_COLOURS = dict(
 def render(scene: str) -> np.ndarray:
     with HeadSim(scene, ideal_head()) as sim:
         sim.move(eye=0.05)
-        return sim.render(0)
+        return sim.render(1)
 
 
 def time_calls(call: Callable[[], object], calls: int) -> dict[str, float]:

@@ -68,7 +68,7 @@ def _point_at_pixel(sim: HeadSim, camera: int, uv, depth_m: float) -> np.ndarray
     """World point at ``depth_m`` on the pinhole ray through pixel ``uv`` of an undistorted camera."""
     k = sim.camera_matrix(camera)
     p_cam = np.array([(uv[0] - k[0, 2]) / k[0, 0], (uv[1] - k[1, 2]) / k[1, 1], 1.0]) * depth_m
-    return sim.transform_points(p_cam, names.CAMERAS[camera], "world")[0]
+    return sim.transform_points(p_cam, names.CAMERAS[camera - 1], "world")[0]
 
 
 def _error_px(detected, truth: np.ndarray) -> float:
@@ -89,7 +89,7 @@ def test_marker_centroid_holds_in_noisy_images(preset: str, rng) -> None:
             target = [rng.uniform(-0.08, 0.08), rng.uniform(0.45, 0.9), rng.uniform(0.15, 0.27)]
             sim.set_body_pose(marker, target)
             sim.move(eye=float(rng.uniform(-0.04, 0.12)), neck_yaw=float(rng.uniform(-0.05, 0.05)))
-            for camera in (0, 1):
+            for camera in (1, 2):
                 detection = find_marker(sim.render(camera), "red")
                 assert detection.found
                 errors.append(_error_px(detection.uv, sim.project(sim.position(marker), camera)[0]))
@@ -102,7 +102,7 @@ def test_six_labelled_objects_are_found_in_one_image(preset: str) -> None:
     with HeadSim("blocks", PRESETS[preset]()) as sim:
         for eye, neck_yaw in ((0.0, 0.0), (0.1, -0.03)):
             sim.move(eye=eye, neck_yaw=neck_yaw)
-            for camera in (0, 1):
+            for camera in (1, 2):
                 detections = find_markers(sim.render(camera), OBJECT_COLOURS)
                 assert set(detections) == set(OBJECT_COLOURS)
                 for label, detection in detections.items():
@@ -114,17 +114,17 @@ def test_six_labelled_objects_are_found_in_one_image(preset: str) -> None:
 def test_each_label_has_its_own_status() -> None:
     with HeadSim("blocks") as sim:
         sim.set_body_pose("object_3", [0.0, -1.0, 0.2])  # behind the head
-        detections = find_markers(sim.render(0), OBJECT_COLOURS)
+        detections = find_markers(sim.render(1), OBJECT_COLOURS)
         assert detections["object_3"].status is DetectionStatus.LOST
         assert all(d.found for label, d in detections.items() if label != "object_3")
         # A sequence of colours labels the detections by colour.
-        assert set(find_markers(sim.render(0), ["red", "cyan"])) == {"red", "cyan"}
+        assert set(find_markers(sim.render(1), ["red", "cyan"])) == {"red", "cyan"}
 
 
 def test_marker_partly_behind_the_plate_is_occluded_given_its_expected_area() -> None:
     with HeadSim("blocks") as sim:
         sim.move(eye=0.05)
-        eye = sim.world_from_camera(0)[:3, 3]  # Ca1's optical centre
+        eye = sim.world_from_camera(1)[:3, 3]  # Ca1's optical centre
         plate_edge = sim.position(names.BLOCKS) + np.array(
             [0.05, 0.0, 0.0]
         )  # the plate's right edge
@@ -134,11 +134,11 @@ def test_marker_partly_behind_the_plate_is_occluded_given_its_expected_area() ->
         sim.set_body_pose(
             marker, half_hidden + np.array([0.04, 0.0, 0.0])
         )  # in the clear beside it
-        clear = find_marker(sim.render(0), "red")
+        clear = find_marker(sim.render(1), "red")
         assert clear.found
 
         sim.set_body_pose(marker, half_hidden)
-        image = sim.render(0)
+        image = sim.render(1)
         hidden = find_marker(image, "red", expected_area_px=clear.area_px)
         assert hidden.status is DetectionStatus.OCCLUDED
         assert hidden.uv is None
@@ -147,10 +147,10 @@ def test_marker_partly_behind_the_plate_is_occluded_given_its_expected_area() ->
         # FOUND, with the biased centroid that the area check exists to catch.
         unchecked = find_marker(image, "red")
         assert unchecked.found
-        assert _error_px(unchecked.uv, sim.project(sim.position(marker), 0)[0]) > 1.0
+        assert _error_px(unchecked.uv, sim.project(sim.position(marker), 1)[0]) > 1.0
 
         sim.set_body_pose(marker, sim.position(names.BLOCKS) + np.array([0.0, 0.05, 0.0]))
-        assert find_marker(sim.render(0), "red").status is DetectionStatus.LOST
+        assert find_marker(sim.render(1), "red").status is DetectionStatus.LOST
 
 
 def test_marker_split_by_a_thin_bar_is_occluded(tmp_path: Path) -> None:
@@ -169,11 +169,11 @@ def test_marker_split_by_a_thin_bar_is_occluded(tmp_path: Path) -> None:
     )
     with HeadSim(scene) as sim:
         marker = names.MARKERS[0]
-        assert find_marker(sim.render(0), "red").found
-        eye = sim.world_from_camera(0)[:3, 3]  # Ca1's optical centre
+        assert find_marker(sim.render(1), "red").found
+        eye = sim.world_from_camera(1)[:3, 3]  # Ca1's optical centre
         # On the line of sight, 5 cm in front of the marker: cuts it in two.
         sim.set_body_pose("bar", eye + 0.9 * (sim.position(marker) - eye))
-        detection = find_marker(sim.render(0), "red")
+        detection = find_marker(sim.render(1), "red")
         assert detection.status is DetectionStatus.OCCLUDED
         assert detection.uv is None
 
@@ -214,7 +214,7 @@ def _board_errors(
         centre = sim.transform_points(centre_head, "head", "world")[0]
         _place(sim, names.CHESSBOARD, rotation, centre, BOARD_CENTRE)
         sim.move(eye=float(np.arctan2(0.075, depth) + rng.uniform(-0.02, 0.02)))
-        for camera in (0, 1):
+        for camera in (1, 2):
             detection = find_chessboard(sim.render(camera), PATTERN)
             assert detection.found, f"board not found at depth {depth:.2f} m, camera {camera}"
             assert detection.corners.shape == (48, 2)
@@ -257,10 +257,10 @@ def test_chessboard_order_starts_top_left_in_the_image() -> None:
         # Upside down: the image's top-left inner corner is the board's (7, 5).
         _place(sim, names.CHESSBOARD, facing @ rotation_z(np.pi), centre, BOARD_CENTRE)
         sim.move(eye=float(np.arctan2(0.075, 0.8)))
-        detection = find_chessboard(sim.render(0))
+        detection = find_chessboard(sim.render(1))
         assert detection.found
         flipped = (np.array(PATTERN) - 1) - detection.indices
-        truth = sim.project(_board_corners_world(sim, flipped), 0)
+        truth = sim.project(_board_corners_world(sim, flipped), 1)
         assert np.max(np.linalg.norm(detection.corners - truth, axis=1)) < 0.25
         assert detection.corners[0, 0] < detection.corners[1, 0]  # rows run left to right
         assert detection.corners[0, 1] < detection.corners[PATTERN[0], 1]  # rows run downwards
@@ -282,13 +282,13 @@ def test_a_board_half_out_of_view_is_cut_and_a_missing_one_lost() -> None:
     with HeadSim("chessboard", paper_head()) as sim:
         facing = _facing_head(sim, names.CHESSBOARD)
         _place(sim, names.CHESSBOARD, facing, np.array([0.3, 0.7, 0.21]), BOARD_CENTRE)
-        detection = find_chessboard(sim.render(0))
+        detection = find_chessboard(sim.render(1))
         assert detection.status is DetectionStatus.CUT
         assert detection.corners is None
         sim.set_body_pose(names.CHESSBOARD, [0.0, -2.0, 0.0])  # behind the head
-        assert find_chessboard(sim.render(0)).status is DetectionStatus.LOST
+        assert find_chessboard(sim.render(1)).status is DetectionStatus.LOST
     with HeadSim("blocks") as sim:  # one X-junction is no board
-        assert find_chessboard(sim.render(0)).status is DetectionStatus.LOST
+        assert find_chessboard(sim.render(1)).status is DetectionStatus.LOST
 
 
 # -- the cross point of two blocks --------------------------------------------------
@@ -303,7 +303,7 @@ def test_cross_point_lands_on_its_projection_anywhere_in_the_image(preset: str) 
         facing = _facing_head(sim, names.BLOCKS)
         for index, uv in enumerate(pixels):
             sim.move(eye=float(rng.uniform(0.0, 0.1)), neck_yaw=float(rng.uniform(-0.1, 0.1)))
-            camera = index % 2
+            camera = 1 + index % 2
             rotation = (
                 facing
                 @ rotation_x(rng.uniform(-0.4, 0.4))
@@ -328,8 +328,8 @@ def test_cross_point_at_the_border_is_cut_and_outside_lost() -> None:
         sim.move(eye=0.05)
         statuses = {}
         for u in (-40.0, 5.0, 634.0, 40.0):
-            sim.set_body_pose(names.BLOCKS, _point_at_pixel(sim, 0, (u, 200.0), 0.7))
-            statuses[u] = find_cross_point(sim.render(0)).status
+            sim.set_body_pose(names.BLOCKS, _point_at_pixel(sim, 1, (u, 200.0), 0.7))
+            statuses[u] = find_cross_point(sim.render(1)).status
     assert statuses == {
         -40.0: DetectionStatus.LOST,
         5.0: DetectionStatus.CUT,
@@ -343,20 +343,20 @@ def test_cross_point_behind_a_marker_is_occluded_or_lost() -> None:
         sim.move(eye=0.05)
         cross = sim.position(names.BLOCKS)
         marker = names.RELATIVE_OBJECTS[0]
-        assert find_cross_point(sim.render(0)).found
+        assert find_cross_point(sim.render(1)).found
         # A 6 mm marker just in front of the plate, 10 mm to the side: it
         # covers part of the pattern around the junction, not the junction.
         sim.set_body_pose(marker, cross + np.array([0.01, -0.007, 0.0]))
-        partly = find_cross_point(sim.render(0))
+        partly = find_cross_point(sim.render(1))
         assert partly.status is DetectionStatus.OCCLUDED
         assert partly.uv is None
         # Right on it: no junction is left to see.
         sim.set_body_pose(marker, cross + np.array([0.0, -0.007, 0.0]))
-        assert find_cross_point(sim.render(0)).status is DetectionStatus.LOST
+        assert find_cross_point(sim.render(1)).status is DetectionStatus.LOST
 
 
 def test_no_cross_point_in_a_scene_without_one() -> None:
     with HeadSim("default", HeadSettings(cameras=(CameraSettings(noise_std=2.0),) * 2)) as sim:
-        detection = find_cross_point(sim.render(0))
+        detection = find_cross_point(sim.render(1))
     assert detection.status is DetectionStatus.LOST
     assert detection.uv is None
