@@ -92,14 +92,6 @@ def test_a_target_that_is_not_seen_is_a_clear_error(calibrated) -> None:
             stereo.measure_point_stereo(sim, calib, names.MARKERS[0])
 
 
-def test_canonical_order_undoes_a_board_seen_from_its_other_end() -> None:
-    grid = stereo.chessboard_object_points()[:, :2] * 1000 + [100.0, 50.0]  # a fronto-parallel view
-    np.testing.assert_array_equal(stereo.canonical_corner_order(grid[::-1]), grid)
-    cols, rows = stereo.CHESSBOARD_PATTERN
-    mirrored_rows = grid.reshape(rows, cols, 2)[::-1].reshape(-1, 2)
-    np.testing.assert_array_equal(stereo.canonical_corner_order(mirrored_rows), grid)
-
-
 def _calibration_from_truth(sim: HeadSim) -> stereo.StereoCalibration:
     cams = [
         stereo.CameraCalibration(
