@@ -31,9 +31,15 @@ HOME = "home"
 
 # Props in the scenes.
 MARKERS = ("marker_red", "marker_green", "marker_blue")
+CALIBRATION_BALL = "calibration_ball"  # yellow, 8 mm
+MARKER_COLOURS = {"marker_red": "red", "marker_green": "green", "marker_blue": "blue"}
 CHESSBOARD = "chessboard"
 BLOCKS = "blocks"
 RELATIVE_OBJECTS = tuple(f"object_{i}" for i in range(1, 7))
+#: Colour of each relative-positioning object (models/scene_blocks.xml).
+RELATIVE_OBJECT_COLOURS = dict(
+    zip(RELATIVE_OBJECTS, ("red", "green", "blue", "yellow", "magenta", "cyan"), strict=True)
+)
 
 # Scene files in models/, by short name.
 SCENES = {

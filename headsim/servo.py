@@ -87,6 +87,11 @@ class EyeServo:
         #: Gain per camera, px per encoder step, carried from one target to the next.
         self.gains: dict[int, float] = {}
 
+    @property
+    def step_range(self) -> tuple[int, int]:
+        """Eye-motor range, whole encoder steps."""
+        return self._step_range
+
     def observe(self, camera: int, detector: Detector) -> Detection:
         """Render ``camera`` and detect the target in it (one render)."""
         return detector(self.sim.render(camera))
@@ -193,3 +198,168 @@ class EyeServo:
         residual = math.nan if uv is None else uv[0] - goal
         subpixel = float(steps) if gain is None or uv is None else steps - residual / gain
         return ServoResult(outcome, steps, uv, residual, gain, subpixel, renders, iterations)
+
+
+@dataclass(frozen=True)
+class NeckServoResult:
+    """How a neck-and-eyes fixation ended.
+
+    ``steps``: final (neck yaw, neck pitch, eye) positions, encoder steps;
+    ``error_px``: (u1 - u10, u2 - u20, mean v - v0) there; ``subpixel_steps``:
+    the fractional positions at which the error would vanish, from the learnt
+    Jacobian; ``jacobian``: px per step (3 x 3), seed for the next fixation.
+    """
+
+    outcome: ServoOutcome
+    steps: tuple[int, int, int]
+    error_px: tuple[float, float, float]
+    subpixel_steps: tuple[float, float, float]
+    jacobian: np.ndarray | None
+    renders: int
+    iterations: int
+
+    @property
+    def converged(self) -> bool:
+        return self.outcome is ServoOutcome.CONVERGED
+
+    @property
+    def residual_px(self) -> float:
+        """Largest |error| component, px."""
+        return float(np.max(np.abs(self.error_px)))
+
+
+class NeckServo:
+    """Model 1's fixation: neck pitch puts P in the plane of the optical axes, neck
+    yaw and the eye motor put it on both goal columns (Sec. II-B), from images only.
+
+    Errors e = (u1 - u10, u2 - u20, (v1 + v2)/2 - v0) are driven to zero by
+    whole-step moves of (yaw, pitch, eye) with a Jacobian measured by probing
+    each joint once, then updated by Broyden's rule; it is kept for the next
+    fixation (tracking).
+    """
+
+    JOINTS = (names.NECK_YAW, names.NECK_PITCH, names.EYE_MOTOR_JOINT)
+
+    def __init__(self, sim: HeadSim, config: ServoConfig | None = None) -> None:
+        self.sim = sim
+        self.config = config or ServoConfig()
+        resolution = sim.settings.encoder_resolution_rad
+        self._ranges = [
+            (math.ceil(lo / resolution), math.floor(hi / resolution))
+            for lo, hi in (sim.joint_range(j) for j in self.JOINTS)
+        ]
+        self.jacobian: np.ndarray | None = None
+
+    def _steps(self) -> np.ndarray:
+        resolution = self.sim.settings.encoder_resolution_rad
+        yaw, pitch = (round(a / resolution) for a in self.sim.neck_encoders())
+        return np.array([yaw, pitch, self.sim.eye_encoder_steps()])
+
+    def _move(self, steps: np.ndarray) -> None:
+        resolution = self.sim.settings.encoder_resolution_rad
+        yaw, pitch, eye = (float(s) * resolution for s in steps)
+        self.sim.command(neck_yaw=yaw, neck_pitch=pitch, eye=eye)
+        self.sim.settle()
+
+    def _error(self, detector: Detector, goals: np.ndarray) -> np.ndarray | None:
+        seen = [detector(self.sim.render(camera)) for camera in (1, 2)]
+        if not all(s.found and s.uv is not None for s in seen):
+            return None
+        (u1, v1), (u2, v2) = seen[0].uv, seen[1].uv  # type: ignore[misc]
+        return np.array([u1, u2, (v1 + v2) / 2]) - goals
+
+    def _in_range(self, steps: np.ndarray) -> bool:
+        return all(lo <= s <= hi for s, (lo, hi) in zip(steps, self._ranges, strict=True))
+
+    def run(
+        self, detector: Detector, goals: tuple[float, float, float] | None = None
+    ) -> NeckServoResult:
+        """Fixate the target with neck and eyes; ``goals`` = (u10, u20, v0), default image centres."""
+        cfg, sim = self.config, self.sim
+        if goals is None:
+            (u10, v10), (u20, v20) = (sim.camera_settings(c).image_centre for c in (1, 2))
+            goals = (u10, u20, (v10 + v20) / 2)
+        goal = np.asarray(goals, dtype=float)
+        start = sim.render_count
+        steps = self._steps()
+        error = self._error(detector, goal)
+        if error is None:
+            return self._result(ServoOutcome.TARGET_LOST, steps, None, start, 0)
+        jac = self.jacobian
+        if jac is None:
+            jac = np.zeros((3, 3))
+            for joint in range(3):
+                probe = np.zeros(3, dtype=int)
+                probe[joint] = cfg.probe_steps * 4
+                moved = steps + probe if self._in_range(steps + probe) else steps - probe
+                self._move(moved)
+                probed = self._error(detector, goal)
+                if probed is None:
+                    self._move(steps)
+                    return self._result(ServoOutcome.TARGET_LOST, steps, None, start, joint + 1)
+                jac[:, joint] = (probed - error) / (moved - steps)[joint]
+            self._move(steps)
+        visited: dict[tuple[int, ...], np.ndarray] = {tuple(steps): error}
+        for iteration in range(1, cfg.max_iterations + 1):
+            tolerance = np.maximum(cfg.tolerance_px, 0.5 * np.abs(jac).max(axis=1))
+            if np.all(np.abs(error) <= tolerance):
+                self.jacobian = jac
+                return self._result(ServoOutcome.CONVERGED, steps, error, start, iteration - 1, jac)
+            move = np.rint(-np.linalg.solve(jac, error)).astype(int)
+            if not move.any():
+                move[int(np.argmax(np.abs(error)))] = 1
+            target = steps + move
+            if not self._in_range(target):
+                self.jacobian = jac
+                return self._result(
+                    ServoOutcome.JOINT_LIMIT, steps, error, start, iteration - 1, jac
+                )
+            if tuple(target) in visited:
+                best = min(visited, key=lambda s: float(np.max(np.abs(visited[s]) / tolerance)))
+                self._move(np.array(best))
+                self.jacobian = jac
+                return self._result(
+                    ServoOutcome.CONVERGED, np.array(best), visited[best], start, iteration, jac
+                )
+            self._move(target)
+            new_error = self._error(detector, goal)
+            if new_error is None:
+                return self._result(ServoOutcome.TARGET_LOST, target, None, start, iteration, jac)
+            if np.abs(move).max() >= cfg.min_secant_steps:
+                dq = move.astype(float)
+                jac = jac + np.outer(new_error - error - jac @ dq, dq) / (dq @ dq)
+            steps, error = target, new_error
+            visited[tuple(steps)] = error
+        self.jacobian = jac
+        return self._result(
+            ServoOutcome.ITERATION_LIMIT, steps, error, start, cfg.max_iterations, jac
+        )
+
+    def _result(
+        self,
+        outcome: ServoOutcome,
+        steps: np.ndarray,
+        error: np.ndarray | None,
+        start: int,
+        iterations: int,
+        jac: np.ndarray | None = None,
+    ) -> NeckServoResult:
+        whole = tuple(int(s) for s in steps)
+        if error is None:
+            err = (math.nan,) * 3
+            sub = tuple(float(s) for s in whole)
+        else:
+            err = tuple(float(e) for e in error)
+            sub = tuple(
+                float(s)
+                for s in (steps - np.linalg.solve(jac, error) if jac is not None else steps)
+            )
+        return NeckServoResult(
+            outcome,
+            whole,
+            err,
+            sub,
+            jac,
+            self.sim.render_count - start,
+            iterations,  # type: ignore[arg-type]
+        )

@@ -1,0 +1,755 @@
+"""The paper's measurement procedures run in the simulator, scored against ground truth.
+
+Each procedure drives the head with its own cameras (the image-only servo of
+``headsim.servo``), feeds encoder readings and pixel coordinates to the pure
+estimators of ``headsim.estimators``, and returns a frozen result holding the
+estimate, its first-order covariance, the simulator's truth and the error.
+Nothing here reads an intrinsic parameter: what the head may know about itself
+is a :class:`HeadKnowledge` (initial directions, and optionally vertical
+references and kx/ky ratios from the extended calibration).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from headsim import names
+from headsim.estimators import Uncertainty, model1, model2
+from headsim.estimators.areas import (
+    AreaComparison,
+    areas_from_geometry,
+    areas_from_pixels,
+    compare_areas,
+)
+from headsim.estimators.calibration import Calibration, calibrate_initial_directions
+from headsim.estimators.vertical import VerticalCalibration, calibrate_vertical_reference
+from headsim.kinematics import head_to_world
+from headsim.servo import Detector, EyeServo, NeckServo, ServoOutcome, ServoResult
+from headsim.sim import HeadSim
+from headsim.vision import Detection, DetectionStatus, find_chessboard, find_markers
+
+#: Centroid precision assumed for covariances, px (measured: ~0.03-0.06 px).
+NOMINAL_PIXEL_SIGMA = 0.05
+
+
+@dataclass(frozen=True)
+class HeadKnowledge:
+    """What the head knows about itself; no focal length, no principal point's u.
+
+    ``alpha_e``: each eye's initial direction, rad (0 until calibrated).
+    ``v0``: each camera's vertical reference row, px (None: the image centre
+    row, the paper's Table VI condition; the principal point's v is Table V).
+    ``kx_over_ky``: each camera's pixel aspect ratio (1 unless calibrated).
+    """
+
+    alpha_e: tuple[float, float] = (0.0, 0.0)
+    v0: tuple[float | None, float | None] = (None, None)
+    kx_over_ky: tuple[float, float] = (1.0, 1.0)
+
+    def reference(self, sim: HeadSim, camera: int) -> tuple[float, float]:
+        """(u_i0, v_i0): the servo's goal column (image centre) and the reference row, px."""
+        u_c, v_c = sim.camera_settings(camera).image_centre
+        v0 = self.v0[camera - 1]
+        return (u_c, v_c if v0 is None else v0)
+
+
+@dataclass(frozen=True)
+class Target:
+    """Something to measure: a name, how to find it in an image, and where it truly is."""
+
+    name: str
+    detector: Detector
+    truth_world: Callable[[HeadSim], np.ndarray]
+
+
+def body_target(name: str, detector: Detector) -> Target:
+    """A target whose true position is a body's origin (markers, the block cross point)."""
+    return Target(name, detector, lambda sim: sim.position(name))
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """One measured point: estimate and truth in H and W, m; covariance in H, m^2.
+
+    ``status``: "ok", or why it failed (a servo outcome or an estimator flag).
+    ``renders``: images this measurement took.  ``servo_residual_px``: the
+    final |u - u_i0| of each servo.  ``details``: angles and pixels used.
+    """
+
+    name: str
+    method: str
+    status: str
+    estimate_head_m: np.ndarray
+    truth_head_m: np.ndarray
+    estimate_world_m: np.ndarray
+    truth_world_m: np.ndarray
+    covariance_head_m2: np.ndarray
+    renders: int
+    servo_residual_px: tuple[float, ...]
+    details: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def error_head_m(self) -> np.ndarray:
+        """Estimate minus truth in H, m."""
+        return self.estimate_head_m - self.truth_head_m
+
+    @property
+    def depth_m(self) -> float:
+        """True depth z_h, m."""
+        return float(self.truth_head_m[2])
+
+    @property
+    def error_pct_of_depth(self) -> float:
+        """3-D error as a percentage of the true depth."""
+        return float(100.0 * np.linalg.norm(self.error_head_m) / self.depth_m)
+
+
+def _nan3() -> np.ndarray:
+    return np.full(3, np.nan)
+
+
+def _failed(
+    sim: HeadSim, target: Target, method: str, status: str, renders: int, residuals: Sequence[float]
+) -> Measurement:
+    truth_world = target.truth_world(sim)
+    return Measurement(
+        name=target.name,
+        method=method,
+        status=status,
+        estimate_head_m=_nan3(),
+        truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
+        estimate_world_m=_nan3(),
+        truth_world_m=truth_world,
+        covariance_head_m2=np.full((3, 3), np.nan),
+        renders=renders,
+        servo_residual_px=tuple(residuals),
+    )
+
+
+def _observe(servo: EyeServo, camera: int, target: Target) -> Detection:
+    return servo.observe(camera, target.detector)
+
+
+def _fixation_angle(sim: HeadSim, result: ServoResult, interpolate: bool) -> float:
+    """Eye angle at fixation, rad: the whole step, or the sub-step interpolated from the image."""
+    steps = result.subpixel_steps if interpolate else float(result.steps)
+    return steps * sim.settings.encoder_resolution_rad
+
+
+@dataclass(frozen=True)
+class Model2Config:
+    """Options of the two-step measurement.
+
+    ``interpolate``: use the servo's sub-step fixation (image residual / gain)
+    instead of the whole encoder step.  ``midline_px``: when P's offset from
+    the goal column in a y image is below this, take that image again at an
+    eye angle ``remedy_px`` of image motion away (the paper's near-midline
+    remedy, generalised from gamma = 0 to any gamma).
+    """
+
+    interpolate: bool = True
+    midline_px: float = 25.0
+    remedy_px: float = 120.0
+
+
+def measure_model2(
+    sim: HeadSim,
+    servo: EyeServo,
+    target: Target,
+    knowledge: HeadKnowledge | None = None,
+    config: Model2Config | None = None,
+) -> Measurement:
+    """Model 2, the two-step measurement of Sec. II-C, with the neck still."""
+    knowledge = knowledge or HeadKnowledge()
+    config = config or Model2Config()
+    resolution = sim.settings.encoder_resolution_rad
+    start = sim.render_count
+    # Step 1: Ca1's u to its goal column; then P's image in Ca2 there.
+    step1 = servo.run(1, target.detector)
+    if not step1.converged:
+        return _failed(
+            sim,
+            target,
+            "model2",
+            f"step 1: {step1.outcome.value}",
+            sim.render_count - start,
+            [step1.residual_px],
+        )
+    seen2 = _observe(servo, 2, target)
+    if not seen2.found or seen2.uv is None:
+        return _failed(
+            sim,
+            target,
+            "model2",
+            f"Ca2 at step 1: target {seen2.status.value}",
+            sim.render_count - start,
+            [step1.residual_px],
+        )
+    # Step 2: Ca2's u to its goal column, starting from that image; then Ca1's image.
+    step2 = servo.run(2, target.detector, first=seen2)
+    residuals = (step1.residual_px, step2.residual_px)
+    if not step2.converged:
+        return _failed(
+            sim,
+            target,
+            "model2",
+            f"step 2: {step2.outcome.value}",
+            sim.render_count - start,
+            residuals,
+        )
+    seen1 = _observe(servo, 1, target)
+    if not seen1.found or seen1.uv is None:
+        return _failed(
+            sim,
+            target,
+            "model2",
+            f"Ca1 at step 2: target {seen1.status.value}",
+            sim.render_count - start,
+            residuals,
+        )
+
+    uv1, uv2 = np.array(seen1.uv), np.array(seen2.uv)
+    gamma1, gamma2 = step2.steps * resolution, step1.steps * resolution
+    (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+    if min(abs(uv1[0] - u10), abs(uv2[0] - u20)) < config.midline_px:
+        remedy = _near_midline_images(sim, servo, target, step1, step2, config)
+        if remedy is not None:
+            gamma, r1, r2 = remedy
+            if r1 is not None and abs(r1[0] - u10) > abs(uv1[0] - u10):
+                uv1, gamma1 = r1, gamma
+            if r2 is not None and abs(r2[0] - u20) > abs(uv2[0] - u20):
+                uv2, gamma2 = r2, gamma
+
+    alpha1 = _fixation_angle(sim, step1, config.interpolate)
+    alpha2 = _fixation_angle(sim, step2, config.interpolate)
+    gains = [abs(r.gain_px_per_step or 1.0) for r in (step1, step2)]
+    angle_sigma = (
+        resolution * NOMINAL_PIXEL_SIGMA / min(gains)
+        if config.interpolate
+        else resolution / math.sqrt(12.0)
+    )
+    estimate = model2(
+        [alpha1],
+        [alpha2],
+        uv1[None],
+        uv2[None],
+        sim.settings.baseline_m,
+        uv10=(u10, v10),
+        uv20=(u20, v20),
+        alpha_e=knowledge.alpha_e,
+        gamma1=[gamma1],
+        gamma2=[gamma2],
+        kx_over_ky=knowledge.kx_over_ky,
+        uncertainty=Uncertainty(encoder=angle_sigma, pixel=NOMINAL_PIXEL_SIGMA),
+    )
+    renders = sim.render_count - start
+    if not bool(estimate.valid[0]):
+        return _failed(
+            sim, target, "model2", f"estimator: {estimate.reasons(0)!r}", renders, residuals
+        )
+    truth_world = target.truth_world(sim)
+    estimate_head = estimate.positions[0]
+    return Measurement(
+        name=target.name,
+        method="model2",
+        status="ok",
+        estimate_head_m=estimate_head,
+        truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
+        estimate_world_m=to_world(sim, estimate_head),
+        truth_world_m=truth_world,
+        covariance_head_m2=estimate.covariance[0]
+        if estimate.covariance is not None
+        else np.full((3, 3), np.nan),
+        renders=renders,
+        servo_residual_px=residuals,
+        details={
+            "alpha1_rad": alpha1,
+            "alpha2_rad": alpha2,
+            "gamma1_rad": gamma1,
+            "gamma2_rad": gamma2,
+            "u11_px": float(uv1[0]),
+            "v11_px": float(uv1[1]),
+            "u21_px": float(uv2[0]),
+            "v21_px": float(uv2[1]),
+        },
+    )
+
+
+def _near_midline_images(
+    sim: HeadSim,
+    servo: EyeServo,
+    target: Target,
+    step1: ServoResult,
+    step2: ServoResult,
+    config: Model2Config,
+) -> tuple[float, np.ndarray | None, np.ndarray | None] | None:
+    """Both cameras' images at an eye angle ``remedy_px`` of image motion off the fixations."""
+    gain = max(abs(step1.gain_px_per_step or 0.0), abs(step2.gain_px_per_step or 0.0))
+    if gain == 0.0:
+        return None
+    offset = round(config.remedy_px / gain)
+    low, high = servo.step_range
+    middle = (step1.steps + step2.steps) / 2
+    # Turn outward (towards 0) when converged far in, else inward: stay within range.
+    gamma_steps = round(middle - offset) if middle - offset >= low else round(middle + offset)
+    if not low <= gamma_steps <= high:
+        return None
+    sim.command_eye_steps(gamma_steps)
+    sim.settle()
+    seen = [_observe(servo, camera, target) for camera in (1, 2)]
+    uv = [np.array(s.uv) if s.found and s.uv is not None else None for s in seen]
+    return gamma_steps * sim.settings.encoder_resolution_rad, uv[0], uv[1]
+
+
+# -- Calibration of the initial directions (Sec. V) ----------------------
+
+
+@dataclass(frozen=True)
+class CalibrationRun:
+    """Sec. V calibration in the simulator, with the truth beside it.
+
+    ``fit``: the estimator's result (offsets, standard errors, residuals).
+    ``truth_alpha_e``: each eye's effective initial direction, rad (simulator).
+    ``vertical``: the extended calibration per camera (v0, kx/ky), or None.
+    """
+
+    fit: Calibration
+    truth_alpha_e: tuple[float, float]
+    samples: int
+    renders: int
+    depth_noise_m: float
+    vertical: tuple[VerticalCalibration, VerticalCalibration] | None
+    knowledge: HeadKnowledge
+
+    @property
+    def alpha_e_error(self) -> np.ndarray:
+        """Calibrated minus true effective initial directions, rad."""
+        return np.asarray(self.fit.alpha_e) - np.asarray(self.truth_alpha_e)
+
+
+def calibration_layout(
+    sim: HeadSim,
+    rng: np.random.Generator,
+    count: int = 60,
+    depth_range_m: tuple[float, float] = (0.25, 0.6),
+    lateral: float = 0.16,
+    vertical: float = 0.08,
+) -> np.ndarray:
+    """World positions (count, 3) for Sec. V calibration targets, seeded.
+
+    Near targets spread sideways separate the two offsets best (eq. 23 is one
+    equation in two unknowns per sample; their sec^2 terms differ most up
+    close): 60 targets at 0.25-0.6 m recover them to about 1e-4 rad with the
+    paper's cameras.  ``lateral``/``vertical``: x_h/z_h and y_h/z_h spread; a
+    vertical spread is what the extended calibration needs.
+    """
+    z = rng.uniform(*depth_range_m, size=count)
+    points_head = np.column_stack(
+        [rng.uniform(-lateral, lateral, count) * z, rng.uniform(-vertical, vertical, count) * z, z]
+    )
+    return sim.transform_points(points_head, "head", "world")
+
+
+def calibrate_head(
+    sim: HeadSim,
+    servo: EyeServo,
+    target: Target,
+    body: str,
+    positions_world: np.ndarray,
+    *,
+    depth_noise_m: float = 0.0,
+    rng: np.random.Generator | None = None,
+    extended: bool = True,
+) -> CalibrationRun:
+    """Fixate ``target`` (moved with body ``body``) at each position and calibrate.
+
+    The depth z_h handed to the estimator is the true one plus Gaussian noise of
+    ``depth_noise_m`` (a tape measure).  With ``extended``, the same samples
+    also give each camera's vertical reference and kx/ky ratio (beyond the
+    paper: it needs the targets' full known positions, not only their depth).
+    """
+    rng = rng or np.random.default_rng(0)
+    start = sim.render_count
+    alpha1, alpha2, depths, rows = [], [], [], []
+    plain = Model2Config(midline_px=0.0)
+    for position in np.atleast_2d(positions_world):
+        sim.set_body_pose(body, position)
+        m = measure_model2(sim, servo, target, HeadKnowledge(), plain)
+        if not m.ok:
+            continue
+        alpha1.append(m.details["alpha1_rad"])
+        alpha2.append(m.details["alpha2_rad"])
+        depths.append(
+            m.truth_head_m[2] + (rng.normal(0.0, depth_noise_m) if depth_noise_m > 0 else 0.0)
+        )
+        rows.append((m.truth_head_m, m.details))
+    baseline = sim.settings.baseline_m
+    if len(alpha1) < 2:
+        raise ValueError(
+            f"calibration needs at least 2 fixated targets, got {len(alpha1)} of "
+            f"{len(np.atleast_2d(positions_world))}: place them where both cameras see them"
+        )
+    # Without a depth error model the fit is unweighted and its standard errors
+    # come from the scatter of its residuals (the angles' noise is not known a priori).
+    fit = calibrate_initial_directions(
+        np.array(alpha1),
+        np.array(alpha2),
+        np.array(depths),
+        baseline,
+        sigma_encoder=sim.settings.encoder_resolution_rad * 0.25 if depth_noise_m > 0 else None,
+        sigma_depth=depth_noise_m if depth_noise_m > 0 else None,
+    )
+    alpha_e = (float(fit.alpha_e[0]), float(fit.alpha_e[1]))
+    knowledge = HeadKnowledge(alpha_e=alpha_e)
+    vertical = None
+    if extended and len(rows) >= 3:
+        vertical = _vertical_from_samples(sim, rows, alpha_e, baseline)
+        knowledge = replace(
+            knowledge,
+            v0=(vertical[0].v0, vertical[1].v0),
+            kx_over_ky=(vertical[0].kx_over_ky, vertical[1].kx_over_ky),
+        )
+    truth = (sim.effective_initial_direction(1), sim.effective_initial_direction(2))
+    return CalibrationRun(
+        fit=fit,
+        truth_alpha_e=truth,
+        samples=len(alpha1),
+        renders=sim.render_count - start,
+        depth_noise_m=depth_noise_m,
+        vertical=vertical,
+        knowledge=knowledge,
+    )
+
+
+def _vertical_from_samples(
+    sim: HeadSim,
+    rows: list[tuple[np.ndarray, dict[str, float]]],
+    alpha_e: tuple[float, float],
+    baseline: float,
+) -> tuple[VerticalCalibration, VerticalCalibration]:
+    """Fit (v0, kx/ky) per camera from the calibration fixations at known positions."""
+    truth = np.array([r[0] for r in rows])
+    d = {key: np.array([r[1][key] for r in rows]) for key in rows[0][1]}
+    z = truth[:, 2]
+    a1, a2 = d["alpha1_rad"] + alpha_e[0], d["alpha2_rad"] + alpha_e[1]
+    # P's x in each camera's effective frame when its y image was taken (eqs. 8, 10).
+    x_c1 = z * np.sin(d["alpha1_rad"] - d["gamma1_rad"]) / np.cos(a1)
+    x_c2 = z * np.sin(d["gamma2_rad"] - d["alpha2_rad"]) / np.cos(a2)
+    u10 = sim.camera_settings(1).image_centre[0]
+    u20 = sim.camera_settings(2).image_centre[0]
+    cam1 = calibrate_vertical_reference(d["u11_px"] - u10, d["v11_px"], x_c1, truth[:, 1])
+    cam2 = calibrate_vertical_reference(d["u21_px"] - u20, d["v21_px"], x_c2, truth[:, 1])
+    return cam1, cam2
+
+
+# -- Model 1: fixation with the neck (Sec. II-B) --------------------------
+
+
+def measure_points_model2(
+    sim: HeadSim,
+    servo: EyeServo,
+    targets: Sequence[Target],
+    knowledge: HeadKnowledge | None = None,
+    config: Model2Config | None = None,
+) -> list[Measurement]:
+    """Model 2 on several targets in turn (the servo's gains carry over)."""
+    return [measure_model2(sim, servo, t, knowledge, config) for t in targets]
+
+
+def to_world(
+    sim: HeadSim, point_head: np.ndarray, neck_rad: tuple[float, float] | None = None
+) -> np.ndarray:
+    """A head-frame estimate in W through eq. (3), with the neck encoder readings by default."""
+    theta1, theta2 = sim.neck_encoders() if neck_rad is None else neck_rad
+    return head_to_world(point_head, theta1, theta2, sim.settings.neck_d1_m, sim.settings.neck_a2_m)
+
+
+def measure_model1(
+    sim: HeadSim,
+    servo: NeckServo,
+    target: Target,
+    knowledge: HeadKnowledge | None = None,
+    interpolate: bool = True,
+) -> Measurement:
+    """Model 1: fixate with neck and eyes, then eqs. (2)-(3) (Sec. II-B)."""
+    knowledge = knowledge or HeadKnowledge()
+    start = sim.render_count
+    (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+    result = servo.run(target.detector, goals=(u10, u20, (v10 + v20) / 2))
+    residual = (result.residual_px,)
+    if not result.converged:
+        return _failed(
+            sim, target, "model1", result.outcome.value, sim.render_count - start, residual
+        )
+    resolution = sim.settings.encoder_resolution_rad
+    yaw, pitch, eye = (
+        s * resolution for s in (result.subpixel_steps if interpolate else result.steps)
+    )
+    angle_sigma = resolution * (0.3 if interpolate else 1 / math.sqrt(12.0))
+    estimate = model1(
+        [eye],
+        sim.settings.baseline_m,
+        alpha_e=knowledge.alpha_e,
+        uncertainty=Uncertainty(encoder=angle_sigma),
+    )
+    if not bool(estimate.valid[0]):
+        return _failed(
+            sim,
+            target,
+            "model1",
+            f"estimator: {estimate.reasons(0)!r}",
+            sim.render_count - start,
+            residual,
+        )
+    truth_world = target.truth_world(sim)
+    estimate_head = estimate.positions[0]
+    return Measurement(
+        name=target.name,
+        method="model1",
+        status="ok",
+        estimate_head_m=estimate_head,
+        truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
+        estimate_world_m=to_world(sim, estimate_head, (yaw, pitch)),
+        truth_world_m=truth_world,
+        covariance_head_m2=estimate.covariance[0]
+        if estimate.covariance is not None
+        else np.full((3, 3), np.nan),
+        renders=sim.render_count - start,
+        servo_residual_px=residual,
+        details={"alpha_rad": eye, "neck_yaw_rad": yaw, "neck_pitch_rad": pitch},
+    )
+
+
+@dataclass(frozen=True)
+class TrackingRun:
+    """A moving target followed with the neck model: one measurement per fixation, time in s."""
+
+    times_s: np.ndarray
+    measurements: tuple[Measurement, ...]
+
+    @property
+    def errors_world_m(self) -> np.ndarray:
+        """(N,) 3-D error of each fixation in W, m (NaN where it failed)."""
+        return np.array(
+            [np.linalg.norm(m.estimate_world_m - m.truth_world_m) for m in self.measurements]
+        )
+
+
+def track_moving_target(
+    sim: HeadSim,
+    servo: NeckServo,
+    target: Target,
+    body: str,
+    trajectory: Callable[[float], np.ndarray],
+    times_s: Sequence[float],
+    knowledge: HeadKnowledge | None = None,
+) -> TrackingRun:
+    """Move ``body`` along ``trajectory(t)`` (world, m) and fixate it at each time with Model 1.
+
+    The servo's Jacobian carries from one fixation to the next, so after the
+    first fixation each one starts from the last and takes few renders.
+    """
+    measurements = []
+    for t in times_s:
+        sim.set_body_pose(body, trajectory(float(t)))
+        measurements.append(measure_model1(sim, servo, target, knowledge))
+    return TrackingRun(np.asarray(times_s, dtype=float), tuple(measurements))
+
+
+# -- Chessboard (Sec. VI-A) ------------------------------------------------
+
+
+def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: float) -> Target:
+    """Inner corner ``index`` (row-major from the top-left) of the scene's chessboard.
+
+    Found by detecting the whole board (``find_chessboard``): a board cut by
+    the image border loses its corners, it does not guess them.
+    """
+    columns, _ = pattern
+    i, j = index % columns, index // columns
+
+    def detect(image: np.ndarray) -> Detection:
+        board = find_chessboard(image, pattern)
+        if not board.found:
+            return Detection(board.status, None, 0.0)
+        u, v = board.corners[index]
+        return Detection(DetectionStatus.FOUND, (float(u), float(v)), 1.0)
+
+    def truth(sim: HeadSim) -> np.ndarray:
+        body = sim.data.body(names.CHESSBOARD)
+        return body.xpos + body.xmat.reshape(3, 3) @ np.array([i * square_m, j * square_m, 0.0])
+
+    return Target(f"corner_{i}_{j}", detect, truth)
+
+
+@dataclass(frozen=True)
+class ChessboardRun:
+    """Every cross point measured with Model 2, and the squares' sides they give, m.
+
+    ``widths_m``/``heights_m``: distances between horizontally/vertically
+    adjacent measured corners (estimate), with the truth beside them.
+    """
+
+    measurements: tuple[Measurement, ...]
+    square_m: float
+    widths_m: np.ndarray
+    heights_m: np.ndarray
+    true_widths_m: np.ndarray
+    true_heights_m: np.ndarray
+
+    @property
+    def measured(self) -> int:
+        return sum(m.ok for m in self.measurements)
+
+
+def measure_chessboard(
+    sim: HeadSim,
+    servo: EyeServo,
+    knowledge: HeadKnowledge | None = None,
+    config: Model2Config | None = None,
+    pattern: tuple[int, int] = (8, 6),
+    square_m: float = 0.030,
+    corners: Sequence[int] | None = None,
+) -> ChessboardRun:
+    """Measure the chessboard's cross points (all, or ``corners``) and its squares' sides."""
+    columns, rows = pattern
+    indices = list(range(columns * rows)) if corners is None else list(corners)
+    measured = {
+        k: measure_model2(
+            sim, servo, chessboard_corner_target(k, pattern, square_m), knowledge, config
+        )
+        for k in indices
+    }
+    widths, heights, true_widths, true_heights = [], [], [], []
+    for k, m in measured.items():
+        for neighbour, out, out_true in (
+            (k + 1, widths, true_widths),
+            (k + columns, heights, true_heights),
+        ):
+            if neighbour == k + 1 and (k + 1) % columns == 0:
+                continue
+            other = measured.get(neighbour)
+            if other is None or not (m.ok and other.ok):
+                continue
+            out.append(float(np.linalg.norm(other.estimate_head_m - m.estimate_head_m)))
+            out_true.append(float(np.linalg.norm(other.truth_head_m - m.truth_head_m)))
+    return ChessboardRun(
+        measurements=tuple(measured.values()),
+        square_m=square_m,
+        widths_m=np.array(widths),
+        heights_m=np.array(heights),
+        true_widths_m=np.array(true_widths),
+        true_heights_m=np.array(true_heights),
+    )
+
+
+# -- Relative positioning of several objects (Sec. III) --------------------
+
+
+@dataclass(frozen=True)
+class RelativeRun:
+    """Areas S1..S12 of objects around a reference, by eq. (12) on pixels and by geometry.
+
+    ``areas``/``true_areas``: label -> area number (0: unclassified or not
+    seen in all four images); ``columns``: label -> (u11, u12, u21, u22), px;
+    ``comparison``: the estimator's count of disagreements by margin.
+    """
+
+    reference: Measurement
+    areas: dict[str, int]
+    true_areas: dict[str, int]
+    columns: dict[str, tuple[float, float, float, float]]
+    missing: tuple[str, ...]
+    comparison: AreaComparison | None
+    renders: int
+
+
+def relative_positioning(
+    sim: HeadSim,
+    servo: EyeServo,
+    reference: Target,
+    objects: dict[str, str],
+    knowledge: HeadKnowledge | None = None,
+) -> RelativeRun:
+    """Measure ``reference`` with Model 2, then place ``objects`` (body -> colour) in areas.
+
+    The four images (each camera at each step) are taken again at the two
+    fixations' whole encoder steps, where the lines L11..L22 are.
+    """
+    knowledge = knowledge or HeadKnowledge()
+    start = sim.render_count
+    ref = measure_model2(sim, servo, reference, knowledge, Model2Config(midline_px=0.0))
+    if not ref.ok:
+        return RelativeRun(ref, {}, {}, {}, tuple(objects), None, sim.render_count - start)
+    resolution = sim.settings.encoder_resolution_rad
+    steps = (
+        round(ref.details["gamma2_rad"] / resolution),
+        round(ref.details["gamma1_rad"] / resolution),
+    )
+    columns: dict[str, list[float]] = {name: [math.nan] * 4 for name in objects}
+    # Order of the four columns: u11 (Ca1, step 1), u12 (Ca1, step 2), u21, u22.
+    for step_index, step in enumerate(steps):
+        sim.command_eye_steps(step)
+        sim.settle()
+        for camera in (1, 2):
+            found = find_markers(sim.render(camera), objects)
+            for name, detection in found.items():
+                if detection.found and detection.uv is not None:
+                    columns[name][2 * (camera - 1) + step_index] = detection.uv[0]
+    seen = [name for name in objects if np.all(np.isfinite(columns[name]))]
+    missing = tuple(name for name in objects if name not in seen)
+    (u10, _), (u20, _) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+    alpha1, alpha2 = steps[0] * resolution, steps[1] * resolution
+    areas: dict[str, int] = dict.fromkeys(objects, 0)
+    true_areas: dict[str, int] = dict.fromkeys(objects, 0)
+    comparison = None
+    if seen:
+        cols = np.array([columns[name] for name in seen])
+        pixel_areas = areas_from_pixels(*cols.T, u10, u20, alpha1=alpha1, alpha2=alpha2)
+        truth_h = np.array([sim.position(name, "head") for name in seen])
+        effective = (sim.effective_initial_direction(1), sim.effective_initial_direction(2))
+        truth = areas_from_geometry(truth_h, alpha1, alpha2, sim.settings.baseline_m, effective)
+        comparison = compare_areas(pixel_areas, truth, *cols.T, u10, u20)
+        areas.update(zip(seen, (int(a) for a in pixel_areas), strict=True))
+        true_areas.update(zip(seen, (int(a) for a in truth), strict=True))
+    return RelativeRun(
+        reference=ref,
+        areas=areas,
+        true_areas=true_areas,
+        columns={name: (c[0], c[1], c[2], c[3]) for name, c in columns.items()},
+        missing=missing,
+        comparison=comparison,
+        renders=sim.render_count - start,
+    )
+
+
+__all__ = [
+    "CalibrationRun",
+    "ChessboardRun",
+    "HeadKnowledge",
+    "Measurement",
+    "Model2Config",
+    "RelativeRun",
+    "ServoOutcome",
+    "Target",
+    "TrackingRun",
+    "body_target",
+    "calibrate_head",
+    "calibration_layout",
+    "chessboard_corner_target",
+    "measure_chessboard",
+    "measure_model1",
+    "measure_model2",
+    "measure_points_model2",
+    "relative_positioning",
+    "to_world",
+    "track_moving_target",
+]
