@@ -273,6 +273,8 @@ def measure_model2(
         details={
             "alpha1_rad": alpha1,
             "alpha2_rad": alpha2,
+            "step1_encoder_rad": step1.steps * resolution,
+            "step2_encoder_rad": step2.steps * resolution,
             "gamma1_rad": gamma1,
             "gamma2_rad": gamma2,
             "u11_px": float(uv1[0]),
