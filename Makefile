@@ -26,6 +26,10 @@ test: setup
 
 bench: setup
 	$(BIN)/python benchmarks/render_speed.py
+	$(BIN)/python benchmarks/estimators_throughput.py
+	$(BIN)/python benchmarks/vision_speed.py
+	$(BIN)/python benchmarks/stereo_calibration.py
+	$(BIN)/python benchmarks/procedures_accuracy.py
 
 clean:
 	rm -rf $(VENV) out
