@@ -10,6 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+from headsim.camera_model import PinholeCamera
+
 #: Largest image side the off-screen buffer is allowed to grow to, px.
 MAX_IMAGE_SIDE = 4096
 #: Eye-motor encoder resolution of the paper's head, rad (Sec. VI).
@@ -105,6 +107,11 @@ class CameraSettings:
     @property
     def distorted(self) -> bool:
         return self.k1 != 0.0 or self.k2 != 0.0
+
+    def pinhole(self) -> PinholeCamera:
+        """The camera's true intrinsics as a :class:`headsim.camera_model.PinholeCamera`."""
+        cx, cy = self.principal
+        return PinholeCamera(self.width, self.height, self.kx, self.ky, cx, cy, self.k1, self.k2)
 
     def with_zoom(self, factor: float) -> CameraSettings:
         """The same camera with both focal lengths scaled by ``factor``."""

@@ -24,7 +24,7 @@ import numpy as np
 
 from headsim import names
 from headsim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
-from headsim.optics import camera_matrix, dist_coeffs, project_points, undistort_normalized
+from headsim.optics import camera_matrix, dist_coeffs, project_points
 from headsim.render import EyeRenderer
 from headsim.settings import CameraSettings, HeadSettings, SettingsError
 
@@ -324,14 +324,7 @@ class HeadSim:
         """
         index = self.camera_index(camera)
         cam = self.settings.cameras[index]
-        (u, v), (cx, cy) = cam.image_centre, cam.principal
-        xy, valid = undistort_normalized(
-            np.array([(u - cx) / cam.kx, (v - cy) / cam.ky]), cam.k1, cam.k2
-        )
-        if not bool(valid):
-            raise ValueError(
-                "the image centre has no undistorted ray: the distortion folds over there"
-            )
+        xy = cam.pinhole().normalise(np.array(cam.image_centre))  # raises if no ray
         ray_eye = eye_from_camera_rotation(cam, index) @ np.array([xy[0], xy[1], 1.0])
         yaw = math.atan2(ray_eye[0], ray_eye[2])
         return yaw if index == 0 else -yaw

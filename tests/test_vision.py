@@ -129,7 +129,9 @@ def test_marker_partly_behind_the_plate_is_occluded_given_its_expected_area() ->
             [0.05, 0.0, 0.0]
         )  # the plate's right edge
         ray = plate_edge - eye
-        half_hidden = eye + ray * (0.73 - eye[1]) / ray[1]  # 3 cm behind the plate, on its edge
+        half_hidden = (
+            eye + ray * (plate_edge[1] + 0.03 - eye[1]) / ray[1]
+        )  # 3 cm behind the plate, on its edge
         marker = names.RELATIVE_OBJECTS[0]
         sim.set_body_pose(
             marker, half_hidden + np.array([0.04, 0.0, 0.0])
@@ -340,6 +342,7 @@ def test_cross_point_at_the_border_is_cut_and_outside_lost() -> None:
 
 def test_cross_point_behind_a_marker_is_occluded_or_lost() -> None:
     with HeadSim("blocks") as sim:
+        sim.set_body_pose(names.BLOCKS, [0.0, 0.70, 0.21])  # near: the blocks 30 px a side
         sim.move(eye=0.05)
         cross = sim.position(names.BLOCKS)
         marker = names.RELATIVE_OBJECTS[0]
