@@ -102,3 +102,21 @@ def test_joint_limit_is_reported() -> None:
         assert result.outcome is ServoOutcome.JOINT_LIMIT
         low, _ = sim.joint_range("eye1_yaw")
         assert sim.eye_encoder() >= low
+
+
+def test_neck_servo_reports_lost_and_iteration_limit() -> None:
+    from headsim.servo import NeckServo
+
+    with HeadSim("default") as sim:
+        sim.set_body_pose(MARKER, [0.0, -1.0, 0.2])
+        lost = NeckServo(sim).run(RED)
+        assert lost.outcome is ServoOutcome.TARGET_LOST
+        assert lost.renders == 2  # one look through each camera
+        sim.set_body_pose(MARKER, [0.2, 0.6, 0.4])
+        limited = NeckServo(sim, ServoConfig(max_iterations=1)).run(RED)
+        assert limited.outcome is ServoOutcome.ITERATION_LIMIT
+        assert limited.residual_px > 0.1
+        converged = NeckServo(sim).run(RED)
+        assert converged.converged
+        assert converged.residual_px <= 0.2
+        assert converged.jacobian is not None and abs(np.linalg.det(converged.jacobian)) > 0
