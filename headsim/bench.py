@@ -1,0 +1,278 @@
+"""Regression benchmarks: a fixed suite, one metrics file, a comparison with a stored baseline.
+
+Metrics are chosen to survive a faster or slower machine: accuracy (errors in
+% of depth, mm, rad), effort (renders per point) and speed as ratios (wall
+time per point over the time of one render; estimator throughput over a bare
+numpy reference on the same arrays).  ``benchmarks/baseline.json`` holds the
+reference values and why they were last set; ``benchmarks/tolerances.json``
+how far each metric may move, and in which direction is worse.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import platform
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import headsim
+from headsim import experiments, names
+from headsim.estimators.throughput import run as estimator_throughput
+from headsim.procedures import HeadKnowledge, measure_model2
+from headsim.results import write_json_atomic
+from headsim.servo import EyeServo
+from headsim.settings import HeadSettings, paper_head
+from headsim.sim import HeadSim
+
+BENCH_DIR = Path(__file__).resolve().parent.parent / "benchmarks"
+BASELINE = BENCH_DIR / "baseline.json"
+TOLERANCES = BENCH_DIR / "tolerances.json"
+
+Metrics = dict[str, float]
+Progress = Callable[[str], None]
+
+
+def _quiet(_: str) -> None:
+    pass
+
+
+@dataclass(frozen=True)
+class Faults:
+    """Regressions injected on purpose, to prove the comparison catches them.
+
+    ``mount_sign``: the calibrated initial directions are used with the wrong
+    sign (a sign slip in an eye's mount offset).  ``double_renders``: every
+    servo observation renders twice (a servo that needs twice the renders).
+    """
+
+    mount_sign: bool = False
+    double_renders: bool = False
+
+
+def _measure_points(
+    settings: HeadSettings,
+    knowledge: HeadKnowledge,
+    points_head: np.ndarray,
+    faults: Faults,
+) -> tuple[list[Any], float]:
+    """Model 2 on each point; returns the measurements and the median render time, s."""
+    with HeadSim("default", settings) as sim:
+        servo = EyeServo(sim)
+        if faults.double_renders:
+            observe = servo.observe
+
+            def twice(camera: int, detector: Any) -> Any:
+                sim.render(camera)
+                return observe(camera, detector)
+
+            servo.observe = twice  # type: ignore[method-assign]
+        render_s = experiments.render_time_s(sim)
+        out = []
+        for p in points_head:
+            sim.set_body_pose("marker_red", sim.transform_points(p, "head", "world")[0])
+            out.append(measure_model2(sim, servo, experiments.RED, knowledge))
+    return out, render_s
+
+
+def suite(seed: int = 0, faults: Faults | None = None, progress: Progress = _quiet) -> Metrics:
+    """Run the fixed suite; metrics by name (see ``benchmarks/tolerances.json``)."""
+    faults = faults or Faults()
+    rng = np.random.default_rng(seed)
+    metrics: Metrics = {}
+
+    progress("ideal cameras, Model 2")
+    points = np.concatenate(
+        [
+            experiments.random_targets_head(rng, 4, band, vertical=(-0.15, 0.15))
+            for band in experiments.DEPTH_BANDS_M
+        ]
+    )
+    start = time.perf_counter()
+    ideal, render_s = _measure_points(HeadSettings(), HeadKnowledge(), points, faults)
+    wall = (time.perf_counter() - start) / len(points)
+    fig = experiments.error_figures(ideal)
+    metrics["ideal.model2.rms_3d_pct_depth"] = fig["rms_3d_pct_depth"]
+    metrics["ideal.model2.failed"] = float(fig["failed"])
+    metrics["ideal.model2.renders_per_point"] = float(np.mean([m.renders for m in ideal[1:]]))
+    metrics["ideal.model2.servo_residual_px_mean"] = float(
+        np.mean([abs(r) for m in ideal if m.ok for r in m.servo_residual_px])
+    )
+    metrics["speed.wall_per_point_over_render"] = wall / render_s
+
+    progress("paper's cameras: Sec. V calibration")
+    settings = paper_head()
+    with HeadSim("default", settings) as sim:
+        from headsim.procedures import calibrate_head, calibration_layout
+
+        run = calibrate_head(
+            sim,
+            EyeServo(sim),
+            experiments.BALL,
+            names.CALIBRATION_BALL,
+            calibration_layout(sim, rng, 30),
+        )
+    knowledge = run.knowledge
+    if faults.mount_sign:
+        knowledge = HeadKnowledge(
+            alpha_e=(-knowledge.alpha_e[0], knowledge.alpha_e[1]),
+            v0=knowledge.v0,
+            kx_over_ky=knowledge.kx_over_ky,
+        )
+    metrics["paper.calibration.max_error_rad"] = float(np.abs(run.alpha_e_error).max())
+
+    progress("paper's cameras: Model 2 near the centre row")
+    low, high = experiments.visible_vertical_range(settings)
+    near = np.concatenate(
+        [
+            experiments.random_targets_head(
+                rng, 3, band, vertical=(max(low, -0.05), min(high, 0.03))
+            )
+            for band in experiments.DEPTH_BANDS_M
+        ]
+    )
+    paper, _ = _measure_points(settings, knowledge, near, faults)
+    fig = experiments.error_figures(paper)
+    x, y, z = fig.get("rms_pct_depth_xyz", [math.nan] * 3)
+    metrics["paper.model2.x_rms_pct_depth"] = x
+    metrics["paper.model2.y_rms_pct_depth"] = y
+    metrics["paper.model2.z_rms_pct_depth"] = z
+    metrics["paper.model2.failed"] = float(fig["failed"])
+
+    progress("chessboard")
+    board = experiments.chessboard_accuracy(settings, knowledge, corners=[18, 19, 20, 26, 27, 28])[
+        "extended calibration"
+    ]
+    metrics["chessboard.width_error_mm"] = (
+        abs(board["width_mean_mm"] - 30.0) if board["width_mean_mm"] else math.inf
+    )
+    metrics["chessboard.height_error_mm"] = (
+        abs(board["height_mean_mm"] - 30.0) if board["height_mean_mm"] else math.inf
+    )
+    metrics["chessboard.corners_missed"] = float(board["corners"] - board["corners_measured"])
+
+    progress("relative positioning")
+    areas = experiments.relative_areas(rng, layouts=2)
+    metrics["areas.correct_pct"] = areas["outside_margin_correct_pct"] or 0.0
+
+    progress("estimator throughput")
+    speed = estimator_throughput(200_000, repeats=3, seed=seed)
+    metrics["speed.model2_over_numpy"] = speed["model2_over_numpy_eq4_11"]
+    return metrics
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """One metric compared with its baseline."""
+
+    metric: str
+    baseline: float | None
+    now: float
+    change: float | None
+    allowed: float | None
+    regressed: bool
+
+    @property
+    def label(self) -> str:
+        if self.baseline is None:
+            return "new"
+        return "REGRESSED" if self.regressed else "ok"
+
+
+def compare(
+    metrics: Metrics, baseline: Metrics, tolerances: dict[str, dict[str, Any]]
+) -> list[Verdict]:
+    """Each metric against the baseline: worse by more than ``abs + rel * |baseline|`` regresses.
+
+    ``tolerances[metric]`` = {"worse": "higher" or "lower", "abs": float, "rel": float}.
+    A metric without a tolerance entry is reported, never failed.
+    """
+    verdicts = []
+    for metric, now in metrics.items():
+        base = baseline.get(metric)
+        rule = tolerances.get(metric)
+        if base is None or rule is None:
+            verdicts.append(Verdict(metric, base, now, None, None, False))
+            continue
+        allowed = float(rule.get("abs", 0.0)) + float(rule.get("rel", 0.0)) * abs(base)
+        worse_by = (now - base) if rule["worse"] == "higher" else (base - now)
+        regressed = not math.isfinite(now) or worse_by > allowed
+        verdicts.append(Verdict(metric, base, now, now - base, allowed, regressed))
+    return verdicts
+
+
+def format_table(verdicts: list[Verdict]) -> str:
+    """The comparison as a readable table."""
+    lines = [
+        f"{'metric':42s} {'baseline':>12s} {'now':>12s} {'change':>11s} {'allowed':>10s}  verdict"
+    ]
+    for v in verdicts:
+        base = "-" if v.baseline is None else f"{v.baseline:12.5g}"
+        change = "-" if v.change is None else f"{v.change:+11.3g}"
+        allowed = "-" if v.allowed is None else f"{v.allowed:10.3g}"
+        lines.append(
+            f"{v.metric:42s} {base:>12s} {v.now:12.5g} {change:>11s} {allowed:>10s}  {v.label}"
+        )
+    return "\n".join(lines)
+
+
+def load_json(path: Path) -> dict[str, Any]:
+    return json.loads(path.read_text()) if path.exists() else {}
+
+
+def environment() -> dict[str, str]:
+    import mujoco
+
+    return {
+        "headsim": headsim.__version__,
+        "mujoco": mujoco.__version__,
+        "numpy": np.__version__,
+        "python": platform.python_version(),
+        "machine": platform.machine(),
+    }
+
+
+def main(args: Any) -> int:
+    """``headsim bench``: run the suite, compare, print, maybe update the baseline."""
+
+    def progress(message: str) -> None:
+        print(f"\r  bench: {message:60s}", end="", file=sys.stderr, flush=True)
+
+    start = time.perf_counter()
+    metrics = suite(seed=args.seed, progress=progress)
+    wall = time.perf_counter() - start
+    print("\r" + " " * 72 + "\r", end="", file=sys.stderr)
+    baseline_path = Path(args.baseline)
+    stored = load_json(baseline_path)
+    verdicts = compare(metrics, stored.get("metrics", {}), load_json(Path(args.tolerances)))
+    print(format_table(verdicts))
+    print(f"suite wall time {wall:.0f} s")
+    if args.json:
+        write_json_atomic(
+            args.json, {"metrics": metrics, "wall_s": wall, "environment": environment()}
+        )
+    if args.update_baseline:
+        if not args.reason:
+            print(
+                "headsim bench: --update-baseline needs --reason 'why the figures changed'",
+                file=sys.stderr,
+            )
+            return 2
+        history = stored.get("history", [])
+        history.append({"reason": args.reason, "environment": environment()})
+        write_json_atomic(
+            baseline_path, {"metrics": metrics, "seed": args.seed, "history": history}
+        )
+        print(f"baseline written to {baseline_path}")
+        return 0
+    regressions = [v for v in verdicts if v.regressed]
+    if regressions:
+        print(f"{len(regressions)} metric(s) regressed: {', '.join(v.metric for v in regressions)}")
+        return 1
+    return 0
