@@ -452,7 +452,7 @@ def _calibration_markdown(block: dict[str, Any]) -> str:
         f"{block['fixated']} of {block['targets']} positions fixated, {block['renders']} renders\n\n"
         "| rad | ours | truth | paper |\n|---|---|---|---|\n" + rows + "\n"
     )
-    vertical = block.get("vertical")
+    vertical = block.get("vertical_reference")
     if vertical:
         text += "\n| extended | ours | truth |\n|---|---|---|\n" + "\n".join(
             f"| v{k + 1}0 px | {vertical['v0_px'][k]:.2f} | {vertical['v0_truth_px'][k]:.2f} |\n"

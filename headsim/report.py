@@ -215,7 +215,7 @@ def _calibration_lines(block: dict[str, Any], paper: bool) -> list[str]:
                 *([_cell(block["alpha_e_paper_rad"][k], ".4f")] if paper else []),
             ]
         )
-    vertical = block.get("vertical")
+    vertical = block.get("vertical_reference")
     if vertical:
         for k in range(2):
             rows.append(

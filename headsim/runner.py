@@ -349,15 +349,31 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
         hub.phase("calibration", sim, HeadKnowledge(), truth)
         hub.watch(names.CALIBRATION_BALL, "calibration")
         ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
+        truth_alpha_e = [sim.effective_initial_direction(c) for c in (1, 2)]
+        truth_v0 = [sim.camera_settings(c).principal[1] for c in (1, 2)]
+        truth_ratio = [sim.camera_settings(c).kx / sim.camera_settings(c).ky for c in (1, 2)]
         block: dict[str, Any] = {
+            "status": "ok",
             "targets": spec.targets,
-            "depth_m": list(spec.depth_m),
-            "lateral": spec.lateral,
-            "vertical": spec.vertical,
+            "fixated": 0,
+            "renders": 0,
+            "layout": {
+                "depth_m": list(spec.depth_m),
+                "lateral": spec.lateral,
+                "vertical": spec.vertical,
+                "positions_world_m": positions,
+            },
             "depth_noise_m": spec.depth_noise_m,
             "extended": spec.extended,
-            "positions_world_m": positions,
+            "alpha_e_rad": None,
+            "alpha_e_std_rad": None,
+            "alpha_e_truth_rad": truth_alpha_e,
+            "alpha_e_error_rad": None,
             "alpha_e_paper_rad": list(PAPER["alpha_e_rad"]),
+            "converged": False,
+            "depth_residual_rms_m": None,
+            "vertical_reference": None,
+            "knowledge": None,
         }
         start = sim.render_count
         try:
@@ -372,23 +388,19 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 extended=spec.extended,
             )
         except ValueError as err:
-            block.update(status=f"failed: {err}", renders=sim.render_count - start, fixated=0)
+            block.update(status=f"failed: {err}", renders=sim.render_count - start)
             hub.calibrated(block)
             return None, block
-        truth_v0 = [sim.camera_settings(c).principal[1] for c in (1, 2)]
-        truth_ratio = [sim.camera_settings(c).kx / sim.camera_settings(c).ky for c in (1, 2)]
-    fit = run.fit
+    fit, knowledge = run.fit, run.knowledge
     block.update(
-        status="ok",
         fixated=run.samples,
         renders=run.renders,
         alpha_e_rad=list(fit.alpha_e),
-        alpha_e_truth_rad=list(run.truth_alpha_e),
-        alpha_e_error_rad=list(run.alpha_e_error),
         alpha_e_std_rad=list(fit.std_errors),
+        alpha_e_error_rad=list(run.alpha_e_error),
         converged=bool(fit.converged),
         depth_residual_rms_m=float(np.sqrt(np.mean(np.square(fit.depth_residuals)))),
-        vertical=None
+        vertical_reference=None
         if run.vertical is None
         else {
             "v0_px": [v.v0 for v in run.vertical],
@@ -398,7 +410,11 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "kx_over_ky_std": [v.kx_over_ky_std for v in run.vertical],
             "kx_over_ky_truth": truth_ratio,
         },
-        knowledge=asdict(run.knowledge),
+        knowledge={
+            "alpha_e_rad": list(knowledge.alpha_e),
+            "v0_px": list(knowledge.v0),
+            "kx_over_ky": list(knowledge.kx_over_ky),
+        },
     )
     hub.calibrated(block)
     return run, block
