@@ -73,6 +73,12 @@ def _run(args: argparse.Namespace) -> int:
     rrd = Path(args.rrd) if args.rrd else None
     if rrd is not None and rrd.is_dir():
         raise ScenarioError("--rrd", "", f"{rrd} is a directory", "a file path, e.g. run.rrd")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise ScenarioError(
+            "--out", "", f"cannot create {out}: {err.strerror}", "a writable directory"
+        ) from err
     observers: list[Observer] = []
     if not args.no_progress and sys.stderr.isatty():
         observers.append(Progress(scenario.fixations, sys.stderr))
@@ -80,7 +86,12 @@ def _run(args: argparse.Namespace) -> int:
     if rrd is not None:
         from headsim.recording import Recorder
 
-        recorder = Recorder(rrd, scenario)
+        try:
+            recorder = Recorder(rrd, scenario)
+        except OSError as err:
+            raise ScenarioError(
+                "--rrd", "", f"cannot write {rrd}: {err}", "a writable file path"
+            ) from err
         observers.append(recorder)
     start = time.perf_counter()
     try:
@@ -116,18 +127,17 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _list(args: argparse.Namespace) -> int:
-    from headsim.report import format_table
     from headsim.scenario import SCENARIOS_DIR, describe_scenarios
 
     directory = Path(args.dir) if args.dir else SCENARIOS_DIR
-    rows = [[name, description] for name, description in describe_scenarios(directory)]
+    rows = list(describe_scenarios(directory))
     if not rows:
         print(f"no scenario files (*.toml) in {directory}")
         return 0
     print(f"scenarios in {directory} (run one with: headsim run NAME --out DIR)")
-    for line in format_table(["name", "description"], rows)[1:]:
-        # Left-align both columns: the description is text.
-        print(line)
+    width = max(len(name) for name, _ in rows)
+    for name, description in rows:
+        print(f"  {name.ljust(width)}  {description}")
     return 0 if all(not d.startswith("INVALID") for _, d in rows) else 2
 
 

@@ -298,10 +298,10 @@ class _Table:
         unit: str = "",
     ) -> float:
         value = self._get(key)
-        allowed = _range_text(lo, hi, lo_open, hi_open, unit)
+        allowed = f"a number {_range_text(lo, hi, lo_open, hi_open, unit)}"
         if value is _MISSING:
             if default is _MISSING:
-                raise self.fail(key, "missing", f"a number {allowed}")
+                raise self.fail(key, "missing", allowed)
             return default
         return self._check_number(key, value, lo, hi, lo_open, hi_open, allowed)
 
