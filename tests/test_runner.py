@@ -107,17 +107,17 @@ def test_every_scenario_runs_in_its_fast_variant(
         assert max(experiment["errors_world_m"]) < 0.003
 
 
-def test_the_same_seed_gives_identical_results(
+def test_the_same_seed_gives_identical_results_with_or_without_a_recording(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     runs = []
-    for name, seed in (("a", "3"), ("b", "3"), ("c", "4")):
-        assert (
-            _run(["quickstart", "--fast", "--seed", seed, "--out", str(tmp_path / name)], capsys)[0]
-            == 0
-        )
-        runs.append((tmp_path / name / "results.json").read_bytes())
-    assert runs[0] == runs[1]
+    for name, seed, rrd in (("a", "3", True), ("b", "3", False), ("c", "4", False)):
+        out = tmp_path / name
+        args = ["quickstart", "--fast", "--seed", seed, "--out", str(out)]
+        args += ["--rrd", str(out / "run.rrd")] if rrd else []
+        assert _run(args, capsys)[0] == 0
+        runs.append((out / "results.json").read_bytes())
+    assert runs[0] == runs[1]  # the recording observes, it does not perturb
     assert runs[0] != runs[2]
     assert json.loads(runs[2])["seed"] == 4
 
