@@ -17,7 +17,8 @@ $(BIN)/headsim: pyproject.toml
 setup: $(BIN)/headsim
 
 demo: setup
-	$(BIN)/headsim snapshot --out out/snapshot
+	$(BIN)/headsim run quickstart --out out/quickstart --rrd out/quickstart/recording.rrd
+	@echo "open the recording with: $(BIN)/rerun out/quickstart/recording.rrd"
 
 test: setup
 	$(BIN)/ruff check headsim tests benchmarks

@@ -1,10 +1,19 @@
-"""The ``headsim`` command line."""
+"""The ``headsim`` command line: ``run`` a scenario, ``list`` them, take a ``snapshot``.
+
+Exit status: 0 when everything succeeded; 1 when a measurement (or the
+calibration it needed) failed; 2 on bad input (a scenario file, an argument),
+when nothing is run or written; 130 when interrupted.
+"""
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
-from collections.abc import Sequence
+import time
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
 
 from headsim import names
 from headsim.settings import PRESETS, SettingsError, preset
@@ -28,12 +37,152 @@ def _snapshot(args: argparse.Namespace) -> int:
     return 0
 
 
+def _size(path: Path) -> str:
+    size = path.stat().st_size
+    return f"{size / 1e6:.1f} MB" if size >= 1e5 else f"{size / 1e3:.0f} kB"
+
+
+@contextmanager
+def _sigterm_interrupts() -> Iterator[None]:
+    """Turn SIGTERM into KeyboardInterrupt, so that a stopped run still closes its files."""
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    try:
+        previous = signal.signal(signal.SIGTERM, interrupt)
+    except ValueError:  # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _run(args: argparse.Namespace) -> int:
+    from headsim.report import results_payload, summary_text
+    from headsim.results import write_json_atomic, write_text_atomic
+    from headsim.runner import Observer, Progress, run_scenario
+    from headsim.scenario import ScenarioError, load_scenario
+
+    scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ScenarioError("--out", "", f"{out} exists and is not a directory", "a directory")
+    rrd = Path(args.rrd) if args.rrd else None
+    if rrd is not None and rrd.is_dir():
+        raise ScenarioError("--rrd", "", f"{rrd} is a directory", "a file path, e.g. run.rrd")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise ScenarioError(
+            "--out", "", f"cannot create {out}: {err.strerror}", "a writable directory"
+        ) from err
+    observers: list[Observer] = []
+    if not args.no_progress and sys.stderr.isatty():
+        observers.append(Progress(scenario.fixations, sys.stderr))
+    recorder = None
+    if rrd is not None:
+        from headsim.recording import Recorder
+
+        try:
+            recorder = Recorder(rrd, scenario)
+        except OSError as err:
+            raise ScenarioError(
+                "--rrd", "", f"cannot write {rrd}: {err}", "a writable file path"
+            ) from err
+        observers.append(recorder)
+    start = time.perf_counter()
+    try:
+        with _sigterm_interrupts():
+            result = run_scenario(scenario, observers)
+    except KeyboardInterrupt:
+        kept = f"; the recording so far is in {rrd}" if rrd is not None else ""
+        print(f"\nheadsim: interrupted: nothing written to {out}{kept}", file=sys.stderr)
+        return 130
+    finally:
+        if recorder is not None:
+            recorder.close()
+    wall = time.perf_counter() - start
+    text = summary_text(result)
+    write_json_atomic(out / "results.json", results_payload(result))
+    write_text_atomic(out / "summary.txt", text + "\n")
+    write_json_atomic(
+        out / "timing.json",
+        {
+            "scenario": scenario.name,
+            "fast": scenario.fast,
+            "wall_s": wall,
+            "phases_s": result.timing_s,
+            "renders": result.renders,
+            "rrd_bytes": rrd.stat().st_size if rrd is not None else None,
+        },
+    )
+    print(text)
+    print(f"\nwall time {wall:.1f} s; results in {out / 'results.json'} (summary.txt, timing.json)")
+    if rrd is not None:
+        print(f"recording {rrd} ({_size(rrd)}): open it with  rerun {rrd}")
+    return 0 if result.ok else 1
+
+
+def _list(args: argparse.Namespace) -> int:
+    from headsim.scenario import SCENARIOS_DIR, describe_scenarios
+
+    directory = Path(args.dir) if args.dir else SCENARIOS_DIR
+    rows = list(describe_scenarios(directory))
+    if not rows:
+        print(f"no scenario files (*.toml) in {directory}")
+        return 0
+    print(f"scenarios in {directory} (run one with: headsim run NAME --out DIR)")
+    width = max(len(name) for name, _ in rows)
+    for name, description in rows:
+        print(f"  {name.ljust(width)}  {description}")
+    return 0 if all(not d.startswith("INVALID") for _, d in rows) else 2
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="headsim",
         description="MuJoCo testbed for vergence-based active stereo vision on humanoid heads.",
     )
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    run = commands.add_parser(
+        "run",
+        help="run a scenario: print a summary, write results.json, optionally record to Rerun",
+        description="Run the experiment of a scenario file in the simulator. Prints a summary "
+        "table, writes DIR/results.json (and summary.txt, timing.json) and, with --rrd, a Rerun "
+        "recording to replay with `rerun FILE`. Exit status: 0 all measurements ok, 1 a "
+        "measurement failed, 2 bad input (nothing run or written), 130 interrupted.",
+    )
+    run.add_argument(
+        "scenario",
+        metavar="SCENARIO",
+        help="a scenario file (.toml) or the name of one in scenarios/ (see `headsim list`)",
+    )
+    run.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
+    run.add_argument("--rrd", metavar="FILE", help="also record the run to this Rerun .rrd file")
+    run.add_argument(
+        "--seed",
+        type=int,
+        metavar="N",
+        help="seed of image noise and random layouts (default: the file's seed)",
+    )
+    run.add_argument(
+        "--fast", action="store_true", help="the scenario's fast variant (its [fast] table)"
+    )
+    run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    run.set_defaults(func=_run)
+
+    listing = commands.add_parser(
+        "list",
+        help="list the scenario files with one-line descriptions",
+        description="List the scenario files (scenarios/*.toml) with their descriptions; "
+        "a file that does not validate says why.",
+    )
+    listing.add_argument("--dir", metavar="DIR", help="another directory of scenario files")
+    listing.set_defaults(func=_list)
 
     snap = commands.add_parser(
         "snapshot",
@@ -63,10 +212,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    from headsim.scenario import ScenarioError
+
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))
-    except (SettingsError, ValueError) as err:
+    except (SettingsError, ScenarioError) as err:
+        print(f"headsim: error: {err}", file=sys.stderr)
+        return 2
+    except ValueError as err:
+        if args.command != "snapshot":
+            raise
         print(f"headsim: error: {err}", file=sys.stderr)
         return 2
 

@@ -66,6 +66,14 @@ def write_json_atomic(path: str | Path, payload: Any) -> Path:
     return path
 
 
+def write_text_atomic(path: str | Path, text: str) -> Path:
+    """Write UTF-8 text, atomically."""
+    path = Path(path)
+    data = text.encode("utf-8")
+    _atomic_write(path, lambda handle: handle.write(data))
+    return path
+
+
 def write_png_atomic(path: str | Path, rgb: np.ndarray) -> Path:
     """Write an RGB uint8 image as PNG, atomically."""
     path = Path(path)

@@ -1,0 +1,465 @@
+"""Recording a run to a Rerun ``.rrd`` file, replayed with ``rerun FILE.rrd``.
+
+A :class:`Recorder` is a :class:`headsim.runner.Observer`: it logs the
+experiment's own images and detections as the procedures make them (no
+render is made for the record) and the results as they come.  Entity paths
+and timelines (README "Scenarios and results" lists them):
+
+- timelines ``frame`` (images rendered in the run, from 0) and ``step``
+  (fixations: calibration samples, then measurements, from 0); every entity
+  is logged on both;
+- ``/world`` (W, z up): ``/world/head`` (Transform3D world_from_head),
+  ``/world/head/cam1``, ``/world/head/cam2`` (Transform3D head_from_camera
+  and a Pinhole with the true K: the frusta), ``.../image`` (the JPEG image),
+  ``.../features`` (the detection), ``.../objects`` (relative positioning),
+  ``.../goal`` (the goal column, static), ``/world/optical_axes``,
+  ``/world/truth``, ``/world/estimate``, ``/world/error``,
+  ``/world/current_target``, ``/world/calibration/positions``,
+  ``/world/moving_target/path``, ``/world/areas/lines``, ``/world/areas/objects``;
+- ``/servo/cam1/u_error_px``, ``/servo/cam2/u_error_px``, ``.../v_error_px``;
+  ``/joints/eye_rad``, ``/joints/neck_yaw_rad``, ``/joints/neck_pitch_rad``;
+  ``/measurements/error_mm``, ``/measurements/error_pct_of_depth``,
+  ``/measurements/renders``, ``/measurements/servo_residual_px``;
+- ``/results/scenario``, ``/results/calibration``, ``/results/summary``
+  (markdown text).
+
+The stream is written as it goes and flushed after every measurement; it is
+closed with its footer when the run ends, also when it is interrupted
+(Ctrl-C).  A killed writer leaves a file without footer that the viewer and
+``rerun.chunk.RrdReader(...).stream()`` still read (``rerun rrd optimize``
+rewrites it).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from headsim import names
+from headsim.kinematics import head_to_world
+from headsim.optics import camera_matrix
+from headsim.procedures import HeadKnowledge
+from headsim.report import summary_text
+from headsim.runner import MeasurementRecord, Observer, RunResult
+from headsim.scenario import Scenario
+from headsim.sim import HeadSim
+from headsim.vision import find_markers
+
+APP_ID = "headsim"
+#: JPEG quality of the recorded images (the experiment's own images are exact; these are for people).
+JPEG_QUALITY = 75
+#: Distance from the image plane to the optical centre of a drawn frustum, m.
+FRUSTUM_DEPTH_M = 0.08
+
+_GREEN = (40, 220, 90)
+_RED = (235, 60, 50)
+_WHITE = (235, 235, 235)
+_ORANGE = (255, 160, 30)
+_GREY = (150, 150, 150)
+
+
+def blueprint() -> rrb.Blueprint:
+    """The default layout: 3-D view, both camera images, servo and joint traces, results."""
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Spatial3DView(origin="/world", name="head, frusta and targets (W)"),
+            rrb.Vertical(
+                rrb.Horizontal(
+                    rrb.Spatial2DView(origin="/world/head/cam1", name="camera 1"),
+                    rrb.Spatial2DView(origin="/world/head/cam2", name="camera 2"),
+                ),
+                rrb.Horizontal(
+                    rrb.TimeSeriesView(origin="/servo", name="servo error, px"),
+                    rrb.TimeSeriesView(origin="/joints", name="joint encoders, rad"),
+                ),
+                rrb.Tabs(
+                    rrb.TextDocumentView(origin="/results", name="results"),
+                    rrb.TimeSeriesView(origin="/measurements", name="measurements"),
+                ),
+                row_shares=[3, 2, 2],
+            ),
+            column_shares=[2, 3],
+        ),
+        rrb.TimePanel(timeline="frame"),
+        collapse_panels=True,
+    )
+
+
+def recording_id(scenario: Scenario) -> str:
+    """Deterministic id: scenario, variant and seed."""
+    return f"{scenario.name}{'-fast' if scenario.fast else ''}-seed{scenario.seed}"
+
+
+class Recorder(Observer):
+    """Logs a run to ``path`` as it goes; :meth:`close` writes the footer."""
+
+    def __init__(self, path: str | Path, scenario: Scenario, jpeg_quality: int = JPEG_QUALITY):
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.scenario = scenario
+        self.jpeg_quality = int(jpeg_quality)
+        self.rec = rr.RecordingStream(APP_ID, recording_id=recording_id(scenario))
+        # No wall-clock timeline: two runs log the same data.
+        self.rec.set_log_time_enabled(False)
+        self.rec.save(self.path, default_blueprint=blueprint())
+        self.rec.send_recording_name(scenario.name)
+        self.current_frame = 0
+        self.current_step = 0
+        self.label = ""
+        self.phase_name = ""
+        self.truth: dict[str, np.ndarray] = {}
+        self.estimates: dict[str, tuple[np.ndarray, np.ndarray, bool]] = {}
+        self._labels: dict[str, str] = {}
+        self.knowledge = HeadKnowledge()
+        self.effective_alpha_e = (0.0, 0.0)
+        self.world_from_head_start = np.eye(4)
+        self.objects: dict[str, str] = {}
+        self.closed = False
+        self._log_static()
+
+    # -- helpers ------------------------------------------------------------------
+    def _time(self) -> None:
+        self.rec.set_time("frame", sequence=self.current_frame)
+        self.rec.set_time("step", sequence=self.current_step)
+
+    def _log_static(self) -> None:
+        s = self.scenario
+        self.rec.log("/world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+        for index, cam in enumerate(names.CAMERAS):
+            settings = s.settings.cameras[index]
+            # headsim's camera frames are OpenCV's (x right, y down, z forward):
+            # Rerun's RDF, so no conversion here (MuJoCo's RUB is converted in headsim.sim).
+            self.rec.log(
+                f"/world/head/{cam}",
+                rr.Pinhole(
+                    image_from_camera=camera_matrix(settings),
+                    resolution=[settings.width, settings.height],
+                    camera_xyz=rr.ViewCoordinates.RDF,
+                    image_plane_distance=FRUSTUM_DEPTH_M,
+                ),
+                static=True,
+            )
+            u0, v0 = settings.image_centre
+            self.rec.log(
+                f"/world/head/{cam}/goal",
+                rr.LineStrips2D(
+                    [
+                        [[u0, 0.0], [u0, settings.height - 1.0]],
+                        [[0.0, v0], [settings.width - 1.0, v0]],
+                    ],
+                    colors=[_ORANGE, _GREY],
+                    labels=["goal column u0", "centre row"],
+                ),
+                static=True,
+            )
+        for key, unit in (
+            ("error_mm", "mm"),
+            ("error_pct_of_depth", "%"),
+            ("servo_residual_px", "px"),
+        ):
+            self.rec.log(
+                f"/measurements/{key}", rr.SeriesPoints(names=[f"{key} ({unit})"]), static=True
+            )
+        for cam in names.CAMERAS:
+            for axis in ("u", "v"):
+                self.rec.log(
+                    f"/servo/{cam}/{axis}_error_px",
+                    rr.SeriesLines(names=[f"{cam} {axis} - {axis}0"]),
+                    static=True,
+                )
+        self.rec.log(
+            "/results/scenario",
+            rr.TextDocument(self._scenario_markdown(), media_type=rr.MediaType.MARKDOWN),
+            static=True,
+        )
+
+    def _scenario_markdown(self) -> str:
+        s = self.scenario
+        rows = "\n".join(
+            f"| cam{k + 1} | {c.width}x{c.height} | {c.kx:.2f} | {c.ky:.2f} | "
+            f"{c.principal[0]:.1f}, {c.principal[1]:.1f} | {c.k1:.4f} | {c.mount_yaw_rad:.4f} | {c.noise_std:g} |"
+            for k, c in enumerate(s.settings.cameras)
+        )
+        return (
+            f"# {s.name}{' (fast)' if s.fast else ''}\n\n{s.description}\n\n"
+            f"procedure `{s.experiment.procedure}`, preset `{s.preset}`, seed {s.seed}, "
+            f"baseline {s.settings.baseline_m * 1000:g} mm\n\n"
+            "| camera | size | kx | ky | principal | k1 | mount yaw | noise |\n"
+            "|---|---|---|---|---|---|---|---|\n" + rows + "\n"
+        )
+
+    def _pose(self, sim: HeadSim) -> None:
+        world_from_head = sim.world_from_head()
+        self.rec.log(
+            "/world/head",
+            rr.Transform3D(translation=world_from_head[:3, 3], mat3x3=world_from_head[:3, :3]),
+        )
+        origins, vectors = [], []
+        target = self.truth.get(self.label)
+        for index, cam in enumerate(names.CAMERAS):
+            head_from_camera = sim.head_from_camera(index + 1)
+            self.rec.log(
+                f"/world/head/{cam}",
+                rr.Transform3D(
+                    translation=head_from_camera[:3, 3], mat3x3=head_from_camera[:3, :3]
+                ),
+            )
+            world_from_camera = sim.world_from_camera(index + 1)
+            centre = world_from_camera[:3, 3]
+            length = 1.0 if target is None else 1.2 * float(np.linalg.norm(target - centre))
+            origins.append(centre)
+            vectors.append(world_from_camera[:3, 2] * length)
+        self.rec.log(
+            "/world/optical_axes",
+            rr.Arrows3D(
+                origins=origins, vectors=vectors, colors=[_ORANGE, _ORANGE], labels=["cam1", "cam2"]
+            ),
+        )
+        eye = sim.eye_encoder()
+        yaw, pitch = sim.neck_encoders()
+        for key, value in (("eye_rad", eye), ("neck_yaw_rad", yaw), ("neck_pitch_rad", pitch)):
+            self.rec.log(f"/joints/{key}", rr.Scalars([value]))
+
+    # -- the observer -------------------------------------------------------------
+    def phase(
+        self, name: str, sim: HeadSim, knowledge: HeadKnowledge, truth: dict[str, np.ndarray]
+    ) -> None:
+        self.phase_name = name
+        self.truth = {k: np.asarray(v, dtype=float) for k, v in truth.items()}
+        self.estimates = {}
+        self.knowledge = knowledge
+        self.effective_alpha_e = (
+            sim.effective_initial_direction(1),
+            sim.effective_initial_direction(2),
+        )
+        self.world_from_head_start = sim.world_from_head()
+        procedure = self.scenario.experiment.procedure
+        self.objects = (
+            {o.body: names.RELATIVE_OBJECT_COLOURS[o.body] for o in self.scenario.scene.objects}
+            if name == "measurement" and procedure == "relative_positioning"
+            else {}
+        )
+        self._time()
+        positions = np.array(list(self.truth.values())).reshape(-1, 3)
+        labels = list(self.truth)
+        if name == "calibration":
+            self.rec.log(
+                "/world/calibration/positions",
+                rr.Points3D(positions, radii=0.004, colors=[_GREY] * len(labels)),
+            )
+        else:
+            self.rec.log("/world/calibration/positions", rr.Clear(recursive=False))
+            self.rec.log(
+                "/world/truth",
+                rr.Points3D(
+                    positions,
+                    radii=0.003,
+                    colors=[_WHITE] * len(labels),
+                    labels=labels,
+                    show_labels=False,
+                ),
+            )
+            self.rec.log("/world/estimate", rr.Clear(recursive=False))
+            self.rec.log("/world/error", rr.Clear(recursive=False))
+        moving = self.scenario.scene.moving
+        if name == "measurement" and moving is not None:
+            self.rec.log(
+                "/world/moving_target/path",
+                rr.LineStrips3D(
+                    [np.asarray(moving.waypoints_world_m)], colors=[_GREY], labels=["waypoints"]
+                ),
+            )
+        self._pose(sim)
+
+    def step(self, step: int, label: str) -> None:
+        self.current_step, self.label = step, label
+        self._time()
+        target = self.truth.get(label)
+        if target is not None:
+            self.rec.log(
+                "/world/current_target",
+                rr.Points3D([target], radii=0.006, colors=[_ORANGE], labels=[label]),
+            )
+
+    def rendered(self, sim: HeadSim, camera: int, image: np.ndarray, frame: int) -> None:
+        self.current_frame = frame
+        self._time()
+        self._pose(sim)
+        cam = names.CAMERAS[camera - 1]
+        ok, jpeg = cv2.imencode(
+            ".jpg",
+            cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
+            [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality],
+        )
+        if ok:
+            self.rec.log(
+                f"/world/head/{cam}/image",
+                rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg"),
+            )
+        # Cleared here; the detection made in this image (if any) follows at the same frame.
+        self.rec.log(f"/world/head/{cam}/features", rr.Clear(recursive=False))
+        if self.objects:
+            found = find_markers(image, self.objects)
+            seen = [(k, d.uv) for k, d in found.items() if d.found and d.uv is not None]
+            self.rec.log(
+                f"/world/head/{cam}/objects",
+                rr.Points2D(
+                    [uv for _, uv in seen],
+                    radii=6.0,
+                    colors=[_WHITE] * len(seen),
+                    labels=[k for k, _ in seen],
+                ),
+            )
+
+    def detected(
+        self, sim: HeadSim, camera: int, uv: tuple[float, float] | None, status: str, frame: int
+    ) -> None:
+        cam = names.CAMERAS[camera - 1]
+        self.current_frame = frame
+        self._time()
+        if uv is None:
+            self.rec.log(f"/world/head/{cam}/features", rr.Clear(recursive=False))
+            return
+        self.rec.log(
+            f"/world/head/{cam}/features",
+            rr.Points2D([uv], radii=5.0, colors=[_GREEN], labels=[f"{self.label}: {status}"]),
+        )
+        u0, v0 = self.knowledge.reference(sim, camera)
+        self.rec.log(f"/servo/{cam}/u_error_px", rr.Scalars([uv[0] - u0]))
+        self.rec.log(f"/servo/{cam}/v_error_px", rr.Scalars([uv[1] - v0]))
+
+    def measured(self, record: MeasurementRecord) -> None:
+        m = record.measurement
+        self.current_step = record.step
+        self._time()
+        label = m.name
+        if record.time_s is not None:
+            label += f" t={record.time_s:g}s"
+        if self.scenario.experiment.procedure == "calibration":
+            label += f" ({record.knowledge})"
+        self.estimates[f"{record.step}"] = (m.estimate_world_m, m.truth_world_m, m.ok)
+        self._labels[f"{record.step}"] = label
+        done = [(k, e, t) for k, (e, t, ok) in self.estimates.items() if ok]
+        if done:
+            self.rec.log(
+                "/world/estimate",
+                rr.Points3D(
+                    [e for _, e, _ in done],
+                    radii=0.004,
+                    colors=[_GREEN] * len(done),
+                    labels=[self._labels[k] for k, _, _ in done],
+                    show_labels=False,
+                ),
+            )
+            self.rec.log(
+                "/world/error",
+                rr.LineStrips3D([[t, e] for _, e, t in done], colors=[_RED] * len(done)),
+            )
+        error = float(np.linalg.norm(m.error_head_m))
+        if math.isfinite(error):
+            self.rec.log("/measurements/error_mm", rr.Scalars([error * 1000.0]))
+            self.rec.log("/measurements/error_pct_of_depth", rr.Scalars([m.error_pct_of_depth]))
+        self.rec.log("/measurements/renders", rr.Scalars([float(m.renders)]))
+        residuals = [abs(r) for r in m.servo_residual_px if math.isfinite(r)]
+        if residuals:
+            self.rec.log("/measurements/servo_residual_px", rr.Scalars([max(residuals)]))
+        self.rec.flush()
+
+    def calibrated(self, calibration: dict[str, Any]) -> None:
+        self._time()
+        self.rec.log(
+            "/results/calibration",
+            rr.TextDocument(_calibration_markdown(calibration), media_type=rr.MediaType.MARKDOWN),
+        )
+        self.rec.flush()
+
+    def finished(self, result: RunResult) -> None:
+        self._time()
+        if (
+            result.experiment.get("procedure") == "relative_positioning"
+            and "objects" in result.experiment
+        ):
+            self._log_areas(result.experiment)
+        text = summary_text(result)
+        self.rec.log(
+            "/results/summary",
+            rr.TextDocument(f"```\n{text}\n```", media_type=rr.MediaType.MARKDOWN),
+        )
+
+    def _log_areas(self, e: dict[str, Any]) -> None:
+        """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
+        baseline = self.scenario.settings.baseline_m
+        s = self.scenario.settings
+        strips, labels = [], []
+        far = 2.0
+        for step_index, alpha in enumerate((e["alpha1_rad"], e["alpha2_rad"])):
+            if not math.isfinite(alpha):
+                return
+            for camera in (1, 2):
+                sign = 1.0 if camera == 1 else -1.0
+                yaw = alpha + self.effective_alpha_e[camera - 1]
+                start = np.array([-sign * baseline / 2, 0.0, 0.0])
+                end = start + far * np.array([sign * math.sin(yaw), 0.0, math.cos(yaw)])
+                strips.append(
+                    head_to_world(np.array([start, end]), 0.0, 0.0, s.neck_d1_m, s.neck_a2_m)
+                )
+                labels.append(f"L{camera}{step_index + 1}")
+        self.rec.log(
+            "/world/areas/lines", rr.LineStrips3D(strips, colors=[_ORANGE] * 4, labels=labels)
+        )
+        objects = e["objects"]
+        positions = [self.truth[o["name"]] for o in objects if o["name"] in self.truth]
+        self.rec.log(
+            "/world/areas/objects",
+            rr.Points3D(
+                positions,
+                radii=0.008,
+                colors=[_GREEN if o["agree"] else _RED for o in objects],
+                labels=[f"{o['name']}: S{o['area']} (true S{o['true_area']})" for o in objects],
+            ),
+        )
+
+    def close(self) -> None:
+        """Flush and write the footer; the file is complete after this."""
+        if not self.closed:
+            self.closed = True
+            self.rec.flush()
+            self.rec.disconnect()
+
+    def __enter__(self) -> Recorder:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _calibration_markdown(block: dict[str, Any]) -> str:
+    if block.get("status") != "ok":
+        return f"# Calibration\n\n{block.get('status')}\n"
+    rows = "\n".join(
+        f"| alpha_e{k + 1} | {block['alpha_e_rad'][k]:.5f} | {block['alpha_e_truth_rad'][k]:.5f} | "
+        f"{block['alpha_e_paper_rad'][k]:.4f} |"
+        for k in range(2)
+    )
+    text = (
+        "# Calibration of the initial directions (Sec. V)\n\n"
+        f"{block['fixated']} of {block['targets']} positions fixated, {block['renders']} renders\n\n"
+        "| rad | ours | truth | paper |\n|---|---|---|---|\n" + rows + "\n"
+    )
+    vertical = block.get("vertical_reference")
+    if vertical:
+        text += "\n| extended | ours | truth |\n|---|---|---|\n" + "\n".join(
+            f"| v{k + 1}0 px | {vertical['v0_px'][k]:.2f} | {vertical['v0_truth_px'][k]:.2f} |\n"
+            f"| kx{k + 1}/ky{k + 1} | {vertical['kx_over_ky'][k]:.4f} | {vertical['kx_over_ky_truth'][k]:.4f} |"
+            for k in range(2)
+        )
+    return text
+
+
+__all__ = ["APP_ID", "JPEG_QUALITY", "Recorder", "blueprint", "recording_id"]
