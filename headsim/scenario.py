@@ -21,7 +21,7 @@ merge key by key, everything else is replaced); both variants are checked.
 from __future__ import annotations
 
 import math
-import sys
+import tomllib
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from functools import cache
@@ -34,7 +34,7 @@ import numpy as np
 from headsim import names
 from headsim.kinematics import head_to_world, world_to_head
 from headsim.model import eye_from_camera_rotation, load_spec
-from headsim.optics import centre_ray_yaw, distort_normalized, undistort_normalized
+from headsim.optics import centre_ray_yaw
 from headsim.settings import (
     MAX_IMAGE_SIDE,
     PAPER_INITIAL_DIRECTIONS,
@@ -43,11 +43,6 @@ from headsim.settings import (
     SettingsError,
     preset,
 )
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
-    import tomli as tomllib
 
 #: Where ``headsim list`` and ``headsim run NAME`` look for scenario files.
 SCENARIOS_DIR = Path(__file__).resolve().parent.parent / "scenarios"
@@ -859,13 +854,7 @@ class _Head:
         p = rotation.T @ (point_head - centre)
         if p[2] <= 0.01:
             return False
-        xy = p[:2] / p[2]
-        distorted = distort_normalized(xy, camera.k1, camera.k2)
-        back, valid = undistort_normalized(distorted, camera.k1, camera.k2)
-        if not bool(valid) or not np.allclose(back, xy, atol=1e-6):
-            return False  # beyond where the lens folds over: not imaged there
-        cx, cy = camera.principal
-        u, v = camera.kx * distorted[0] + cx, camera.ky * distorted[1] + cy
+        u, v = camera.pinhole().project(p)  # NaN beyond where the lens folds over
         return bool(0 <= u <= camera.width - 1 and 0 <= v <= camera.height - 1)
 
     def model2_angles(self, p: np.ndarray) -> tuple[float, float]:
