@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 export MUJOCO_GL ?= egl
 
-.PHONY: setup demo test lint bench clean
+.PHONY: setup demo test regress bench clean
 
 $(BIN)/headsim: pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -25,6 +25,11 @@ test: setup
 	$(BIN)/ruff format --check headsim tests benchmarks
 	$(BIN)/python -m pytest -q
 
+# The regression suite CI runs after the tests: exits 1 on a regression.
+regress: setup
+	$(BIN)/headsim bench
+
+# Every benchmark script's figures (minutes; not run by CI).
 bench: setup
 	$(BIN)/python benchmarks/render_speed.py
 	$(BIN)/python benchmarks/estimators_throughput.py

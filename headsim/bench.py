@@ -25,7 +25,7 @@ import numpy as np
 import headsim
 from headsim import experiments, names
 from headsim.estimators.throughput import run as estimator_throughput
-from headsim.procedures import HeadKnowledge, measure_model2
+from headsim.procedures import HeadKnowledge, calibrate_head, calibration_layout, measure_model2
 from headsim.results import write_json_atomic
 from headsim.servo import EyeServo
 from headsim.settings import HeadSettings, paper_head
@@ -81,12 +81,40 @@ def _measure_points(
     return out, render_s
 
 
-def suite(seed: int = 0, faults: Faults | None = None, progress: Progress = _quiet) -> Metrics:
+#: The suite's parts, in order; ``suite(parts=...)`` runs a subset (tests do).
+PARTS = ("ideal", "paper", "scenarios", "speed")
+
+
+def suite(
+    seed: int = 0,
+    faults: Faults | None = None,
+    progress: Progress = _quiet,
+    parts: tuple[str, ...] = PARTS,
+) -> Metrics:
     """Run the fixed suite; metrics by name (see ``benchmarks/tolerances.json``)."""
+    unknown = set(parts) - set(PARTS)
+    if unknown:
+        raise ValueError(f"unknown bench parts {sorted(unknown)}; allowed: {', '.join(PARTS)}")
     faults = faults or Faults()
+    metrics: Metrics = {}
+    if "ideal" in parts:
+        metrics.update(_ideal_part(seed, faults, progress))
+    if "paper" in parts:
+        metrics.update(_paper_part(seed, faults, progress))
+    if "scenarios" in parts:
+        for name in PAPER_SCENARIOS:
+            progress(f"scenario {name} (fast)")
+            metrics.update(scenario_metrics(name))
+    if "speed" in parts:
+        progress("estimator throughput")
+        speed = estimator_throughput(200_000, repeats=3, seed=seed)
+        metrics["speed.model2_over_numpy"] = speed["model2_over_numpy_eq4_11"]
+    return metrics
+
+
+def _ideal_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     rng = np.random.default_rng(seed)
     metrics: Metrics = {}
-
     progress("ideal cameras, Model 2")
     points = np.concatenate(
         [
@@ -105,12 +133,15 @@ def suite(seed: int = 0, faults: Faults | None = None, progress: Progress = _qui
         np.mean([abs(r) for m in ideal if m.ok for r in m.servo_residual_px])
     )
     metrics["speed.wall_per_point_over_render"] = wall / render_s
+    return metrics
 
+
+def _paper_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
+    rng = np.random.default_rng(seed + 1)
+    metrics: Metrics = {}
     progress("paper's cameras: Sec. V calibration")
     settings = paper_head()
     with HeadSim("default", settings) as sim:
-        from headsim.procedures import calibrate_head, calibration_layout
-
         run = calibrate_head(
             sim,
             EyeServo(sim),
@@ -160,10 +191,37 @@ def suite(seed: int = 0, faults: Faults | None = None, progress: Progress = _qui
     progress("relative positioning")
     areas = experiments.relative_areas(rng, layouts=2)
     metrics["areas.correct_pct"] = areas["outside_margin_correct_pct"] or 0.0
+    return metrics
 
-    progress("estimator throughput")
-    speed = estimator_throughput(200_000, repeats=3, seed=seed)
-    metrics["speed.model2_over_numpy"] = speed["model2_over_numpy_eq4_11"]
+
+#: The paper scenarios whose fast variants the suite runs.
+PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "tracking")
+
+
+def scenario_metrics(name: str) -> Metrics:
+    """Run a scenario's fast variant: failures, RMS error (% of depth) and renders."""
+    from headsim.runner import run_scenario
+    from headsim.scenario import load_scenario
+
+    result = run_scenario(load_scenario(name, fast=True))
+    # Measurements made without the scenario's calibration (its "before" checks) do not count.
+    calibrated = result.calibration is not None
+    errors = [
+        r.measurement.error_pct_of_depth
+        for r in result.records
+        if r.measurement.ok and (r.knowledge != "none" or not calibrated)
+    ]
+    metrics = {
+        f"scenario.{name}.failures": float(len(result.failures)),
+        f"scenario.{name}.rms_error_pct_depth": float(np.sqrt(np.mean(np.square(errors))))
+        if errors
+        else math.inf,
+        f"scenario.{name}.renders": float(result.renders["total"]),
+    }
+    if result.calibration and "alpha_e_error_rad" in result.calibration:
+        metrics[f"scenario.{name}.calibration_max_error_rad"] = float(
+            np.max(np.abs(result.calibration["alpha_e_error_rad"]))
+        )
     return metrics
 
 

@@ -141,6 +141,14 @@ def _list(args: argparse.Namespace) -> int:
     return 0 if all(not d.startswith("INVALID") for _, d in rows) else 2
 
 
+def _bench(args: argparse.Namespace) -> int:
+    from headsim import bench
+
+    args.baseline = args.baseline or str(bench.BASELINE)
+    args.tolerances = args.tolerances or str(bench.TOLERANCES)
+    return bench.main(args)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="headsim",
@@ -208,6 +216,26 @@ def build_parser() -> argparse.ArgumentParser:
     )
     snap.add_argument("--seed", type=int, default=0, help="seed of the image noise")
     snap.set_defaults(func=_snapshot)
+
+    bench = commands.add_parser(
+        "bench",
+        help="run the regression suite and compare it with the stored baseline",
+        description="Run a fixed suite (Model 2 on ideal and paper cameras, calibration, "
+        "chessboard, areas, the paper scenarios' fast variants, estimator speed) and compare "
+        "each metric with benchmarks/baseline.json within benchmarks/tolerances.json. Exit "
+        "status 1 on a regression beyond tolerance.",
+    )
+    bench.add_argument("--seed", type=int, default=0, help="seed of the suite (default 0)")
+    bench.add_argument("--json", metavar="FILE", help="also write the metrics to FILE")
+    bench.add_argument("--baseline", default=None, metavar="FILE", help="baseline to compare with")
+    bench.add_argument("--tolerances", default=None, metavar="FILE", help="per-metric tolerances")
+    bench.add_argument(
+        "--update-baseline", action="store_true", help="rewrite the baseline with these figures"
+    )
+    bench.add_argument(
+        "--reason", help="why the baseline changes (required with --update-baseline)"
+    )
+    bench.set_defaults(func=_bench)
     return parser
 
 
