@@ -149,6 +149,40 @@ def _bench(args: argparse.Namespace) -> int:
     return bench.main(args)
 
 
+def _sweep(args: argparse.Namespace) -> int:
+    from headsim import sweep
+
+    spec = sweep.load_sweep(args.sweep)
+    print(f"sweep {spec.path.name}: {spec.description}")
+    print(f"  {len(spec.jobs)} jobs of {Path(spec.scenario).stem}{' (fast)' if spec.fast else ''}")
+    where = f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers} local process(es)"
+    print(f"  running on {where}; log {Path(args.out) / 'jobs.jsonl'}", flush=True)
+    with _sigterm_interrupts():
+        try:
+            outcome = sweep.run_sweep(
+                spec,
+                args.out,
+                workers=args.workers,
+                scheduler=args.scheduler,
+                progress=not args.no_progress,
+            )
+        except KeyboardInterrupt:
+            print(
+                "\ninterrupted: finished jobs are in jobs.jsonl; run again to resume",
+                file=sys.stderr,
+            )
+            return 130
+    print(sweep.summary_table(spec, outcome.records.values()))
+    rate = 60 * outcome.ran / outcome.wall_s if outcome.wall_s > 0 else 0.0
+    print(
+        f"{outcome.ran} jobs run ({outcome.skipped} already done) in {outcome.wall_s:.1f} s, "
+        f"{rate:.1f} jobs/min; {len(outcome.failed)} failed"
+    )
+    for kind, path in outcome.files.items():
+        print(f"  {kind:18s} {path}")
+    return 1 if outcome.failed else 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="headsim",
@@ -217,6 +251,29 @@ def build_parser() -> argparse.ArgumentParser:
     snap.add_argument("--seed", type=int, default=0, help="seed of the image noise")
     snap.set_defaults(func=_snapshot)
 
+    sweep = commands.add_parser(
+        "sweep",
+        help="run a parameter sweep (many scenario runs) locally or on a Dask cluster",
+        description="Run every job of a sweep file (a grid or a seeded random sample over "
+        "scenario fields). Jobs are appended to DIR/jobs.jsonl as they finish: run the same "
+        "command again to resume. Writes DIR/aggregate.csv, aggregate.json and plots. Exit "
+        "status 1 if a job failed, 2 on a bad sweep file.",
+    )
+    sweep.add_argument(
+        "sweep", metavar="SWEEP", help="a sweep file (.toml), e.g. sweeps/focal.toml"
+    )
+    sweep.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
+    sweep.add_argument(
+        "--workers", type=int, default=1, metavar="N", help="local processes (default 1)"
+    )
+    sweep.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help="run the jobs on this Dask scheduler instead (pip install 'headsim[dask]')",
+    )
+    sweep.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    sweep.set_defaults(func=_sweep)
+
     bench = commands.add_parser(
         "bench",
         help="run the regression suite and compare it with the stored baseline",
@@ -241,11 +298,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     from headsim.scenario import ScenarioError
+    from headsim.sweep import SweepError
 
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))
-    except (SettingsError, ScenarioError) as err:
+    except (SettingsError, ScenarioError, SweepError) as err:
         print(f"headsim: error: {err}", file=sys.stderr)
         return 2
     except ValueError as err:

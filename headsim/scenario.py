@@ -1071,13 +1071,45 @@ def resolve_path(name_or_path: str | Path) -> Path:
     )
 
 
+def _drop_field(doc: dict[str, Any], dotted: str) -> dict[str, Any]:
+    head, _, rest = dotted.partition(".")
+    if head not in doc:
+        return doc
+    out = dict(doc)
+    if not rest:
+        del out[head]
+    elif isinstance(out[head], dict):
+        out[head] = _drop_field(out[head], rest)
+    return out
+
+
+def set_field(doc: dict[str, Any], dotted: str, value: Any) -> dict[str, Any]:
+    """A copy of ``doc`` with the field at ``dotted`` (e.g. ``"cam1.kx"``) set to ``value``."""
+    head, _, rest = dotted.partition(".")
+    out = dict(doc)
+    if not rest:
+        out[head] = value
+        return out
+    child = out.get(head, {})
+    if not isinstance(child, dict):
+        raise ValueError(f"{dotted}: {head} is not a table")
+    out[head] = set_field(child, rest, value)
+    return out
+
+
 def load_scenario(
-    name_or_path: str | Path, *, fast: bool = False, seed: int | None = None
+    name_or_path: str | Path,
+    *,
+    fast: bool = False,
+    seed: int | None = None,
+    overrides: dict[str, Any] | None = None,
 ) -> Scenario:
     """Read, merge ``[fast]`` if asked, draw the random parts, check everything.
 
     Both the full and the fast variant are checked, whichever is returned.
-    ``seed`` overrides the file's ``seed``.  Raises :class:`ScenarioError`.
+    ``seed`` overrides the file's ``seed``; ``overrides`` sets fields by
+    dotted name (``{"cam1.kx": 700.0}``) in both variants, checked like the
+    file's own.  Raises :class:`ScenarioError`.
     """
     path = resolve_path(name_or_path)
     source = str(path)
@@ -1091,7 +1123,16 @@ def load_scenario(
         raise ScenarioError(
             source, "seed", f"{seed!r} is out of range", "an integer from 0 to 2**32 - 1"
         )
+    for dotted, value in (overrides or {}).items():
+        try:
+            doc = set_field(doc, dotted, value)
+        except ValueError as err:
+            raise ScenarioError(source, dotted, f"cannot be set: {err}") from err
     fast_doc = doc.get("fast", {})
+    if overrides and isinstance(fast_doc, dict):
+        # An override wins over the fast table's value for the same field.
+        for dotted in overrides:
+            fast_doc = _drop_field(fast_doc, dotted)
     if not isinstance(fast_doc, dict):
         raise ScenarioError(
             source,
