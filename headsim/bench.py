@@ -268,14 +268,14 @@ def compare(
 def format_table(verdicts: list[Verdict]) -> str:
     """The comparison as a readable table."""
     lines = [
-        f"{'metric':42s} {'baseline':>12s} {'now':>12s} {'change':>11s} {'allowed':>10s}  verdict"
+        f"{'metric':54s} {'baseline':>12s} {'now':>12s} {'change':>11s} {'allowed':>10s}  verdict"
     ]
     for v in verdicts:
         base = "-" if v.baseline is None else f"{v.baseline:12.5g}"
         change = "-" if v.change is None else f"{v.change:+11.3g}"
         allowed = "-" if v.allowed is None else f"{v.allowed:10.3g}"
         lines.append(
-            f"{v.metric:42s} {base:>12s} {v.now:12.5g} {change:>11s} {allowed:>10s}  {v.label}"
+            f"{v.metric:54s} {base:>12s} {v.now:12.5g} {change:>11s} {allowed:>10s}  {v.label}"
         )
     return "\n".join(lines)
 
