@@ -38,12 +38,16 @@ from headsim import names
 from headsim.estimators.calibration import calibrate_initial_directions
 from headsim.estimators.vertical import VerticalCalibration, calibrate_vertical_reference
 from headsim.model import eye_from_camera_rotation
-from headsim.optics import undistort_normalized
 from headsim.procedures import CalibrationRun, HeadKnowledge, Model2Config, Target, measure_model2
 from headsim.servo import Detection, Detector, EyeServo, ServoConfig, ServoResult
 from headsim.settings import HeadSettings
 from headsim.sim import HeadSim
-from headsim.stereo import detect_chessboard, place_chessboard, sample_board_pose
+from headsim.stereo import (
+    detect_chessboard,
+    place_chessboard,
+    sample_board_pose,
+    undistort_normalized_points,
+)
 
 #: Zoom used to find the principal point when the study needs one (f' = 1.3 f).
 PROBE_ZOOM = 1.3
@@ -294,10 +298,10 @@ def column_direction(sim: HeadSim, camera: int, u_px: float) -> float:
     """
     index = sim.camera_index(camera)
     cam = sim.settings.cameras[index]
-    cx, _ = cam.principal
-    xy, valid = undistort_normalized(np.array([(u_px - cx) / cam.kx, 0.0]), cam.k1, cam.k2)
-    if not bool(valid):
-        raise ValueError(f"column {u_px} px has no undistorted ray at the principal row")
+    _, cy = cam.principal
+    xy = undistort_normalized_points(
+        np.array([[u_px, cy]]), sim.camera_matrix(camera), sim.dist_coeffs(camera)
+    )[0]
     ray = eye_from_camera_rotation(cam, index) @ np.array([xy[0], xy[1], 1.0])
     yaw = math.atan2(ray[0], ray[2])
     return yaw if index == 0 else -yaw
