@@ -212,6 +212,14 @@ def _quat_from_rotation(rotation: np.ndarray) -> np.ndarray:
     return quat
 
 
+def place_chessboard(sim: HeadSim, head_from_board: np.ndarray) -> None:
+    """Put the scene's chessboard at ``head_from_board`` (4, 4), a pose in H."""
+    world_from_board = sim.world_from_head() @ head_from_board
+    sim.set_body_pose(
+        names.CHESSBOARD, world_from_board[:3, 3], _quat_from_rotation(world_from_board[:3, :3])
+    )
+
+
 def detect_chessboard(image: np.ndarray) -> np.ndarray | None:
     """Inner corners (N, 2) px of the scene's chessboard in board order, or None.
 
