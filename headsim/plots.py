@@ -24,7 +24,7 @@ matplotlib.use("Agg")  # no display; must precede pyplot
 import matplotlib.pyplot as plt
 import numpy as np
 
-from headsim.results import _atomic_write
+from headsim.results import write_bytes_atomic
 
 if TYPE_CHECKING:
     from headsim.study import ExperimentResult
@@ -50,7 +50,7 @@ def _save(fig: plt.Figure, path: str | Path) -> Path:
     fig.savefig(buffer, format="png", dpi=110, bbox_inches="tight")
     plt.close(fig)
     data = buffer.getvalue()
-    _atomic_write(path, lambda handle: handle.write(data))
+    write_bytes_atomic(path, data)
     return path
 
 

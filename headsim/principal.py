@@ -20,33 +20,25 @@ pose, ``p' = s p + t`` is linear in (s, t); least squares gives them and
 feature is which.  :func:`principal_points_by_zoom` does it in the simulator
 with the chessboard's 48 corners, both eyes at angle 0.
 
-**Servoing to it** (:class:`GoalServo`, :class:`GoalKnowledge`): the eye servo
-and the head's knowledge with a goal column per camera instead of the image
-centre.  Both subclass the procedures' own types, so ``measure_model2`` takes
-them unchanged; :func:`calibrate_head_on_columns` is ``calibrate_head`` with
-the goal columns also in its vertical fit (which assumes the image centre's).
+**Servoing to it**: ``HeadKnowledge(u0=columns)`` makes ``measure_model2``
+servo each camera to its column, and ``calibrate_head(..., knowledge=...)``
+calibrates the initial directions on those columns; the simulator's truth
+for them is ``HeadSim.effective_initial_direction(camera, goal_u)``.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from headsim import names
-from headsim.estimators.calibration import calibrate_initial_directions
-from headsim.estimators.vertical import VerticalCalibration, calibrate_vertical_reference
-from headsim.model import eye_from_camera_rotation
-from headsim.procedures import CalibrationRun, HeadKnowledge, Model2Config, Target, measure_model2
-from headsim.servo import Detection, Detector, EyeServo, ServoConfig, ServoResult
 from headsim.settings import HeadSettings
 from headsim.sim import HeadSim
 from headsim.stereo import (
     detect_chessboard,
     place_chessboard,
     sample_board_pose,
-    undistort_normalized_points,
 )
 
 #: Zoom used to find the principal point when the study needs one (f' = 1.3 f).
@@ -239,169 +231,11 @@ def principal_points_by_zoom(
     )
 
 
-# -- the active method with a goal column per camera ---------------------------
-
-
-class GoalServo(EyeServo):
-    """:class:`EyeServo` whose default goal column is ``goal_columns[camera - 1]``, px.
-
-    Everything else (gains, bounds, sub-step interpolation) is the eye servo's.
-    """
-
-    def __init__(
-        self, sim: HeadSim, goal_columns: tuple[float, float], config: ServoConfig | None = None
-    ) -> None:
-        super().__init__(sim, config)
-        for camera, u in zip((1, 2), goal_columns, strict=True):
-            width = sim.camera_settings(camera).width
-            if not (math.isfinite(u) and 0 <= u <= width - 1):
-                raise ValueError(
-                    f"goal column of camera {camera} must lie in the image [0, {width - 1}], got {u}"
-                )
-        self.goal_columns = (float(goal_columns[0]), float(goal_columns[1]))
-
-    def run(
-        self,
-        camera: int,
-        detector: Detector,
-        goal_u: float | None = None,
-        first: Detection | None = None,
-    ) -> ServoResult:
-        goal = self.goal_columns[camera - 1] if goal_u is None else goal_u
-        return super().run(camera, detector, goal_u=goal, first=first)
-
-
-@dataclass(frozen=True)
-class GoalKnowledge(HeadKnowledge):
-    """:class:`HeadKnowledge` with each camera's goal column ``u0`` (None: the image centre's).
-
-    Pair it with a :class:`GoalServo` on the same columns: the estimator's
-    u_i0 must be the column the servo centred the target on.
-    """
-
-    u0: tuple[float | None, float | None] = (None, None)
-
-    def reference(self, sim: HeadSim, camera: int) -> tuple[float, float]:
-        u, v = super().reference(sim, camera)
-        u0 = self.u0[camera - 1]
-        return (u if u0 is None else u0, v)
-
-
-def column_direction(sim: HeadSim, camera: int, u_px: float) -> float:
-    """True horizontal direction of image column ``u_px`` at the principal row, rad, + inward.
-
-    In the eye frame at eye angle 0, like ``HeadSim.effective_initial_direction``
-    (which is this at the image centre's column, give or take the row): what
-    the Sec. V calibration finds when the servo centres targets on that
-    column.  At the principal point's column it is the mount yaw.  Truth, for
-    scoring only.
-    """
-    index = sim.camera_index(camera)
-    cam = sim.settings.cameras[index]
-    _, cy = cam.principal
-    xy = undistort_normalized_points(
-        np.array([[u_px, cy]]), sim.camera_matrix(camera), sim.dist_coeffs(camera)
-    )[0]
-    ray = eye_from_camera_rotation(cam, index) @ np.array([xy[0], xy[1], 1.0])
-    yaw = math.atan2(ray[0], ray[2])
-    return yaw if index == 0 else -yaw
-
-
-def calibrate_head_on_columns(
-    sim: HeadSim,
-    servo: GoalServo,
-    target: Target,
-    body: str,
-    positions_world: np.ndarray,
-    *,
-    extended: bool = True,
-) -> CalibrationRun:
-    """``procedures.calibrate_head`` with the servo on ``servo.goal_columns`` instead of the image centre.
-
-    The same Sec. V fit of the initial directions (unweighted, exact depths)
-    and, with ``extended``, the same vertical fit per camera, with each
-    camera's goal column as u_i0.  The returned knowledge is a
-    :class:`GoalKnowledge` on those columns; ``truth_alpha_e`` is the true
-    direction of each goal column (:func:`column_direction`).  A thin
-    variant: ``calibrate_head`` taking a base ``HeadKnowledge`` would make it
-    unnecessary.
-    """
-    start = sim.render_count
-    base = GoalKnowledge(u0=servo.goal_columns)
-    plain = Model2Config(midline_px=0.0)
-    alpha1, alpha2, depths = [], [], []
-    rows: list[tuple[np.ndarray, dict[str, float]]] = []
-    positions = np.atleast_2d(positions_world)
-    for position in positions:
-        sim.set_body_pose(body, position)
-        m = measure_model2(sim, servo, target, base, plain)
-        if not m.ok:
-            continue
-        alpha1.append(m.details["alpha1_rad"])
-        alpha2.append(m.details["alpha2_rad"])
-        depths.append(float(m.truth_head_m[2]))
-        rows.append((m.truth_head_m, m.details))
-    if len(alpha1) < 2:
-        raise ValueError(
-            f"calibration needs at least 2 fixated targets, got {len(alpha1)} of "
-            f"{len(positions)}: place them where both cameras see them"
-        )
-    baseline = sim.settings.baseline_m
-    fit = calibrate_initial_directions(
-        np.array(alpha1), np.array(alpha2), np.array(depths), baseline
-    )
-    alpha_e = (float(fit.alpha_e[0]), float(fit.alpha_e[1]))
-    knowledge = replace(base, alpha_e=alpha_e)
-    vertical = None
-    if extended and len(rows) >= 3:
-        vertical = _vertical_on_columns(rows, alpha_e, servo.goal_columns)
-        knowledge = replace(
-            knowledge,
-            v0=(vertical[0].v0, vertical[1].v0),
-            kx_over_ky=(vertical[0].kx_over_ky, vertical[1].kx_over_ky),
-        )
-    truth = tuple(column_direction(sim, c, servo.goal_columns[c - 1]) for c in (1, 2))
-    return CalibrationRun(
-        fit=fit,
-        truth_alpha_e=(truth[0], truth[1]),
-        samples=len(alpha1),
-        renders=sim.render_count - start,
-        depth_noise_m=0.0,
-        vertical=vertical,
-        knowledge=knowledge,
-    )
-
-
-def _vertical_on_columns(
-    rows: list[tuple[np.ndarray, dict[str, float]]],
-    alpha_e: tuple[float, float],
-    columns: tuple[float, float],
-) -> tuple[VerticalCalibration, VerticalCalibration]:
-    """(v0, kx/ky) per camera from fixations at known positions, u_i0 = ``columns``.
-
-    As ``procedures._vertical_from_samples``, whose u_i0 is the image centre's.
-    """
-    truth = np.array([r[0] for r in rows])
-    d = {key: np.array([r[1][key] for r in rows]) for key in rows[0][1]}
-    z = truth[:, 2]
-    a1, a2 = d["alpha1_rad"] + alpha_e[0], d["alpha2_rad"] + alpha_e[1]
-    # P's x in each camera's frame when its y image was taken (eqs. 8, 10).
-    x_c1 = z * np.sin(d["alpha1_rad"] - d["gamma1_rad"]) / np.cos(a1)
-    x_c2 = z * np.sin(d["gamma2_rad"] - d["alpha2_rad"]) / np.cos(a2)
-    cam1 = calibrate_vertical_reference(d["u11_px"] - columns[0], d["v11_px"], x_c1, truth[:, 1])
-    cam2 = calibrate_vertical_reference(d["u21_px"] - columns[1], d["v21_px"], x_c2, truth[:, 1])
-    return cam1, cam2
-
-
 __all__ = [
     "PROBE_ZOOM",
-    "GoalKnowledge",
-    "GoalServo",
     "PrincipalPointError",
     "PrincipalPointRun",
     "ZoomFixedPoint",
-    "calibrate_head_on_columns",
-    "column_direction",
     "fixed_point_of_zoom",
     "principal_points_by_zoom",
     "view_scale",

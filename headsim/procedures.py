@@ -44,17 +44,21 @@ class HeadKnowledge:
     ``v0``: each camera's vertical reference row, px (None: the image centre
     row, the paper's Table VI condition; the principal point's v is Table V).
     ``kx_over_ky``: each camera's pixel aspect ratio (1 unless calibrated).
+    ``u0``: each camera's goal column for the servo, px (None: the image
+    centre's; e.g. the principal point's column found from a zoom,
+    ``headsim.principal``).  The initial directions belong to these columns.
     """
 
     alpha_e: tuple[float, float] = (0.0, 0.0)
     v0: tuple[float | None, float | None] = (None, None)
     kx_over_ky: tuple[float, float] = (1.0, 1.0)
+    u0: tuple[float | None, float | None] = (None, None)
 
     def reference(self, sim: HeadSim, camera: int) -> tuple[float, float]:
-        """(u_i0, v_i0): the servo's goal column (image centre) and the reference row, px."""
+        """(u_i0, v_i0): the servo's goal column and the reference row of camera 1 or 2, px."""
         u_c, v_c = sim.camera_settings(camera).image_centre
-        v0 = self.v0[camera - 1]
-        return (u_c, v_c if v0 is None else v0)
+        u0, v0 = self.u0[camera - 1], self.v0[camera - 1]
+        return (u_c if u0 is None else u0, v_c if v0 is None else v0)
 
 
 @dataclass(frozen=True)
@@ -172,8 +176,9 @@ def measure_model2(
     config = config or Model2Config()
     resolution = sim.settings.encoder_resolution_rad
     start = sim.render_count
+    (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
     # Step 1: Ca1's u to its goal column; then P's image in Ca2 there.
-    step1 = servo.run(1, target.detector)
+    step1 = servo.run(1, target.detector, goal_u=u10)
     if not step1.converged:
         return _failed(
             sim,
@@ -194,7 +199,7 @@ def measure_model2(
             [step1.residual_px],
         )
     # Step 2: Ca2's u to its goal column, starting from that image; then Ca1's image.
-    step2 = servo.run(2, target.detector, first=seen2)
+    step2 = servo.run(2, target.detector, goal_u=u20, first=seen2)
     residuals = (step1.residual_px, step2.residual_px)
     if not step2.converged:
         return _failed(
@@ -218,7 +223,6 @@ def measure_model2(
 
     uv1, uv2 = np.array(seen1.uv), np.array(seen2.uv)
     gamma1, gamma2 = step2.steps * resolution, step1.steps * resolution
-    (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
     if min(abs(uv1[0] - u10), abs(uv2[0] - u20)) < config.midline_px:
         remedy = _near_midline_images(sim, servo, target, step1, step2, config)
         if remedy is not None:
@@ -370,6 +374,7 @@ def calibrate_head(
     depth_noise_m: float = 0.0,
     rng: np.random.Generator | None = None,
     extended: bool = True,
+    knowledge: HeadKnowledge | None = None,
 ) -> CalibrationRun:
     """Fixate ``target`` (moved with body ``body``) at each position and calibrate.
 
@@ -377,14 +382,17 @@ def calibrate_head(
     ``depth_noise_m`` (a tape measure).  With ``extended``, the same samples
     also give each camera's vertical reference and kx/ky ratio (beyond the
     paper: it needs the targets' full known positions, not only their depth).
+    ``knowledge``: what the head already knows; its goal columns ``u0`` are
+    the ones the servo fixates on (default: the image centres).
     """
+    base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0))
     rng = rng or np.random.default_rng(0)
     start = sim.render_count
     alpha1, alpha2, depths, rows = [], [], [], []
     plain = Model2Config(midline_px=0.0)
     for position in np.atleast_2d(positions_world):
         sim.set_body_pose(body, position)
-        m = measure_model2(sim, servo, target, HeadKnowledge(), plain)
+        m = measure_model2(sim, servo, target, base, plain)
         if not m.ok:
             continue
         alpha1.append(m.details["alpha1_rad"])
@@ -410,24 +418,26 @@ def calibrate_head(
         sigma_depth=depth_noise_m if depth_noise_m > 0 else None,
     )
     alpha_e = (float(fit.alpha_e[0]), float(fit.alpha_e[1]))
-    knowledge = HeadKnowledge(alpha_e=alpha_e)
+    calibrated = replace(base, alpha_e=alpha_e)
     vertical = None
     if extended and len(rows) >= 3:
-        vertical = _vertical_from_samples(sim, rows, alpha_e, baseline)
-        knowledge = replace(
-            knowledge,
+        vertical = _vertical_from_samples(sim, rows, alpha_e, base)
+        calibrated = replace(
+            calibrated,
             v0=(vertical[0].v0, vertical[1].v0),
             kx_over_ky=(vertical[0].kx_over_ky, vertical[1].kx_over_ky),
         )
-    truth = (sim.effective_initial_direction(1), sim.effective_initial_direction(2))
+    truth = tuple(
+        sim.effective_initial_direction(camera, base.reference(sim, camera)[0]) for camera in (1, 2)
+    )
     return CalibrationRun(
         fit=fit,
-        truth_alpha_e=truth,
+        truth_alpha_e=(truth[0], truth[1]),
         samples=len(alpha1),
         renders=sim.render_count - start,
         depth_noise_m=depth_noise_m,
         vertical=vertical,
-        knowledge=knowledge,
+        knowledge=calibrated,
     )
 
 
@@ -435,7 +445,7 @@ def _vertical_from_samples(
     sim: HeadSim,
     rows: list[tuple[np.ndarray, dict[str, float]]],
     alpha_e: tuple[float, float],
-    baseline: float,
+    base: HeadKnowledge,
 ) -> tuple[VerticalCalibration, VerticalCalibration]:
     """Fit (v0, kx/ky) per camera from the calibration fixations at known positions."""
     truth = np.array([r[0] for r in rows])
@@ -445,8 +455,7 @@ def _vertical_from_samples(
     # P's x in each camera's effective frame when its y image was taken (eqs. 8, 10).
     x_c1 = z * np.sin(d["alpha1_rad"] - d["gamma1_rad"]) / np.cos(a1)
     x_c2 = z * np.sin(d["gamma2_rad"] - d["alpha2_rad"]) / np.cos(a2)
-    u10 = sim.camera_settings(1).image_centre[0]
-    u20 = sim.camera_settings(2).image_centre[0]
+    u10, u20 = base.reference(sim, 1)[0], base.reference(sim, 2)[0]
     cam1 = calibrate_vertical_reference(d["u11_px"] - u10, d["v11_px"], x_c1, truth[:, 1])
     cam2 = calibrate_vertical_reference(d["u21_px"] - u20, d["v21_px"], x_c2, truth[:, 1])
     return cam1, cam2

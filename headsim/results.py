@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import csv
+import io
 import json
+import math
 import os
 import tempfile
+from collections.abc import Sequence
 from dataclasses import asdict, is_dataclass
 from enum import Enum
 from pathlib import Path
@@ -64,6 +68,30 @@ def write_json_atomic(path: str | Path, payload: Any) -> Path:
     text = json.dumps(to_jsonable(payload), indent=2, allow_nan=False) + "\n"
     _atomic_write(path, lambda handle: handle.write(text.encode()))
     return path
+
+
+def write_bytes_atomic(path: str | Path, data: bytes) -> Path:
+    """Write bytes, atomically."""
+    path = Path(path)
+    _atomic_write(path, lambda handle: handle.write(data))
+    return path
+
+
+def write_csv_atomic(path: str | Path, rows: Sequence[dict[str, Any]]) -> Path:
+    """Write ``rows`` (dicts with one set of keys) as CSV, atomically; floats to 6 digits."""
+    buffer = io.StringIO()
+    if rows:
+        writer = csv.DictWriter(buffer, fieldnames=list(rows[0]), lineterminator="\n")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: _csv_value(v) for k, v in row.items()})
+    return write_bytes_atomic(path, buffer.getvalue().encode())
+
+
+def _csv_value(value: Any) -> Any:
+    if isinstance(value, float):
+        return "" if not math.isfinite(value) else f"{value:.6g}"
+    return value
 
 
 def write_text_atomic(path: str | Path, text: str) -> Path:

@@ -315,16 +315,20 @@ class HeadSim:
         )
         return project_points(cam_points, self.camera_settings(camera))
 
-    def effective_initial_direction(self, camera: CameraId) -> float:
+    def effective_initial_direction(self, camera: CameraId, goal_u: float | None = None) -> float:
         """The eye's effective initial direction, rad (what Sec. V calibration finds).
 
         The horizontal angle, in the eye frame at eye angle 0, of the ray through
-        the image centre, positive inward: the mount yaw plus the angle by which
-        the centre's ray is off the optical axis.
+        the servo's goal column ``goal_u`` (default: the image centre's) at the
+        image centre row, positive inward: the mount yaw plus the angle by which
+        that column's ray is off the optical axis.  At the principal point's
+        column it is the mount yaw, on every row.
         """
         index = self.camera_index(camera)
         cam = self.settings.cameras[index]
-        xy = cam.pinhole().normalise(np.array(cam.image_centre))  # raises if no ray
+        u_c, v_c = cam.image_centre
+        pixel = np.array([u_c if goal_u is None else goal_u, v_c])
+        xy = cam.pinhole().normalise(pixel)  # raises if no ray
         ray_eye = eye_from_camera_rotation(cam, index) @ np.array([xy[0], xy[1], 1.0])
         yaw = math.atan2(ray_eye[0], ray_eye[2])
         return yaw if index == 0 else -yaw

@@ -49,8 +49,6 @@ which indexes every experiment written to the directory.
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import json
 import math
 import sys
@@ -67,9 +65,7 @@ from headsim import names, stereo
 from headsim.optics import centre_ray_yaw
 from headsim.principal import (
     PROBE_ZOOM,
-    GoalServo,
     PrincipalPointRun,
-    calibrate_head_on_columns,
     principal_points_by_zoom,
     view_scale,
     zoomed,
@@ -82,7 +78,7 @@ from headsim.procedures import (
     calibration_layout,
     measure_model2,
 )
-from headsim.results import _atomic_write, to_jsonable, write_json_atomic
+from headsim.results import to_jsonable, write_csv_atomic, write_json_atomic
 from headsim.servo import EyeServo
 from headsim.settings import HeadSettings, preset
 from headsim.sim import HeadSim
@@ -224,7 +220,7 @@ class Calibrations:
             if refound is None:
                 raise ValueError("active_refound needs the fixed points found again (refound)")
             (u1, v1), (u2, v2) = refound.principal_px
-            return replace(self.fixed_point.knowledge, u0=(u1, u2), v0=(v1, v2))  # type: ignore[call-arg]
+            return replace(self.fixed_point.knowledge, u0=(u1, u2), v0=(v1, v2))
         raise ValueError(f"unknown active method {method!r}; allowed: {', '.join(METHODS[1:])}")
 
     def goal_columns(self) -> tuple[float, float]:
@@ -332,8 +328,13 @@ def calibrate_methods(
             + " mrad"
         )
         (u1, _), (u2, _) = principal.principal_px
-        fixed = calibrate_head_on_columns(
-            sim, GoalServo(sim, (u1, u2)), BALL, names.CALIBRATION_BALL, positions
+        fixed = calibrate_head(
+            sim,
+            EyeServo(sim),
+            BALL,
+            names.CALIBRATION_BALL,
+            positions,
+            knowledge=HeadKnowledge(u0=(u1, u2)),
         )
         renders += active.renders + fixed.renders
     progress(
@@ -409,14 +410,11 @@ def measure_methods(
     out: list[TargetError] = []
     with HeadSim("default", settings) as sim:
         servo = EyeServo(sim)
-        goal_servo = GoalServo(sim, calibrations.goal_columns())
+        refound = None
         if "active_refound" in methods:
             refound = principal_points_by_zoom(
                 settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
             )
-            refound_servo = GoalServo(sim, (refound.principal_px[0][0], refound.principal_px[1][0]))
-        else:
-            refound, refound_servo = None, servo
         for index, p_head in enumerate(np.atleast_2d(np.asarray(targets_head, dtype=float))):
             _place(sim, TARGET.name, p_head)
             truth = sim.position(TARGET.name, "head")
@@ -429,13 +427,7 @@ def measure_methods(
                     except stereo.StereoError as error:
                         estimate, status = np.full(3, np.nan), str(error)
                 else:
-                    chosen = {"active_fixed_point": goal_servo, "active_refound": refound_servo}
-                    m2 = measure_model2(
-                        sim,
-                        chosen.get(method, servo),
-                        TARGET,
-                        calibrations.knowledge(method, refound),
-                    )
+                    m2 = measure_model2(sim, servo, TARGET, calibrations.knowledge(method, refound))
                     estimate, status = m2.estimate_head_m, m2.status
                 out.append(
                     TargetError(method, index, truth, estimate, status, sim.render_count - start)
@@ -886,26 +878,6 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
 
 
 # -- writing -------------------------------------------------------------------------
-
-
-def write_csv_atomic(path: str | Path, rows: Sequence[dict[str, Any]]) -> Path:
-    """Write ``rows`` (dicts with one set of keys) as CSV; readers never see half a file."""
-    path = Path(path)
-    buffer = io.StringIO()
-    if rows:
-        writer = csv.DictWriter(buffer, fieldnames=list(rows[0]), lineterminator="\n")
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({k: _csv_value(v) for k, v in row.items()})
-    data = buffer.getvalue().encode()
-    _atomic_write(path, lambda handle: handle.write(data))
-    return path
-
-
-def _csv_value(value: Any) -> Any:
-    if isinstance(value, float):
-        return "" if not math.isfinite(value) else f"{value:.6g}"
-    return value
 
 
 def summary_rows(result: ExperimentResult) -> list[dict[str, Any]]:

@@ -26,7 +26,6 @@ end ``DIR/aggregate.csv``, ``DIR/aggregate.json`` and a plot per swept field.
 from __future__ import annotations
 
 import concurrent.futures as cf
-import csv
 import hashlib
 import io
 import itertools
@@ -45,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from headsim.results import _atomic_write, write_json_atomic
+from headsim.results import write_bytes_atomic, write_csv_atomic, write_json_atomic
 
 #: Fault injection for tests: job indices (comma-separated) whose process dies.
 CRASH_ENV = "HEADSIM_SWEEP_CRASH_JOBS"
@@ -494,13 +493,8 @@ def write_aggregate(
 ) -> dict[str, Path]:
     """aggregate.csv, aggregate.json and one PNG per numeric swept field."""
     rows = aggregate_rows(spec, records)
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=list(rows[0]), lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
     files = {"csv": out / "aggregate.csv", "json": out / "aggregate.json"}
-    text = buffer.getvalue()
-    _atomic_write(files["csv"], lambda handle: handle.write(text.encode()))
+    write_csv_atomic(files["csv"], rows)
     write_json_atomic(
         files["json"], {"sweep": spec.description, "scenario": spec.scenario, "rows": rows}
     )
@@ -548,7 +542,7 @@ def plot_metric(rows: list[dict[str, Any]], x: str, y: str, path: Path, title: s
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png")
     plt.close(fig)
-    _atomic_write(path, lambda handle: handle.write(buffer.getvalue()))
+    write_bytes_atomic(path, buffer.getvalue())
     return path
 
 

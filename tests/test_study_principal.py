@@ -10,16 +10,18 @@ import pytest
 
 from headsim import names
 from headsim.principal import (
-    GoalKnowledge,
-    GoalServo,
     PrincipalPointError,
-    calibrate_head_on_columns,
-    column_direction,
     fixed_point_of_zoom,
     principal_points_by_zoom,
     zoomed,
 )
-from headsim.procedures import HeadKnowledge, body_target, calibration_layout, measure_model2
+from headsim.procedures import (
+    HeadKnowledge,
+    body_target,
+    calibrate_head,
+    calibration_layout,
+    measure_model2,
+)
 from headsim.servo import EyeServo
 from headsim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim import HeadSim
@@ -71,25 +73,22 @@ def test_rendered_chessboards_give_the_papers_off_centre_principal_points() -> N
         assert fit.residual_rms_px < 0.2  # radial distortion scales about the same point
 
 
-def test_column_direction_is_the_mount_yaw_on_the_principal_column() -> None:
+def test_the_principal_column_points_along_the_mount_yaw() -> None:
     cams = (
-        CameraSettings(cx=300.0, mount_yaw_rad=0.03, k1=-0.2),
+        CameraSettings(cx=300.0, cy=250.0, mount_yaw_rad=0.03, k1=-0.2),
         CameraSettings(cx=330.0, mount_yaw_rad=-0.02),
     )
     with HeadSim("default", HeadSettings(cameras=cams)) as sim:
         for camera, cam in zip((1, 2), cams, strict=True):
-            assert column_direction(sim, camera, cam.principal[0]) == pytest.approx(
+            # On every row: a radial lens keeps x = 0 on the principal column.
+            assert sim.effective_initial_direction(camera, cam.principal[0]) == pytest.approx(
                 cam.mount_yaw_rad, abs=1e-12
             )
-        # Without distortion the image centre's column is the effective initial direction.
-        assert column_direction(sim, 2, 319.5) == pytest.approx(
-            sim.effective_initial_direction(2), abs=1e-12
+        # The image centre's column adds the angle of its ray off the axis.
+        assert sim.effective_initial_direction(2, 319.5) == sim.effective_initial_direction(2)
+        assert sim.effective_initial_direction(2) == pytest.approx(
+            -0.02 - np.arctan((319.5 - 330.0) / cams[1].kx), abs=1e-12
         )
-
-
-def test_a_goal_column_outside_the_image_is_refused() -> None:
-    with HeadSim("default") as sim, pytest.raises(ValueError, match=r"camera 2 .* got 700"):
-        GoalServo(sim, (319.5, 700.0))
 
 
 def test_servoing_on_the_fixed_point_keeps_the_calibration_through_a_zoom() -> None:
@@ -99,14 +98,19 @@ def test_servoing_on_the_fixed_point_keeps_the_calibration_through_a_zoom() -> N
     p_head = np.array([0.06, 0.02, 0.8])
     with HeadSim("default", head) as sim:
         positions = calibration_layout(sim, np.random.default_rng(2), 16)
-        run = calibrate_head_on_columns(
-            sim, GoalServo(sim, columns), BALL, names.CALIBRATION_BALL, positions
+        run = calibrate_head(
+            sim,
+            EyeServo(sim),
+            BALL,
+            names.CALIBRATION_BALL,
+            positions,
+            knowledge=HeadKnowledge(u0=columns),
         )
         assert run.samples >= 12
         mount = np.array([c.mount_yaw_rad for c in head.cameras])
         np.testing.assert_allclose(run.truth_alpha_e, mount, atol=2e-4)  # column within 0.15 px
         assert np.abs(run.alpha_e_error).max() < 5e-4
-        assert isinstance(run.knowledge, GoalKnowledge) and run.knowledge.u0 == columns
+        assert run.knowledge.u0 == columns
         ratios = [c.kx / c.ky for c in head.cameras]
         np.testing.assert_allclose(run.knowledge.kx_over_ky, ratios, atol=0.01)
     # The plain method with perfectly known effective directions, for contrast.
@@ -118,7 +122,7 @@ def test_servoing_on_the_fixed_point_keeps_the_calibration_through_a_zoom() -> N
     for zoom in (1.0, 1.5):
         with HeadSim("default", zoomed(head, zoom)) as sim:
             sim.set_body_pose(RED.name, sim.transform_points(p_head, "head", "world")[0])
-            fixed = measure_model2(sim, GoalServo(sim, columns), RED, run.knowledge)
+            fixed = measure_model2(sim, EyeServo(sim), RED, run.knowledge)
             centre = measure_model2(sim, EyeServo(sim), RED, replace(plain, v0=run.knowledge.v0))
             assert fixed.ok and centre.ok
             errors[zoom] = (fixed.error_pct_of_depth, centre.error_pct_of_depth)
