@@ -141,6 +141,12 @@ def _list(args: argparse.Namespace) -> int:
     return 0 if all(not d.startswith("INVALID") for _, d in rows) else 2
 
 
+def _study(args: argparse.Namespace) -> int:
+    from headsim import study
+
+    return study.run(args)
+
+
 def _bench(args: argparse.Namespace) -> int:
     from headsim import bench
 
@@ -273,6 +279,16 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     sweep.set_defaults(func=_sweep)
+
+    from headsim.study import STUDY_DESCRIPTION, add_arguments
+
+    study = commands.add_parser(
+        "study",
+        help="the insensitivity study: stereo against the active method, sweeps, plots",
+        description=STUDY_DESCRIPTION,
+    )
+    add_arguments(study)
+    study.set_defaults(func=_study)
 
     bench = commands.add_parser(
         "bench",

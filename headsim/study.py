@@ -536,35 +536,103 @@ class CalibrationCache:
         return list(self._cache.values())
 
 
+@dataclass(frozen=True)
+class ConditionJob:
+    """One condition to measure, as a job for :func:`headsim.sweep.map_jobs`.
+
+    ``calibrations``: made by the parent for "kept" conditions (shared by
+    many); None for "redone" ones, which the worker calibrates itself.
+    """
+
+    index: int
+    id: str
+    condition: Condition
+    calibrations: Calibrations | None
+    methods: tuple[str, ...]
+    config: StudyConfig
+
+
+def measure_condition(job: ConditionJob, marker_dir: str | None = None) -> dict[str, Any]:
+    """Run one condition (in a worker process); the record carries its ConditionResult."""
+    start = time.perf_counter()
+    calibrations = job.calibrations or calibrate_methods(job.condition.head, job.config)
+    errors = measure_methods(
+        job.condition.head, calibrations, job.condition.targets_head, job.methods, job.config
+    )
+    summaries = tuple(summarise(errors, m) for m in job.methods)
+    result = ConditionResult(job.condition, tuple(errors), summaries, time.perf_counter() - start)
+    return {
+        "id": job.id,
+        "index": job.index,
+        "status": "ok",
+        "result": result,
+        "calibrations": None if job.calibrations else calibrations,
+    }
+
+
 def run_conditions(
     base: dict[str, HeadSettings],
     conditions: Sequence[Condition],
     cache: CalibrationCache,
     methods: Sequence[str] = SWEEP_METHODS,
     progress: Progress = quiet,
+    workers: int = 1,
+    scheduler: str | None = None,
 ) -> list[ConditionResult]:
-    """Measure every condition; ``base`` maps each condition's ``group`` to the head calibrated for "kept"."""
-    results = []
-    for number, condition in enumerate(conditions, 1):
-        start = time.perf_counter()
-        calibrated_on = base[condition.group] if condition.calibration == "kept" else condition.head
-        calibrations = cache(calibrated_on, f"{condition.group}: {condition.label}")
-        errors = measure_methods(
-            condition.head, calibrations, condition.targets_head, methods, cache.config
-        )
-        summaries = tuple(summarise(errors, m) for m in methods)
-        seconds = time.perf_counter() - start
-        results.append(ConditionResult(condition, tuple(errors), summaries, seconds))
+    """Measure every condition; ``base`` maps each condition's ``group`` to the head calibrated for "kept".
+
+    With ``workers`` > 1 or a Dask ``scheduler`` the conditions run as jobs of
+    :func:`headsim.sweep.map_jobs` (the "kept" calibrations are made here once
+    and shipped with them); otherwise one after the other in this process.
+    """
+    methods = tuple(methods)
+    jobs = []
+    for number, condition in enumerate(conditions):
+        calibrations = None
+        if condition.calibration == "kept":
+            calibrations = cache(base[condition.group], f"{condition.group} (base head)")
+        elif workers == 1 and scheduler is None:
+            calibrations = cache(condition.head, f"{condition.group}: {condition.label}")
+        job_id = f"{number}-{condition.group}-{condition.label}-{condition.calibration}"
+        jobs.append(ConditionJob(number, job_id, condition, calibrations, methods, cache.config))
+    done = 0
+
+    def report(record: dict[str, Any]) -> None:
+        nonlocal done
+        done += 1
+        if record.get("status") != "ok":
+            progress(f"[{done}/{len(jobs)}] job {record['id']} failed: {record.get('error')}")
+            return
+        result = record["result"]
+        c = result.condition
         figures = ", ".join(
             f"{m.removeprefix('active_')} {s.rms_pct_depth:.3f}"
             + (f" ({s.failed} failed)" if s.failed else "")
-            for m, s in zip(methods, summaries, strict=True)
+            for m, s in zip(methods, result.summaries, strict=True)
         )
         progress(
-            f"[{number}/{len(conditions)}] {condition.group}: {condition.label} "
-            f"({condition.calibration}): RMS % of depth: {figures}  [{seconds:.1f} s]"
+            f"[{done}/{len(jobs)}] {c.group}: {c.label} ({c.calibration}): "
+            f"RMS % of depth: {figures}  [{result.seconds:.1f} s]"
         )
-    return results
+
+    if workers == 1 and scheduler is None:
+        records = []
+        for job in jobs:
+            records.append(measure_condition(job))
+            report(records[-1])
+    else:
+        from headsim.sweep import map_jobs
+
+        records = map_jobs(
+            measure_condition, jobs, workers=workers, scheduler=scheduler, on_record=report
+        )
+    failed = [r for r in records if r.get("status") != "ok"]
+    if failed:
+        raise RuntimeError(f"{len(failed)} condition(s) failed: {failed[0].get('error')}")
+    for record in records:
+        if record.get("calibrations") is not None:
+            cache.add(record["calibrations"])
+    return [record["result"] for record in records]
 
 
 # -- heads and changes -------------------------------------------------------------
@@ -824,13 +892,20 @@ def run_experiment(
     methods: Sequence[str] | None = None,
     progress: Progress = quiet,
     cache: CalibrationCache | None = None,
+    workers: int = 1,
+    scheduler: str | None = None,
 ) -> ExperimentResult:
-    """Run every condition of ``experiment`` with ``methods`` (default: the experiment's)."""
+    """Run every condition of ``experiment`` with ``methods`` (default: the experiment's).
+
+    ``workers``/``scheduler``: as :func:`run_conditions`.
+    """
     methods = experiment.methods if methods is None else tuple(methods)
     start = time.perf_counter()
     progress(f"== {experiment.name}: {experiment.title} ({len(experiment.conditions)} conditions)")
     cache = cache or CalibrationCache(config, progress)
-    results = run_conditions(experiment.base, experiment.conditions, cache, methods, progress)
+    results = run_conditions(
+        experiment.base, experiment.conditions, cache, methods, progress, workers, scheduler
+    )
     used = {
         (experiment.base[c.group] if c.calibration == "kept" else c.head)
         for c in experiment.conditions
@@ -1026,12 +1101,8 @@ def print_result(result: ExperimentResult) -> None:
 # -- command line ------------------------------------------------------------------------
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="python -m headsim.study",
-        description="Calibrated stereo against the active method: the Tables V/VI comparison, "
-        "changes after calibration, and sweeps; writes CSV, JSON and PNG to --out.",
-    )
+def add_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """The study's options (shared by ``python -m headsim.study`` and ``headsim study``)."""
     what = parser.add_mutually_exclusive_group(required=True)
     what.add_argument("--experiment", choices=["compare"], help="the Tables V/VI comparison")
     what.add_argument("--sweep", choices=sorted(SWEEPS), help="one sweep")
@@ -1042,11 +1113,38 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--fast", action="store_true", help="small calibrations and two values per sweep"
     )
+    parser.add_argument(
+        "--workers", type=int, default=1, metavar="N", help="run conditions on N local processes"
+    )
+    parser.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help="run conditions on this Dask scheduler (pip install 'headsim[dask]')",
+    )
     return parser
 
 
+STUDY_DESCRIPTION = (
+    "Calibrated stereo against the active method: the Tables V/VI comparison, changes of "
+    "focal length, principal point and distortion after calibration, and sweeps (depth, focal, "
+    "principal, k1, noise, encoder); writes CSV, JSON and PNG to --out."
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    return add_arguments(
+        argparse.ArgumentParser(prog="python -m headsim.study", description=STUDY_DESCRIPTION)
+    )
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    return run(build_parser().parse_args(argv))
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run what ``args`` (see :func:`add_arguments`) asks for; 0 on success."""
+    if args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
     make = StudyConfig.quick if args.fast else StudyConfig
     config = make(preset=args.preset, seed=args.seed)
     progress = StderrProgress()
@@ -1060,7 +1158,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     else:
         experiments = [sweep_experiment(args.sweep, config)]
     for experiment in experiments:
-        result = run_experiment(experiment, config, progress=progress, cache=cache)
+        result = run_experiment(
+            experiment,
+            config,
+            progress=progress,
+            cache=cache,
+            workers=args.workers,
+            scheduler=args.scheduler,
+        )
         files = write_experiment(result, args.out)
         progress(
             f"{experiment.name}: {result.seconds:.1f} s; wrote {', '.join(map(str, files.values()))}"

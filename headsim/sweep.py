@@ -340,13 +340,18 @@ class _Progress:
 
 
 def _execute(
-    jobs: list[Job],
+    jobs: list[Any],
     make_executor: Callable[[], cf.Executor],
     on_record: Callable[[dict[str, Any]], None],
     stop_after: int | None,
     marker_dir: Path | None = None,
+    function: Callable[..., dict[str, Any]] | None = None,
 ) -> int:
     """Run ``jobs`` with one retry each; survive a broken pool by building a new one.
+
+    ``function(job, marker_dir)`` runs one job (default :func:`run_job`) and
+    returns its record, a dict with at least ``status``; a job is anything
+    with an ``id`` and an ``index``.
 
     When a local pool breaks, every job still queued in it fails with it; only
     those whose marker shows they were running count an attempt.
@@ -362,7 +367,7 @@ def _execute(
             for job in queue:
                 attempts[job.id] += 1
                 marker = str(marker_dir) if marker_dir is not None else None
-                futures[executor.submit(run_job, job, marker)] = job
+                futures[executor.submit(function or run_job, job, marker)] = job
             queue = []
             for future in cf.as_completed(futures):
                 job = futures[future]
@@ -382,7 +387,7 @@ def _execute(
                     record = {
                         "id": job.id,
                         "index": job.index,
-                        "params": job.params,
+                        "params": getattr(job, "params", {}),
                         "status": "crashed",
                         "error": f"{type(err).__name__}: {err}",
                     }
@@ -465,6 +470,46 @@ def run_sweep(
     if len(outcome.records) == len(spec.jobs):
         outcome.files = write_aggregate(spec, outcome.records, out)
     return outcome
+
+
+def map_jobs(
+    function: Callable[..., dict[str, Any]],
+    jobs: list[Any],
+    *,
+    workers: int = 1,
+    scheduler: str | None = None,
+    on_record: Callable[[dict[str, Any]], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Run ``function(job, None)`` for every job on local processes or Dask; records in job order.
+
+    The same machinery as :func:`run_sweep` (spawned processes, one retry,
+    crash-proof) for any picklable jobs with ``id`` and ``index``, such as the
+    insensitivity study's conditions.
+    """
+    records: dict[str, dict[str, Any]] = {}
+
+    def keep(record: dict[str, Any]) -> None:
+        records[record["id"]] = record
+        if on_record is not None:
+            on_record(record)
+
+    if scheduler is not None:
+        client = _dask_client(scheduler)
+        try:
+            _execute(jobs, client.get_executor, keep, None, None, function)
+        finally:
+            client.close()
+    else:
+        context = multiprocessing.get_context("spawn")
+        _execute(
+            jobs,
+            lambda: cf.ProcessPoolExecutor(max_workers=workers, mp_context=context),
+            keep,
+            None,
+            None,
+            function,
+        )
+    return [records[job.id] for job in jobs]
 
 
 def _dask_client(scheduler: str) -> Any:

@@ -98,6 +98,18 @@ def test_a_sweep_writes_its_table_plot_and_index(calibrations, tmp_path) -> None
     assert index["experiments"]["depth"]["files"]["png"] == "depth.png"
 
 
+def test_the_study_sweep_runs_through_the_sweep_pool_with_the_same_answers(calibrations) -> None:
+    experiment = study.sweep_experiment("depth", CONFIG)
+    cache = study.CalibrationCache(CONFIG)
+    cache.add(calibrations)
+    serial = study.run_experiment(experiment, CONFIG, cache=cache)
+    pooled = study.run_experiment(experiment, CONFIG, cache=cache, workers=2)
+    for a, b in zip(serial.results, pooled.results, strict=True):
+        assert a.condition.label == b.condition.label
+        for ea, eb in zip(a.errors, b.errors, strict=True):
+            np.testing.assert_array_equal(ea.estimate_head_m, eb.estimate_head_m)
+
+
 def test_the_comparison_figures_are_ratios_of_rms_errors(calibrations) -> None:
     experiment = study.compare_experiment(CONFIG)
     labels = [(c.group, c.label) for c in experiment.conditions]
