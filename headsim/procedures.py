@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from headsim import names
-from headsim.estimators import Uncertainty, model1, model2
+from headsim.estimators import PositionEstimate, Uncertainty, model1, model2
 from headsim.estimators.areas import (
     AreaComparison,
     areas_from_geometry,
@@ -254,38 +254,51 @@ def measure_model2(
         kx_over_ky=knowledge.kx_over_ky,
         uncertainty=Uncertainty(encoder=angle_sigma, pixel=NOMINAL_PIXEL_SIGMA),
     )
+    details = {
+        "alpha1_rad": alpha1,
+        "alpha2_rad": alpha2,
+        "step1_encoder_rad": step1.steps * resolution,
+        "step2_encoder_rad": step2.steps * resolution,
+        "gamma1_rad": gamma1,
+        "gamma2_rad": gamma2,
+        "u11_px": float(uv1[0]),
+        "v11_px": float(uv1[1]),
+        "u21_px": float(uv2[0]),
+        "v21_px": float(uv2[1]),
+    }
+    return _measured(sim, target, "model2", estimate, start, residuals, details)
+
+
+def _measured(
+    sim: HeadSim,
+    target: Target,
+    method: str,
+    estimate: PositionEstimate,
+    start: int,
+    residuals: tuple[float, ...],
+    details: dict[str, float],
+    neck_rad: tuple[float, float] | None = None,
+) -> Measurement:
+    """The measurement of one estimated point (or why it is invalid) beside the truth."""
     renders = sim.render_count - start
     if not bool(estimate.valid[0]):
-        return _failed(
-            sim, target, "model2", f"estimator: {estimate.reasons(0)!r}", renders, residuals
-        )
+        status = f"estimator: {estimate.reasons(0)!r}"
+        return _failed(sim, target, method, status, renders, residuals)
     truth_world = target.truth_world(sim)
     estimate_head = estimate.positions[0]
+    covariance = estimate.covariance
     return Measurement(
         name=target.name,
-        method="model2",
+        method=method,
         status="ok",
         estimate_head_m=estimate_head,
         truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
-        estimate_world_m=to_world(sim, estimate_head),
+        estimate_world_m=to_world(sim, estimate_head, neck_rad),
         truth_world_m=truth_world,
-        covariance_head_m2=estimate.covariance[0]
-        if estimate.covariance is not None
-        else np.full((3, 3), np.nan),
+        covariance_head_m2=covariance[0] if covariance is not None else np.full((3, 3), np.nan),
         renders=renders,
         servo_residual_px=residuals,
-        details={
-            "alpha1_rad": alpha1,
-            "alpha2_rad": alpha2,
-            "step1_encoder_rad": step1.steps * resolution,
-            "step2_encoder_rad": step2.steps * resolution,
-            "gamma1_rad": gamma1,
-            "gamma2_rad": gamma2,
-            "u11_px": float(uv1[0]),
-            "v11_px": float(uv1[1]),
-            "u21_px": float(uv2[0]),
-            "v21_px": float(uv2[1]),
-        },
+        details=details,
     )
 
 
@@ -511,32 +524,8 @@ def measure_model1(
         alpha_e=knowledge.alpha_e,
         uncertainty=Uncertainty(encoder=angle_sigma),
     )
-    if not bool(estimate.valid[0]):
-        return _failed(
-            sim,
-            target,
-            "model1",
-            f"estimator: {estimate.reasons(0)!r}",
-            sim.render_count - start,
-            residual,
-        )
-    truth_world = target.truth_world(sim)
-    estimate_head = estimate.positions[0]
-    return Measurement(
-        name=target.name,
-        method="model1",
-        status="ok",
-        estimate_head_m=estimate_head,
-        truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
-        estimate_world_m=to_world(sim, estimate_head, (yaw, pitch)),
-        truth_world_m=truth_world,
-        covariance_head_m2=estimate.covariance[0]
-        if estimate.covariance is not None
-        else np.full((3, 3), np.nan),
-        renders=sim.render_count - start,
-        servo_residual_px=residual,
-        details={"alpha_rad": eye, "neck_yaw_rad": yaw, "neck_pitch_rad": pitch},
-    )
+    details = {"alpha_rad": eye, "neck_yaw_rad": yaw, "neck_pitch_rad": pitch}
+    return _measured(sim, target, "model1", estimate, start, residual, details, (yaw, pitch))
 
 
 @dataclass(frozen=True)
