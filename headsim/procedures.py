@@ -401,6 +401,7 @@ def calibrate_head(
     base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0))
     rng = rng or np.random.default_rng(0)
     start = sim.render_count
+    parked = sim.position(body)  # put the target back afterwards: it must not hide others
     alpha1, alpha2, depths, rows = [], [], [], []
     plain = Model2Config(midline_px=0.0)
     for position in np.atleast_2d(positions_world):
@@ -414,6 +415,7 @@ def calibrate_head(
             m.truth_head_m[2] + (rng.normal(0.0, depth_noise_m) if depth_noise_m > 0 else 0.0)
         )
         rows.append((m.truth_head_m, m.details))
+    sim.set_body_pose(body, parked)
     baseline = sim.settings.baseline_m
     if len(alpha1) < 2:
         raise ValueError(

@@ -591,6 +591,10 @@ def plot_metric(rows: list[dict[str, Any]], x: str, y: str, path: Path, title: s
     return path
 
 
+def _cell(value: Any) -> str:
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
 def summary_table(spec: SweepSpec, records: Iterable[dict[str, Any]]) -> str:
     """A readable table of the jobs."""
     lines = [
@@ -606,7 +610,7 @@ def summary_table(spec: SweepSpec, records: Iterable[dict[str, Any]]) -> str:
     ]
     by_index = sorted(records, key=lambda r: r["index"])
     for r in by_index:
-        values = [f"{r['params'].get(f)!s:>16s}" for f in spec.fields]
+        values = [f"{_cell(r['params'].get(f)):>16s}" for f in spec.fields]
         err = r.get("rms_error_pct_depth")
         lines.append(
             "  ".join(

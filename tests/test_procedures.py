@@ -88,6 +88,8 @@ def test_calibration_recovers_effective_initial_directions_and_corrects_measurem
             sim, servo, BALL, names.CALIBRATION_BALL, calibration_layout(sim, rng, 24)
         )
         assert run.samples >= 22  # a target or two may fall out of one camera's view
+        # The ball is parked again where it was, not left in front of other targets.
+        np.testing.assert_allclose(sim.position(names.CALIBRATION_BALL), [0.0, 0.5, -1.0])
         assert np.abs(run.alpha_e_error).max() < 5e-4
         truth = np.array(run.truth_alpha_e)
         assert np.all(np.abs(truth) >= 0.02)  # there was something to find
