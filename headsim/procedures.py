@@ -179,6 +179,11 @@ def measure_model2(
     (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
     # Step 1: Ca1's u to its goal column; then P's image in Ca2 there.
     step1 = servo.run(1, target.detector, goal_u=u10)
+    if step1.outcome is ServoOutcome.TARGET_LOST and step1.iterations == 0 and step1.steps != 0:
+        # Not in view where the last measurement left the eyes: look straight ahead again.
+        sim.command_eye_steps(0)
+        sim.settle()
+        step1 = servo.run(1, target.detector, goal_u=u10)
     if not step1.converged:
         return _failed(
             sim,

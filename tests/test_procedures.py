@@ -194,3 +194,13 @@ def test_paper_cameras_after_calibration_measure_within_the_papers_accuracy() ->
             assert abs(m.error_head_m[1]) < 0.003 * m.depth_m  # with the extended calibration
             plain = measure_model2(sim, servo, RED, HeadKnowledge(alpha_e=run.knowledge.alpha_e))
             assert abs(plain.error_head_m[1]) > abs(m.error_head_m[1])
+
+
+def test_a_target_out_of_view_where_the_eyes_are_is_found_straight_ahead() -> None:
+    with HeadSim("default") as sim:
+        sim.move(eye=0.6)  # converged on something near: the new target is out of Ca1's view
+        _place_in_head(sim, "marker_red", [-0.1, 0.0, 0.9])
+        assert not find_marker(sim.render(1), "red").found
+        m = measure_model2(sim, EyeServo(sim), RED)
+        assert m.ok, m.status
+        assert m.error_pct_of_depth < 0.3
