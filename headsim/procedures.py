@@ -420,7 +420,7 @@ def calibrate_head(
             m.truth_head_m[2] + (rng.normal(0.0, depth_noise_m) if depth_noise_m > 0 else 0.0)
         )
         rows.append((m.truth_head_m, m.details))
-    sim.set_body_pose(body, parked)
+    sim.park_body(body, parked)
     baseline = sim.settings.baseline_m
     if len(alpha1) < 2:
         raise ValueError(
