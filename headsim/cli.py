@@ -42,22 +42,33 @@ def _size(path: Path) -> str:
     return f"{size / 1e6:.1f} MB" if size >= 1e5 else f"{size / 1e3:.0f} kB"
 
 
+class _Interrupted:
+    """Whether SIGINT or SIGTERM arrived (a KeyboardInterrupt raised inside a ctypes
+    call, e.g. EGL's, reaches Python as a ctypes.ArgumentError instead)."""
+
+    def __init__(self) -> None:
+        self.signalled = False
+
+
 @contextmanager
-def _sigterm_interrupts() -> Iterator[None]:
-    """Turn SIGTERM into KeyboardInterrupt, so that a stopped run still closes its files."""
+def _sigterm_interrupts() -> Iterator[_Interrupted]:
+    """Turn SIGINT and SIGTERM into KeyboardInterrupt, so that a stopped run still closes its files."""
+    state = _Interrupted()
 
     def interrupt(signum: int, frame: object) -> None:
+        state.signalled = True
         raise KeyboardInterrupt
 
     try:
-        previous = signal.signal(signal.SIGTERM, interrupt)
+        previous = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
     except ValueError:  # not the main thread
-        yield
+        yield state
         return
     try:
-        yield
+        yield state
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -94,10 +105,13 @@ def _run(args: argparse.Namespace) -> int:
             ) from err
         observers.append(recorder)
     start = time.perf_counter()
+    state = _Interrupted()
     try:
-        with _sigterm_interrupts():
+        with _sigterm_interrupts() as state:
             result = run_scenario(scenario, observers)
-    except KeyboardInterrupt:
+    except BaseException as err:
+        if not (isinstance(err, KeyboardInterrupt) or state.signalled):
+            raise
         kept = f"; the recording so far is in {rrd}" if rrd is not None else ""
         print(f"\nheadsim: interrupted: nothing written to {out}{kept}", file=sys.stderr)
         return 130
