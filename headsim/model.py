@@ -1,6 +1,6 @@
 """Building scenes: load an MJCF scene and apply head settings through MjSpec.
 
-The XML files in ``models/`` hold the defaults (ideal cameras, D = 150 mm);
+The XML files in ``headsim/models/`` hold the defaults (ideal cameras, D = 150 mm);
 :func:`build_model` edits a fresh spec from them with a :class:`HeadSettings`
 and compiles it.  Props (markers, chessboards) can be added the same way.
 """
@@ -8,6 +8,7 @@ and compiles it.  Props (markers, chessboards) can be added the same way.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 import mujoco
@@ -17,7 +18,8 @@ from headsim import names
 from headsim.optics import DistortionCanvas, distortion_canvas
 from headsim.settings import MAX_IMAGE_SIDE, CameraSettings, HeadSettings, SettingsError
 
-MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
+#: The head and scene MJCF files, installed as package data (headsim/models).
+MODELS_DIR = Path(str(resources.files("headsim") / "models"))
 #: Sensor pixel pitch used to express pixel intrinsics in MuJoCo's length units, m.
 PIXEL_PITCH_M = 1e-5
 

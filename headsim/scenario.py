@@ -25,6 +25,7 @@ import tomllib
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from functools import cache
+from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -45,7 +46,7 @@ from headsim.settings import (
 )
 
 #: Where ``headsim list`` and ``headsim run NAME`` look for scenario files.
-SCENARIOS_DIR = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS_DIR = Path(str(resources.files("headsim") / "scenarios"))
 
 #: Procedure -> the scene (``names.SCENES``) it runs in.
 PROCEDURES = {
@@ -58,7 +59,7 @@ PROCEDURES = {
 }
 #: Bodies of the default scene that can be measured, and the colour each is found by.
 MARKER_BODIES = {**names.MARKER_COLOURS, names.CALIBRATION_BALL: "yellow"}
-#: The chessboard of ``models/scene_chessboard.xml``: inner corners (columns, rows), square, m.
+#: The chessboard of ``headsim/models/scene_chessboard.xml``: inner corners (columns, rows), square, m.
 CHESSBOARD_PATTERN = (8, 6)
 CHESSBOARD_SQUARE_M = 0.030
 #: Nearest a target may be to the head, m (z_h at the start pose).
@@ -1058,7 +1059,7 @@ def _build(
 
 
 def resolve_path(name_or_path: str | Path) -> Path:
-    """A scenario file: a path, or the name of a file in ``scenarios/`` (without .toml)."""
+    """A scenario file: a path, or the name of a file in ``headsim/scenarios/`` (without .toml)."""
     path = Path(name_or_path)
     if path.is_file():
         return path
@@ -1150,7 +1151,7 @@ def load_scenario(
 
 
 def scenario_files(directory: Path | None = None) -> list[Path]:
-    """The scenario files in ``directory`` (default ``scenarios/``), sorted by name."""
+    """The scenario files in ``directory`` (default ``headsim/scenarios/``), sorted by name."""
     directory = SCENARIOS_DIR if directory is None else directory
     return sorted(directory.glob("*.toml")) if directory.is_dir() else []
 

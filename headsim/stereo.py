@@ -40,7 +40,7 @@ from headsim.optics import project_points, undistort_pixels
 from headsim.sim import HeadSim, invert_transform
 from headsim.vision import Detection, find_chessboard, find_marker
 
-#: Inner corners of the scene's chessboard (columns, rows): models/scene_chessboard.xml.
+#: Inner corners of the scene's chessboard (columns, rows): headsim/models/scene_chessboard.xml.
 CHESSBOARD_PATTERN = (8, 6)
 #: Side of one chessboard square, m (paper Sec. VI-A).
 CHESSBOARD_SQUARE_M = 0.03

@@ -1,4 +1,4 @@
-"""Scenario files: every file in scenarios/ validates; a bad file says what is wrong and where."""
+"""Scenario files: every file in headsim/scenarios/ validates; a bad file says what is wrong and where."""
 
 from __future__ import annotations
 
