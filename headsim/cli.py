@@ -1,36 +1,65 @@
-"""The ``headsim`` command line: ``run`` a scenario, ``list`` them, take a ``snapshot``.
+"""The ``headsim`` command line: ``run`` a scenario, ``list`` them, take a ``snapshot``, ...
 
-Exit status: 0 when everything succeeded; 1 when a measurement (or the
-calibration it needed) failed; 2 on bad input (a scenario file, an argument),
-when nothing is run or written; 130 when interrupted.
+Exit status (the contract of :mod:`headsim.errors`, held by every command): 0
+everything succeeded; 1 a measurement or job failed; 2 bad input or arguments,
+found before anything runs; 3 the environment (no GL backend, output not
+writable, disk full, a dependency missing); 130 interrupted.  No traceback
+reaches the user; ``--debug`` shows one.
+
+This module imports only the standard library at the top, so that ``--help``,
+``list`` and an interrupt during start-up are handled before numpy or mujoco load.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 import time
 from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 
-from headsim import names
-from headsim.settings import PRESETS, SettingsError, preset
+from headsim import backend
+from headsim.errors import (
+    EXIT_CODES_HELP,
+    NO_SPACE_ERRNOS,
+    BadInput,
+    ExitCode,
+    OutputNotWritable,
+    clear_interrupted,
+    guarded,
+    interrupt_handler,
+)
+from headsim.outputs import Outputs
+
+#: Commands that never render: they run without any GL backend (so does ``--help``).
+RENDER_FREE_COMMANDS = frozenset({"list"})
+#: Options every command takes, anywhere on the command line.
+GLOBAL_FLAGS = ("--debug", "--quiet")
 
 
 def _snapshot(args: argparse.Namespace) -> int:
+    from headsim.settings import preset
     from headsim.snapshot import take_snapshot
 
     settings = preset(args.preset, seed=args.seed)
-    written = take_snapshot(
-        args.out,
-        args.scene,
-        settings,
-        neck_yaw=args.neck_yaw,
-        neck_pitch=args.neck_pitch,
-        eye=args.eye,
-    )
+    outputs = Outputs()
+    try:
+        out = outputs.directory(args.out, "--out")
+        written = take_snapshot(
+            out,
+            args.scene,
+            settings,
+            neck_yaw=args.neck_yaw,
+            neck_pitch=args.neck_pitch,
+            eye=args.eye,
+        )
+    except ValueError as err:  # a pose beyond a joint's range, a bad scene
+        raise BadInput(str(err)) from err
+    finally:
+        outputs.remove_empty_created()
     print(f"scene {args.scene!r}, preset {args.preset!r}: wrote")
     for kind, path in written.items():
         print(f"  {kind:9s} {path}")
@@ -71,73 +100,152 @@ def _sigterm_interrupts() -> Iterator[_Interrupted]:
             signal.signal(sig, handler)
 
 
+#: The files ``headsim run`` writes in --out, besides the optional --rrd.
+RUN_FILES = ("results.json", "summary.txt", "timing.json")
+
+
 def _run(args: argparse.Namespace) -> int:
     from headsim.report import results_payload, summary_text
-    from headsim.results import write_json_atomic, write_text_atomic
-    from headsim.runner import Observer, Progress, run_scenario
-    from headsim.scenario import ScenarioError, load_scenario
+    from headsim.runner import Observer, run_scenario
+    from headsim.scenario import load_scenario
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise ScenarioError("--out", "", f"{out} exists and is not a directory", "a directory")
-    rrd = Path(args.rrd) if args.rrd else None
-    if rrd is not None and rrd.is_dir():
-        raise ScenarioError("--rrd", "", f"{rrd} is a directory", "a file path, e.g. run.rrd")
+    outputs = Outputs()
     try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        raise ScenarioError(
-            "--out", "", f"cannot create {out}: {err.strerror}", "a writable directory"
-        ) from err
-    observers: list[Observer] = []
-    if not args.no_progress and sys.stderr.isatty():
-        observers.append(Progress(scenario.fixations, sys.stderr))
-    recorder = None
-    if rrd is not None:
-        from headsim.recording import Recorder
+        # Every output, as the real file, before anything is rendered.
+        out = outputs.directory(args.out, "--out")
+        for name in RUN_FILES:
+            outputs.file(out / name, "--out")
+        rrd = outputs.file(args.rrd, "--rrd", atomic=False) if args.rrd else None
+        observers: list[Observer] = []
+        progress = _progress_observer(args, scenario.fixations, "fixations")
+        if progress is not None:
+            observers.append(progress)
+        recorder = None
+        if rrd is not None:
+            from headsim.recording import Recorder
 
+            try:
+                recorder = Recorder(rrd, scenario)
+            except (OSError, RuntimeError) as err:
+                if _recording_failed(err):
+                    raise _recording_disk_full(rrd, err) from err
+                raise OutputNotWritable(f"--rrd: cannot write {rrd}: {err}") from err
+            observers.append(recorder)
+        start = time.perf_counter()
+        state = _Interrupted()
         try:
-            recorder = Recorder(rrd, scenario)
-        except OSError as err:
-            raise ScenarioError(
-                "--rrd", "", f"cannot write {rrd}: {err}", "a writable file path"
-            ) from err
-        observers.append(recorder)
-    start = time.perf_counter()
-    state = _Interrupted()
-    try:
-        with _sigterm_interrupts() as state:
-            result = run_scenario(scenario, observers)
-    except BaseException as err:
-        if not (isinstance(err, KeyboardInterrupt) or state.signalled):
-            raise
-        kept = f"; the recording so far is in {rrd}" if rrd is not None else ""
-        print(f"\nheadsim: interrupted: nothing written to {out}{kept}", file=sys.stderr)
-        return 130
-    finally:
+            with _sigterm_interrupts() as state:
+                result = run_scenario(scenario, observers)
+        except BaseException as err:
+            if recorder is not None:
+                with suppress(Exception):  # the writer may have died with the run
+                    recorder.close()
+            if not (isinstance(err, KeyboardInterrupt) or state.signalled):
+                if rrd is not None and _recording_failed(err):
+                    raise _recording_disk_full(rrd, err) from err
+                raise
+            kept = f"; the recording so far is in {rrd}" if rrd is not None else ""
+            print(f"\nheadsim: interrupted: nothing written to {out}{kept}", file=sys.stderr)
+            return ExitCode.INTERRUPTED
         if recorder is not None:
-            recorder.close()
-    wall = time.perf_counter() - start
-    text = summary_text(result)
-    write_json_atomic(out / "results.json", results_payload(result))
-    write_text_atomic(out / "summary.txt", text + "\n")
-    write_json_atomic(
-        out / "timing.json",
-        {
-            "scenario": scenario.name,
-            "fast": scenario.fast,
-            "wall_s": wall,
-            "phases_s": result.timing_s,
-            "renders": result.renders,
-            "rrd_bytes": rrd.stat().st_size if rrd is not None else None,
-        },
-    )
+            _close_recorder(recorder, rrd)
+        wall = time.perf_counter() - start
+        text = summary_text(result)
+        _write_all(
+            {
+                out / "results.json": results_payload(result),
+                out / "summary.txt": text + "\n",
+                out / "timing.json": {
+                    "scenario": scenario.name,
+                    "fast": scenario.fast,
+                    "wall_s": wall,
+                    "phases_s": result.timing_s,
+                    "renders": result.renders,
+                    "rrd_bytes": rrd.stat().st_size if rrd is not None else None,
+                },
+            }
+        )
+    finally:
+        outputs.remove_empty_created()
     print(text)
     print(f"\nwall time {wall:.1f} s; results in {out / 'results.json'} (summary.txt, timing.json)")
     if rrd is not None:
         print(f"recording {rrd} ({_size(rrd)}): open it with  rerun {rrd}")
     return 0 if result.ok else 1
+
+
+def _progress_observer(args: argparse.Namespace, total: int, unit: str):
+    """The run's progress on stderr: a bar on a terminal, plain lines otherwise; none when quiet."""
+    from headsim.runner import Progress
+
+    if getattr(args, "no_progress", False) or getattr(args, "quiet", False):
+        return None
+    if sys.stderr.isatty():
+        return Progress(total, sys.stderr)
+    from headsim.progress import LineProgress
+
+    return LineProgress(total, sys.stderr, unit=unit)
+
+
+def _write_all(files: dict[Path, object]) -> None:
+    """Write the result files atomically; on a full disk remove the ones this call wrote."""
+    from headsim.outputs import disk_full
+    from headsim.results import write_json_atomic, write_text_atomic
+
+    written: list[Path] = []
+    for path, content in files.items():
+        data = content if isinstance(content, str) else None
+        try:
+            if data is not None:
+                write_text_atomic(path, data)
+            else:
+                write_json_atomic(path, content)
+        except OSError as err:
+            for done in written:
+                done.unlink(missing_ok=True)
+            if err.errno in NO_SPACE_ERRNOS:
+                size = len(data.encode()) if data is not None else _json_size(content)
+                raise disk_full(path, size, err) from err
+            raise OutputNotWritable(f"cannot write {path}: {err.strerror or err}") from err
+        written.append(path)
+
+
+def _json_size(payload: object) -> int:
+    import json
+
+    from headsim.results import to_jsonable
+
+    return len(json.dumps(to_jsonable(payload), indent=2).encode()) + 1
+
+
+#: What Rerun's file writer says when a write found no space (ENOSPC, EFBIG).
+_NO_SPACE_TEXTS = ("os error 28", "os error 27", "no space left", "file too large", "file-writer")
+
+
+def _recording_failed(err: BaseException) -> bool:
+    """Whether ``err`` is Rerun's file writer giving up for lack of space (or the size limit)."""
+    if isinstance(err, OSError):
+        return err.errno in NO_SPACE_ERRNOS
+    text = f"{err} {err.__cause__ or ''}".lower()
+    return isinstance(err, RuntimeError) and any(t in text for t in _NO_SPACE_TEXTS)
+
+
+def _recording_disk_full(rrd: Path, err: BaseException) -> Exception:
+    from headsim.outputs import disk_full
+
+    size = rrd.stat().st_size if rrd.is_file() else None
+    return disk_full(rrd, None, err if isinstance(err, OSError) else None, written_bytes=size)
+
+
+def _close_recorder(recorder, rrd: Path | None) -> None:
+    """Close the recording as far as Rerun allows; a writer that already died is no new error."""
+    try:
+        recorder.close()
+    except Exception as err:  # the file writer already failed: reported by the caller
+        if rrd is not None and _recording_failed(err):
+            raise _recording_disk_full(rrd, err) from err
+        raise
 
 
 def _list(args: argparse.Namespace) -> int:
@@ -177,21 +285,26 @@ def _sweep(args: argparse.Namespace) -> int:
     print(f"  {len(spec.jobs)} jobs of {Path(spec.scenario).stem}{' (fast)' if spec.fast else ''}")
     where = f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers} local process(es)"
     print(f"  running on {where}; log {Path(args.out) / 'jobs.jsonl'}", flush=True)
-    with _sigterm_interrupts():
-        try:
-            outcome = sweep.run_sweep(
-                spec,
-                args.out,
-                workers=args.workers,
-                scheduler=args.scheduler,
-                progress=not args.no_progress,
-            )
-        except KeyboardInterrupt:
-            print(
-                "\ninterrupted: finished jobs are in jobs.jsonl; run again to resume",
-                file=sys.stderr,
-            )
-            return 130
+    outputs = Outputs()
+    try:
+        outputs.directory(args.out, "--out")
+        with _sigterm_interrupts():
+            try:
+                outcome = sweep.run_sweep(
+                    spec,
+                    args.out,
+                    workers=args.workers,
+                    scheduler=args.scheduler,
+                    progress=not (args.no_progress or args.quiet),
+                )
+            except KeyboardInterrupt:
+                print(
+                    "\ninterrupted: finished jobs are in jobs.jsonl; run again to resume",
+                    file=sys.stderr,
+                )
+                return ExitCode.INTERRUPTED
+    finally:
+        outputs.remove_empty_created()
     print(sweep.summary_table(spec, outcome.records.values()))
     rate = 60 * outcome.ran / outcome.wall_s if outcome.wall_s > 0 else 0.0
     print(
@@ -203,10 +316,33 @@ def _sweep(args: argparse.Namespace) -> int:
     return 1 if outcome.failed else 0
 
 
+def _positive_int(text: str) -> int:
+    """An argparse type: an integer >= 1 (a bad one is a usage error, exit 2)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{value} is not allowed (allowed: an integer >= 1)")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
+    from headsim import names
+    from headsim.settings import PRESETS
+
     parser = argparse.ArgumentParser(
         prog="headsim",
         description="MuJoCo testbed for vergence-based active stereo vision on humanoid heads.",
+        epilog=EXIT_CODES_HELP,
+    )
+    parser.add_argument(
+        "--debug", action="store_true", help="show the Python traceback of an error (any position)"
+    )
+    parser.add_argument(
+        "--quiet",
+        action="store_true",
+        help="no progress output on stderr, only errors (any position)",
     )
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -215,8 +351,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="run a scenario: print a summary, write results.json, optionally record to Rerun",
         description="Run the experiment of a scenario file in the simulator. Prints a summary "
         "table, writes DIR/results.json (and summary.txt, timing.json) and, with --rrd, a Rerun "
-        "recording to replay with `rerun FILE`. Exit status: 0 all measurements ok, 1 a "
-        "measurement failed, 2 bad input (nothing run or written), 130 interrupted.",
+        "recording to replay with `rerun FILE`.",
     )
     run.add_argument(
         "scenario",
@@ -234,7 +369,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--fast", action="store_true", help="the scenario's fast variant (its [fast] table)"
     )
-    run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    run.add_argument(
+        "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"
+    )
     run.set_defaults(func=_run)
 
     listing = commands.add_parser(
@@ -284,7 +421,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sweep.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
     sweep.add_argument(
-        "--workers", type=int, default=1, metavar="N", help="local processes (default 1)"
+        "--workers", type=_positive_int, default=1, metavar="N", help="local processes (default 1)"
     )
     sweep.add_argument(
         "--scheduler",
@@ -323,24 +460,60 @@ def build_parser() -> argparse.ArgumentParser:
         "--reason", help="why the baseline changes (required with --update-baseline)"
     )
     bench.set_defaults(func=_bench)
+    for sub in commands.choices.values():  # every command states the exit-code contract
+        sub.epilog = sub.epilog or EXIT_CODES_HELP
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    from headsim.scenario import ScenarioError
-    from headsim.sweep import SweepError
+def _command(argv: Sequence[str]) -> str | None:
+    """The subcommand named on the command line (None for ``--help`` or none)."""
+    if any(arg in ("-h", "--help") for arg in argv):
+        return None
+    return next((arg for arg in argv if not arg.startswith("-")), None)
 
+
+def _main(argv: list[str], *, debug: bool, quiet: bool) -> int:
+    command = _command(argv)
+    if command is not None and command not in RENDER_FREE_COMMANDS:
+        backend.check_backend()  # MUJOCO_GL was settled when headsim was imported
     args = build_parser().parse_args(argv)
+    args.debug, args.quiet = debug, quiet
+    return int(args.func(args))
+
+
+@contextmanager
+def _process_signals() -> Iterator[None]:
+    """SIGINT and SIGTERM interrupt (exit 130, noted even where they surface as another
+    error); the file-size limit fails a write (EFBIG) instead of killing the process."""
+    clear_interrupted()
+
+    previous: dict[int, object] = {}
     try:
-        return int(args.func(args))
-    except (SettingsError, ScenarioError, SweepError) as err:
-        print(f"headsim: error: {err}", file=sys.stderr)
-        return 2
-    except ValueError as err:
-        if args.command != "snapshot":
-            raise
-        print(f"headsim: error: {err}", file=sys.stderr)
-        return 2
+        previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, interrupt_handler)
+        # A SIGINT the shell set to be ignored (a background job) stays ignored.
+        if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+            previous[signal.SIGINT] = signal.signal(signal.SIGINT, interrupt_handler)
+        if hasattr(signal, "SIGXFSZ"):
+            previous[signal.SIGXFSZ] = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    except ValueError:  # not the main thread
+        pass
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)  # type: ignore[arg-type]
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """The ``headsim`` entry point: runs a command and returns its exit code (0, 1, 2, 3, 130)."""
+    given = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in given
+    quiet = "--quiet" in given
+    rest = [arg for arg in given if arg not in GLOBAL_FLAGS]
+    if not debug:  # Rerun's own log lines repeat errors that headsim reports in one line
+        os.environ.setdefault("RUST_LOG", "off")
+    with _process_signals():
+        return guarded(lambda: _main(rest, debug=debug, quiet=quiet), debug=debug)
 
 
 if __name__ == "__main__":

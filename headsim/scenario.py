@@ -33,6 +33,7 @@ import mujoco
 import numpy as np
 
 from headsim import names
+from headsim.errors import BadInput
 from headsim.kinematics import head_to_world, world_to_head
 from headsim.model import eye_from_camera_rotation, load_spec
 from headsim.optics import centre_ray_yaw
@@ -72,7 +73,7 @@ STREAM_CALIBRATION, STREAM_TARGETS, STREAM_OBJECTS, STREAM_MOVING, STREAM_DEPTH_
 _MISSING = object()
 
 
-class ScenarioError(ValueError):
+class ScenarioError(BadInput, ValueError):
     """A scenario file is wrong; the message names the file, the field and what is allowed."""
 
     def __init__(self, source: str, field_path: str, message: str, allowed: str | None = None):

@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass, field, replace
 
 from headsim.camera_model import PinholeCamera
+from headsim.errors import BadInput
 
 #: Largest image side the off-screen buffer is allowed to grow to, px.
 MAX_IMAGE_SIDE = 4096
@@ -20,7 +21,7 @@ PAPER_ENCODER_RESOLUTION = 2 * math.pi / 25600
 IDEAL_FOCAL_PX = 240.0 / math.tan(math.radians(22.5))
 
 
-class SettingsError(ValueError):
+class SettingsError(BadInput, ValueError):
     """A setting is out of its allowed range; the message names it."""
 
 

@@ -44,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from headsim.errors import BadInput
 from headsim.results import write_bytes_atomic, write_csv_atomic, write_json_atomic
 
 #: Fault injection for tests: job indices (comma-separated) whose process dies.
@@ -65,7 +66,7 @@ METRICS = (
 )
 
 
-class SweepError(ValueError):
+class SweepError(BadInput, ValueError):
     """A bad sweep file: the message names the file, the field and what is allowed."""
 
     def __init__(self, source: str, path: str, message: str, allowed: str | None = None) -> None:

@@ -1,0 +1,162 @@
+"""The exit-code contract of the ``headsim`` command line, in one place.
+
+Every command ends with one of these codes, and no Python traceback reaches the
+user (``headsim --debug ...`` shows one):
+
+====  ==================================================================
+0     everything succeeded
+1     a measurement or job failed (or an internal error, reported as one)
+2     bad input or arguments, found before anything runs
+3     the environment: no GL backend, output not writable, disk full, a
+      dependency missing
+130   interrupted (Ctrl-C or SIGTERM)
+====  ==================================================================
+
+Raise :class:`BadInput` or :class:`EnvironmentProblem` (or a subclass) anywhere
+below a command; :func:`guarded` maps them, and any other exception, to a code
+and one line on stderr.  New subcommands get this for free from ``cli.main``.
+"""
+
+from __future__ import annotations
+
+import errno
+import sys
+import traceback
+from collections.abc import Callable
+from enum import IntEnum
+from typing import TextIO
+
+
+class ExitCode(IntEnum):
+    """What ``headsim`` returns to the shell."""
+
+    OK = 0
+    FAILED = 1
+    BAD_INPUT = 2
+    ENVIRONMENT = 3
+    INTERRUPTED = 130
+
+
+#: The contract as text, for ``--help`` and the README.
+EXIT_CODES_HELP = (
+    "exit status: 0 everything succeeded; 1 a measurement or job failed; 2 bad input or "
+    "arguments, found before anything runs; 3 the environment (no GL backend, output not "
+    "writable, disk full, a dependency missing); 130 interrupted. No traceback unless --debug."
+)
+
+
+class HeadsimError(Exception):
+    """An error whose message is meant for the user, with its exit code."""
+
+    exit_code: ExitCode = ExitCode.FAILED
+
+
+class BadInput(HeadsimError):
+    """A file or an argument that cannot work; found before anything runs (exit 2)."""
+
+    exit_code = ExitCode.BAD_INPUT
+
+
+class EnvironmentProblem(HeadsimError):
+    """The machine cannot do it: GL, permissions, disk space, a dependency (exit 3)."""
+
+    exit_code = ExitCode.ENVIRONMENT
+
+
+class OutputNotWritable(EnvironmentProblem):
+    """An output file or directory cannot be created or written."""
+
+
+class DiskFull(EnvironmentProblem):
+    """A write ran out of space (ENOSPC) or into the file-size limit (EFBIG)."""
+
+
+#: errno values that mean "no room to write".
+NO_SPACE_ERRNOS = frozenset({errno.ENOSPC, errno.EFBIG, errno.EDQUOT})
+
+
+def describe_os_error(err: OSError) -> str:
+    """One line for an OSError: what failed, on which file, and why."""
+    name = f" {err.filename}" if err.filename else ""
+    reason = err.strerror or str(err)
+    if err.errno in NO_SPACE_ERRNOS:
+        return f"no space to write{name}: {reason} (free some space or write elsewhere)"
+    return f"cannot use{name}: {reason}"
+
+
+class _Signals:
+    """Whether SIGINT or SIGTERM arrived in this process (see :func:`interrupt_handler`)."""
+
+    received = False
+
+
+def interrupt_handler(signum: int, frame: object) -> None:
+    """A signal handler: note the interrupt, then raise KeyboardInterrupt.
+
+    An interrupt that lands inside a C extension's import or a ctypes call reaches
+    Python as another exception (ImportError "initialization failed",
+    ctypes.ArgumentError); the note makes it exit 130 all the same.
+    """
+    _Signals.received = True
+    raise KeyboardInterrupt
+
+
+def clear_interrupted() -> None:
+    """Forget an earlier interrupt (a new command starts)."""
+    _Signals.received = False
+
+
+def interrupted() -> bool:
+    """Whether an interrupt arrived through :func:`interrupt_handler`."""
+    return _Signals.received
+
+
+def exit_code_for(err: BaseException) -> tuple[ExitCode, str]:
+    """The exit code and the one-line message for an exception that ended a command."""
+    if isinstance(err, KeyboardInterrupt) or interrupted():
+        return ExitCode.INTERRUPTED, "interrupted"
+    if isinstance(err, HeadsimError):
+        return err.exit_code, str(err)
+    if isinstance(err, OSError):
+        return ExitCode.ENVIRONMENT, describe_os_error(err)
+    if isinstance(err, MemoryError):
+        return ExitCode.ENVIRONMENT, "out of memory"
+    if isinstance(err, ImportError):
+        missing = err.name or str(err)
+        return (
+            ExitCode.ENVIRONMENT,
+            f"a dependency is missing: {missing} ({err}); reinstall headsim with pip",
+        )
+    if isinstance(err, RecursionError):
+        return ExitCode.BAD_INPUT, "input nested too deeply to process"
+    text = str(err) or type(err).__name__
+    return (
+        ExitCode.FAILED,
+        f"internal error: {type(err).__name__}: {text} (run with --debug for the traceback)",
+    )
+
+
+def guarded(body: Callable[[], int], *, debug: bool = False, stream: TextIO | None = None) -> int:
+    """Run ``body`` and return its exit code; an exception becomes a code and one line.
+
+    ``SystemExit`` (argparse's usage errors, exit 2) passes through unchanged.
+    With ``debug`` the traceback is printed too.
+    """
+    stream = sys.stderr if stream is None else stream
+    try:
+        return int(body())
+    except SystemExit:
+        raise
+    except BaseException as err:
+        code, message = exit_code_for(err)
+        if debug:
+            traceback.print_exception(err, file=stream)
+        try:
+            print(
+                f"headsim: {'' if code == ExitCode.INTERRUPTED else 'error: '}{message}",
+                file=stream,
+            )
+            stream.flush()
+        except (OSError, ValueError):  # stderr itself is gone
+            pass
+        return int(code)
