@@ -21,6 +21,7 @@ merge key by key, everything else is replaced); both variants are checked.
 from __future__ import annotations
 
 import math
+import re
 import tomllib
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
@@ -45,6 +46,9 @@ from headsim.settings import (
     SettingsError,
     preset,
 )
+
+#: The narrowest baseline a scenario may set, m: below it vergence carries no depth.
+MIN_BASELINE_M = 0.01
 
 #: Where ``headsim list`` and ``headsim run NAME`` look for scenario files.
 SCENARIOS_DIR = Path(str(resources.files("headsim") / "scenarios"))
@@ -218,10 +222,20 @@ def _corner_count() -> int:
 # -- reading TOML tables -------------------------------------------------------
 
 
+def _short(value: Any) -> str:
+    """A value for a message: long integers and strings shortened."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**15:
+        return f"{'-' if value < 0 else ''}an integer of {len(str(abs(value)))} digits"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _describe(value: Any) -> str:
     kind = {bool: "boolean", int: "integer", float: "number", str: "string"}.get(type(value))
+    if kind == "integer" and abs(value) >= 10**15:
+        return _short(value)
     if kind:
-        return f"{kind} {value!r}"
+        return f"{kind} {_short(value)}"
     if isinstance(value, list):
         return f"array of {len(value)}"
     if isinstance(value, dict):
@@ -314,7 +328,10 @@ class _Table:
     ) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.fail(key, f"must be a number, got {_describe(value)}", allowed)
-        value = float(value)
+        try:
+            value = float(value)
+        except OverflowError:  # an integer beyond 1.8e308
+            raise self.fail(key, f"{_short(value)} is out of range", allowed) from None
         bad = (
             not math.isfinite(value)
             or (lo is not None and (value <= lo if lo_open else value < lo))
@@ -334,7 +351,7 @@ class _Table:
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.fail(key, f"must be an integer, got {_describe(value)}", allowed)
         if not lo <= value <= hi:
-            raise self.fail(key, f"{value} is out of range", allowed)
+            raise self.fail(key, f"{_short(value)} is out of range", allowed)
         return value
 
     def boolean(self, key: str, default: bool) -> bool:
@@ -370,7 +387,7 @@ class _Table:
         if not isinstance(value, str):
             raise self.fail(key, f"must be a string, got {_describe(value)}", text)
         if value not in allowed:
-            raise self.fail(key, f"unknown value {value!r}", text)
+            raise self.fail(key, f"unknown value {_short(value)}", text)
         return value
 
     def numbers(
@@ -457,6 +474,9 @@ def _read_camera(
     camera = CameraSettings(
         width=width, height=height, kx=kx, ky=ky, cx=cx, cy=cy, k1=k1, k2=k2, noise_std=noise
     )
+    problem = _lens_problem(camera)
+    if problem is not None:
+        raise table.fail("k1", *problem)
     try:
         centre_ray_yaw(camera)
     except ValueError as err:
@@ -466,12 +486,45 @@ def _read_camera(
     return camera, name
 
 
+def _lens_problem(camera: CameraSettings) -> tuple[str, str] | None:
+    """Why the lens gives no ray through the image centre (the servo's aim), in the user's
+    terms, with the widest image that works; None when it does."""
+    lens = camera.pinhole()
+    fold = lens.fold_radius  # undistorted normalised radius where r (1 + k1 r^2 + k2 r^4) peaks
+    if not math.isfinite(fold):
+        return None
+    reach = fold * (1.0 + camera.k1 * fold**2 + camera.k2 * fold**4)  # distorted, same units
+    cx, cy = camera.principal
+    uc, vc = (camera.width - 1) / 2.0, (camera.height - 1) / 2.0
+    du, dv = (uc - cx) / camera.kx, (vc - cy) / camera.ky
+    if math.hypot(du, dv) < reach * (1.0 - 1e-9):
+        return None
+    limit_deg = math.degrees(math.atan(fold))
+    room = max(reach**2 - dv**2, 0.0) ** 0.5 * camera.kx  # px the centre may sit from cx
+    widest = 2.0 * (cx + room) + 1.0
+    return (
+        f"an image {camera.width} x {camera.height} px with the principal point at "
+        f"({cx:g}, {cy:g}) px and kx {camera.kx:g} px puts the image centre "
+        f"{math.hypot(du, dv):.3g} focal lengths off axis, beyond where k1 = {camera.k1:g}, k2 = {camera.k2:g} is monotonic "
+        f"({reach:.3g} focal lengths, {limit_deg:.0f} degrees off axis): no ray reaches the "
+        f"image centre",
+        f"for this lens and principal point an image at most {max(int(widest), 0)} px wide "
+        f"(or cx, cy near the image centre, or a larger kx)",
+    )
+
+
 def _read_head(doc: _Table, ctx: _Context) -> tuple[HeadSettings, str, str]:
     """``[head]`` with ``[cam1]``, ``[cam2]``: the head's settings, preset name, settle mode."""
     head = doc.table("head") or _Table({}, "head", ctx)
     preset_name = head.choice("preset", ("ideal", "paper"), "ideal")
     base = preset(preset_name)
-    baseline = head.number("baseline_m", base.baseline_m, 0.0, 1.0, lo_open=True, unit="m")
+    baseline = head.number(
+        "baseline_m",
+        base.baseline_m,
+        MIN_BASELINE_M,
+        1.0,
+        unit="m; narrower gives no usable vergence",
+    )
     d1 = head.number("neck_d1_m", base.neck_d1_m, 0.0, 2.0, unit="m")
     a2 = head.number("neck_a2_m", base.neck_a2_m, 0.0, 1.0, unit="m")
     resolution = head.number(
@@ -545,6 +598,13 @@ def _read_calibration(table: _Table | None) -> CalibrationSpec | None:
         extended=table.boolean("extended", True),
     )
     table.done()
+    if spec.extended and spec.vertical == 0.0:
+        raise table.fail(
+            "vertical",
+            "0 with the extended fit: fitting each camera's reference row and kx/ky needs "
+            "ball positions above and below the centre row",
+            "a vertical spread > 0 (e.g. 0.08), or extended = false",
+        )
     return spec
 
 
@@ -829,6 +889,8 @@ class _Head:
     eye_range: tuple[float, float]
     neck_yaw_range: tuple[float, float]
     neck_pitch_range: tuple[float, float]
+    #: Each camera's effective direction (mount yaw and image-centre ray), computed once.
+    directions: tuple[float, float]
 
     @classmethod
     def of(cls, settings: HeadSettings) -> _Head:
@@ -838,12 +900,21 @@ class _Head:
             lo, hi = model.joint(joint).range
             return float(lo), float(hi)
 
-        return cls(settings, rng(names.EYE_MOTOR_JOINT), rng(names.NECK_YAW), rng(names.NECK_PITCH))
+        directions = tuple(
+            camera.mount_yaw_rad + sign * centre_ray_yaw(camera)
+            for camera, sign in zip(settings.cameras, (1.0, -1.0), strict=True)
+        )
+        return cls(
+            settings,
+            rng(names.EYE_MOTOR_JOINT),
+            rng(names.NECK_YAW),
+            rng(names.NECK_PITCH),
+            directions,  # type: ignore[arg-type]
+        )
 
     def effective_direction(self, index: int) -> float:
-        camera = self.settings.cameras[index]
-        sign = 1.0 if index == 0 else -1.0
-        return camera.mount_yaw_rad + sign * centre_ray_yaw(camera)
+        """Camera ``index``'s image-centre ray off the head's forward axis at eye 0, rad."""
+        return self.directions[index]
 
     def in_view(self, point_head: np.ndarray, index: int, eye: float = 0.0) -> bool:
         """Whether a point projects into camera ``index``'s image at eye angle ``eye``."""
@@ -928,8 +999,17 @@ def _check_model1_reach(
     ctx: _Context, head: _Head, source: str, p_world: np.ndarray, what: str, start: bool
 ) -> None:
     """Within the neck's and eye's ranges; seen by a camera at the start pose if ``start``."""
-    p = head.to_head(p_world)
     yaw, pitch, eye = _model1_angles(head, p_world)
+    if math.isnan(pitch):
+        s = head.settings
+        distance = math.hypot(math.hypot(p_world[0], p_world[1]), p_world[2] - s.neck_d1_m)
+        raise ctx.error(
+            source,
+            f"{what} at {_fmt(np.asarray(p_world))} m in W is {distance:.3f} m from the neck's "
+            f"pitch axis, inside the eyes' offset from it (head.neck_a2_m = {s.neck_a2_m:g} m): "
+            "no neck pitch turns the eyes towards it",
+            "targets farther from the neck's pitch axis than head.neck_a2_m",
+        )
     ranges = (
         ("neck yaw", yaw, head.neck_yaw_range),
         ("neck pitch", pitch, head.neck_pitch_range),
@@ -946,6 +1026,7 @@ def _check_model1_reach(
                 f"[{head.eye_range[0]:g}, {head.eye_range[1]:g}] rad",
             )
     if start:
+        p = head.to_head(p_world)
         _check_in_front(ctx, source, p, what)
         if not (head.in_view(p, 0) or head.in_view(p, 1)):
             raise ctx.error(
@@ -1055,8 +1136,25 @@ def _build(
         scene=scene,
         experiment=experiment,
     )
+    _check_servo(ctx, scenario)
     _check_reach(ctx, scenario)
     return scenario
+
+
+def _check_servo(ctx: _Context, scenario: Scenario) -> None:
+    """The servo's probe must fit in the eye's range (a probe step moves both eyes)."""
+    lo, hi = _Head.of(scenario.settings).eye_range
+    resolution = scenario.settings.encoder_resolution_rad
+    half_range = (hi - lo) / 2.0
+    steps = scenario.experiment.servo.probe_steps
+    if steps * resolution > half_range:
+        raise ctx.error(
+            "experiment.servo.probe_steps",
+            f"{steps} encoder steps of {resolution:.3g} rad turn the eyes by "
+            f"{steps * resolution:.3g} rad, more than they can turn from the centre of their "
+            f"range [{lo:g}, {hi:g}] rad",
+            f"at most {int(half_range / resolution)} steps",
+        )
 
 
 def resolve_path(name_or_path: str | Path) -> Path:
@@ -1115,12 +1213,109 @@ def load_scenario(
     """
     path = resolve_path(name_or_path)
     source = str(path)
+    doc = read_toml(path)
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+        return _load(doc, path, fast=fast, seed=seed, overrides=overrides)
+    except RecursionError as err:  # a structure nested too deeply for the checks
+        raise ScenarioError(
+            source, "", f"nested too deeply{_deep_line(_text_or_empty(path))}"
+        ) from err
+
+
+#: Deepest nesting of arrays and inline tables a scenario file may have.
+MAX_NESTING = 50
+#: Most digits an integer in a scenario file may have (Python's int() limit is 4300).
+MAX_DIGITS = 4300
+
+
+def read_toml(path: Path) -> dict[str, Any]:
+    """Parse a TOML file; any failure (syntax, nesting, huge integers, encoding) is a
+    :class:`ScenarioError` naming the line.  A UTF-8 byte-order mark is allowed."""
+    source = str(path)
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except UnicodeDecodeError as err:
+        line = path.read_bytes()[: err.start].count(b"\n") + 1
+        raise ScenarioError(source, "", f"line {line}: not UTF-8 text ({err.reason})") from err
+    except OSError as err:
+        raise ScenarioError(source, "", f"cannot be read: {err.strerror or err}") from err
+    deep = _deep_line(text)
+    if deep:
+        raise ScenarioError(
+            source, "", f"arrays or inline tables nested too deeply{deep}",
+            f"at most {MAX_NESTING} levels",
+        )  # fmt: skip
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise ScenarioError(source, "", f"not valid TOML: {err}", "TOML 1.0") from err
-    except (OSError, UnicodeDecodeError) as err:
-        raise ScenarioError(source, "", f"cannot be read: {err}") from err
+        last = text.count("\n") + (0 if text.endswith("\n") else 1)
+        reason = str(err).replace("(at end of document)", f"(at line {last}, the end of the file)")
+        raise ScenarioError(source, "", f"not valid TOML: {reason}", "TOML 1.0") from err
+    except RecursionError as err:
+        raise ScenarioError(source, "", "nested too deeply for the TOML parser") from err
+    except ValueError as err:  # int() refuses more than 4300 digits
+        line = _long_number_line(text)
+        raise ScenarioError(
+            source, "", f"{line}a number with too many digits ({err})",
+            f"integers of at most {MAX_DIGITS} digits",
+        ) from err  # fmt: skip
+
+
+def _text_or_empty(path: Path) -> str:
+    try:
+        return path.read_bytes().decode("utf-8-sig", errors="replace")
+    except OSError:
+        return ""
+
+
+def _deep_line(text: str) -> str:
+    """``" at line N"`` where brackets nest deeper than :data:`MAX_NESTING`, else ``""``.
+
+    Counts ``[`` and ``{`` outside strings and comments; a table header's ``[[``
+    adds at most two levels, far below the limit.
+    """
+    depth, line, quote, comment = 0, 1, "", False
+    for index, char in enumerate(text):
+        if char == "\n":
+            line, comment = line + 1, False
+            if quote in ('"', "'"):
+                quote = ""
+            continue
+        if comment:
+            continue
+        if quote:
+            if char == quote[0] and not (quote == '"' and text[index - 1] == "\\"):
+                quote = ""
+            continue
+        if char == "#":
+            comment = True
+        elif char in "\"'":
+            quote = char
+        elif char in "[{":
+            depth += 1
+            if depth > MAX_NESTING:
+                return f" at line {line}"
+        elif char in "]}":
+            depth = max(depth - 1, 0)
+    return ""
+
+
+def _long_number_line(text: str) -> str:
+    match = re.search(rf"[0-9_]{{{MAX_DIGITS + 1},}}", text)
+    if match is None:
+        return ""
+    return f"line {text.count(chr(10), 0, match.start()) + 1}: "
+
+
+def _load(
+    doc: dict[str, Any],
+    path: Path,
+    *,
+    fast: bool,
+    seed: int | None,
+    overrides: dict[str, Any] | None,
+) -> Scenario:
+    source = str(path)
     if seed is not None and not (isinstance(seed, int) and 0 <= seed < 2**32):
         raise ScenarioError(
             source, "seed", f"{seed!r} is out of range", "an integer from 0 to 2**32 - 1"
@@ -1164,6 +1359,8 @@ def describe_scenarios(directory: Path | None = None) -> Iterator[tuple[str, str
             yield path.stem, load_scenario(path).description
         except ScenarioError as err:
             yield path.stem, f"INVALID: {err}"
+        except Exception as err:  # one unreadable file must not end the listing
+            yield path.stem, f"INVALID: cannot be checked: {type(err).__name__}: {err}"
 
 
 __all__ = [

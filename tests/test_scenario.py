@@ -91,11 +91,11 @@ BAD = [
     ),
     (
         "[head]\nbaseline_m = 'wide'\n",
-        "head.baseline_m: must be a number, got string 'wide' (allowed: a number > 0 and <= 1 m)",
+        "head.baseline_m: must be a number, got string 'wide' (allowed: a number >= 0.01 and <= 1 m; narrower gives no usable vergence)",
     ),
     (
         "[head]\nbaseline_m = 2.0\n",
-        "head.baseline_m: 2 is out of range (allowed: a number > 0 and <= 1 m)",
+        "head.baseline_m: 2 is out of range (allowed: a number >= 0.01 and <= 1 m; narrower gives no usable vergence)",
     ),
     ("[head]\npreset = 'sony'\n", "head.preset: unknown value 'sony' (allowed: ideal, paper)"),
     (
