@@ -299,13 +299,23 @@ def environment() -> dict[str, str]:
 def main(args: Any) -> int:
     """``headsim bench``: run the suite, compare, print, maybe update the baseline."""
 
-    def progress(message: str) -> None:
-        print(f"\r  bench: {message:60s}", end="", file=sys.stderr, flush=True)
-
+    terminal = sys.stderr.isatty()
+    quiet = getattr(args, "quiet", False)
     start = time.perf_counter()
+
+    def progress(message: str) -> None:
+        if quiet:
+            return
+        if terminal:
+            print(f"\r  bench: {message:60s}", end="", file=sys.stderr, flush=True)
+        else:  # a log: one plain line per phase, no carriage returns
+            elapsed = time.perf_counter() - start
+            print(f"headsim bench: [{elapsed:6.1f} s] {message}", file=sys.stderr, flush=True)
+
     metrics = suite(seed=args.seed, progress=progress)
     wall = time.perf_counter() - start
-    print("\r" + " " * 72 + "\r", end="", file=sys.stderr)
+    if terminal and not quiet:
+        print("\r" + " " * 72 + "\r", end="", file=sys.stderr)
     baseline_path = Path(args.baseline)
     stored = load_json(baseline_path)
     verdicts = compare(metrics, stored.get("metrics", {}), load_json(Path(args.tolerances)))

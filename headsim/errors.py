@@ -51,6 +51,12 @@ class HeadsimError(Exception):
     exit_code: ExitCode = ExitCode.FAILED
 
 
+class JobFailed(HeadsimError, RuntimeError):
+    """A measurement or job failed (exit 1); the message says which and why."""
+
+    exit_code = ExitCode.FAILED
+
+
 class BadInput(HeadsimError):
     """A file or an argument that cannot work; found before anything runs (exit 2)."""
 

@@ -62,6 +62,7 @@ from typing import Any
 import numpy as np
 
 from headsim import names, stereo
+from headsim.errors import BadInput, JobFailed
 from headsim.optics import centre_ray_yaw
 from headsim.principal import (
     PROBE_ZOOM,
@@ -628,7 +629,7 @@ def run_conditions(
         )
     failed = [r for r in records if r.get("status") != "ok"]
     if failed:
-        raise RuntimeError(f"{len(failed)} condition(s) failed: {failed[0].get('error')}")
+        raise JobFailed(f"{len(failed)} condition(s) failed: {failed[0].get('error')}")
     for record in records:
         if record.get("calibrations") is not None:
             cache.add(record["calibrations"])
@@ -1144,10 +1145,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 def run(args: argparse.Namespace) -> int:
     """Run what ``args`` (see :func:`add_arguments`) asks for; 0 on success."""
     if args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+        raise BadInput(f"--workers must be >= 1, got {args.workers}")
     make = StudyConfig.quick if args.fast else StudyConfig
     config = make(preset=args.preset, seed=args.seed)
-    progress = StderrProgress()
+    progress: Progress = quiet if getattr(args, "quiet", False) else StderrProgress()
     cache = CalibrationCache(config, progress)
     if args.all:
         experiments = [compare_experiment(config)] + [

@@ -324,6 +324,16 @@ class _Progress:
         elapsed = time.perf_counter() - self.start
         rate = self.done / elapsed if elapsed > 0 else 0.0
         eta = (self.total - self.done) / rate if rate > 0 else math.inf
+        if not sys.stderr.isatty():  # a log: one plain line per job, no carriage returns
+            left = f"about {eta:.0f} s left" if math.isfinite(eta) else "time left unknown"
+            print(
+                f"headsim sweep: {self.done}/{self.total} jobs done"
+                + (" (this one failed)" if failed else "")
+                + f", {60 * rate:.1f}/min, {left}",
+                file=sys.stderr,
+                flush=True,
+            )
+            return
         width = 30
         filled = round(width * self.done / max(self.total, 1))
         bar = "#" * filled + "-" * (width - filled)
@@ -336,7 +346,7 @@ class _Progress:
         )
 
     def close(self) -> None:
-        if self.enabled and self.total:
+        if self.enabled and self.total and sys.stderr.isatty():
             print(file=sys.stderr)
 
 
