@@ -20,6 +20,7 @@ import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager, suppress
 from pathlib import Path
+from typing import Any
 
 from headsim import backend
 from headsim.errors import (
@@ -175,7 +176,7 @@ def _run(args: argparse.Namespace) -> int:
     return 0 if result.ok else 1
 
 
-def _progress_observer(args: argparse.Namespace, total: int, unit: str):
+def _progress_observer(args: argparse.Namespace, total: int, unit: str) -> Any:
     """The run's progress on stderr: a bar on a terminal, plain lines otherwise; none when quiet."""
     from headsim.runner import Progress
 
