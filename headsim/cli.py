@@ -282,13 +282,17 @@ def _sweep(args: argparse.Namespace) -> int:
     from headsim import sweep
 
     spec = sweep.load_sweep(args.sweep)
-    print(f"sweep {spec.path.name}: {spec.description}")
-    print(f"  {len(spec.jobs)} jobs of {Path(spec.scenario).stem}{' (fast)' if spec.fast else ''}")
-    where = f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers} local process(es)"
-    print(f"  running on {where}; log {Path(args.out) / 'jobs.jsonl'}", flush=True)
     outputs = Outputs()
     try:
-        outputs.directory(args.out, "--out")
+        outputs.directory(args.out, "--out")  # before anything is printed or run
+        print(f"sweep {spec.path.name}: {spec.description}")
+        print(
+            f"  {len(spec.jobs)} jobs of {Path(spec.scenario).stem}{' (fast)' if spec.fast else ''}"
+        )
+        where = (
+            f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers} local process(es)"
+        )
+        print(f"  running on {where}; log {Path(args.out) / 'jobs.jsonl'}", flush=True)
         with _sigterm_interrupts():
             try:
                 outcome = sweep.run_sweep(

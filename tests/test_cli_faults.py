@@ -14,6 +14,7 @@ import resource
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -62,15 +63,22 @@ def assert_one_line_error(result: subprocess.CompletedProcess[str], code: int, *
 
 
 def read_only_dir(tmp_path: Path) -> Path:
-    """An existing directory this process cannot write in (chmod; /proc/sys when root)."""
+    """An existing directory this process cannot write in (chmod; as root, where permission
+    bits do not apply, /proc/sys: procfs takes no new files)."""
     if os.geteuid() == 0:  # root ignores permission bits: use a read-only file system
         path = Path("/proc/sys")
     else:
         path = tmp_path / "read-only"
         path.mkdir()
         path.chmod(0o555)
-    assert path.is_dir() and not os.access(path, os.W_OK)
-    return path
+    assert path.is_dir()
+    try:  # the premise: no file can be created there
+        fd, name = tempfile.mkstemp(dir=path)
+    except OSError:
+        return path
+    os.close(fd)
+    os.unlink(name)
+    raise AssertionError(f"{path} is writable: no read-only directory for this test")
 
 
 # -- the contract is documented ---------------------------------------------------
