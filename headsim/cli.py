@@ -267,7 +267,12 @@ def _list(args: argparse.Namespace) -> int:
 def _study(args: argparse.Namespace) -> int:
     from headsim import study
 
-    return study.run(args)
+    outputs = Outputs()
+    try:
+        outputs.directory(args.out, "--out")  # before hours of calibration, not after
+        return study.run(args)
+    finally:
+        outputs.remove_empty_created()
 
 
 def _bench(args: argparse.Namespace) -> int:
@@ -275,7 +280,15 @@ def _bench(args: argparse.Namespace) -> int:
 
     args.baseline = args.baseline or str(bench.BASELINE)
     args.tolerances = args.tolerances or str(bench.TOLERANCES)
-    return bench.main(args)
+    outputs = Outputs()
+    try:
+        if args.json:
+            outputs.file(args.json, "--json")
+        if args.update_baseline:
+            outputs.file(args.baseline, "--baseline")
+        return bench.main(args)
+    finally:
+        outputs.remove_empty_created()
 
 
 def _sweep(args: argparse.Namespace) -> int:
