@@ -203,13 +203,13 @@ class MotorDriver:
                     min(math.sqrt(2.0 * lim.max_accel * abs(error)), abs(error) / dt), error
                 )
                 wanted = motor.goal_vel + approach
-            wanted = float(np.clip(wanted, -lim.max_speed, lim.max_speed))
-            dv = float(np.clip(wanted - motor.vel, -lim.max_accel * dt, lim.max_accel * dt))
+            wanted = min(max(wanted, -lim.max_speed), lim.max_speed)
+            dv = min(max(wanted - motor.vel, -lim.max_accel * dt), lim.max_accel * dt)
             motor.acc = dv / dt
             motor.vel += dv
             motor.ref += motor.vel * dt
             if not motor.low <= motor.ref <= motor.high:
-                motor.ref = float(np.clip(motor.ref, motor.low, motor.high))
+                motor.ref = min(max(motor.ref, motor.low), motor.high)
                 motor.vel, motor.acc = 0.0, 0.0
         self._write()
 
