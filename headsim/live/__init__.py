@@ -2,10 +2,11 @@
 
 from headsim.live.head import Frame, LiveConfig, LiveHead
 from headsim.live.motors import MotorDriver, MotorLimits
-from headsim.live.paths import RandomWalk, Sinusoid, Static, Throw, Visibility, Waypoints
+from headsim.live.paths import Jump, RandomWalk, Sinusoid, Static, Throw, Visibility, Waypoints
 
 __all__ = [
     "Frame",
+    "Jump",
     "LiveConfig",
     "LiveHead",
     "MotorDriver",

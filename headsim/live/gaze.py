@@ -301,8 +301,10 @@ def pursue(
         saccade = False
         if frame.end_s >= busy_until:
             if np.max(np.abs(correction[list(joints)])) > cfg.saccade_threshold_rad:
+                # A jump of the fixation angles is no motion to extrapolate: restart the predictor.
+                velocity = np.zeros(3)
                 apply_at = frame.end_s + live.config.latency_s
-                goal = fixation + velocity * (apply_at - frame.time_s)
+                goal = fixation
                 move = np.zeros(3)
                 move[list(joints)] = (goal - frame.encoders_rad)[list(joints)]
                 duration = _saccade_duration(move, live, cfg.saccade)

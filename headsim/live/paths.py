@@ -198,4 +198,22 @@ class Static:
     max_speed_m_s: float = 0.0
 
 
-Path = Waypoints | Sinusoid | RandomWalk | Throw | Static
+@dataclass(frozen=True)
+class Jump:
+    """At ``start`` until ``time_s``, then at once at ``end`` (world, m): a saccade's target."""
+
+    start: tuple[float, float, float]
+    end: tuple[float, float, float]
+    time_s: float
+
+    def __post_init__(self) -> None:
+        _vector("start", self.start)
+        _vector("end", self.end)
+        if not (math.isfinite(self.time_s) and self.time_s >= 0):
+            raise SettingsError(f"jump time_s must be >= 0 s, got {self.time_s}")
+
+    def position(self, t: float) -> np.ndarray:
+        return np.asarray(self.start if t < self.time_s else self.end, dtype=float).copy()
+
+
+Path = Waypoints | Sinusoid | RandomWalk | Throw | Static | Jump
