@@ -128,6 +128,7 @@ class FrameRecord:
     encoders_rad: np.ndarray
     fixation_rad: np.ndarray | None
     saccade: bool
+    uv_px: tuple[tuple[float, float] | None, tuple[float, float] | None] = (None, None)
 
 
 @dataclass(frozen=True)
@@ -257,8 +258,12 @@ def pursue(
     estimator: GazeEstimator,
     duration_s: float,
     config: GazeConfig | None = None,
+    on_frame: Callable[[FrameRecord], None] | None = None,
 ) -> PursuitRun:
-    """Run the gaze controller for ``duration_s`` of simulated time (bounded by ``max_frames``)."""
+    """Run the gaze controller for ``duration_s`` of simulated time (bounded by ``max_frames``).
+
+    ``on_frame`` is called with every frame's record (progress, recording).
+    """
     cfg = config or GazeConfig()
     joints = (0, 1, 2) if cfg.mode is GazeMode.NECK else (2,)
     records: list[FrameRecord] = []
@@ -271,7 +276,8 @@ def pursue(
             break
         frame: Frame = live.capture()
         seen = [detector(image) for image in frame.images]
-        if not all(s.found and s.uv is not None for s in seen):
+        uv = (seen[0].uv if seen[0].found else None, seen[1].uv if seen[1].found else None)
+        if uv[0] is None or uv[1] is None:
             records.append(
                 FrameRecord(
                     frame.time_s,
@@ -282,8 +288,11 @@ def pursue(
                     frame.encoders_rad,
                     None,
                     False,
+                    uv,
                 )
             )
+            if on_frame is not None:
+                on_frame(records[-1])
             last = None
             continue
         offsets = estimator.measure((seen[0].uv, seen[1].uv), frame.encoders_rad)  # type: ignore[arg-type]
@@ -323,8 +332,11 @@ def pursue(
                 frame.encoders_rad,
                 fixation,
                 saccade,
+                uv,
             )
         )
+        if on_frame is not None:
+            on_frame(records[-1])
     else:
         ended = "frame limit"
     return PursuitRun(tuple(records), ended)

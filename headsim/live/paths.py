@@ -9,7 +9,7 @@ step) is exact.  ``visible(t)`` says whether the target is in the scene at
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -126,7 +126,6 @@ class RandomWalk:
     seed: int = 0
     box_half_m: tuple[float, float, float] = (0.2, 0.2, 0.1)
     step_s: float = 0.01
-    _samples: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         start = _vector("start", self.start)
@@ -154,6 +153,7 @@ class RandomWalk:
             out = np.abs(nxt - start) > half
             velocity[out] = -velocity[out]
             points[i] = np.clip(nxt, start - half, start + half)
+        # Not a field: kept out of asdict (results.json) and of comparisons.
         object.__setattr__(self, "_samples", points)
 
     def position(self, t: float) -> np.ndarray:
