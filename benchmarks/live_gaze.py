@@ -39,7 +39,7 @@ EYE_HEIGHT = 0.21  # m, d1 + a2 of the default head
 
 
 def paths(depth: float, speed: float, duration: float, seed: int) -> dict[str, object]:
-    half = speed * duration / 4
+    half = min(speed * duration / 4, 0.25 * depth)  # within about 14 degrees of the midline
     return {
         "lateral": Waypoints(
             (
@@ -136,15 +136,17 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--fast", action="store_true", help="one depth, shorter runs")
     parser.add_argument("--json", help="write the figures to this JSON file")
+    parser.add_argument("--only", choices=("pursuit", "saccade", "blur"), help="one part only")
     args = parser.parse_args()
     duration = 1.0 if args.fast else 3.0
     depths = (1.0,) if args.fast else (0.5, 1.0, 1.5)
     results: dict[str, object] = {"pursuit": {}, "saccade": {}, "blur": {}}
+    parts = {args.only} if args.only else {"pursuit", "saccade", "blur"}
     print("pursuit: 0.3 m/s, 30 Hz, 1 frame latency, Model 1 with the neck, 640 x 480")
     print(
         f"{'path':<12} {'depth':>5} {'pred':>5} {'loss':>4} {'lost':>4} {'rms %':>6} {'rms mm':>7} {'lag ms':>7} {'off px':>6}"
     )
-    for depth in depths:
+    for depth in depths if "pursuit" in parts else ():
         for name, path in paths(depth, 0.3, duration, seed=int(depth * 10)).items():
             for predictor in (True, False):
                 fig = pursuit_case(path, predictor, duration)
@@ -157,7 +159,9 @@ def main() -> None:
                     f"{fig.get('rms_mm', math.nan):>7.2f} {fig.get('lag_ms', math.nan):>7.1f} {fig.get('offset_rms_px', math.nan):>6.2f}"
                 )
     print("saccades at 1 m: time from the jump to within 1 px (2 px) of the goals, ms")
-    for degrees in (10, 20, 30) if args.fast else (10, 15, 20, 25, 30):
+    for degrees in (
+        ((10, 20, 30) if args.fast else (10, 15, 20, 25, 30)) if "saccade" in parts else ()
+    ):
         for profile in SaccadeProfile:
             fig = saccade_case(degrees, profile)
             results["saccade"][f"{degrees} deg {profile.value}"] = fig  # type: ignore[index]
@@ -165,7 +169,8 @@ def main() -> None:
                 f"{degrees:>3} deg {profile.value:<10} {fig.get('time_to_fixation_ms', math.nan):7.1f} "
                 f"({fig.get('time_to_2px_ms', math.nan):.1f})  saccades {fig.get('saccades', 0):.0f}"
             )
-    results["blur"] = blur_cost(5 if args.fast else 20)
+    if "blur" in parts:
+        results["blur"] = blur_cost(5 if args.fast else 20)
     print("motion blur: " + ", ".join(f"{k} = {v:.2f}" for k, v in results["blur"].items()))  # type: ignore[union-attr]
     if args.json:
         write_json_atomic(args.json, results)
