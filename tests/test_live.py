@@ -7,7 +7,16 @@ from functools import partial
 import numpy as np
 import pytest
 
-from headsim.live import LiveConfig, LiveHead, MotorLimits, RandomWalk, Static, Waypoints
+from headsim.live import (
+    Jump,
+    LiveConfig,
+    LiveHead,
+    MotorLimits,
+    RandomWalk,
+    Static,
+    Visibility,
+    Waypoints,
+)
 from headsim.live.gaze import GazeConfig, acquire, pursue
 from headsim.live.motors import bang_bang_duration, min_jerk, min_jerk_duration
 from headsim.settings import IDEAL_FOCAL_PX, CameraSettings, HeadSettings, SettingsError
@@ -195,3 +204,26 @@ def test_pursuit_scenario_writes_results_and_a_recording_of_path_estimates_and_e
     )  # one per frame, on the frame timeline
     assert len(frames_of("/world/pursuit/estimates", "Points3D:positions")) == frames
     assert max(experiment["per_frame"]["error_m"]) < 0.02  # m, at about 1 m, 320 x 240
+
+
+def test_losses_reacquisitions_and_a_target_that_disappears_and_reappears_elsewhere() -> None:
+    centre, aside = (0.0, 0.8, 0.21), (0.08, 0.8, 0.24)
+    out_of_view = (0.0, 0.8, 1.5)  # present, far above the view
+    # Seen, then out of view for 0.1 s (a loss), then back (a re-acquisition).
+    lost_path = Waypoints((centre, out_of_view, (0.0, 0.8, 1.501), centre), (1000.0, 0.01, 1000.0))
+    # Seen, absent from 0.3 to 0.5 s, back elsewhere: no loss, a saccade, a new fixation.
+    jump = Jump(centre, aside, 0.4)
+    windows = Visibility(((0.0, 0.3), (0.5, 2.0)))
+    runs = {}
+    for name, path, visibility in (("lost", lost_path, None), ("jump", jump, windows)):
+        with HeadSim(settings=small_head()) as sim:
+            live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path, visibility)
+            estimator = acquire(live, RED)
+            assert estimator is not None
+            runs[name] = pursue(live, RED, estimator, 1.0)
+    lost, jumped = runs["lost"], runs["jump"]
+    assert lost.losses == 1 and lost.reacquisitions == 1 and lost.frames_lost >= 3
+    assert jumped.losses == 0 and jumped.frames_lost == 0
+    assert sum(1 for r in jumped.records if r.truth_world_m is None) == 6  # 0.2 s at 30 Hz
+    assert any(r.saccade for r in jumped.records if r.time_s >= 0.5)
+    assert 0.0 < jumped.time_to_fixation_s(1.0, since_s=0.5) < 0.4

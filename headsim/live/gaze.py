@@ -16,8 +16,9 @@ From these, every frame gives
 Smooth pursuit drives the motors towards ``q*``; with the constant-velocity
 predictor the goal moves on at ``q*``'s estimated velocity, which makes up for
 the latency.  A saccade (minimum-jerk or bang-bang, within the motor limits)
-is made when the target is newly seen or the offset is large.  Truth is read
-only to score the run.
+is made when the target is newly seen or the offset is large.  A target not
+seen is coasted after on the prediction for ``coast_frames`` frames; then the
+gaze holds.  Truth is read only to score the run.
 """
 
 from __future__ import annotations
@@ -56,6 +57,7 @@ class GazeConfig:
     saccade_threshold_rad: float = 0.05  # a larger fixation correction starts a saccade
     fixation_tolerance_px: float = 1.0
     velocity_smoothing: float = 0.5  # weight of the newest velocity sample, (0, 1]
+    coast_frames: int = 10  # frames the gaze coasts on its prediction when the target is not seen
     max_frames: int = 100_000
 
 
@@ -270,6 +272,7 @@ def pursue(
     last: tuple[float, np.ndarray] | None = None
     velocity = np.zeros(3)
     busy_until = -math.inf
+    unseen = 0
     ended = "duration"
     for _ in range(cfg.max_frames):
         if live.time_s >= duration_s:
@@ -294,7 +297,12 @@ def pursue(
             if on_frame is not None:
                 on_frame(records[-1])
             last = None
+            unseen += 1
+            if unseen == cfg.coast_frames + 1:  # stop coasting: hold where the joints are
+                held = frame.encoders_rad.copy()
+                live.send(_command(held, np.zeros(3), frame.time_s, joints), frame)
             continue
+        unseen = 0
         offsets = estimator.measure((seen[0].uv, seen[1].uv), frame.encoders_rad)  # type: ignore[arg-type]
         fixation = offsets.fixation_rad.copy()
         if cfg.mode is GazeMode.EYES:
