@@ -42,6 +42,32 @@ def steps_per_second(env: gymnasium.Env, policy: object | None, steps: int) -> f
     return done / elapsed
 
 
+def step_over_render_ratio(
+    env: gymnasium.Env, blocks: int = 6, size: int = 50
+) -> tuple[float, float]:
+    """Env step time over a bare stereo render's (the same renderer), interleaved in blocks.
+
+    A ratio survives a loaded machine better than a rate.  Returns (ratio,
+    bare stereo renders per second).
+    """
+    env.reset(seed=0)
+    sim = env.unwrapped._sim
+    zero = np.zeros(3, np.float32)
+    step_s = render_s = 0.0
+    for _ in range(blocks):
+        start = time.perf_counter()
+        for _ in range(size):
+            if any(env.step(zero)[2:4]):
+                env.reset(seed=0)
+        step_s += time.perf_counter() - start
+        start = time.perf_counter()
+        for _ in range(size):
+            sim.render(1)
+            sim.render(2)
+        render_s += time.perf_counter() - start
+    return step_s / render_s, blocks * size / render_s
+
+
 def episodes(env: gymnasium.Env, policy: object, count: int, limit: int = 10) -> list[int | None]:
     lengths: list[int | None] = []
     for seed in range(count):
@@ -87,6 +113,9 @@ def main() -> None:
         "env_steps_per_s_zero_action": steps_per_second(env, None, args.steps),
         "env_steps_per_s_with_servo_policy": steps_per_second(env, servo, args.steps),
     }
+    ratio, renders = step_over_render_ratio(env)
+    results["env_step_over_bare_stereo_render"] = ratio
+    results["bare_stereo_renders_per_s"] = renders
     servo = ServoPolicy(env.action_space, env.unwrapped.period_s)
     lengths = episodes(env, servo, args.episodes)
     fixated = [n is not None for n in lengths]
