@@ -308,23 +308,29 @@ def pursue(
         if cfg.mode is GazeMode.EYES:
             fixation[:2] = frame.encoders_rad[:2]
             fixation[2] = estimator.eye_fixation(offsets, frame.encoders_rad)
-        if last is not None and cfg.predictor:
-            sample = (fixation - last[1]) / (frame.time_s - last[0])
-            velocity = cfg.velocity_smoothing * sample + (1 - cfg.velocity_smoothing) * velocity
-        elif last is None:
+        # A jump of the fixation angles (a target newly seen or moved at once) is no
+        # motion to extrapolate: the predictor restarts.
+        jumped = last is None or bool(
+            np.max(np.abs(fixation - last[1])) > cfg.saccade_threshold_rad
+        )
+        if jumped or not cfg.predictor:
             velocity = np.zeros(3)
+        else:
+            sample = (fixation - last[1]) / (frame.time_s - last[0])  # type: ignore[index]
+            velocity = cfg.velocity_smoothing * sample + (1 - cfg.velocity_smoothing) * velocity
         last = (frame.time_s, fixation)
         correction = fixation - frame.encoders_rad
         saccade = False
         if frame.end_s >= busy_until:
             if np.max(np.abs(correction[list(joints)])) > cfg.saccade_threshold_rad:
-                # A jump of the fixation angles is no motion to extrapolate: restart the predictor.
-                velocity = np.zeros(3)
+                # Aim where the target will be when the saccade lands (catch-up saccade).
                 apply_at = frame.end_s + live.config.latency_s
-                goal = fixation
-                move = np.zeros(3)
-                move[list(joints)] = (goal - frame.encoders_rad)[list(joints)]
-                duration = _saccade_duration(move, live, cfg.saccade)
+                duration = 0.0
+                for _ in range(2):
+                    goal = fixation + velocity * (apply_at + duration - frame.time_s)
+                    move = np.zeros(3)
+                    move[list(joints)] = (goal - frame.encoders_rad)[list(joints)]
+                    duration = _saccade_duration(move, live, cfg.saccade)
                 live.send(_saccade_command(goal, duration, joints, cfg.saccade), frame)
                 busy_until = apply_at + duration
                 saccade = True
