@@ -36,6 +36,8 @@ bench: setup
 	$(BIN)/python benchmarks/vision_speed.py
 	$(BIN)/python benchmarks/stereo_calibration.py
 	$(BIN)/python benchmarks/procedures_accuracy.py
+	$(BIN)/python benchmarks/live_gaze.py
+	$(BIN)/python benchmarks/gym_env.py
 
 clean:
 	rm -rf $(VENV) out

@@ -16,6 +16,10 @@ and timelines (README "Scenarios and results" lists them):
   ``/world/truth``, ``/world/estimate``, ``/world/error``,
   ``/world/current_target``, ``/world/calibration/positions``,
   ``/world/moving_target/path``, ``/world/areas/lines``, ``/world/areas/objects``;
+  the pursuit procedure adds ``/world/pursuit/path`` (the target's path) and
+  ``/world/pursuit/estimates`` (every frame's estimate so far), and logs
+  ``/world/truth``, ``/world/estimate``, ``/world/error``, the servo offsets
+  and ``/measurements/error_mm``, ``.../error_pct_of_depth`` once per frame;
 - ``/servo/cam1/u_error_px``, ``/servo/cam2/u_error_px``, ``.../v_error_px``;
   ``/joints/eye_rad``, ``/joints/neck_yaw_rad``, ``/joints/neck_pitch_rad``;
   ``/measurements/error_mm``, ``/measurements/error_pct_of_depth``,
@@ -121,6 +125,7 @@ class Recorder(Observer):
         self.world_from_head_start = np.eye(4)
         self.objects: dict[str, str] = {}
         self.closed = False
+        self._pursuit_trail: list[np.ndarray] = []
         self._log_static()
 
     # -- helpers ------------------------------------------------------------------
@@ -370,6 +375,57 @@ class Recorder(Observer):
         if residuals:
             self.rec.log("/measurements/servo_residual_px", rr.Scalars([max(residuals)]))
         self.rec.flush()
+
+    def pursued(self, record: Any, frame: int) -> None:
+        """A live pursuit frame: truth, estimate and error on the frame timeline."""
+        self.current_frame = frame
+        self._time()
+        spec = self.scenario.scene.pursuit
+        if not self._pursuit_trail and spec is not None:
+            times = spec.sample_times(0.02)
+            path = [
+                spec.path.position(float(t)) for t in times if spec.visibility.visible(float(t))
+            ]
+            if len(path) > 1:
+                self.rec.log(
+                    "/world/pursuit/path",
+                    rr.LineStrips3D([np.array(path)], colors=[_GREY], labels=["path"]),
+                    static=True,
+                )
+        truth, estimate = record.truth_world_m, record.estimate_world_m
+        if truth is not None:
+            self.rec.log("/world/truth", rr.Points3D([truth], radii=0.003, colors=[_WHITE]))
+        else:
+            self.rec.log("/world/truth", rr.Clear(recursive=False))
+        for index, cam in enumerate(names.CAMERAS):
+            uv = record.uv_px[index]
+            if uv is None:
+                self.rec.log(f"/world/head/{cam}/features", rr.Clear(recursive=False))
+                continue
+            self.rec.log(
+                f"/world/head/{cam}/features", rr.Points2D([uv], radii=4.0, colors=[_GREEN])
+            )
+        if record.error_px is not None:
+            for index, cam in enumerate(names.CAMERAS):
+                self.rec.log(
+                    f"/servo/{cam}/u_error_px", rr.Scalars([float(record.error_px[index])])
+                )
+        if estimate is None or not np.all(np.isfinite(estimate)):
+            self.rec.log("/world/estimate", rr.Clear(recursive=False))
+            self.rec.log("/world/error", rr.Clear(recursive=False))
+            return
+        self._pursuit_trail.append(np.asarray(estimate, float))
+        self.rec.log("/world/estimate", rr.Points3D([estimate], radii=0.004, colors=[_GREEN]))
+        self.rec.log(
+            "/world/pursuit/estimates",
+            rr.Points3D(np.array(self._pursuit_trail), radii=0.0015, colors=[_GREEN]),
+        )
+        if truth is not None:
+            error = float(np.linalg.norm(estimate - truth))
+            self.rec.log("/world/error", rr.LineStrips3D([[truth, estimate]], colors=[_RED]))
+            self.rec.log("/measurements/error_mm", rr.Scalars([error * 1000.0]))
+            depth = float(np.linalg.norm(truth - self.world_from_head_start[:3, 3]))
+            self.rec.log("/measurements/error_pct_of_depth", rr.Scalars([100.0 * error / depth]))
 
     def calibrated(self, calibration: dict[str, Any]) -> None:
         self._time()

@@ -406,7 +406,13 @@ def summary_text(result: RunResult) -> str:
         lines += [*_tracking_lines(e), ""]
     elif procedure == "calibration" and "check_targets" in e:
         lines += [*_check_lines(e), ""]
-    if result.ok:
+    elif procedure == "pursuit" and "frames" in e:
+        from headsim.live.procedure import summary_lines
+
+        lines += [*summary_lines(e), ""]
+    if result.ok and procedure == "pursuit":
+        lines.append(f"OK: {e.get('frames', 0)} frames, the target never lost")
+    elif result.ok:
         count = len(result.records)
         lines.append(f"OK: {count} measurement{'' if count == 1 else 's'}, none failed")
     else:

@@ -95,6 +95,9 @@ class Observer:
     def calibrated(self, calibration: dict[str, Any]) -> None:
         """The calibration is finished (the results.json ``calibration`` block)."""
 
+    def pursued(self, record: Any, frame: int) -> None:
+        """A live frame of the pursuit procedure (``headsim.live.gaze.FrameRecord``) is measured."""
+
     def finished(self, result: RunResult) -> None:
         """The run is over."""
 
@@ -199,6 +202,10 @@ class Hub:
     def calibrated(self, calibration: dict[str, Any]) -> None:
         for o in self.observers:
             o.calibrated(calibration)
+
+    def pursued(self, record: Any) -> None:
+        for o in self.observers:
+            o.pursued(record, self.frame - 1)
 
     def finished(self, result: RunResult) -> None:
         for o in self.observers:
@@ -652,6 +659,15 @@ def _run_tracking(
     return records, experiment
 
 
+def _run_pursuit(
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], dict[str, Any]]:
+    """The live head pursues a moving target (headsim.live.procedure)."""
+    from headsim.live.procedure import run_pursuit
+
+    return run_pursuit(scenario, hub, knowledge, label)
+
+
 RUNNERS = {
     "model2": _run_points,
     "model1": _run_points,
@@ -659,6 +675,7 @@ RUNNERS = {
     "chessboard": _run_chessboard,
     "relative_positioning": _run_relative,
     "tracking": _run_tracking,
+    "pursuit": _run_pursuit,
 }
 
 
@@ -693,6 +710,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
         f"{r.measurement.name}: {r.measurement.status}" for r in records if not r.measurement.ok
     ]
     failures += [f"{name}: not seen in all four images" for name in experiment.get("missing", [])]
+    failures += list(experiment.pop("failures", []))
     renders["total"] = renders["calibration"] + renders["experiment"]
     timing["total"] = sum(timing.values())
     result = RunResult(

@@ -61,6 +61,7 @@ PROCEDURES = {
     "tracking": "default",
     "chessboard": "chessboard",
     "relative_positioning": "blocks",
+    "pursuit": "default",  # the live head (headsim.live.spec)
 }
 #: Bodies of the default scene that can be measured, and the colour each is found by.
 MARKER_BODIES = {**names.MARKER_COLOURS, names.CALIBRATION_BALL: "yellow"}
@@ -177,6 +178,7 @@ class SceneSpec:
     objects: tuple[Placement, ...] = ()
     parked: tuple[str, ...] = ()
     moving: MovingTarget | None = None
+    pursuit: Any = None  # headsim.live.spec.PursuitSpec for the pursuit procedure
 
 
 @dataclass(frozen=True)
@@ -211,6 +213,9 @@ class Scenario:
             return count + 1
         if procedure == "tracking":
             return count + (self.scene.moving.steps if self.scene.moving else 0)
+        if procedure == "pursuit":  # one step per camera frame
+            pursuit = self.scene.pursuit
+            return count + math.ceil(pursuit.duration_s * pursuit.live.frame_rate_hz)
         per_target = 2 if procedure == "calibration" else 1
         return count + per_target * len(self.scene.targets)
 
@@ -752,6 +757,10 @@ def _read_scene(
         spec = _read_blocks(table, ctx, settings, seed)
     elif procedure == "tracking":
         spec = replace(spec, moving=_read_moving(table, ctx, settings, seed))
+    elif procedure == "pursuit":
+        from headsim.live.spec import read_pursuit
+
+        spec = replace(spec, pursuit=read_pursuit(table, seed, tuple(MARKER_BODIES)))
     table.done()
     return spec
 
@@ -1084,6 +1093,21 @@ def _check_reach(ctx: _Context, scenario: Scenario) -> None:
                     f"{placement.name} at {_fmt(p)} m in H is outside a camera's view at the start pose",
                     "objects that both cameras see with neck and eyes at 0",
                 )
+    if scene.pursuit is not None:
+        pursuit = scene.pursuit
+        first = True
+        for t in pursuit.sample_times():
+            if not pursuit.visibility.visible(float(t)):
+                continue
+            _check_model1_reach(
+                ctx,
+                head,
+                "scene.pursuit.path",
+                pursuit.path.position(float(t)),
+                f"the target at t = {t:g} s",
+                first,
+            )
+            first = False
     if scene.moving is not None:
         moving = scene.moving
         for k, t in enumerate(moving.times_s):

@@ -105,6 +105,12 @@ def test_every_scenario_runs_in_its_fast_variant(
     if path.stem == "tracking":
         assert len(experiment["errors_world_m"]) == scenario.scene.moving.steps  # type: ignore[union-attr]
         assert max(experiment["errors_world_m"]) < 0.003
+    if path.stem == "pursuit":
+        frames = experiment["per_frame"]
+        assert experiment["frames"] == len(frames["time_s"]) >= 15  # 0.5 s at 30 Hz
+        assert experiment["losses"] == 0 and all(frames["found"])
+        assert experiment["position_rms_pct_of_depth"] < 1.0
+        assert "position error RMS along the path" in out
 
 
 def test_the_same_seed_gives_identical_results_with_or_without_a_recording(

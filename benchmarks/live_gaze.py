@@ -1,0 +1,180 @@
+"""The live head: pursuit accuracy, saccade time to fixation, the cost of motion blur.
+
+Pursuit: a marker on paths at up to 0.3 m/s at 0.5, 1.0 and 1.5 m (a lateral
+waypoint path, a sinusoid and a seeded random walk), 30 Hz camera, 1 frame of
+latency, Model 1 with the neck; with and without the constant-velocity
+predictor.  Figures per run: losses, re-acquisitions, frames lost, position
+error RMS along the path (% of distance, every frame the target is seen),
+pursuit lag, image offset RMS.
+
+Saccades: the head fixates a marker, which then jumps by 10-30 degrees (a
+direction 35 degrees above the horizontal, so that the 30 degree jump stays in
+the 640 x 480 view); time from the jump to the first frame within 1 px of the
+goals, for minimum-jerk and bang-bang profiles, against the motor limits.
+
+Motion blur: render time per stereo frame with 1 and with 5 sub-frames.
+
+    python benchmarks/live_gaze.py [--fast] [--json out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from functools import partial
+
+import numpy as np
+
+import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
+from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Sinusoid, Waypoints
+from headsim.live.gaze import GazeConfig, SaccadeProfile, acquire, pursue
+from headsim.results import write_json_atomic
+from headsim.settings import HeadSettings
+from headsim.sim import HeadSim
+from headsim.vision import find_marker
+
+RED = partial(find_marker, colour="red")
+EYE_HEIGHT = 0.21  # m, d1 + a2 of the default head
+
+
+def paths(depth: float, speed: float, duration: float, seed: int) -> dict[str, object]:
+    half = min(speed * duration / 4, 0.25 * depth)  # within about 14 degrees of the midline
+    return {
+        "lateral": Waypoints(
+            (
+                (-half, depth, EYE_HEIGHT),
+                (half, depth, EYE_HEIGHT),
+                (-half, depth, EYE_HEIGHT + 0.05),
+            ),
+            (speed, speed),
+        ),
+        # Peak speed = 2 pi f |A| = 0.3 m/s.
+        "sinusoid": Sinusoid(
+            (0.0, depth, EYE_HEIGHT),
+            (0.08, 0.06, 0.03),
+            speed / (2 * math.pi * math.sqrt(0.08**2 + 0.06**2 + 0.03**2)),
+        ),
+        "random walk": RandomWalk(
+            (0.0, depth, EYE_HEIGHT), speed, duration + 1, seed=seed, box_half_m=(0.15, 0.1, 0.06)
+        ),
+    }
+
+
+def pursuit_case(path: object, predictor: bool, duration: float) -> dict[str, float]:
+    with HeadSim(settings=HeadSettings()) as sim:
+        live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path)  # type: ignore[arg-type]
+        estimator = acquire(live, RED)
+        if estimator is None:
+            return {"acquired": 0.0}
+        run = pursue(live, RED, estimator, duration, GazeConfig(predictor=predictor))
+        depth = float(np.mean(run.depths_m))
+        return {
+            "acquired": 1.0,
+            "frames": float(len(run.records)),
+            "losses": float(run.losses),
+            "reacquisitions": float(run.reacquisitions),
+            "frames_lost": float(run.frames_lost),
+            "rms_pct_of_depth": run.rms_error_pct_of_depth(),
+            "rms_mm": 1000 * float(np.sqrt(np.mean(run.errors_m**2))),
+            "lag_ms": 1000 * run.lag_s(),
+            "offset_rms_px": run.rms_offset_px(),
+            "mean_depth_m": depth,
+        }
+
+
+def saccade_case(degrees: float, profile: SaccadeProfile, depth: float = 1.0) -> dict[str, float]:
+    start = np.array([0.0, depth, EYE_HEIGHT])
+    direction = math.radians(35.0)
+    angle = math.radians(degrees)
+    azimuth, elevation = angle * math.cos(direction), angle * math.sin(direction)
+    end = np.array(
+        [
+            depth * math.sin(azimuth) * math.cos(elevation),
+            depth * math.cos(azimuth) * math.cos(elevation),
+            EYE_HEIGHT + depth * math.sin(elevation),
+        ]
+    )
+    jump_s = 0.1
+    path = Jump(tuple(start), tuple(end), jump_s)
+    with HeadSim(settings=HeadSettings()) as sim:
+        live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path)
+        estimator = acquire(live, RED)
+        if estimator is None:
+            return {"acquired": 0.0}
+        run = pursue(live, RED, estimator, jump_s + 1.0, GazeConfig(saccade=profile))
+        return {
+            "time_to_fixation_ms": 1000 * run.time_to_fixation_s(1.0, since_s=jump_s),
+            "time_to_2px_ms": 1000 * run.time_to_fixation_s(2.0, since_s=jump_s),
+            "saccades": float(sum(r.saccade for r in run.records)),
+            "frames_lost": float(run.frames_lost),
+        }
+
+
+def blur_cost(frames: int) -> dict[str, float]:
+    out = {}
+    for sub in (1, 5):
+        config = LiveConfig(exposure_s=1 / 60, blur_subframes=sub, latency_frames=0)
+        with HeadSim(settings=HeadSettings()) as sim:
+            live = LiveHead(
+                sim, config, "marker_red", Waypoints(((0, 0.8, 0.2), (0.3, 0.8, 0.2)), (0.3,))
+            )
+            live.capture()
+            start = time.perf_counter()
+            for _ in range(frames):
+                live.capture()
+            out[f"ms_per_stereo_frame_{sub}_subframes"] = (
+                1000 * (time.perf_counter() - start) / frames
+            )
+    out["blur_cost_ratio"] = (
+        out["ms_per_stereo_frame_5_subframes"] / out["ms_per_stereo_frame_1_subframes"]
+    )
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--fast", action="store_true", help="one depth, shorter runs")
+    parser.add_argument("--json", help="write the figures to this JSON file")
+    parser.add_argument("--only", choices=("pursuit", "saccade", "blur"), help="one part only")
+    args = parser.parse_args()
+    duration = 1.0 if args.fast else 3.0
+    depths = (1.0,) if args.fast else (0.5, 1.0, 1.5)
+    results: dict[str, object] = {"pursuit": {}, "saccade": {}, "blur": {}}
+    parts = {args.only} if args.only else {"pursuit", "saccade", "blur"}
+    print("pursuit: 0.3 m/s, 30 Hz, 1 frame latency, Model 1 with the neck, 640 x 480")
+    print(
+        f"{'path':<12} {'depth':>5} {'pred':>5} {'loss':>4} {'lost':>4} {'rms %':>6} {'rms mm':>7} {'lag ms':>7} {'off px':>6}"
+    )
+    for depth in depths if "pursuit" in parts else ():
+        for name, path in paths(depth, 0.3, duration, seed=int(depth * 10)).items():
+            for predictor in (True, False):
+                fig = pursuit_case(path, predictor, duration)
+                results["pursuit"][
+                    f"{name} {depth} m {'predictor' if predictor else 'no predictor'}"
+                ] = fig  # type: ignore[index]
+                print(
+                    f"{name:<12} {depth:>5.1f} {'yes' if predictor else 'no':>5} {fig.get('losses', -1):>4.0f} "
+                    f"{fig.get('frames_lost', -1):>4.0f} {fig.get('rms_pct_of_depth', math.nan):>6.3f} "
+                    f"{fig.get('rms_mm', math.nan):>7.2f} {fig.get('lag_ms', math.nan):>7.1f} {fig.get('offset_rms_px', math.nan):>6.2f}"
+                )
+    print("saccades at 1 m: time from the jump to within 1 px (2 px) of the goals, ms")
+    for degrees in (
+        ((10, 20, 30) if args.fast else (10, 15, 20, 25, 30)) if "saccade" in parts else ()
+    ):
+        for profile in SaccadeProfile:
+            fig = saccade_case(degrees, profile)
+            results["saccade"][f"{degrees} deg {profile.value}"] = fig  # type: ignore[index]
+            print(
+                f"{degrees:>3} deg {profile.value:<10} {fig.get('time_to_fixation_ms', math.nan):7.1f} "
+                f"({fig.get('time_to_2px_ms', math.nan):.1f})  saccades {fig.get('saccades', 0):.0f}"
+            )
+    if "blur" in parts:
+        results["blur"] = blur_cost(5 if args.fast else 20)
+    print("motion blur: " + ", ".join(f"{k} = {v:.2f}" for k, v in results["blur"].items()))  # type: ignore[union-attr]
+    if args.json:
+        write_json_atomic(args.json, results)
+
+
+if __name__ == "__main__":
+    main()

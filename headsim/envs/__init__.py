@@ -1,0 +1,21 @@
+"""Gymnasium environments of the head (optional extra ``gym``).
+
+``import headsim.envs`` registers ``headsim/Fixate-v0``; then
+``gymnasium.make("headsim/Fixate-v0")``.  In spawned worker processes
+(``gymnasium.make_vec(..., vectorization_mode="async",
+vector_kwargs={"context": "spawn"})``) the entry point imports this module.
+"""
+
+from __future__ import annotations
+
+try:
+    import gymnasium
+except ImportError as err:  # pragma: no cover - depends on the install
+    raise ImportError("headsim.envs needs Gymnasium: pip install 'headsim[gym]'") from err
+
+FIXATE_ID = "headsim/Fixate-v0"
+
+if FIXATE_ID not in gymnasium.registry:
+    gymnasium.register(id=FIXATE_ID, entry_point="headsim.envs.fixate:FixateEnv")
+
+__all__ = ["FIXATE_ID"]

@@ -1,0 +1,312 @@
+"""``headsim/Fixate-v0``: bring a marker onto both cameras' goal columns with neck and eyes.
+
+Observation (``Dict``): ``cam1``, ``cam2`` -- both cameras' RGB images
+(default 128 x 96); ``encoders`` -- (neck yaw, neck pitch, eye motor), rad.
+Action (``Box``): velocity commands for (neck yaw, neck pitch, eye motor),
+rad/s, within the motors' speed limits; each is held for one frame period
+while the motor ramps to it within its acceleration limit (physics).
+
+Reward ``"offsets"`` (default): minus the mean of the absolute image offsets
+``(u1 - u10)/(W/2), (u2 - u20)/(W/2), ((v1 + v2)/2 - v0)/(H/2)``, each 1 when
+the marker is not seen.  Reward ``"position"``: minus the 3-D error of the
+head's own Model 1 estimate (eqs. (2), (3) from the encoders) against the
+truth, as a fraction of the target's distance (1 when no estimate).
+
+Episodes: ``reset(seed=..., options=...)`` places the marker at a seeded
+random depth and bearing (and, with ``target_speed_m_s`` > 0, on a seeded
+straight path); ``randomise`` maps a field to a ``(low, high)`` range drawn
+per episode: camera fields (``kx``, ``ky``, ``k1``, ``k2``,
+``mount_yaw_rad``, ``mount_pitch_rad``, ``mount_roll_rad``, ``noise_std``;
+each camera drawn independently), ``baseline_m``, and the target's
+``depth_m``, ``bearing_rad``, ``speed_m_s``.  Terminated when the marker is
+within ``tolerance_px`` of the goals in both images; truncated after
+``max_steps`` steps.
+
+The target is a red ball (``target_radius_m``, default 20 mm: the scenes' 4 mm
+markers are a third of a pixel across at 1.5 m in a 128 x 96 image).
+``multisamples`` is MuJoCo's off-screen multisampling: 0 by default here,
+because 4 (the at-rest procedures' setting, edges to a quarter pixel) made a
+128 x 96 render about 5 times slower on the CPU renderer (6.5 against 1.3 ms
+per image, one run).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any, ClassVar
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from headsim.kinematics import head_to_world
+from headsim.live.head import EYE_LIMITS, NECK_LIMITS, LiveConfig, LiveHead
+from headsim.live.paths import Static, Waypoints
+from headsim.settings import IDEAL_FOCAL_PX, CameraSettings, HeadSettings, SettingsError
+from headsim.sim import HeadSim
+from headsim.vision import find_marker
+
+TARGET_BODY = "marker_red"
+TARGET_COLOUR = "red"
+CAMERA_FIELDS = (
+    "kx",
+    "ky",
+    "k1",
+    "k2",
+    "mount_yaw_rad",
+    "mount_pitch_rad",
+    "mount_roll_rad",
+    "noise_std",
+)
+HEAD_FIELDS = ("baseline_m",)
+TARGET_FIELDS = ("depth_m", "bearing_rad", "speed_m_s")
+REWARDS = ("offsets", "position")
+
+
+def _check_ranges(randomise: dict[str, Any]) -> dict[str, tuple[float, float]]:
+    allowed = (*CAMERA_FIELDS, *HEAD_FIELDS, *TARGET_FIELDS)
+    ranges = {}
+    for name, bounds in randomise.items():
+        if name not in allowed:
+            raise SettingsError(f"randomise: unknown field {name!r}; allowed: {', '.join(allowed)}")
+        lo, hi = (float(b) for b in bounds)
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+            raise SettingsError(
+                f"randomise.{name} must be (low, high) with low <= high, got {bounds!r}"
+            )
+        ranges[name] = (lo, hi)
+    return ranges
+
+
+class FixateEnv(gymnasium.Env):
+    """Fixate a marker with the live head (see the module docstring)."""
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(
+        self,
+        width: int = 128,
+        height: int = 96,
+        frame_rate_hz: float = 30.0,
+        latency_frames: int = 0,
+        max_steps: int = 50,
+        reward: str = "offsets",
+        tolerance_px: float = 1.0,
+        randomise: dict[str, Any] | None = None,
+        target_radius_m: float = 0.02,
+        multisamples: int = 0,
+        render_mode: str | None = None,
+    ) -> None:
+        if reward not in REWARDS:
+            raise SettingsError(f"reward must be one of {', '.join(REWARDS)}, got {reward!r}")
+        if render_mode not in (None, "rgb_array"):
+            raise SettingsError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        if not (isinstance(max_steps, int) and max_steps >= 1):
+            raise SettingsError(f"max_steps must be an integer >= 1, got {max_steps!r}")
+        if not (math.isfinite(target_radius_m) and 0.001 <= target_radius_m <= 0.1):
+            raise SettingsError(
+                f"target_radius_m must be within [0.001, 0.1] m, got {target_radius_m}"
+            )
+        if multisamples not in (0, 2, 4, 8):
+            raise SettingsError(f"multisamples must be 0, 2, 4 or 8, got {multisamples!r}")
+        self.target_radius_m = float(target_radius_m)
+        self.multisamples = multisamples
+        self.render_mode = render_mode
+        self.reward_kind = reward
+        self.max_steps = max_steps
+        self.tolerance_px = float(tolerance_px)
+        self.live_config = LiveConfig(frame_rate_hz=frame_rate_hz, latency_frames=latency_frames)
+        focal = IDEAL_FOCAL_PX * height / 480.0
+        camera = CameraSettings(width=width, height=height, kx=focal, ky=focal)
+        self.base_settings = HeadSettings(cameras=(camera, camera))
+        self.defaults = {
+            "depth_m": (0.5, 1.5),
+            "bearing_rad": (-0.15, 0.15),
+            "speed_m_s": (0.0, 0.0),
+        }
+        self.randomise = _check_ranges(randomise or {})
+        image = spaces.Box(0, 255, (height, width, 3), np.uint8)
+        low = np.array([-1.5708, -0.8, -0.7], np.float32)  # joint ranges, models/head.xml
+        self.observation_space = spaces.Dict(
+            {
+                "cam1": image,
+                "cam2": image,
+                "encoders": spaces.Box(low, -low, (3,), np.float32),
+            }
+        )
+        limits = np.array(
+            [NECK_LIMITS.max_speed, NECK_LIMITS.max_speed, EYE_LIMITS.max_speed], np.float32
+        )
+        self.action_space = spaces.Box(-limits, limits, (3,), np.float32)
+        self._sim: HeadSim | None = None
+        self._settings: HeadSettings | None = None
+        self._live: LiveHead | None = None
+        self._frame = None
+        self._steps = 0
+
+    # -- episodes --------------------------------------------------------------
+    @property
+    def period_s(self) -> float:
+        return self.live_config.period_s
+
+    def _draw(self, ranges: dict[str, tuple[float, float]], name: str) -> float:
+        lo, hi = ranges[name]
+        return float(self.np_random.uniform(lo, hi)) if hi > lo else lo
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        super().reset(seed=seed)
+        options = options or {}
+        ranges = {**self.defaults, **self.randomise, **_check_ranges(options.get("randomise", {}))}
+        cameras = []
+        for cam in self.base_settings.cameras:
+            changes = {f: self._draw(ranges, f) for f in CAMERA_FIELDS if f in ranges}
+            cameras.append(replace(cam, **changes))
+        head = {f: self._draw(ranges, f) for f in HEAD_FIELDS if f in ranges}
+        seed_noise = int(self.np_random.integers(0, 2**31 - 1))
+        if all(c.noise_std == 0 for c in cameras):
+            seed_noise = 0  # noiseless images do not depend on it: keep the renderer
+        settings = replace(
+            self.base_settings, cameras=(cameras[0], cameras[1]), seed=seed_noise, **head
+        )
+        if self._sim is None or settings != self._settings:
+            if self._sim is not None:
+                self._sim.close()
+            self._sim, self._settings = HeadSim("default", settings), settings
+            self._prepare_model(self._sim)
+        sim = self._sim
+        sim.reset()
+        depth = self._draw(ranges, "depth_m")
+        azimuth, elevation = self._draw(ranges, "bearing_rad"), self._draw(ranges, "bearing_rad")
+        eye_height = settings.neck_d1_m + settings.neck_a2_m
+        start = np.array(
+            [
+                depth * math.sin(azimuth) * math.cos(elevation),
+                depth * math.cos(azimuth) * math.cos(elevation),
+                eye_height + depth * math.sin(elevation),
+            ]
+        )
+        if "target_world_m" in options:
+            start = np.asarray(options["target_world_m"], float)
+        speed = self._draw(ranges, "speed_m_s")
+        if speed > 0:
+            direction = self.np_random.normal(size=3)
+            direction /= np.linalg.norm(direction)
+            end = start + direction * speed * self.max_steps * self.period_s
+            path = Waypoints((tuple(start), tuple(end)), (speed,))
+        else:
+            path = Static(tuple(start))
+        self._live = LiveHead(sim, self.live_config, target_body=TARGET_BODY, path=path)
+        self._steps = 0
+        self._frame = self._live.capture()
+        return self._observation(), self._info(self._measure())
+
+    def step(
+        self, action: np.ndarray
+    ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
+        if self._live is None or self._frame is None:
+            raise RuntimeError("call reset() before step()")
+        speeds = np.clip(np.asarray(action, float), self.action_space.low, self.action_space.high)
+
+        def command(motors, _now: float) -> None:
+            for index, speed in enumerate(speeds):
+                motors.set_velocity(index, float(speed))
+
+        if self.live_config.latency_frames == 0:
+            self._live.now(command)
+        else:
+            self._live.send(command, self._frame)
+        self._frame = self._live.capture()
+        self._steps += 1
+        measured = self._measure()
+        offsets, found = measured["offsets_px"], measured["found"]
+        terminated = bool(found and np.all(np.abs(offsets) <= self.tolerance_px))
+        truncated = bool(not terminated and self._steps >= self.max_steps)
+        return (
+            self._observation(),
+            self._reward(measured),
+            terminated,
+            truncated,
+            self._info(measured),
+        )
+
+    def _prepare_model(self, sim: HeadSim) -> None:
+        """This env's own model: its target's size and the renderer's multisampling."""
+        geom = sim.model.geom(TARGET_BODY)
+        sim.model.geom_size[geom.id, 0] = self.target_radius_m
+        sim.model.geom_rbound[geom.id] = self.target_radius_m
+        # Read when the renderer is made, at the first render (after this).
+        sim.model.vis.quality.offsamples = self.multisamples
+
+    # -- measurements ------------------------------------------------------------
+    def _goals(self) -> np.ndarray:
+        assert self._settings is not None
+        (u10, v10), (u20, v20) = (c.image_centre for c in self._settings.cameras)
+        return np.array([u10, u20, (v10 + v20) / 2])
+
+    def _measure(self) -> dict[str, Any]:
+        assert self._frame is not None
+        seen = [find_marker(image, TARGET_COLOUR) for image in self._frame.images]
+        found = all(s.found and s.uv is not None for s in seen)
+        offsets = np.full(3, np.nan)
+        if found:
+            (u1, v1), (u2, v2) = seen[0].uv, seen[1].uv  # type: ignore[misc]
+            offsets = np.array([u1, u2, (v1 + v2) / 2]) - self._goals()
+        return {"found": found, "offsets_px": offsets}
+
+    def _reward(self, measured: dict[str, Any]) -> float:
+        assert self._frame is not None and self._settings is not None
+        if self.reward_kind == "offsets":
+            if not measured["found"]:
+                return -1.0
+            cam = self._settings.cameras[0]
+            scale = np.array([cam.width / 2, cam.width / 2, cam.height / 2])
+            return -float(np.mean(np.minimum(np.abs(measured["offsets_px"]) / scale, 1.0)))
+        yaw, pitch, eye = self._frame.encoders_rad
+        truth = self._frame.truth_target_world_m
+        if truth is None or eye <= 0:
+            return -1.0
+        s = self._settings
+        estimate = head_to_world(
+            np.array([0.0, 0.0, s.baseline_m / (2 * math.tan(eye))]),
+            yaw,
+            pitch,
+            s.neck_d1_m,
+            s.neck_a2_m,
+        )
+        depth = float(np.linalg.norm(truth - np.array([0.0, 0.0, s.neck_d1_m + s.neck_a2_m])))
+        return -min(float(np.linalg.norm(estimate - truth)) / depth, 1.0)
+
+    def _observation(self) -> dict[str, np.ndarray]:
+        assert self._frame is not None
+        return {
+            "cam1": self._frame.images[0],
+            "cam2": self._frame.images[1],
+            "encoders": self._frame.encoders_rad.astype(np.float32),
+        }
+
+    def _info(self, measured: dict[str, Any]) -> dict[str, Any]:
+        assert self._frame is not None
+        truth = self._frame.truth_target_world_m
+        return {
+            "found": measured["found"],
+            "offsets_px": measured["offsets_px"],
+            "time_s": self._frame.time_s,
+            "truth_world_m": None if truth is None else truth.copy(),
+            "steps": self._steps,
+        }
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode != "rgb_array" or self._frame is None:
+            return None
+        return np.concatenate(self._frame.images, axis=1)
+
+    def close(self) -> None:
+        if self._sim is not None:
+            self._sim.close()
+            self._sim = None
+
+
+__all__ = ["FixateEnv"]

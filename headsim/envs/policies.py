@@ -1,0 +1,99 @@
+"""Reference policies for ``headsim/Fixate-v0``: the paper's servo as a policy, and a random one.
+
+Both see only what an agent sees: the observation (images, encoders) and the
+action space.  :class:`ServoPolicy` is the paper's uncalibrated servo
+(``headsim.servo.NeckServo``) recast for velocity commands: it measures its
+image Jacobian (px per rad) by probing each joint once, moves by
+``-J^-1 e`` in one frame period, and refines J with Broyden's rule from every
+frame's measured joint motion (encoders) and image motion.  J is kept across
+episodes, as the paper's servo keeps it from one fixation to the next.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from gymnasium import spaces
+
+from headsim.vision import find_marker
+
+#: Probe size per joint, rad.
+PROBE_RAD = 0.02
+#: Smallest joint motion that updates the Jacobian, rad.
+MIN_SECANT_RAD = 2e-3
+
+
+class ServoPolicy:
+    """The paper's image servo as a policy ``action = policy(observation)``."""
+
+    def __init__(self, action_space: spaces.Box, period_s: float, colour: str = "red") -> None:
+        self.action_space = action_space
+        self.period_s = period_s
+        self.colour = colour
+        self.jacobian: np.ndarray | None = None  # px per rad, rows (u1, u2, v), columns joints
+        self._probe = np.zeros((3, 3))
+        self._probe_joint = 0
+        self._last: tuple[np.ndarray, np.ndarray] | None = None  # (encoders, error)
+
+    def reset(self) -> None:
+        """A new episode: forget the last frame, keep the Jacobian."""
+        self._last = None
+
+    def _error(self, observation: dict[str, np.ndarray]) -> np.ndarray | None:
+        seen = [find_marker(observation[c], self.colour) for c in ("cam1", "cam2")]
+        if not all(s.found and s.uv is not None for s in seen):
+            return None
+        height, width = observation["cam1"].shape[:2]
+        u0, v0 = (width - 1) / 2, (height - 1) / 2
+        (u1, v1), (u2, v2) = seen[0].uv, seen[1].uv  # type: ignore[misc]
+        return np.array([u1 - u0, u2 - u0, (v1 + v2) / 2 - v0])
+
+    def __call__(self, observation: dict[str, np.ndarray]) -> np.ndarray:
+        encoders = np.asarray(observation["encoders"], float)
+        error = self._error(observation)
+        if error is None:
+            self._last = None
+            return np.zeros(3, np.float32)
+        last, self._last = self._last, (encoders, error)
+        if self.jacobian is None:
+            if last is not None and self._probe_joint > 0:
+                joint = self._probe_joint - 1
+                moved = encoders[joint] - last[0][joint]
+                if abs(moved) > 1e-6:
+                    self._probe[:, joint] = (error - last[1]) / moved
+            if self._probe_joint == 3:
+                self.jacobian = self._probe.copy()
+            else:
+                action = np.zeros(3)
+                action[self._probe_joint] = PROBE_RAD / self.period_s
+                self._probe_joint += 1
+                return self._clip(action)
+        if last is not None:
+            dq = encoders - last[0]
+            if np.max(np.abs(dq)) >= MIN_SECANT_RAD:
+                de = error - last[1]
+                self.jacobian = self.jacobian + np.outer(de - self.jacobian @ dq, dq) / (dq @ dq)
+        try:
+            move = -np.linalg.solve(self.jacobian, error)
+        except np.linalg.LinAlgError:
+            self.jacobian = None
+            self._probe_joint = 0
+            return np.zeros(3, np.float32)
+        return self._clip(move / self.period_s)
+
+    def _clip(self, action: np.ndarray) -> np.ndarray:
+        return np.clip(action, self.action_space.low, self.action_space.high).astype(np.float32)
+
+
+class RandomPolicy:
+    """Uniform random actions from a seeded generator."""
+
+    def __init__(self, action_space: spaces.Box, seed: int = 0) -> None:
+        self.action_space = action_space
+        self.rng = np.random.default_rng(seed)
+
+    def reset(self) -> None:
+        pass
+
+    def __call__(self, observation: dict[str, np.ndarray]) -> np.ndarray:
+        low, high = self.action_space.low, self.action_space.high
+        return self.rng.uniform(low, high).astype(np.float32)

@@ -1,0 +1,230 @@
+"""Motors with speed and acceleration limits, driven through MuJoCo's position actuators.
+
+Each motor (neck yaw, neck pitch, the eye motor) has a reference trajectory
+``r(t)`` that never exceeds the motor's speed and acceleration limits.  At every
+physics step the reference is advanced by one of three laws and written to the
+position actuator with velocity and acceleration feed-forward, so the joint
+follows it closely while the physics (inertia, damping, the eye coupling)
+decides where the joint really is.  Units: rad, rad/s, rad/s^2, s.
+
+Laws (:class:`MotorMode`):
+- ``VELOCITY``: ramp to a commanded speed (the Gymnasium action).
+- ``TRACK``: reach a goal that moves at a constant velocity, time-optimally
+  (bang-bang in acceleration: accelerate at the limit, coast at the speed
+  limit, brake at the limit); smooth pursuit and bang-bang saccades use it.
+- ``PROFILE``: follow a precomputed minimum-jerk move (a saccade).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from headsim import names
+from headsim.settings import SettingsError
+
+#: The motors in the order of every 3-vector here: (neck yaw, neck pitch, eye).
+MOTORS = ("neck_yaw", "neck_pitch", "eye")
+MOTOR_JOINTS = (names.NECK_YAW, names.NECK_PITCH, names.EYE_MOTOR_JOINT)
+MOTOR_ACTUATORS = (names.NECK_YAW_MOTOR, names.NECK_PITCH_MOTOR, names.EYE_MOTOR)
+
+#: Peak speed and acceleration of a minimum-jerk move of amplitude 1 over time 1.
+MIN_JERK_PEAK_SPEED = 1.875
+MIN_JERK_PEAK_ACCEL = 10.0 / math.sqrt(3.0)
+
+
+@dataclass(frozen=True)
+class MotorLimits:
+    """Speed (rad/s) and acceleration (rad/s^2) limits of one motor."""
+
+    max_speed: float
+    max_accel: float
+
+    def __post_init__(self) -> None:
+        for name in ("max_speed", "max_accel"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise SettingsError(f"motor {name} must be a finite number > 0, got {value!r}")
+
+
+class MotorMode(enum.Enum):
+    VELOCITY = "velocity"
+    TRACK = "track"
+    PROFILE = "profile"
+
+
+def min_jerk_duration(amplitude: float, limits: MotorLimits) -> float:
+    """Shortest minimum-jerk move of ``amplitude`` rad within ``limits``, s."""
+    a = abs(amplitude)
+    return max(
+        MIN_JERK_PEAK_SPEED * a / limits.max_speed,
+        math.sqrt(MIN_JERK_PEAK_ACCEL * a / limits.max_accel),
+    )
+
+
+def bang_bang_duration(amplitude: float, limits: MotorLimits) -> float:
+    """Time-optimal rest-to-rest move of ``amplitude`` rad within ``limits``, s."""
+    a, v, acc = abs(amplitude), limits.max_speed, limits.max_accel
+    if a <= v * v / acc:  # triangular: the speed limit is never reached
+        return 2.0 * math.sqrt(a / acc)
+    return a / v + v / acc
+
+
+def min_jerk(start: float, goal: float, duration: float, t: float) -> tuple[float, float, float]:
+    """Position, velocity, acceleration of a minimum-jerk move at time ``t`` after its start."""
+    if duration <= 0 or t >= duration:
+        return goal, 0.0, 0.0
+    s = max(t, 0.0) / duration
+    d = goal - start
+    pos = start + d * (10 * s**3 - 15 * s**4 + 6 * s**5)
+    vel = d * (30 * s**2 - 60 * s**3 + 30 * s**4) / duration
+    acc = d * (60 * s - 180 * s**2 + 120 * s**3) / duration**2
+    return pos, vel, acc
+
+
+@dataclass
+class _Motor:
+    limits: MotorLimits
+    low: float
+    high: float
+    ref: float = 0.0
+    vel: float = 0.0
+    acc: float = 0.0
+    mode: MotorMode = MotorMode.VELOCITY
+    speed: float = 0.0  # VELOCITY
+    goal: float = 0.0  # TRACK: goal at goal_time, moving at goal_vel
+    goal_vel: float = 0.0
+    goal_time: float = 0.0
+    start: float = 0.0  # PROFILE
+    start_time: float = 0.0
+    duration: float = 0.0
+
+
+class MotorDriver:
+    """The three motors of a head in a MuJoCo model: rate-limited references to the actuators.
+
+    The actuators are retuned to a stiff critically damped servo of natural
+    frequency ``bandwidth_hz`` on each joint's effective inertia (at the home
+    pose), so that with feed-forward the joints follow their references to a
+    small fraction of a degree even at the acceleration limits.
+    """
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        limits: tuple[MotorLimits, MotorLimits, MotorLimits],
+        bandwidth_hz: float = 20.0,
+    ) -> None:
+        self.model, self.data = model, data
+        self._qadr = [int(model.joint(j).qposadr[0]) for j in MOTOR_JOINTS]
+        self._act = [int(model.actuator(a).id) for a in MOTOR_ACTUATORS]
+        omega = 2 * math.pi * bandwidth_hz
+        inertia = self._effective_inertia()
+        self._ff_vel, self._ff_acc = [], []
+        for act, mass in zip(self._act, inertia, strict=True):
+            kp, kv = mass * omega**2, 2.0 * mass * omega
+            model.actuator_gainprm[act, 0] = kp
+            model.actuator_biasprm[act, :3] = (0.0, -kp, -kv)
+            model.actuator_forcelimited[act] = 0
+            self._ff_vel.append(kv / kp)
+            self._ff_acc.append(1.0 / omega**2)
+        self.motors = [
+            _Motor(lim, *map(float, model.joint(j).range))
+            for lim, j in zip(limits, MOTOR_JOINTS, strict=True)
+        ]
+        self.sync()
+
+    def _effective_inertia(self) -> list[float]:
+        """Diagonal of the joint-space inertia at the current pose; the eye motor carries both eyes."""
+        mujoco.mj_forward(self.model, self.data)
+        full = np.zeros((self.model.nv, self.model.nv))
+        mujoco.mj_fullM(self.model, self.data, full)
+        dof = {j: int(self.model.joint(j).dofadr[0]) for j in (*MOTOR_JOINTS, names.EYE_JOINTS[1])}
+        eyes = (
+            full[dof[names.EYE_JOINTS[0]], dof[names.EYE_JOINTS[0]]]
+            + full[dof[names.EYE_JOINTS[1]], dof[names.EYE_JOINTS[1]]]
+        )
+        return [
+            full[dof[names.NECK_YAW]][dof[names.NECK_YAW]],
+            full[dof[names.NECK_PITCH]][dof[names.NECK_PITCH]],
+            eyes,
+        ]
+
+    def sync(self) -> None:
+        """Start the references where the joints are, at rest."""
+        for motor, adr in zip(self.motors, self._qadr, strict=True):
+            motor.ref, motor.vel, motor.acc = float(self.data.qpos[adr]), 0.0, 0.0
+            motor.mode, motor.speed = MotorMode.VELOCITY, 0.0
+        self._write()
+
+    # -- commands ----------------------------------------------------------
+    def set_velocity(self, index: int, speed: float) -> None:
+        """Ramp motor ``index`` to ``speed`` rad/s (clipped to its limit)."""
+        motor = self.motors[index]
+        motor.mode = MotorMode.VELOCITY
+        motor.speed = float(np.clip(speed, -motor.limits.max_speed, motor.limits.max_speed))
+
+    def track(self, index: int, goal: float, goal_vel: float, goal_time: float) -> None:
+        """Reach ``goal + goal_vel (t - goal_time)`` time-optimally and follow it."""
+        motor = self.motors[index]
+        motor.mode = MotorMode.TRACK
+        motor.goal, motor.goal_vel, motor.goal_time = float(goal), float(goal_vel), float(goal_time)
+
+    def profile(self, index: int, goal: float, start_time: float, duration: float) -> None:
+        """A minimum-jerk move from the present reference to ``goal`` over ``duration`` s."""
+        motor = self.motors[index]
+        motor.mode = MotorMode.PROFILE
+        motor.start, motor.goal = motor.ref, float(np.clip(goal, motor.low, motor.high))
+        motor.start_time, motor.duration = float(start_time), float(duration)
+
+    # -- stepping ----------------------------------------------------------
+    def advance(self, time_s: float, dt: float) -> None:
+        """Advance every reference by ``dt`` to ``time_s + dt`` and write the actuators."""
+        for motor in self.motors:
+            lim = motor.limits
+            if motor.mode is MotorMode.PROFILE:
+                pos, vel, acc = min_jerk(
+                    motor.start, motor.goal, motor.duration, time_s + dt - motor.start_time
+                )
+                motor.ref, motor.vel, motor.acc = pos, vel, acc
+                continue
+            if motor.mode is MotorMode.VELOCITY:
+                wanted = motor.speed
+            else:
+                goal_now = motor.goal + motor.goal_vel * (time_s - motor.goal_time)
+                error = goal_now - motor.ref
+                # The fastest approach that can still brake at the limit, plus the goal's own speed.
+                approach = math.copysign(
+                    min(math.sqrt(2.0 * lim.max_accel * abs(error)), abs(error) / dt), error
+                )
+                wanted = motor.goal_vel + approach
+            wanted = min(max(wanted, -lim.max_speed), lim.max_speed)
+            dv = min(max(wanted - motor.vel, -lim.max_accel * dt), lim.max_accel * dt)
+            motor.acc = dv / dt
+            motor.vel += dv
+            motor.ref += motor.vel * dt
+            if not motor.low <= motor.ref <= motor.high:
+                motor.ref = min(max(motor.ref, motor.low), motor.high)
+                motor.vel, motor.acc = 0.0, 0.0
+        self._write()
+
+    def _write(self) -> None:
+        for motor, act, fv, fa in zip(
+            self.motors, self._act, self._ff_vel, self._ff_acc, strict=True
+        ):
+            self.data.ctrl[act] = motor.ref + fv * motor.vel + fa * motor.acc
+
+    @property
+    def references(self) -> np.ndarray:
+        """(3,) reference positions, rad."""
+        return np.array([m.ref for m in self.motors])
+
+    @property
+    def moving(self) -> bool:
+        """Whether any reference is still moving."""
+        return any(abs(m.vel) > 1e-9 for m in self.motors)

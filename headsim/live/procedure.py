@@ -1,0 +1,125 @@
+"""The ``pursuit`` scenario procedure: acquire at rest, then pursue on the live head.
+
+The head first fixates the target at rest with the paper's Model 1 servo (the
+scenario's servo settings), at the first instant the target is present; the
+servo's image Jacobian then serves the live gaze controller
+(:mod:`headsim.live.gaze`), which runs for ``duration_s`` of simulated time.
+Results (the ``experiment`` block of results.json): the figures of the run
+(time to fixation, pursuit lag, position error RMS along the path, losses and
+re-acquisitions) and, per frame, time, found, image offsets, estimate, truth
+and error.  Observers see every render, each frame is a step (``Observer.step``)
+and its record goes to ``Observer.pursued``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from headsim.live.gaze import FrameRecord, PursuitRun, acquire, pursue
+from headsim.live.head import LiveHead
+from headsim.live.spec import PursuitSpec, describe
+from headsim.procedures import HeadKnowledge
+
+
+def figures(run: PursuitRun, spec: PursuitSpec) -> dict[str, Any]:
+    """The figures that score a pursuit run (all frames on which the target was present)."""
+    errors = run.errors_m
+    start = spec.visibility.windows[0][0] if spec.visibility.windows else 0.0
+    return {
+        "frames": len(run.records),
+        "frames_present": sum(1 for r in run.records if r.truth_world_m is not None),
+        "frames_lost": run.frames_lost,
+        "losses": run.losses,
+        "reacquisitions": run.reacquisitions,
+        "saccades": sum(1 for r in run.records if r.saccade),
+        "time_to_fixation_s": run.time_to_fixation_s(spec.gaze.fixation_tolerance_px, start),
+        "lag_s": run.lag_s(),
+        "offset_rms_px": run.rms_offset_px(),
+        "position_rms_m": float(np.sqrt(np.mean(errors**2))) if errors.size else math.nan,
+        "position_rms_pct_of_depth": run.rms_error_pct_of_depth(),
+        "position_max_m": float(errors.max()) if errors.size else math.nan,
+        "ended": run.ended,
+    }
+
+
+def _per_frame(records: tuple[FrameRecord, ...]) -> dict[str, Any]:
+    def vec(values: list[np.ndarray | None]) -> list[Any]:
+        return [None if v is None else np.asarray(v).tolist() for v in values]
+
+    return {
+        "time_s": [r.time_s for r in records],
+        "found": [r.found for r in records],
+        "offsets_px": vec([r.error_px for r in records]),
+        "estimate_world_m": vec([r.estimate_world_m for r in records]),
+        "truth_world_m": vec([r.truth_world_m for r in records]),
+        "error_m": [
+            None
+            if r.estimate_world_m is None or r.truth_world_m is None
+            else float(np.linalg.norm(r.estimate_world_m - r.truth_world_m))
+            for r in records
+        ],
+        "encoders_rad": vec([r.encoders_rad for r in records]),
+    }
+
+
+def run_pursuit(
+    scenario: Any, hub: Any, knowledge: HeadKnowledge, label: str
+) -> tuple[list[Any], dict[str, Any]]:
+    """The runner's entry for ``procedure = "pursuit"``: (no point records, the experiment block)."""
+    from headsim.runner import ObservedSim, marker_target
+
+    spec: PursuitSpec = scenario.scene.pursuit
+    target = marker_target(spec.name, spec.body)
+    with ObservedSim(hub, "default", scenario) as sim:
+        live = LiveHead(sim, spec.live, spec.body, spec.path, spec.visibility)
+        first = next(
+            (
+                float(t)
+                for t in spec.sample_times(live.config.period_s)
+                if spec.visibility.visible(float(t))
+            ),
+            None,
+        )
+        truth = {} if first is None else {spec.name: spec.path.position(first)}
+        hub.phase("measurement", sim, knowledge, truth)
+        experiment: dict[str, Any] = {"pursuit": describe(spec)}
+        if first is None:
+            return [], {**experiment, "failures": [f"{spec.name}: never present in the run"]}
+        live.advance_to(first)
+        estimator = acquire(live, hub.detector(sim, target.detector), knowledge)
+        if estimator is None:
+            return [], {**experiment, "failures": [f"{spec.name}: not acquired at rest"]}
+
+        def on_frame(record: FrameRecord) -> None:
+            hub.begin(f"{spec.name} t={record.time_s:.3f}s")  # a step per frame
+            hub.pursued(record)
+
+        run = pursue(live, target.detector, estimator, spec.duration_s, spec.gaze, on_frame)
+    experiment.update(figures(run, spec))
+    experiment["per_frame"] = _per_frame(run.records)
+    if run.losses:
+        experiment["failures"] = [f"{spec.name}: lost {run.losses} times"]
+    return [], experiment
+
+
+def summary_lines(e: dict[str, Any]) -> list[str]:
+    """The summary's lines for a pursuit run."""
+    p = e.get("pursuit", {})
+
+    def f(key: str, scale: float = 1.0, fmt: str = ".2f") -> str:
+        value = e.get(key)
+        return "n/a" if value is None or not math.isfinite(value) else format(value * scale, fmt)
+
+    return [
+        f"pursuit: {p.get('path_kind')} path for {p.get('duration_s')} s; {p.get('frame_rate_hz')} Hz, "
+        f"latency {p.get('latency_frames')} frame(s), exposure {p.get('exposure_s')} s x {p.get('blur_subframes')} "
+        f"sub-frames; gaze {p.get('mode')}, predictor {'on' if p.get('predictor') else 'off'}, saccade {p.get('saccade')}",
+        f"frames {e.get('frames')} (target present {e.get('frames_present')}), lost {e.get('frames_lost')}, "
+        f"losses {e.get('losses')}, re-acquisitions {e.get('reacquisitions')}, saccades {e.get('saccades')}",
+        f"position error RMS along the path {f('position_rms_m', 1000)} mm = {f('position_rms_pct_of_depth')} % of "
+        f"distance (max {f('position_max_m', 1000)} mm); pursuit lag {f('lag_s', 1000, '.1f')} ms; "
+        f"image offset RMS {f('offset_rms_px')} px; time to fixation {f('time_to_fixation_s', 1000, '.0f')} ms",
+    ]
