@@ -27,6 +27,7 @@ import numpy as np
 
 from headsim import names
 from headsim.procedures import (
+    CalibrationError,
     CalibrationRun,
     HeadKnowledge,
     Measurement,
@@ -48,6 +49,7 @@ from headsim.scenario import (
     STREAM_DEPTH_NOISE,
     Scenario,
 )
+from headsim.search import Failure
 from headsim.servo import Detector, EyeServo, NeckServo, NeckServoResult, ServoConfig
 from headsim.settings import PAPER_INITIAL_DIRECTIONS
 from headsim.sim import CameraId, HeadSim
@@ -337,14 +339,20 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
     assert spec is not None
     seed = scenario.seed
     with ObservedSim(hub, "default", scenario) as sim:
-        positions = calibration_layout(
-            sim,
-            np.random.default_rng([seed, STREAM_CALIBRATION]),
-            spec.targets,
-            spec.depth_m,
-            spec.lateral,
-            spec.vertical,
-        )
+        try:
+            positions = calibration_layout(
+                sim,
+                np.random.default_rng([seed, STREAM_CALIBRATION]),
+                spec.targets,
+                spec.depth_m,
+                spec.lateral,
+                spec.vertical,
+            )
+        except ValueError as err:
+            block = {"status": f"failed: {err}", "targets": spec.targets, "fixated": 0}
+            block.update(renders=0, positions=[])
+            hub.calibrated(block)
+            return None, block
         truth = {f"calibration {k + 1}": p for k, p in enumerate(positions)}
         hub.phase("calibration", sim, HeadKnowledge(), truth)
         hub.watch(names.CALIBRATION_BALL, "calibration")
@@ -388,12 +396,19 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 extended=spec.extended,
             )
         except ValueError as err:
-            block.update(status=f"failed: {err}", renders=sim.render_count - start)
+            outcomes = err.outcomes if isinstance(err, CalibrationError) else ()
+            block.update(
+                status=f"failed: {err}",
+                renders=sim.render_count - start,
+                fixated=sum(o is None for o in outcomes),
+                positions=position_outcomes(outcomes),
+            )
             hub.calibrated(block)
             return None, block
     fit, knowledge = run.fit, run.knowledge
     block.update(
         fixated=run.samples,
+        positions=position_outcomes(run.outcomes),
         renders=run.renders,
         alpha_e_rad=list(fit.alpha_e),
         alpha_e_std_rad=list(fit.std_errors),
@@ -418,6 +433,16 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
     )
     hub.calibrated(block)
     return run, block
+
+
+def position_outcomes(outcomes: Sequence[Failure | None]) -> list[dict[str, Any]]:
+    """Each calibration position's outcome: status "ok" or the failure and its cause."""
+    return [
+        {"status": "ok", "failure": None}
+        if o is None
+        else {"status": o.message, "failure": o.as_dict()}
+        for o in outcomes
+    ]
 
 
 def _record(
