@@ -626,8 +626,40 @@ def _tuple3(p: np.ndarray) -> tuple[float, float, float]:
     return (float(p[0]), float(p[1]), float(p[2]))
 
 
+def _redraw_out_of_reach(
+    table: _Table,
+    settings: HeadSettings,
+    procedure: str,
+    body: str,
+    points_world: np.ndarray,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """Points drawn again from the same box until the reach check accepts each (bounded)."""
+    head = _Head.of(settings)
+    radius = _body_radius(body)
+
+    def refused(p: np.ndarray) -> bool:
+        if procedure == "model1":
+            return model1_refusal(head, p, "target", True, radius) is not None
+        return model2_refusal(head, p, "target", radius) is not None
+
+    points_world = np.array(points_world)
+    for k in range(len(points_world)):
+        for _ in range(200):
+            if not refused(points_world[k]):
+                break
+            points_world[k] = _head_to_world(settings, _random_points_head(table, 1, rng))[0]
+        else:
+            raise table.fail(
+                "within",
+                f"no point of the box within the head's reach in 200 draws (target {k + 1})",
+                "a depth_m, lateral and vertical box that overlaps the field both cameras see",
+            )
+    return points_world
+
+
 def _read_targets(
-    scene: _Table, settings: HeadSettings, seed: int, required: bool
+    scene: _Table, settings: HeadSettings, seed: int, required: bool, procedure: str = "model2"
 ) -> tuple[Placement, ...]:
     """``[[scene.targets]]`` and ``[scene.random_targets]``: markers to measure, in turn."""
     bodies = tuple(MARKER_BODIES)
@@ -642,8 +674,11 @@ def _read_targets(
     if random_table is not None:
         count = random_table.integer("count", _MISSING, 1, 1000)
         body = random_table.choice("body", bodies, names.MARKERS[0])
+        within = random_table.choice("within", ("box", "reach"), "box")
         rng = np.random.default_rng([seed, STREAM_TARGETS])
         points = _head_to_world(settings, _random_points_head(random_table, count, rng))
+        if within == "reach":
+            points = _redraw_out_of_reach(random_table, settings, procedure, body, points, rng)
         random_table.done()
         targets += [
             Placement(f"random_{k + 1}", body, _tuple3(p), f"{random_table.path} (target {k + 1})")
@@ -682,7 +717,9 @@ def _read_scene(
     table = doc.table("scene") or _Table({}, "scene", ctx)
     spec = SceneSpec(scene=scene_name)
     if procedure in ("model2", "model1", "calibration"):
-        targets = _read_targets(table, settings, seed, required=procedure != "calibration")
+        targets = _read_targets(
+            table, settings, seed, required=procedure != "calibration", procedure=procedure
+        )
         spec = replace(spec, targets=targets)
     elif procedure == "chessboard":
         spec = _read_chessboard(table, ctx, settings)

@@ -198,9 +198,10 @@ class EyeServo:
             steps, uv = target, detection.uv
             visited[steps] = uv
             self._seen.append((steps, *uv))
-        return self._result(
-            ServoOutcome.ITERATION_LIMIT, steps, uv, goal, cfg.max_iterations, camera, gain
-        )
+        # The last move may have landed within tolerance: that is converged.
+        done = gain is not None and abs(uv[0] - goal) <= max(cfg.tolerance_px, 0.5 * abs(gain))
+        outcome = ServoOutcome.CONVERGED if done else ServoOutcome.ITERATION_LIMIT
+        return self._result(outcome, steps, uv, goal, cfg.max_iterations, camera, gain)
 
     def _result(
         self,
@@ -379,9 +380,10 @@ class NeckServo:
             steps, error = target, new_error
             visited[tuple(steps)] = error
         self.jacobian = jac
-        return self._result(
-            ServoOutcome.ITERATION_LIMIT, steps, error, start, cfg.max_iterations, jac
-        )
+        tolerance = np.maximum(cfg.tolerance_px, 0.5 * np.abs(jac).max(axis=1))
+        done = bool(np.all(np.abs(error) <= tolerance))
+        outcome = ServoOutcome.CONVERGED if done else ServoOutcome.ITERATION_LIMIT
+        return self._result(outcome, steps, error, start, cfg.max_iterations, jac)
 
     def _result(
         self,
