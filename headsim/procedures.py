@@ -457,14 +457,14 @@ def calibration_layout(
     points_world = sim.transform_points(draw(count), "head", "world")
     # Placement (truth allowed): keep positions both cameras see whole from where the
     # head stands; a position that one cannot see is drawn again, a bounded number of times.
-    for _ in range(50):
+    for _ in range(500):
         unseen = ~seen_by_both(sim, points_world, radius_m)
         if not unseen.any():
             return points_world
         points_world[unseen] = sim.transform_points(draw(int(unseen.sum())), "head", "world")
     raise ValueError(
         f"calibration layout: {int(unseen.sum())} of {count} positions stay outside a camera's "
-        f"view after 50 draws: depth {depth_range_m} m, lateral {lateral}, vertical {vertical} "
+        f"view after 500 draws: depth {depth_range_m} m, lateral {lateral}, vertical {vertical} "
         "reach outside the field both cameras share at this focal length"
     )
 

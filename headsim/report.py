@@ -44,6 +44,7 @@ MEASUREMENT_KEYS = (
     "name",
     "method",
     "status",
+    "failure",
     "knowledge",
     "step",
     "time_s",
@@ -57,6 +58,7 @@ MEASUREMENT_KEYS = (
     "error_pct_of_depth",
     "covariance_head_m2",
     "renders",
+    "search_renders",
     "servo_residual_px",
     "details",
 )
@@ -89,6 +91,7 @@ def measurement_entry(record: MeasurementRecord) -> dict[str, Any]:
         "name": m.name,
         "method": m.method,
         "status": m.status,
+        "failure": None if m.failure is None else m.failure.as_dict(),
         "knowledge": record.knowledge,
         "step": record.step,
         "time_s": record.time_s,
@@ -103,7 +106,6 @@ def measurement_entry(record: MeasurementRecord) -> dict[str, Any]:
         "covariance_head_m2": m.covariance_head_m2,
         "renders": m.renders,
         "search_renders": m.search_renders,
-        "failure": None if m.failure is None else m.failure.as_dict(),
         "servo_residual_px": list(m.servo_residual_px),
         "details": dict(m.details),
     }
