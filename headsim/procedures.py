@@ -825,6 +825,10 @@ class RelativeRun:
     ``areas``/``true_areas``: label -> area number (0: unclassified or not
     seen in all four images); ``columns``: label -> (u11, u12, u21, u22), px;
     ``comparison``: the estimator's count of disagreements by margin.
+    ``gain_areas``/``gain_comparison``: the same with each camera's offsets
+    divided by its gain (px per encoder step, learnt by the servo from the
+    images: no intrinsics), so the magnitude tests compare angles, not pixels
+    of two different focal lengths; margins in px at the mean gain.
     """
 
     reference: Measurement
@@ -834,6 +838,8 @@ class RelativeRun:
     missing: tuple[str, ...]
     comparison: AreaComparison | None
     renders: int
+    gain_areas: dict[str, int] = field(default_factory=dict)
+    gain_comparison: AreaComparison | None = None
 
 
 def relative_positioning(
@@ -874,7 +880,8 @@ def relative_positioning(
     alpha1, alpha2 = steps[0] * resolution, steps[1] * resolution
     areas: dict[str, int] = dict.fromkeys(objects, 0)
     true_areas: dict[str, int] = dict.fromkeys(objects, 0)
-    comparison = None
+    comparison = gain_comparison = None
+    gain_areas: dict[str, int] = {}
     if seen:
         cols = np.array([columns[name] for name in seen])
         pixel_areas = areas_from_pixels(*cols.T, u10, u20, alpha1=alpha1, alpha2=alpha2)
@@ -884,6 +891,15 @@ def relative_positioning(
         comparison = compare_areas(pixel_areas, truth, *cols.T, u10, u20)
         areas.update(zip(seen, (int(a) for a in pixel_areas), strict=True))
         true_areas.update(zip(seen, (int(a) for a in truth), strict=True))
+        g1, g2 = (abs(servo.gains.get(camera) or 0.0) for camera in (1, 2))
+        if g1 > 0 and g2 > 0:
+            gain = areas_from_pixels(*cols.T, u10, u20, alpha1=alpha1, alpha2=alpha2, kx=(g1, g2))
+            mean = (g1 + g2) / 2
+            scaled = cols.copy()
+            scaled[:, :2] = u10 + (cols[:, :2] - u10) * mean / g1
+            scaled[:, 2:] = u20 + (cols[:, 2:] - u20) * mean / g2
+            gain_comparison = compare_areas(gain, truth, *scaled.T, u10, u20)
+            gain_areas = dict(zip(seen, (int(a) for a in gain), strict=True))
     return RelativeRun(
         reference=ref,
         areas=areas,
@@ -892,6 +908,8 @@ def relative_positioning(
         missing=missing,
         comparison=comparison,
         renders=sim.render_count - start,
+        gain_areas=gain_areas,
+        gain_comparison=gain_comparison,
     )
 
 

@@ -611,6 +611,8 @@ def _run_relative(
             "true_area": run.true_areas.get(name, 0),
             "agree": name in margins and run.areas[name] == run.true_areas[name],
             "margin_px": margins.get(name, float("nan")),
+            "gain_area": run.gain_areas.get(name, 0),
+            "gain_agree": name in run.gain_areas and run.gain_areas[name] == run.true_areas[name],
             "columns_px": list(run.columns.get(name, (float("nan"),) * 4)),
             "position_head_m": positions_head[name],
         }
@@ -628,6 +630,10 @@ def _run_relative(
         "missing": list(run.missing),
         "agree": sum(o["agree"] for o in objects),
         "disagree_outside_margin": comparison.n_disagree_outside if comparison else None,
+        "gain_agree": sum(o["gain_agree"] for o in objects),
+        "gain_disagree_outside_margin": run.gain_comparison.n_disagree_outside
+        if run.gain_comparison
+        else None,
         "margin_threshold_px": comparison.threshold_px if comparison else None,
         "renders": run.renders,
         "paper": {
