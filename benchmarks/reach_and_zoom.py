@@ -1,6 +1,6 @@
 """Every target the reach check accepts gets measured, across zoom (issue 11's figures).
 
-Per focal length (0.7x, 1x, 1.3x, 1.6x, 2x the paper's, mounts unchanged):
+Per focal length (0.5x, 0.7x, 1x, 1.3x, 1.6x, 2x the paper's, mounts unchanged):
 calibrate (Sec. V, the layout's every position recorded), then draw random
 targets over the whole field in front of the head, let the scenario's reach
 check accept or refuse each (with its reason), and measure every accepted one
@@ -10,7 +10,8 @@ per zoom and model: accepted, measured, failures by cause, 3-D error RMS
 without the ones that needed a search, and the search's extra renders.
 Figures, not a test.
 
-    python benchmarks/reach_and_zoom.py [--per-zoom 40] [--calibration 20] [--seed 0] [--json F]
+    python benchmarks/reach_and_zoom.py [--per-zoom 40] [--calibration 20] [--zooms 0.7,1,2]
+                                        [--goal centre|fixed-point] [--seed 0] [--json F]
 """
 
 from __future__ import annotations
@@ -26,8 +27,10 @@ import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim import names
+from headsim.principal import principal_points_by_zoom
 from headsim.procedures import (
     CalibrationError,
+    HeadKnowledge,
     Measurement,
     calibrate_head,
     calibration_layout,
@@ -41,7 +44,7 @@ from headsim.servo import EyeServo, NeckServo
 from headsim.settings import HeadSettings, paper_head
 from headsim.sim import HeadSim
 
-ZOOMS = (0.7, 1.0, 1.3, 1.6, 2.0)
+ZOOMS = (0.5, 0.7, 1.0, 1.3, 1.6, 2.0)
 BODY = names.MARKERS[0]
 #: The field targets are drawn from, in H at the start pose: depth m, |x/z|, |y/z|.
 FIELD = {"depth_m": (0.4, 1.4), "lateral": 0.3, "vertical": 0.15}
@@ -114,17 +117,26 @@ def stats(ms: list[Measurement]) -> dict[str, Any]:
     }
 
 
-def run_zoom(zoom: float, per_zoom: int, calibration: int, seed: int) -> dict[str, Any]:
+def run_zoom(zoom: float, per_zoom: int, calibration: int, seed: int, goal: str) -> dict[str, Any]:
     settings = zoomed(zoom, seed)
     rng = np.random.default_rng([seed, int(zoom * 100)])
     targets, refused = draw_targets(settings, rng, per_zoom)
     out: dict[str, Any] = {"zoom": zoom, "accepted": len(targets), "refused": dict(refused)}
+    base = HeadKnowledge()
+    if goal == "fixed-point":
+        # The goal columns through each camera's zoom fixed point, from images alone.
+        found = principal_points_by_zoom(settings, rng=np.random.default_rng(seed))
+        base = HeadKnowledge(u0=(found.principal_px[0][0], found.principal_px[1][0]))
+        out["goal_columns_px"] = [base.u0[0], base.u0[1]]
+        out["goal_column_error_px"] = [float(e) for e in found.errors_px[:, 0]]
     with HeadSim("default", settings) as sim:
         servo = EyeServo(sim)
         ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
         positions = calibration_layout(sim, rng, calibration)
         try:
-            run = calibrate_head(sim, servo, ball, names.CALIBRATION_BALL, positions)
+            run = calibrate_head(
+                sim, servo, ball, names.CALIBRATION_BALL, positions, knowledge=base
+            )
             knowledge = run.knowledge
             outcomes = run.outcomes
             out["calibration"] = {
@@ -156,17 +168,26 @@ def main() -> int:
     parser.add_argument("--per-zoom", type=int, default=40, help="accepted targets per zoom")
     parser.add_argument("--calibration", type=int, default=20, help="calibration positions")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--goal",
+        choices=("centre", "fixed-point"),
+        default="centre",
+        help="servo goal columns: the image centre's, or each zoom's fixed point",
+    )
+    parser.add_argument("--zooms", help="comma-separated focal factors (default 0.5,...,2)")
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
     start = time.perf_counter()
     rows = []
-    for zoom in ZOOMS:
+    zooms = [float(z) for z in args.zooms.split(",")] if args.zooms else ZOOMS
+    for zoom in zooms:
         print(f"  zoom {zoom}x ...", file=sys.stderr, flush=True)
-        rows.append(run_zoom(zoom, args.per_zoom, args.calibration, args.seed))
-    base = {m: next(r for r in rows if r["zoom"] == 1.0).get(m, {}) for m in ("model2", "model1")}
+        rows.append(run_zoom(zoom, args.per_zoom, args.calibration, args.seed, args.goal))
+    one = [r for r in rows if r["zoom"] == 1.0]
+    base = {m: one[0].get(m, {}) if one else {} for m in ("model2", "model1")}
     print(
         f"Field: depth {FIELD['depth_m']} m, |x/z| <= {FIELD['lateral']}, "
-        f"|y/z| <= {FIELD['vertical']}; paper's cameras, focal x zoom"
+        f"|y/z| <= {FIELD['vertical']}; paper's cameras, focal x zoom; goal columns: {args.goal}"
     )
     print(
         f"{'zoom':>5} {'model':>6} {'acc':>4} {'ok':>4} {'lost':>4} {'rms mm':>8} {'rms %':>7} "
@@ -194,6 +215,13 @@ def main() -> int:
             f"{'':>5} calib: {cal['fixated']} of {cal['positions']} positions fixated"
             + (f"; FAILED {cal['failed']}" if "failed" in cal else "")
             + f"; refused by the check: {r['refused']}"
+            + (
+                f"; goal columns {r['goal_columns_px'][0]:.1f}, {r['goal_columns_px'][1]:.1f} px "
+                f"(fixed point minus true cx: {r['goal_column_error_px'][0]:+.2f}, "
+                f"{r['goal_column_error_px'][1]:+.2f})"
+                if "goal_columns_px" in r
+                else ""
+            )
         )
     total = sum(r["accepted"] for r in rows)
     print(f"{total} accepted targets in all; wall {time.perf_counter() - start:.0f} s")
