@@ -142,6 +142,7 @@ def run_zoom(zoom: float, per_zoom: int, calibration: int, seed: int, goal: str)
             out["calibration"] = {
                 "positions": len(outcomes),
                 "fixated": sum(o is None for o in outcomes),
+                "not_fixated": dict(Counter(o.message for o in outcomes if o is not None)),
                 "alpha_e_error_rad": [float(x) for x in run.alpha_e_error],
             }
         except CalibrationError as err:
@@ -213,6 +214,7 @@ def main() -> int:
             )
         print(
             f"{'':>5} calib: {cal['fixated']} of {cal['positions']} positions fixated"
+            + (f" (not: {cal['not_fixated']})" if cal.get("not_fixated") else "")
             + (f"; FAILED {cal['failed']}" if "failed" in cal else "")
             + f"; refused by the check: {r['refused']}"
             + (
