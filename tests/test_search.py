@@ -12,6 +12,7 @@ from headsim import names
 from headsim.procedures import (
     CalibrationError,
     HeadKnowledge,
+    Model2Config,
     body_target,
     calibrate_head,
     measure_model1,
@@ -128,6 +129,11 @@ def test_each_failure_names_its_cause() -> None:
         cut = measure_model2(sim, EyeServo(sim), RED)
         assert cut.failure is not None and cut.failure.cause is FailureCause.CUT, cut.status
         assert (cut.failure.camera, cut.failure.stage) == (1, "step 1")
+        # Estimator: on the midline without the near-midline remedy, y is 0/0.
+        _place_in_head(sim, "marker_red", [0.0, 0.03, 0.6])
+        flat = measure_model2(sim, EyeServo(sim), RED, config=Model2Config(midline_px=0.0))
+        assert flat.failure is not None and flat.failure.cause is FailureCause.ESTIMATOR
+        assert "NO_Y" in flat.status
         # Iteration limit: one move allowed.
         _place_in_head(sim, "marker_red", [0.1, 0.0, 0.5])
         short = measure_model2(sim, EyeServo(sim, ServoConfig(max_iterations=1)), RED)
