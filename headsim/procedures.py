@@ -28,6 +28,15 @@ from headsim.estimators.areas import (
 from headsim.estimators.calibration import Calibration, calibrate_initial_directions
 from headsim.estimators.vertical import VerticalCalibration, calibrate_vertical_reference
 from headsim.kinematics import head_to_world
+from headsim.search import (
+    Failure,
+    FailureCause,
+    detection_failure,
+    find_view,
+    nearest_seen,
+    neck_failure,
+    servo_failure,
+)
 from headsim.servo import Detector, EyeServo, NeckServo, ServoOutcome, ServoResult
 from headsim.sim import HeadSim
 from headsim.vision import Detection, DetectionStatus, find_chessboard, find_markers
@@ -79,9 +88,11 @@ def body_target(name: str, detector: Detector) -> Target:
 class Measurement:
     """One measured point: estimate and truth in H and W, m; covariance in H, m^2.
 
-    ``status``: "ok", or why it failed (a servo outcome or an estimator flag).
-    ``renders``: images this measurement took.  ``servo_residual_px``: the
-    final |u - u_i0| of each servo.  ``details``: angles and pixels used.
+    ``status``: "ok", or why it failed (``failure.message``).
+    ``renders``: images this measurement took, ``search_renders`` of them
+    spent finding a lost target again.  ``servo_residual_px``: the final
+    |u - u_i0| of each servo.  ``details``: angles and pixels used.
+    ``failure``: the cause, None when ok.
     """
 
     name: str
@@ -95,6 +106,8 @@ class Measurement:
     renders: int
     servo_residual_px: tuple[float, ...]
     details: dict[str, float] = field(default_factory=dict)
+    failure: Failure | None = None
+    search_renders: int = 0
 
     @property
     def ok(self) -> bool:
@@ -121,13 +134,21 @@ def _nan3() -> np.ndarray:
 
 
 def _failed(
-    sim: HeadSim, target: Target, method: str, status: str, renders: int, residuals: Sequence[float]
+    sim: HeadSim,
+    target: Target,
+    method: str,
+    failure: Failure,
+    renders: int,
+    residuals: Sequence[float],
+    search_renders: int = 0,
 ) -> Measurement:
     truth_world = target.truth_world(sim)
     return Measurement(
         name=target.name,
         method=method,
-        status=status,
+        status=failure.message,
+        failure=failure,
+        search_renders=search_renders,
         estimate_head_m=_nan3(),
         truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
         estimate_world_m=_nan3(),
@@ -179,30 +200,48 @@ def measure_model2(
     (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
     # Step 1: Ca1's u to its goal column; then P's image in Ca2 there.
     step1 = servo.run(1, target.detector, goal_u=u10)
-    if step1.outcome is ServoOutcome.TARGET_LOST and step1.iterations == 0 and step1.steps != 0:
-        # Not in view where the last measurement left the eyes: look straight ahead again.
-        sim.command_eye_steps(0)
-        sim.settle()
-        step1 = servo.run(1, target.detector, goal_u=u10)
+    search = 0  # renders spent finding the target again
+    if step1.outcome is ServoOutcome.TARGET_LOST and step1.iterations == 0:
+        # Not in Ca1's view where the last measurement left the eyes: search.
+        before = sim.render_count
+        found = find_view(servo, 1, target.detector)
+        search += sim.render_count - before
+        if found is not None:
+            step1 = servo.run(1, target.detector, goal_u=u10, first=found.detection)
     if not step1.converged:
+        failure = servo_failure(step1, "step 1", 1)
+        if search:
+            failure = replace(failure, detail=f"{failure.detail}; searched {search} poses")
         return _failed(
             sim,
             target,
             "model2",
-            f"step 1: {step1.outcome.value}",
+            failure,
             sim.render_count - start,
             [step1.residual_px],
+            search,
         )
     seen2 = _observe(servo, 2, target)
+    gamma2_steps = step1.steps
     if not seen2.found or seen2.uv is None:
-        return _failed(
-            sim,
-            target,
-            "model2",
-            f"Ca2 at step 1: target {seen2.status.value}",
-            sim.render_count - start,
-            [step1.residual_px],
-        )
+        # Ca2 does not see P where Ca1 fixates it (a lateral target, a long focal
+        # length): its y image is taken at an intermediate eye angle where it does,
+        # and step 2 starts there.
+        before = sim.render_count
+        found = find_view(servo, 2, target.detector)
+        search += sim.render_count - before
+        if found is None:
+            failure = detection_failure(seen2, "step 1", 2, f"and at {search} eye angles searched")
+            return _failed(
+                sim,
+                target,
+                "model2",
+                failure,
+                sim.render_count - start,
+                [step1.residual_px],
+                search,
+            )
+        seen2, gamma2_steps = found.detection, found.steps
     # Step 2: Ca2's u to its goal column, starting from that image; then Ca1's image.
     step2 = servo.run(2, target.detector, goal_u=u20, first=seen2)
     residuals = (step1.residual_px, step2.residual_px)
@@ -211,23 +250,32 @@ def measure_model2(
             sim,
             target,
             "model2",
-            f"step 2: {step2.outcome.value}",
+            servo_failure(step2, "step 2", 2),
             sim.render_count - start,
             residuals,
+            search,
         )
     seen1 = _observe(servo, 1, target)
-    if not seen1.found or seen1.uv is None:
-        return _failed(
-            sim,
-            target,
-            "model2",
-            f"Ca1 at step 2: target {seen1.status.value}",
-            sim.render_count - start,
-            residuals,
-        )
+    gamma1_steps = step2.steps
+    uv1_seen = seen1.uv if seen1.found else None
+    if uv1_seen is None:
+        # Ca1 does not see P where Ca2 fixates it: its y image is one step 1 took.
+        memory = nearest_seen(step1.seen, step2.steps, u10, config.midline_px)
+        if memory is None:
+            return _failed(
+                sim,
+                target,
+                "model2",
+                detection_failure(seen1, "step 2", 1),
+                sim.render_count - start,
+                residuals,
+                search,
+            )
+        gamma1_steps, uv1_seen = memory[0], (memory[1], memory[2])
+    assert seen2.uv is not None
 
-    uv1, uv2 = np.array(seen1.uv), np.array(seen2.uv)
-    gamma1, gamma2 = step2.steps * resolution, step1.steps * resolution
+    uv1, uv2 = np.array(uv1_seen), np.array(seen2.uv)
+    gamma1, gamma2 = gamma1_steps * resolution, gamma2_steps * resolution
     if min(abs(uv1[0] - u10), abs(uv2[0] - u20)) < config.midline_px:
         remedy = _near_midline_images(sim, servo, target, step1, step2, config)
         if remedy is not None:
@@ -271,7 +319,7 @@ def measure_model2(
         "u21_px": float(uv2[0]),
         "v21_px": float(uv2[1]),
     }
-    return _measured(sim, target, "model2", estimate, start, residuals, details)
+    return _measured(sim, target, "model2", estimate, start, residuals, details, search=search)
 
 
 def _measured(
@@ -283,12 +331,13 @@ def _measured(
     residuals: tuple[float, ...],
     details: dict[str, float],
     neck_rad: tuple[float, float] | None = None,
+    search: int = 0,
 ) -> Measurement:
     """The measurement of one estimated point (or why it is invalid) beside the truth."""
     renders = sim.render_count - start
     if not bool(estimate.valid[0]):
-        status = f"estimator: {estimate.reasons(0)!r}"
-        return _failed(sim, target, method, status, renders, residuals)
+        failure = Failure(FailureCause.ESTIMATOR, "estimate", None, repr(estimate.reasons(0)))
+        return _failed(sim, target, method, failure, renders, residuals, search)
     truth_world = target.truth_world(sim)
     estimate_head = estimate.positions[0]
     covariance = estimate.covariance
@@ -304,6 +353,7 @@ def _measured(
         renders=renders,
         servo_residual_px=residuals,
         details=details,
+        search_renders=search,
     )
 
 
@@ -336,6 +386,24 @@ def _near_midline_images(
 # -- Calibration of the initial directions (Sec. V) ----------------------
 
 
+class CalibrationError(ValueError):
+    """The calibration failed; the message names the cause, ``outcomes`` has each position's."""
+
+    def __init__(self, message: str, outcomes: Sequence[Failure | None]) -> None:
+        super().__init__(message)
+        self.outcomes = tuple(outcomes)
+
+
+def _causes_text(outcomes: Sequence[Failure | None]) -> str:
+    """'3 Ca2 at step 1: target lost, 1 Ca1 at step 1: target cut' (most common first)."""
+    counts: dict[str, int] = {}
+    for f in outcomes:
+        if f is not None:
+            key = f.message.split(" (")[0]
+            counts[key] = counts.get(key, 0) + 1
+    return ", ".join(f"{n} {k}" for k, n in sorted(counts.items(), key=lambda kv: -kv[1]))
+
+
 @dataclass(frozen=True)
 class CalibrationRun:
     """Sec. V calibration in the simulator, with the truth beside it.
@@ -343,6 +411,7 @@ class CalibrationRun:
     ``fit``: the estimator's result (offsets, standard errors, residuals).
     ``truth_alpha_e``: each eye's effective initial direction, rad (simulator).
     ``vertical``: the extended calibration per camera (v0, kx/ky), or None.
+    ``outcomes``: per layout position, None (fixated) or why it was not.
     """
 
     fit: Calibration
@@ -352,6 +421,7 @@ class CalibrationRun:
     depth_noise_m: float
     vertical: tuple[VerticalCalibration, VerticalCalibration] | None
     knowledge: HeadKnowledge
+    outcomes: tuple[Failure | None, ...] = ()
 
     @property
     def alpha_e_error(self) -> np.ndarray:
@@ -366,6 +436,7 @@ def calibration_layout(
     depth_range_m: tuple[float, float] = (0.25, 0.6),
     lateral: float = 0.16,
     vertical: float = 0.08,
+    radius_m: float = 0.008,
 ) -> np.ndarray:
     """World positions (count, 3) for Sec. V calibration targets, seeded.
 
@@ -373,13 +444,53 @@ def calibration_layout(
     equation in two unknowns per sample; their sec^2 terms differ most up
     close): 60 targets at 0.25-0.6 m recover them to about 1e-4 rad with the
     paper's cameras.  ``lateral``/``vertical``: x_h/z_h and y_h/z_h spread; a
-    vertical spread is what the extended calibration needs.
+    vertical spread is what the extended calibration needs.  Every position is
+    seen whole (ball of ``radius_m``) by both cameras at the current pose.
     """
-    z = rng.uniform(*depth_range_m, size=count)
-    points_head = np.column_stack(
-        [rng.uniform(-lateral, lateral, count) * z, rng.uniform(-vertical, vertical, count) * z, z]
+
+    def draw(n: int) -> np.ndarray:
+        z = rng.uniform(*depth_range_m, size=n)
+        return np.column_stack(
+            [rng.uniform(-lateral, lateral, n) * z, rng.uniform(-vertical, vertical, n) * z, z]
+        )
+
+    points_world = sim.transform_points(draw(count), "head", "world")
+    # Placement (truth allowed): keep positions both cameras see whole from where the
+    # head stands; a position that one cannot see is drawn again, a bounded number of times.
+    for _ in range(500):
+        unseen = ~seen_by_both(sim, points_world, radius_m)
+        if not unseen.any():
+            return points_world
+        points_world[unseen] = sim.transform_points(draw(int(unseen.sum())), "head", "world")
+    raise ValueError(
+        f"calibration layout: {int(unseen.sum())} of {count} positions stay outside a camera's "
+        f"view after 500 draws: depth {depth_range_m} m, lateral {lateral}, vertical {vertical} "
+        "reach outside the field both cameras share at this focal length"
     )
-    return sim.transform_points(points_head, "head", "world")
+
+
+def seen_by_both(sim: HeadSim, points_world: np.ndarray, radius_m: float = 0.0) -> np.ndarray:
+    """(N,) whether each world point images whole inside both cameras at the current pose.
+
+    Placement and checks only (it uses the true intrinsics): the point's image,
+    plus its apparent radius and 2 px, lies inside the image.
+    """
+    points_world = np.atleast_2d(points_world)
+    ok = np.ones(len(points_world), dtype=bool)
+    for camera in (1, 2):
+        cam = sim.camera_settings(camera)
+        uv = sim.project(points_world, camera)
+        depth = sim.transform_points(points_world, "world", names.CAMERAS[camera - 1])[:, 2]
+        margin = 2.0 + max(cam.kx, cam.ky) * radius_m / np.maximum(depth, 1e-9)
+        with np.errstate(invalid="ignore"):
+            ok &= (
+                (depth > 0)
+                & (uv[:, 0] >= margin)
+                & (uv[:, 0] <= cam.width - 1 - margin)
+                & (uv[:, 1] >= margin)
+                & (uv[:, 1] <= cam.height - 1 - margin)
+            )
+    return ok
 
 
 def calibrate_head(
@@ -408,10 +519,12 @@ def calibrate_head(
     start = sim.render_count
     parked = sim.position(body)  # put the target back afterwards: it must not hide others
     alpha1, alpha2, depths, rows = [], [], [], []
+    outcomes: list[Failure | None] = []
     plain = Model2Config(midline_px=0.0)
     for position in np.atleast_2d(positions_world):
         sim.set_body_pose(body, position)
         m = measure_model2(sim, servo, target, base, plain)
+        outcomes.append(m.failure)
         if not m.ok:
             continue
         alpha1.append(m.details["alpha1_rad"])
@@ -422,26 +535,52 @@ def calibrate_head(
         rows.append((m.truth_head_m, m.details))
     sim.park_body(body, parked)
     baseline = sim.settings.baseline_m
+    total = len(outcomes)
     if len(alpha1) < 2:
-        raise ValueError(
-            f"calibration needs at least 2 fixated targets, got {len(alpha1)} of "
-            f"{len(np.atleast_2d(positions_world))}: place them where both cameras see them"
+        raise CalibrationError(
+            f"too few positions seen: {len(alpha1)} of {total} fixated (at least 2 needed) "
+            f"because {_causes_text(outcomes)}",
+            outcomes,
         )
+    truth_rows = np.array([r[0] for r in rows])
+    ratios = truth_rows[:, 0] / truth_rows[:, 2]
     # Without a depth error model the fit is unweighted and its standard errors
     # come from the scatter of its residuals (the angles' noise is not known a priori).
-    fit = calibrate_initial_directions(
-        np.array(alpha1),
-        np.array(alpha2),
-        np.array(depths),
-        baseline,
-        sigma_encoder=sim.settings.encoder_resolution_rad * 0.25 if depth_noise_m > 0 else None,
-        sigma_depth=depth_noise_m if depth_noise_m > 0 else None,
-    )
+    try:
+        fit = calibrate_initial_directions(
+            np.array(alpha1),
+            np.array(alpha2),
+            np.array(depths),
+            baseline,
+            sigma_encoder=sim.settings.encoder_resolution_rad * 0.25 if depth_noise_m > 0 else None,
+            sigma_depth=depth_noise_m if depth_noise_m > 0 else None,
+        )
+    except ValueError as err:
+        raise CalibrationError(
+            f"degenerate layout because the {len(alpha1)} fixated positions span depths "
+            f"{truth_rows[:, 2].min():.3f}-{truth_rows[:, 2].max():.3f} m and x/z "
+            f"{ratios.min():+.3f} to {ratios.max():+.3f}, which do not separate the two "
+            f"initial directions ({err})",
+            outcomes,
+        ) from err
     alpha_e = (float(fit.alpha_e[0]), float(fit.alpha_e[1]))
     calibrated = replace(base, alpha_e=alpha_e)
     vertical = None
     if extended and len(rows) >= 3:
-        vertical = _vertical_from_samples(sim, rows, alpha_e, base)
+        heights = truth_rows[:, 1] / truth_rows[:, 2]
+        if np.ptp(heights) < 1e-6:
+            raise CalibrationError(
+                f"the extended fit (v0, kx/ky) needs a vertical spread, but the "
+                f"{len(rows)} fixated positions all have y/z = {heights[0]:+.4f}: set "
+                "experiment.calibration.vertical > 0, or extended = false",
+                outcomes,
+            )
+        try:
+            vertical = _vertical_from_samples(sim, rows, alpha_e, base)
+        except ValueError as err:
+            raise CalibrationError(
+                f"degenerate layout for the extended fit because {err}", outcomes
+            ) from err
         calibrated = replace(
             calibrated,
             v0=(vertical[0].v0, vertical[1].v0),
@@ -458,6 +597,7 @@ def calibrate_head(
         depth_noise_m=depth_noise_m,
         vertical=vertical,
         knowledge=calibrated,
+        outcomes=tuple(outcomes),
     )
 
 
@@ -514,11 +654,26 @@ def measure_model1(
     knowledge = knowledge or HeadKnowledge()
     start = sim.render_count
     (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
-    result = servo.run(target.detector, goals=(u10, u20, (v10 + v20) / 2))
+    goals = (u10, u20, (v10 + v20) / 2)
+    result = servo.run(target.detector, goals=goals)
+    search = 0
+    if result.outcome is ServoOutcome.TARGET_LOST and result.iterations == 0 and any(result.steps):
+        # Not in both views where the neck was left (the last target's pose):
+        # back to the start pose and fixate from there.
+        search = result.renders  # the look that did not find it
+        sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
+        sim.settle()
+        result = servo.run(target.detector, goals=goals)
     residual = (result.residual_px,)
     if not result.converged:
         return _failed(
-            sim, target, "model1", result.outcome.value, sim.render_count - start, residual
+            sim,
+            target,
+            "model1",
+            neck_failure(result),
+            sim.render_count - start,
+            residual,
+            search,
         )
     resolution = sim.settings.encoder_resolution_rad
     yaw, pitch, eye = (
@@ -532,7 +687,9 @@ def measure_model1(
         uncertainty=Uncertainty(encoder=angle_sigma),
     )
     details = {"alpha_rad": eye, "neck_yaw_rad": yaw, "neck_pitch_rad": pitch}
-    return _measured(sim, target, "model1", estimate, start, residual, details, (yaw, pitch))
+    return _measured(
+        sim, target, "model1", estimate, start, residual, details, (yaw, pitch), search
+    )
 
 
 @dataclass(frozen=True)
@@ -668,6 +825,10 @@ class RelativeRun:
     ``areas``/``true_areas``: label -> area number (0: unclassified or not
     seen in all four images); ``columns``: label -> (u11, u12, u21, u22), px;
     ``comparison``: the estimator's count of disagreements by margin.
+    ``gain_areas``/``gain_comparison``: the same with each camera's offsets
+    divided by its gain (px per encoder step, learnt by the servo from the
+    images: no intrinsics), so the magnitude tests compare angles, not pixels
+    of two different focal lengths; margins in px at the mean gain.
     """
 
     reference: Measurement
@@ -677,6 +838,8 @@ class RelativeRun:
     missing: tuple[str, ...]
     comparison: AreaComparison | None
     renders: int
+    gain_areas: dict[str, int] = field(default_factory=dict)
+    gain_comparison: AreaComparison | None = None
 
 
 def relative_positioning(
@@ -717,7 +880,8 @@ def relative_positioning(
     alpha1, alpha2 = steps[0] * resolution, steps[1] * resolution
     areas: dict[str, int] = dict.fromkeys(objects, 0)
     true_areas: dict[str, int] = dict.fromkeys(objects, 0)
-    comparison = None
+    comparison = gain_comparison = None
+    gain_areas: dict[str, int] = {}
     if seen:
         cols = np.array([columns[name] for name in seen])
         pixel_areas = areas_from_pixels(*cols.T, u10, u20, alpha1=alpha1, alpha2=alpha2)
@@ -727,6 +891,15 @@ def relative_positioning(
         comparison = compare_areas(pixel_areas, truth, *cols.T, u10, u20)
         areas.update(zip(seen, (int(a) for a in pixel_areas), strict=True))
         true_areas.update(zip(seen, (int(a) for a in truth), strict=True))
+        g1, g2 = (abs(servo.gains.get(camera) or 0.0) for camera in (1, 2))
+        if g1 > 0 and g2 > 0:
+            gain = areas_from_pixels(*cols.T, u10, u20, alpha1=alpha1, alpha2=alpha2, kx=(g1, g2))
+            mean = (g1 + g2) / 2
+            scaled = cols.copy()
+            scaled[:, :2] = u10 + (cols[:, :2] - u10) * mean / g1
+            scaled[:, 2:] = u20 + (cols[:, 2:] - u20) * mean / g2
+            gain_comparison = compare_areas(gain, truth, *scaled.T, u10, u20)
+            gain_areas = dict(zip(seen, (int(a) for a in gain), strict=True))
     return RelativeRun(
         reference=ref,
         areas=areas,
@@ -735,10 +908,13 @@ def relative_positioning(
         missing=missing,
         comparison=comparison,
         renders=sim.render_count - start,
+        gain_areas=gain_areas,
+        gain_comparison=gain_comparison,
     )
 
 
 __all__ = [
+    "CalibrationError",
     "CalibrationRun",
     "ChessboardRun",
     "HeadKnowledge",
@@ -757,6 +933,7 @@ __all__ = [
     "measure_model2",
     "measure_points_model2",
     "relative_positioning",
+    "seen_by_both",
     "to_world",
     "track_moving_target",
 ]

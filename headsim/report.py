@@ -44,6 +44,7 @@ MEASUREMENT_KEYS = (
     "name",
     "method",
     "status",
+    "failure",
     "knowledge",
     "step",
     "time_s",
@@ -57,6 +58,7 @@ MEASUREMENT_KEYS = (
     "error_pct_of_depth",
     "covariance_head_m2",
     "renders",
+    "search_renders",
     "servo_residual_px",
     "details",
 )
@@ -89,6 +91,7 @@ def measurement_entry(record: MeasurementRecord) -> dict[str, Any]:
         "name": m.name,
         "method": m.method,
         "status": m.status,
+        "failure": None if m.failure is None else m.failure.as_dict(),
         "knowledge": record.knowledge,
         "step": record.step,
         "time_s": record.time_s,
@@ -102,6 +105,7 @@ def measurement_entry(record: MeasurementRecord) -> dict[str, Any]:
         "error_pct_of_depth": m.error_pct_of_depth,
         "covariance_head_m2": m.covariance_head_m2,
         "renders": m.renders,
+        "search_renders": m.search_renders,
         "servo_residual_px": list(m.servo_residual_px),
         "details": dict(m.details),
     }
@@ -127,7 +131,19 @@ def _summary(records: list[MeasurementRecord]) -> dict[str, Any]:
         if records
         else nan,
         "servo_residual_px_max": max(residuals) if residuals else nan,
+        "searched": sum(r.measurement.search_renders > 0 for r in records),
+        "search_renders": sum(r.measurement.search_renders for r in records),
+        "failure_causes": _cause_counts([r.measurement.failure for r in records]),
     }
+
+
+def _cause_counts(failures: list[Any]) -> dict[str, int]:
+    """How many failures had each cause (FailureCause values), most common first."""
+    counts: dict[str, int] = {}
+    for f in failures:
+        if f is not None:
+            counts[f.cause.value] = counts.get(f.cause.value, 0) + 1
+    return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
 
 
 def summaries(result: RunResult) -> dict[str, dict[str, Any]]:
@@ -200,6 +216,13 @@ def _calibration_lines(block: dict[str, Any], paper: bool) -> list[str]:
         f"Calibration of the initial directions (Sec. V): {block.get('fixated', 0)} of "
         f"{block['targets']} ball positions fixated, {block.get('renders', 0)} renders"
     ]
+    missed = [p["status"] for p in block.get("positions", []) if p["failure"] is not None]
+    if missed:
+        counts: dict[str, int] = {}
+        for status in missed:
+            key = status.split(" (")[0]
+            counts[key] = counts.get(key, 0) + 1
+        lines.append("  not fixated: " + ", ".join(f"{n} {k}" for k, n in counts.items()))
     if block["status"] != "ok":
         return [*lines, f"  {block['status']}"]
     headers = ["", "ours", "+-", "truth", "error"] + (["paper"] if paper else [])
@@ -278,6 +301,14 @@ def _measurement_lines(result: RunResult) -> list[str]:
             f"{_cell(s['renders_per_point'], '.1f')} renders per point; servo residual "
             f"<= {_cell(s['servo_residual_px_max'], '.2f')} px"
         )
+        if s["searched"]:
+            lines.append(
+                f"  head knew {label}: {s['searched']} targets searched for again, "
+                f"{s['search_renders']} renders of search"
+            )
+        if s["failure_causes"]:
+            causes = ", ".join(f"{n} {c}" for c, n in s["failure_causes"].items())
+            lines.append(f"  head knew {label}: failures by cause: {causes}")
     return lines
 
 

@@ -27,6 +27,7 @@ import numpy as np
 
 from headsim import names
 from headsim.procedures import (
+    CalibrationError,
     CalibrationRun,
     HeadKnowledge,
     Measurement,
@@ -48,6 +49,7 @@ from headsim.scenario import (
     STREAM_DEPTH_NOISE,
     Scenario,
 )
+from headsim.search import Failure
 from headsim.servo import Detector, EyeServo, NeckServo, NeckServoResult, ServoConfig
 from headsim.settings import PAPER_INITIAL_DIRECTIONS
 from headsim.sim import CameraId, HeadSim
@@ -344,14 +346,20 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
     assert spec is not None
     seed = scenario.seed
     with ObservedSim(hub, "default", scenario) as sim:
-        positions = calibration_layout(
-            sim,
-            np.random.default_rng([seed, STREAM_CALIBRATION]),
-            spec.targets,
-            spec.depth_m,
-            spec.lateral,
-            spec.vertical,
-        )
+        try:
+            positions = calibration_layout(
+                sim,
+                np.random.default_rng([seed, STREAM_CALIBRATION]),
+                spec.targets,
+                spec.depth_m,
+                spec.lateral,
+                spec.vertical,
+            )
+        except ValueError as err:
+            block = {"status": f"failed: {err}", "targets": spec.targets, "fixated": 0}
+            block.update(renders=0, positions=[])
+            hub.calibrated(block)
+            return None, block
         truth = {f"calibration {k + 1}": p for k, p in enumerate(positions)}
         hub.phase("calibration", sim, HeadKnowledge(), truth)
         hub.watch(names.CALIBRATION_BALL, "calibration")
@@ -395,12 +403,19 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 extended=spec.extended,
             )
         except ValueError as err:
-            block.update(status=f"failed: {err}", renders=sim.render_count - start)
+            outcomes = err.outcomes if isinstance(err, CalibrationError) else ()
+            block.update(
+                status=f"failed: {err}",
+                renders=sim.render_count - start,
+                fixated=sum(o is None for o in outcomes),
+                positions=position_outcomes(outcomes),
+            )
             hub.calibrated(block)
             return None, block
     fit, knowledge = run.fit, run.knowledge
     block.update(
         fixated=run.samples,
+        positions=position_outcomes(run.outcomes),
         renders=run.renders,
         alpha_e_rad=list(fit.alpha_e),
         alpha_e_std_rad=list(fit.std_errors),
@@ -425,6 +440,16 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
     )
     hub.calibrated(block)
     return run, block
+
+
+def position_outcomes(outcomes: Sequence[Failure | None]) -> list[dict[str, Any]]:
+    """Each calibration position's outcome: status "ok" or the failure and its cause."""
+    return [
+        {"status": "ok", "failure": None}
+        if o is None
+        else {"status": o.message, "failure": o.as_dict()}
+        for o in outcomes
+    ]
 
 
 def _record(
@@ -593,6 +618,8 @@ def _run_relative(
             "true_area": run.true_areas.get(name, 0),
             "agree": name in margins and run.areas[name] == run.true_areas[name],
             "margin_px": margins.get(name, float("nan")),
+            "gain_area": run.gain_areas.get(name, 0),
+            "gain_agree": name in run.gain_areas and run.gain_areas[name] == run.true_areas[name],
             "columns_px": list(run.columns.get(name, (float("nan"),) * 4)),
             "position_head_m": positions_head[name],
         }
@@ -610,6 +637,10 @@ def _run_relative(
         "missing": list(run.missing),
         "agree": sum(o["agree"] for o in objects),
         "disagree_outside_margin": comparison.n_disagree_outside if comparison else None,
+        "gain_agree": sum(o["gain_agree"] for o in objects),
+        "gain_disagree_outside_margin": run.gain_comparison.n_disagree_outside
+        if run.gain_comparison
+        else None,
         "margin_threshold_px": comparison.threshold_px if comparison else None,
         "renders": run.renders,
         "paper": {

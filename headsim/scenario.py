@@ -693,8 +693,40 @@ def _tuple3(p: np.ndarray) -> tuple[float, float, float]:
     return (float(p[0]), float(p[1]), float(p[2]))
 
 
+def _redraw_out_of_reach(
+    table: _Table,
+    settings: HeadSettings,
+    procedure: str,
+    body: str,
+    points_world: np.ndarray,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """Points drawn again from the same box until the reach check accepts each (bounded)."""
+    head = _Head.of(settings)
+    radius = _body_radius(body)
+
+    def refused(p: np.ndarray) -> bool:
+        if procedure == "model1":
+            return model1_refusal(head, p, "target", True, radius) is not None
+        return model2_refusal(head, p, "target", radius) is not None
+
+    points_world = np.array(points_world)
+    for k in range(len(points_world)):
+        for _ in range(200):
+            if not refused(points_world[k]):
+                break
+            points_world[k] = _head_to_world(settings, _random_points_head(table, 1, rng))[0]
+        else:
+            raise table.fail(
+                "within",
+                f"no point of the box within the head's reach in 200 draws (target {k + 1})",
+                "a depth_m, lateral and vertical box that overlaps the field both cameras see",
+            )
+    return points_world
+
+
 def _read_targets(
-    scene: _Table, settings: HeadSettings, seed: int, required: bool
+    scene: _Table, settings: HeadSettings, seed: int, required: bool, procedure: str = "model2"
 ) -> tuple[Placement, ...]:
     """``[[scene.targets]]`` and ``[scene.random_targets]``: markers to measure, in turn."""
     bodies = tuple(MARKER_BODIES)
@@ -709,8 +741,11 @@ def _read_targets(
     if random_table is not None:
         count = random_table.integer("count", _MISSING, 1, 1000)
         body = random_table.choice("body", bodies, names.MARKERS[0])
+        within = random_table.choice("within", ("box", "reach"), "box")
         rng = np.random.default_rng([seed, STREAM_TARGETS])
         points = _head_to_world(settings, _random_points_head(random_table, count, rng))
+        if within == "reach":
+            points = _redraw_out_of_reach(random_table, settings, procedure, body, points, rng)
         random_table.done()
         targets += [
             Placement(f"random_{k + 1}", body, _tuple3(p), f"{random_table.path} (target {k + 1})")
@@ -749,7 +784,9 @@ def _read_scene(
     table = doc.table("scene") or _Table({}, "scene", ctx)
     spec = SceneSpec(scene=scene_name)
     if procedure in ("model2", "model1", "calibration"):
-        targets = _read_targets(table, settings, seed, required=procedure != "calibration")
+        targets = _read_targets(
+            table, settings, seed, required=procedure != "calibration", procedure=procedure
+        )
         spec = replace(spec, targets=targets)
     elif procedure == "chessboard":
         spec = _read_chessboard(table, ctx, settings)
@@ -925,8 +962,15 @@ class _Head:
         """Camera ``index``'s image-centre ray off the head's forward axis at eye 0, rad."""
         return self.directions[index]
 
-    def in_view(self, point_head: np.ndarray, index: int, eye: float = 0.0) -> bool:
-        """Whether a point projects into camera ``index``'s image at eye angle ``eye``."""
+    def in_view(
+        self, point_head: np.ndarray, index: int, eye: float = 0.0, radius_m: float = 0.0
+    ) -> bool:
+        """Whether a point projects into camera ``index``'s image at eye angle ``eye``.
+
+        With ``radius_m``, a ball of that radius around it images whole: its
+        centre's image is its apparent radius plus 2 px inside the border (what
+        the detector needs not to call it cut).
+        """
         camera = self.settings.cameras[index]
         sign = 1.0 if index == 0 else -1.0
         centre = np.array([sign * -self.settings.baseline_m / 2, 0.0, 0.0])
@@ -937,7 +981,8 @@ class _Head:
         if p[2] <= 0.01:
             return False
         u, v = camera.pinhole().project(p)  # NaN beyond where the lens folds over
-        return bool(0 <= u <= camera.width - 1 and 0 <= v <= camera.height - 1)
+        m = 2.0 + max(camera.kx, camera.ky) * radius_m / p[2] if radius_m > 0 else 0.0
+        return bool(m <= u <= camera.width - 1 - m and m <= v <= camera.height - 1 - m)
 
     def model2_angles(self, p: np.ndarray) -> tuple[float, float]:
         """Encoder readings alpha1, alpha2 at which each camera fixates ``p`` (H), rad."""
@@ -965,27 +1010,65 @@ def _check_in_front(ctx: _Context, source: str, p_head: np.ndarray, what: str) -
         )
 
 
-def _check_model2_reach(
-    ctx: _Context, head: _Head, source: str, p_world: np.ndarray, what: str
-) -> None:
-    """In front, fixatable by both eyes within the eye range, seen by a camera at the start."""
+def _body_radius(body: str | None) -> float:
+    """A marker body's sphere radius, m (0 for other bodies)."""
+    if body is None:
+        return 0.0
+    model = _scene_model("default")
+    try:
+        geom = model.geom(body)
+    except KeyError:
+        return 0.0
+    return float(geom.size[0])
+
+
+def model2_refusal(
+    head: _Head, p_world: np.ndarray, what: str, radius_m: float = 0.0
+) -> tuple[str, str] | None:
+    """Why Model 2 cannot measure a point (message, what is allowed), or None: it can.
+
+    The criterion the procedure meets (``headsim.procedures.measure_model2``
+    searches the start pose when a camera loses the target): in front of the
+    head, each camera's fixation angle within the eye range, and the target
+    seen whole by both cameras at the start pose (neck and eyes at 0).
+    """
     p = head.to_head(p_world)
-    _check_in_front(ctx, source, p, what)
+    if not MIN_DEPTH_M <= p[2] <= MAX_DEPTH_M:
+        where = "behind or too close to the head" if p[2] < MIN_DEPTH_M else "too far"
+        return (
+            f"{what} at {_fmt(p)} m in H is {where}",
+            f"z_h from {MIN_DEPTH_M:g} to {MAX_DEPTH_M:g} m in front of the head",
+        )
     lo, hi = head.eye_range
     for camera, alpha in enumerate(head.model2_angles(p), start=1):
         if not lo <= alpha <= hi:
-            raise ctx.error(
-                source,
+            return (
                 f"{what} at {_fmt(p)} m in H needs an eye angle of {alpha:.3f} rad for "
                 f"camera {camera} to fixate it",
                 f"targets that both eyes fixate within the eye range [{lo:g}, {hi:g}] rad",
             )
-    if not (head.in_view(p, 0) or head.in_view(p, 1)):
-        raise ctx.error(
-            source,
-            f"{what} at {_fmt(p)} m in H is outside both cameras' view at the start pose",
-            "a target that camera 1 or 2 sees with neck and eyes at 0",
-        )
+    for index in (0, 1):
+        if not head.in_view(p, index, 0.0, radius_m):
+            return (
+                f"{what} at {_fmt(p)} m in H is not seen whole by camera {index + 1} at the "
+                "start pose",
+                "a target that both cameras see whole with neck and eyes at 0",
+            )
+    return None
+
+
+def _check_model2_reach(
+    ctx: _Context,
+    head: _Head,
+    source: str,
+    p_world: np.ndarray,
+    what: str,
+    radius_m: float = 0.0,
+) -> None:
+    """Refuse a point that :func:`model2_refusal` refuses, naming the reason."""
+    refusal = model2_refusal(head, p_world, what, radius_m)
+    if refusal is not None:
+        raise ctx.error(source, *refusal)
 
 
 def _model1_angles(head: _Head, p_world: np.ndarray) -> tuple[float, float, float]:
@@ -1004,16 +1087,21 @@ def _model1_angles(head: _Head, p_world: np.ndarray) -> tuple[float, float, floa
     return yaw, pitch, eye
 
 
-def _check_model1_reach(
-    ctx: _Context, head: _Head, source: str, p_world: np.ndarray, what: str, start: bool
-) -> None:
-    """Within the neck's and eye's ranges; seen by a camera at the start pose if ``start``."""
+def model1_refusal(
+    head: _Head, p_world: np.ndarray, what: str, start: bool, radius_m: float = 0.0
+) -> tuple[str, str] | None:
+    """Why Model 1 cannot fixate a point (message, what is allowed), or None: it can.
+
+    Within the neck's and eye's ranges; if ``start`` (a first position, which the
+    procedure looks for at the start pose), in front and seen whole by both
+    cameras with neck and eyes at 0.
+    """
+    p = head.to_head(p_world)
     yaw, pitch, eye = _model1_angles(head, p_world)
     if math.isnan(pitch):
         s = head.settings
         distance = math.hypot(math.hypot(p_world[0], p_world[1]), p_world[2] - s.neck_d1_m)
-        raise ctx.error(
-            source,
+        return (
             f"{what} at {_fmt(np.asarray(p_world))} m in W is {distance:.3f} m from the neck's "
             f"pitch axis, inside the eyes' offset from it (head.neck_a2_m = {s.neck_a2_m:g} m): "
             "no neck pitch turns the eyes towards it",
@@ -1026,8 +1114,7 @@ def _check_model1_reach(
     )
     for label, angle, (lo, hi) in ranges:
         if not lo <= angle <= hi:
-            raise ctx.error(
-                source,
+            return (
                 f"{what} at {_fmt(np.asarray(p_world))} m in W needs a {label} of {angle:.3f} rad",
                 f"targets the neck and eyes fixate within their ranges: neck yaw "
                 f"[{head.neck_yaw_range[0]:g}, {head.neck_yaw_range[1]:g}], neck pitch "
@@ -1035,14 +1122,35 @@ def _check_model1_reach(
                 f"[{head.eye_range[0]:g}, {head.eye_range[1]:g}] rad",
             )
     if start:
-        p = head.to_head(p_world)
-        _check_in_front(ctx, source, p, what)
-        if not (head.in_view(p, 0) or head.in_view(p, 1)):
-            raise ctx.error(
-                source,
-                f"{what} at {_fmt(p)} m in H is outside both cameras' view at the start pose",
-                "a first position that camera 1 or 2 sees with neck and eyes at 0",
+        if not MIN_DEPTH_M <= p[2] <= MAX_DEPTH_M:
+            where = "behind or too close to the head" if p[2] < MIN_DEPTH_M else "too far"
+            return (
+                f"{what} at {_fmt(p)} m in H is {where}",
+                f"z_h from {MIN_DEPTH_M:g} to {MAX_DEPTH_M:g} m in front of the head",
             )
+        for index in (0, 1):
+            if not head.in_view(p, index, 0.0, radius_m):
+                return (
+                    f"{what} at {_fmt(p)} m in H is not seen whole by camera {index + 1} at "
+                    "the start pose",
+                    "a first position that both cameras see whole with neck and eyes at 0",
+                )
+    return None
+
+
+def _check_model1_reach(
+    ctx: _Context,
+    head: _Head,
+    source: str,
+    p_world: np.ndarray,
+    what: str,
+    start: bool,
+    radius_m: float = 0.0,
+) -> None:
+    """Refuse a point that :func:`model1_refusal` refuses, naming the reason."""
+    refusal = model1_refusal(head, p_world, what, start, radius_m)
+    if refusal is not None:
+        raise ctx.error(source, *refusal)
 
 
 def _chessboard_corners_world(placement: Placement, corners: tuple[int, ...] | None) -> np.ndarray:
@@ -1066,13 +1174,20 @@ def _check_reach(ctx: _Context, scenario: Scenario) -> None:
     scene = scenario.scene
     procedure = scenario.experiment.procedure
     for target in scene.targets:
+        radius = _body_radius(target.body)
         if procedure == "model1":
             _check_model1_reach(
-                ctx, head, f"{target.source}", np.array(target.position_world_m), "target", True
+                ctx,
+                head,
+                f"{target.source}",
+                np.array(target.position_world_m),
+                "target",
+                True,
+                radius,
             )
         else:
             _check_model2_reach(
-                ctx, head, target.source, np.array(target.position_world_m), "target"
+                ctx, head, target.source, np.array(target.position_world_m), "target", radius
             )
     if scene.chessboard is not None:
         indices = range(_corner_count()) if scene.corners is None else scene.corners
@@ -1118,6 +1233,7 @@ def _check_reach(ctx: _Context, scenario: Scenario) -> None:
                 moving.position(float(t)),
                 f"the target at t = {t:g} s",
                 k == 0,
+                _body_radius(moving.body),
             )
 
 

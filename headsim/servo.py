@@ -19,7 +19,7 @@ import numpy as np
 
 from headsim import names
 from headsim.sim import HeadSim
-from headsim.vision import Detection
+from headsim.vision import Detection, DetectionStatus
 
 Detector = Callable[[np.ndarray], Detection]
 
@@ -40,7 +40,11 @@ class ServoResult:
     ``gain_px_per_step``: the last gain estimate (seed for the next target);
     ``subpixel_steps``: the fractional step at which u would equal the goal,
     interpolated with the gain (the image tells more than the encoder);
-    ``renders``: images taken; ``iterations``: moves made.
+    ``renders``: images taken; ``iterations``: moves made.  ``lost_status``:
+    when the target was lost, what the detector said (lost, cut, occluded).
+    ``seen``: every (steps, u, v) at which the camera saw the target, in order
+    (the memory a search returns to).  ``retreats``: moves undone because the
+    target was lost there (re-acquired at the last pose that saw it).
     """
 
     outcome: ServoOutcome
@@ -51,6 +55,9 @@ class ServoResult:
     subpixel_steps: float
     renders: int
     iterations: int
+    lost_status: DetectionStatus | None = None
+    seen: tuple[tuple[int, float, float], ...] = ()
+    retreats: int = 0
 
     @property
     def converged(self) -> bool:
@@ -66,6 +73,8 @@ class ServoConfig:
     ``probe_steps``: first probe when no gain is known; grown x4 until the
     image moves ``min_probe_px``.  ``min_secant_steps``: moves shorter than this
     do not update the gain (centroid pixel-locking would corrupt it).
+    ``max_retreats``: moves after which the target was gone that are undone
+    and retried at half the length, per run.
     """
 
     tolerance_px: float = 0.1
@@ -73,6 +82,7 @@ class ServoConfig:
     probe_steps: int = 16
     min_probe_px: float = 2.0
     min_secant_steps: int = 8
+    max_retreats: int = 3
 
 
 class EyeServo:
@@ -106,35 +116,44 @@ class EyeServo:
         """Drive the eye motor until ``camera`` sees the target at ``goal_u`` (image centre).
 
         ``first``: a detection already made at the current eye position (saves
-        a render).
+        a render).  A move after which the target is gone is undone (back to
+        the last step that saw it, no render needed) and retried at half the
+        length, at most ``max_retreats`` times.
         """
         sim, cfg = self.sim, self.config
         goal = sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
-        renders = 0
+        self._renders = 0
         steps = sim.eye_encoder_steps()
         if first is None:
             first = self.observe(camera, detector)
-            renders += 1
+            self._renders += 1
+        self._seen: list[tuple[int, float, float]] = []
+        self._retreats = 0
         if not first.found or first.uv is None:
-            return self._result(ServoOutcome.TARGET_LOST, steps, None, goal, renders, 0, camera)
+            return self._result(
+                ServoOutcome.TARGET_LOST, steps, None, goal, 0, camera, lost=first.status
+            )
         visited: dict[int, tuple[float, float]] = {steps: first.uv}
+        self._seen.append((steps, *first.uv))
         uv = first.uv
         gain = self.gains.get(camera)
         probe = cfg.probe_steps
+        damping = 1.0
         for iteration in range(1, cfg.max_iterations + 1):
             error = uv[0] - goal
             if gain is not None and abs(error) <= max(cfg.tolerance_px, 0.5 * abs(gain)):
                 return self._result(
-                    ServoOutcome.CONVERGED, steps, uv, goal, renders, iteration - 1, camera, gain
+                    ServoOutcome.CONVERGED, steps, uv, goal, iteration - 1, camera, gain
                 )
             if gain is None:
                 move = probe if steps + probe <= self._step_range[1] else -probe
+                move = round(move * damping) or (1 if move > 0 else -1)
             else:
-                move = round(-error / gain) or (-1 if error / gain > 0 else 1)
+                move = round(-damping * error / gain) or (-1 if error / gain > 0 else 1)
             target = steps + move
             if not self._step_range[0] <= target <= self._step_range[1]:
                 return self._result(
-                    ServoOutcome.JOINT_LIMIT, steps, uv, goal, renders, iteration - 1, camera, gain
+                    ServoOutcome.JOINT_LIMIT, steps, uv, goal, iteration - 1, camera, gain
                 )
             if target in visited:
                 # Revisiting a step (pixel locking between neighbours): the best
@@ -144,23 +163,30 @@ class EyeServo:
                     sim.command_eye_steps(best)
                     sim.settle()
                 return self._result(
-                    ServoOutcome.CONVERGED,
-                    best,
-                    visited[best],
-                    goal,
-                    renders,
-                    iteration,
-                    camera,
-                    gain,
+                    ServoOutcome.CONVERGED, best, visited[best], goal, iteration, camera, gain
                 )
             sim.command_eye_steps(target)
             sim.settle()
             detection = self.observe(camera, detector)
-            renders += 1
+            self._renders += 1
             if not detection.found or detection.uv is None:
-                return self._result(
-                    ServoOutcome.TARGET_LOST, target, None, goal, renders, iteration, camera, gain
-                )
+                if self._retreats >= cfg.max_retreats or abs(move) <= 1:
+                    return self._result(
+                        ServoOutcome.TARGET_LOST,
+                        target,
+                        None,
+                        goal,
+                        iteration,
+                        camera,
+                        gain,
+                        lost=detection.status,
+                    )
+                # Re-acquire: back to the last step that saw it, then a shorter move.
+                self._retreats += 1
+                damping *= 0.5
+                sim.command_eye_steps(steps)
+                sim.settle()
+                continue
             change = detection.uv[0] - uv[0]
             if gain is None:
                 if abs(change) >= cfg.min_probe_px:
@@ -171,16 +197,11 @@ class EyeServo:
                 gain = change / move
             steps, uv = target, detection.uv
             visited[steps] = uv
-        return self._result(
-            ServoOutcome.ITERATION_LIMIT,
-            steps,
-            uv,
-            goal,
-            renders,
-            cfg.max_iterations,
-            camera,
-            gain,
-        )
+            self._seen.append((steps, *uv))
+        # The last move may have landed within tolerance: that is converged.
+        done = gain is not None and abs(uv[0] - goal) <= max(cfg.tolerance_px, 0.5 * abs(gain))
+        outcome = ServoOutcome.CONVERGED if done else ServoOutcome.ITERATION_LIMIT
+        return self._result(outcome, steps, uv, goal, cfg.max_iterations, camera, gain)
 
     def _result(
         self,
@@ -188,16 +209,28 @@ class EyeServo:
         steps: int,
         uv: tuple[float, float] | None,
         goal: float,
-        renders: int,
         iterations: int,
         camera: int,
         gain: float | None = None,
+        lost: DetectionStatus | None = None,
     ) -> ServoResult:
         if gain is not None:
             self.gains[camera] = gain
         residual = math.nan if uv is None else uv[0] - goal
         subpixel = float(steps) if gain is None or uv is None else steps - residual / gain
-        return ServoResult(outcome, steps, uv, residual, gain, subpixel, renders, iterations)
+        return ServoResult(
+            outcome,
+            steps,
+            uv,
+            residual,
+            gain,
+            subpixel,
+            self._renders,
+            iterations,
+            lost,
+            tuple(self._seen),
+            self._retreats,
+        )
 
 
 @dataclass(frozen=True)
@@ -217,6 +250,9 @@ class NeckServoResult:
     jacobian: np.ndarray | None
     renders: int
     iterations: int
+    lost_camera: int | None = None
+    lost_status: DetectionStatus | None = None
+    retreats: int = 0
 
     @property
     def converged(self) -> bool:
@@ -263,8 +299,10 @@ class NeckServo:
 
     def _error(self, detector: Detector, goals: np.ndarray) -> np.ndarray | None:
         seen = [detector(self.sim.render(camera)) for camera in (1, 2)]
-        if not all(s.found and s.uv is not None for s in seen):
-            return None
+        for camera, s in enumerate(seen, start=1):
+            if not s.found or s.uv is None:
+                self._lost = (camera, s.status)
+                return None
         (u1, v1), (u2, v2) = seen[0].uv, seen[1].uv  # type: ignore[misc]
         return np.array([u1, u2, (v1 + v2) / 2]) - goals
 
@@ -281,6 +319,8 @@ class NeckServo:
             goals = (u10, u20, (v10 + v20) / 2)
         goal = np.asarray(goals, dtype=float)
         start = sim.render_count
+        self._lost: tuple[int, DetectionStatus] | None = None
+        self._retreats = 0
         steps = self._steps()
         error = self._error(detector, goal)
         if error is None:
@@ -300,12 +340,13 @@ class NeckServo:
                 jac[:, joint] = (probed - error) / (moved - steps)[joint]
             self._move(steps)
         visited: dict[tuple[int, ...], np.ndarray] = {tuple(steps): error}
+        damping = 1.0
         for iteration in range(1, cfg.max_iterations + 1):
             tolerance = np.maximum(cfg.tolerance_px, 0.5 * np.abs(jac).max(axis=1))
             if np.all(np.abs(error) <= tolerance):
                 self.jacobian = jac
                 return self._result(ServoOutcome.CONVERGED, steps, error, start, iteration - 1, jac)
-            move = np.rint(-np.linalg.solve(jac, error)).astype(int)
+            move = np.rint(-damping * np.linalg.solve(jac, error)).astype(int)
             if not move.any():
                 move[int(np.argmax(np.abs(error)))] = 1
             target = steps + move
@@ -324,16 +365,25 @@ class NeckServo:
             self._move(target)
             new_error = self._error(detector, goal)
             if new_error is None:
-                return self._result(ServoOutcome.TARGET_LOST, target, None, start, iteration, jac)
+                if self._retreats >= cfg.max_retreats or np.abs(move).max() <= 1:
+                    return self._result(
+                        ServoOutcome.TARGET_LOST, target, None, start, iteration, jac
+                    )
+                # Re-acquire: back to the last pose both cameras saw it, then a shorter move.
+                self._retreats += 1
+                damping *= 0.5
+                self._move(steps)
+                continue
             if np.abs(move).max() >= cfg.min_secant_steps:
                 dq = move.astype(float)
                 jac = jac + np.outer(new_error - error - jac @ dq, dq) / (dq @ dq)
             steps, error = target, new_error
             visited[tuple(steps)] = error
         self.jacobian = jac
-        return self._result(
-            ServoOutcome.ITERATION_LIMIT, steps, error, start, cfg.max_iterations, jac
-        )
+        tolerance = np.maximum(cfg.tolerance_px, 0.5 * np.abs(jac).max(axis=1))
+        done = bool(np.all(np.abs(error) <= tolerance))
+        outcome = ServoOutcome.CONVERGED if done else ServoOutcome.ITERATION_LIMIT
+        return self._result(outcome, steps, error, start, cfg.max_iterations, jac)
 
     def _result(
         self,
@@ -354,12 +404,16 @@ class NeckServo:
                 float(s)
                 for s in (steps - np.linalg.solve(jac, error) if jac is not None else steps)
             )
+        lost = self._lost if outcome is ServoOutcome.TARGET_LOST else None
         return NeckServoResult(
             outcome,
             whole,
-            err,
-            sub,
+            err,  # type: ignore[arg-type]
+            sub,  # type: ignore[arg-type]
             jac,
             self.sim.render_count - start,
-            iterations,  # type: ignore[arg-type]
+            iterations,
+            None if lost is None else lost[0],
+            None if lost is None else lost[1],
+            self._retreats,
         )

@@ -10,6 +10,7 @@ import pytest
 
 from headsim import names
 from headsim.procedures import (
+    CalibrationError,
     HeadKnowledge,
     Model2Config,
     body_target,
@@ -21,6 +22,7 @@ from headsim.procedures import (
     relative_positioning,
     track_moving_target,
 )
+from headsim.search import FailureCause
 from headsim.servo import EyeServo, NeckServo
 from headsim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim import HeadSim
@@ -71,7 +73,9 @@ def test_a_target_out_of_view_fails_cleanly() -> None:
     with HeadSim("default") as sim:
         sim.set_body_pose("marker_red", [0.0, -1.0, 0.2])
         m = measure_model2(sim, EyeServo(sim), RED)
-        assert m.status == "step 1: target lost"
+        assert m.failure is not None and m.failure.cause is FailureCause.LOST
+        assert (m.failure.camera, m.failure.stage) == (1, "step 1")
+        assert m.status.startswith("Ca1 at step 1: target lost")
         assert np.all(np.isnan(m.estimate_head_m))
         assert np.all(np.isfinite(m.truth_head_m))
 
@@ -105,7 +109,10 @@ def test_calibration_recovers_effective_initial_directions_and_corrects_measurem
 def test_calibration_with_too_few_visible_targets_says_so() -> None:
     with (
         HeadSim("default") as sim,
-        pytest.raises(ValueError, match="at least 2 fixated targets, got 0 of 2"),
+        pytest.raises(
+            CalibrationError,
+            match=r"too few positions seen: 0 of 2 fixated .* because 2 Ca1 at step 1: target lost",
+        ),
     ):
         calibrate_head(
             sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, np.array([[0, -1, 0.2]] * 2)

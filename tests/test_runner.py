@@ -131,19 +131,29 @@ def test_the_same_seed_gives_identical_results_with_or_without_a_recording(
 def test_a_failed_measurement_exits_1_and_still_writes_results(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    # Within reach (camera 2 sees it, both eyes could fixate it), but step 1
-    # servos camera 1, which does not see it from the start pose.
+    # Within reach, but the servo may make only three moves: for the first target
+    # (its gain still unknown) that is an iteration limit.
     path = tmp_path / "unseen.toml"
     path.write_text(
-        'description = "seen by camera 2 only"\n[experiment]\nprocedure = "model2"\n'
-        "[[scene.targets]]\nname = 'right'\nposition_head_m = [0.3, 0.0, 0.5]\n"
+        'description = "a servo cut short"\n[experiment]\nprocedure = "model2"\n'
+        "[experiment.servo]\nmax_iterations = 3\n"
+        "[[scene.targets]]\nname = 'right'\nposition_head_m = [0.1, 0.0, 0.5]\n"
         "[[scene.targets]]\nname = 'ahead'\nposition_head_m = [0.0, 0.02, 0.7]\n"
     )
     code, out = _run([str(path), "--out", str(tmp_path / "out")], capsys)
     assert code == 1
-    assert "FAILED: 1 problem(s)\n  right: step 1: target lost" in out
+    line = "right: Ca1 at step 1: iteration limit (after 3 moves)"
+    assert f"FAILED: 1 problem(s)\n  {line}" in out
+    assert "failures by cause: 1 iteration limit" in out
     results = json.loads((tmp_path / "out" / "results.json").read_text())
-    assert results["status"] == "failed" and results["failures"] == ["right: step 1: target lost"]
+    assert results["status"] == "failed" and results["failures"] == [line]
+    assert results["measurements"][0]["failure"] == {
+        "cause": "iteration limit",
+        "stage": "step 1",
+        "camera": 1,
+        "detail": "after 3 moves",
+    }
+    assert results["summary"]["none"]["failure_causes"] == {"iteration limit": 1}
     right, ahead = results["measurements"]
     assert right["estimate_head_m"] == [None, None, None] and right["error_m"] is None
     assert ahead["status"] == "ok"

@@ -157,13 +157,21 @@ REACH = [
     ),
     (
         "[0.0, 0.7, 1.0]",
-        "scene.targets[0]: target at [0.000, 0.700, 1.000] m in H is outside both cameras' view at the "
-        "start pose (allowed: a target that camera 1 or 2 sees with neck and eyes at 0)",
+        "scene.targets[0]: target at [0.000, 0.700, 1.000] m in H is not seen whole by camera 1 at the "
+        "start pose (allowed: a target that both cameras see whole with neck and eyes at 0)",
+    ),
+    (
+        # Camera 2 sees it, camera 1 does not: the procedure could not start step 1.
+        "[0.3, 0.0, 0.5]",
+        "scene.targets[0]: target at [0.300, 0.000, 0.500] m in H is not seen whole by camera 1 at the "
+        "start pose (allowed: a target that both cameras see whole with neck and eyes at 0)",
     ),
 ]
 
 
-@pytest.mark.parametrize(("position", "message"), REACH, ids=["behind", "eye range", "out of view"])
+@pytest.mark.parametrize(
+    ("position", "message"), REACH, ids=["behind", "eye range", "out of view", "one camera only"]
+)
 def test_a_target_out_of_reach_is_refused_without_rendering(
     tmp_path: Path, position: str, message: str
 ) -> None:

@@ -1,0 +1,41 @@
+"""Layouts that populate the magnitude-test areas, and the gain-normalised area test, rendered."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from headsim import names
+from headsim.area_layouts import area_layout
+from headsim.procedures import body_target, relative_positioning
+from headsim.servo import EyeServo
+from headsim.settings import paper_head
+from headsim.sim import HeadSim
+from headsim.vision import find_cross_point
+
+
+def test_objects_placed_in_the_magnitude_areas_are_classified_by_both_tests() -> None:
+    wanted = [1, 2, 3, 4, 7, 8]  # the areas random layouts almost never reach
+    with HeadSim("blocks", paper_head()) as sim:
+        ref_head = np.array([0.01, 0.0, 0.8])
+        sim.set_body_pose(names.BLOCKS, sim.transform_points(ref_head, "head", "world")[0])
+        placed = area_layout(
+            sim, ref_head, wanted, np.random.default_rng(1), radius_m=0.006, depth_m=(0.3, 3.0)
+        )
+        for body, p in zip(names.RELATIVE_OBJECTS, placed, strict=True):
+            sim.set_body_pose(body, sim.transform_points(p, "head", "world")[0])
+        servo = EyeServo(sim)
+        run = relative_positioning(
+            sim, servo, body_target(names.BLOCKS, find_cross_point), names.RELATIVE_OBJECT_COLOURS
+        )
+    assert run.reference.ok and run.missing == ()
+    # The layout put each object where it was wanted (the fixations' whole steps
+    # may move a boundary by a hair, so most, not all).
+    true = [run.true_areas[b] for b in names.RELATIVE_OBJECTS]
+    assert sum(t == w for t, w in zip(true, wanted, strict=True)) >= 5
+    assert run.gain_comparison is not None and run.comparison is not None
+    # Outside the 2 px margin both tests agree with the geometry.
+    for comparison in (run.comparison, run.gain_comparison):
+        assert comparison.n_disagree_outside == 0
+    assert set(run.gain_areas) == set(names.RELATIVE_OBJECTS)
+    # The gain-normalised test used the servo's learnt gains, nothing else.
+    assert servo.gains[1] < 0 < servo.gains[2] or servo.gains[2] < 0 < servo.gains[1]
