@@ -13,7 +13,7 @@ import numpy as np
 
 from headsim import names
 from headsim.backend import INSTALL_HINT, RenderBackendError, check_backend
-from headsim.optics import DistortionCanvas, add_noise, apply_canvas
+from headsim.optics import DistortionCanvas, GaussianNoise, apply_canvas
 from headsim.settings import CameraSettings
 
 
@@ -33,9 +33,11 @@ class EyeRenderer:
         self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
         self._option = mujoco.MjvOption()
         self._option.geomgroup[names.HEAD_VISUAL_GROUP] = 0
-        # One noise stream per camera, so each camera's noise depends only on
-        # the seed and on how many images that camera has taken.
-        self._noise = tuple(np.random.default_rng([seed, index]) for index in range(2))
+        # One noise stream per camera: image k of camera i gets the noise drawn
+        # from (seed, i, k), whatever else was rendered.
+        self._seed = seed
+        self._noise = tuple(GaussianNoise.of(camera.noise_std) for camera in cameras)
+        self._taken = [0, 0]
         self.render_count = 0
 
     def _renderer(self, size: tuple[int, int]) -> mujoco.Renderer:
@@ -60,7 +62,9 @@ class EyeRenderer:
         renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
         image = apply_canvas(renderer.render(), canvas)
         self.render_count += 1
-        return add_noise(image, self._cameras[index].noise_std, self._noise[index])
+        frame = self._taken[index]
+        self._taken[index] += 1
+        return self._noise[index].apply(image, (self._seed, index), frame)
 
     def close(self) -> None:
         for renderer in self._renderers.values():
