@@ -226,21 +226,38 @@ class GaussianNoise:
                     law[value] = law.get(value, 0.0) + p / _BUCKETS
         return law
 
-    def apply(self, image: np.ndarray, key: tuple[int, ...], frame: int) -> np.ndarray:
-        """``image`` (8-bit) plus noise image number ``frame`` of stream ``key``."""
+    def apply(
+        self,
+        image: np.ndarray,
+        key: tuple[int, ...],
+        frame: int,
+        crop: tuple[int, int, int, int] | None = None,
+    ) -> np.ndarray:
+        """``image`` (8-bit) plus noise image number ``frame`` of stream ``key``.
+
+        ``crop`` = (x0, y0, full width, full height): ``image`` is the window at
+        (x0, y0) of a full frame of that size, and gets that part of the full
+        frame's noise.
+        """
         if self.std <= 0:
             return image
+        height, width = image.shape[:2]
+        x0, y0, full_w, full_h = (0, 0, width, height) if crop is None else crop
+        channels = image.shape[2] if image.ndim == 3 else 1
+        full_shape = (full_h, full_w * channels)
+        rows = slice(y0, y0 + height)
+        columns = slice(x0 * channels, (x0 + width) * channels)
         bits = np.random.SFC64(np.random.SeedSequence([*key, frame]))
+        flat = np.ascontiguousarray(image).reshape(height, width * channels)
         if self.tables is None:
-            z = np.random.Generator(bits).standard_normal(size=image.shape, dtype=np.float32)
-            noisy = image.astype(np.float32) + np.float32(self.std) * z
-            return np.clip(np.rint(noisy), 0, 255).astype(np.uint8)
+            z = np.random.Generator(bits).standard_normal(size=full_shape, dtype=np.float32)
+            noisy = flat.astype(np.float32) + np.float32(self.std) * z[rows, columns]
+            return np.clip(np.rint(noisy), 0, 255).astype(np.uint8).reshape(image.shape)
         alias, threshold, k_max = self.tables
-        flat = np.ascontiguousarray(image).reshape(image.shape[0], -1)
-        size = flat.size
+        size = full_shape[0] * full_shape[1]
         raw = bits.random_raw((2 * size + 7) // 8).view(np.uint8)
-        bucket = raw[:size].reshape(flat.shape)
-        within = raw[size : 2 * size].reshape(flat.shape)
+        bucket = raw[:size].reshape(full_shape)[rows, columns]
+        within = raw[size : 2 * size].reshape(full_shape)[rows, columns]
         # Outcome index: the bucket itself (Vose's primary) or its alias; offset = index - k_max.
         outcome = cv2.LUT(bucket, alias)
         cv2.copyTo(bucket, cv2.compare(within, cv2.LUT(bucket, threshold), cv2.CMP_LT), outcome)

@@ -1,12 +1,26 @@
 """Off-screen rendering of the eye cameras: MuJoCo pinhole render, lens, noise.
 
-One :class:`mujoco.Renderer` per canvas size is created lazily and reused.
-The head's own geoms (group ``names.HEAD_VISUAL_GROUP``) are hidden from the
-eye cameras.  Every call of :meth:`EyeRenderer.render` is one render and is
-counted.
+One :class:`mujoco.Renderer` (an OpenGL context) per compiled head and scene
+is kept in a small process-wide pool and reused by every simulator of that
+head, within a run and across the jobs of a worker: creating one costs about
+0.2 s.  Images are drawn into a viewport of its off-screen buffer, so one
+context serves every canvas size and every window.
+
+A *window* is a sub-rectangle of a camera's image, rendered as the same
+camera with a shifted principal point (for a distorted camera: the region of
+its pinhole canvas that the window's pixels sample).  Its pixels are the full
+frame's crop, noise included (the noise of image k of a camera is drawn for
+the whole frame and cropped).  The head's own geoms (group
+``names.HEAD_VISUAL_GROUP``) are hidden from the eye cameras.  Every image is
+one render and is counted, with its pixels in full-frame equivalents.
 """
 
 from __future__ import annotations
+
+import math
+from collections import OrderedDict
+from collections.abc import Hashable
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -16,9 +30,81 @@ from headsim.backend import INSTALL_HINT, RenderBackendError, check_backend
 from headsim.optics import DistortionCanvas, GaussianNoise, apply_canvas
 from headsim.settings import CameraSettings
 
+#: Renderers kept per process (one per head and scene); the least recently used goes first.
+POOL_SIZE = 4
+_POOL: OrderedDict[Hashable, mujoco.Renderer] = OrderedDict()
+#: Renderers created in this process (the pool's misses), for the bench and tests.
+created = 0
+
+
+@dataclass(frozen=True)
+class Window:
+    """A sub-rectangle of a camera's output image: top-left (x0, y0) and size, px."""
+
+    x0: int
+    y0: int
+    width: int
+    height: int
+
+    @property
+    def x1(self) -> int:
+        return self.x0 + self.width
+
+    @property
+    def y1(self) -> int:
+        return self.y0 + self.height
+
+    @classmethod
+    def around(
+        cls, centre_uv: tuple[float, float], half_px: float, image_size: tuple[int, int]
+    ) -> Window:
+        """The square of half-side ``half_px`` around ``centre_uv``, moved inside the image."""
+        width, height = image_size
+        side_u = min(width, 2 * math.ceil(half_px) + 1)
+        side_v = min(height, 2 * math.ceil(half_px) + 1)
+        x0 = min(max(round(centre_uv[0] - side_u / 2), 0), width - side_u)
+        y0 = min(max(round(centre_uv[1] - side_v / 2), 0), height - side_v)
+        return cls(int(x0), int(y0), int(side_u), int(side_v))
+
+
+def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
+    """The pooled renderer of ``key`` (a head and scene), made for ``model`` if new."""
+    global created
+    renderer = _POOL.pop(key, None)
+    if renderer is None:
+        backend = check_backend()
+        width, height = int(model.vis.global_.offwidth), int(model.vis.global_.offheight)
+        try:
+            renderer = mujoco.Renderer(model, height=height, width=width)
+        except ValueError as err:  # larger than the model's off-screen buffer
+            raise ValueError(f"cannot render {width}x{height}: {err}") from err
+        except Exception as err:  # GL context creation failed
+            raise RenderBackendError(
+                f"could not create an off-screen OpenGL context with MUJOCO_GL={backend}: {err}. "
+                f"{INSTALL_HINT}"
+            ) from err
+        created += 1
+    _POOL[key] = renderer
+    while len(_POOL) > POOL_SIZE:
+        _, oldest = _POOL.popitem(last=False)
+        oldest.close()
+    return renderer
+
+
+def release_renderers() -> None:
+    """Close every pooled renderer (their OpenGL contexts)."""
+    while _POOL:
+        _, renderer = _POOL.popitem()
+        renderer.close()
+
 
 class EyeRenderer:
-    """Renders the two eye cameras of one compiled model to 8-bit RGB arrays."""
+    """Renders the two eye cameras of one compiled model to 8-bit RGB arrays.
+
+    ``key``: what identifies the compiled model (scene and head settings); two
+    models with equal keys must be compiled from the same MJCF and settings,
+    and then share one OpenGL context.  None: a context of its own.
+    """
 
     def __init__(
         self,
@@ -26,11 +112,13 @@ class EyeRenderer:
         cameras: tuple[CameraSettings, CameraSettings],
         canvases: tuple[DistortionCanvas, DistortionCanvas],
         seed: int = 0,
+        key: Hashable | None = None,
     ) -> None:
         self._model = model
         self._cameras = cameras
         self._canvases = canvases
-        self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
+        self._key: Hashable = key if key is not None else ("own", id(self))
+        self._own = key is None
         self._option = mujoco.MjvOption()
         self._option.geomgroup[names.HEAD_VISUAL_GROUP] = 0
         # One noise stream per camera: image k of camera i gets the noise drawn
@@ -38,35 +126,128 @@ class EyeRenderer:
         self._seed = seed
         self._noise = tuple(GaussianNoise.of(camera.noise_std) for camera in cameras)
         self._taken = [0, 0]
+        self._cam_ids = [
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, name) for name in names.CAMERAS
+        ]
         self.render_count = 0
+        #: Pixels rendered, in full frames of the camera that rendered them.
+        self.rendered_frames = 0.0
 
-    def _renderer(self, size: tuple[int, int]) -> mujoco.Renderer:
-        if size not in self._renderers:
-            backend = check_backend()
-            width, height = size
-            try:
-                self._renderers[size] = mujoco.Renderer(self._model, height=height, width=width)
-            except ValueError as err:  # larger than the model's off-screen buffer
-                raise ValueError(f"cannot render {width}x{height}: {err}") from err
-            except Exception as err:  # GL context creation failed
-                raise RenderBackendError(
-                    f"could not create an off-screen OpenGL context with MUJOCO_GL={backend}: {err}. "
-                    f"{INSTALL_HINT}"
-                ) from err
-        return self._renderers[size]
+    def _renderer(self) -> mujoco.Renderer:
+        renderer = _acquire(self._key, self._model)
+        renderer._model = self._model  # the same MJCF and settings; this data's model
+        return renderer
+
+    def _draw(self, data: mujoco.MjData, index: int, rect: Window | None) -> np.ndarray:
+        """The pinhole canvas of camera ``index``, or its sub-rectangle ``rect``: (h, w, 3)."""
+        canvas = self._canvases[index]
+        renderer = self._renderer()
+        width_c, height_c = canvas.size
+        cam = self._cam_ids[index]
+        model = self._model
+        saved = None
+        if rect is not None and (rect.width, rect.height) != (width_c, height_c):
+            # The same camera, its image cut to ``rect``: resolution and sensor
+            # shrink, the principal point moves by the window's offset.
+            saved = (
+                model.cam_resolution[cam].copy(),
+                model.cam_sensorsize[cam].copy(),
+                model.cam_intrinsic[cam].copy(),
+            )
+            pitch = model.cam_sensorsize[cam] / model.cam_resolution[cam]
+            offset_px = model.cam_intrinsic[cam][2:4] / pitch
+            window_offset = offset_px + np.array(
+                [
+                    (rect.width - width_c) / 2 + rect.x0,
+                    (rect.height - height_c) / 2 + rect.y0,
+                ]
+            )
+            model.cam_resolution[cam] = (rect.width, rect.height)
+            model.cam_sensorsize[cam] = pitch * np.array([rect.width, rect.height])
+            model.cam_intrinsic[cam][2:4] = window_offset * pitch
+        try:
+            renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
+        finally:
+            if saved is not None:
+                (
+                    model.cam_resolution[cam],
+                    model.cam_sensorsize[cam],
+                    model.cam_intrinsic[cam],
+                ) = saved
+        width, height = (width_c, height_c) if rect is None else (rect.width, rect.height)
+        gl_context = renderer._gl_context
+        if gl_context is not None:
+            gl_context.make_current()
+        viewport = mujoco.MjrRect(0, 0, width, height)
+        mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
+        pixels = np.empty((height, width, 3), dtype=np.uint8)
+        mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
+        self.rendered_frames += (width * height) / (width_c * height_c)
+        return np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
 
     def render(self, data: mujoco.MjData, index: int) -> np.ndarray:
         """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8."""
-        canvas = self._canvases[index]
-        renderer = self._renderer(canvas.size)
-        renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
-        image = apply_canvas(renderer.render(), canvas)
+        image = apply_canvas(self._draw(data, index, None), self._canvases[index])
+        return self._add_noise(image, index, None)
+
+    def render_window(self, data: mujoco.MjData, index: int, window: Window) -> np.ndarray:
+        """Render only ``window`` of camera ``index``: the full frame's crop, (h, w, 3) uint8."""
+        camera, canvas = self._cameras[index], self._canvases[index]
+        if not (
+            0 <= window.x0 < window.x1 <= camera.width
+            and 0 <= window.y0 < window.y1 <= camera.height
+        ):
+            raise ValueError(
+                f"window {window} is not inside the {camera.width}x{camera.height} image"
+            )
+        if canvas.identity:
+            image = self._draw(data, index, window)
+        else:
+            assert canvas.map_x is not None and canvas.map_y is not None
+            map_x = canvas.map_x[window.y0 : window.y1, window.x0 : window.x1]
+            map_y = canvas.map_y[window.y0 : window.y1, window.x0 : window.x1]
+            source = _canvas_region(map_x, map_y, canvas.size)
+            if source is None:  # nothing of the canvas is seen through this window
+                image = np.zeros((window.height, window.width, 3), dtype=np.uint8)
+            else:
+                region = self._draw(data, index, source)
+                # Shifting float32 maps by whole pixels is exact: the same samples.
+                shifted = DistortionCanvas(
+                    size=(source.width, source.height),
+                    principal=canvas.principal,
+                    map_x=np.where(map_x >= 0, map_x - np.float32(source.x0), np.float32(-1)),
+                    map_y=np.where(map_y >= 0, map_y - np.float32(source.y0), np.float32(-1)),
+                    valid_fraction=canvas.valid_fraction,
+                )
+                image = apply_canvas(region, shifted)
+        return self._add_noise(image, index, window)
+
+    def _add_noise(self, image: np.ndarray, index: int, window: Window | None) -> np.ndarray:
         self.render_count += 1
         frame = self._taken[index]
         self._taken[index] += 1
-        return self._noise[index].apply(image, (self._seed, index), frame)
+        camera = self._cameras[index]
+        crop = None if window is None else (window.x0, window.y0, camera.width, camera.height)
+        return self._noise[index].apply(image, (self._seed, index), frame, crop=crop)
 
     def close(self) -> None:
-        for renderer in self._renderers.values():
-            renderer.close()
-        self._renderers.clear()
+        """Give the OpenGL context back to the pool (closed if it was this renderer's own)."""
+        if self._own:
+            renderer = _POOL.pop(self._key, None)
+            if renderer is not None:
+                renderer.close()
+
+
+def _canvas_region(
+    map_x: np.ndarray, map_y: np.ndarray, canvas_size: tuple[int, int]
+) -> Window | None:
+    """The canvas rectangle that bilinear sampling at (map_x, map_y) reads (None: no valid source)."""
+    valid = map_x >= 0
+    if not valid.any():
+        return None
+    xs, ys = map_x[valid], map_y[valid]
+    x0 = max(math.floor(float(xs.min())) - 1, 0)
+    y0 = max(math.floor(float(ys.min())) - 1, 0)
+    x1 = min(math.floor(float(xs.max())) + 3, canvas_size[0])
+    y1 = min(math.floor(float(ys.max())) + 3, canvas_size[1])
+    return Window(x0, y0, x1 - x0, y1 - y0)

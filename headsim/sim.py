@@ -25,7 +25,7 @@ import numpy as np
 from headsim import names
 from headsim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
 from headsim.optics import camera_matrix, dist_coeffs, project_points
-from headsim.render import EyeRenderer
+from headsim.render import EyeRenderer, Window
 from headsim.settings import CameraSettings, HeadSettings, SettingsError
 
 #: A camera: 1 or 2 (the paper's Ca1, Ca2) or its MJCF name "cam1"/"cam2".
@@ -109,7 +109,11 @@ class HeadSim:
         }
         self._commands = _Commands()
         self._renderer = EyeRenderer(
-            self.model, self.settings.cameras, self.built.canvases, seed=self.settings.seed
+            self.model,
+            self.settings.cameras,
+            self.built.canvases,
+            seed=self.settings.seed,
+            key=(str(scene), repr(self.settings)),
         )
         self.reset()
 
@@ -347,7 +351,16 @@ class HeadSim:
         """The camera's current image, (H, W, 3) uint8, with its lens and noise."""
         return self._renderer.render(self.data, self.camera_index(camera))
 
+    def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
+        """Only ``window`` of the camera's image: the full image's crop, (h, w, 3) uint8."""
+        return self._renderer.render_window(self.data, self.camera_index(camera), window)
+
     @property
     def render_count(self) -> int:
-        """Images rendered so far by this simulator."""
+        """Images rendered so far by this simulator (full frames and windows)."""
         return self._renderer.render_count
+
+    @property
+    def rendered_frames(self) -> float:
+        """Pixels rendered so far by this simulator, in full frames."""
+        return self._renderer.rendered_frames
