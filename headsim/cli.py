@@ -130,6 +130,8 @@ def _run(args: argparse.Namespace) -> int:
             "wall_s": wall,
             "phases_s": result.timing_s,
             "renders": result.renders,
+            "rendered_frames": result.rendered_frames,
+            "windows": result.windows,
             "rrd_bytes": rrd.stat().st_size if rrd is not None else None,
         },
     )

@@ -40,6 +40,7 @@ from headsim.procedures import (
     relative_positioning,
     track_moving_target,
 )
+from headsim.render import Window
 from headsim.scenario import (
     CHESSBOARD_PATTERN,
     CHESSBOARD_SQUARE_M,
@@ -124,6 +125,10 @@ class RunResult:
     renders: dict[str, int]
     failures: tuple[str, ...]
     timing_s: dict[str, float] = field(default_factory=dict, compare=False)
+    #: Pixels rendered by phase, in full frames (a window counts its share), and
+    #: the servo's windows: rendered, and missed (a full frame followed).
+    rendered_frames: dict[str, float] = field(default_factory=dict)
+    windows: dict[str, int] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
@@ -139,6 +144,10 @@ class Hub:
         self.step = -1
         self.steps: list[int] = []  # steps begun in the current phase, in order
         self.camera = 0
+        self.offset_px = (0, 0)
+        self.rendered_frames = 0.0
+        self.windows = 0
+        self.window_misses = 0
         self._watched: tuple[str, str] | None = None
         self._detector: Detector | None = None
         self._auto_label: Callable[[], str] | None = None
@@ -171,8 +180,16 @@ class Hub:
         if self._watched is not None and body == self._watched[0]:
             self.begin(f"{self._watched[1]} {len(self.steps) + 1}")
 
-    def rendered(self, sim: HeadSim, camera: int, image: np.ndarray) -> None:
+    def rendered(
+        self,
+        sim: HeadSim,
+        camera: int,
+        image: np.ndarray,
+        offset_px: tuple[int, int] = (0, 0),
+    ) -> None:
+        """An image was rendered; ``offset_px``: where the detector's image (a window) starts."""
         self.camera = camera
+        self.offset_px = offset_px
         for o in self.observers:
             o.rendered(sim, camera, image, self.frame)
         self.frame += 1
@@ -186,6 +203,8 @@ class Hub:
         def observed(image: np.ndarray) -> Any:
             detection = detector(image)
             uv = detection.uv if detection.found else None
+            if uv is not None:  # in the full frame's pixels
+                uv = (uv[0] + self.offset_px[0], uv[1] + self.offset_px[1])
             for o in self.observers:
                 o.detected(sim, self.camera, uv, detection.status.value, self.frame - 1)
             return detection
@@ -213,8 +232,22 @@ class ObservedSim(HeadSim):
         self.hub = hub
 
     def render(self, camera: CameraId) -> np.ndarray:
+        before = self.rendered_frames
         image = super().render(camera)
+        self.hub.rendered_frames += self.rendered_frames - before
         self.hub.rendered(self, self.camera_index(camera) + 1, image)
+        return image
+
+    def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
+        """The window; observers see it in a full-size frame, black elsewhere."""
+        before = self.rendered_frames
+        image = super().render_window(camera, window)
+        self.hub.rendered_frames += self.rendered_frames - before
+        self.hub.windows += 1
+        settings = self.camera_settings(camera)
+        frame = np.zeros((settings.height, settings.width, 3), dtype=np.uint8)
+        frame[window.y0 : window.y1, window.x0 : window.x1] = image
+        self.hub.rendered(self, self.camera_index(camera) + 1, frame, (window.x0, window.y0))
         return image
 
     def set_body_pose(
@@ -233,8 +266,12 @@ class ObservedEyeServo(EyeServo):
 
     sim: ObservedSim
 
-    def observe(self, camera: int, detector: Detector) -> Any:
-        return super().observe(camera, self.sim.hub.detector(self.sim, detector))
+    def observe(self, camera: int, detector: Detector, key: object = None) -> Any:
+        key = detector if key is None else key
+        misses = self.window_misses
+        detection = super().observe(camera, self.sim.hub.detector(self.sim, detector), key)
+        self.sim.hub.window_misses += self.window_misses - misses
+        return detection
 
 
 class ObservedNeckServo(NeckServo):
@@ -667,6 +704,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
     hub = Hub(observers)
     timing: dict[str, float] = {}
     renders = {"calibration": 0, "experiment": 0, "recording": 0}
+    rendered_frames = {"calibration": 0.0, "experiment": 0.0}
     knowledge, label = HeadKnowledge(), "none"
     calibration = None
     failures: list[str] = []
@@ -675,6 +713,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
         run, calibration = _calibrate(scenario, hub)
         timing["calibration"] = time.perf_counter() - start
         renders["calibration"] = calibration["renders"]
+        rendered_frames["calibration"] = hub.rendered_frames
         if run is None:
             failures.append(f"calibration: {calibration['status']}")
         else:
@@ -689,6 +728,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
         )
         timing["experiment"] = time.perf_counter() - start
         renders["experiment"] = hub.frame - frames
+        rendered_frames["experiment"] = hub.rendered_frames - rendered_frames["calibration"]
     failures += [
         f"{r.measurement.name}: {r.measurement.status}" for r in records if not r.measurement.ok
     ]
@@ -703,6 +743,11 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
         renders=renders,
         failures=tuple(failures),
         timing_s=timing,
+        rendered_frames={
+            **rendered_frames,
+            "total": rendered_frames["calibration"] + rendered_frames["experiment"],
+        },
+        windows={"rendered": hub.windows, "missed": hub.window_misses},
     )
     hub.finished(result)
     return result

@@ -18,8 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from headsim import names
+from headsim.render import Window
 from headsim.sim import HeadSim
-from headsim.vision import Detection
+from headsim.vision import Detection, DetectionStatus
 
 Detector = Callable[[np.ndarray], Detection]
 
@@ -66,6 +67,9 @@ class ServoConfig:
     ``probe_steps``: first probe when no gain is known; grown x4 until the
     image moves ``min_probe_px``.  ``min_secant_steps``: moves shorter than this
     do not update the gain (centroid pixel-locking would corrupt it).
+    ``windows``: render only a window around where the target is expected
+    (see :meth:`EyeServo.observe`); ``window_margin_px`` is added to its
+    half-side beyond the blob and a quarter of the predicted motion.
     """
 
     tolerance_px: float = 0.1
@@ -73,6 +77,8 @@ class ServoConfig:
     probe_steps: int = 16
     min_probe_px: float = 2.0
     min_secant_steps: int = 8
+    windows: bool = True
+    window_margin_px: float = 8.0
 
 
 class EyeServo:
@@ -86,15 +92,81 @@ class EyeServo:
         self._step_range = (math.ceil(low / resolution), math.floor(high / resolution))
         #: Gain per camera, px per encoder step, carried from one target to the next.
         self.gains: dict[int, float] = {}
+        #: Per camera, the last detection the window is predicted from:
+        #: (detector, eye steps, neck encoders, placements, uv px, area px^2).
+        self._seen: dict[
+            int, tuple[object, int, tuple[float, float], int, tuple[float, float], float]
+        ] = {}
+        #: Windows rendered, and windows that missed the target (a full frame followed).
+        self.window_renders = 0
+        self.window_misses = 0
 
     @property
     def step_range(self) -> tuple[int, int]:
         """Eye-motor range, whole encoder steps."""
         return self._step_range
 
-    def observe(self, camera: int, detector: Detector) -> Detection:
-        """Render ``camera`` and detect the target in it (one render)."""
-        return detector(self.sim.render(camera))
+    def observe(self, camera: int, detector: Detector, key: object = None) -> Detection:
+        """Render ``camera`` and detect the target in it (one render, two on a window miss).
+
+        With windows on, and when this camera last saw the same target
+        (``key``, default the detector) with the neck and the scene unchanged
+        since and a gain known, only a window is rendered: around where the
+        head expects the target from that detection and the eye steps moved
+        since (u + gain * steps), of half-side 3 blob radii plus the margin
+        and a quarter of the predicted motion (blob detectors only: those
+        returning a :class:`Detection` with its area).  The detection there counts
+        only if it is FOUND at least 3 blob radii + 2 px inside the window
+        (so the blob and every piece the detector looks for beside it lie in
+        the window); otherwise the window is a miss (counted) and a full
+        frame is rendered.  Never from the truth: detections, gain, encoders.
+        """
+        key = detector if key is None else key
+        sim = self.sim
+        steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
+        window = self._window(camera, key, steps, neck)
+        detection = None
+        if window is not None:
+            self.window_renders += 1
+            seen = detector(sim.render_window(camera, window))
+            if seen.found and seen.uv is not None:
+                u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0
+                inset = 3.0 * math.sqrt(seen.area_px / math.pi) + 2.0
+                if (
+                    window.x0 + inset <= u <= window.x1 - 1 - inset
+                    and window.y0 + inset <= v <= window.y1 - 1 - inset
+                ):
+                    detection = Detection(DetectionStatus.FOUND, (u, v), seen.area_px)
+            if detection is None:
+                self.window_misses += 1
+        if detection is None:
+            detection = detector(sim.render(camera))
+        # Only blob detections (a centroid and an area) predict a window.
+        if isinstance(detection, Detection) and detection.found and detection.uv is not None:
+            self._seen[camera] = (key, steps, neck, sim.placements, detection.uv, detection.area_px)
+        else:
+            self._seen.pop(camera, None)
+        return detection
+
+    def _window(
+        self, camera: int, key: object, steps: int, neck: tuple[float, float]
+    ) -> Window | None:
+        """Where to look for ``key``'s target in ``camera``, or None for the full frame."""
+        cfg, sim = self.config, self.sim
+        seen, gain = self._seen.get(camera), self.gains.get(camera)
+        if not cfg.windows or seen is None or gain is None:
+            return None
+        seen_key, seen_steps, seen_neck, placements, uv, area = seen
+        if seen_key is not key or seen_neck != neck or placements != sim.placements:
+            return None
+        motion = gain * (steps - seen_steps)
+        expected = (uv[0] + motion, uv[1])
+        half = 3.0 * math.sqrt(area / math.pi) + cfg.window_margin_px + 0.25 * abs(motion)
+        settings = sim.camera_settings(camera)
+        window = Window.around(expected, half, (settings.width, settings.height))
+        if window.width * window.height >= 0.5 * settings.width * settings.height:
+            return None  # barely cheaper than the frame: render the frame
+        return window
 
     def run(
         self,
@@ -169,6 +241,8 @@ class EyeServo:
                     probe *= 4
             elif abs(move) >= cfg.min_secant_steps and change != 0.0:
                 gain = change / move
+            if gain is not None:
+                self.gains[camera] = gain  # what the next window is predicted with
             steps, uv = target, detection.uv
             visited[steps] = uv
         return self._result(

@@ -108,6 +108,8 @@ class HeadSim:
             )
         }
         self._commands = _Commands()
+        #: Bodies placed so far (targets moved: earlier images are out of date).
+        self.placements = 0
         self._renderer = EyeRenderer(
             self.model,
             self.settings.cameras,
@@ -308,6 +310,7 @@ class HeadSim:
         mocap_id = int(self.model.body_mocapid[body_id]) if body_id >= 0 else -1
         if mocap_id < 0:
             raise SettingsError(f"{name!r} is not a movable (mocap) body in this scene")
+        self.placements += 1
         self.data.mocap_pos[mocap_id] = position_world_m
         if quat_world is not None:
             self.data.mocap_quat[mocap_id] = quat_world

@@ -5,8 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim import render
+from headsim import experiments, render
+from headsim.procedures import HeadKnowledge, measure_model2
 from headsim.render import Window
+from headsim.servo import EyeServo, ServoConfig
 from headsim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim import HeadSim
 
@@ -75,3 +77,52 @@ def test_simulators_of_one_head_share_one_renderer_and_render_alike() -> None:
     with HeadSim("default", HeadSettings(seed=11, baseline_m=0.12)) as sim:
         sim.render(1)
     assert render.created == before + 1
+
+
+class LoggingServo(EyeServo):
+    """An eye servo that keeps every detection it made (full-frame pixels)."""
+
+    seen: list[tuple[float, float] | None]
+
+    def observe(self, camera: int, detector, key: object = None):  # type: ignore[no-untyped-def]
+        detection = super().observe(camera, detector, key)
+        self.seen = [*getattr(self, "seen", []), detection.uv]
+        return detection
+
+
+@pytest.mark.parametrize("head", ["ideal", "distorted"])
+def test_windows_change_no_measurement(head: str) -> None:
+    settings = HeadSettings() if head == "ideal" else paper_head()
+    rng = np.random.default_rng(5)
+    points = np.concatenate(
+        [
+            experiments.random_targets_head(rng, 2, band, vertical=(-0.1, 0.1))
+            for band in experiments.DEPTH_BANDS_M
+        ]
+    )
+    runs = {}
+    for windows in (False, True):
+        with HeadSim("default", settings) as sim:
+            servo = LoggingServo(sim, ServoConfig(windows=windows))
+            measured = []
+            for p in points:
+                sim.set_body_pose("marker_red", sim.transform_points(p, "head", "world")[0])
+                measured.append(measure_model2(sim, servo, experiments.RED, HeadKnowledge()))
+            runs[windows] = (measured, sim.rendered_frames, sim.render_count, servo)
+    (plain, plain_frames, plain_renders, plain_servo), (windowed, frames, renders, servo) = (
+        runs[False],
+        runs[True],
+    )
+    assert all(m.ok for m in plain) and all(m.ok for m in windowed)
+    for a, b in zip(plain, windowed, strict=True):
+        np.testing.assert_allclose(b.estimate_head_m, a.estimate_head_m, rtol=0, atol=1e-6)
+    # Every detection the servo made, in order: the same place to 0.01 px.
+    assert len(servo.seen) == len(plain_servo.seen)
+    for a_uv, b_uv in zip(plain_servo.seen, servo.seen, strict=True):
+        assert (a_uv is None) == (b_uv is None)
+        if a_uv is not None and b_uv is not None:
+            assert np.max(np.abs(np.subtract(a_uv, b_uv))) <= 0.01
+    # Same images taken; far fewer pixels rendered.
+    assert renders == plain_renders
+    assert servo.window_renders > renders / 2
+    assert frames < 0.5 * plain_frames
