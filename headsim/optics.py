@@ -10,6 +10,7 @@ integer coordinates).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -75,10 +76,12 @@ class DistortionCanvas:
         return self.map_x is None
 
 
+@functools.lru_cache(maxsize=16)
 def distortion_canvas(
     camera: CameraSettings, max_side: int, margin_px: int = 3
 ) -> DistortionCanvas:
-    """Canvas and remap tables for rendering ``camera`` (computed once per camera)."""
+    """Canvas and remap tables for rendering ``camera`` (computed once per camera and process;
+    the tables are shared: read-only)."""
     w, h = camera.width, camera.height
     cx, cy = camera.principal
     if not camera.distorted:
@@ -103,11 +106,13 @@ def distortion_canvas(
     valid &= inside
     map_x[~valid] = -1.0
     map_y[~valid] = -1.0
+    map_x, map_y = map_x.astype(np.float32), map_y.astype(np.float32)
+    map_x.flags.writeable = map_y.flags.writeable = False  # shared through the cache
     return DistortionCanvas(
         size=(width_c, height_c),
         principal=(cx - u_lo, cy - v_lo),
-        map_x=map_x.astype(np.float32),
-        map_y=map_y.astype(np.float32),
+        map_x=map_x,
+        map_y=map_y,
         valid_fraction=float(valid.mean()),
     )
 
