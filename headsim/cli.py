@@ -142,6 +142,59 @@ def _run(args: argparse.Namespace) -> int:
     return 0 if result.ok else 1
 
 
+def _calibrate(args: argparse.Namespace) -> int:
+    from headsim.calibration_file import head_hash, write_calibration
+    from headsim.runner import Progress, calibrate_scenario
+    from headsim.scenario import ScenarioError, load_scenario
+
+    scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
+    spec = scenario.experiment.calibration
+    if spec is None or spec.source is not None:
+        raise ScenarioError(
+            str(scenario.path),
+            "experiment.calibration",
+            "no calibration to run" if spec is None else "it reads a calibration file itself",
+            "an [experiment.calibration] table with targets (e.g. the quickstart scenario)",
+        )
+    out = Path(args.out)
+    if out.is_dir():
+        raise ScenarioError("--out", "", f"{out} is a directory", "a file path, e.g. head.json")
+    observers = []
+    if not args.no_progress and sys.stderr.isatty():
+        observers.append(Progress(spec.targets, sys.stderr))
+    start = time.perf_counter()
+    with _sigterm_interrupts():
+        try:
+            block = calibrate_scenario(scenario, observers)
+        except KeyboardInterrupt:
+            print(f"\nheadsim: interrupted: nothing written to {out}", file=sys.stderr)
+            return 130
+    wall = time.perf_counter() - start
+    if observers:
+        print(file=sys.stderr)
+    if block["status"] != "ok" or block.get("knowledge") is None:
+        print(f"headsim: calibration failed: {block['status']}; nothing written", file=sys.stderr)
+        return 1
+    try:
+        write_calibration(out, scenario.settings, block, scenario.name, scenario.seed)
+    except OSError as err:
+        print(f"headsim: error: cannot write {out}: {err}", file=sys.stderr)
+        return 3
+    alpha, std = block["alpha_e_rad"], block["alpha_e_std_rad"]
+    print(
+        f"{scenario.name}{' (fast)' if scenario.fast else ''}: {block['fixated']} of "
+        f"{block['targets']} ball positions fixated, {block['renders']} renders "
+        f"({block['rendered_frames']:.1f} full frames of pixels) in {wall:.1f} s"
+    )
+    for index in (0, 1):
+        print(f"  alpha_e{index + 1} = {alpha[index]:+.5f} rad (std {std[index]:.1e})")
+    known = block["knowledge"]
+    print(f"  v0 = {known['v0_px']} px; kx/ky = {known['kx_over_ky']}")
+    print(f"head {head_hash(scenario.settings)[:12]}; written to {out}")
+    print(f'use it with  [experiment.calibration] from = "{out}"')
+    return 0
+
+
 def _list(args: argparse.Namespace) -> int:
     from headsim.scenario import SCENARIOS_DIR, describe_scenarios
 
@@ -238,6 +291,24 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     run.set_defaults(func=_run)
+
+    calibrate = commands.add_parser(
+        "calibrate",
+        help="calibrate a head once (Sec. V) and write what it learnt to a file",
+        description="Run only the Sec. V calibration of a scenario and write what the head "
+        "learnt (initial directions, extended fit, standard errors) with the head settings it "
+        "holds for (by a hash) to FILE. Scenarios use it with [experiment.calibration] from = "
+        '"FILE" and refuse it for another head. Exit status: 0 written, 1 the calibration '
+        "failed, 2 bad input, 3 FILE not writable, 130 interrupted.",
+    )
+    calibrate.add_argument(
+        "scenario", metavar="SCENARIO", help="a scenario with [experiment.calibration]"
+    )
+    calibrate.add_argument("--out", required=True, metavar="FILE", help="the file to write")
+    calibrate.add_argument("--seed", type=int, metavar="N", help="seed (default: the file's)")
+    calibrate.add_argument("--fast", action="store_true", help="the scenario's fast variant")
+    calibrate.add_argument("--no-progress", action="store_true", help="no progress bar")
+    calibrate.set_defaults(func=_calibrate)
 
     listing = commands.add_parser(
         "list",

@@ -451,6 +451,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "alpha_e_rad": list(knowledge.alpha_e),
             "v0_px": list(knowledge.v0),
             "kx_over_ky": list(knowledge.kx_over_ky),
+            "u0_px": list(knowledge.u0),
         },
     )
     hub.calibrated(block)
@@ -699,6 +700,20 @@ RUNNERS = {
 }
 
 
+def calibrate_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> dict[str, Any]:
+    """Only the scenario's Sec. V calibration (``headsim calibrate``): its results.json block.
+
+    ``status`` is "ok" or why it failed; ``rendered_frames`` the pixels it
+    rendered, in full frames.
+    """
+    spec = scenario.experiment.calibration
+    if spec is None or spec.source is not None:
+        raise ValueError("the scenario has no calibration to run ([experiment.calibration])")
+    hub = Hub(observers)
+    _, block = _calibrate(scenario, hub)
+    return {**block, "rendered_frames": hub.rendered_frames}
+
+
 def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunResult:
     """Run a checked scenario; the observers see every image, detection and result."""
     hub = Hub(observers)
@@ -708,7 +723,25 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
     knowledge, label = HeadKnowledge(), "none"
     calibration = None
     failures: list[str] = []
-    if scenario.experiment.calibration is not None:
+    spec = scenario.experiment.calibration
+    if spec is not None and spec.source is not None:
+        from headsim.calibration_file import read_calibration
+
+        stored = read_calibration(spec.source, scenario.settings)
+        calibration = {
+            **stored.block,
+            "renders": 0,
+            "from": {
+                "path": str(stored.path),
+                "scenario": stored.scenario,
+                "seed": stored.seed,
+                "head_hash": stored.head_hash,
+                "renders": stored.block.get("renders"),
+            },
+        }
+        hub.calibrated(calibration)
+        knowledge, label = stored.knowledge, "calibrated"
+    elif spec is not None:
         start = time.perf_counter()
         run, calibration = _calibrate(scenario, hub)
         timing["calibration"] = time.perf_counter() - start
@@ -763,6 +796,7 @@ __all__ = [
     "Observer",
     "Progress",
     "RunResult",
+    "calibrate_scenario",
     "marker_target",
     "run_scenario",
 ]

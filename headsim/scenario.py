@@ -101,6 +101,8 @@ class CalibrationSpec:
     depth z_h in ``depth_m``, |x_h/z_h| <= ``lateral``, |y_h/z_h| <= ``vertical``.
     ``depth_noise_m``: error of the tape-measured depth.  ``extended``: also
     fit each camera's vertical reference row and kx/ky (beyond the paper).
+    ``source``: a calibration file (``headsim calibrate``) to use instead of
+    calibrating; the other fields are then not used.
     """
 
     targets: int = 60
@@ -109,6 +111,7 @@ class CalibrationSpec:
     vertical: float = 0.08
     depth_noise_m: float = 0.0
     extended: bool = True
+    source: str | None = None
 
 
 @dataclass(frozen=True)
@@ -541,6 +544,7 @@ def _read_calibration(table: _Table | None) -> CalibrationSpec | None:
         vertical=table.number("vertical", 0.08, 0.0, 1.0, unit="(|y_h / z_h|)"),
         depth_noise_m=table.number("depth_noise_m", 0.0, 0.0, 0.1, unit="m"),
         extended=table.boolean("extended", True),
+        source=table.string("from", None, max_length=1000),
     )
     table.done()
     return spec
@@ -1038,6 +1042,14 @@ def _build(
     settings, preset_name, settle = _read_head(top, ctx)
     settings = replace(settings, seed=seed)
     experiment = _read_experiment(top, ctx)
+    calibration = experiment.calibration
+    if calibration is not None and calibration.source is not None:
+        from headsim.calibration_file import CalibrationFileError, read_calibration
+
+        try:
+            read_calibration(calibration.source, settings)
+        except CalibrationFileError as err:
+            raise ctx.error("experiment.calibration.from", str(err)) from err
     scene = _read_scene(top, ctx, experiment.procedure, settings, seed)
     top.has("fast")
     top.done()
