@@ -27,7 +27,7 @@ from headsim import experiments, names
 from headsim.estimators.throughput import run as estimator_throughput
 from headsim.procedures import HeadKnowledge, calibrate_head, calibration_layout, measure_model2
 from headsim.results import write_json_atomic
-from headsim.servo import EyeServo
+from headsim.servo import EyeServo, ServoConfig
 from headsim.settings import HeadSettings, paper_head
 from headsim.sim import HeadSim
 
@@ -61,24 +61,37 @@ def _measure_points(
     knowledge: HeadKnowledge,
     points_head: np.ndarray,
     faults: Faults,
-) -> tuple[list[Any], float]:
-    """Model 2 on each point; returns the measurements and the median render time, s."""
+    windows: bool = True,
+) -> tuple[list[Any], float, float, list[Any]]:
+    """Model 2 on each point; returns the measurements, the median render time, s, the
+    pixels rendered for the points in full frames, and every detection the servo made."""
     with HeadSim("default", settings) as sim:
-        servo = EyeServo(sim)
+        servo = EyeServo(sim, ServoConfig(windows=windows))
+        seen: list[Any] = []
+        look = servo.observe
+
+        def logged(camera: int, detector: Any, key: object = None) -> Any:
+            detection = look(camera, detector, key)
+            seen.append(detection.uv)
+            return detection
+
+        servo.observe = logged  # type: ignore[method-assign]
         if faults.double_renders:
             observe = servo.observe
 
-            def twice(camera: int, detector: Any) -> Any:
+            def twice(camera: int, detector: Any, key: object = None) -> Any:
                 sim.render(camera)
-                return observe(camera, detector)
+                return observe(camera, detector, key)
 
             servo.observe = twice  # type: ignore[method-assign]
         render_s = experiments.render_time_s(sim)
+        frames = sim.rendered_frames
         out = []
         for p in points_head:
             sim.set_body_pose("marker_red", sim.transform_points(p, "head", "world")[0])
             out.append(measure_model2(sim, servo, experiments.RED, knowledge))
-    return out, render_s
+        frames = sim.rendered_frames - frames
+    return out, render_s, frames, seen
 
 
 #: The suite's parts, in order; ``suite(parts=...)`` runs a subset (tests do).
@@ -123,8 +136,12 @@ def _ideal_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
         ]
     )
     start = time.perf_counter()
-    ideal, render_s = _measure_points(HeadSettings(), HeadKnowledge(), points, faults)
+    ideal, render_s, frames, seen = _measure_points(HeadSettings(), HeadKnowledge(), points, faults)
     wall = (time.perf_counter() - start) / len(points)
+    # The same points with full frames only: windows must change no answer.
+    plain, _, _, plain_seen = _measure_points(
+        HeadSettings(), HeadKnowledge(), points, faults, windows=False
+    )
     fig = experiments.error_figures(ideal)
     metrics["ideal.model2.rms_3d_pct_depth"] = fig["rms_3d_pct_depth"]
     metrics["ideal.model2.failed"] = float(fig["failed"])
@@ -133,7 +150,43 @@ def _ideal_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
         np.mean([abs(r) for m in ideal if m.ok for r in m.servo_residual_px])
     )
     metrics["speed.wall_per_point_over_render"] = wall / render_s
+    metrics["ideal.model2.rendered_frames_per_point"] = frames / len(points)
+    metrics["windows.max_estimate_change_m"] = max(
+        (
+            float(np.max(np.abs(a.estimate_head_m - b.estimate_head_m)))
+            for a, b in zip(ideal, plain, strict=True)
+            if a.ok and b.ok
+        ),
+        default=math.inf,
+    )
+    same_sequence = len(seen) == len(plain_seen) and all(
+        (a is None) == (b is None) for a, b in zip(seen, plain_seen, strict=True)
+    )
+    metrics["windows.max_detection_change_px"] = (
+        max(
+            (
+                float(np.max(np.abs(np.subtract(a, b))))
+                for a, b in zip(seen, plain_seen, strict=True)
+                if a is not None and b is not None
+            ),
+            default=0.0,
+        )
+        if same_sequence
+        else math.inf
+    )
+    progress("quick start, full size")
+    metrics["speed.quickstart_over_render"] = _quickstart_s() / render_s
     return metrics
+
+
+def _quickstart_s() -> float:
+    """Wall time of the quick start scenario at full size, as ``make demo`` runs it, s."""
+    from headsim.runner import run_scenario
+    from headsim.scenario import load_scenario
+
+    start = time.perf_counter()
+    run_scenario(load_scenario("quickstart"))
+    return time.perf_counter() - start
 
 
 def _paper_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
@@ -168,7 +221,7 @@ def _paper_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
             for band in experiments.DEPTH_BANDS_M
         ]
     )
-    paper, _ = _measure_points(settings, knowledge, near, faults)
+    paper, _, _, _ = _measure_points(settings, knowledge, near, faults)
     fig = experiments.error_figures(paper)
     x, y, z = fig.get("rms_pct_depth_xyz", [math.nan] * 3)
     metrics["paper.model2.x_rms_pct_depth"] = x

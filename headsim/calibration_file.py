@@ -5,7 +5,7 @@ calibration and writes what the head learnt (initial directions, the extended
 fit, standard errors: the results.json ``calibration`` block and the
 :class:`HeadKnowledge` built from it) with the head settings it holds for.
 A scenario uses it with ``[experiment.calibration] from = "head.json"``
-(a path relative to the working directory) and calibrates no more; a file
+(a path relative to the scenario file's directory) and calibrates no more; a file
 made for another head is refused, naming the settings that differ.
 
 The head a calibration holds for is every field of

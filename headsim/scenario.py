@@ -102,7 +102,8 @@ class CalibrationSpec:
     ``depth_noise_m``: error of the tape-measured depth.  ``extended``: also
     fit each camera's vertical reference row and kx/ky (beyond the paper).
     ``source``: a calibration file (``headsim calibrate``) to use instead of
-    calibrating; the other fields are then not used.
+    calibrating (a relative path is relative to the scenario file's
+    directory); the other fields are then not used.
     """
 
     targets: int = 60
@@ -1046,8 +1047,12 @@ def _build(
     if calibration is not None and calibration.source is not None:
         from headsim.calibration_file import CalibrationFileError, read_calibration
 
+        source = Path(calibration.source)
+        if not source.is_absolute():  # relative to the scenario file, like the file's own paths
+            source = path.parent / source
+            experiment = replace(experiment, calibration=replace(calibration, source=str(source)))
         try:
-            read_calibration(calibration.source, settings)
+            read_calibration(source, settings)
         except CalibrationFileError as err:
             raise ctx.error("experiment.calibration.from", str(err)) from err
     scene = _read_scene(top, ctx, experiment.procedure, settings, seed)

@@ -73,6 +73,11 @@ def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
     # The measurement used the stored directions: millimetres at 0.5 m.
     assert result.records[0].measurement.error_pct_of_depth < 0.2
 
+    # A relative path is relative to the scenario file, wherever the run starts.
+    scenario_file.write_text(SCENARIO.format(head="head.json", extra=""))
+    relative = load_scenario(scenario_file).experiment.calibration
+    assert relative is not None and relative.source == str(head_file)
+
     # Another head refuses the file and says which setting differs (exit 2).
     other = tmp_path / "other.toml"
     other.write_text(SCENARIO.format(head=head_file, extra="baseline_m = 0.16"))
