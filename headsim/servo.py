@@ -11,6 +11,7 @@ learnt on one target seeds the next.  Every loop is bounded and returns a
 from __future__ import annotations
 
 import enum
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -20,9 +21,21 @@ import numpy as np
 from headsim import names
 from headsim.render import Window
 from headsim.sim import HeadSim
-from headsim.vision import Detection, DetectionStatus
+from headsim.vision import Detection, DetectionStatus, find_marker
 
 Detector = Callable[[np.ndarray], Detection]
+
+#: Detectors (or the functions that partials of them wrap) that find their target
+#: in a window: a blob's centroid, decided by the blob and what lies within one blob
+#: size of it.  Others (a whole chessboard, a cross point) always see full frames.
+WINDOWED_DETECTORS: set[Callable[..., object]] = {find_marker}
+
+
+def windowed(detector: object) -> bool:
+    """Whether ``detector`` (possibly a ``functools.partial``) may look at windows."""
+    while isinstance(detector, functools.partial):
+        detector = detector.func
+    return detector in WINDOWED_DETECTORS
 
 
 class ServoOutcome(enum.Enum):
@@ -114,8 +127,8 @@ class EyeServo:
         since and a gain known, only a window is rendered: around where the
         head expects the target from that detection and the eye steps moved
         since (u + gain * steps), of half-side 3 blob radii plus the margin
-        and a quarter of the predicted motion (blob detectors only: those
-        returning a :class:`Detection` with its area).  The detection there counts
+        and a quarter of the predicted motion (blob detectors only, see
+        :data:`WINDOWED_DETECTORS`).  The detection there counts
         only if it is FOUND at least 3 blob radii + 2 px inside the window
         (so the blob and every piece the detector looks for beside it lie in
         the window); otherwise the window is a miss (counted) and a full
@@ -124,7 +137,7 @@ class EyeServo:
         key = detector if key is None else key
         sim = self.sim
         steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
-        window = self._window(camera, key, steps, neck)
+        window = self._window(camera, key, steps, neck) if windowed(key) else None
         detection = None
         if window is not None:
             self.window_renders += 1
