@@ -199,7 +199,8 @@ def _reproduce(args: argparse.Namespace) -> int:
     from headsim import reproduce
 
     try:
-        return reproduce.main(args)
+        with _sigterm_interrupts():  # SIGTERM too leaves the report so far
+            return reproduce.main(args)
     except reproduce.ReproduceError as err:
         print(f"headsim: error: {err}", file=sys.stderr)
         return 2

@@ -697,8 +697,10 @@ def reproduce(
         )
     except KeyboardInterrupt:
         state["status"] = "interrupted"
+        # Stop the workers now: their experiments are lost, the finished ones are kept.
+        processes = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
-        for process in list(getattr(pool, "_processes", {}).values()):
+        for process in processes:
             process.terminate()
         write_report()
         raise

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import json
+import signal
+import subprocess
 import sys
+import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
@@ -115,3 +119,25 @@ def test_bad_input_exits_2_and_writes_nothing(tmp_path: Path, capsys) -> None:
     assert main(["reproduce", "--out", str(afile)]) == 2
     assert "not a directory" in capsys.readouterr().err
     assert not (tmp_path / "r").exists()
+
+
+def test_an_interrupted_run_leaves_a_readable_partial_report(tmp_path: Path) -> None:
+    out = tmp_path / "r"
+    process = subprocess.Popen(
+        [str(Path(sys.executable).parent / "headsim"), "reproduce", "--fast", "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    report = out / "report.md"
+    deadline = time.monotonic() + 120
+    while not report.exists() and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert report.exists(), process.communicate()
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 130, err
+    assert "the report so far is in" in err and "Traceback" not in err
+    text = report.read_text()
+    assert "status: **interrupted**" in text and "not run (interrupted)" in text
+    assert json.loads((out / "report.json").read_text())["status"] == "interrupted"
