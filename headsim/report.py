@@ -35,6 +35,8 @@ RESULTS_KEYS = (
     "software",
     "settings",
     "renders",
+    "rendered_frames",
+    "windows",
     "calibration",
     "measurements",
     "summary",

@@ -82,7 +82,9 @@ def _calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.scenario import load_scenario
 
     scenario = load_scenario("calibration", fast=fast, seed=seed)
+    start = time.perf_counter()
     block = calibrate_scenario(scenario)
+    wall = time.perf_counter() - start
     if block["status"] != "ok":
         raise RuntimeError(f"calibration failed: {block['status']}")
     path = write_calibration(
@@ -93,6 +95,7 @@ def _calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
         "block": block,
         "head_hash": head_hash(scenario.settings),
         "seed": scenario.seed,
+        "wall_s": wall,
     }
 
 
@@ -517,7 +520,8 @@ def report_text(
         "- one calibration: `head.json` "
         + (
             f"({calibration['block']['fixated']} of {calibration['block']['targets']} ball positions, "
-            f"{calibration['block']['renders']} renders), used by every scenario experiment"
+            f"{calibration['block']['renders']} renders, {calibration.get('wall_s', math.nan):.1f} s), used by "
+            "every scenario experiment"
             if calibration
             else "(not made)"
         ),
@@ -683,8 +687,13 @@ def reproduce(
             try:
                 data = done.result()
                 failed = bool(data.get("results", {}).get("failures"))
+                # The job's own time, not the time it waited for a worker.
+                own = data.get("wall_s", data.get("seconds"))
                 outcomes[name] = JobOutcome(
-                    name, "failed" if failed else "ok", time.perf_counter() - began, data
+                    name,
+                    "failed" if failed else "ok",
+                    float(own) if own is not None else time.perf_counter() - began,
+                    data,
                 )
             except Exception as err:
                 outcomes[name] = JobOutcome(

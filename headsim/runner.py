@@ -280,9 +280,16 @@ class ObservedNeckServo(NeckServo):
     sim: ObservedSim
 
     def run(
-        self, detector: Detector, goals: tuple[float, float, float] | None = None
+        self,
+        detector: Detector,
+        goals: tuple[float, float, float] | None = None,
+        key: object = None,
     ) -> NeckServoResult:
-        return super().run(self.sim.hub.detector(self.sim, detector), goals)
+        key = detector if key is None else key
+        misses = self.window_misses
+        result = super().run(self.sim.hub.detector(self.sim, detector), goals, key)
+        self.sim.hub.window_misses += self.window_misses - misses
+        return result
 
 
 class Progress(Observer):

@@ -38,6 +38,47 @@ def windowed(detector: object) -> bool:
     return detector in WINDOWED_DETECTORS
 
 
+def expected_window(
+    sim: HeadSim,
+    camera: int,
+    expected_uv: tuple[float, float],
+    area_px: float,
+    motion_px: float,
+    margin_px: float,
+) -> Window | None:
+    """The window to look for a blob of ``area_px`` expected at ``expected_uv`` after an
+    image motion of ``motion_px``: half-side 3 blob radii + margin + a quarter of the
+    motion.  None where it would be barely cheaper than the frame."""
+    half = 3.0 * math.sqrt(area_px / math.pi) + margin_px + 0.25 * abs(motion_px)
+    settings = sim.camera_settings(camera)
+    window = Window.around(expected_uv, half, (settings.width, settings.height))
+    if window.width * window.height >= 0.5 * settings.width * settings.height:
+        return None
+    return window
+
+
+def look_in_window(
+    sim: HeadSim, camera: int, detector: Detector, window: Window
+) -> Detection | None:
+    """Render ``window`` and detect there: the detection in full-frame pixels, or None (a miss).
+
+    It counts only if FOUND at least 3 blob radii + 2 px inside the window, so
+    that the blob and every piece the detector looks for beside it (within one
+    blob size) lie in the window: then the full frame gives the same answer.
+    """
+    seen = detector(sim.render_window(camera, window))
+    if not seen.found or seen.uv is None:
+        return None
+    u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0
+    inset = 3.0 * math.sqrt(seen.area_px / math.pi) + 2.0
+    if (
+        window.x0 + inset <= u <= window.x1 - 1 - inset
+        and window.y0 + inset <= v <= window.y1 - 1 - inset
+    ):
+        return Detection(DetectionStatus.FOUND, (u, v), seen.area_px)
+    return None
+
+
 class ServoOutcome(enum.Enum):
     CONVERGED = "converged"
     TARGET_LOST = "target lost"
@@ -141,15 +182,7 @@ class EyeServo:
         detection = None
         if window is not None:
             self.window_renders += 1
-            seen = detector(sim.render_window(camera, window))
-            if seen.found and seen.uv is not None:
-                u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0
-                inset = 3.0 * math.sqrt(seen.area_px / math.pi) + 2.0
-                if (
-                    window.x0 + inset <= u <= window.x1 - 1 - inset
-                    and window.y0 + inset <= v <= window.y1 - 1 - inset
-                ):
-                    detection = Detection(DetectionStatus.FOUND, (u, v), seen.area_px)
+            detection = look_in_window(sim, camera, detector, window)
             if detection is None:
                 self.window_misses += 1
         if detection is None:
@@ -173,13 +206,9 @@ class EyeServo:
         if seen_key is not key or seen_neck != neck or placements != sim.placements:
             return None
         motion = gain * (steps - seen_steps)
-        expected = (uv[0] + motion, uv[1])
-        half = 3.0 * math.sqrt(area / math.pi) + cfg.window_margin_px + 0.25 * abs(motion)
-        settings = sim.camera_settings(camera)
-        window = Window.around(expected, half, (settings.width, settings.height))
-        if window.width * window.height >= 0.5 * settings.width * settings.height:
-            return None  # barely cheaper than the frame: render the frame
-        return window
+        return expected_window(
+            sim, camera, (uv[0] + motion, uv[1]), area, motion, cfg.window_margin_px
+        )
 
     def run(
         self,
@@ -336,6 +365,16 @@ class NeckServo:
             for lo, hi in (sim.joint_range(j) for j in self.JOINTS)
         ]
         self.jacobian: np.ndarray | None = None
+        #: The last images' detections the windows are predicted from:
+        #: (detector, steps, placements, ((u, v), area) per camera), and the count
+        #: of windows rendered and missed (see :meth:`EyeServo.observe`).
+        self._seen: (
+            tuple[object, tuple[int, ...], int, list[tuple[tuple[float, float], float]]] | None
+        ) = None
+        self.window_renders = 0
+        self.window_misses = 0
+        self._key: object = None
+        self._current: np.ndarray | None = None  # the Jacobian as the run stands
 
     def _steps(self) -> np.ndarray:
         resolution = self.sim.settings.encoder_resolution_rad
@@ -349,20 +388,67 @@ class NeckServo:
         self.sim.settle()
 
     def _error(self, detector: Detector, goals: np.ndarray) -> np.ndarray | None:
-        seen = [detector(self.sim.render(camera)) for camera in (1, 2)]
+        seen = [self._look(camera, detector) for camera in (1, 2)]
+        steps = tuple(int(s) for s in self._steps())
+        if all(isinstance(s, Detection) and s.found and s.uv is not None for s in seen):
+            self._seen = (self._key, steps, self.sim.placements, [(s.uv, s.area_px) for s in seen])  # type: ignore[misc]
+        else:
+            self._seen = None
         if not all(s.found and s.uv is not None for s in seen):
             return None
         (u1, v1), (u2, v2) = seen[0].uv, seen[1].uv  # type: ignore[misc]
         return np.array([u1, u2, (v1 + v2) / 2]) - goals
 
+    def _look(self, camera: int, detector: Detector) -> Detection:
+        """Detect in ``camera``: in a window around where the last images and the
+        Jacobian put the target (same target, scene unchanged, blob detector), else
+        in the full frame; a miss costs the full frame and is counted."""
+        sim, seen = self.sim, self._seen
+        jac = self._current
+        if (
+            self.config.windows
+            and seen is not None
+            and jac is not None
+            and seen[0] is self._key
+            and seen[2] == sim.placements
+            and windowed(self._key)
+        ):
+            move = self._steps() - np.array(seen[1])
+            du1, du2, dv = jac @ move
+            (u, v), area = seen[3][camera - 1]
+            du = du1 if camera == 1 else du2
+            window = expected_window(
+                sim,
+                camera,
+                (u + du, v + dv),
+                area,
+                max(abs(du), abs(dv)),
+                self.config.window_margin_px,
+            )
+            if window is not None:
+                self.window_renders += 1
+                detection = look_in_window(sim, camera, detector, window)
+                if detection is not None:
+                    return detection
+                self.window_misses += 1
+        return detector(sim.render(camera))
+
     def _in_range(self, steps: np.ndarray) -> bool:
         return all(lo <= s <= hi for s, (lo, hi) in zip(steps, self._ranges, strict=True))
 
     def run(
-        self, detector: Detector, goals: tuple[float, float, float] | None = None
+        self,
+        detector: Detector,
+        goals: tuple[float, float, float] | None = None,
+        key: object = None,
     ) -> NeckServoResult:
-        """Fixate the target with neck and eyes; ``goals`` = (u10, u20, v0), default image centres."""
+        """Fixate the target with neck and eyes; ``goals`` = (u10, u20, v0), default image centres.
+
+        ``key``: what identifies the target for windows (default the detector).
+        """
         cfg, sim = self.config, self.sim
+        self._key = detector if key is None else key
+        self._current = self.jacobian
         if goals is None:
             (u10, v10), (u20, v20) = (sim.camera_settings(c).image_centre for c in (1, 2))
             goals = (u10, u20, (v10 + v20) / 2)
@@ -386,6 +472,7 @@ class NeckServo:
                     return self._result(ServoOutcome.TARGET_LOST, steps, None, start, joint + 1)
                 jac[:, joint] = (probed - error) / (moved - steps)[joint]
             self._move(steps)
+            self._current = jac
         visited: dict[tuple[int, ...], np.ndarray] = {tuple(steps): error}
         for iteration in range(1, cfg.max_iterations + 1):
             tolerance = np.maximum(cfg.tolerance_px, 0.5 * np.abs(jac).max(axis=1))
@@ -415,6 +502,7 @@ class NeckServo:
             if np.abs(move).max() >= cfg.min_secant_steps:
                 dq = move.astype(float)
                 jac = jac + np.outer(new_error - error - jac @ dq, dq) / (dq @ dq)
+                self._current = jac
             steps, error = target, new_error
             visited[tuple(steps)] = error
         self.jacobian = jac

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from headsim import experiments, render
-from headsim.procedures import HeadKnowledge, measure_model2
+from headsim.procedures import HeadKnowledge, measure_model1, measure_model2
 from headsim.render import Window
-from headsim.servo import EyeServo, ServoConfig
+from headsim.servo import EyeServo, NeckServo, ServoConfig
 from headsim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim import HeadSim
 
@@ -126,3 +126,42 @@ def test_windows_change_no_measurement(head: str) -> None:
     assert renders == plain_renders
     assert servo.window_renders > renders / 2
     assert frames < 0.5 * plain_frames
+
+
+class LoggingNeckServo(NeckServo):
+    """A neck servo that keeps every detection it made (full-frame pixels)."""
+
+    seen: list[tuple[float, float] | None]
+
+    def _look(self, camera: int, detector):  # type: ignore[no-untyped-def]
+        detection = super()._look(camera, detector)
+        self.seen = [*getattr(self, "seen", []), detection.uv]
+        return detection
+
+
+def test_windows_change_no_fixation_with_the_neck() -> None:
+    settings = paper_head()
+    rng = np.random.default_rng(8)
+    points = experiments.random_targets_head(rng, 4, (0.5, 1.2), vertical=(-0.1, 0.1))
+    runs = {}
+    for windows in (False, True):
+        with HeadSim("default", settings) as sim:
+            servo = LoggingNeckServo(sim, ServoConfig(windows=windows))
+            measured = []
+            for p in points:
+                sim.set_body_pose("marker_red", sim.transform_points(p, "head", "world")[0])
+                measured.append(measure_model1(sim, servo, experiments.RED, HeadKnowledge()))
+            runs[windows] = (measured, sim.rendered_frames, sim.render_count, servo)
+    plain, plain_frames, plain_renders, plain_servo = runs[False]
+    windowed, frames, renders, servo = runs[True]
+    assert all(m.ok for m in plain) and all(m.ok for m in windowed)
+    for a, b in zip(plain, windowed, strict=True):
+        np.testing.assert_allclose(b.estimate_head_m, a.estimate_head_m, rtol=0, atol=1e-6)
+    assert len(servo.seen) == len(plain_servo.seen)
+    for a_uv, b_uv in zip(plain_servo.seen, servo.seen, strict=True):
+        assert (a_uv is None) == (b_uv is None)
+        if a_uv is not None and b_uv is not None:
+            assert np.max(np.abs(np.subtract(a_uv, b_uv))) <= 0.01
+    assert renders == plain_renders
+    assert servo.window_renders > 0 and servo.window_misses <= servo.window_renders // 10
+    assert frames < 0.7 * plain_frames
