@@ -185,10 +185,14 @@ class EyeRenderer:
         self.rendered_frames += (width * height) / (width_c * height_c)
         return np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
 
-    def render(self, data: mujoco.MjData, index: int) -> np.ndarray:
-        """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8."""
+    def render(self, data: mujoco.MjData, index: int, retake: bool = False) -> np.ndarray:
+        """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8.
+
+        ``retake``: the whole of the image just taken as a window (the same
+        instant: the same noise); it is still a render and is counted.
+        """
         image = apply_canvas(self._draw(data, index, None), self._canvases[index])
-        return self._add_noise(image, index, None)
+        return self._add_noise(image, index, None, retake)
 
     def render_window(self, data: mujoco.MjData, index: int, window: Window) -> np.ndarray:
         """Render only ``window`` of camera ``index``: the full frame's crop, (h, w, 3) uint8."""
@@ -222,10 +226,15 @@ class EyeRenderer:
                 image = apply_canvas(region, shifted)
         return self._add_noise(image, index, window)
 
-    def _add_noise(self, image: np.ndarray, index: int, window: Window | None) -> np.ndarray:
+    def _add_noise(
+        self, image: np.ndarray, index: int, window: Window | None, retake: bool = False
+    ) -> np.ndarray:
         self.render_count += 1
-        frame = self._taken[index]
-        self._taken[index] += 1
+        if retake and self._taken[index] > 0:
+            frame = self._taken[index] - 1
+        else:
+            frame = self._taken[index]
+            self._taken[index] += 1
         camera = self._cameras[index]
         crop = None if window is None else (window.x0, window.y0, camera.width, camera.height)
         return self._noise[index].apply(image, (self._seed, index), frame, crop=crop)

@@ -238,6 +238,13 @@ class ObservedSim(HeadSim):
         self.hub.rendered(self, self.camera_index(camera) + 1, image)
         return image
 
+    def retake(self, camera: CameraId) -> np.ndarray:
+        before = self.rendered_frames
+        image = super().retake(camera)
+        self.hub.rendered_frames += self.rendered_frames - before
+        self.hub.rendered(self, self.camera_index(camera) + 1, image)
+        return image
+
     def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
         """The window; observers see it in a full-size frame, black elsewhere."""
         before = self.rendered_frames

@@ -185,6 +185,7 @@ class EyeServo:
             detection = look_in_window(sim, camera, detector, window)
             if detection is None:
                 self.window_misses += 1
+                detection = detector(sim.retake(camera))  # the same instant, whole
         if detection is None:
             detection = detector(sim.render(camera))
         # Only blob detections (a centroid and an area) predict a window.
@@ -431,6 +432,7 @@ class NeckServo:
                 if detection is not None:
                     return detection
                 self.window_misses += 1
+                return detector(sim.retake(camera))  # the same instant, whole
         return detector(sim.render(camera))
 
     def _in_range(self, steps: np.ndarray) -> bool:

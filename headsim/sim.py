@@ -354,6 +354,10 @@ class HeadSim:
         """The camera's current image, (H, W, 3) uint8, with its lens and noise."""
         return self._renderer.render(self.data, self.camera_index(camera))
 
+    def retake(self, camera: CameraId) -> np.ndarray:
+        """The whole image of the instant just taken as a window (same noise), counted."""
+        return self._renderer.render(self.data, self.camera_index(camera), retake=True)
+
     def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
         """Only ``window`` of the camera's image: the full image's crop, (h, w, 3) uint8."""
         return self._renderer.render_window(self.data, self.camera_index(camera), window)

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from headsim import experiments, render
+from headsim import servo as servo_module
 from headsim.procedures import HeadKnowledge, measure_model1, measure_model2
 from headsim.render import Window
 from headsim.servo import EyeServo, NeckServo, ServoConfig
@@ -165,3 +166,32 @@ def test_windows_change_no_fixation_with_the_neck() -> None:
     assert renders == plain_renders
     assert servo.window_renders > 0 and servo.window_misses <= servo.window_renders // 10
     assert frames < 0.7 * plain_frames
+
+
+def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
+    """Every window misses (it is put where the target is not): the full frames that
+    follow are the same images, noise included, so nothing changes but the cost."""
+    settings = HeadSettings(cameras=(CameraSettings(noise_std=3.0),) * 2, seed=4)
+    rng = np.random.default_rng(9)
+    points = experiments.random_targets_head(rng, 3, (0.5, 1.0), vertical=(-0.1, 0.1))
+
+    def far_away(sim, camera, expected_uv, area_px, motion_px, margin_px):  # type: ignore[no-untyped-def]
+        return Window(0, 0, 24, 24) if expected_uv[0] > 100 else Window(600, 440, 24, 24)
+
+    runs = {}
+    for windows in (False, True):
+        if windows:
+            monkeypatch.setattr(servo_module, "expected_window", far_away)
+        with HeadSim("default", settings) as sim:
+            servo = LoggingServo(sim, ServoConfig(windows=windows))
+            measured = []
+            for p in points:
+                sim.set_body_pose("marker_red", sim.transform_points(p, "head", "world")[0])
+                measured.append(measure_model2(sim, servo, experiments.RED, HeadKnowledge()))
+            runs[windows] = (measured, sim.render_count, servo)
+    (plain, plain_renders, plain_servo), (missed, renders, servo) = runs[False], runs[True]
+    assert servo.window_misses == servo.window_renders > 0
+    assert renders == plain_renders + servo.window_misses
+    assert servo.seen == plain_servo.seen
+    for a, b in zip(plain, missed, strict=True):
+        np.testing.assert_array_equal(a.estimate_head_m, b.estimate_head_m)
