@@ -25,6 +25,7 @@ reported as such beside the others.
 from __future__ import annotations
 
 import concurrent.futures as futures
+import functools
 import math
 import multiprocessing
 import statistics
@@ -76,6 +77,23 @@ class JobOutcome:
 # -- jobs (run in worker processes; module-level so they pickle) ---------------------
 
 
+class JobError(RuntimeError):
+    """An experiment failed in its worker; the message says why (picklable, unlike
+    some of the errors it stands for: a worker must not break the pool)."""
+
+
+def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str, Any]]:
+    @functools.wraps(job)
+    def run(*args: Any) -> dict[str, Any]:
+        try:
+            return job(*args)
+        except Exception as err:
+            raise JobError(_why(err)) from None
+
+    return run
+
+
+@_plain_errors
 def _calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.calibration_file import head_hash, write_calibration
     from headsim.runner import calibrate_scenario
@@ -88,7 +106,7 @@ def _calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     if block["status"] != "ok":
         raise RuntimeError(f"calibration failed: {block['status']}")
     path = write_calibration(
-        Path(out) / "head.json", scenario.settings, block, "calibration", scenario.seed
+        (Path(out) / "head.json").resolve(), scenario.settings, block, "calibration", scenario.seed
     )
     return {
         "path": str(path),
@@ -99,6 +117,7 @@ def _calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     }
 
 
+@_plain_errors
 def _scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
     from headsim.report import results_payload, summary_text
     from headsim.runner import run_scenario
@@ -124,6 +143,7 @@ def _scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) 
     }
 
 
+@_plain_errors
 def _study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim import study
 
@@ -663,7 +683,10 @@ def reproduce(
             calibration = pool.submit(_calibrate_job, str(out), fast, seed).result()
         except Exception as err:
             outcomes["initial_directions"] = JobOutcome(
-                "initial_directions", "error", time.perf_counter() - t0, error=_why(err)
+                "initial_directions",
+                "error",
+                time.perf_counter() - t0,
+                error=str(err) if isinstance(err, JobError) else _why(err),
             )
         jobs: dict[futures.Future[dict[str, Any]], tuple[str, float]] = {}
         now = time.perf_counter()
@@ -697,7 +720,10 @@ def reproduce(
                 )
             except Exception as err:
                 outcomes[name] = JobOutcome(
-                    name, "error", time.perf_counter() - began, error=_why(err)
+                    name,
+                    "error",
+                    time.perf_counter() - began,
+                    error=str(err) if isinstance(err, JobError) else _why(err),
                 )
             progress(f"{name}: {outcomes[name].status}")
             write_report()

@@ -9,6 +9,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "benchmarks"))
 
 from check_reproduce import problems
@@ -141,3 +143,18 @@ def test_an_interrupted_run_leaves_a_readable_partial_report(tmp_path: Path) -> 
     text = report.read_text()
     assert "status: **interrupted**" in text and "not run (interrupted)" in text
     assert json.loads((out / "report.json").read_text())["status"] == "interrupted"
+
+
+def test_a_failing_job_says_why_and_leaves_the_pool_working(tmp_path: Path) -> None:
+    # A scenario error cannot be unpickled as such: it must not break the pool.
+    missing = str(tmp_path / "missing.json")
+    pool = reproduce._pool(1)
+    try:
+        for _ in range(2):
+            job = pool.submit(
+                reproduce._scenario_job, "chessboard", str(tmp_path), True, None, missing
+            )
+            with pytest.raises(reproduce.JobError, match=r"ScenarioError: .*cannot read"):
+                job.result(timeout=300)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
