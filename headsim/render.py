@@ -1,9 +1,9 @@
 """Off-screen rendering of the eye cameras: MuJoCo pinhole render, lens, noise.
 
-One :class:`mujoco.Renderer` (an OpenGL context) per compiled head and scene
-is kept in a small process-wide pool and reused by every simulator of that
-head, within a run and across the jobs of a worker: creating one costs about
-0.2 s.  Images are drawn into a viewport of its off-screen buffer, so one
+One :class:`mujoco.Renderer` (an OpenGL context) per scene (its assets and
+off-screen buffer size, :func:`context_key`) is kept in a small process-wide
+pool and reused by every simulator of that scene, whatever its head, within a
+run and across the jobs of a worker: creating one costs about 0.2 s.  Images are drawn into a viewport of its off-screen buffer, so one
 context serves every canvas size and every window.
 
 A *window* is a sub-rectangle of a camera's image, rendered as the same
@@ -17,6 +17,7 @@ one render and is counted, with its pixels in full-frame equivalents.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections import OrderedDict
 from collections.abc import Hashable
@@ -67,13 +68,41 @@ class Window:
         return cls(int(x0), int(y0), int(side_u), int(side_v))
 
 
+#: What an OpenGL context holds of a model (uploaded once): meshes, textures, height
+#: fields, skins.  Everything else (cameras, bodies, geom sizes and colours) is read
+#: from the model and data at every render.
+_CONTEXT_ARRAYS = ("mesh_vert", "mesh_face", "mesh_normal", "tex_data", "hfield_data", "skin_vert")
+
+
+def context_key(scene: str, model: mujoco.MjModel) -> tuple[str, str]:
+    """What identifies the OpenGL context a model needs: its scene and a digest of the
+    assets the context uploads.  Heads that differ only in their settings (cameras,
+    baseline, mounts) share one context; its off-screen buffer grows to the largest
+    canvas asked of it."""
+    digest = hashlib.sha1()
+    for name in _CONTEXT_ARRAYS:
+        array = getattr(model, name, None)
+        if array is not None:
+            digest.update(name.encode())
+            digest.update(np.ascontiguousarray(array).tobytes())
+    return (str(scene), digest.hexdigest())
+
+
 def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
-    """The pooled renderer of ``key`` (a head and scene), made for ``model`` if new."""
+    """The pooled renderer of ``key``, with a buffer at least ``model``'s off-screen size."""
     global created
+    need = (int(model.vis.global_.offwidth), int(model.vis.global_.offheight))
     renderer = _POOL.pop(key, None)
+    if renderer is not None and (renderer.width < need[0] or renderer.height < need[1]):
+        need = (max(need[0], renderer.width), max(need[1], renderer.height))
+        renderer.close()
+        renderer = None
     if renderer is None:
         backend = check_backend()
-        width, height = int(model.vis.global_.offwidth), int(model.vis.global_.offheight)
+        width, height = need
+        saved = (model.vis.global_.offwidth, model.vis.global_.offheight)
+        # The context's buffer is sized from the model it is made with.
+        model.vis.global_.offwidth, model.vis.global_.offheight = width, height
         try:
             renderer = mujoco.Renderer(model, height=height, width=width)
         except ValueError as err:  # larger than the model's off-screen buffer
@@ -83,6 +112,8 @@ def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
                 f"could not create an off-screen OpenGL context with MUJOCO_GL={backend}: {err}. "
                 f"{INSTALL_HINT}"
             ) from err
+        finally:
+            model.vis.global_.offwidth, model.vis.global_.offheight = saved
         created += 1
     _POOL[key] = renderer
     while len(_POOL) > POOL_SIZE:
@@ -101,9 +132,9 @@ def release_renderers() -> None:
 class EyeRenderer:
     """Renders the two eye cameras of one compiled model to 8-bit RGB arrays.
 
-    ``key``: what identifies the compiled model (scene and head settings); two
-    models with equal keys must be compiled from the same MJCF and settings,
-    and then share one OpenGL context.  None: a context of its own.
+    ``key``: what identifies the OpenGL context the model needs
+    (:func:`context_key`); models with equal keys share one.  None: a context
+    of its own.
     """
 
     def __init__(
@@ -135,7 +166,7 @@ class EyeRenderer:
 
     def _renderer(self) -> mujoco.Renderer:
         renderer = _acquire(self._key, self._model)
-        renderer._model = self._model  # the same MJCF and settings; this data's model
+        renderer._model = self._model  # the same assets; this model's cameras and bodies
         return renderer
 
     def _draw(self, data: mujoco.MjData, index: int, rect: Window | None) -> np.ndarray:

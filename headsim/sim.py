@@ -25,7 +25,7 @@ import numpy as np
 from headsim import names
 from headsim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
 from headsim.optics import camera_matrix, dist_coeffs, project_points
-from headsim.render import EyeRenderer, Window
+from headsim.render import EyeRenderer, Window, context_key
 from headsim.settings import CameraSettings, HeadSettings, SettingsError
 
 #: A camera: 1 or 2 (the paper's Ca1, Ca2) or its MJCF name "cam1"/"cam2".
@@ -115,7 +115,7 @@ class HeadSim:
             self.settings.cameras,
             self.built.canvases,
             seed=self.settings.seed,
-            key=(str(scene), repr(self.settings)),
+            key=context_key(str(scene), self.model),
         )
         self.reset()
 

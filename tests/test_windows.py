@@ -74,10 +74,19 @@ def test_simulators_of_one_head_share_one_renderer_and_render_alike() -> None:
         _pose(sim)
         np.testing.assert_array_equal(sim.render(1), first)
     assert render.created == before
-    # Another head gets a context of its own.
-    with HeadSim("default", HeadSettings(seed=11, baseline_m=0.12)) as sim:
-        sim.render(1)
-    assert render.created == before + 1
+    # Another head of the same scene shares it too, and renders as with a context of its own.
+    other = HeadSettings(
+        seed=11, baseline_m=0.12, cameras=(CameraSettings(kx=700.0, ky=690.0, cx=330.0),) * 2
+    )
+    with HeadSim("default", other) as sim:
+        _pose(sim)
+        shared = sim.render(1)
+        own = render.EyeRenderer(sim.model, other.cameras, sim.built.canvases, seed=11)
+        try:
+            np.testing.assert_array_equal(own.render(sim.data, 0), shared)
+        finally:
+            own.close()
+    assert render.created == before + 1  # the one of its own only
 
 
 class LoggingServo(EyeServo):
