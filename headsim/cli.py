@@ -163,6 +163,8 @@ def _run(args: argparse.Namespace) -> int:
                     "wall_s": wall,
                     "phases_s": result.timing_s,
                     "renders": result.renders,
+                    "rendered_frames": result.rendered_frames,
+                    "windows": result.windows,
                     "rrd_bytes": rrd.stat().st_size if rrd is not None else None,
                 },
             }
@@ -247,6 +249,71 @@ def _close_recorder(recorder, rrd: Path | None) -> None:
         if rrd is not None and _recording_failed(err):
             raise _recording_disk_full(rrd, err) from err
         raise
+
+
+def _calibrate(args: argparse.Namespace) -> int:
+    from headsim.calibration_file import head_hash, write_calibration
+    from headsim.runner import calibrate_scenario
+    from headsim.scenario import ScenarioError, load_scenario
+
+    scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
+    spec = scenario.experiment.calibration
+    if spec is None or spec.source is not None:
+        raise ScenarioError(
+            str(scenario.path),
+            "experiment.calibration",
+            "no calibration to run" if spec is None else "it reads a calibration file itself",
+            "an [experiment.calibration] table with targets (e.g. the quickstart scenario)",
+        )
+    out = Path(args.out)
+    if out.is_dir():
+        raise ScenarioError("--out", "", f"{out} is a directory", "a file path, e.g. head.json")
+    outputs = Outputs()
+    out = outputs.file(out, "--out")  # writable, as the real file, before anything renders
+    observers = []
+    progress = _progress_observer(args, spec.targets, "ball positions")
+    if progress is not None:
+        observers.append(progress)
+    start = time.perf_counter()
+    with _sigterm_interrupts():
+        try:
+            block = calibrate_scenario(scenario, observers)
+        except KeyboardInterrupt:
+            print(f"\nheadsim: interrupted: nothing written to {out}", file=sys.stderr)
+            return 130
+    wall = time.perf_counter() - start
+    if observers:
+        print(file=sys.stderr)
+    if block["status"] != "ok" or block.get("knowledge") is None:
+        print(f"headsim: calibration failed: {block['status']}; nothing written", file=sys.stderr)
+        return 1
+    try:
+        write_calibration(out, scenario.settings, block, scenario.name, scenario.seed)
+    except OSError as err:
+        raise OutputNotWritable(f"cannot write {out}: {err.strerror or err}") from err
+    alpha, std = block["alpha_e_rad"], block["alpha_e_std_rad"]
+    print(
+        f"{scenario.name}{' (fast)' if scenario.fast else ''}: {block['fixated']} of "
+        f"{block['targets']} ball positions fixated, {block['renders']} renders "
+        f"({block['rendered_frames']:.1f} full frames of pixels) in {wall:.1f} s"
+    )
+    for index in (0, 1):
+        print(f"  alpha_e{index + 1} = {alpha[index]:+.5f} rad (std {std[index]:.1e})")
+    known = block["knowledge"]
+    print(f"  v0 = {known['v0_px']} px; kx/ky = {known['kx_over_ky']}")
+    print(f"head {head_hash(scenario.settings)[:12]}; written to {out}")
+    print(f'use it with  [experiment.calibration] from = "{out.resolve()}"')
+    return 0
+
+
+def _reproduce(args: argparse.Namespace) -> int:
+    from headsim import reproduce
+
+    try:
+        with _sigterm_interrupts():  # SIGTERM too leaves the report so far
+            return reproduce.main(args)
+    except reproduce.ReproduceError as err:
+        raise BadInput(str(err)) from err
 
 
 def _list(args: argparse.Namespace) -> int:
@@ -391,6 +458,43 @@ def build_parser() -> argparse.ArgumentParser:
         "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"
     )
     run.set_defaults(func=_run)
+
+    calibrate = commands.add_parser(
+        "calibrate",
+        help="calibrate a head once (Sec. V) and write what it learnt to a file",
+        description="Run only the Sec. V calibration of a scenario and write what the head "
+        "learnt (initial directions, extended fit, standard errors) with the head settings it "
+        "holds for (by a hash) to FILE. Scenarios use it with [experiment.calibration] from = "
+        '"FILE" and refuse it for another head. Exit status: 0 written, 1 the calibration '
+        "failed, 2 bad input, 3 FILE not writable, 130 interrupted.",
+    )
+    calibrate.add_argument(
+        "scenario", metavar="SCENARIO", help="a scenario with [experiment.calibration]"
+    )
+    calibrate.add_argument("--out", required=True, metavar="FILE", help="the file to write")
+    calibrate.add_argument("--seed", type=int, metavar="N", help="seed (default: the file's)")
+    calibrate.add_argument("--fast", action="store_true", help="the scenario's fast variant")
+    calibrate.add_argument("--no-progress", action="store_true", help="no progress bar")
+    calibrate.set_defaults(func=_calibrate)
+
+    repro = commands.add_parser(
+        "reproduce",
+        help="every Sec. VI experiment of the paper on one head, one calibration, one report",
+        description="Calibrate the paper's head once, then run the initial directions, the "
+        "chessboard, relative positioning, Tables V/VI against calibrated stereo with the "
+        "focal length changed, and tracking, spread over workers. Writes DIR/report.md (the "
+        "paper's figures beside ours, a verdict per row) with DIR/figures/*.png. Exit status: 0 "
+        "all ran, 1 an experiment failed (the others are still reported), 2 bad input, 130 "
+        "interrupted (the report so far stays).",
+    )
+    repro.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
+    repro.add_argument("--fast", action="store_true", help="every experiment's fast variant")
+    repro.add_argument(
+        "--workers", type=int, default=1, metavar="N", help="worker processes (default 1)"
+    )
+    repro.add_argument("--sweeps", action="store_true", help="also the insensitivity sweeps (long)")
+    repro.add_argument("--seed", type=int, metavar="N", help="seed (default 0)")
+    repro.set_defaults(func=_reproduce)
 
     listing = commands.add_parser(
         "list",

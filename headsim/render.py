@@ -1,24 +1,141 @@
 """Off-screen rendering of the eye cameras: MuJoCo pinhole render, lens, noise.
 
-One :class:`mujoco.Renderer` per canvas size is created lazily and reused.
-The head's own geoms (group ``names.HEAD_VISUAL_GROUP``) are hidden from the
-eye cameras.  Every call of :meth:`EyeRenderer.render` is one render and is
-counted.
+One :class:`mujoco.Renderer` (an OpenGL context) per scene (its assets and
+off-screen buffer size, :func:`context_key`) is kept in a small process-wide
+pool and reused by every simulator of that scene, whatever its head, within a
+run and across the jobs of a worker: creating one costs about 0.2 s.  Images are drawn into a viewport of its off-screen buffer, so one
+context serves every canvas size and every window.
+
+A *window* is a sub-rectangle of a camera's image, rendered as the same
+camera with a shifted principal point (for a distorted camera: the region of
+its pinhole canvas that the window's pixels sample).  Its pixels are the full
+frame's crop, noise included (the noise of image k of a camera is drawn for
+the whole frame and cropped).  The head's own geoms (group
+``names.HEAD_VISUAL_GROUP``) are hidden from the eye cameras.  Every image is
+one render and is counted, with its pixels in full-frame equivalents.
 """
 
 from __future__ import annotations
+
+import hashlib
+import math
+from collections import OrderedDict
+from collections.abc import Hashable
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
 from headsim import names
 from headsim.backend import INSTALL_HINT, RenderBackendError, check_backend
-from headsim.optics import DistortionCanvas, add_noise, apply_canvas
+from headsim.optics import DistortionCanvas, GaussianNoise, apply_canvas
 from headsim.settings import CameraSettings
+
+#: Renderers kept per process (one per head and scene); the least recently used goes first.
+POOL_SIZE = 4
+_POOL: OrderedDict[Hashable, mujoco.Renderer] = OrderedDict()
+#: Renderers created in this process (the pool's misses), for the bench and tests.
+created = 0
+
+
+@dataclass(frozen=True)
+class Window:
+    """A sub-rectangle of a camera's output image: top-left (x0, y0) and size, px."""
+
+    x0: int
+    y0: int
+    width: int
+    height: int
+
+    @property
+    def x1(self) -> int:
+        return self.x0 + self.width
+
+    @property
+    def y1(self) -> int:
+        return self.y0 + self.height
+
+    @classmethod
+    def around(
+        cls, centre_uv: tuple[float, float], half_px: float, image_size: tuple[int, int]
+    ) -> Window:
+        """The square of half-side ``half_px`` around ``centre_uv``, moved inside the image."""
+        width, height = image_size
+        side_u = min(width, 2 * math.ceil(half_px) + 1)
+        side_v = min(height, 2 * math.ceil(half_px) + 1)
+        x0 = min(max(round(centre_uv[0] - side_u / 2), 0), width - side_u)
+        y0 = min(max(round(centre_uv[1] - side_v / 2), 0), height - side_v)
+        return cls(int(x0), int(y0), int(side_u), int(side_v))
+
+
+#: What an OpenGL context holds of a model (uploaded once): meshes, textures, height
+#: fields, skins.  Everything else (cameras, bodies, geom sizes and colours) is read
+#: from the model and data at every render.
+_CONTEXT_ARRAYS = ("mesh_vert", "mesh_face", "mesh_normal", "tex_data", "hfield_data", "skin_vert")
+
+
+def context_key(scene: str, model: mujoco.MjModel) -> tuple[str, str]:
+    """What identifies the OpenGL context a model needs: its scene and a digest of the
+    assets the context uploads.  Heads that differ only in their settings (cameras,
+    baseline, mounts) share one context; its off-screen buffer grows to the largest
+    canvas asked of it."""
+    digest = hashlib.sha1()
+    for name in _CONTEXT_ARRAYS:
+        array = getattr(model, name, None)
+        if array is not None:
+            digest.update(name.encode())
+            digest.update(np.ascontiguousarray(array).tobytes())
+    return (str(scene), digest.hexdigest())
+
+
+def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
+    """The pooled renderer of ``key``, with a buffer at least ``model``'s off-screen size."""
+    global created
+    need = (int(model.vis.global_.offwidth), int(model.vis.global_.offheight))
+    renderer = _POOL.pop(key, None)
+    if renderer is not None and (renderer.width < need[0] or renderer.height < need[1]):
+        need = (max(need[0], renderer.width), max(need[1], renderer.height))
+        renderer.close()
+        renderer = None
+    if renderer is None:
+        backend = check_backend()
+        width, height = need
+        saved = (model.vis.global_.offwidth, model.vis.global_.offheight)
+        # The context's buffer is sized from the model it is made with.
+        model.vis.global_.offwidth, model.vis.global_.offheight = width, height
+        try:
+            renderer = mujoco.Renderer(model, height=height, width=width)
+        except ValueError as err:  # larger than the model's off-screen buffer
+            raise ValueError(f"cannot render {width}x{height}: {err}") from err
+        except Exception as err:  # GL context creation failed
+            raise RenderBackendError(
+                f"could not create an off-screen OpenGL context with MUJOCO_GL={backend}: {err}. "
+                f"{INSTALL_HINT}"
+            ) from err
+        finally:
+            model.vis.global_.offwidth, model.vis.global_.offheight = saved
+        created += 1
+    _POOL[key] = renderer
+    while len(_POOL) > POOL_SIZE:
+        _, oldest = _POOL.popitem(last=False)
+        oldest.close()
+    return renderer
+
+
+def release_renderers() -> None:
+    """Close every pooled renderer (their OpenGL contexts)."""
+    while _POOL:
+        _, renderer = _POOL.popitem()
+        renderer.close()
 
 
 class EyeRenderer:
-    """Renders the two eye cameras of one compiled model to 8-bit RGB arrays."""
+    """Renders the two eye cameras of one compiled model to 8-bit RGB arrays.
+
+    ``key``: what identifies the OpenGL context the model needs
+    (:func:`context_key`); models with equal keys share one.  None: a context
+    of its own.
+    """
 
     def __init__(
         self,
@@ -26,43 +143,151 @@ class EyeRenderer:
         cameras: tuple[CameraSettings, CameraSettings],
         canvases: tuple[DistortionCanvas, DistortionCanvas],
         seed: int = 0,
+        key: Hashable | None = None,
     ) -> None:
         self._model = model
         self._cameras = cameras
         self._canvases = canvases
-        self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
+        self._key: Hashable = key if key is not None else ("own", id(self))
+        self._own = key is None
         self._option = mujoco.MjvOption()
         self._option.geomgroup[names.HEAD_VISUAL_GROUP] = 0
-        # One noise stream per camera, so each camera's noise depends only on
-        # the seed and on how many images that camera has taken.
-        self._noise = tuple(np.random.default_rng([seed, index]) for index in range(2))
+        # One noise stream per camera: image k of camera i gets the noise drawn
+        # from (seed, i, k), whatever else was rendered.
+        self._seed = seed
+        self._noise = tuple(GaussianNoise.of(camera.noise_std) for camera in cameras)
+        self._taken = [0, 0]
+        self._cam_ids = [
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, name) for name in names.CAMERAS
+        ]
         self.render_count = 0
+        #: Pixels rendered, in full frames of the camera that rendered them.
+        self.rendered_frames = 0.0
 
-    def _renderer(self, size: tuple[int, int]) -> mujoco.Renderer:
-        if size not in self._renderers:
-            backend = check_backend()
-            width, height = size
-            try:
-                self._renderers[size] = mujoco.Renderer(self._model, height=height, width=width)
-            except ValueError as err:  # larger than the model's off-screen buffer
-                raise ValueError(f"cannot render {width}x{height}: {err}") from err
-            except Exception as err:  # GL context creation failed
-                raise RenderBackendError(
-                    f"could not create an off-screen OpenGL context with MUJOCO_GL={backend}: {err}. "
-                    f"{INSTALL_HINT}"
-                ) from err
-        return self._renderers[size]
+    def _renderer(self) -> mujoco.Renderer:
+        renderer = _acquire(self._key, self._model)
+        renderer._model = self._model  # the same assets; this model's cameras and bodies
+        return renderer
 
-    def render(self, data: mujoco.MjData, index: int) -> np.ndarray:
-        """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8."""
+    def _draw(self, data: mujoco.MjData, index: int, rect: Window | None) -> np.ndarray:
+        """The pinhole canvas of camera ``index``, or its sub-rectangle ``rect``: (h, w, 3)."""
         canvas = self._canvases[index]
-        renderer = self._renderer(canvas.size)
-        renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
-        image = apply_canvas(renderer.render(), canvas)
+        renderer = self._renderer()
+        width_c, height_c = canvas.size
+        cam = self._cam_ids[index]
+        model = self._model
+        saved = None
+        if rect is not None and (rect.width, rect.height) != (width_c, height_c):
+            # The same camera, its image cut to ``rect``: resolution and sensor
+            # shrink, the principal point moves by the window's offset.
+            saved = (
+                model.cam_resolution[cam].copy(),
+                model.cam_sensorsize[cam].copy(),
+                model.cam_intrinsic[cam].copy(),
+            )
+            pitch = model.cam_sensorsize[cam] / model.cam_resolution[cam]
+            offset_px = model.cam_intrinsic[cam][2:4] / pitch
+            window_offset = offset_px + np.array(
+                [
+                    (rect.width - width_c) / 2 + rect.x0,
+                    (rect.height - height_c) / 2 + rect.y0,
+                ]
+            )
+            model.cam_resolution[cam] = (rect.width, rect.height)
+            model.cam_sensorsize[cam] = pitch * np.array([rect.width, rect.height])
+            model.cam_intrinsic[cam][2:4] = window_offset * pitch
+        try:
+            renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
+        finally:
+            if saved is not None:
+                (
+                    model.cam_resolution[cam],
+                    model.cam_sensorsize[cam],
+                    model.cam_intrinsic[cam],
+                ) = saved
+        width, height = (width_c, height_c) if rect is None else (rect.width, rect.height)
+        gl_context = renderer._gl_context
+        if gl_context is not None:
+            gl_context.make_current()
+        viewport = mujoco.MjrRect(0, 0, width, height)
+        mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
+        pixels = np.empty((height, width, 3), dtype=np.uint8)
+        mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
+        self.rendered_frames += (width * height) / (width_c * height_c)
+        return np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
+
+    def render(self, data: mujoco.MjData, index: int, retake: bool = False) -> np.ndarray:
+        """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8.
+
+        ``retake``: the whole of the image just taken as a window (the same
+        instant: the same noise); it is still a render and is counted.
+        """
+        image = apply_canvas(self._draw(data, index, None), self._canvases[index])
+        return self._add_noise(image, index, None, retake)
+
+    def render_window(self, data: mujoco.MjData, index: int, window: Window) -> np.ndarray:
+        """Render only ``window`` of camera ``index``: the full frame's crop, (h, w, 3) uint8."""
+        camera, canvas = self._cameras[index], self._canvases[index]
+        if not (
+            0 <= window.x0 < window.x1 <= camera.width
+            and 0 <= window.y0 < window.y1 <= camera.height
+        ):
+            raise ValueError(
+                f"window {window} is not inside the {camera.width}x{camera.height} image"
+            )
+        if canvas.identity:
+            image = self._draw(data, index, window)
+        else:
+            assert canvas.map_x is not None and canvas.map_y is not None
+            map_x = canvas.map_x[window.y0 : window.y1, window.x0 : window.x1]
+            map_y = canvas.map_y[window.y0 : window.y1, window.x0 : window.x1]
+            source = _canvas_region(map_x, map_y, canvas.size)
+            if source is None:  # nothing of the canvas is seen through this window
+                image = np.zeros((window.height, window.width, 3), dtype=np.uint8)
+            else:
+                region = self._draw(data, index, source)
+                # Shifting float32 maps by whole pixels is exact: the same samples.
+                shifted = DistortionCanvas(
+                    size=(source.width, source.height),
+                    principal=canvas.principal,
+                    map_x=np.where(map_x >= 0, map_x - np.float32(source.x0), np.float32(-1)),
+                    map_y=np.where(map_y >= 0, map_y - np.float32(source.y0), np.float32(-1)),
+                    valid_fraction=canvas.valid_fraction,
+                )
+                image = apply_canvas(region, shifted)
+        return self._add_noise(image, index, window)
+
+    def _add_noise(
+        self, image: np.ndarray, index: int, window: Window | None, retake: bool = False
+    ) -> np.ndarray:
         self.render_count += 1
-        return add_noise(image, self._cameras[index].noise_std, self._noise[index])
+        if retake and self._taken[index] > 0:
+            frame = self._taken[index] - 1
+        else:
+            frame = self._taken[index]
+            self._taken[index] += 1
+        camera = self._cameras[index]
+        crop = None if window is None else (window.x0, window.y0, camera.width, camera.height)
+        return self._noise[index].apply(image, (self._seed, index), frame, crop=crop)
 
     def close(self) -> None:
-        for renderer in self._renderers.values():
-            renderer.close()
-        self._renderers.clear()
+        """Give the OpenGL context back to the pool (closed if it was this renderer's own)."""
+        if self._own:
+            renderer = _POOL.pop(self._key, None)
+            if renderer is not None:
+                renderer.close()
+
+
+def _canvas_region(
+    map_x: np.ndarray, map_y: np.ndarray, canvas_size: tuple[int, int]
+) -> Window | None:
+    """The canvas rectangle that bilinear sampling at (map_x, map_y) reads (None: no valid source)."""
+    valid = map_x >= 0
+    if not valid.any():
+        return None
+    xs, ys = map_x[valid], map_y[valid]
+    x0 = max(math.floor(float(xs.min())) - 1, 0)
+    y0 = max(math.floor(float(ys.min())) - 1, 0)
+    x1 = min(math.floor(float(xs.max())) + 3, canvas_size[0])
+    y1 = min(math.floor(float(ys.max())) + 3, canvas_size[1])
+    return Window(x0, y0, x1 - x0, y1 - y0)

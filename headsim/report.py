@@ -35,6 +35,8 @@ RESULTS_KEYS = (
     "software",
     "settings",
     "renders",
+    "rendered_frames",
+    "windows",
     "calibration",
     "measurements",
     "summary",
@@ -175,6 +177,8 @@ def results_payload(result: RunResult) -> dict[str, Any]:
         "software": software_versions(),
         "settings": {**asdict(s.settings), "settle_mode": s.settle_mode},
         "renders": result.renders,
+        "rendered_frames": result.rendered_frames,
+        "windows": result.windows,
         "calibration": result.calibration,
         "measurements": [measurement_entry(r) for r in result.records],
         "summary": summaries(result),
@@ -420,6 +424,11 @@ def summary_text(result: RunResult) -> str:
         f"{s.name}{' (fast variant)' if s.fast else ''}: {s.description}",
         f"head: {s.preset} preset; seed {s.seed}; procedure {s.experiment.procedure}; "
         f"{result.renders['total']} renders"
+        + (
+            f" ({result.rendered_frames['total']:.1f} full frames of pixels)"
+            if result.rendered_frames
+            else ""
+        )
         + ("; the paper's figures beside ours" if paper else ""),
         "",
     ]

@@ -41,6 +41,7 @@ from headsim.procedures import (
     relative_positioning,
     track_moving_target,
 )
+from headsim.render import Window
 from headsim.scenario import (
     CHESSBOARD_PATTERN,
     CHESSBOARD_SQUARE_M,
@@ -129,6 +130,10 @@ class RunResult:
     renders: dict[str, int]
     failures: tuple[str, ...]
     timing_s: dict[str, float] = field(default_factory=dict, compare=False)
+    #: Pixels rendered by phase, in full frames (a window counts its share), and
+    #: the servo's windows: rendered, and missed (a full frame followed).
+    rendered_frames: dict[str, float] = field(default_factory=dict)
+    windows: dict[str, int] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
@@ -144,6 +149,10 @@ class Hub:
         self.step = -1
         self.steps: list[int] = []  # steps begun in the current phase, in order
         self.camera = 0
+        self.offset_px = (0, 0)
+        self.rendered_frames = 0.0
+        self.windows = 0
+        self.window_misses = 0
         self._watched: tuple[str, str] | None = None
         self._detector: Detector | None = None
         self._auto_label: Callable[[], str] | None = None
@@ -176,8 +185,16 @@ class Hub:
         if self._watched is not None and body == self._watched[0]:
             self.begin(f"{self._watched[1]} {len(self.steps) + 1}")
 
-    def rendered(self, sim: HeadSim, camera: int, image: np.ndarray) -> None:
+    def rendered(
+        self,
+        sim: HeadSim,
+        camera: int,
+        image: np.ndarray,
+        offset_px: tuple[int, int] = (0, 0),
+    ) -> None:
+        """An image was rendered; ``offset_px``: where the detector's image (a window) starts."""
         self.camera = camera
+        self.offset_px = offset_px
         for o in self.observers:
             o.rendered(sim, camera, image, self.frame)
         self.frame += 1
@@ -191,6 +208,8 @@ class Hub:
         def observed(image: np.ndarray) -> Any:
             detection = detector(image)
             uv = detection.uv if detection.found else None
+            if uv is not None:  # in the full frame's pixels
+                uv = (uv[0] + self.offset_px[0], uv[1] + self.offset_px[1])
             for o in self.observers:
                 o.detected(sim, self.camera, uv, detection.status.value, self.frame - 1)
             return detection
@@ -222,8 +241,29 @@ class ObservedSim(HeadSim):
         self.hub = hub
 
     def render(self, camera: CameraId) -> np.ndarray:
+        before = self.rendered_frames
         image = super().render(camera)
+        self.hub.rendered_frames += self.rendered_frames - before
         self.hub.rendered(self, self.camera_index(camera) + 1, image)
+        return image
+
+    def retake(self, camera: CameraId) -> np.ndarray:
+        before = self.rendered_frames
+        image = super().retake(camera)
+        self.hub.rendered_frames += self.rendered_frames - before
+        self.hub.rendered(self, self.camera_index(camera) + 1, image)
+        return image
+
+    def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
+        """The window; observers see it in a full-size frame, black elsewhere."""
+        before = self.rendered_frames
+        image = super().render_window(camera, window)
+        self.hub.rendered_frames += self.rendered_frames - before
+        self.hub.windows += 1
+        settings = self.camera_settings(camera)
+        frame = np.zeros((settings.height, settings.width, 3), dtype=np.uint8)
+        frame[window.y0 : window.y1, window.x0 : window.x1] = image
+        self.hub.rendered(self, self.camera_index(camera) + 1, frame, (window.x0, window.y0))
         return image
 
     def set_body_pose(
@@ -242,8 +282,12 @@ class ObservedEyeServo(EyeServo):
 
     sim: ObservedSim
 
-    def observe(self, camera: int, detector: Detector) -> Any:
-        return super().observe(camera, self.sim.hub.detector(self.sim, detector))
+    def observe(self, camera: int, detector: Detector, key: object = None) -> Any:
+        key = detector if key is None else key
+        misses = self.window_misses
+        detection = super().observe(camera, self.sim.hub.detector(self.sim, detector), key)
+        self.sim.hub.window_misses += self.window_misses - misses
+        return detection
 
 
 class ObservedNeckServo(NeckServo):
@@ -252,9 +296,16 @@ class ObservedNeckServo(NeckServo):
     sim: ObservedSim
 
     def run(
-        self, detector: Detector, goals: tuple[float, float, float] | None = None
+        self,
+        detector: Detector,
+        goals: tuple[float, float, float] | None = None,
+        key: object = None,
     ) -> NeckServoResult:
-        return super().run(self.sim.hub.detector(self.sim, detector), goals)
+        key = detector if key is None else key
+        misses = self.window_misses
+        result = super().run(self.sim.hub.detector(self.sim, detector), goals, key)
+        self.sim.hub.window_misses += self.window_misses - misses
+        return result
 
 
 class Progress(Observer):
@@ -436,6 +487,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "alpha_e_rad": list(knowledge.alpha_e),
             "v0_px": list(knowledge.v0),
             "kx_over_ky": list(knowledge.kx_over_ky),
+            "u0_px": list(knowledge.u0),
         },
     )
     hub.calibrated(block)
@@ -710,19 +762,53 @@ RUNNERS = {
 }
 
 
+def calibrate_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> dict[str, Any]:
+    """Only the scenario's Sec. V calibration (``headsim calibrate``): its results.json block.
+
+    ``status`` is "ok" or why it failed; ``rendered_frames`` the pixels it
+    rendered, in full frames.
+    """
+    spec = scenario.experiment.calibration
+    if spec is None or spec.source is not None:
+        raise ValueError("the scenario has no calibration to run ([experiment.calibration])")
+    hub = Hub(observers)
+    _, block = _calibrate(scenario, hub)
+    return {**block, "rendered_frames": hub.rendered_frames}
+
+
 def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunResult:
     """Run a checked scenario; the observers see every image, detection and result."""
     hub = Hub(observers)
     timing: dict[str, float] = {}
     renders = {"calibration": 0, "experiment": 0, "recording": 0}
+    rendered_frames = {"calibration": 0.0, "experiment": 0.0}
     knowledge, label = HeadKnowledge(), "none"
     calibration = None
     failures: list[str] = []
-    if scenario.experiment.calibration is not None:
+    spec = scenario.experiment.calibration
+    if spec is not None and spec.source is not None:
+        from headsim.calibration_file import read_calibration
+
+        stored = read_calibration(spec.source, scenario.settings)
+        calibration = {
+            **stored.block,
+            "renders": 0,
+            "from": {
+                "path": str(stored.path),
+                "scenario": stored.scenario,
+                "seed": stored.seed,
+                "head_hash": stored.head_hash,
+                "renders": stored.block.get("renders"),
+            },
+        }
+        hub.calibrated(calibration)
+        knowledge, label = stored.knowledge, "calibrated"
+    elif spec is not None:
         start = time.perf_counter()
         run, calibration = _calibrate(scenario, hub)
         timing["calibration"] = time.perf_counter() - start
         renders["calibration"] = calibration["renders"]
+        rendered_frames["calibration"] = hub.rendered_frames
         if run is None:
             failures.append(f"calibration: {calibration['status']}")
         else:
@@ -737,6 +823,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
         )
         timing["experiment"] = time.perf_counter() - start
         renders["experiment"] = hub.frame - frames
+        rendered_frames["experiment"] = hub.rendered_frames - rendered_frames["calibration"]
     failures += [
         f"{r.measurement.name}: {r.measurement.status}" for r in records if not r.measurement.ok
     ]
@@ -752,6 +839,11 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
         renders=renders,
         failures=tuple(failures),
         timing_s=timing,
+        rendered_frames={
+            **rendered_frames,
+            "total": rendered_frames["calibration"] + rendered_frames["experiment"],
+        },
+        windows={"rendered": hub.windows, "missed": hub.window_misses},
     )
     hub.finished(result)
     return result
@@ -767,6 +859,7 @@ __all__ = [
     "Observer",
     "Progress",
     "RunResult",
+    "calibrate_scenario",
     "marker_target",
     "run_scenario",
 ]

@@ -108,6 +108,9 @@ class CalibrationSpec:
     depth z_h in ``depth_m``, |x_h/z_h| <= ``lateral``, |y_h/z_h| <= ``vertical``.
     ``depth_noise_m``: error of the tape-measured depth.  ``extended``: also
     fit each camera's vertical reference row and kx/ky (beyond the paper).
+    ``source``: a calibration file (``headsim calibrate``) to use instead of
+    calibrating (a relative path is relative to the scenario file's
+    directory); the other fields are then not used.
     """
 
     targets: int = 60
@@ -116,6 +119,7 @@ class CalibrationSpec:
     vertical: float = 0.08
     depth_noise_m: float = 0.0
     extended: bool = True
+    source: str | None = None
 
 
 @dataclass(frozen=True)
@@ -601,6 +605,7 @@ def _read_calibration(table: _Table | None) -> CalibrationSpec | None:
         vertical=table.number("vertical", 0.08, 0.0, 1.0, unit="(|y_h / z_h|)"),
         depth_noise_m=table.number("depth_noise_m", 0.0, 0.0, 0.1, unit="m"),
         extended=table.boolean("extended", True),
+        source=table.string("from", None, max_length=1000),
     )
     table.done()
     if spec.extended and spec.vertical == 0.0:
@@ -1261,6 +1266,18 @@ def _build(
     settings, preset_name, settle = _read_head(top, ctx)
     settings = replace(settings, seed=seed)
     experiment = _read_experiment(top, ctx)
+    calibration = experiment.calibration
+    if calibration is not None and calibration.source is not None:
+        from headsim.calibration_file import CalibrationFileError, read_calibration
+
+        source = Path(calibration.source)
+        if not source.is_absolute():  # relative to the scenario file, like the file's own paths
+            source = path.parent / source
+            experiment = replace(experiment, calibration=replace(calibration, source=str(source)))
+        try:
+            read_calibration(source, settings)
+        except CalibrationFileError as err:
+            raise ctx.error("experiment.calibration.from", str(err)) from err
     scene = _read_scene(top, ctx, experiment.procedure, settings, seed)
     top.has("fast")
     top.done()

@@ -11,6 +11,7 @@ learnt on one target seeds the next.  Every loop is bounded and returns a
 from __future__ import annotations
 
 import enum
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -18,10 +19,64 @@ from dataclasses import dataclass
 import numpy as np
 
 from headsim import names
+from headsim.render import Window
 from headsim.sim import HeadSim
-from headsim.vision import Detection, DetectionStatus
+from headsim.vision import Detection, DetectionStatus, find_marker
 
 Detector = Callable[[np.ndarray], Detection]
+
+#: Detectors (or the functions that partials of them wrap) that find their target
+#: in a window: a blob's centroid, decided by the blob and what lies within one blob
+#: size of it.  Others (a whole chessboard, a cross point) always see full frames.
+WINDOWED_DETECTORS: set[Callable[..., object]] = {find_marker}
+
+
+def windowed(detector: object) -> bool:
+    """Whether ``detector`` (possibly a ``functools.partial``) may look at windows."""
+    while isinstance(detector, functools.partial):
+        detector = detector.func
+    return detector in WINDOWED_DETECTORS
+
+
+def expected_window(
+    sim: HeadSim,
+    camera: int,
+    expected_uv: tuple[float, float],
+    area_px: float,
+    motion_px: float,
+    margin_px: float,
+) -> Window | None:
+    """The window to look for a blob of ``area_px`` expected at ``expected_uv`` after an
+    image motion of ``motion_px``: half-side 3 blob radii + margin + a quarter of the
+    motion.  None where it would be barely cheaper than the frame."""
+    half = 3.0 * math.sqrt(area_px / math.pi) + margin_px + 0.25 * abs(motion_px)
+    settings = sim.camera_settings(camera)
+    window = Window.around(expected_uv, half, (settings.width, settings.height))
+    if window.width * window.height >= 0.5 * settings.width * settings.height:
+        return None
+    return window
+
+
+def look_in_window(
+    sim: HeadSim, camera: int, detector: Detector, window: Window
+) -> Detection | None:
+    """Render ``window`` and detect there: the detection in full-frame pixels, or None (a miss).
+
+    It counts only if FOUND at least 3 blob radii + 2 px inside the window, so
+    that the blob and every piece the detector looks for beside it (within one
+    blob size) lie in the window: then the full frame gives the same answer.
+    """
+    seen = detector(sim.render_window(camera, window))
+    if not seen.found or seen.uv is None:
+        return None
+    u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0
+    inset = 3.0 * math.sqrt(seen.area_px / math.pi) + 2.0
+    if (
+        window.x0 + inset <= u <= window.x1 - 1 - inset
+        and window.y0 + inset <= v <= window.y1 - 1 - inset
+    ):
+        return Detection(DetectionStatus.FOUND, (u, v), seen.area_px)
+    return None
 
 
 class ServoOutcome(enum.Enum):
@@ -75,6 +130,9 @@ class ServoConfig:
     do not update the gain (centroid pixel-locking would corrupt it).
     ``max_retreats``: moves after which the target was gone that are undone
     and retried at half the length, per run.
+    ``windows``: render only a window around where the target is expected
+    (see :meth:`EyeServo.observe`); ``window_margin_px`` is added to its
+    half-side beyond the blob and a quarter of the predicted motion.
     """
 
     tolerance_px: float = 0.1
@@ -83,6 +141,8 @@ class ServoConfig:
     min_probe_px: float = 2.0
     min_secant_steps: int = 8
     max_retreats: int = 3
+    windows: bool = True
+    window_margin_px: float = 8.0
 
 
 class EyeServo:
@@ -96,15 +156,70 @@ class EyeServo:
         self._step_range = (math.ceil(low / resolution), math.floor(high / resolution))
         #: Gain per camera, px per encoder step, carried from one target to the next.
         self.gains: dict[int, float] = {}
+        #: Per camera, the last detection the window is predicted from:
+        #: (detector, eye steps, neck encoders, placements, uv px, area px^2).
+        self._seen: dict[
+            int, tuple[object, int, tuple[float, float], int, tuple[float, float], float]
+        ] = {}
+        #: Windows rendered, and windows that missed the target (a full frame followed).
+        self.window_renders = 0
+        self.window_misses = 0
 
     @property
     def step_range(self) -> tuple[int, int]:
         """Eye-motor range, whole encoder steps."""
         return self._step_range
 
-    def observe(self, camera: int, detector: Detector) -> Detection:
-        """Render ``camera`` and detect the target in it (one render)."""
-        return detector(self.sim.render(camera))
+    def observe(self, camera: int, detector: Detector, key: object = None) -> Detection:
+        """Render ``camera`` and detect the target in it (one render, two on a window miss).
+
+        With windows on, and when this camera last saw the same target
+        (``key``, default the detector) with the neck and the scene unchanged
+        since and a gain known, only a window is rendered: around where the
+        head expects the target from that detection and the eye steps moved
+        since (u + gain * steps), of half-side 3 blob radii plus the margin
+        and a quarter of the predicted motion (blob detectors only, see
+        :data:`WINDOWED_DETECTORS`).  The detection there counts
+        only if it is FOUND at least 3 blob radii + 2 px inside the window
+        (so the blob and every piece the detector looks for beside it lie in
+        the window); otherwise the window is a miss (counted) and a full
+        frame is rendered.  Never from the truth: detections, gain, encoders.
+        """
+        key = detector if key is None else key
+        sim = self.sim
+        steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
+        window = self._window(camera, key, steps, neck) if windowed(key) else None
+        detection = None
+        if window is not None:
+            self.window_renders += 1
+            detection = look_in_window(sim, camera, detector, window)
+            if detection is None:
+                self.window_misses += 1
+                detection = detector(sim.retake(camera))  # the same instant, whole
+        if detection is None:
+            detection = detector(sim.render(camera))
+        # Only blob detections (a centroid and an area) predict a window.
+        if isinstance(detection, Detection) and detection.found and detection.uv is not None:
+            self._seen[camera] = (key, steps, neck, sim.placements, detection.uv, detection.area_px)
+        else:
+            self._seen.pop(camera, None)
+        return detection
+
+    def _window(
+        self, camera: int, key: object, steps: int, neck: tuple[float, float]
+    ) -> Window | None:
+        """Where to look for ``key``'s target in ``camera``, or None for the full frame."""
+        cfg, sim = self.config, self.sim
+        seen, gain = self._seen.get(camera), self.gains.get(camera)
+        if not cfg.windows or seen is None or gain is None:
+            return None
+        seen_key, seen_steps, seen_neck, placements, uv, area = seen
+        if seen_key is not key or seen_neck != neck or placements != sim.placements:
+            return None
+        motion = gain * (steps - seen_steps)
+        return expected_window(
+            sim, camera, (uv[0] + motion, uv[1]), area, motion, cfg.window_margin_px
+        )
 
     def run(
         self,
@@ -127,14 +242,14 @@ class EyeServo:
         if first is None:
             first = self.observe(camera, detector)
             self._renders += 1
-        self._seen: list[tuple[int, float, float]] = []
+        self._path: list[tuple[int, float, float]] = []
         self._retreats = 0
         if not first.found or first.uv is None:
             return self._result(
                 ServoOutcome.TARGET_LOST, steps, None, goal, 0, camera, lost=first.status
             )
         visited: dict[int, tuple[float, float]] = {steps: first.uv}
-        self._seen.append((steps, *first.uv))
+        self._path.append((steps, *first.uv))
         uv = first.uv
         gain = self.gains.get(camera)
         probe = cfg.probe_steps
@@ -195,9 +310,11 @@ class EyeServo:
                     probe *= 4
             elif abs(move) >= cfg.min_secant_steps and change != 0.0:
                 gain = change / move
+            if gain is not None:
+                self.gains[camera] = gain  # what the next window is predicted with
             steps, uv = target, detection.uv
             visited[steps] = uv
-            self._seen.append((steps, *uv))
+            self._path.append((steps, *uv))
         # The last move may have landed within tolerance: that is converged.
         done = gain is not None and abs(uv[0] - goal) <= max(cfg.tolerance_px, 0.5 * abs(gain))
         outcome = ServoOutcome.CONVERGED if done else ServoOutcome.ITERATION_LIMIT
@@ -228,7 +345,7 @@ class EyeServo:
             self._renders,
             iterations,
             lost,
-            tuple(self._seen),
+            tuple(self._path),
             self._retreats,
         )
 
@@ -285,6 +402,16 @@ class NeckServo:
             for lo, hi in (sim.joint_range(j) for j in self.JOINTS)
         ]
         self.jacobian: np.ndarray | None = None
+        #: The last images' detections the windows are predicted from:
+        #: (detector, steps, placements, ((u, v), area) per camera), and the count
+        #: of windows rendered and missed (see :meth:`EyeServo.observe`).
+        self._seen: (
+            tuple[object, tuple[int, ...], int, list[tuple[tuple[float, float], float]]] | None
+        ) = None
+        self.window_renders = 0
+        self.window_misses = 0
+        self._key: object = None
+        self._current: np.ndarray | None = None  # the Jacobian as the run stands
 
     def _steps(self) -> np.ndarray:
         resolution = self.sim.settings.encoder_resolution_rad
@@ -298,7 +425,12 @@ class NeckServo:
         self.sim.settle()
 
     def _error(self, detector: Detector, goals: np.ndarray) -> np.ndarray | None:
-        seen = [detector(self.sim.render(camera)) for camera in (1, 2)]
+        seen = [self._look(camera, detector) for camera in (1, 2)]
+        steps = tuple(int(s) for s in self._steps())
+        if all(isinstance(s, Detection) and s.found and s.uv is not None for s in seen):
+            self._seen = (self._key, steps, self.sim.placements, [(s.uv, s.area_px) for s in seen])  # type: ignore[misc]
+        else:
+            self._seen = None
         for camera, s in enumerate(seen, start=1):
             if not s.found or s.uv is None:
                 self._lost = (camera, s.status)
@@ -306,14 +438,57 @@ class NeckServo:
         (u1, v1), (u2, v2) = seen[0].uv, seen[1].uv  # type: ignore[misc]
         return np.array([u1, u2, (v1 + v2) / 2]) - goals
 
+    def _look(self, camera: int, detector: Detector) -> Detection:
+        """Detect in ``camera``: in a window around where the last images and the
+        Jacobian put the target (same target, scene unchanged, blob detector), else
+        in the full frame; a miss costs the full frame and is counted."""
+        sim, seen = self.sim, self._seen
+        jac = self._current
+        if (
+            self.config.windows
+            and seen is not None
+            and jac is not None
+            and seen[0] is self._key
+            and seen[2] == sim.placements
+            and windowed(self._key)
+        ):
+            move = self._steps() - np.array(seen[1])
+            du1, du2, dv = jac @ move
+            (u, v), area = seen[3][camera - 1]
+            du = du1 if camera == 1 else du2
+            window = expected_window(
+                sim,
+                camera,
+                (u + du, v + dv),
+                area,
+                max(abs(du), abs(dv)),
+                self.config.window_margin_px,
+            )
+            if window is not None:
+                self.window_renders += 1
+                detection = look_in_window(sim, camera, detector, window)
+                if detection is not None:
+                    return detection
+                self.window_misses += 1
+                return detector(sim.retake(camera))  # the same instant, whole
+        return detector(sim.render(camera))
+
     def _in_range(self, steps: np.ndarray) -> bool:
         return all(lo <= s <= hi for s, (lo, hi) in zip(steps, self._ranges, strict=True))
 
     def run(
-        self, detector: Detector, goals: tuple[float, float, float] | None = None
+        self,
+        detector: Detector,
+        goals: tuple[float, float, float] | None = None,
+        key: object = None,
     ) -> NeckServoResult:
-        """Fixate the target with neck and eyes; ``goals`` = (u10, u20, v0), default image centres."""
+        """Fixate the target with neck and eyes; ``goals`` = (u10, u20, v0), default image centres.
+
+        ``key``: what identifies the target for windows (default the detector).
+        """
         cfg, sim = self.config, self.sim
+        self._key = detector if key is None else key
+        self._current = self.jacobian
         if goals is None:
             (u10, v10), (u20, v20) = (sim.camera_settings(c).image_centre for c in (1, 2))
             goals = (u10, u20, (v10 + v20) / 2)
@@ -339,6 +514,7 @@ class NeckServo:
                     return self._result(ServoOutcome.TARGET_LOST, steps, None, start, joint + 1)
                 jac[:, joint] = (probed - error) / (moved - steps)[joint]
             self._move(steps)
+            self._current = jac
         visited: dict[tuple[int, ...], np.ndarray] = {tuple(steps): error}
         damping = 1.0
         for iteration in range(1, cfg.max_iterations + 1):
@@ -377,6 +553,7 @@ class NeckServo:
             if np.abs(move).max() >= cfg.min_secant_steps:
                 dq = move.astype(float)
                 jac = jac + np.outer(new_error - error - jac @ dq, dq) / (dq @ dq)
+                self._current = jac
             steps, error = target, new_error
             visited[tuple(steps)] = error
         self.jacobian = jac

@@ -25,7 +25,7 @@ import numpy as np
 from headsim import names
 from headsim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
 from headsim.optics import camera_matrix, dist_coeffs, project_points
-from headsim.render import EyeRenderer
+from headsim.render import EyeRenderer, Window, context_key
 from headsim.settings import CameraSettings, HeadSettings, SettingsError
 
 #: A camera: 1 or 2 (the paper's Ca1, Ca2) or its MJCF name "cam1"/"cam2".
@@ -108,8 +108,14 @@ class HeadSim:
             )
         }
         self._commands = _Commands()
+        #: Bodies placed so far (targets moved: earlier images are out of date).
+        self.placements = 0
         self._renderer = EyeRenderer(
-            self.model, self.settings.cameras, self.built.canvases, seed=self.settings.seed
+            self.model,
+            self.settings.cameras,
+            self.built.canvases,
+            seed=self.settings.seed,
+            key=context_key(str(scene), self.model),
         )
         self.reset()
 
@@ -304,6 +310,7 @@ class HeadSim:
         mocap_id = int(self.model.body_mocapid[body_id]) if body_id >= 0 else -1
         if mocap_id < 0:
             raise SettingsError(f"{name!r} is not a movable (mocap) body in this scene")
+        self.placements += 1
         self.data.mocap_pos[mocap_id] = position_world_m
         if quat_world is not None:
             self.data.mocap_quat[mocap_id] = quat_world
@@ -347,7 +354,20 @@ class HeadSim:
         """The camera's current image, (H, W, 3) uint8, with its lens and noise."""
         return self._renderer.render(self.data, self.camera_index(camera))
 
+    def retake(self, camera: CameraId) -> np.ndarray:
+        """The whole image of the instant just taken as a window (same noise), counted."""
+        return self._renderer.render(self.data, self.camera_index(camera), retake=True)
+
+    def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
+        """Only ``window`` of the camera's image: the full image's crop, (h, w, 3) uint8."""
+        return self._renderer.render_window(self.data, self.camera_index(camera), window)
+
     @property
     def render_count(self) -> int:
-        """Images rendered so far by this simulator."""
+        """Images rendered so far by this simulator (full frames and windows)."""
         return self._renderer.render_count
+
+    @property
+    def rendered_frames(self) -> float:
+        """Pixels rendered so far by this simulator, in full frames."""
+        return self._renderer.rendered_frames
