@@ -91,7 +91,8 @@ def load_spec(scene: str | Path = "default") -> mujoco.MjSpec:
 def apply_settings(
     spec: mujoco.MjSpec, settings: HeadSettings
 ) -> tuple[DistortionCanvas, DistortionCanvas]:
-    """Write baseline, neck D-H offsets and cameras into ``spec``; return the render canvases."""
+    """Write baseline, neck D-H offsets, cameras (with optical-centre offsets and yaw-axis
+    tilts) into ``spec``; return the render canvases."""
     spec.body(names.NECK_PITCH_LINK).pos = [0.0, 0.0, settings.neck_d1_m]
     spec.body(names.HEAD).pos = [0.0, 0.0, settings.neck_a2_m]
     half = settings.baseline_m / 2
@@ -114,6 +115,17 @@ def apply_settings(
         eye_from_mjcam = eye_from_camera_rotation(cam, index) @ CV_FROM_MJCAM
         mj_cam.alt.type = mujoco.mjtOrientation.mjORIENTATION_QUAT  # drop the XML's xyaxes
         mj_cam.quat = _quat_from_matrix(eye_from_mjcam)
+        # Optical centre off the yaw axis: forward along the optical axis, sideways along x.
+        offset_cv = np.array([cam.side_offset_m, 0.0, cam.nodal_offset_m])
+        mj_cam.pos = eye_from_camera_rotation(cam, index) @ offset_cv
+        # Yaw axis leaning forward about H's x (eye2's axis is -y, mirrored).
+        tilt = cam.eye_axis_tilt_rad
+        axis_sign = 1.0 if index == 0 else -1.0
+        spec.joint(names.EYE_JOINTS[index]).axis = [
+            0.0,
+            axis_sign * np.cos(tilt),
+            axis_sign * np.sin(tilt),
+        ]
         canvases.append(canvas)
 
     spec.visual.global_.offwidth = max(c.size[0] for c in canvases)

@@ -158,6 +158,8 @@ def results_payload(result: RunResult) -> dict[str, Any]:
         "failures": list(result.failures),
         "software": software_versions(),
         "settings": {**asdict(s.settings), "settle_mode": s.settle_mode},
+        # The truth above; what the head believes (and its estimators use) here.
+        "belief": asdict(s.settings.believed),
         "renders": result.renders,
         "calibration": result.calibration,
         "measurements": [measurement_entry(r) for r in result.records],
