@@ -87,7 +87,7 @@ BAD = [
         "[head]\nbaseline = 0.1\n",
         "head.baseline: unknown key (allowed: preset, baseline_m, neck_d1_m, neck_a2_m, "
         "encoder_resolution_rad, initial_direction_rad, mount_yaw_rad, mount_pitch_rad, "
-        "mount_roll_rad, settle)",
+        "mount_roll_rad, settle, backlash_rad, count_error)",
     ),
     (
         "[head]\nbaseline_m = 'wide'\n",
@@ -97,7 +97,7 @@ BAD = [
         "[head]\nbaseline_m = 2.0\n",
         "head.baseline_m: 2 is out of range (allowed: a number > 0 and <= 1 m)",
     ),
-    ("[head]\npreset = 'sony'\n", "head.preset: unknown value 'sony' (allowed: ideal, paper)"),
+    ("[head]\npreset = 'sony'\n", "head.preset: unknown value 'sony' (allowed: ideal, paper, realistic)"),
     (
         "[cam1]\ncx = 700\n",
         "cam1.cx: 700 is out of range (allowed: a number >= 0 and <= 639 px (inside the image))",
