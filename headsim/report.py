@@ -34,6 +34,7 @@ RESULTS_KEYS = (
     "failures",
     "software",
     "settings",
+    "belief",
     "renders",
     "calibration",
     "measurements",
