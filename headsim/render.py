@@ -8,6 +8,7 @@ counted.
 
 from __future__ import annotations
 
+import cv2
 import mujoco
 import numpy as np
 
@@ -26,8 +27,13 @@ class EyeRenderer:
         cameras: tuple[CameraSettings, CameraSettings],
         canvases: tuple[DistortionCanvas, DistortionCanvas],
         seed: int = 0,
+        supersample: int = 1,
     ) -> None:
+        """``supersample``: the model's cameras render at this many times each
+        canvas's size (``headsim.settings.RenderFidelity``); images are area-averaged
+        back to the canvas."""
         self._model = model
+        self._supersample = supersample
         self._cameras = cameras
         self._canvases = canvases
         self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
@@ -56,9 +62,13 @@ class EyeRenderer:
     def render(self, data: mujoco.MjData, index: int) -> np.ndarray:
         """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8."""
         canvas = self._canvases[index]
-        renderer = self._renderer(canvas.size)
+        k = self._supersample
+        renderer = self._renderer((k * canvas.size[0], k * canvas.size[1]))
         renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
-        image = apply_canvas(renderer.render(), canvas)
+        frame = renderer.render()
+        if k > 1:
+            frame = cv2.resize(frame, canvas.size, interpolation=cv2.INTER_AREA)
+        image = apply_canvas(frame, canvas)
         self.render_count += 1
         return add_noise(image, self._cameras[index].noise_std, self._noise[index])
 

@@ -108,6 +108,18 @@ def measurement_entry(record: MeasurementRecord) -> dict[str, Any]:
     }
 
 
+#: Depth bands of the honest headline, m: every target counts in exactly one.
+DEPTH_BANDS_M = ((0.0, 0.6), (0.6, 1.0), (1.0, math.inf))
+
+
+def _band_name(lo: float, hi: float) -> str:
+    return f"{lo:g}-{hi:g} m" if math.isfinite(hi) else f">= {lo:g} m"
+
+
+def _rms_pct(pct: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(pct * pct))) if pct.size else float("nan")
+
+
 def _summary(records: list[MeasurementRecord]) -> dict[str, Any]:
     ok = [r.measurement for r in records if r.measurement.ok]
     errors = np.array([np.linalg.norm(m.error_head_m) for m in ok])
@@ -128,6 +140,18 @@ def _summary(records: list[MeasurementRecord]) -> dict[str, Any]:
         if records
         else nan,
         "servo_residual_px_max": max(residuals) if residuals else nan,
+        # The whole field, all targets: the RMS of the 3-D error in % of depth,
+        # and by depth band (count and RMS), so that no subset stands alone.
+        "error_pct_of_depth_rms": _rms_pct(pct),
+        "by_depth": [
+            {
+                "band": _band_name(lo, hi),
+                "count": int(np.sum(sel)),
+                "error_pct_of_depth_rms": _rms_pct(pct[sel]),
+            }
+            for lo, hi in DEPTH_BANDS_M
+            for sel in [np.array([lo <= m.depth_m < hi for m in ok], dtype=bool)]
+        ],
     }
 
 
@@ -242,7 +266,47 @@ def _calibration_lines(block: dict[str, Any], paper: bool) -> list[str]:
                     *(["-"] if paper else []),
                 ]
             )
-    return lines + format_table(headers, rows)
+    los = block.get("lines_of_sight")
+    if los:
+        truth_e = block["alpha_e_truth_rad"]
+        for k in range(2):
+            rows.append(
+                [
+                    f"alpha_e{k + 1} (rad, extended)",
+                    _cell(los["alpha_e_rad"][k], ".5f"),
+                    _cell(los["std_errors"]["alpha_e_rad"][k], ".1e"),
+                    _cell(truth_e[k], ".5f"),
+                    _cell(los["alpha_e_rad"][k] - truth_e[k], "+.1e"),
+                    *(["-"] if paper else []),
+                ]
+            )
+        for k in range(2):
+            rows.append(
+                [
+                    f"s{k + 1} (mm, extended)",
+                    _cell(1e3 * los["offset_m"][k], ".3f"),
+                    _cell(1e3 * los["std_errors"]["offset_m"][k], ".3f"),
+                    _cell(1e3 * los["offset_truth_m"][k], ".3f"),
+                    _cell(1e3 * (los["offset_m"][k] - los["offset_truth_m"][k]), "+.3f"),
+                    *(["-"] if paper else []),
+                ]
+            )
+        rows.append(
+            [
+                "D effective (mm)",
+                _cell(1e3 * los["effective_baseline_m"], ".3f"),
+                _cell(1e3 * los["effective_baseline_std_m"], ".3f"),
+                _cell(1e3 * los["effective_baseline_truth_m"], ".3f"),
+                _cell(
+                    1e3 * (los["effective_baseline_m"] - los["effective_baseline_truth_m"]), "+.3f"
+                ),
+                *(["-"] if paper else []),
+            ]
+        )
+    out = lines + format_table(headers, rows)
+    if los and not los["separable"]:
+        out.append(f"  line-of-sight offsets: {los['message']}")
+    return out
 
 
 def _measurement_lines(result: RunResult) -> list[str]:
@@ -280,6 +344,14 @@ def _measurement_lines(result: RunResult) -> list[str]:
             f"({_cell(s['error_pct_of_depth_mean'], '.3f')} % of depth), max {_mm(s['error_m_max'])} mm; "
             f"{_cell(s['renders_per_point'], '.1f')} renders per point; servo residual "
             f"<= {_cell(s['servo_residual_px_max'], '.2f')} px"
+        )
+        bands = "; ".join(
+            f"{b['band']}: {_cell(b['error_pct_of_depth_rms'], '.3f')} % ({b['count']})"
+            for b in s["by_depth"]
+        )
+        lines.append(
+            f"    whole field, all {s['ok']} targets: 3-D error RMS "
+            f"{_cell(s['error_pct_of_depth_rms'], '.3f')} % of depth; by depth: {bands}"
         )
     return lines
 

@@ -152,6 +152,31 @@ class CameraSettings:
 
 
 @dataclass(frozen=True)
+class RenderFidelity:
+    """How finely the eye images are rendered: the one knob for edge accuracy.
+
+    ``offsamples``: MuJoCo's multisampling of the off-screen buffer (0 = none;
+    4 puts edges on a quarter-pixel grid).  ``supersample``: each image is
+    rendered at this many times its resolution (focal lengths scaled, pixel
+    centres kept) and area-averaged back down (1 = off).  Windowed renderers
+    must render at the same ratio.
+    """
+
+    offsamples: int = 4
+    supersample: int = 1
+
+    def __post_init__(self) -> None:
+        _check(
+            isinstance(self.offsamples, int) and 0 <= self.offsamples <= 16,
+            f"render offsamples must be an integer within [0, 16], got {self.offsamples!r}",
+        )
+        _check(
+            isinstance(self.supersample, int) and 1 <= self.supersample <= 8,
+            f"render supersample must be an integer within [1, 8], got {self.supersample!r}",
+        )
+
+
+@dataclass(frozen=True)
 class HeadBelief:
     """What the head believes about its own geometry (its design drawings), m.
 
@@ -217,6 +242,7 @@ class HeadSettings:
     belief: HeadBelief | None = None
     backlash_rad: float = 0.0
     count_error: bool = False
+    render: RenderFidelity = field(default_factory=RenderFidelity)
 
     def __post_init__(self) -> None:
         _finite("backlash_rad", self.backlash_rad)

@@ -122,7 +122,11 @@ class HeadSim:
         }
         self._commands = _Commands()
         self._renderer = EyeRenderer(
-            self.model, self.settings.cameras, self.built.canvases, seed=self.settings.seed
+            self.model,
+            self.settings.cameras,
+            self.built.canvases,
+            seed=self.settings.seed,
+            supersample=self.settings.render.supersample,
         )
         self.reset()
 
