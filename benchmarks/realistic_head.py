@@ -15,13 +15,17 @@ those).  Whole shared field: |x/z| <= 0.15, |y/z| <= 0.1, 0.3-1.5 m.
 from __future__ import annotations
 
 import argparse
+import io
 import math
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
 from headsim.camera_model import PinholeCamera
 from headsim.estimators import model2
-from headsim.estimators.calibration import calibrate_lines_of_sight
+from headsim.estimators.calibration import calibrate_initial_directions, calibrate_lines_of_sight
+from headsim.results import write_bytes_atomic, write_csv_atomic
 from headsim.settings import PAPER_INITIAL_DIRECTIONS, PAPER_INTRINSICS, REALISTIC_BUDGET
 from headsim.synthetic import StereoHead, observe, quantise
 
@@ -94,9 +98,120 @@ def calibrate(head: StereoHead, seed: int, n: int = 60, noise: float = 1e-3):
                                     sigma_encoder=head.encoder_resolution / math.sqrt(12))  # fmt: skip
 
 
+def _head(offsets: bool = True, baseline_error: bool = True) -> StereoHead:
+    h = realistic()
+    return replace(
+        h,
+        baseline=h.baseline if baseline_error else BELIEVED_D,
+        nodal1=h.nodal1 if offsets else 0.0,
+        nodal2=h.nodal2 if offsets else 0.0,
+        side1=h.side1 if offsets else 0.0,
+        side2=h.side2 if offsets else 0.0,
+    )
+
+
+def _condition(
+    name: str, p: np.ndarray, seeds: int, *, offsets=True, baseline_error=True, count=True,
+    tape=1e-3, extended=True, correct=True,
+) -> dict[str, float | str]:  # fmt: skip
+    """Median over calibrations of the whole-field errors, beside eqs. 15-18's first-order depth error."""
+    head = _head(offsets, baseline_error)
+    if not count:
+        head = replace(head, encoder_resolution=1e-9)
+    res = head.encoder_resolution
+    rows, predicted = [], []
+    obs = observe(head, p)
+    a_sum = obs.alpha1 + obs.alpha2 + sum(head.effective_initial_directions())  # a1 + a2, rad
+    for seed in range(seeds):
+        rng = np.random.default_rng(3000 + seed)
+        c = field(rng, 60, depth=(0.25, 1.5), lateral=0.16, vertical=0.08)
+        o = observe(head, c)
+        a1, a2 = quantise(o.alpha1, res), quantise(o.alpha2, res)
+        measured = c + rng.normal(0.0, tape, c.shape) if tape > 0 else c
+        if extended:
+            fit = calibrate_lines_of_sight(a1, a2, measured, BELIEVED_D, sigma_position=max(tape, 1e-5),
+                                           sigma_encoder=res / math.sqrt(12))  # fmt: skip
+            alpha_e, offs = tuple(fit.alpha_e), tuple(fit.offset_m) if correct else (0.0, 0.0)
+            cov = fit.covariance
+            # Eqs. 15/17 to first order: dz/z = dD/D - d(a1 + a2)/(a1 + a2), here from the
+            # calibration's errors (covariance) and the truth's offsets left uncorrected.
+            var_sum = cov[0, 0] + cov[1, 1] + 2 * cov[0, 1]
+            var_d = cov[2, 2] + cov[3, 3] - 2 * cov[2, 3]
+        else:
+            sec5 = calibrate_initial_directions(a1, a2, measured[:, 2], BELIEVED_D)
+            alpha_e, offs = tuple(sec5.alpha_e), (0.0, 0.0)
+            var_sum = float(np.sum(sec5.covariance))
+            var_d = 0.0
+        err = measure(head, p, alpha_e, offs, BELIEVED_D) - p
+        z_pct = float(100 * np.sqrt(np.nanmean((err[:, 2] / p[:, 2]) ** 2)))
+        rows.append((pct(err, p), z_pct))
+        s1, s2 = head.line_of_sight_offsets()
+        bias = (
+            0.0 if (extended and correct) else (head.baseline - s1 + s2 - BELIEVED_D) / BELIEVED_D
+        )
+        quant = (res / math.sqrt(6)) ** 2 if count else 0.0  # two readings, each uniform in a count
+        dz = np.sqrt(bias**2 + var_d / BELIEVED_D**2 + (var_sum + quant) / a_sum**2)
+        predicted.append(float(100 * np.sqrt(np.mean(dz**2))))
+    rows_a = np.array(rows)
+    return {
+        "condition": name,
+        "rms_3d_pct": float(np.median(rows_a[:, 0])),
+        "rms_depth_pct": float(np.median(rows_a[:, 1])),
+        "predicted_depth_pct": float(np.median(predicted)),
+    }
+
+
+def budget(p: np.ndarray, seeds: int, out: Path | None) -> None:
+    """The error budget: the realistic head, each imperfection off in turn, each extension on/off."""
+    conditions = [
+        _condition("realistic, all on", p, seeds),
+        _condition("  optical-centre offsets off", p, seeds, offsets=False),
+        _condition("  baseline error off", p, seeds, baseline_error=False),
+        _condition("  count error off", p, seeds, count=False),
+        _condition("  tape noise off", p, seeds, tape=0.0),
+        _condition("  offsets not corrected", p, seeds, correct=False),
+        _condition("  Sec. V only (no extension)", p, seeds, extended=False),
+    ]
+    print(
+        f"\n4. Error budget, whole field (median over {seeds} calibrations); predicted: eqs. 15-18 to first order"
+    )
+    print(f"   {'condition':32s} {'3-D RMS %':>10s} {'depth RMS %':>12s} {'eqs. 15-18 %':>13s}")
+    for c in conditions:
+        print(
+            f"   {c['condition']:32s} {c['rms_3d_pct']:10.3f} {c['rms_depth_pct']:12.3f} {c['predicted_depth_pct']:13.3f}"
+        )
+    if out is None:
+        return
+    out.mkdir(parents=True, exist_ok=True)
+    write_csv_atomic(out / "error_budget.csv", conditions)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 4))
+    y = np.arange(len(conditions))
+    for k, (key, label) in enumerate((("rms_3d_pct", "3-D RMS (measured)"), ("rms_depth_pct", "depth RMS (measured)"),
+                                      ("predicted_depth_pct", "depth, eqs. 15-18"))):  # fmt: skip
+        ax.barh(y + (k - 1) * 0.27, [c[key] for c in conditions], height=0.27, label=label)
+    ax.set_yticks(y, [str(c["condition"]).strip() for c in conditions])
+    ax.invert_yaxis()
+    ax.set_xlabel("error, % of depth (whole field, 0.3-1.5 m)")
+    ax.set_title("Realistic head: error budget (exact forward model)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=120)
+    plt.close(fig)
+    write_bytes_atomic(out / "error_budget.png", buffer.getvalue())
+    print(f"   wrote {out / 'error_budget.csv'} and {out / 'error_budget.png'}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=50)
+    parser.add_argument("--budget-seeds", type=int, default=10)
+    parser.add_argument("--out", type=Path, default=None, help="write error_budget.csv/.png here")
     args = parser.parse_args()
     rng = np.random.default_rng(2026)
     p = field(rng, 2000)
@@ -196,6 +311,8 @@ def main() -> None:
         print(
             f"   {name} error RMS {np.sqrt(np.mean(err[:, k] ** 2)):.2e} rad; z-score spread {np.std(err[:, k] / std[:, k]):.2f}"
         )
+
+    budget(p[:500], args.budget_seeds, args.out)
 
 
 if __name__ == "__main__":
