@@ -41,6 +41,7 @@ from headsim.settings import (
     CameraSettings,
     HeadBelief,
     HeadSettings,
+    RenderFidelity,
     SettingsError,
     preset,
 )
@@ -516,6 +517,8 @@ def _read_head(doc: _Table, ctx: _Context) -> tuple[HeadSettings, str, str]:
     settle = head.choice("settle", ("kinematic", "physics"), "kinematic")
     backlash = head.number("backlash_rad", base.backlash_rad, 0.0, 0.01, unit="rad")
     count_error = head.boolean("count_error", base.count_error)
+    offsamples = head.integer("render_offsamples", base.render.offsamples, 0, 16)
+    supersample = head.integer("render_supersample", base.render.supersample, 1, 8)
     head.done()
 
     cameras = []
@@ -558,6 +561,7 @@ def _read_head(doc: _Table, ctx: _Context) -> tuple[HeadSettings, str, str]:
             backlash_rad=backlash,
             count_error=count_error,
             belief=_read_belief(doc.table("belief"), base),
+            render=RenderFidelity(offsamples=offsamples, supersample=supersample),
         )
     except SettingsError as err:  # pragma: no cover - the checks above are stricter
         raise ctx.error("head", str(err)) from err

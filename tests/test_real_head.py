@@ -18,10 +18,12 @@ from headsim.estimators import model1, model2
 from headsim.estimators.calibration import calibrate_lines_of_sight
 from headsim.kinematics import head_to_camera
 from headsim.settings import (
+    FINE_RENDERING,
     REALISTIC_BUDGET,
     CameraSettings,
     HeadBelief,
     HeadSettings,
+    RenderFidelity,
     SettingsError,
     preset,
 )
@@ -281,3 +283,30 @@ def test_eye_axis_tilt_leans_the_yaw_axis_forward() -> None:
     # A tilted axis pitches the optical axis as the eye turns; the upright one does not.
     assert abs(axis1[1]) > 1e-3 * 0.3
     assert abs(axis2[1]) < 1e-12
+
+
+def test_supersampled_rendering_keeps_pixel_centres_and_sharpens_the_centroid() -> None:
+    rng = np.random.default_rng(5)
+    poses = [
+        ([rng.uniform(-0.08, 0.08), rng.uniform(0.45, 0.9), 0.21 + rng.uniform(-0.06, 0.06)],
+         float(rng.uniform(-0.04, 0.12)))
+        for _ in range(12)
+    ]  # fmt: skip
+    floors = {}
+    for fidelity in (RenderFidelity(4, 1), FINE_RENDERING):
+        errors = []
+        with HeadSim("default", HeadSettings(render=fidelity)) as sim:
+            for target, eye in poses:
+                sim.set_body_pose("marker_red", target)
+                sim.move(eye=eye)
+                seen = find_marker(sim.render(1), "red")
+                truth = sim.project(sim.position("marker_red"), 1)[0]
+                errors.append(float(np.linalg.norm(np.array(seen.uv) - truth)))
+        floors[fidelity.supersample] = np.mean(errors)
+        assert max(errors) < 0.15  # a shifted pixel grid would be off by 0.25-0.5 px
+    assert floors[2] < floors[1]
+
+
+def test_bad_render_fidelity_names_its_key() -> None:
+    with pytest.raises(SettingsError, match="render supersample must be"):
+        RenderFidelity(supersample=0)

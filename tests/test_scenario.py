@@ -87,7 +87,7 @@ BAD = [
         "[head]\nbaseline = 0.1\n",
         "head.baseline: unknown key (allowed: preset, baseline_m, neck_d1_m, neck_a2_m, "
         "encoder_resolution_rad, initial_direction_rad, mount_yaw_rad, mount_pitch_rad, "
-        "mount_roll_rad, settle, backlash_rad, count_error)",
+        "mount_roll_rad, settle, backlash_rad, count_error, render_offsamples, render_supersample)",
     ),
     (
         "[head]\nbaseline_m = 'wide'\n",
