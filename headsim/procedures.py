@@ -446,7 +446,8 @@ def calibrate_head(
     the depth noise adds to it on z_h.  Every fit takes the measured values.
     With ``extended`` and at least 3 targets, each eye's initial direction
     and line-of-sight offset are fitted jointly from the measured positions
-    (:func:`calibrate_lines_of_sight`) and replace Sec. V's directions.
+    (:func:`calibrate_lines_of_sight`) and replace Sec. V's directions, unless
+    the layout cannot separate them (``lines.separable`` False, with its message).
     """
     base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0), los_offset_m=(0.0, 0.0))
     rng = rng or np.random.default_rng(0)
@@ -502,9 +503,13 @@ def calibrate_head(
             sigma_encoder=sim.settings.encoder_resolution_rad * 0.3,
             initial=alpha_e,
         )
-        alpha_e = (float(lines.alpha_e[0]), float(lines.alpha_e[1]))
-        offsets = (float(lines.offset_m[0]), float(lines.offset_m[1]))
-        calibrated = replace(calibrated, alpha_e=alpha_e, los_offset_m=offsets)
+        if lines.separable:
+            alpha_e = (float(lines.alpha_e[0]), float(lines.alpha_e[1]))
+            offsets = (float(lines.offset_m[0]), float(lines.offset_m[1]))
+            calibrated = replace(calibrated, alpha_e=alpha_e, los_offset_m=offsets)
+        else:  # the layout cannot tell offsets from directions: keep Sec. V's and the belief's
+            offsets = base.head_belief(sim).side_offset_m
+            calibrated = replace(calibrated, los_offset_m=None)
         vertical = _vertical_from_samples(sim, rows, alpha_e, base, offsets)
         calibrated = replace(
             calibrated,

@@ -348,7 +348,9 @@ def neck_fixation(
     y_h = 0, |P_h| is the same for every neck pose, so it fixes alpha (1-D
     solve), then theta2 and theta1 follow in closed form.  With ``quantised`` only alpha is rounded
     to the encoder (the neck angles and the point stay those of the exact
-    fixation); quantise the neck yourself with :func:`quantise`.
+    fixation); quantise the neck yourself with :func:`quantise`.  The optical
+    centres' offsets (``nodal*``, ``side*``) are not modelled here (Model 2's
+    functions cover them); yaw-axis tilt is modelled nowhere in this module.
     """
     pw = np.asarray(points_w, dtype=float)
     if pw.ndim != 2 or pw.shape[1] != 3:
