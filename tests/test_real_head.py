@@ -7,6 +7,7 @@ the rest render with real MuJoCo and detect with OpenCV.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -310,3 +311,55 @@ def test_supersampled_rendering_keeps_pixel_centres_and_sharpens_the_centroid() 
 def test_bad_render_fidelity_names_its_key() -> None:
     with pytest.raises(SettingsError, match="render supersample must be"):
         RenderFidelity(supersample=0)
+
+
+# -- scenario files: [belief] and the new keys --------------------------------------
+
+_SCENARIO = """
+description = "a test"
+{head}
+[experiment]
+procedure = "model2"
+
+[[scene.targets]]
+position_head_m = [0.02, 0.01, 0.6]
+"""
+
+
+def _scenario(tmp_path, head: str):
+    from headsim.scenario import load_scenario
+
+    path = tmp_path / "s.toml"
+    path.write_text(_SCENARIO.format(head=head))
+    return load_scenario(path)
+
+
+def test_the_belief_differs_from_the_truth_only_where_the_scenario_says(tmp_path) -> None:
+    plain = _scenario(tmp_path, "[head]\nbaseline_m = 0.16\n").settings
+    assert plain.believed.baseline_m == 0.16  # built as designed
+    told = _scenario(
+        tmp_path,
+        "[head]\nbaseline_m = 0.16\n[belief]\nbaseline_m = 0.15\nside_offset_m = [0.001, 0.0]\n",
+    ).settings
+    assert told.baseline_m == 0.16 and told.believed.baseline_m == 0.15
+    assert told.believed.side_offset_m == (0.001, 0.0)
+    assert told.believed.neck_d1_m == told.neck_d1_m  # not said: as built
+    realistic = _scenario(tmp_path, '[head]\npreset = "realistic"\n').settings
+    assert realistic.believed.baseline_m == 0.150 != realistic.baseline_m
+
+
+@pytest.mark.parametrize(
+    ("head", "field"),
+    [
+        ("[belief]\nbaseline_m = 2.0\n", "belief.baseline_m"),
+        ("[belief]\nnodal_offset_m = [0.5, 0.0]\n", "belief.nodal_offset_m[0]"),
+        ("[cam1]\nside_offset_m = 0.1\n", "cam1.side_offset_m"),
+        ("[head]\nbacklash_rad = 1.0\n", "head.backlash_rad"),
+        ("[head]\nrender_supersample = 0\n", "head.render_supersample"),
+    ],
+)
+def test_a_bad_new_key_in_a_scenario_is_named_with_its_range(tmp_path, head, field) -> None:
+    from headsim.scenario import ScenarioError
+
+    with pytest.raises(ScenarioError, match=re.escape(f"{field}:") + ".*allowed"):
+        _scenario(tmp_path, head)
