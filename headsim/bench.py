@@ -222,6 +222,7 @@ def _realistic_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
             calibration_layout(sim, rng, 30, depth_range_m=(0.25, 1.5)),
             position_noise_m=0.001,
             rng=np.random.default_rng([seed, 7]),
+            lines_of_sight=True,
         )
         truth = line_of_sight_truth(sim, run.knowledge)
     knowledge = run.knowledge

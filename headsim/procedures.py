@@ -432,6 +432,7 @@ def calibrate_head(
     extended: bool = True,
     knowledge: HeadKnowledge | None = None,
     position_noise_m: float = 0.0,
+    lines_of_sight: bool = False,
 ) -> CalibrationRun:
     """Fixate ``target`` (moved with body ``body``) at each position and calibrate.
 
@@ -444,12 +445,12 @@ def calibrate_head(
     ``position_noise_m``: Gaussian error of every coordinate a user measures
     of each target (x_h, y_h, z_h from the head's frame: a tape measure), m;
     the depth noise adds to it on z_h.  Every fit takes the measured values.
-    With ``extended`` and at least 3 targets, each eye's initial direction
-    and line-of-sight offset are fitted jointly from the measured positions
+    With ``extended``, ``lines_of_sight`` and at least 3 targets, each eye's
+    initial direction and line-of-sight offset are fitted jointly from the measured positions
     (:func:`calibrate_lines_of_sight`) and replace Sec. V's directions, unless
     the layout cannot separate them (``lines.separable`` False, with its message).
     """
-    base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0), los_offset_m=(0.0, 0.0))
+    base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0), los_offset_m=None)
     rng = rng or np.random.default_rng(0)
     start = sim.render_count
     parked = sim.position(body)  # put the target back afterwards: it must not hide others
@@ -491,7 +492,10 @@ def calibrate_head(
     calibrated = replace(base, alpha_e=alpha_e)
     vertical = None
     lines = None
-    if extended and len(rows) >= 3:
+    offsets = base.head_belief(sim).side_offset_m
+    if extended and lines_of_sight and len(rows) >= 3:
+        # Off by default: on a head whose centres are on their axes the two
+        # extra unknowns only add their calibration noise (about 0.01 % of depth).
         positions = np.array([r[0] for r in rows])
         lines = calibrate_lines_of_sight(
             np.array(alpha1),
@@ -508,8 +512,8 @@ def calibrate_head(
             offsets = (float(lines.offset_m[0]), float(lines.offset_m[1]))
             calibrated = replace(calibrated, alpha_e=alpha_e, los_offset_m=offsets)
         else:  # the layout cannot tell offsets from directions: keep Sec. V's and the belief's
-            offsets = base.head_belief(sim).side_offset_m
             calibrated = replace(calibrated, los_offset_m=None)
+    if extended and len(rows) >= 3:
         vertical = _vertical_from_samples(sim, rows, alpha_e, base, offsets)
         calibrated = replace(
             calibrated,

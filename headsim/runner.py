@@ -366,6 +366,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             },
             "depth_noise_m": spec.depth_noise_m,
             "position_noise_m": spec.position_noise_m,
+            "lines_of_sight_fit": spec.lines_of_sight,
             "extended": spec.extended,
             "alpha_e_rad": None,
             "alpha_e_std_rad": None,
@@ -390,6 +391,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 rng=np.random.default_rng([seed, STREAM_DEPTH_NOISE]),
                 extended=spec.extended,
                 position_noise_m=spec.position_noise_m,
+                lines_of_sight=spec.lines_of_sight,
             )
         except ValueError as err:
             block.update(status=f"failed: {err}", renders=sim.render_count - start)

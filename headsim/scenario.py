@@ -105,7 +105,8 @@ class CalibrationSpec:
     fit each camera's vertical reference row and kx/ky, initial directions and
     line-of-sight offsets (beyond the paper).  ``position_noise_m``: error of
     every measured coordinate of each target (x_h, y_h, z_h), m; the depth
-    noise adds to it on z_h.
+    noise adds to it on z_h.  ``lines_of_sight``: with ``extended``, also fit
+    each eye's line-of-sight offset (default: on for the realistic preset).
     """
 
     targets: int = 60
@@ -115,6 +116,7 @@ class CalibrationSpec:
     depth_noise_m: float = 0.0
     extended: bool = True
     position_noise_m: float = 0.0
+    lines_of_sight: bool = False
 
 
 @dataclass(frozen=True)
@@ -592,7 +594,7 @@ def _read_belief(table: _Table | None, base: HeadSettings) -> HeadBelief | None:
     )
 
 
-def _read_calibration(table: _Table | None) -> CalibrationSpec | None:
+def _read_calibration(table: _Table | None, lines_default: bool = False) -> CalibrationSpec | None:
     """``[experiment.calibration]``: Sec. V before the experiment."""
     if table is None:
         return None
@@ -604,6 +606,7 @@ def _read_calibration(table: _Table | None) -> CalibrationSpec | None:
         depth_noise_m=table.number("depth_noise_m", 0.0, 0.0, 0.1, unit="m"),
         extended=table.boolean("extended", True),
         position_noise_m=table.number("position_noise_m", 0.0, 0.0, 0.1, unit="m"),
+        lines_of_sight=table.boolean("lines_of_sight", lines_default),
     )
     table.done()
     return spec
@@ -616,13 +619,13 @@ def _depth_range(table: _Table, default: tuple[float, float]) -> tuple[float, fl
     return lo, hi
 
 
-def _read_experiment(doc: _Table, ctx: _Context) -> ExperimentSpec:
+def _read_experiment(doc: _Table, ctx: _Context, preset_name: str = "ideal") -> ExperimentSpec:
     """``[experiment]``: procedure, optional calibration first, and options."""
     table = doc.table("experiment")
     if table is None:
         raise ctx.error("experiment", "missing", "an [experiment] table with a procedure")
     procedure = table.choice("procedure", tuple(PROCEDURES))
-    calibration = _read_calibration(table.table("calibration"))
+    calibration = _read_calibration(table.table("calibration"), preset_name == "realistic")
     if procedure == "calibration" and calibration is None:
         raise table.fail(
             "calibration", "missing", "an [experiment.calibration] table (the calibration to run)"
@@ -1100,7 +1103,7 @@ def _build(
     seed = file_seed if seed is None else seed
     settings, preset_name, settle = _read_head(top, ctx)
     settings = replace(settings, seed=seed)
-    experiment = _read_experiment(top, ctx)
+    experiment = _read_experiment(top, ctx, preset_name)
     scene = _read_scene(top, ctx, experiment.procedure, settings, seed)
     top.has("fast")
     top.done()
