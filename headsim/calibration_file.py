@@ -81,6 +81,9 @@ def knowledge_from_block(block: dict[str, Any]) -> HeadKnowledge:
         v0=tuple(None if v is None else float(v) for v in known["v0_px"]),  # type: ignore[arg-type]
         kx_over_ky=tuple(float(r) for r in known["kx_over_ky"]),  # type: ignore[arg-type]
         u0=tuple(None if u is None else float(u) for u in known.get("u0_px", [None, None])),  # type: ignore[arg-type]
+        los_offset_m=None
+        if known.get("los_offset_m") is None
+        else tuple(float(o) for o in known["los_offset_m"]),  # type: ignore[arg-type]
     )
 
 

@@ -281,17 +281,21 @@ def chessboard_accuracy(
 
 
 def relative_areas(
-    rng: np.random.Generator, layouts: int = 9, progress: Progress = _quiet
+    rng: np.random.Generator,
+    layouts: int = 9,
+    progress: Progress = _quiet,
+    settings: HeadSettings | None = None,
 ) -> dict[str, Any]:
     """Eq. (12) on pixels against the geometric truth over random object layouts.
 
     Each layout keeps the paper's reference and scatters the six objects at
-    0.8-1.9 m, |x/z| <= 0.3 (all four images see them).
+    0.8-1.9 m, |x/z| <= 0.3 (all four images see them).  ``settings``: the
+    head (default: ideal cameras).
     """
     agree_outside = disagree_outside = inside = disagree_inside = missing = 0
     areas_seen: set[int] = set()
     renders = []
-    with HeadSim("blocks") as sim:
+    with HeadSim("blocks", settings) as sim:
         servo = EyeServo(sim)
         reference = body_target(names.BLOCKS, find_cross_point)
         for layout in range(layouts):

@@ -68,13 +68,16 @@ def camera_centre(camera: int, baseline: float) -> np.ndarray:
     return np.array([sign * baseline / 2.0, 0.0, 0.0])
 
 
-def head_from_camera(camera: int, yaw: ArrayLike, baseline: float) -> np.ndarray:
+def head_from_camera(
+    camera: int, yaw: ArrayLike, baseline: float, nodal: float = 0.0, side: float = 0.0
+) -> np.ndarray:
     """Pose H_T_Ci of camera 1 or 2, (..., 4, 4).
 
     yaw: the camera's true yaw, rad (eye angle plus mount offset), positive
     inwards.  Camera 1 turns about H's +y by ``yaw``, camera 2 by ``-yaw``, so the
     optical axis in H is ``(sin yaw, 0, cos yaw)`` for camera 1 and
-    ``(-sin yaw, 0, cos yaw)`` for camera 2.
+    ``(-sin yaw, 0, cos yaw)`` for camera 2.  ``nodal``/``side``, m: the optical
+    centre sits that far from the yaw axis along the optical axis and the camera's x.
     """
     sign = _camera_sign(camera)
     psi = -sign * np.asarray(yaw, float)  # rotation about +y: +yaw for Ca1, -yaw for Ca2
@@ -82,22 +85,33 @@ def head_from_camera(camera: int, yaw: ArrayLike, baseline: float) -> np.ndarray
     t = np.zeros((*psi.shape, 4, 4))
     t[..., 0, 0], t[..., 0, 2], t[..., 2, 0], t[..., 2, 2] = c, s, -s, c
     t[..., 1, 1] = t[..., 3, 3] = 1.0
-    t[..., 0, 3] = sign * baseline / 2.0
+    t[..., 0, 3] = sign * baseline / 2.0 + c * side + s * nodal
+    t[..., 2, 3] = -s * side + c * nodal
     return t
 
 
-def head_to_camera(points_h: ArrayLike, camera: int, yaw: ArrayLike, baseline: float) -> np.ndarray:
-    """Points (..., 3) in H expressed in camera i's frame, m; ``yaw`` as in ``head_from_camera``.
+def head_to_camera(
+    points_h: ArrayLike,
+    camera: int,
+    yaw: ArrayLike,
+    baseline: float,
+    nodal: float = 0.0,
+    side: float = 0.0,
+) -> np.ndarray:
+    """Points (..., 3) in H expressed in camera i's frame, m; arguments as in ``head_from_camera``.
 
     The inverse of :func:`head_from_camera` applied to the points, written out
-    (no 4 x 4 per point): rotate ``p - C_i`` about y by ``-yaw`` (Ca1) or ``+yaw`` (Ca2).
+    (no 4 x 4 per point): rotate ``p - A_i`` about y by ``-yaw`` (Ca1) or ``+yaw``
+    (Ca2), A_i the yaw axis, then subtract the optical centre's offset (side, 0, nodal).
     """
     p = _points(points_h, "points_h")
     sign = _camera_sign(camera)
     psi = -sign * np.asarray(yaw, float)
     c, s = np.cos(psi), np.sin(psi)
     dx, dy, dz = p[..., 0] - sign * baseline / 2.0, p[..., 1], p[..., 2]
-    return np.stack(np.broadcast_arrays(c * dx - s * dz, dy, s * dx + c * dz), axis=-1)
+    return np.stack(
+        np.broadcast_arrays(c * dx - s * dz - side, dy, s * dx + c * dz - nodal), axis=-1
+    )
 
 
 def _camera_sign(camera: int) -> float:

@@ -93,7 +93,8 @@ def load_spec(scene: str | Path = "default") -> mujoco.MjSpec:
 def apply_settings(
     spec: mujoco.MjSpec, settings: HeadSettings
 ) -> tuple[DistortionCanvas, DistortionCanvas]:
-    """Write baseline, neck D-H offsets and cameras into ``spec``; return the render canvases."""
+    """Write baseline, neck D-H offsets, cameras (with optical-centre offsets and yaw-axis
+    tilts) into ``spec``; return the render canvases."""
     spec.body(names.NECK_PITCH_LINK).pos = [0.0, 0.0, settings.neck_d1_m]
     spec.body(names.HEAD).pos = [0.0, 0.0, settings.neck_a2_m]
     half = settings.baseline_m / 2
@@ -101,25 +102,40 @@ def apply_settings(
     spec.body(names.EYE_BODIES[1]).pos = [half, 0.0, 0.0]
 
     canvases = []
+    k = settings.render.supersample
+    spec.visual.quality.offsamples = settings.render.offsamples
     for index, (cam_name, cam) in enumerate(zip(names.CAMERAS, settings.cameras, strict=True)):
-        canvas = distortion_canvas(cam, MAX_IMAGE_SIDE)
+        canvas = distortion_canvas(cam, MAX_IMAGE_SIDE // k)
         width_c, height_c = canvas.size
         pcx, pcy = canvas.principal
         mj_cam = spec.camera(cam_name)
-        mj_cam.resolution = [width_c, height_c]
-        mj_cam.sensor_size = [width_c * PIXEL_PITCH_M, height_c * PIXEL_PITCH_M]
-        mj_cam.focal_pixel = [cam.kx, cam.ky]
+        # Supersampled k times: pixel i of the canvas is the area average of
+        # pixels k i .. k i + k - 1, whose centres average to k i + (k - 1) / 2.
+        mj_cam.resolution = [k * width_c, k * height_c]
+        mj_cam.sensor_size = [k * width_c * PIXEL_PITCH_M, k * height_c * PIXEL_PITCH_M]
+        mj_cam.focal_pixel = [k * cam.kx, k * cam.ky]
         # MuJoCo's principal offset is from the image centre with the opposite
         # sign of OpenCV's habit: cx = (W - 1) / 2 - principalpixel_x (checked by
-        # rendering, tests/test_render.py).
-        mj_cam.principal_pixel = [(width_c - 1) / 2 - pcx, (height_c - 1) / 2 - pcy]
+        # rendering, tests/test_render.py); supersampled, every term scales by k.
+        mj_cam.principal_pixel = [k * ((width_c - 1) / 2 - pcx), k * ((height_c - 1) / 2 - pcy)]
         eye_from_mjcam = eye_from_camera_rotation(cam, index) @ CV_FROM_MJCAM
         mj_cam.alt.type = mujoco.mjtOrientation.mjORIENTATION_QUAT  # drop the XML's xyaxes
         mj_cam.quat = _quat_from_matrix(eye_from_mjcam)
+        # Optical centre off the yaw axis: forward along the optical axis, sideways along x.
+        offset_cv = np.array([cam.side_offset_m, 0.0, cam.nodal_offset_m])
+        mj_cam.pos = eye_from_camera_rotation(cam, index) @ offset_cv
+        # Yaw axis leaning forward about H's x (eye2's axis is -y, mirrored).
+        tilt = cam.eye_axis_tilt_rad
+        axis_sign = 1.0 if index == 0 else -1.0
+        spec.joint(names.EYE_JOINTS[index]).axis = [
+            0.0,
+            axis_sign * np.cos(tilt),
+            axis_sign * np.sin(tilt),
+        ]
         canvases.append(canvas)
 
-    spec.visual.global_.offwidth = max(c.size[0] for c in canvases)
-    spec.visual.global_.offheight = max(c.size[1] for c in canvases)
+    spec.visual.global_.offwidth = k * max(c.size[0] for c in canvases)
+    spec.visual.global_.offheight = k * max(c.size[1] for c in canvases)
     return canvases[0], canvases[1]
 
 

@@ -25,7 +25,12 @@ from headsim.estimators.areas import (
     areas_from_pixels,
     compare_areas,
 )
-from headsim.estimators.calibration import Calibration, calibrate_initial_directions
+from headsim.estimators.calibration import (
+    Calibration,
+    LineOfSightCalibration,
+    calibrate_initial_directions,
+    calibrate_lines_of_sight,
+)
 from headsim.estimators.vertical import VerticalCalibration, calibrate_vertical_reference
 from headsim.kinematics import head_to_world
 from headsim.search import (
@@ -38,6 +43,7 @@ from headsim.search import (
     servo_failure,
 )
 from headsim.servo import Detector, EyeServo, NeckServo, ServoOutcome, ServoResult
+from headsim.settings import HeadBelief
 from headsim.sim import HeadSim
 from headsim.vision import Detection, DetectionStatus, find_chessboard, find_markers
 
@@ -56,12 +62,29 @@ class HeadKnowledge:
     ``u0``: each camera's goal column for the servo, px (None: the image
     centre's; e.g. the principal point's column found from a zoom,
     ``headsim.principal``).  The initial directions belong to these columns.
+    ``belief``: the head's own geometry (baseline, neck D-H, optical-centre
+    offsets; None: the simulator's ``belief``, its design, never its truth).
+    ``los_offset_m``: how far each goal column's line of sight misses its
+    eye's yaw axis, m, along the camera's x (None: the belief's side offsets,
+    until the extended calibration measures them).
     """
 
     alpha_e: tuple[float, float] = (0.0, 0.0)
     v0: tuple[float | None, float | None] = (None, None)
     kx_over_ky: tuple[float, float] = (1.0, 1.0)
     u0: tuple[float | None, float | None] = (None, None)
+    belief: HeadBelief | None = None
+    los_offset_m: tuple[float, float] | None = None
+
+    def head_belief(self, sim: HeadSim) -> HeadBelief:
+        """The geometry the head believes it has."""
+        return self.belief if self.belief is not None else sim.belief
+
+    def line_of_sight_offsets(self, sim: HeadSim) -> tuple[float, float]:
+        """(s1, s2), m: calibrated, else the believed side offsets."""
+        if self.los_offset_m is not None:
+            return self.los_offset_m
+        return self.head_belief(sim).side_offset_m
 
     def reference(self, sim: HeadSim, camera: int) -> tuple[float, float]:
         """(u_i0, v_i0): the servo's goal column and the reference row of camera 1 or 2, px."""
@@ -298,7 +321,7 @@ def measure_model2(
         [alpha2],
         uv1[None],
         uv2[None],
-        sim.settings.baseline_m,
+        knowledge.head_belief(sim).baseline_m,
         uv10=(u10, v10),
         uv20=(u20, v20),
         alpha_e=knowledge.alpha_e,
@@ -306,6 +329,7 @@ def measure_model2(
         gamma2=[gamma2],
         kx_over_ky=knowledge.kx_over_ky,
         uncertainty=Uncertainty(encoder=angle_sigma, pixel=NOMINAL_PIXEL_SIGMA),
+        los_offset_m=knowledge.line_of_sight_offsets(sim),
     )
     details = {
         "alpha1_rad": alpha1,
@@ -319,7 +343,17 @@ def measure_model2(
         "u21_px": float(uv2[0]),
         "v21_px": float(uv2[1]),
     }
-    return _measured(sim, target, "model2", estimate, start, residuals, details, search=search)
+    return _measured(
+        sim,
+        target,
+        "model2",
+        estimate,
+        start,
+        residuals,
+        details,
+        belief=knowledge.head_belief(sim),
+        search=search,
+    )
 
 
 def _measured(
@@ -331,6 +365,7 @@ def _measured(
     residuals: tuple[float, ...],
     details: dict[str, float],
     neck_rad: tuple[float, float] | None = None,
+    belief: HeadBelief | None = None,
     search: int = 0,
 ) -> Measurement:
     """The measurement of one estimated point (or why it is invalid) beside the truth."""
@@ -347,7 +382,7 @@ def _measured(
         status="ok",
         estimate_head_m=estimate_head,
         truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
-        estimate_world_m=to_world(sim, estimate_head, neck_rad),
+        estimate_world_m=to_world(sim, estimate_head, neck_rad, belief),
         truth_world_m=truth_world,
         covariance_head_m2=covariance[0] if covariance is not None else np.full((3, 3), np.nan),
         renders=renders,
@@ -411,6 +446,8 @@ class CalibrationRun:
     ``fit``: the estimator's result (offsets, standard errors, residuals).
     ``truth_alpha_e``: each eye's effective initial direction, rad (simulator).
     ``vertical``: the extended calibration per camera (v0, kx/ky), or None.
+    ``lines``: the extended fit of each eye's initial direction and
+    line-of-sight offset from the targets' measured positions, or None.
     ``outcomes``: per layout position, None (fixated) or why it was not.
     """
 
@@ -421,6 +458,8 @@ class CalibrationRun:
     depth_noise_m: float
     vertical: tuple[VerticalCalibration, VerticalCalibration] | None
     knowledge: HeadKnowledge
+    lines: LineOfSightCalibration | None = None
+    position_noise_m: float = 0.0
     outcomes: tuple[Failure | None, ...] = ()
 
     @property
@@ -504,6 +543,8 @@ def calibrate_head(
     rng: np.random.Generator | None = None,
     extended: bool = True,
     knowledge: HeadKnowledge | None = None,
+    position_noise_m: float = 0.0,
+    lines_of_sight: bool = False,
 ) -> CalibrationRun:
     """Fixate ``target`` (moved with body ``body``) at each position and calibrate.
 
@@ -513,8 +554,15 @@ def calibrate_head(
     paper: it needs the targets' full known positions, not only their depth).
     ``knowledge``: what the head already knows; its goal columns ``u0`` are
     the ones the servo fixates on (default: the image centres).
+    ``position_noise_m``: Gaussian error of every coordinate a user measures
+    of each target (x_h, y_h, z_h from the head's frame: a tape measure), m;
+    the depth noise adds to it on z_h.  Every fit takes the measured values.
+    With ``extended``, ``lines_of_sight`` and at least 3 targets, each eye's
+    initial direction and line-of-sight offset are fitted jointly from the measured positions
+    (:func:`calibrate_lines_of_sight`) and replace Sec. V's directions, unless
+    the layout cannot separate them (``lines.separable`` False, with its message).
     """
-    base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0))
+    base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0), los_offset_m=None)
     rng = rng or np.random.default_rng(0)
     start = sim.render_count
     parked = sim.position(body)  # put the target back afterwards: it must not hide others
@@ -529,12 +577,15 @@ def calibrate_head(
             continue
         alpha1.append(m.details["alpha1_rad"])
         alpha2.append(m.details["alpha2_rad"])
-        depths.append(
-            m.truth_head_m[2] + (rng.normal(0.0, depth_noise_m) if depth_noise_m > 0 else 0.0)
-        )
-        rows.append((m.truth_head_m, m.details))
+        measured = m.truth_head_m.copy()
+        if position_noise_m > 0:
+            measured = measured + rng.normal(0.0, position_noise_m, 3)
+        if depth_noise_m > 0:
+            measured[2] += rng.normal(0.0, depth_noise_m)
+        depths.append(measured[2])
+        rows.append((measured, m.details))
     sim.park_body(body, parked)
-    baseline = sim.settings.baseline_m
+    baseline = base.head_belief(sim).baseline_m
     total = len(outcomes)
     if len(alpha1) < 2:
         raise CalibrationError(
@@ -542,23 +593,24 @@ def calibrate_head(
             f"because {_causes_text(outcomes)}",
             outcomes,
         )
-    truth_rows = np.array([r[0] for r in rows])
-    ratios = truth_rows[:, 0] / truth_rows[:, 2]
+    measured_rows = np.array([r[0] for r in rows])
+    ratios = measured_rows[:, 0] / measured_rows[:, 2]
     # Without a depth error model the fit is unweighted and its standard errors
     # come from the scatter of its residuals (the angles' noise is not known a priori).
+    z_sigma = math.hypot(depth_noise_m, position_noise_m)
     try:
         fit = calibrate_initial_directions(
             np.array(alpha1),
             np.array(alpha2),
             np.array(depths),
             baseline,
-            sigma_encoder=sim.settings.encoder_resolution_rad * 0.25 if depth_noise_m > 0 else None,
-            sigma_depth=depth_noise_m if depth_noise_m > 0 else None,
+            sigma_encoder=sim.settings.encoder_resolution_rad * 0.25 if z_sigma > 0 else None,
+            sigma_depth=z_sigma if z_sigma > 0 else None,
         )
     except ValueError as err:
         raise CalibrationError(
             f"degenerate layout because the {len(alpha1)} fixated positions span depths "
-            f"{truth_rows[:, 2].min():.3f}-{truth_rows[:, 2].max():.3f} m and x/z "
+            f"{measured_rows[:, 2].min():.3f}-{measured_rows[:, 2].max():.3f} m and x/z "
             f"{ratios.min():+.3f} to {ratios.max():+.3f}, which do not separate the two "
             f"initial directions ({err})",
             outcomes,
@@ -566,8 +618,30 @@ def calibrate_head(
     alpha_e = (float(fit.alpha_e[0]), float(fit.alpha_e[1]))
     calibrated = replace(base, alpha_e=alpha_e)
     vertical = None
+    lines = None
+    offsets = base.head_belief(sim).side_offset_m
+    if extended and lines_of_sight and len(rows) >= 3:
+        # Off by default: on a head whose centres are on their axes the two
+        # extra unknowns only add their calibration noise (about 0.01 % of depth).
+        positions = np.array([r[0] for r in rows])
+        lines = calibrate_lines_of_sight(
+            np.array(alpha1),
+            np.array(alpha2),
+            positions,
+            baseline,
+            # A floor of 0.1 mm: the servo's own scatter when the tape is exact.
+            sigma_position=max(position_noise_m, depth_noise_m, 1e-4),
+            sigma_encoder=sim.settings.encoder_resolution_rad * 0.3,
+            initial=alpha_e,
+        )
+        if lines.separable:
+            alpha_e = (float(lines.alpha_e[0]), float(lines.alpha_e[1]))
+            offsets = (float(lines.offset_m[0]), float(lines.offset_m[1]))
+            calibrated = replace(calibrated, alpha_e=alpha_e, los_offset_m=offsets)
+        else:  # the layout cannot tell offsets from directions: keep Sec. V's and the belief's
+            calibrated = replace(calibrated, los_offset_m=None)
     if extended and len(rows) >= 3:
-        heights = truth_rows[:, 1] / truth_rows[:, 2]
+        heights = measured_rows[:, 1] / measured_rows[:, 2]
         if np.ptp(heights) < 1e-6:
             raise CalibrationError(
                 f"the extended fit (v0, kx/ky) needs a vertical spread, but the "
@@ -576,7 +650,7 @@ def calibrate_head(
                 outcomes,
             )
         try:
-            vertical = _vertical_from_samples(sim, rows, alpha_e, base)
+            vertical = _vertical_from_samples(sim, rows, alpha_e, base, offsets)
         except ValueError as err:
             raise CalibrationError(
                 f"degenerate layout for the extended fit because {err}", outcomes
@@ -597,8 +671,38 @@ def calibrate_head(
         depth_noise_m=depth_noise_m,
         vertical=vertical,
         knowledge=calibrated,
+        lines=lines,
+        position_noise_m=position_noise_m,
         outcomes=tuple(outcomes),
     )
+
+
+@dataclass(frozen=True)
+class LineOfSightTruth:
+    """Each goal column's true line-of-sight offset from its *believed* yaw axis, m.
+
+    ``offset_m``: (s1, s2) along each camera's x, at eye angle 0 and the image
+    centre row: the optical centre's own offset ``e cos t - n sin t`` plus the
+    axis's true-minus-believed position (half the baseline error, outward).
+    ``effective_baseline_m``: believed D - s1 + s2 = true D - s1_own + s2_own.
+    """
+
+    offset_m: tuple[float, float]
+    effective_baseline_m: float
+
+
+def line_of_sight_truth(sim: HeadSim, knowledge: HeadKnowledge) -> LineOfSightTruth:
+    """Ground truth for the extended calibration's offsets (scoring only)."""
+    believed = knowledge.head_belief(sim).baseline_m
+    half_error = 0.5 * (sim.settings.baseline_m - believed)
+    out = []
+    for camera, sign in ((1, -1.0), (2, 1.0)):
+        cam = sim.camera_settings(camera)
+        u0 = knowledge.reference(sim, camera)[0]
+        t = float(cam.pinhole().column_angle(u0))
+        own = cam.side_offset_m * math.cos(t) - cam.nodal_offset_m * math.sin(t)
+        out.append(own + sign * half_error)
+    return LineOfSightTruth((out[0], out[1]), believed - out[0] + out[1])
 
 
 def _vertical_from_samples(
@@ -606,15 +710,20 @@ def _vertical_from_samples(
     rows: list[tuple[np.ndarray, dict[str, float]]],
     alpha_e: tuple[float, float],
     base: HeadKnowledge,
+    offsets: tuple[float, float] = (0.0, 0.0),
 ) -> tuple[VerticalCalibration, VerticalCalibration]:
-    """Fit (v0, kx/ky) per camera from the calibration fixations at known positions."""
+    """Fit (v0, kx/ky) per camera from the calibration fixations at measured positions."""
     truth = np.array([r[0] for r in rows])
     d = {key: np.array([r[1][key] for r in rows]) for key in rows[0][1]}
     z = truth[:, 2]
     a1, a2 = d["alpha1_rad"] + alpha_e[0], d["alpha2_rad"] + alpha_e[1]
-    # P's x in each camera's effective frame when its y image was taken (eqs. 8, 10).
-    x_c1 = z * np.sin(d["alpha1_rad"] - d["gamma1_rad"]) / np.cos(a1)
-    x_c2 = z * np.sin(d["gamma2_rad"] - d["alpha2_rad"]) / np.cos(a2)
+    s1, s2 = offsets
+    # P's x in each camera's effective frame when its y image was taken (eqs. 8, 10,
+    # with the line-of-sight offsets as in headsim.estimators.model2).
+    rel1 = d["alpha1_rad"] - d["gamma1_rad"]
+    rel2 = d["gamma2_rad"] - d["alpha2_rad"]
+    x_c1 = (z + s1 * np.sin(a1)) / np.cos(a1) * np.sin(rel1) + s1 * (np.cos(rel1) - 1.0)
+    x_c2 = (z - s2 * np.sin(a2)) / np.cos(a2) * np.sin(rel2) + s2 * (np.cos(rel2) - 1.0)
     u10, u20 = base.reference(sim, 1)[0], base.reference(sim, 2)[0]
     cam1 = calibrate_vertical_reference(d["u11_px"] - u10, d["v11_px"], x_c1, truth[:, 1])
     cam2 = calibrate_vertical_reference(d["u21_px"] - u20, d["v21_px"], x_c2, truth[:, 1])
@@ -636,11 +745,16 @@ def measure_points_model2(
 
 
 def to_world(
-    sim: HeadSim, point_head: np.ndarray, neck_rad: tuple[float, float] | None = None
+    sim: HeadSim,
+    point_head: np.ndarray,
+    neck_rad: tuple[float, float] | None = None,
+    belief: HeadBelief | None = None,
 ) -> np.ndarray:
-    """A head-frame estimate in W through eq. (3), with the neck encoder readings by default."""
+    """A head-frame estimate in W through eq. (3) with the believed D-H lengths
+    (default ``sim.belief``), with the neck encoder readings by default."""
     theta1, theta2 = sim.neck_encoders() if neck_rad is None else neck_rad
-    return head_to_world(point_head, theta1, theta2, sim.settings.neck_d1_m, sim.settings.neck_a2_m)
+    b = belief if belief is not None else sim.belief
+    return head_to_world(point_head, theta1, theta2, b.neck_d1_m, b.neck_a2_m)
 
 
 def measure_model1(
@@ -680,15 +794,17 @@ def measure_model1(
         s * resolution for s in (result.subpixel_steps if interpolate else result.steps)
     )
     angle_sigma = resolution * (0.3 if interpolate else 1 / math.sqrt(12.0))
+    belief = knowledge.head_belief(sim)
     estimate = model1(
         [eye],
-        sim.settings.baseline_m,
+        belief.baseline_m,
         alpha_e=knowledge.alpha_e,
         uncertainty=Uncertainty(encoder=angle_sigma),
+        los_offset_m=knowledge.line_of_sight_offsets(sim),
     )
     details = {"alpha_rad": eye, "neck_yaw_rad": yaw, "neck_pitch_rad": pitch}
     return _measured(
-        sim, target, "model1", estimate, start, residual, details, (yaw, pitch), search
+        sim, target, "model1", estimate, start, residual, details, (yaw, pitch), belief, search
     )
 
 
@@ -918,6 +1034,7 @@ __all__ = [
     "CalibrationRun",
     "ChessboardRun",
     "HeadKnowledge",
+    "LineOfSightTruth",
     "Measurement",
     "Model2Config",
     "RelativeRun",
@@ -928,6 +1045,7 @@ __all__ = [
     "calibrate_head",
     "calibration_layout",
     "chessboard_corner_target",
+    "line_of_sight_truth",
     "measure_chessboard",
     "measure_model1",
     "measure_model2",

@@ -196,7 +196,26 @@ class Recorder(Observer):
             f"procedure `{s.experiment.procedure}`, preset `{s.preset}`, seed {s.seed}, "
             f"baseline {s.settings.baseline_m * 1000:g} mm\n\n"
             "| camera | size | kx | ky | principal | k1 | mount yaw | noise |\n"
-            "|---|---|---|---|---|---|---|---|\n" + rows + "\n"
+            "|---|---|---|---|---|---|---|---|\n" + rows + "\n" + self._real_head_markdown()
+        )
+
+    def _real_head_markdown(self) -> str:
+        """The imperfections beyond the paper and what the head believes (issue 10)."""
+        s = self.scenario.settings
+        b = s.believed
+        cams = "\n".join(
+            f"| cam{k + 1} | {1e3 * c.nodal_offset_m:g} | {1e3 * c.side_offset_m:g} | "
+            f"{1e3 * c.eye_axis_tilt_rad:g} | {1e3 * b.nodal_offset_m[k]:g} | {1e3 * b.side_offset_m[k]:g} |"
+            for k, c in enumerate(s.cameras)
+        )
+        return (
+            f"\ntruth / belief: baseline {s.baseline_m * 1000:g} / {b.baseline_m * 1000:g} mm, "
+            f"neck d1 {s.neck_d1_m * 1000:g} / {b.neck_d1_m * 1000:g} mm, "
+            f"a2 {s.neck_a2_m * 1000:g} / {b.neck_a2_m * 1000:g} mm; backlash "
+            f"{s.backlash_rad:g} rad; count error {'on' if s.count_error else 'off'}; rendering "
+            f"offsamples {s.render.offsamples}, supersample {s.render.supersample}\n\n"
+            "| camera | nodal mm | side mm | axis tilt mrad | believed nodal mm | believed side mm |\n"
+            "|---|---|---|---|---|---|\n" + cams + "\n"
         )
 
     def _pose(self, sim: HeadSim) -> None:

@@ -23,6 +23,7 @@ from collections import OrderedDict
 from collections.abc import Hashable
 from dataclasses import dataclass
 
+import cv2
 import mujoco
 import numpy as np
 
@@ -80,6 +81,7 @@ def context_key(scene: str, model: mujoco.MjModel) -> tuple[str, str]:
     baseline, mounts) share one context; its off-screen buffer grows to the largest
     canvas asked of it."""
     digest = hashlib.sha1()
+    digest.update(f"offsamples={int(model.vis.quality.offsamples)}".encode())
     for name in _CONTEXT_ARRAYS:
         array = getattr(model, name, None)
         if array is not None:
@@ -144,8 +146,13 @@ class EyeRenderer:
         canvases: tuple[DistortionCanvas, DistortionCanvas],
         seed: int = 0,
         key: Hashable | None = None,
+        supersample: int = 1,
     ) -> None:
+        """``supersample``: the model's cameras render at this many times each
+        canvas's size (``headsim.settings.RenderFidelity``); images are area-averaged
+        back to the canvas."""
         self._model = model
+        self._supersample = supersample
         self._cameras = cameras
         self._canvases = canvases
         self._key: Hashable = key if key is not None else ("own", id(self))
@@ -173,7 +180,13 @@ class EyeRenderer:
         """The pinhole canvas of camera ``index``, or its sub-rectangle ``rect``: (h, w, 3)."""
         canvas = self._canvases[index]
         renderer = self._renderer()
+        # Supersampled k times (headsim.settings.RenderFidelity): the model's
+        # camera renders k x the canvas, and each canvas pixel is the area
+        # average of a k x k block; a window is cut on whole blocks, so its
+        # pixels are the full frame's crop.
+        k = self._supersample
         width_c, height_c = canvas.size
+        full_w, full_h = k * width_c, k * height_c
         cam = self._cam_ids[index]
         model = self._model
         saved = None
@@ -189,12 +202,12 @@ class EyeRenderer:
             offset_px = model.cam_intrinsic[cam][2:4] / pitch
             window_offset = offset_px + np.array(
                 [
-                    (rect.width - width_c) / 2 + rect.x0,
-                    (rect.height - height_c) / 2 + rect.y0,
+                    (k * rect.width - full_w) / 2 + k * rect.x0,
+                    (k * rect.height - full_h) / 2 + k * rect.y0,
                 ]
             )
-            model.cam_resolution[cam] = (rect.width, rect.height)
-            model.cam_sensorsize[cam] = pitch * np.array([rect.width, rect.height])
+            model.cam_resolution[cam] = (k * rect.width, k * rect.height)
+            model.cam_sensorsize[cam] = pitch * np.array([k * rect.width, k * rect.height])
             model.cam_intrinsic[cam][2:4] = window_offset * pitch
         try:
             renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
@@ -209,12 +222,15 @@ class EyeRenderer:
         gl_context = renderer._gl_context
         if gl_context is not None:
             gl_context.make_current()
-        viewport = mujoco.MjrRect(0, 0, width, height)
+        viewport = mujoco.MjrRect(0, 0, k * width, k * height)
         mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
-        pixels = np.empty((height, width, 3), dtype=np.uint8)
+        pixels = np.empty((k * height, k * width, 3), dtype=np.uint8)
         mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
         self.rendered_frames += (width * height) / (width_c * height_c)
-        return np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
+        pixels = np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
+        if k > 1:
+            pixels = cv2.resize(pixels, (width, height), interpolation=cv2.INTER_AREA)
+        return pixels
 
     def render(self, data: mujoco.MjData, index: int, retake: bool = False) -> np.ndarray:
         """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8.

@@ -34,6 +34,7 @@ RESULTS_KEYS = (
     "failures",
     "software",
     "settings",
+    "belief",
     "renders",
     "rendered_frames",
     "windows",
@@ -113,6 +114,18 @@ def measurement_entry(record: MeasurementRecord) -> dict[str, Any]:
     }
 
 
+#: Depth bands of the honest headline, m: every target counts in exactly one.
+DEPTH_BANDS_M = ((0.0, 0.6), (0.6, 1.0), (1.0, math.inf))
+
+
+def _band_name(lo: float, hi: float) -> str:
+    return f"{lo:g}-{hi:g} m" if math.isfinite(hi) else f">= {lo:g} m"
+
+
+def _rms_pct(pct: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(pct * pct))) if pct.size else float("nan")
+
+
 def _summary(records: list[MeasurementRecord]) -> dict[str, Any]:
     ok = [r.measurement for r in records if r.measurement.ok]
     errors = np.array([np.linalg.norm(m.error_head_m) for m in ok])
@@ -136,6 +149,18 @@ def _summary(records: list[MeasurementRecord]) -> dict[str, Any]:
         "searched": sum(r.measurement.search_renders > 0 for r in records),
         "search_renders": sum(r.measurement.search_renders for r in records),
         "failure_causes": _cause_counts([r.measurement.failure for r in records]),
+        # The whole field, all targets: the RMS of the 3-D error in % of depth,
+        # and by depth band (count and RMS), so that no subset stands alone.
+        "error_pct_of_depth_rms": _rms_pct(pct),
+        "by_depth": [
+            {
+                "band": _band_name(lo, hi),
+                "count": int(np.sum(sel)),
+                "error_pct_of_depth_rms": _rms_pct(pct[sel]),
+            }
+            for lo, hi in DEPTH_BANDS_M
+            for sel in [np.array([lo <= m.depth_m < hi for m in ok], dtype=bool)]
+        ],
     }
 
 
@@ -176,6 +201,8 @@ def results_payload(result: RunResult) -> dict[str, Any]:
         "failures": list(result.failures),
         "software": software_versions(),
         "settings": {**asdict(s.settings), "settle_mode": s.settle_mode},
+        # The truth above; what the head believes (and its estimators use) here.
+        "belief": asdict(s.settings.believed),
         "renders": result.renders,
         "rendered_frames": result.rendered_frames,
         "windows": result.windows,
@@ -266,7 +293,47 @@ def _calibration_lines(block: dict[str, Any], paper: bool) -> list[str]:
                     *(["-"] if paper else []),
                 ]
             )
-    return lines + format_table(headers, rows)
+    los = block.get("lines_of_sight")
+    if los:
+        truth_e = block["alpha_e_truth_rad"]
+        for k in range(2):
+            rows.append(
+                [
+                    f"alpha_e{k + 1} (rad, extended)",
+                    _cell(los["alpha_e_rad"][k], ".5f"),
+                    _cell(los["std_errors"]["alpha_e_rad"][k], ".1e"),
+                    _cell(truth_e[k], ".5f"),
+                    _cell(los["alpha_e_rad"][k] - truth_e[k], "+.1e"),
+                    *(["-"] if paper else []),
+                ]
+            )
+        for k in range(2):
+            rows.append(
+                [
+                    f"s{k + 1} (mm, extended)",
+                    _cell(1e3 * los["offset_m"][k], ".3f"),
+                    _cell(1e3 * los["std_errors"]["offset_m"][k], ".3f"),
+                    _cell(1e3 * los["offset_truth_m"][k], ".3f"),
+                    _cell(1e3 * (los["offset_m"][k] - los["offset_truth_m"][k]), "+.3f"),
+                    *(["-"] if paper else []),
+                ]
+            )
+        rows.append(
+            [
+                "D effective (mm)",
+                _cell(1e3 * los["effective_baseline_m"], ".3f"),
+                _cell(1e3 * los["effective_baseline_std_m"], ".3f"),
+                _cell(1e3 * los["effective_baseline_truth_m"], ".3f"),
+                _cell(
+                    1e3 * (los["effective_baseline_m"] - los["effective_baseline_truth_m"]), "+.3f"
+                ),
+                *(["-"] if paper else []),
+            ]
+        )
+    out = lines + format_table(headers, rows)
+    if los and not los["separable"]:
+        out.append(f"  line-of-sight offsets: {los['message']}")
+    return out
 
 
 def _measurement_lines(result: RunResult) -> list[str]:
@@ -313,6 +380,14 @@ def _measurement_lines(result: RunResult) -> list[str]:
         if s["failure_causes"]:
             causes = ", ".join(f"{n} {c}" for c, n in s["failure_causes"].items())
             lines.append(f"  head knew {label}: failures by cause: {causes}")
+        bands = "; ".join(
+            f"{b['band']}: {_cell(b['error_pct_of_depth_rms'], '.3f')} % ({b['count']})"
+            for b in s["by_depth"]
+        )
+        lines.append(
+            f"    whole field, all {s['ok']} targets: 3-D error RMS "
+            f"{_cell(s['error_pct_of_depth_rms'], '.3f')} % of depth; by depth: {bands}"
+        )
     return lines
 
 

@@ -35,6 +35,7 @@ from headsim.procedures import (
     Target,
     calibrate_head,
     calibration_layout,
+    line_of_sight_truth,
     measure_chessboard,
     measure_model1,
     measure_model2,
@@ -430,6 +431,8 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 "positions_world_m": positions,
             },
             "depth_noise_m": spec.depth_noise_m,
+            "position_noise_m": spec.position_noise_m,
+            "lines_of_sight_fit": spec.lines_of_sight,
             "extended": spec.extended,
             "alpha_e_rad": None,
             "alpha_e_std_rad": None,
@@ -439,6 +442,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "converged": False,
             "depth_residual_rms_m": None,
             "vertical_reference": None,
+            "lines_of_sight": None,
             "knowledge": None,
         }
         start = sim.render_count
@@ -452,6 +456,8 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 depth_noise_m=spec.depth_noise_m,
                 rng=np.random.default_rng([seed, STREAM_DEPTH_NOISE]),
                 extended=spec.extended,
+                position_noise_m=spec.position_noise_m,
+                lines_of_sight=spec.lines_of_sight,
             )
         except ValueError as err:
             outcomes = err.outcomes if isinstance(err, CalibrationError) else ()
@@ -483,11 +489,15 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "kx_over_ky_std": [v.kx_over_ky_std for v in run.vertical],
             "kx_over_ky_truth": truth_ratio,
         },
+        lines_of_sight=None if run.lines is None else _lines_block(run, sim),
         knowledge={
             "alpha_e_rad": list(knowledge.alpha_e),
             "v0_px": list(knowledge.v0),
             "kx_over_ky": list(knowledge.kx_over_ky),
             "u0_px": list(knowledge.u0),
+            "los_offset_m": None
+            if knowledge.los_offset_m is None
+            else list(knowledge.los_offset_m),
         },
     )
     hub.calibrated(block)
@@ -502,6 +512,27 @@ def position_outcomes(outcomes: Sequence[Failure | None]) -> list[dict[str, Any]
         else {"status": o.message, "failure": o.as_dict()}
         for o in outcomes
     ]
+
+
+def _lines_block(run: CalibrationRun, sim: HeadSim) -> dict[str, Any]:
+    """The extended line-of-sight fit beside the truth, for results.json."""
+    lines = run.lines
+    assert lines is not None
+    truth = line_of_sight_truth(sim, run.knowledge)
+    return {
+        "alpha_e_rad": list(lines.alpha_e),
+        "offset_m": list(lines.offset_m),
+        "std_errors": {
+            "alpha_e_rad": list(lines.std_errors[:2]),
+            "offset_m": list(lines.std_errors[2:]),
+        },
+        "offset_truth_m": list(truth.offset_m),
+        "effective_baseline_m": lines.effective_baseline_m,
+        "effective_baseline_std_m": lines.effective_baseline_std_m,
+        "effective_baseline_truth_m": truth.effective_baseline_m,
+        "separable": lines.separable,
+        "message": lines.message,
+    }
 
 
 def _record(

@@ -42,7 +42,9 @@ from headsim.settings import (
     MAX_IMAGE_SIDE,
     PAPER_INITIAL_DIRECTIONS,
     CameraSettings,
+    HeadBelief,
     HeadSettings,
+    RenderFidelity,
     SettingsError,
     preset,
 )
@@ -107,7 +109,11 @@ class CalibrationSpec:
     ``targets`` ball positions drawn by ``procedures.calibration_layout``:
     depth z_h in ``depth_m``, |x_h/z_h| <= ``lateral``, |y_h/z_h| <= ``vertical``.
     ``depth_noise_m``: error of the tape-measured depth.  ``extended``: also
-    fit each camera's vertical reference row and kx/ky (beyond the paper).
+    fit each camera's vertical reference row and kx/ky, initial directions and
+    line-of-sight offsets (beyond the paper).  ``position_noise_m``: error of
+    every measured coordinate of each target (x_h, y_h, z_h), m; the depth
+    noise adds to it on z_h.  ``lines_of_sight``: with ``extended``, also fit
+    each eye's line-of-sight offset (default: on for the realistic preset).
     ``source``: a calibration file (``headsim calibrate``) to use instead of
     calibrating (a relative path is relative to the scenario file's
     directory); the other fields are then not used.
@@ -119,6 +125,8 @@ class CalibrationSpec:
     vertical: float = 0.08
     depth_noise_m: float = 0.0
     extended: bool = True
+    position_noise_m: float = 0.0
+    lines_of_sight: bool = False
     source: str | None = None
 
 
@@ -203,7 +211,7 @@ class Scenario:
     @property
     def paper_cameras(self) -> bool:
         """Whether the head is the paper's preset (its figures are shown beside ours)."""
-        return self.preset == "paper"
+        return self.preset in ("paper", "realistic")
 
     @property
     def fixations(self) -> int:
@@ -457,7 +465,17 @@ class _Table:
 
 # -- the schema, table by table ---------------------------------------------------
 
-_FIRST_TABLES = ("description", "seed", "head", "cam1", "cam2", "scene", "experiment")
+_FIRST_TABLES = (
+    "description",
+    "seed",
+    "head",
+    "cam1",
+    "cam2",
+    "belief",
+    "scene",
+    "experiment",
+)
+_PRESETS = ("ideal", "paper", "realistic")
 
 
 def _read_camera(
@@ -466,7 +484,7 @@ def _read_camera(
     """``[cam1]``/``[cam2]``: one camera; missing keys from its preset."""
     if table is None:
         return preset(default_preset).cameras[index], default_preset
-    name = table.choice("preset", ("ideal", "paper"), default_preset)
+    name = table.choice("preset", _PRESETS, default_preset)
     base = preset(name).cameras[index]
     width = table.integer("width", base.width, 16, MAX_IMAGE_SIDE)
     height = table.integer("height", base.height, 16, MAX_IMAGE_SIDE)
@@ -479,9 +497,23 @@ def _read_camera(
     k1 = table.number("k1", base.k1, -1.0, 1.0)
     k2 = table.number("k2", base.k2, -1.0, 1.0)
     noise = table.number("noise_std", base.noise_std, 0.0, 50.0, unit="grey levels")
+    nodal = table.number("nodal_offset_m", base.nodal_offset_m, -0.05, 0.1, unit="m")
+    side = table.number("side_offset_m", base.side_offset_m, -0.02, 0.02, unit="m")
+    tilt = table.number("eye_axis_tilt_rad", base.eye_axis_tilt_rad, -0.1, 0.1, unit="rad")
     table.done()
     camera = CameraSettings(
-        width=width, height=height, kx=kx, ky=ky, cx=cx, cy=cy, k1=k1, k2=k2, noise_std=noise
+        width=width,
+        height=height,
+        kx=kx,
+        ky=ky,
+        cx=cx,
+        cy=cy,
+        k1=k1,
+        k2=k2,
+        noise_std=noise,
+        nodal_offset_m=nodal,
+        side_offset_m=side,
+        eye_axis_tilt_rad=tilt,
     )
     problem = _lens_problem(camera)
     if problem is not None:
@@ -525,7 +557,7 @@ def _lens_problem(camera: CameraSettings) -> tuple[str, str] | None:
 def _read_head(doc: _Table, ctx: _Context) -> tuple[HeadSettings, str, str]:
     """``[head]`` with ``[cam1]``, ``[cam2]``: the head's settings, preset name, settle mode."""
     head = doc.table("head") or _Table({}, "head", ctx)
-    preset_name = head.choice("preset", ("ideal", "paper"), "ideal")
+    preset_name = head.choice("preset", _PRESETS, "ideal")
     base = preset(preset_name)
     baseline = head.number(
         "baseline_m",
@@ -549,12 +581,16 @@ def _read_head(doc: _Table, ctx: _Context) -> tuple[HeadSettings, str, str]:
     pitch = head.numbers("mount_pitch_rad", 2, (0.0, 0.0), **mount_range)  # type: ignore[arg-type]
     roll = head.numbers("mount_roll_rad", 2, (0.0, 0.0), **mount_range)  # type: ignore[arg-type]
     settle = head.choice("settle", ("kinematic", "physics"), "kinematic")
+    backlash = head.number("backlash_rad", base.backlash_rad, 0.0, 0.01, unit="rad")
+    count_error = head.boolean("count_error", base.count_error)
+    offsamples = head.integer("render_offsamples", base.render.offsamples, 0, 16)
+    supersample = head.integer("render_supersample", base.render.supersample, 1, 8)
     head.done()
 
     cameras = []
     for index, key in enumerate(names.CAMERAS):
         camera, camera_preset = _read_camera(doc.table(key), index, preset_name)
-        if initial is None and yaw is None and camera_preset == "paper":
+        if initial is None and yaw is None and camera_preset in ("paper", "realistic"):
             direction = PAPER_INITIAL_DIRECTIONS[index]
         elif initial is not None:
             direction = initial[index]
@@ -588,13 +624,41 @@ def _read_head(doc: _Table, ctx: _Context) -> tuple[HeadSettings, str, str]:
             neck_a2_m=a2,
             encoder_resolution_rad=resolution,
             cameras=(cameras[0], cameras[1]),
+            backlash_rad=backlash,
+            count_error=count_error,
+            belief=_read_belief(doc.table("belief"), base),
+            render=RenderFidelity(offsamples=offsamples, supersample=supersample),
         )
     except SettingsError as err:  # pragma: no cover - the checks above are stricter
         raise ctx.error("head", str(err)) from err
     return settings, preset_name, settle
 
 
-def _read_calibration(table: _Table | None) -> CalibrationSpec | None:
+def _read_belief(table: _Table | None, base: HeadSettings) -> HeadBelief | None:
+    """``[belief]``: what the head believes of its geometry; missing keys from the preset's.
+
+    Without the table (and on presets with no belief of their own) the head is
+    believed to be as built: None.
+    """
+    if table is None:
+        return base.belief
+    nominal = base.believed
+    baseline = table.number("baseline_m", nominal.baseline_m, 0.0, 1.0, lo_open=True, unit="m")
+    d1 = table.number("neck_d1_m", nominal.neck_d1_m, 0.0, 2.0, unit="m")
+    a2 = table.number("neck_a2_m", nominal.neck_a2_m, 0.0, 1.0, unit="m")
+    nodal = table.numbers("nodal_offset_m", 2, nominal.nodal_offset_m, -0.05, 0.1, unit="m")
+    side = table.numbers("side_offset_m", 2, nominal.side_offset_m, -0.02, 0.02, unit="m")
+    table.done()
+    return HeadBelief(
+        baseline_m=baseline,
+        neck_d1_m=d1,
+        neck_a2_m=a2,
+        nodal_offset_m=(nodal[0], nodal[1]),
+        side_offset_m=(side[0], side[1]),
+    )
+
+
+def _read_calibration(table: _Table | None, lines_default: bool = False) -> CalibrationSpec | None:
     """``[experiment.calibration]``: Sec. V before the experiment."""
     if table is None:
         return None
@@ -605,6 +669,8 @@ def _read_calibration(table: _Table | None) -> CalibrationSpec | None:
         vertical=table.number("vertical", 0.08, 0.0, 1.0, unit="(|y_h / z_h|)"),
         depth_noise_m=table.number("depth_noise_m", 0.0, 0.0, 0.1, unit="m"),
         extended=table.boolean("extended", True),
+        position_noise_m=table.number("position_noise_m", 0.0, 0.0, 0.1, unit="m"),
+        lines_of_sight=table.boolean("lines_of_sight", lines_default),
         source=table.string("from", None, max_length=1000),
     )
     table.done()
@@ -625,13 +691,13 @@ def _depth_range(table: _Table, default: tuple[float, float]) -> tuple[float, fl
     return lo, hi
 
 
-def _read_experiment(doc: _Table, ctx: _Context) -> ExperimentSpec:
+def _read_experiment(doc: _Table, ctx: _Context, preset_name: str = "ideal") -> ExperimentSpec:
     """``[experiment]``: procedure, optional calibration first, and options."""
     table = doc.table("experiment")
     if table is None:
         raise ctx.error("experiment", "missing", "an [experiment] table with a procedure")
     procedure = table.choice("procedure", tuple(PROCEDURES))
-    calibration = _read_calibration(table.table("calibration"))
+    calibration = _read_calibration(table.table("calibration"), preset_name == "realistic")
     if procedure == "calibration" and calibration is None:
         raise table.fail(
             "calibration", "missing", "an [experiment.calibration] table (the calibration to run)"
@@ -1265,7 +1331,7 @@ def _build(
     seed = file_seed if seed is None else seed
     settings, preset_name, settle = _read_head(top, ctx)
     settings = replace(settings, seed=seed)
-    experiment = _read_experiment(top, ctx)
+    experiment = _read_experiment(top, ctx, preset_name)
     calibration = experiment.calibration
     if calibration is not None and calibration.source is not None:
         from headsim.calibration_file import CalibrationFileError, read_calibration

@@ -10,6 +10,11 @@ measure a head at rest, so this is exact, deterministic and costs nothing.
 ``"physics"`` drives the position actuators and steps the dynamics until the
 joints are still (bounded; the outcome says why it stopped), for studies of
 settling error and moving heads.
+
+Joint errors (``HeadSettings.backlash_rad``, ``count_error``): each motor's
+encoder reads its commanded count, while the joint settles (in either mode)
+at the command plus a seeded offset within that count and minus half the
+backlash on the side it came from.  The true angles are ground truth only.
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ from headsim import names
 from headsim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
 from headsim.optics import camera_matrix, dist_coeffs, project_points
 from headsim.render import EyeRenderer, Window, context_key
-from headsim.settings import CameraSettings, HeadSettings, SettingsError
+from headsim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
 
 #: A camera: 1 or 2 (the paper's Ca1, Ca2) or its MJCF name "cam1"/"cam2".
 CameraId = int | str
@@ -57,6 +62,14 @@ class _Commands:
     neck_pitch: float = 0.0
     eye: float = 0.0
     pending: set[str] = field(default_factory=set)
+    #: Direction each joint last moved in (+1, -1; 0 before any move): backlash side.
+    approach: dict[str, float] = field(
+        default_factory=lambda: {"neck_yaw": 0.0, "neck_pitch": 0.0, "eye": 0.0}
+    )
+
+
+#: Index of each motor in the seeded count-error draw.
+_MOTOR_INDEX = {"neck_yaw": 0, "neck_pitch": 1, "eye": 2}
 
 
 def _homogeneous(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
@@ -116,6 +129,7 @@ class HeadSim:
             self.built.canvases,
             seed=self.settings.seed,
             key=context_key(str(scene), self.model),
+            supersample=self.settings.render.supersample,
         )
         self.reset()
 
@@ -160,15 +174,24 @@ class HeadSim:
         eye: float | None = None,
     ) -> None:
         """Set joint targets, rad (eye: the eye-motor angle, positive inward)."""
+        previous = {
+            "neck_yaw": self._commands.neck_yaw,
+            "neck_pitch": self._commands.neck_pitch,
+            "eye": self._commands.eye,
+        }
         if neck_yaw is not None:
             self._commands.neck_yaw = self._checked(names.NECK_YAW, neck_yaw)
         if neck_pitch is not None:
             self._commands.neck_pitch = self._checked(names.NECK_PITCH, neck_pitch)
         if eye is not None:
             self._commands.eye = self._checked(names.EYE_MOTOR_JOINT, eye)
-        self.data.ctrl[self._actuator["neck_yaw"]] = self._commands.neck_yaw
-        self.data.ctrl[self._actuator["neck_pitch"]] = self._commands.neck_pitch
-        self.data.ctrl[self._actuator["eye"]] = self._commands.eye
+        for motor, old in previous.items():
+            new = getattr(self._commands, motor)
+            if new != old:
+                self._commands.approach[motor] = 1.0 if new > old else -1.0
+        true = self._true_targets()
+        for motor in ("neck_yaw", "neck_pitch", "eye"):
+            self.data.ctrl[self._actuator[motor]] = true[motor]
 
     def command_eye_steps(self, steps: int) -> None:
         """Command the eye motor to a whole number of encoder steps."""
@@ -179,13 +202,34 @@ class HeadSim:
         self.command(**targets)
         return self.settle()
 
-    def _targets(self) -> dict[str, float]:
+    def _joint_offset(self, motor: str, command: float) -> float:
+        """True minus commanded angle of a motor's joint, rad (0 on an ideal head)."""
+        settings = self.settings
+        offset = -0.5 * settings.backlash_rad * self._commands.approach[motor]
+        if settings.count_error:
+            resolution = settings.encoder_resolution_rad
+            count = round(command / resolution)
+            rng = np.random.default_rng(
+                [settings.seed, _MOTOR_INDEX[motor], count & 0xFFFFFFFF, count < 0]
+            )
+            offset += float(rng.uniform(-0.5, 0.5)) * resolution
+        return offset
+
+    def _true_targets(self) -> dict[str, float]:
+        """Where each motor's joint truly settles, rad, by motor name."""
         c = self._commands
+        commands = {"neck_yaw": c.neck_yaw, "neck_pitch": c.neck_pitch, "eye": c.eye}
+        if not self.settings.joint_errors:
+            return commands
+        return {m: a + self._joint_offset(m, a) for m, a in commands.items()}
+
+    def _targets(self) -> dict[str, float]:
+        true = self._true_targets()
         return {
-            names.NECK_YAW: c.neck_yaw,
-            names.NECK_PITCH: c.neck_pitch,
-            names.EYE_JOINTS[0]: c.eye,
-            names.EYE_JOINTS[1]: c.eye,
+            names.NECK_YAW: true["neck_yaw"],
+            names.NECK_PITCH: true["neck_pitch"],
+            names.EYE_JOINTS[0]: true["eye"],
+            names.EYE_JOINTS[1]: true["eye"],
         }
 
     def settle(self) -> SettleResult:
@@ -218,22 +262,34 @@ class HeadSim:
         resolution = self.settings.encoder_resolution_rad
         return round(angle / resolution) * resolution
 
+    def _read(self, motor: str, joint: str) -> float:
+        """What a motor's encoder sees, rad, before quantisation: the joint, or with
+        joint errors the motor shaft (its command), since the errors lie beyond it."""
+        if self.settings.joint_errors:
+            return float(getattr(self._commands, motor))
+        return float(self.data.qpos[self._qadr[joint]])
+
     def eye_encoder(self) -> float:
         """Eye-motor encoder reading, rad, a whole multiple of the resolution."""
-        return self._quantise(self.data.qpos[self._qadr[names.EYE_MOTOR_JOINT]])
+        return self._quantise(self._read("eye", names.EYE_MOTOR_JOINT))
 
     def eye_encoder_steps(self) -> int:
         """Eye-motor encoder reading, whole steps."""
         return round(
-            self.data.qpos[self._qadr[names.EYE_MOTOR_JOINT]] / self.settings.encoder_resolution_rad
+            self._read("eye", names.EYE_MOTOR_JOINT) / self.settings.encoder_resolution_rad
         )
 
     def neck_encoders(self) -> tuple[float, float]:
         """Neck (yaw, pitch) encoder readings, rad, quantised like the eye encoder."""
         return (
-            self._quantise(self.data.qpos[self._qadr[names.NECK_YAW]]),
-            self._quantise(self.data.qpos[self._qadr[names.NECK_PITCH]]),
+            self._quantise(self._read("neck_yaw", names.NECK_YAW)),
+            self._quantise(self._read("neck_pitch", names.NECK_PITCH)),
         )
+
+    @property
+    def belief(self) -> HeadBelief:
+        """What the head believes of its own geometry (its design); see ``HeadSettings.believed``."""
+        return self.settings.believed
 
     # -- ground truth ------------------------------------------------------
     def true_joint_angles(self) -> dict[str, float]:

@@ -41,7 +41,10 @@ __all__ = [
 class StereoHead:
     """The eyes: baseline D, m; intrinsics; mount offsets alpha_ei, rad; servo target columns, px.
 
-    ``u10``/``u20`` default to each image's centre column.
+    ``u10``/``u20`` default to each image's centre column.  ``nodal1``/``nodal2``
+    and ``side1``/``side2``, m: each optical centre's offset from its eye's yaw
+    axis, forward along the optical axis and along the camera's x
+    (equations.md, last section); 0 is the paper's eye.
     """
 
     baseline: float
@@ -52,8 +55,15 @@ class StereoHead:
     u10: float | None = None
     u20: float | None = None
     encoder_resolution: float = ENCODER_RESOLUTION
+    nodal1: float = 0.0
+    nodal2: float = 0.0
+    side1: float = 0.0
+    side2: float = 0.0
 
     def __post_init__(self) -> None:
+        for name in ("nodal1", "nodal2", "side1", "side2"):
+            if not abs(getattr(self, name)) < 0.25 * self.baseline + 0.1:
+                raise ValueError(f"{name} must be an offset in metres, got {getattr(self, name)!r}")
         if not (math.isfinite(self.baseline) and 0.0 < self.baseline < 10.0):
             raise ValueError(f"baseline must be in metres, 0 < D < 10, got {self.baseline!r}")
         for name in ("alpha_e1", "alpha_e2"):
@@ -77,6 +87,25 @@ class StereoHead:
         if camera not in (1, 2):
             raise ValueError(f"camera must be 1 or 2, got {camera!r}")
         return self.cam1 if camera == 1 else self.cam2
+
+    def offsets(self, camera: int) -> tuple[float, float]:
+        """(nodal, side) offsets of camera 1 or 2's optical centre, m."""
+        self.camera(camera)
+        return (self.nodal1, self.side1) if camera == 1 else (self.nodal2, self.side2)
+
+    def line_of_sight_offsets(self, v: float | None = None) -> tuple[float, float]:
+        """(s1, s2): how far each target column's line of sight misses its yaw axis, m.
+
+        ``s_i = e_i cos t_i - n_i sin t_i`` along the effective camera's x, t_i the
+        column's horizontal angle off the optical axis (at row ``v``, default each
+        image's centre row; exact for points on that row, or without distortion).
+        """
+        out = []
+        for camera, u0 in zip((1, 2), self.target_columns, strict=True):
+            nodal, side = self.offsets(camera)
+            t = float(self.camera(camera).column_angle(u0, v))
+            out.append(side * math.cos(t) - nodal * math.sin(t))
+        return (out[0], out[1])
 
     def effective_initial_directions(self, v: float | None = None) -> tuple[float, float]:
         """(alpha_e1, alpha_e2) as Model 2 sees them when fixating at the target columns, rad.
@@ -125,7 +154,10 @@ def image_points(
     p = _points_h(points_h)
     offset = head.alpha_e1 if camera == 1 else head.alpha_e2
     yaw = np.asarray(eye_angle, dtype=float) + offset
-    return head.camera(camera).project(head_to_camera(p, camera, yaw, head.baseline))
+    nodal, side = head.offsets(camera)
+    return head.camera(camera).project(
+        head_to_camera(p, camera, yaw, head.baseline, nodal=nodal, side=side)
+    )
 
 
 @dataclass(frozen=True)
@@ -148,16 +180,24 @@ def fixation_angles(head: StereoHead, points_h: ArrayLike) -> Fixation:
 
     Closed form for a distortion-free camera; with distortion a safeguarded
     Newton solve of the column equation in the camera's horizontal angle, on
-    the lens's monotonic branch.
+    the lens's monotonic branch.  With the optical centre off the yaw axis the
+    column's line of sight misses the axis by ``s = e cos t - n sin t``: the
+    ray's direction is ``phi -+ asin(s / R)`` (R: P's horizontal distance from
+    the axis); with distortion t and the range along the ray are iterated to a
+    fixed point.
     """
     p = _points_h(points_h)
     u10, u20 = head.target_columns
-    t1 = _column_ray_angle(head.cam1, u10, p, head.baseline, camera=1)
-    t2 = _column_ray_angle(head.cam2, u20, p, head.baseline, camera=2)
-    phi1 = np.arctan2(p[:, 0] + head.baseline / 2.0, p[:, 2])
-    phi2 = np.arctan2(p[:, 0] - head.baseline / 2.0, p[:, 2])
-    yaw1 = phi1 - t1  # Ca1 sees P at angle phi1 - yaw1
-    yaw2 = t2 - phi2  # Ca2 sees P at angle phi2 + yaw2
+    half = head.baseline / 2.0
+    phi1 = np.arctan2(p[:, 0] + half, p[:, 2])
+    phi2 = np.arctan2(p[:, 0] - half, p[:, 2])
+    r1 = np.hypot(p[:, 0] + half, p[:, 2])
+    r2 = np.hypot(p[:, 0] - half, p[:, 2])
+    t1, b1 = _offset_ray(head, 1, u10, p, r1)
+    t2, b2 = _offset_ray(head, 2, u20, p, r2)
+    with np.errstate(invalid="ignore"):
+        yaw1 = phi1 - b1 - t1  # Ca1 sees P at angle phi1 - yaw1 (on its axis)
+        yaw2 = t2 + b2 - phi2  # Ca2 sees P at angle phi2 + yaw2
     valid = (
         np.isfinite(yaw1)
         & np.isfinite(yaw2)
@@ -173,15 +213,36 @@ def fixation_angles(head: StereoHead, points_h: ArrayLike) -> Fixation:
     )
 
 
-def _column_ray_angle(
-    cam: PinholeCamera, u0: float, p: np.ndarray, baseline: float, camera: int
-) -> np.ndarray:
-    """Horizontal angle t in the camera at which P images at column u0, (N,), rad."""
+def _offset_ray(
+    head: StereoHead, camera: int, u0: float, p: np.ndarray, r: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Column angle t (N,) and the angle asin(s / R) (N,) by which the ray misses the axis, rad."""
+    nodal, side = head.offsets(camera)
+    cam = head.camera(camera)
+    rho = r
+    t = _column_ray_angle(cam, u0, p[:, 1] / rho)
+    if nodal == 0.0 and side == 0.0:
+        return t, np.zeros_like(t)
+    for _ in range(1 if not cam.is_distorted else 8):  # bounded fixed point; 8 reach 1e-16
+        s = side * np.cos(t) - nodal * np.sin(t)
+        with np.errstate(invalid="ignore"):
+            # P's horizontal range from the optical centre along the ray.
+            rho = np.sqrt(r * r - s * s) - (side * np.sin(t) + nodal * np.cos(t))
+        if cam.is_distorted:
+            t = _column_ray_angle(cam, u0, p[:, 1] / rho)
+    s = side * np.cos(t) - nodal * np.sin(t)
+    with np.errstate(invalid="ignore"):
+        return t, np.arcsin(s / r)
+
+
+def _column_ray_angle(cam: PinholeCamera, u0: float, eta: np.ndarray) -> np.ndarray:
+    """Horizontal angle t in the camera at which P images at column u0, (N,), rad.
+
+    eta: (N,) P's y over its horizontal range from the optical centre (y_n cos t).
+    """
     target = (u0 - cam.cx) / cam.kx  # distorted normalised x at the target column
     if not cam.is_distorted:
-        return np.full(p.shape[0], math.atan(target))
-    sign = -1.0 if camera == 1 else 1.0
-    eta = p[:, 1] / np.hypot(p[:, 0] - sign * baseline / 2.0, p[:, 2])  # y_n cos t, fixed
+        return np.full(eta.shape[0], math.atan(target))
     k1, k2 = cam.k1, cam.k2
 
     def column(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -287,7 +348,9 @@ def neck_fixation(
     y_h = 0, |P_h| is the same for every neck pose, so it fixes alpha (1-D
     solve), then theta2 and theta1 follow in closed form.  With ``quantised`` only alpha is rounded
     to the encoder (the neck angles and the point stay those of the exact
-    fixation); quantise the neck yourself with :func:`quantise`.
+    fixation); quantise the neck yourself with :func:`quantise`.  The optical
+    centres' offsets (``nodal*``, ``side*``) are not modelled here (Model 2's
+    functions cover them); yaw-axis tilt is modelled nowhere in this module.
     """
     pw = np.asarray(points_w, dtype=float)
     if pw.ndim != 2 or pw.shape[1] != 3:

@@ -44,7 +44,7 @@ def test_every_scenario_file_validates_in_both_variants(path: Path) -> None:
     assert fast.fixations < full.fixations
     if path.stem in (*PAPER_SCENARIOS, "quickstart"):
         # The paper's cameras, and the initial directions calibrated before measuring.
-        assert full.preset == fast.preset == "paper"
+        assert full.preset == fast.preset == ("realistic" if path.stem == "quickstart" else "paper")
         assert full.experiment.calibration is not None and fast.experiment.calibration is not None
 
 
@@ -87,7 +87,7 @@ BAD = [
         "[head]\nbaseline = 0.1\n",
         "head.baseline: unknown key (allowed: preset, baseline_m, neck_d1_m, neck_a2_m, "
         "encoder_resolution_rad, initial_direction_rad, mount_yaw_rad, mount_pitch_rad, "
-        "mount_roll_rad, settle)",
+        "mount_roll_rad, settle, backlash_rad, count_error, render_offsamples, render_supersample)",
     ),
     (
         "[head]\nbaseline_m = 'wide'\n",
@@ -97,7 +97,10 @@ BAD = [
         "[head]\nbaseline_m = 2.0\n",
         "head.baseline_m: 2 is out of range (allowed: a number >= 0.01 and <= 1 m; narrower gives no usable vergence)",
     ),
-    ("[head]\npreset = 'sony'\n", "head.preset: unknown value 'sony' (allowed: ideal, paper)"),
+    (
+        "[head]\npreset = 'sony'\n",
+        "head.preset: unknown value 'sony' (allowed: ideal, paper, realistic)",
+    ),
     (
         "[cam1]\ncx = 700\n",
         "cam1.cx: 700 is out of range (allowed: a number >= 0 and <= 639 px (inside the image))",
@@ -129,7 +132,7 @@ BAD = [
     ("seed = -1\n", "seed: -1 is out of range (allowed: an integer from 0 to 4294967295)"),
     (
         "colour = 'red'\n",
-        "colour: unknown key (allowed: description, seed, head, cam1, cam2, experiment, scene, fast)",
+        "colour: unknown key (allowed: description, seed, head, cam1, cam2, belief, experiment, scene, fast)",
     ),
 ]
 

@@ -19,7 +19,14 @@ from scipy.optimize import minimize
 
 from headsim.estimators.result import as_vector, check_angles, check_baseline
 
-__all__ = ["Calibration", "calibrate_initial_directions", "calibration_coefficients"]
+__all__ = [
+    "Calibration",
+    "LineOfSightCalibration",
+    "calibrate_initial_directions",
+    "calibrate_lines_of_sight",
+    "calibration_coefficients",
+    "line_of_sight_residuals",
+]
 
 
 @dataclass(frozen=True)
@@ -175,3 +182,162 @@ def _residual_variance(
     df_dk = t1 * t2 * x * y - t1 * x - t2 * y + 1.0
     var_enc = ((df_dt1 * (1.0 + t1 * t1)) ** 2 + (df_dt2 * (1.0 + t2 * t2)) ** 2) * se**2
     return var_enc + (df_dk * k * sd / z) ** 2 + math.ulp(1.0)
+
+
+# -- Beyond the paper: each line of sight's offset from its yaw axis -------------
+
+
+@dataclass(frozen=True)
+class LineOfSightCalibration:
+    """Result of :func:`calibrate_lines_of_sight`.
+
+    alpha_e: (2,) initial directions (alpha_e1, alpha_e2), rad.  offset_m: (2,)
+    (s1, s2), how far each goal column's line of sight misses its believed
+    yaw axis, m, along the camera's x (it takes in the baseline's error too).
+    std_errors: (4,) of (alpha_e1, alpha_e2, s1, s2).  covariance: (4, 4).
+    effective_baseline_m: D - s1 + s2 (the lines' separation at small angles),
+    with its standard error.  separable: whether the layout separates each
+    offset from its direction; message: why not, or "ok".
+    residuals_m: (n, 2) each target's distance from the two fitted lines.
+    """
+
+    alpha_e: np.ndarray
+    offset_m: np.ndarray
+    std_errors: np.ndarray
+    covariance: np.ndarray
+    effective_baseline_m: float
+    effective_baseline_std_m: float
+    separable: bool
+    message: str
+    residuals_m: np.ndarray
+
+
+def line_of_sight_residuals(
+    params: np.ndarray,
+    alpha1: np.ndarray,
+    alpha2: np.ndarray,
+    x_h: np.ndarray,
+    z_h: np.ndarray,
+    baseline: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Residuals (n, 2), their Jacobian (n, 2, 4) and ranges along each line (n, 2).
+
+    params = (alpha_e1, alpha_e2, s1, s2).  Ca1's line through the axis at
+    (-D/2, 0) with direction a1 = alpha1 + alpha_e1 holds P when
+    (x + D/2) cos a1 - z sin a1 = s1; Ca2's when (x - D/2) cos a2 + z sin a2 = s2.
+    """
+    e1, e2, s1, s2 = params
+    a1, a2 = alpha1 + e1, alpha2 + e2
+    x1, x2 = x_h + baseline / 2.0, x_h - baseline / 2.0
+    c1, n1, c2, n2 = np.cos(a1), np.sin(a1), np.cos(a2), np.sin(a2)
+    r = np.stack([x1 * c1 - z_h * n1 - s1, x2 * c2 + z_h * n2 - s2], axis=-1)
+    range1, range2 = x1 * n1 + z_h * c1, -x2 * n2 + z_h * c2
+    jac = np.zeros((alpha1.size, 2, 4))
+    jac[:, 0, 0], jac[:, 0, 2] = -range1, -1.0
+    jac[:, 1, 1], jac[:, 1, 3] = range2, -1.0
+    return r, jac, np.stack([range1, range2], axis=-1)
+
+
+def calibrate_lines_of_sight(
+    alpha1: ArrayLike,
+    alpha2: ArrayLike,
+    positions_h: ArrayLike,
+    baseline: float,
+    *,
+    sigma_position: float,
+    sigma_encoder: float,
+    initial: tuple[float, float] = (0.0, 0.0),
+    max_iterations: int = 50,
+) -> LineOfSightCalibration:
+    """Initial directions and line-of-sight offsets from fixations of targets at measured positions.
+
+    alpha1, alpha2: (n,) Model 2's fixation readings, rad; positions_h: (n, 3)
+    the targets' measured positions in H, m (a tape measure: Gaussian error
+    ``sigma_position`` m on each coordinate); baseline: the believed D, m;
+    sigma_encoder: error of each fixation angle, rad.  Weighted Gauss-Newton
+    with each target's 2 x 2 residual covariance (x and z errors are shared by
+    both lines); covariance (J^T W J)^-1.  Raises ValueError for fewer than
+    three targets, non-finite input or non-positive sigmas.
+    """
+    a1, a2 = as_vector(alpha1, "alpha1"), as_vector(alpha2, "alpha2")
+    p = np.asarray(positions_h, dtype=float)
+    if p.shape != (a1.size, 3) or a2.shape != a1.shape:
+        raise ValueError(
+            f"alpha1, alpha2 (n,) and positions_h (n, 3) must agree, got "
+            f"{a1.shape}, {a2.shape}, {p.shape}"
+        )
+    if a1.size < 3:
+        raise ValueError(f"the line-of-sight fit needs at least 3 targets, got {a1.size}")
+    if not (np.isfinite(a1).all() and np.isfinite(a2).all() and np.isfinite(p).all()):
+        raise ValueError("line-of-sight samples must be finite (NaN or inf in angles or positions)")
+    check_angles(a1, "alpha1")
+    check_angles(a2, "alpha2")
+    d = check_baseline(baseline)
+    if not (sigma_position > 0.0 and sigma_encoder >= 0.0):
+        raise ValueError(
+            f"sigma_position must be > 0 m and sigma_encoder >= 0 rad, "
+            f"got {sigma_position!r}, {sigma_encoder!r}"
+        )
+    x, z = p[:, 0], p[:, 2]
+    params = np.array([initial[0], initial[1], 0.0, 0.0])
+    message = f"did not settle in {max_iterations} Gauss-Newton steps"
+    settled = False
+    for _ in range(max_iterations):
+        r, jac, ranges = line_of_sight_residuals(params, a1, a2, x, z, d)
+        weight = _los_weights(params, a1, a2, ranges, sigma_position, sigma_encoder)
+        jtw = np.einsum("nij,nik->njk", jac, weight)  # (n, 4, 2)
+        normal = np.einsum("njk,nkl->jl", jtw, jac)
+        gradient = np.einsum("njk,nk->j", jtw, r)
+        try:
+            step = np.linalg.solve(normal, -gradient)
+        except np.linalg.LinAlgError:
+            message = "singular normal equations"
+            break
+        params = params + step
+        if np.max(np.abs(step)) < 1e-14:
+            settled = True
+            message = "ok"
+            break
+    r, jac, ranges = line_of_sight_residuals(params, a1, a2, x, z, d)
+    weight = _los_weights(params, a1, a2, ranges, sigma_position, sigma_encoder)
+    normal = np.einsum("nij,nik,nkl->jl", jac, weight, jac)
+    cond = np.linalg.cond(normal)
+    spread = float(np.min(np.std(ranges, axis=0) / np.mean(np.abs(ranges), axis=0)))
+    separable = bool(cond < 1e12 and spread > 0.05 and settled)
+    if not separable and settled:
+        message = (
+            f"the targets' ranges along the lines of sight vary by {spread:.1%} only: the "
+            "layout cannot separate each offset from its direction; spread the targets in depth"
+        )
+    covariance = np.linalg.pinv(normal)
+    std = np.sqrt(np.clip(np.diag(covariance), 0.0, None))
+    grad_b = np.array([0.0, 0.0, -1.0, 1.0])
+    return LineOfSightCalibration(
+        alpha_e=params[:2].copy(),
+        offset_m=params[2:].copy(),
+        std_errors=std,
+        covariance=covariance,
+        effective_baseline_m=float(d - params[2] + params[3]),
+        effective_baseline_std_m=float(np.sqrt(max(grad_b @ covariance @ grad_b, 0.0))),
+        separable=separable,
+        message=message,
+        residuals_m=r,
+    )
+
+
+def _los_weights(
+    params: np.ndarray,
+    a1: np.ndarray,
+    a2: np.ndarray,
+    ranges: np.ndarray,
+    sigma_position: float,
+    sigma_encoder: float,
+) -> np.ndarray:
+    """Inverse (n, 2, 2) of each target's residual covariance."""
+    t1, t2 = a1 + params[0], a2 + params[1]
+    cov = np.empty((a1.size, 2, 2))
+    var_p = sigma_position**2
+    cov[:, 0, 0] = var_p + (ranges[:, 0] * sigma_encoder) ** 2
+    cov[:, 1, 1] = var_p + (ranges[:, 1] * sigma_encoder) ** 2
+    cov[:, 0, 1] = cov[:, 1, 0] = var_p * np.cos(t1 + t2)  # x: cos a1 cos a2; z: -sin a1 sin a2
+    return np.linalg.inv(cov)

@@ -34,6 +34,7 @@ def model1(
     *,
     alpha_e: float | tuple[float, float] = 0.0,
     uncertainty: Uncertainty | None = None,
+    los_offset_m: tuple[float, float] = (0.0, 0.0),
 ) -> PositionEstimate:
     """Positions (N, 3) in H of points fixated with the neck, eq. (2).
 
@@ -43,6 +44,8 @@ def model1(
     offsets: one eye angle then centres P where the two lines of sight cross,
     off the Z_h axis, so z_h and x_h follow eqs. (4)-(5) with alpha1 = alpha2.
     uncertainty: baseline and encoder errors for the covariance of z_h, or None.
+    los_offset_m: (s1, s2), m, each line of sight's offset from its yaw axis
+    (see :func:`headsim.estimators.model2`): P is the crossing of the offset lines.
     Points with alpha + alpha_e <= 0 (lines of sight parallel or diverging) or
     >= pi/2 are flagged invalid.
     """
@@ -51,6 +54,10 @@ def model1(
     d = check_baseline(baseline)
     pair = np.broadcast_to(np.asarray(alpha_e, dtype=float), (2,))
     check_angles(pair, "alpha_e")
+    if not all(math.isfinite(float(o)) and abs(float(o)) < d / 2 for o in los_offset_m):
+        raise ValueError(
+            f"los_offset_m must be two offsets in metres, |s| < D/2, got {los_offset_m!r}"
+        )
     a = a_enc + float(pair.mean())
     finite = np.isfinite(a)
     flags = np.zeros(a.shape, dtype=np.int64)
@@ -60,8 +67,11 @@ def model1(
     valid = flags == 0
     with np.errstate(divide="ignore", invalid="ignore"):
         t1, t2 = np.tan(a_enc + pair[0]), np.tan(a_enc + pair[1])
-        z = np.where(valid, d / (t1 + t2), np.nan)  # = D / (2 tan a) for equal offsets
-        x = np.where(valid, z * t1 - 0.5 * d, np.nan)  # 0 for equal offsets
+        o1, o2 = (float(o) for o in los_offset_m)
+        sec1, sec2 = np.sqrt(1.0 + t1 * t1), np.sqrt(1.0 + t2 * t2)
+        depth = d - o1 * sec1 + o2 * sec2  # the offset lines' crossing (model2's docstring)
+        z = np.where(valid, depth / (t1 + t2), np.nan)  # = D / (2 tan a) for equal offsets
+        x = np.where(valid, z * t1 + o1 * sec1 - 0.5 * d, np.nan)  # 0 for equal offsets
     positions = np.stack([x, np.zeros_like(z), z], axis=-1)
     positions[~valid] = np.nan
     covariance = None

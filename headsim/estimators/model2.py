@@ -11,6 +11,17 @@ a_i = alpha_i + alpha_ei:
     y_ci = (v_id / u_id) (kx_i / ky_i) x_ci                (7), (9), (10)
     y_h = (y_c1 + y_c2) / 2                                (11)
 
+Beyond the paper (equations.md, last section): when each line of sight
+misses its yaw axis by s_i (along the effective camera's x), P is the exact
+crossing of the two offset lines, and x_c takes the offset too:
+
+    z_h = (D - s1 / cos a1 + s2 / cos a2) / (tan a1 + tan a2)
+    x_h = z_h tan a1 + s1 / cos a1 - D/2
+    x_c1 = L1 sin(alpha1 - gamma1) + s1 (cos(alpha1 - gamma1) - 1),  L1 = (z_h + s1 sin a1) / cos a1
+    x_c2 = L2 sin(gamma2 - alpha2) + s2 (cos(gamma2 - alpha2) - 1),  L2 = (z_h - s2 sin a2) / cos a2
+
+with s_i = 0 these are eqs. (4), (5), (8), (10).
+
 gamma1 = alpha2 and gamma2 = alpha1 are the paper's (u11, v11) and (u21, v21);
 gamma = 0 is its near-midline remedy.  The offsets enter only the tangents and
 the cos denominators: alpha1 - gamma1 is a relative rotation of one motor.
@@ -54,6 +65,7 @@ def model2(
     kx_over_ky: tuple[float, float] = (1.0, 1.0),
     min_abs_ud: float = 1.0,
     uncertainty: Uncertainty | None = None,
+    los_offset_m: tuple[float, float] = (0.0, 0.0),
 ) -> PositionEstimate:
     """Positions of N points in H from Model 2's two fixations.
 
@@ -67,7 +79,10 @@ def model2(
     kx_over_ky: the ratio kx_i / ky_i of each camera (eq. 7; 1 if unknown).
     min_abs_ud: |u_id| below this, px, makes eq. (9) or (10) unusable: y_h then
     comes from the other camera alone, or is undetermined if both are.
-    uncertainty: input errors for a first-order covariance (N, 3, 3), or None.
+    uncertainty: input errors for a first-order covariance (N, 3, 3), or None
+    (it leaves out the offsets' small effect).
+    los_offset_m: (s1, s2), m: how far each goal column's line of sight misses
+    its eye's yaw axis, along the camera's x (as calibrated; 0 is the paper's eye).
 
     Per-point degeneracies are flagged (``valid`` False, positions NaN), not
     raised; wrong shapes and angles that are not radians raise ValueError.
@@ -89,6 +104,11 @@ def model2(
     r1, r2 = (float(r) for r in kx_over_ky)
     if not (r1 > 0.0 and r2 > 0.0 and math.isfinite(r1) and math.isfinite(r2)):
         raise ValueError(f"kx_over_ky must be two positive ratios, got {kx_over_ky!r}")
+    o1, o2 = (float(o) for o in los_offset_m)
+    if not (math.isfinite(o1) and math.isfinite(o2) and abs(o1) < d / 2 and abs(o2) < d / 2):
+        raise ValueError(
+            f"los_offset_m must be two offsets in metres, |s| < D/2, got {los_offset_m!r}"
+        )
     if not min_abs_ud >= 0.0:
         raise ValueError(f"min_abs_ud must be >= 0 px, got {min_abs_ud!r}")
 
@@ -97,8 +117,12 @@ def model2(
     s = t1 + t2
     sec1, sec2 = np.sqrt(1.0 + t1 * t1), np.sqrt(1.0 + t2 * t2)  # 1/cos a_i for |a_i| < pi/2
     with np.errstate(divide="ignore", invalid="ignore"):
-        z = d / s
-        x = z * t1 - 0.5 * d
+        if o1 == 0.0 and o2 == 0.0:
+            z = d / s
+            x = z * t1 - 0.5 * d
+        else:
+            z = (d - o1 * sec1 + o2 * sec2) / s
+            x = z * t1 + o1 * sec1 - 0.5 * d
         sin1, cos1 = _sin_cos(a1_enc - g1)
         if gamma1 is None and gamma2 is None:
             sin2, cos2 = sin1, cos1  # gamma2 - alpha2 = alpha1 - alpha2 = alpha1 - gamma1
@@ -106,8 +130,14 @@ def model2(
             sin2, cos2 = _sin_cos(g2 - a2_enc)
         u1d, v1d = uv1[:, 0] - uv10[0], uv1[:, 1] - uv10[1]
         u2d, v2d = uv2[:, 0] - uv20[0], uv2[:, 1] - uv20[1]
-        y1 = (r1 * v1d / u1d) * (z * sin1 * sec1)
-        y2 = (r2 * v2d / u2d) * (z * sin2 * sec2)
+        if o1 == 0.0 and o2 == 0.0:
+            xc1, xc2 = z * sin1 * sec1, z * sin2 * sec2
+        else:
+            # L1 = z sec a1 + s1 tan a1, L2 = z sec a2 - s2 tan a2.
+            xc1 = (z * sec1 + o1 * t1) * sin1 + o1 * (cos1 - 1.0)
+            xc2 = (z * sec2 - o2 * t2) * sin2 + o2 * (cos2 - 1.0)
+        y1 = (r1 * v1d / u1d) * xc1
+        y2 = (r2 * v2d / u2d) * xc2
 
     finite = (
         np.isfinite(a1)

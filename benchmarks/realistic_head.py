@@ -1,0 +1,319 @@
+"""Issue 10's "done when" figures that the exact forward model can give, in seconds.
+
+Run: .venv/bin/python benchmarks/realistic_head.py [--seeds 50]
+
+Everything here is the exact synthetic model (headsim.synthetic) with the
+realistic preset's tolerances (headsim.settings.REALISTIC_BUDGET): the paper's
+cameras (intrinsics, distortion, initial directions), optical centres 20 mm
+forward and 1 / -0.5 mm sideways, a baseline 0.3 mm longer than believed,
+encoder readings with the true angle anywhere within the count, a 1 mm
+(Gaussian, per coordinate) tape measure.  Not here: rendering and centroid
+noise, the servo, backlash and axis tilt (the rendered scenarios measure
+those).  Whole shared field: |x/z| <= 0.15, |y/z| <= 0.1, 0.3-1.5 m.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from headsim.camera_model import PinholeCamera
+from headsim.estimators import model2
+from headsim.estimators.calibration import calibrate_initial_directions, calibrate_lines_of_sight
+from headsim.results import write_bytes_atomic, write_csv_atomic
+from headsim.settings import PAPER_INITIAL_DIRECTIONS, PAPER_INTRINSICS, REALISTIC_BUDGET
+from headsim.synthetic import StereoHead, observe, quantise
+
+BELIEVED_D = 0.150
+BANDS = ((0.3, 0.6), (0.6, 1.0), (1.0, 1.5))
+
+
+def paper_cameras(distorted: bool = True) -> tuple[PinholeCamera, PinholeCamera]:
+    cams = []
+    for intr in PAPER_INTRINSICS:
+        k1 = intr["k1"] if distorted else 0.0
+        cams.append(
+            PinholeCamera(640, 480, intr["kx"], intr["ky"], intr["cx"], intr["cy"], k1, 0.0)
+        )
+    return cams[0], cams[1]
+
+
+def realistic(distorted: bool = True) -> StereoHead:
+    b = REALISTIC_BUDGET
+    c1, c2 = paper_cameras(distorted)
+    return StereoHead(
+        BELIEVED_D + b["baseline_error_m"][0],
+        c1,
+        c2,
+        PAPER_INITIAL_DIRECTIONS[0],
+        PAPER_INITIAL_DIRECTIONS[1],
+        nodal1=b["nodal_offset_m"][0],
+        nodal2=b["nodal_offset_m"][0],
+        side1=b["side_offset_m"][0],
+        side2=-0.5 * b["side_offset_m"][0],
+    )
+
+
+def field(rng: np.random.Generator, n: int, depth=(0.3, 1.5), lateral=0.15, vertical=0.1):
+    z = rng.uniform(*depth, n)
+    return np.column_stack(
+        [rng.uniform(-lateral, lateral, n) * z, rng.uniform(-vertical, vertical, n) * z, z]
+    )
+
+
+def measure(head: StereoHead, p: np.ndarray, alpha_e, offsets, baseline: float) -> np.ndarray:
+    """Model 2 from encoder readings (true angle anywhere within the count) and exact pixels."""
+    obs = observe(head, p, gamma1=0.0, gamma2=0.0)
+    a1, a2 = (
+        quantise(obs.alpha1, head.encoder_resolution),
+        quantise(obs.alpha2, head.encoder_resolution),
+    )
+    (u10, u20), cams = head.target_columns, (head.cam1, head.cam2)
+    est = model2(a1, a2, obs.uv1, obs.uv2, baseline, uv10=(u10, cams[0].cy), uv20=(u20, cams[1].cy),
+                 alpha_e=alpha_e, gamma1=0.0, gamma2=0.0,
+                 kx_over_ky=(cams[0].kx / cams[0].ky, cams[1].kx / cams[1].ky),
+                 los_offset_m=offsets)  # fmt: skip
+    return est.positions
+
+
+def pct(err: np.ndarray, p: np.ndarray) -> float:
+    return float(100 * np.sqrt(np.nanmean(np.sum(err**2, axis=1) / p[:, 2] ** 2)))
+
+
+def calibrate(head: StereoHead, seed: int, n: int = 60, noise: float = 1e-3):
+    rng = np.random.default_rng(seed)
+    p = field(rng, n, depth=(0.25, 1.5), lateral=0.16, vertical=0.08)
+    obs = observe(head, p)
+    a1, a2 = (
+        quantise(obs.alpha1, head.encoder_resolution),
+        quantise(obs.alpha2, head.encoder_resolution),
+    )
+    measured = p + rng.normal(0.0, noise, p.shape)
+    return calibrate_lines_of_sight(a1, a2, measured, BELIEVED_D, sigma_position=noise,
+                                    sigma_encoder=head.encoder_resolution / math.sqrt(12))  # fmt: skip
+
+
+def _head(offsets: bool = True, baseline_error: bool = True) -> StereoHead:
+    h = realistic()
+    return replace(
+        h,
+        baseline=h.baseline if baseline_error else BELIEVED_D,
+        nodal1=h.nodal1 if offsets else 0.0,
+        nodal2=h.nodal2 if offsets else 0.0,
+        side1=h.side1 if offsets else 0.0,
+        side2=h.side2 if offsets else 0.0,
+    )
+
+
+def _condition(
+    name: str, p: np.ndarray, seeds: int, *, offsets=True, baseline_error=True, count=True,
+    tape=1e-3, extended=True, correct=True,
+) -> dict[str, float | str]:  # fmt: skip
+    """Median over calibrations of the whole-field errors, beside eqs. 15-18's first-order depth error."""
+    head = _head(offsets, baseline_error)
+    if not count:
+        head = replace(head, encoder_resolution=1e-9)
+    res = head.encoder_resolution
+    rows, predicted = [], []
+    obs = observe(head, p)
+    a_sum = obs.alpha1 + obs.alpha2 + sum(head.effective_initial_directions())  # a1 + a2, rad
+    for seed in range(seeds):
+        rng = np.random.default_rng(3000 + seed)
+        c = field(rng, 60, depth=(0.25, 1.5), lateral=0.16, vertical=0.08)
+        o = observe(head, c)
+        a1, a2 = quantise(o.alpha1, res), quantise(o.alpha2, res)
+        measured = c + rng.normal(0.0, tape, c.shape) if tape > 0 else c
+        if extended:
+            fit = calibrate_lines_of_sight(a1, a2, measured, BELIEVED_D, sigma_position=max(tape, 1e-5),
+                                           sigma_encoder=res / math.sqrt(12))  # fmt: skip
+            alpha_e, offs = tuple(fit.alpha_e), tuple(fit.offset_m) if correct else (0.0, 0.0)
+            cov = fit.covariance
+            # Eqs. 15/17 to first order: dz/z = dD/D - d(a1 + a2)/(a1 + a2), here from the
+            # calibration's errors (covariance) and the truth's offsets left uncorrected.
+            var_sum = cov[0, 0] + cov[1, 1] + 2 * cov[0, 1]
+            var_d = cov[2, 2] + cov[3, 3] - 2 * cov[2, 3]
+        else:
+            sec5 = calibrate_initial_directions(a1, a2, measured[:, 2], BELIEVED_D)
+            alpha_e, offs = tuple(sec5.alpha_e), (0.0, 0.0)
+            var_sum = float(np.sum(sec5.covariance))
+            var_d = 0.0
+        err = measure(head, p, alpha_e, offs, BELIEVED_D) - p
+        z_pct = float(100 * np.sqrt(np.nanmean((err[:, 2] / p[:, 2]) ** 2)))
+        rows.append((pct(err, p), z_pct))
+        s1, s2 = head.line_of_sight_offsets()
+        bias = (
+            0.0 if (extended and correct) else (head.baseline - s1 + s2 - BELIEVED_D) / BELIEVED_D
+        )
+        quant = (res / math.sqrt(6)) ** 2 if count else 0.0  # two readings, each uniform in a count
+        dz = np.sqrt(bias**2 + var_d / BELIEVED_D**2 + (var_sum + quant) / a_sum**2)
+        predicted.append(float(100 * np.sqrt(np.mean(dz**2))))
+    rows_a = np.array(rows)
+    return {
+        "condition": name,
+        "rms_3d_pct": float(np.median(rows_a[:, 0])),
+        "rms_depth_pct": float(np.median(rows_a[:, 1])),
+        "predicted_depth_pct": float(np.median(predicted)),
+    }
+
+
+def budget(p: np.ndarray, seeds: int, out: Path | None) -> None:
+    """The error budget: the realistic head, each imperfection off in turn, each extension on/off."""
+    conditions = [
+        _condition("realistic, all on", p, seeds),
+        _condition("  optical-centre offsets off", p, seeds, offsets=False),
+        _condition("  baseline error off", p, seeds, baseline_error=False),
+        _condition("  count error off", p, seeds, count=False),
+        _condition("  tape noise off", p, seeds, tape=0.0),
+        _condition("  offsets not corrected", p, seeds, correct=False),
+        _condition("  Sec. V only (no extension)", p, seeds, extended=False),
+    ]
+    print(
+        f"\n4. Error budget, whole field (median over {seeds} calibrations); predicted: eqs. 15-18 to first order"
+    )
+    print(f"   {'condition':32s} {'3-D RMS %':>10s} {'depth RMS %':>12s} {'eqs. 15-18 %':>13s}")
+    for c in conditions:
+        print(
+            f"   {c['condition']:32s} {c['rms_3d_pct']:10.3f} {c['rms_depth_pct']:12.3f} {c['predicted_depth_pct']:13.3f}"
+        )
+    if out is None:
+        return
+    out.mkdir(parents=True, exist_ok=True)
+    write_csv_atomic(out / "error_budget.csv", conditions)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 4))
+    y = np.arange(len(conditions))
+    for k, (key, label) in enumerate((("rms_3d_pct", "3-D RMS (measured)"), ("rms_depth_pct", "depth RMS (measured)"),
+                                      ("predicted_depth_pct", "depth, eqs. 15-18"))):  # fmt: skip
+        ax.barh(y + (k - 1) * 0.27, [c[key] for c in conditions], height=0.27, label=label)
+    ax.set_yticks(y, [str(c["condition"]).strip() for c in conditions])
+    ax.invert_yaxis()
+    ax.set_xlabel("error, % of depth (whole field, 0.3-1.5 m)")
+    ax.set_title("Realistic head: error budget (exact forward model)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=120)
+    plt.close(fig)
+    write_bytes_atomic(out / "error_budget.png", buffer.getvalue())
+    print(f"   wrote {out / 'error_budget.csv'} and {out / 'error_budget.png'}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=50)
+    parser.add_argument("--budget-seeds", type=int, default=10)
+    parser.add_argument("--out", type=Path, default=None, help="write error_budget.csv/.png here")
+    args = parser.parse_args()
+    rng = np.random.default_rng(2026)
+    p = field(rng, 2000)
+
+    print(
+        "1. Realistic head, whole field (2000 targets), after the extended calibration (60 targets, 1 mm tape)"
+    )
+    head = realistic()
+    rows = []
+    for seed in range(args.seeds):
+        fit = calibrate(head, seed)
+        err = measure(head, p, tuple(fit.alpha_e), tuple(fit.offset_m), BELIEVED_D) - p
+        rows.append(
+            [pct(err, p)]
+            + [
+                pct(err[(p[:, 2] >= lo) & (p[:, 2] < hi)], p[(p[:, 2] >= lo) & (p[:, 2] < hi)])
+                for lo, hi in BANDS
+            ]
+        )
+    rows = np.array(rows)
+    print(f"   3-D error RMS, % of depth, median over {args.seeds} calibrations (95th percentile):")
+    for k, name in enumerate(["all", *(f"{lo}-{hi} m" for lo, hi in BANDS)]):
+        print(f"     {name:10s} {np.median(rows[:, k]):.3f} ({np.percentile(rows[:, k], 95):.3f})")
+
+    print(
+        "\n2. Offsets left uncorrected (initial directions exact; line-of-sight offsets taken as 0)"
+    )
+    s_true = head.line_of_sight_offsets()
+    half = (head.baseline - BELIEVED_D) / 2
+    exact_e = head.effective_initial_directions()
+    for label, h in (
+        (
+            "n = 20 mm both, delta of the paper's cameras",
+            StereoHead(
+                BELIEVED_D,
+                *paper_cameras(False),
+                *PAPER_INITIAL_DIRECTIONS,
+                nodal1=0.02,
+                nodal2=0.02,
+            ),
+        ),
+        (
+            "e = 1 mm both eyes",
+            StereoHead(
+                BELIEVED_D, *paper_cameras(False), *PAPER_INITIAL_DIRECTIONS, side1=1e-3, side2=1e-3
+            ),
+        ),
+        ("realistic (offsets and baseline error)", realistic(False)),
+    ):
+        s1, s2 = h.line_of_sight_offsets()
+        err = measure(h, p, h.effective_initial_directions(), (0.0, 0.0), BELIEVED_D) - p
+        dz = float(100 * np.sqrt(np.mean((err[:, 2] / p[:, 2]) ** 2)))
+        predicted = 100 * abs(h.baseline - s1 + s2 - BELIEVED_D) / BELIEVED_D  # dz/z = dD/D, eq. 15
+        print(f"   {label}: s = ({s1 * 1e3:.3f}, {s2 * 1e3:.3f}) mm; depth error RMS {dz:.3f} %, "
+              f"first-order |dD_eff|/D {predicted:.3f} %, ratio {dz / predicted:.3f}")  # fmt: skip
+    c = paper_cameras(False)
+    h0 = StereoHead(
+        BELIEVED_D,
+        *c,
+        *PAPER_INITIAL_DIRECTIONS,
+        u10=c[0].cx,
+        u20=c[1].cx,
+        nodal1=0.02,
+        nodal2=0.02,
+    )
+    hp = StereoHead(BELIEVED_D, *c, *PAPER_INITIAL_DIRECTIONS, u10=c[0].cx, u20=c[1].cx)
+    diff = np.abs(
+        measure(h0, p, h0.effective_initial_directions(), (0.0, 0.0), BELIEVED_D)
+        - measure(hp, p, hp.effective_initial_directions(), (0.0, 0.0), BELIEVED_D)
+    )
+    print(
+        "   goal columns at the principal points, n = 20 mm alone: largest change of any x, z "
+        f"estimate {np.nanmax(diff[:, [0, 2]]):.2e} m; of y {np.nanmax(diff[:, 1]):.2e} m "
+        "(y: near-midline targets switch between one camera's y and the mean)"
+    )
+
+    print(
+        f"\n3. Calibration recovery over {args.seeds} seeds (60 targets at 0.25-1.5 m, 1 mm tape), realistic head"
+    )
+    truth = np.r_[exact_e, s_true[0] - half, s_true[1] + half]
+    truth_b = head.baseline - s_true[0] + s_true[1]
+    est, std, be, bs = [], [], [], []
+    for seed in range(args.seeds):
+        fit = calibrate(head, 1000 + seed)
+        est.append(np.r_[fit.alpha_e, fit.offset_m])
+        std.append(fit.std_errors)
+        be.append(fit.effective_baseline_m - truth_b)
+        bs.append(fit.effective_baseline_std_m)
+    est, std, be, bs = np.array(est), np.array(std), np.array(be), np.array(bs)
+    err = est - truth
+    print(f"   effective baseline error: RMS {1e3 * np.sqrt(np.mean(be**2)):.3f} mm, max {1e3 * np.max(np.abs(be)):.3f} mm; "
+          f"stated std {1e3 * np.mean(bs):.3f} mm, z-score spread {np.std(be / bs):.2f}")  # fmt: skip
+    for k, name in ((2, "s1"), (3, "s2")):
+        print(f"   {name} error: RMS {1e3 * np.sqrt(np.mean(err[:, k] ** 2)):.3f} mm, max {1e3 * np.max(np.abs(err[:, k])):.3f} mm; "
+              f"stated std {1e3 * np.mean(std[:, k]):.3f} mm, z-score spread {np.std(err[:, k] / std[:, k]):.2f}")  # fmt: skip
+    for k, name in ((0, "alpha_e1"), (1, "alpha_e2")):
+        print(
+            f"   {name} error RMS {np.sqrt(np.mean(err[:, k] ** 2)):.2e} rad; z-score spread {np.std(err[:, k] / std[:, k]):.2f}"
+        )
+
+    budget(p[:500], args.budget_seeds, args.out)
+
+
+if __name__ == "__main__":
+    main()
