@@ -81,9 +81,13 @@ def _run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise ScenarioError("--out", "", f"{out} exists and is not a directory", "a directory")
-    rrd = Path(args.rrd) if args.rrd else None
-    if rrd is not None and rrd.is_dir():
-        raise ScenarioError("--rrd", "", f"{rrd} is a directory", "a file path, e.g. run.rrd")
+    from headsim.rerun_cli import RecordingArgumentError, recording_target
+
+    try:
+        target = recording_target(args)
+    except RecordingArgumentError as err:
+        raise ScenarioError(err.field, "", err.message, err.allowed) from err
+    rrd = target.rrd
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as err:
@@ -94,21 +98,25 @@ def _run(args: argparse.Namespace) -> int:
     if not args.no_progress and sys.stderr.isatty():
         observers.append(Progress(scenario.fixations, sys.stderr))
     recorder = None
-    if rrd is not None:
+    if target.wanted:
         from headsim.recording import Recorder
 
         try:
-            recorder = Recorder(rrd, scenario)
+            recorder = Recorder(rrd, scenario, target=target)
         except OSError as err:
             raise ScenarioError(
                 "--rrd", "", f"cannot write {rrd}: {err}", "a writable file path"
             ) from err
         observers.append(recorder)
+        if target.serve:
+            print(f"serving the run live at {target.web_viewer_url}", flush=True)
     start = time.perf_counter()
     state = _Interrupted()
+    finished = False
     try:
         with _sigterm_interrupts() as state:
             result = run_scenario(scenario, observers)
+        finished = True
     except BaseException as err:
         if not (isinstance(err, KeyboardInterrupt) or state.signalled):
             raise
@@ -116,7 +124,8 @@ def _run(args: argparse.Namespace) -> int:
         print(f"\nheadsim: interrupted: nothing written to {out}{kept}", file=sys.stderr)
         return 130
     finally:
-        if recorder is not None:
+        # --serve keeps the stream open after a finished run; it is closed after serving.
+        if recorder is not None and not (finished and target.serve):
             recorder.close()
     wall = time.perf_counter() - start
     text = summary_text(result)
@@ -137,7 +146,22 @@ def _run(args: argparse.Namespace) -> int:
     print(f"\nwall time {wall:.1f} s; results in {out / 'results.json'} (summary.txt, timing.json)")
     if rrd is not None:
         print(f"recording {rrd} ({_size(rrd)}): open it with  rerun {rrd}")
+    if recorder is not None and target.serve:
+        _serve_until_interrupted(recorder, target.web_viewer_url)
     return 0 if result.ok else 1
+
+
+def _serve_until_interrupted(recorder: object, url: str) -> None:
+    """Keep --serve's viewer up after the run until Ctrl-C or SIGTERM; then close the recording."""
+    print(f"serving the recording at {url} until Ctrl-C", flush=True)
+    try:
+        with _sigterm_interrupts():
+            while True:  # ends on Ctrl-C or SIGTERM only: serving is what the user asked for
+                time.sleep(0.5)
+    except KeyboardInterrupt:
+        print("stopped serving (interrupted)", file=sys.stderr)
+    finally:
+        recorder.close()  # type: ignore[attr-defined]
 
 
 def _list(args: argparse.Namespace) -> int:
@@ -173,6 +197,12 @@ def _sweep(args: argparse.Namespace) -> int:
     from headsim import sweep
 
     spec = sweep.load_sweep(args.sweep)
+    from headsim.rerun_cli import RecordingArgumentError, recording_target
+
+    try:
+        target = recording_target(args, per_job=True)
+    except RecordingArgumentError as err:
+        raise sweep.SweepError(err.field, "", err.message, err.allowed) from err
     print(f"sweep {spec.path.name}: {spec.description}")
     print(f"  {len(spec.jobs)} jobs of {Path(spec.scenario).stem}{' (fast)' if spec.fast else ''}")
     where = f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers} local process(es)"
@@ -185,6 +215,7 @@ def _sweep(args: argparse.Namespace) -> int:
                 workers=args.workers,
                 scheduler=args.scheduler,
                 progress=not args.no_progress,
+                recording=target if target.wanted else None,
             )
         except KeyboardInterrupt:
             print(
@@ -224,7 +255,6 @@ def build_parser() -> argparse.ArgumentParser:
         help="a scenario file (.toml) or the name of one in scenarios/ (see `headsim list`)",
     )
     run.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
-    run.add_argument("--rrd", metavar="FILE", help="also record the run to this Rerun .rrd file")
     run.add_argument(
         "--seed",
         type=int,
@@ -235,6 +265,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--fast", action="store_true", help="the scenario's fast variant (its [fast] table)"
     )
     run.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    from headsim.rerun_cli import add_recording_arguments
+
+    add_recording_arguments(run)
     run.set_defaults(func=_run)
 
     listing = commands.add_parser(
@@ -292,6 +325,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="run the jobs on this Dask scheduler instead (pip install 'headsim[dask]')",
     )
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    from headsim.rerun_cli import add_recording_arguments
+
+    add_recording_arguments(sweep, per_job=True)
     sweep.set_defaults(func=_sweep)
 
     from headsim.study import STUDY_DESCRIPTION, add_arguments

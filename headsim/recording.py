@@ -47,6 +47,7 @@ from headsim.kinematics import head_to_world
 from headsim.optics import camera_matrix
 from headsim.procedures import HeadKnowledge
 from headsim.report import summary_text
+from headsim.rerun_cli import RecordingTarget
 from headsim.runner import MeasurementRecord, Observer, RunResult
 from headsim.scenario import Scenario
 from headsim.sim import HeadSim
@@ -92,8 +93,8 @@ def eye_controls(scenario: Scenario | None = None) -> rrb.EyeControls3D:
     points = [head] + [np.asarray(p, dtype=float) for p in _placements(scenario)]
     targets = np.array(points[1:]) if len(points) > 1 else head + np.array([[0.0, 0.8, 0.0]])
     reach = float(np.max(np.linalg.norm(targets - head, axis=1)))
-    look_target = head + 0.5 * (targets.mean(axis=0) - head)
-    position = head + reach * np.array([0.45, -0.75, 0.55])
+    look_target = head + 0.6 * (targets.mean(axis=0) - head)
+    position = head + reach * np.array([0.35, -0.95, 0.75])
     return rrb.EyeControls3D(
         kind=rrb.Eye3DKind.Orbital,
         position=position,
@@ -143,7 +144,7 @@ def blueprint(scenario: Scenario | None = None) -> rrb.Blueprint:
             ),
             column_shares=[2, 3],
         ),
-        rrb.TimePanel(timeline="frame"),
+        rrb.TimePanel(timeline="frame", state="collapsed"),
         collapse_panels=True,
     )
 
@@ -156,21 +157,54 @@ def recording_id(scenario: Scenario) -> str:
 class Recorder(Observer):
     """Logs a run to ``path`` as it goes; :meth:`close` writes the footer."""
 
-    def __init__(self, path: str | Path, scenario: Scenario, jpeg_quality: int = JPEG_QUALITY):
-        self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+    def __init__(
+        self,
+        path: str | Path | None,
+        scenario: Scenario,
+        jpeg_quality: int = JPEG_QUALITY,
+        *,
+        target: RecordingTarget | None = None,
+        recording: str | None = None,
+    ):
+        """``path``: the .rrd file; or ``target``: a file, a viewer to connect to, a server
+        to host (any of them; :mod:`headsim.rerun_cli`).  ``recording``: the recording
+        id (default :func:`recording_id`)."""
+        if target is None:
+            if path is None:
+                raise ValueError("Recorder needs a path or a target")
+            target = RecordingTarget(rrd=Path(path))
+        self.target = target
+        self.path = target.rrd
+        if self.path is not None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
         self.scenario = scenario
         self.jpeg_quality = int(jpeg_quality)
         self.rec = rr.RecordingStream(
             APP_ID,
-            recording_id=recording_id(scenario),
+            recording_id=recording or recording_id(scenario),
             # Chunks end at each flush (every measurement) or after a second: fewer, larger
             # chunks than the default 8 ms tick (each chunk costs about 1 kB in the file).
             batcher_config=rr.ChunkBatcherConfig(flush_tick=FLUSH_TICK),
         )
         # No wall-clock timeline: two runs log the same data.
         self.rec.set_log_time_enabled(False)
-        self.rec.save(self.path, default_blueprint=blueprint(scenario))
+        layout = blueprint(scenario)
+        sinks: list[rr.FileSink | rr.GrpcSink | rr.GrpcServerSink] = []
+        if target.connect_url is not None:
+            sinks.append(rr.GrpcSink(target.connect_url))
+        if target.serve:
+            sinks.append(rr.GrpcServerSink(port=target.grpc_port))
+        if sinks and self.path is not None:
+            sinks.append(rr.FileSink(self.path))
+        if sinks:
+            self.rec.set_sinks(*sinks, default_blueprint=layout)  # each sink gets the layout
+        else:
+            self.rec.save(self.path, default_blueprint=layout)
+        if target.serve:
+            # The page only; the data comes from the gRPC server above.
+            rr.serve_web_viewer(
+                web_port=target.web_port, open_browser=False, connect_to=target.server_url
+            )
         self.rec.send_recording_name(scenario.name)
         self.current_frame = 0
         self.current_step = 0
