@@ -66,6 +66,10 @@ _RED = (235, 60, 50)
 _WHITE = (235, 235, 235)
 _ORANGE = (255, 160, 30)
 _GREY = (150, 150, 150)
+#: Target markers are a few mm: drawn in screen points so that they show at any zoom.
+_UI_RADIUS_SMALL = rr.components.Radius.ui_points(3.0)
+_UI_RADIUS = rr.components.Radius.ui_points(4.0)
+_UI_RADIUS_LARGE = rr.components.Radius.ui_points(6.0)
 
 
 #: The text documents of a recording, each shown by its own view (one per tab).
@@ -395,7 +399,7 @@ class Recorder(Observer):
         if name == "calibration":
             self.rec.log(
                 "/world/calibration/positions",
-                rr.Points3D(positions, radii=0.004, colors=[_GREY] * len(labels)),
+                rr.Points3D(positions, radii=_UI_RADIUS_SMALL, colors=[_GREY] * len(labels)),
             )
         else:
             self.rec.log("/world/calibration/positions", rr.Clear(recursive=False))
@@ -403,7 +407,7 @@ class Recorder(Observer):
                 "/world/truth",
                 rr.Points3D(
                     positions,
-                    radii=0.003,
+                    radii=_UI_RADIUS_SMALL,
                     colors=[_WHITE] * len(labels),
                     labels=labels,
                     show_labels=False,
@@ -428,7 +432,7 @@ class Recorder(Observer):
         if target is not None:
             self.rec.log(
                 "/world/current_target",
-                rr.Points3D([target], radii=0.006, colors=[_ORANGE], labels=[label]),
+                rr.Points3D([target], radii=_UI_RADIUS_LARGE, colors=[_ORANGE], labels=[label]),
             )
 
     def rendered(self, sim: HeadSim, camera: int, image: np.ndarray, frame: int) -> None:
@@ -495,7 +499,7 @@ class Recorder(Observer):
                 "/world/estimate",
                 rr.Points3D(
                     [e for _, e, _ in done],
-                    radii=0.004,
+                    radii=_UI_RADIUS,
                     colors=[_GREEN] * len(done),
                     labels=[self._labels[k] for k, _, _ in done],
                     show_labels=False,

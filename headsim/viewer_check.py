@@ -36,7 +36,7 @@ import cv2
 import numpy as np
 
 #: Browser window, px (the screenshot's size).
-WINDOW = (1600, 1000)
+WINDOW = (1280, 800)
 #: Chromium's flags: headless, no network beyond 127.0.0.1, WebGL through SwiftShader.
 CHROMIUM_FLAGS = (
     "--headless=new",
