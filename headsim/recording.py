@@ -20,8 +20,13 @@ and timelines (README "Scenarios and results" lists them):
   ``/joints/eye_rad``, ``/joints/neck_yaw_rad``, ``/joints/neck_pitch_rad``;
   ``/measurements/error_mm``, ``/measurements/error_pct_of_depth``,
   ``/measurements/renders``, ``/measurements/servo_residual_px``;
-- ``/results/scenario``, ``/results/calibration``, ``/results/summary``
-  (markdown text).
+- ``/results/scenario``, ``/results/calibration``, ``/results/summary``,
+  ``/results/measurements`` (markdown text; each shown by its own view);
+- ``/world/model/<body>`` (Transform3D world_from_body when it moved) and
+  its geoms (:mod:`headsim.mjcf_rerun`): the head and the scene in 3-D.
+
+The stream goes to a file, a running viewer (``--connect``) or a served web
+viewer (``--serve``), or several (:class:`headsim.rerun_cli.RecordingTarget`).
 
 The stream is written as it goes and flushed after every measurement; it is
 closed with its footer when the run ends, also when it is interrupted
