@@ -107,32 +107,36 @@ RUN_FILES = ("results.json", "summary.txt", "timing.json")
 
 def _run(args: argparse.Namespace) -> int:
     from headsim.report import results_payload, summary_text
+    from headsim.rerun_cli import recording_target
     from headsim.runner import Observer, run_scenario
     from headsim.scenario import load_scenario
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
+    target = recording_target(args)  # a bad --url or port is bad input (exit 2)
     outputs = Outputs()
     try:
         # Every output, as the real file, before anything is rendered.
         out = outputs.directory(args.out, "--out")
         for name in RUN_FILES:
             outputs.file(out / name, "--out")
-        rrd = outputs.file(args.rrd, "--rrd", atomic=False) if args.rrd else None
+        rrd = outputs.file(target.rrd, "--rrd", atomic=False) if target.rrd else None
         observers: list[Observer] = []
         progress = _progress_observer(args, scenario.fixations, "fixations")
         if progress is not None:
             observers.append(progress)
         recorder = None
-        if rrd is not None:
+        if target.wanted:
             from headsim.recording import Recorder
 
             try:
-                recorder = Recorder(rrd, scenario)
+                recorder = Recorder(rrd, scenario, target=target)
             except (OSError, RuntimeError) as err:
-                if _recording_failed(err):
+                if rrd is not None and _recording_failed(err):
                     raise _recording_disk_full(rrd, err) from err
                 raise OutputNotWritable(f"--rrd: cannot write {rrd}: {err}") from err
             observers.append(recorder)
+            if target.serve:
+                print(f"serving the run live at {target.web_viewer_url}", flush=True)
         start = time.perf_counter()
         state = _Interrupted()
         try:
@@ -149,7 +153,8 @@ def _run(args: argparse.Namespace) -> int:
             kept = f"; the recording so far is in {rrd}" if rrd is not None else ""
             print(f"\nheadsim: interrupted: nothing written to {out}{kept}", file=sys.stderr)
             return ExitCode.INTERRUPTED
-        if recorder is not None:
+        # --serve keeps the stream open after a finished run; it is closed after serving.
+        if recorder is not None and not target.serve:
             _close_recorder(recorder, rrd)
         wall = time.perf_counter() - start
         text = summary_text(result)
@@ -175,6 +180,8 @@ def _run(args: argparse.Namespace) -> int:
     print(f"\nwall time {wall:.1f} s; results in {out / 'results.json'} (summary.txt, timing.json)")
     if rrd is not None:
         print(f"recording {rrd} ({_size(rrd)}): open it with  rerun {rrd}")
+    if recorder is not None and target.serve:
+        _serve_until_interrupted(recorder, target.web_viewer_url)
     return 0 if result.ok else 1
 
 
@@ -316,6 +323,19 @@ def _reproduce(args: argparse.Namespace) -> int:
         raise BadInput(str(err)) from err
 
 
+def _serve_until_interrupted(recorder: object, url: str) -> None:
+    """Keep --serve's viewer up after the run until Ctrl-C or SIGTERM; then close the recording."""
+    print(f"serving the recording at {url} until Ctrl-C", flush=True)
+    try:
+        with _sigterm_interrupts():
+            while True:  # ends on Ctrl-C or SIGTERM only: serving is what the user asked for
+                time.sleep(0.5)
+    except KeyboardInterrupt:
+        print("stopped serving (interrupted)", file=sys.stderr)
+    finally:
+        recorder.close()  # type: ignore[attr-defined]
+
+
 def _list(args: argparse.Namespace) -> int:
     from headsim.scenario import SCENARIOS_DIR, describe_scenarios
 
@@ -362,6 +382,9 @@ def _sweep(args: argparse.Namespace) -> int:
     from headsim import sweep
 
     spec = sweep.load_sweep(args.sweep)
+    from headsim.rerun_cli import recording_target
+
+    target = recording_target(args, per_job=True)
     outputs = Outputs()
     try:
         outputs.directory(args.out, "--out")  # before anything is printed or run
@@ -381,6 +404,7 @@ def _sweep(args: argparse.Namespace) -> int:
                     workers=args.workers,
                     scheduler=args.scheduler,
                     progress=not (args.no_progress or args.quiet),
+                    recording=target if target.wanted else None,
                 )
             except KeyboardInterrupt:
                 print(
@@ -444,7 +468,6 @@ def build_parser() -> argparse.ArgumentParser:
         help="a scenario file (.toml) or the name of one in headsim/scenarios/ (see `headsim list`)",
     )
     run.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
-    run.add_argument("--rrd", metavar="FILE", help="also record the run to this Rerun .rrd file")
     run.add_argument(
         "--seed",
         type=int,
@@ -457,6 +480,9 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"
     )
+    from headsim.rerun_cli import add_recording_arguments
+
+    add_recording_arguments(run)
     run.set_defaults(func=_run)
 
     calibrate = commands.add_parser(
@@ -551,6 +577,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="run the jobs on this Dask scheduler instead (pip install 'headsim[dask]')",
     )
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    from headsim.rerun_cli import add_recording_arguments
+
+    add_recording_arguments(sweep, per_job=True)
     sweep.set_defaults(func=_sweep)
 
     from headsim.study import STUDY_DESCRIPTION, add_arguments

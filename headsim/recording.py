@@ -24,8 +24,13 @@ and timelines (README "Scenarios and results" lists them):
   ``/joints/eye_rad``, ``/joints/neck_yaw_rad``, ``/joints/neck_pitch_rad``;
   ``/measurements/error_mm``, ``/measurements/error_pct_of_depth``,
   ``/measurements/renders``, ``/measurements/servo_residual_px``;
-- ``/results/scenario``, ``/results/calibration``, ``/results/summary``
-  (markdown text).
+- ``/results/scenario``, ``/results/calibration``, ``/results/summary``,
+  ``/results/measurements`` (markdown text; each shown by its own view);
+- ``/world/model/<body>`` (Transform3D world_from_body when it moved) and
+  its geoms (:mod:`headsim.mjcf_rerun`): the head and the scene in 3-D.
+
+The stream goes to a file, a running viewer (``--connect``) or a served web
+viewer (``--serve``), or several (:class:`headsim.rerun_cli.RecordingTarget`).
 
 The stream is written as it goes and flushed after every measurement; it is
 closed with its footer when the run ends, also when it is interrupted
@@ -37,6 +42,7 @@ rewrites it).
 from __future__ import annotations
 
 import math
+from datetime import timedelta
 from pathlib import Path
 from typing import Any
 
@@ -45,11 +51,12 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from headsim import names
+from headsim import mjcf_rerun, names
 from headsim.kinematics import head_to_world
 from headsim.optics import camera_matrix
 from headsim.procedures import HeadKnowledge
 from headsim.report import summary_text
+from headsim.rerun_cli import RecordingTarget
 from headsim.runner import MeasurementRecord, Observer, RunResult
 from headsim.scenario import Scenario
 from headsim.sim import HeadSim
@@ -60,19 +67,81 @@ APP_ID = "headsim"
 JPEG_QUALITY = 75
 #: Distance from the image plane to the optical centre of a drawn frustum, m.
 FRUSTUM_DEPTH_M = 0.08
+#: Longest time logged data waits in the batcher before it is written or streamed.
+FLUSH_TICK = timedelta(seconds=1)
 
 _GREEN = (40, 220, 90)
 _RED = (235, 60, 50)
 _WHITE = (235, 235, 235)
 _ORANGE = (255, 160, 30)
 _GREY = (150, 150, 150)
+#: Target markers are a few mm: drawn in screen points so that they show at any zoom.
+_UI_RADIUS_SMALL = rr.components.Radius.ui_points(3.0)
+_UI_RADIUS = rr.components.Radius.ui_points(4.0)
+_UI_RADIUS_LARGE = rr.components.Radius.ui_points(6.0)
 
 
-def blueprint() -> rrb.Blueprint:
-    """The default layout: 3-D view, both camera images, servo and joint traces, results."""
+#: The text documents of a recording, each shown by its own view (one per tab).
+TEXT_DOCUMENTS = {
+    "/results/scenario": "scenario",
+    "/results/calibration": "calibration",
+    "/results/summary": "summary",
+    "/results/measurements": "measurements",
+}
+
+
+def text_views() -> list[rrb.TextDocumentView]:
+    """One view per text document; each view's query is its document's path alone."""
+    return [
+        rrb.TextDocumentView(origin=path, contents="$origin", name=name)
+        for path, name in TEXT_DOCUMENTS.items()
+    ]
+
+
+def eye_controls(scenario: Scenario | None = None) -> rrb.EyeControls3D:
+    """The 3-D view's starting eye: behind and above the head, looking past it at the targets."""
+    head = np.array([0.0, 0.0, 0.21])
+    if scenario is not None:
+        head = np.array([0.0, 0.0, scenario.settings.neck_d1_m + scenario.settings.neck_a2_m])
+    points = [head] + [np.asarray(p, dtype=float) for p in _placements(scenario)]
+    targets = np.array(points[1:]) if len(points) > 1 else head + np.array([[0.0, 0.8, 0.0]])
+    reach = float(np.max(np.linalg.norm(targets - head, axis=1)))
+    look_target = head + 0.6 * (targets.mean(axis=0) - head)
+    position = head + reach * np.array([0.35, -0.95, 0.75])
+    return rrb.EyeControls3D(
+        kind=rrb.Eye3DKind.Orbital,
+        position=position,
+        look_target=look_target,
+        eye_up=[0.0, 0.0, 1.0],
+    )
+
+
+def _placements(scenario: Scenario | None) -> list[tuple[float, float, float]]:
+    """World positions of what the scenario places (targets, boards, objects, waypoints), m."""
+    if scenario is None:
+        return []
+    scene = scenario.scene
+    points = [t.position_world_m for t in (*scene.targets, *scene.objects)]
+    points += [p.position_world_m for p in (scene.chessboard, scene.blocks) if p is not None]
+    if scene.moving is not None:
+        points += list(scene.moving.waypoints_world_m)
+    return points
+
+
+def blueprint(scenario: Scenario | None = None) -> rrb.Blueprint:
+    """The default layout: 3-D view, both camera images, servo and joint traces, results.
+
+    Every text document has a view of its own (tabs), so that no view is
+    asked to show more than one document.
+    """
     return rrb.Blueprint(
         rrb.Horizontal(
-            rrb.Spatial3DView(origin="/world", name="head, frusta and targets (W)"),
+            rrb.Spatial3DView(
+                origin="/world",
+                name="head, scene and targets (W)",
+                eye_controls=eye_controls(scenario),
+                defaults=mjcf_rerun.view_defaults(),
+            ),
             rrb.Vertical(
                 rrb.Horizontal(
                     rrb.Spatial2DView(origin="/world/head/cam1", name="camera 1"),
@@ -81,16 +150,14 @@ def blueprint() -> rrb.Blueprint:
                 rrb.Horizontal(
                     rrb.TimeSeriesView(origin="/servo", name="servo error, px"),
                     rrb.TimeSeriesView(origin="/joints", name="joint encoders, rad"),
-                ),
-                rrb.Tabs(
-                    rrb.TextDocumentView(origin="/results", name="results"),
                     rrb.TimeSeriesView(origin="/measurements", name="measurements"),
                 ),
+                rrb.Tabs(*text_views(), active_tab=2),
                 row_shares=[3, 2, 2],
             ),
             column_shares=[2, 3],
         ),
-        rrb.TimePanel(timeline="frame"),
+        rrb.TimePanel(timeline="frame", state="collapsed"),
         collapse_panels=True,
     )
 
@@ -103,15 +170,54 @@ def recording_id(scenario: Scenario) -> str:
 class Recorder(Observer):
     """Logs a run to ``path`` as it goes; :meth:`close` writes the footer."""
 
-    def __init__(self, path: str | Path, scenario: Scenario, jpeg_quality: int = JPEG_QUALITY):
-        self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+    def __init__(
+        self,
+        path: str | Path | None,
+        scenario: Scenario,
+        jpeg_quality: int = JPEG_QUALITY,
+        *,
+        target: RecordingTarget | None = None,
+        recording: str | None = None,
+    ):
+        """``path``: the .rrd file; or ``target``: a file, a viewer to connect to, a server
+        to host (any of them; :mod:`headsim.rerun_cli`).  ``recording``: the recording
+        id (default :func:`recording_id`)."""
+        if target is None:
+            if path is None:
+                raise ValueError("Recorder needs a path or a target")
+            target = RecordingTarget(rrd=Path(path))
+        self.target = target
+        self.path = target.rrd
+        if self.path is not None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
         self.scenario = scenario
         self.jpeg_quality = int(jpeg_quality)
-        self.rec = rr.RecordingStream(APP_ID, recording_id=recording_id(scenario))
+        self.rec = rr.RecordingStream(
+            APP_ID,
+            recording_id=recording or recording_id(scenario),
+            # Chunks end at each flush (every measurement) or after a second: fewer, larger
+            # chunks than the default 8 ms tick (each chunk costs about 1 kB in the file).
+            batcher_config=rr.ChunkBatcherConfig(flush_tick=FLUSH_TICK),
+        )
         # No wall-clock timeline: two runs log the same data.
         self.rec.set_log_time_enabled(False)
-        self.rec.save(self.path, default_blueprint=blueprint())
+        layout = blueprint(scenario)
+        sinks: list[rr.FileSink | rr.GrpcSink | rr.GrpcServerSink] = []
+        if target.connect_url is not None:
+            sinks.append(rr.GrpcSink(target.connect_url))
+        if target.serve:
+            sinks.append(rr.GrpcServerSink(port=target.grpc_port))
+        if sinks and self.path is not None:
+            sinks.append(rr.FileSink(self.path))
+        if sinks:
+            self.rec.set_sinks(*sinks, default_blueprint=layout)  # each sink gets the layout
+        else:
+            self.rec.save(self.path, default_blueprint=layout)
+        if target.serve:
+            # The page only; the data comes from the gRPC server above.
+            rr.serve_web_viewer(
+                web_port=target.web_port, open_browser=False, connect_to=target.server_url
+            )
         self.rec.send_recording_name(scenario.name)
         self.current_frame = 0
         self.current_step = 0
@@ -126,6 +232,15 @@ class Recorder(Observer):
         self.objects: dict[str, str] = {}
         self.closed = False
         self._pursuit_trail: list[np.ndarray] = []
+        self._scene_key: tuple[str, ...] | None = None
+        self._body_poses: mjcf_rerun.BodyPoses | None = None
+        # Geometry is static when the whole run is in one scene; else logged per phase.
+        scenes = {scenario.scene.scene}
+        if scenario.experiment.calibration is not None:
+            scenes.add("default")
+        self._static_geometry = len(scenes) == 1
+        self.geometry: list[mjcf_rerun.ModelGeometry] = []
+        self._rows: list[str] = []
         self._log_static()
 
     # -- helpers ------------------------------------------------------------------
@@ -160,6 +275,7 @@ class Recorder(Observer):
                     ],
                     colors=[_ORANGE, _GREY],
                     labels=["goal column u0", "centre row"],
+                    show_labels=False,
                 ),
                 static=True,
             )
@@ -183,6 +299,19 @@ class Recorder(Observer):
             rr.TextDocument(self._scenario_markdown(), media_type=rr.MediaType.MARKDOWN),
             static=True,
         )
+        # Until they exist, the other documents say what will be there (frame 0).
+        self._time()
+        calibration = self.scenario.experiment.calibration
+        for path, text in (
+            (
+                "/results/calibration",
+                "# Calibration\n\n"
+                + ("running ..." if calibration else "none: this scenario does not calibrate"),
+            ),
+            ("/results/summary", "# Summary\n\nwritten when the run ends"),
+            ("/results/measurements", "# Measurements\n\nnone yet"),
+        ):
+            self.rec.log(path, rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN))
 
     def _scenario_markdown(self) -> str:
         s = self.scenario
@@ -218,7 +347,25 @@ class Recorder(Observer):
             "|---|---|---|---|---|---|\n" + cams + "\n"
         )
 
+    def _scene(self, sim: HeadSim) -> None:
+        """Log the model's geometry when this sim's model is new to the recording."""
+        model = sim.model
+        key = tuple(mjcf_rerun.body_name(model, b) for b in range(model.nbody)) + tuple(
+            mjcf_rerun.geom_name(model, g) for g in range(model.ngeom)
+        )
+        if key == self._scene_key:
+            return
+        if self._scene_key is not None and not self._static_geometry:
+            self.rec.log(mjcf_rerun.ROOT, rr.Clear(recursive=True))
+        self._scene_key = key
+        self.geometry.append(
+            mjcf_rerun.log_model_geometry(self.rec, model, static=self._static_geometry)
+        )
+        self._body_poses = mjcf_rerun.BodyPoses(model)
+
     def _pose(self, sim: HeadSim) -> None:
+        if self._body_poses is not None:
+            self._body_poses.log(self.rec, sim.data)
         world_from_head = sim.world_from_head()
         self.rec.log(
             "/world/head",
@@ -242,7 +389,11 @@ class Recorder(Observer):
         self.rec.log(
             "/world/optical_axes",
             rr.Arrows3D(
-                origins=origins, vectors=vectors, colors=[_ORANGE, _ORANGE], labels=["cam1", "cam2"]
+                origins=origins,
+                vectors=vectors,
+                colors=[_ORANGE, _ORANGE],
+                labels=["cam1", "cam2"],
+                show_labels=False,
             ),
         )
         eye = sim.eye_encoder()
@@ -263,6 +414,8 @@ class Recorder(Observer):
             sim.effective_initial_direction(2),
         )
         self.world_from_head_start = sim.world_from_head()
+        self._time()
+        self._scene(sim)
         procedure = self.scenario.experiment.procedure
         self.objects = (
             {o.body: names.RELATIVE_OBJECT_COLOURS[o.body] for o in self.scenario.scene.objects}
@@ -275,7 +428,7 @@ class Recorder(Observer):
         if name == "calibration":
             self.rec.log(
                 "/world/calibration/positions",
-                rr.Points3D(positions, radii=0.004, colors=[_GREY] * len(labels)),
+                rr.Points3D(positions, radii=_UI_RADIUS_SMALL, colors=[_GREY] * len(labels)),
             )
         else:
             self.rec.log("/world/calibration/positions", rr.Clear(recursive=False))
@@ -283,7 +436,7 @@ class Recorder(Observer):
                 "/world/truth",
                 rr.Points3D(
                     positions,
-                    radii=0.003,
+                    radii=_UI_RADIUS_SMALL,
                     colors=[_WHITE] * len(labels),
                     labels=labels,
                     show_labels=False,
@@ -308,7 +461,7 @@ class Recorder(Observer):
         if target is not None:
             self.rec.log(
                 "/world/current_target",
-                rr.Points3D([target], radii=0.006, colors=[_ORANGE], labels=[label]),
+                rr.Points3D([target], radii=_UI_RADIUS_LARGE, colors=[_ORANGE], labels=[label]),
             )
 
     def rendered(self, sim: HeadSim, camera: int, image: np.ndarray, frame: int) -> None:
@@ -352,7 +505,7 @@ class Recorder(Observer):
             return
         self.rec.log(
             f"/world/head/{cam}/features",
-            rr.Points2D([uv], radii=5.0, colors=[_GREEN], labels=[f"{self.label}: {status}"]),
+            rr.Points2D([uv], radii=5.0, colors=[_GREEN], labels=[self.label]),
         )
         u0, v0 = self.knowledge.reference(sim, camera)
         self.rec.log(f"/servo/{cam}/u_error_px", rr.Scalars([uv[0] - u0]))
@@ -375,7 +528,7 @@ class Recorder(Observer):
                 "/world/estimate",
                 rr.Points3D(
                     [e for _, e, _ in done],
-                    radii=0.004,
+                    radii=_UI_RADIUS,
                     colors=[_GREEN] * len(done),
                     labels=[self._labels[k] for k, _, _ in done],
                     show_labels=False,
@@ -393,6 +546,19 @@ class Recorder(Observer):
         residuals = [abs(r) for r in m.servo_residual_px if math.isfinite(r)]
         if residuals:
             self.rec.log("/measurements/servo_residual_px", rr.Scalars([max(residuals)]))
+        self._rows.append(
+            f"| {record.step} | {label} | {m.status} | {error * 1000.0:.2f} | "
+            f"{m.error_pct_of_depth:.3f} | {m.renders} | "
+            f"{max(residuals) if residuals else float('nan'):.2f} |"
+        )
+        self.rec.log(
+            "/results/measurements",
+            rr.TextDocument(
+                "# Measurements\n\n| step | target | status | error mm | % of depth | renders "
+                "| residual px |\n|---|---|---|---|---|---|---|\n" + "\n".join(self._rows) + "\n",
+                media_type=rr.MediaType.MARKDOWN,
+            ),
+        )
         self.rec.flush()
 
     def pursued(self, record: Any, frame: int) -> None:

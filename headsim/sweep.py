@@ -26,6 +26,7 @@ end ``DIR/aggregate.csv``, ``DIR/aggregate.json`` and a plot per swept field.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import functools
 import hashlib
 import io
 import itertools
@@ -206,11 +207,13 @@ def _random_params(source: str, table: Any) -> tuple[list[dict[str, Any]], tuple
     return [{k: columns[k][i] for k in names} for i in range(count)], names
 
 
-def run_job(job: Job, marker_dir: str | None = None) -> dict[str, Any]:
+def run_job(job: Job, marker_dir: str | None = None, recording: Any = None) -> dict[str, Any]:
     """Run one job in this process; never raises (failures become a record).
 
     ``marker_dir``: a file named after the job sits there while it runs, so
-    that after a crash the sweep knows which jobs were running.
+    that after a crash the sweep knows which jobs were running.  ``recording``:
+    a :class:`headsim.rerun_cli.RecordingTarget` for every job (``--rrd DIR``,
+    ``--connect``), or None.
     """
     marker = Path(marker_dir) / job.id if marker_dir else None
     if marker is not None:
@@ -219,13 +222,13 @@ def run_job(job: Job, marker_dir: str | None = None) -> dict[str, Any]:
     if job.index in crash:
         os._exit(86)  # a hard crash, as a segfault in a renderer would be
     try:
-        return _run_job(job)
+        return _run_job(job, recording)
     finally:
         if marker is not None:
             marker.unlink(missing_ok=True)
 
 
-def _run_job(job: Job) -> dict[str, Any]:
+def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
     start = time.perf_counter()
     record: dict[str, Any] = {"id": job.id, "index": job.index, "params": job.params}
     try:
@@ -236,7 +239,16 @@ def _run_job(job: Job) -> dict[str, Any]:
         scenario = load_scenario(
             job.scenario, fast=job.fast, seed=job.params.get("seed"), overrides=overrides
         )
-        result = run_scenario(scenario)
+        if recording is not None:
+            from headsim.recording import Recorder
+            from headsim.rerun_cli import job_target
+
+            with Recorder(
+                None, scenario, target=job_target(recording, job.id), recording=job.id
+            ) as recorder:
+                result = run_scenario(scenario, [recorder])
+        else:
+            result = run_scenario(scenario)
         calibrated = result.calibration is not None
         ok = [r.measurement for r in result.records if r.measurement.ok]
         used = [
@@ -429,12 +441,14 @@ def run_sweep(
     scheduler: str | None = None,
     progress: bool = True,
     stop_after: int | None = None,
+    recording: Any = None,
 ) -> SweepOutcome:
     """Run the jobs not yet in ``out_dir/jobs.jsonl``; then write the aggregate and plots.
 
     ``workers``: local processes (spawn start method).  ``scheduler``: a Dask
     scheduler address (``tcp://host:8786``) instead; needs ``headsim[dask]``.
     ``stop_after``: stop after that many jobs (for tests of resuming).
+    ``recording``: record every job (:func:`run_job`).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -443,6 +457,7 @@ def run_sweep(
     remaining = [job for job in spec.jobs if job.id not in done]
     bar = _Progress(len(remaining), progress)
     start = time.perf_counter()
+    job_function = functools.partial(run_job, recording=recording) if recording else run_job
 
     def on_record(record: dict[str, Any]) -> None:
         _append(log, record)
@@ -452,7 +467,9 @@ def run_sweep(
     if scheduler is not None:
         client = _dask_client(scheduler)
         try:
-            ran = _execute(remaining, client.get_executor, on_record, stop_after)
+            ran = _execute(
+                remaining, client.get_executor, on_record, stop_after, None, job_function
+            )
         finally:
             client.close()
     else:
@@ -469,6 +486,7 @@ def run_sweep(
             on_record,
             stop_after,
             markers,
+            job_function,
         )
     bar.close()
     wall = time.perf_counter() - start

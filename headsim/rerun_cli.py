@@ -1,0 +1,175 @@
+"""Rerun's command-line conventions for every command that records.
+
+``--rrd FILE`` writes a file; ``--connect`` (with ``--url``) streams to a
+running viewer; ``--serve`` hosts a gRPC server and a web viewer for it.
+The names and meanings are those of ``rerun.script_add_args`` (Rerun's
+examples); its ``--save``/``--stdout``/``--headless`` are left out (``--rrd``
+is headsim's ``--save``, and headsim never spawns a native viewer).  This
+module imports no Rerun, so that ``headsim --help`` stays fast.
+
+    parser = argparse.ArgumentParser()
+    add_recording_arguments(parser)
+    target = recording_target(parser.parse_args())   # RecordingTarget
+"""
+
+from __future__ import annotations
+
+import argparse
+import urllib.parse
+from dataclasses import dataclass
+from pathlib import Path
+
+from headsim.errors import BadInput
+
+#: Rerun's default ports: the gRPC server and the web viewer.
+DEFAULT_GRPC_PORT = 9876
+DEFAULT_WEB_PORT = 9090
+#: Where ``--connect`` streams without ``--url`` (a viewer started with ``rerun``).
+DEFAULT_URL = f"rerun+http://127.0.0.1:{DEFAULT_GRPC_PORT}/proxy"
+
+
+class RecordingArgumentError(BadInput, ValueError):
+    """A recording option is invalid: ``field`` names it, ``allowed`` says what is."""
+
+    def __init__(self, field: str, message: str, allowed: str) -> None:
+        super().__init__(f"{field}: {message} (allowed: {allowed})")
+        self.field, self.message, self.allowed = field, message, allowed
+
+
+def job_target(target: RecordingTarget, job_id: str) -> RecordingTarget:
+    """One sweep job's target: its own file ``DIR/JOB_ID.rrd``, the same viewer."""
+    rrd = target.rrd / f"{job_id}.rrd" if target.rrd is not None else None
+    return RecordingTarget(rrd=rrd, connect_url=target.connect_url)
+
+
+@dataclass(frozen=True)
+class RecordingTarget:
+    """Where a recording goes: a file, a running viewer, a served web viewer (any of them)."""
+
+    rrd: Path | None = None
+    connect_url: str | None = None
+    serve: bool = False
+    grpc_port: int = DEFAULT_GRPC_PORT
+    web_port: int = DEFAULT_WEB_PORT
+
+    @property
+    def wanted(self) -> bool:
+        """Whether anything is to be recorded."""
+        return self.rrd is not None or self.connect_url is not None or self.serve
+
+    @property
+    def server_url(self) -> str:
+        """The gRPC address of ``--serve``'s server, as a viewer opens it."""
+        return f"rerun+http://127.0.0.1:{self.grpc_port}/proxy"
+
+    @property
+    def web_viewer_url(self) -> str:
+        """The address of ``--serve``'s web viewer, opening this run."""
+        source = urllib.parse.quote(self.server_url, safe="")
+        return f"http://127.0.0.1:{self.web_port}/?url={source}"
+
+
+def add_recording_arguments(parser: argparse.ArgumentParser, *, per_job: bool = False) -> None:
+    """Add ``--rrd``, ``--connect``, ``--url``, ``--serve`` and the two ports to ``parser``.
+
+    ``per_job``: for a command of many runs (``sweep``): ``--rrd DIR`` holds one file
+    per job, ``--connect`` streams each job as its own recording, and there is no
+    ``--serve`` (parallel jobs cannot share one server's port).
+    """
+    group = parser.add_argument_group("recording (Rerun)")
+    if per_job:
+        group.add_argument(
+            "--rrd", metavar="DIR", help="record each job to DIR/JOB_ID.rrd (created)"
+        )
+        group.add_argument(
+            "--connect",
+            action="store_true",
+            help="stream each job live to a running Rerun viewer, one recording per job",
+        )
+        group.add_argument(
+            "--url", metavar="URL", help=f"the viewer --connect streams to (default {DEFAULT_URL})"
+        )
+        return
+    group.add_argument("--rrd", metavar="FILE", help="record the run to this Rerun .rrd file")
+    group.add_argument(
+        "--connect",
+        action="store_true",
+        help="stream the recording live to a running Rerun viewer (start one with `rerun`)",
+    )
+    group.add_argument(
+        "--url",
+        metavar="URL",
+        help=f"the viewer --connect streams to (default {DEFAULT_URL})",
+    )
+    group.add_argument(
+        "--serve",
+        action="store_true",
+        help="host the recording live in a web viewer (the URL is printed); after the run "
+        "it is served until Ctrl-C",
+    )
+    group.add_argument(
+        "--web-port",
+        type=int,
+        default=DEFAULT_WEB_PORT,
+        metavar="PORT",
+        help=f"--serve: the web viewer's port (default {DEFAULT_WEB_PORT})",
+    )
+    group.add_argument(
+        "--grpc-port",
+        type=int,
+        default=DEFAULT_GRPC_PORT,
+        metavar="PORT",
+        help=f"--serve: the gRPC server's port (default {DEFAULT_GRPC_PORT})",
+    )
+
+
+def recording_target(args: argparse.Namespace, *, per_job: bool = False) -> RecordingTarget:
+    """The checked target of parsed recording options; :class:`RecordingArgumentError` if bad.
+
+    ``per_job``: ``rrd`` is a directory (see :func:`add_recording_arguments`).
+    """
+    rrd = Path(args.rrd) if getattr(args, "rrd", None) else None
+    if per_job and rrd is not None and rrd.exists() and not rrd.is_dir():
+        raise RecordingArgumentError("--rrd", f"{rrd} is not a directory", "a directory")
+    if not per_job and rrd is not None and rrd.is_dir():
+        raise RecordingArgumentError("--rrd", f"{rrd} is a directory", "a file path, e.g. run.rrd")
+    url = getattr(args, "url", None)
+    connect = bool(getattr(args, "connect", False))
+    if url is not None and not connect:
+        raise RecordingArgumentError("--url", "given without --connect", "--connect --url URL")
+    if url is not None:
+        parsed = urllib.parse.urlparse(url)
+        if parsed.scheme not in ("rerun", "rerun+http", "rerun+https") or not parsed.path.endswith(
+            "/proxy"
+        ):
+            raise RecordingArgumentError(
+                "--url", f"{url!r} is not a Rerun gRPC address", "e.g. " + DEFAULT_URL
+            )
+    ports = {
+        "--web-port": getattr(args, "web_port", DEFAULT_WEB_PORT),
+        "--grpc-port": getattr(args, "grpc_port", DEFAULT_GRPC_PORT),
+    }
+    for field, port in ports.items():
+        if not 1 <= port <= 65535:
+            raise RecordingArgumentError(field, f"{port} is not a port", "1 to 65535")
+    if ports["--web-port"] == ports["--grpc-port"]:
+        raise RecordingArgumentError(
+            "--web-port", "is the same as --grpc-port", "two different ports"
+        )
+    return RecordingTarget(
+        rrd=rrd,
+        connect_url=(url or DEFAULT_URL) if connect else None,
+        serve=bool(getattr(args, "serve", False)),
+        grpc_port=ports["--grpc-port"],
+        web_port=ports["--web-port"],
+    )
+
+
+__all__ = [
+    "DEFAULT_URL",
+    "RecordingArgumentError",
+    "RecordingTarget",
+    "add_recording_arguments",
+    "job_target",
+    "recording_target",
+]
