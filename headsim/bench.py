@@ -305,7 +305,7 @@ def _realistic_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
             for band in experiments.DEPTH_BANDS_M
         ]
     )
-    measured, _ = _measure_points(settings, knowledge, points, faults)
+    measured, *_ = _measure_points(settings, knowledge, points, faults)
     fig = experiments.error_figures(measured)
     near = experiments.error_figures([m for m in measured if m.depth_m < 0.6])
     metrics["realistic.model2.rms_3d_pct_depth"] = fig.get("rms_3d_pct_depth", math.inf)
