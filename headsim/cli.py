@@ -664,7 +664,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not debug:  # Rerun's own log lines repeat errors that headsim reports in one line
         os.environ.setdefault("RUST_LOG", "off")
     with _process_signals():
-        return guarded(lambda: _main(rest, debug=debug, quiet=quiet), debug=debug)
+        code = guarded(lambda: _main(rest, debug=debug, quiet=quiet), debug=debug)
+    if code == ExitCode.INTERRUPTED and argv is None:
+        # The process's own entry point, interrupted: its files are closed. Leave now, for
+        # CPython ends a process by SIGINT at exit (status -2, not 130) once a
+        # KeyboardInterrupt passed through an extension's PyRun_* call (pybind11's exec
+        # while mujoco imports), even when headsim caught it.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(int(code))
+    return code
 
 
 if __name__ == "__main__":

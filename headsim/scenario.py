@@ -356,7 +356,7 @@ class _Table:
         )
         if bad:
             raise self.fail(key, f"{value:g} is out of range", allowed)
-        return value
+        return value + 0.0  # -0.0 is 0: a range [-x, x] of it must not come out reversed
 
     def integer(self, key: str, default: Any = _MISSING, lo: int = 0, hi: int = 10**6) -> int:
         value = self._get(key)
@@ -488,8 +488,8 @@ def _read_camera(
     base = preset(name).cameras[index]
     width = table.integer("width", base.width, 16, MAX_IMAGE_SIDE)
     height = table.integer("height", base.height, 16, MAX_IMAGE_SIDE)
-    kx = table.number("kx", base.kx, 0.0, 1e5, lo_open=True, unit="px")
-    ky = table.number("ky", base.ky, 0.0, 1e5, lo_open=True, unit="px")
+    kx = table.number("kx", base.kx, 1.0, 1e5, unit="px")
+    ky = table.number("ky", base.ky, 1.0, 1e5, unit="px")
     cx_default = base.cx if base.cx is not None and base.cx <= width - 1 else None
     cy_default = base.cy if base.cy is not None and base.cy <= height - 1 else None
     cx = table.number("cx", cx_default, 0.0, width - 1.0, unit="px (inside the image)")
@@ -541,7 +541,7 @@ def _lens_problem(camera: CameraSettings) -> tuple[str, str] | None:
     if math.hypot(du, dv) < reach * (1.0 - 1e-9):
         return None
     limit_deg = math.degrees(math.atan(fold))
-    room = max(reach**2 - dv**2, 0.0) ** 0.5 * camera.kx  # px the centre may sit from cx
+    room = max((reach - abs(dv)) * (reach + abs(dv)), 0.0) ** 0.5 * camera.kx  # px from cx
     widest = 2.0 * (cx + room) + 1.0
     return (
         f"an image {camera.width} x {camera.height} px with the principal point at "

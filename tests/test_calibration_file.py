@@ -21,7 +21,7 @@ from headsim.settings import HeadSettings, paper_head
 
 SCENARIO = """description = "measure with a stored calibration"
 [head]
-preset = "paper"
+preset = "realistic"
 {extra}
 [cam1]
 noise_std = 1.0

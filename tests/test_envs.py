@@ -22,8 +22,17 @@ def test_env_passes_gymnasiums_checker() -> None:
 
 
 def test_same_seed_gives_identical_observations_and_another_seed_does_not() -> None:
-    env = gymnasium.make(ID, randomise={"kx": (100.0, 130.0), "mount_yaw_rad": (-0.02, 0.02)})
+    env = gymnasium.make(
+        ID,
+        randomise={
+            "kx": (100.0, 130.0),
+            "mount_yaw_rad": (-0.02, 0.02),
+            "nodal_offset_m": (0.01, 0.03),  # the realistic head's optical centres
+        },
+    )
     first, _ = env.reset(seed=7)
+    drawn = [c.nodal_offset_m for c in env.unwrapped._settings.cameras]
+    assert all(0.01 <= n <= 0.03 for n in drawn) and drawn[0] != drawn[1]
     action = np.array([0.3, -0.2, 1.0], np.float32)
     after_first = env.step(action)[0]
     other, _ = env.reset(seed=8)

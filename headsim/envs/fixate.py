@@ -58,6 +58,9 @@ CAMERA_FIELDS = (
     "mount_pitch_rad",
     "mount_roll_rad",
     "noise_std",
+    "nodal_offset_m",
+    "side_offset_m",
+    "eye_axis_tilt_rad",
 )
 HEAD_FIELDS = ("baseline_m",)
 TARGET_FIELDS = ("depth_m", "bearing_rad", "speed_m_s")
