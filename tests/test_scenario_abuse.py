@@ -46,7 +46,7 @@ def _model2(tmp_path: Path, head: str = "", cam1: str = "", experiment: str = ""
 
 @pytest.mark.parametrize(
     ("cam1", "widest"),
-    [("[cam1]\nwidth = 4096", "at most 1632 px wide"), ("[cam1]\nkx = 0.001", "a larger kx")],
+    [("[cam1]\nwidth = 4096", "at most 1632 px wide"), ("[cam1]\nkx = 20.0", "a larger kx")],
 )
 def test_a_lens_that_cannot_reach_the_image_centre_says_why(
     tmp_path: Path, cam1: str, widest: str
@@ -58,6 +58,11 @@ def test_a_lens_that_cannot_reach_the_image_centre_says_why(
     assert "beyond where k1 = -0.38741, k2 = 0 is monotonic" in message
     assert "43 degrees off axis" in message and widest in message
     assert "flat index" not in message
+
+
+def test_a_focal_length_below_a_pixel_names_its_range(tmp_path: Path) -> None:
+    with pytest.raises(ScenarioError, match=r"cam1\.kx: 0\.001 is out of range .*>= 1"):
+        load_scenario(_model2(tmp_path, cam1="[cam1]\nkx = 0.001"))
 
 
 def test_a_target_inside_the_neck_offset_names_the_setting_not_nan(tmp_path: Path) -> None:
