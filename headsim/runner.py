@@ -240,11 +240,14 @@ class ObservedSim(HeadSim):
     def __init__(self, hub: Hub, scene: str, scenario: Scenario) -> None:
         super().__init__(scene, scenario.settings, settle_mode=scenario.settle_mode)
         self.hub = hub
+        #: Each camera's last whole image, the backdrop of the windows that follow it.
+        self._last_full: dict[int, np.ndarray] = {}
 
     def render(self, camera: CameraId) -> np.ndarray:
         before = self.rendered_frames
         image = super().render(camera)
         self.hub.rendered_frames += self.rendered_frames - before
+        self._last_full[self.camera_index(camera)] = image
         self.hub.rendered(self, self.camera_index(camera) + 1, image)
         return image
 
@@ -252,17 +255,23 @@ class ObservedSim(HeadSim):
         before = self.rendered_frames
         image = super().retake(camera)
         self.hub.rendered_frames += self.rendered_frames - before
+        self._last_full[self.camera_index(camera)] = image
         self.hub.rendered(self, self.camera_index(camera) + 1, image)
         return image
 
     def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
-        """The window; observers see it in a full-size frame, black elsewhere."""
+        """The window; observers see it in a full-size frame: around it the camera's last
+        whole image at half brightness (not rendered now), or black before there is one."""
         before = self.rendered_frames
         image = super().render_window(camera, window)
         self.hub.rendered_frames += self.rendered_frames - before
         self.hub.windows += 1
         settings = self.camera_settings(camera)
-        frame = np.zeros((settings.height, settings.width, 3), dtype=np.uint8)
+        last = self._last_full.get(self.camera_index(camera))
+        if last is not None and last.shape == (settings.height, settings.width, 3):
+            frame = last // 2
+        else:
+            frame = np.zeros((settings.height, settings.width, 3), dtype=np.uint8)
         frame[window.y0 : window.y1, window.x0 : window.x1] = image
         self.hub.rendered(self, self.camera_index(camera) + 1, frame, (window.x0, window.y0))
         return image
