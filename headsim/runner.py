@@ -266,6 +266,9 @@ class ObservedSim(HeadSim):
         image = super().render_window(camera, window)
         self.hub.rendered_frames += self.rendered_frames - before
         self.hub.windows += 1
+        if not self.hub.observers:  # nobody looks at the frame: only count the render
+            self.hub.rendered(self, self.camera_index(camera) + 1, image, (window.x0, window.y0))
+            return image
         settings = self.camera_settings(camera)
         last = self._last_full.get(self.camera_index(camera))
         if last is not None and last.shape == (settings.height, settings.width, 3):
