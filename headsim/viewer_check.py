@@ -20,7 +20,9 @@ import argparse
 import base64
 import contextlib
 import json
+import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -136,15 +138,38 @@ def serve_file(rrd: Path, timeout_s: float = 60.0) -> Iterator[str]:
             _stop(process)
 
 
-def _stop(process: subprocess.Popen) -> None:
-    """Terminate a child process, kill it if it does not end within 10 s."""
-    if process.poll() is None:
+def _stop(process: subprocess.Popen, group: bool = False) -> None:
+    """Terminate a child process (its whole process group when ``group``), kill it if it
+    does not end within 10 s."""
+    if group:
+        _signal_group(process, signal.SIGTERM)
+    elif process.poll() is None:
         process.terminate()
+    try:
+        process.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait(timeout=10)
+    if group:
+        # Chromium's helpers (zygote, GPU, crashpad) can outlive the browser and keep
+        # writing into the profile; end them all before the profile is removed.
+        _signal_group(process, signal.SIGKILL)
+
+
+def _signal_group(process: subprocess.Popen, sig: int) -> None:
+    with contextlib.suppress(ProcessLookupError, PermissionError):
+        os.killpg(process.pid, sig)
+
+
+def _remove_profile(profile: tempfile.TemporaryDirectory) -> None:
+    """Remove a browser profile; a helper still writing into it gets a few tries."""
+    for _ in range(10):
         try:
-            process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=10)
+            profile.cleanup()
+            return
+        except OSError:
+            time.sleep(0.3)
+    shutil.rmtree(profile.name, ignore_errors=True)
 
 
 @dataclass
@@ -189,13 +214,15 @@ def chromium(executable: str | None = None, timeout_s: float = 60.0) -> Iterator
         "about:blank",
     ]
     with tempfile.TemporaryFile() as log:
-        process = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT)
+        process = subprocess.Popen(
+            command, stdout=log, stderr=subprocess.STDOUT, start_new_session=True
+        )
         try:
             wait_for_port(port, timeout_s, process)
             yield Browser(process, port, profile)
         finally:
-            _stop(process)
-            profile.cleanup()
+            _stop(process, group=True)
+            _remove_profile(profile)
 
 
 class _DevTools:
