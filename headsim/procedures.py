@@ -976,9 +976,11 @@ def relative_positioning(
     if not ref.ok:
         return RelativeRun(ref, {}, {}, {}, tuple(objects), None, sim.render_count - start)
     resolution = sim.settings.encoder_resolution_rad
+    # The lines L11..L22 are the cameras' lines of sight at the two fixations
+    # (not where a search took a y image).
     steps = (
-        round(ref.details["gamma2_rad"] / resolution),
-        round(ref.details["gamma1_rad"] / resolution),
+        round(ref.details["step1_encoder_rad"] / resolution),
+        round(ref.details["step2_encoder_rad"] / resolution),
     )
     columns: dict[str, list[float]] = {name: [math.nan] * 4 for name in objects}
     # Order of the four columns: u11 (Ca1, step 1), u12 (Ca1, step 2), u21, u22.
