@@ -37,6 +37,7 @@ from headsim.search import (
     Failure,
     FailureCause,
     detection_failure,
+    find_neck_view,
     find_view,
     nearest_seen,
     neck_failure,
@@ -763,21 +764,40 @@ def measure_model1(
     target: Target,
     knowledge: HeadKnowledge | None = None,
     interpolate: bool = True,
+    last_seen: Sequence[tuple[int, int, int]] = (),
 ) -> Measurement:
-    """Model 1: fixate with neck and eyes, then eqs. (2)-(3) (Sec. II-B)."""
+    """Model 1: fixate with neck and eyes, then eqs. (2)-(3) (Sec. II-B).
+
+    ``last_seen``: (yaw, pitch, eye) steps of the last fixations of this same
+    target, oldest first (tracking).  If both cameras do not see it where the
+    neck was left, the head looks around the last of them (and where the last
+    two predict it), then from the start pose; every look is counted in
+    ``search_renders``.
+    """
     knowledge = knowledge or HeadKnowledge()
     start = sim.render_count
     (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
     goals = (u10, u20, (v10 + v20) / 2)
     result = servo.run(target.detector, goals=goals)
     search = 0
-    if result.outcome is ServoOutcome.TARGET_LOST and result.iterations == 0 and any(result.steps):
-        # Not in both views where the neck was left (the last target's pose):
-        # back to the start pose and fixate from there.
+    if result.outcome is ServoOutcome.TARGET_LOST and result.iterations == 0:
         search = result.renders  # the look that did not find it
-        sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
-        sim.settle()
-        result = servo.run(target.detector, goals=goals)
+        found = None
+        if last_seen:
+            # A tracked target left the view: look around its last fixation.
+            before = sim.render_count
+            found = find_neck_view(servo, target.detector, last_seen)
+            search += sim.render_count - before
+            if found is not None:
+                result = servo.run(target.detector, goals=goals)
+        if found is None and any(servo.steps()):
+            # Not in both views where the neck was left (the last target's pose),
+            # nor around it: back to the start pose and fixate from there.
+            sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
+            sim.settle()
+            result = servo.run(target.detector, goals=goals)
+        elif found is None:
+            search = 0  # nothing else was tried: the first look's failure stands
     residual = (result.residual_px,)
     if not result.converged:
         return _failed(
@@ -835,12 +855,18 @@ def track_moving_target(
     """Move ``body`` along ``trajectory(t)`` (world, m) and fixate it at each time with Model 1.
 
     The servo's Jacobian carries from one fixation to the next, so after the
-    first fixation each one starts from the last and takes few renders.
+    first fixation each one starts from the last and takes few renders.  A
+    target that left both views since is searched for around the last
+    fixation (:func:`headsim.search.find_neck_view`), then from the start pose.
     """
     measurements = []
+    fixations: list[tuple[int, int, int]] = []  # where the target was seen, in steps
     for t in times_s:
         sim.set_body_pose(body, trajectory(float(t)))
-        measurements.append(measure_model1(sim, servo, target, knowledge))
+        m = measure_model1(sim, servo, target, knowledge, last_seen=fixations[-2:])
+        measurements.append(m)
+        if m.ok:
+            fixations.append(servo.steps())
     return TrackingRun(np.asarray(times_s, dtype=float), tuple(measurements))
 
 

@@ -19,7 +19,7 @@ from headsim.procedures import (
     measure_model2,
 )
 from headsim.scenario import _Head, model2_refusal
-from headsim.search import FailureCause
+from headsim.search import FailureCause, neck_search_poses
 from headsim.servo import EyeServo, NeckServo, ServoConfig
 from headsim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim import HeadSim
@@ -174,3 +174,21 @@ def test_calibration_failures_name_their_cause() -> None:
             calibrate_head(
                 sim, servo, BALL, names.CALIBRATION_BALL, np.array([ahead, beside, near])
             )
+
+
+def test_neck_search_looks_first_where_the_last_two_fixations_predict_the_target() -> None:
+    with HeadSim("default", HeadSettings()) as sim:
+        servo = NeckServo(sim)
+        assert neck_search_poses(servo, [(0, 0, 0)], (640, 480)) == []  # no gains learnt yet
+        # px per step: yaw moves both u by 2, pitch moves v by 2 (a learnt Jacobian).
+        servo.jacobian = np.array([[2.0, 0.0, 1.0], [2.0, 0.0, -1.0], [0.0, 2.0, 0.0]])
+        last = [(0, 0, 40), (100, 20, 40)]
+        poses = neck_search_poses(servo, last, (640, 480))
+    assert poses[0] == (200, 40, 40)  # constant velocity in steps
+    # The rest: a grid around the last fixation in strides of 0.7 of the view.
+    stride = (int(0.7 * 640 / 2), int(0.7 * 480 / 2))
+    assert (100 + stride[0], 20, 40) in poses and (100, 20 - stride[1], 40) in poses
+    assert (100, 20, 40) not in poses and len(poses) == len(set(poses))
+    yaw_range, pitch_range, _ = servo.step_ranges
+    assert all(yaw_range[0] <= p[0] <= yaw_range[1] for p in poses)
+    assert all(pitch_range[0] <= p[1] <= pitch_range[1] for p in poses)
