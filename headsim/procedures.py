@@ -573,6 +573,10 @@ def calibrate_head(
     for position in np.atleast_2d(positions_world):
         sim.set_body_pose(body, position)
         m = measure_model2(sim, servo, target, base, plain)
+        if m.failure is not None and m.failure.cause is FailureCause.ESTIMATOR:
+            # Near the midline the y images hold almost no x offset (NO_Y): take
+            # them again at an intermediate eye angle, the near-midline remedy.
+            m = measure_model2(sim, servo, target, base, Model2Config())
         outcomes.append(m.failure)
         if not m.ok:
             continue

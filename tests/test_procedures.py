@@ -7,6 +7,7 @@ from functools import partial
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 
 from headsim import names
 from headsim.procedures import (
@@ -105,6 +106,23 @@ def test_calibration_recovers_effective_initial_directions_and_corrects_measurem
         after = measure_model2(sim, servo, RED, run.knowledge)
         assert after.error_pct_of_depth < 0.3
         assert before.error_pct_of_depth > 3 * after.error_pct_of_depth
+
+
+def test_calibration_fixates_a_position_on_the_midline_with_the_near_midline_remedy() -> None:
+    with HeadSim("default", paper_head()) as sim:
+        e1, e2 = (sim.effective_initial_direction(c) for c in (1, 2))
+        half, z = sim.settings.baseline_m / 2, 0.4
+        # Where both eyes fixate at the same angle: each camera's y image then
+        # shows P on its goal column (NO_Y), unless taken at another eye angle.
+        x = brentq(lambda x: np.arctan2(x + half, z) - e1 - np.arctan2(half - x, z) + e2, -0.2, 0.2)
+        layout = np.array([[x, 0.01, z], [-0.05, -0.02, 0.3], [0.06, 0.03, 0.5], [0.0, 0.0, 0.35]])
+        world = sim.transform_points(layout, "head", "world")
+        sim.set_body_pose(names.CALIBRATION_BALL, world[0])
+        plain = measure_model2(sim, EyeServo(sim), BALL, config=Model2Config(midline_px=0.0))
+        assert plain.failure is not None and plain.failure.cause is FailureCause.ESTIMATOR
+        run = calibrate_head(sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, world)
+    assert run.outcomes == (None, None, None, None) and run.samples == 4
+    assert np.abs(run.alpha_e_error).max() < 1e-3
 
 
 def test_calibration_with_too_few_visible_targets_says_so() -> None:
