@@ -477,6 +477,7 @@ def calibration_layout(
     lateral: float = 0.16,
     vertical: float = 0.08,
     radius_m: float = 0.008,
+    eye_angles_rad: Sequence[float] = (),
 ) -> np.ndarray:
     """World positions (count, 3) for Sec. V calibration targets, seeded.
 
@@ -485,8 +486,26 @@ def calibration_layout(
     close): 60 targets at 0.25-0.6 m recover them to about 1e-4 rad with the
     paper's cameras.  ``lateral``/``vertical``: x_h/z_h and y_h/z_h spread; a
     vertical spread is what the extended calibration needs.  Every position is
-    seen whole (ball of ``radius_m``) by both cameras at the current pose.
+    seen whole (ball of ``radius_m``) by both cameras at the current pose, or
+    at one of ``eye_angles_rad`` (encoder angles, neck still): at a long focal
+    length the near, lateral positions that separate the offsets are in the
+    common view only with the eyes turned in (Model 2 finds them by search;
+    the first position is always in view at the current pose).
     """
+    resolution = sim.settings.encoder_resolution_rad
+    eye_steps = [round(a / resolution) for a in eye_angles_rad]
+
+    def seen(points: np.ndarray) -> np.ndarray:
+        ok = seen_by_both(sim, points, radius_m)
+        if eye_steps:
+            before = sim.eye_encoder_steps()
+            for steps in eye_steps:
+                sim.command_eye_steps(steps)
+                sim.settle()
+                ok |= seen_by_both(sim, points, radius_m)
+            sim.command_eye_steps(before)
+            sim.settle()
+        return ok
 
     def draw(n: int) -> np.ndarray:
         z = rng.uniform(*depth_range_m, size=n)
@@ -498,7 +517,10 @@ def calibration_layout(
     # Placement (truth allowed): keep positions both cameras see whole from where the
     # head stands; a position that one cannot see is drawn again, a bounded number of times.
     for _ in range(500):
-        unseen = ~seen_by_both(sim, points_world, radius_m)
+        unseen = ~seen(points_world)
+        # The first position in view from where the head stands: the servo learns
+        # its gains there, which the search for the others needs.
+        unseen[0] |= not seen_by_both(sim, points_world[:1], radius_m)[0]
         if not unseen.any():
             return points_world
         points_world[unseen] = sim.transform_points(draw(int(unseen.sum())), "head", "world")

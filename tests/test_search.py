@@ -15,8 +15,10 @@ from headsim.procedures import (
     Model2Config,
     body_target,
     calibrate_head,
+    calibration_layout,
     measure_model1,
     measure_model2,
+    seen_by_both,
 )
 from headsim.scenario import _Head, model2_refusal
 from headsim.search import FailureCause, neck_search_poses
@@ -192,3 +194,24 @@ def test_neck_search_looks_first_where_the_last_two_fixations_predict_the_target
     yaw_range, pitch_range, _ = servo.step_ranges
     assert all(yaw_range[0] <= p[0] <= yaw_range[1] for p in poses)
     assert all(pitch_range[0] <= p[1] <= pitch_range[1] for p in poses)
+
+
+def test_a_calibration_layout_with_the_eyes_turned_in_spreads_wider_and_is_all_fixated() -> None:
+    # Twice the paper's focal length: from the start pose both cameras share
+    # only a narrow view of the near range that separates the two offsets.
+    base = paper_head()
+    cams = tuple(replace(c, kx=c.kx * 2, ky=c.ky * 2) for c in base.cameras)
+    with HeadSim("default", replace(base, cameras=cams)) as sim:  # type: ignore[arg-type]
+        narrow = calibration_layout(sim, np.random.default_rng(5), 16)
+        wide = calibration_layout(sim, np.random.default_rng(5), 16, eye_angles_rad=(0.1, 0.2, 0.3))
+        assert seen_by_both(sim, wide[:1], 0.008)[0]  # the first one from the start pose
+        assert not seen_by_both(sim, wide, 0.008).all()  # others need the eyes turned in
+
+        def spread(p: np.ndarray) -> float:
+            p_head = sim.transform_points(p, "world", "head")
+            return float(np.std(p_head[:, 0] / p_head[:, 2]))
+
+        assert spread(wide) > 2 * spread(narrow)
+        run = calibrate_head(sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, wide)
+    assert run.outcomes == (None,) * 16
+    assert np.abs(run.alpha_e_error).max() < 5e-4
