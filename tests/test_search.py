@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from headsim import names
+from headsim.kinematics import head_to_world
 from headsim.procedures import (
     CalibrationError,
     HeadKnowledge,
@@ -20,7 +21,7 @@ from headsim.procedures import (
     measure_model2,
     seen_by_both,
 )
-from headsim.scenario import _Head, model2_refusal
+from headsim.scenario import _Head, model2_refusal, reach_refusal
 from headsim.search import FailureCause, neck_search_poses
 from headsim.servo import EyeServo, NeckServo, ServoConfig
 from headsim.settings import CameraSettings, HeadSettings, paper_head
@@ -215,3 +216,17 @@ def test_a_calibration_layout_with_the_eyes_turned_in_spreads_wider_and_is_all_f
         run = calibrate_head(sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, wide)
     assert run.outcomes == (None,) * 16
     assert np.abs(run.alpha_e_error).max() < 5e-4
+
+
+def test_reach_refusal_is_the_scenario_check_for_both_models() -> None:
+    settings = paper_head()
+    ahead = head_to_world(
+        np.array([0.0, 0.0, 0.8]), 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m
+    )
+    aside = head_to_world(
+        np.array([0.6, 0.0, 0.8]), 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m
+    )
+    assert reach_refusal(settings, ahead) is None
+    refusal = reach_refusal(settings, aside, "ball")
+    assert refusal is not None and refusal[0].startswith("ball at ")
+    assert refusal == model2_refusal(_Head.of(settings), aside, "ball")
