@@ -41,7 +41,7 @@ OBJECT_RADIUS_M = 0.006
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-area", type=int, default=20)
-    parser.add_argument("--preset", default="paper", choices=("paper", "ideal"))
+    parser.add_argument("--preset", default="paper", choices=("paper", "ideal", "realistic"))
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument(
         "--near-axis", type=int, default=10, help="extra layouts near Z_h (magnitude areas)"
