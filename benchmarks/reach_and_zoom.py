@@ -45,7 +45,7 @@ from headsim.results import write_json_atomic
 from headsim.runner import marker_target
 from headsim.scenario import reach_refusal
 from headsim.servo import EyeServo, NeckServo
-from headsim.settings import HeadSettings, paper_head
+from headsim.settings import FINE_RENDERING, HeadSettings, paper_head
 from headsim.sim import HeadSim
 
 ZOOMS = (0.5, 0.7, 1.0, 1.3, 1.6, 2.0)
@@ -56,9 +56,12 @@ FIELD = {"depth_m": (0.4, 1.4), "lateral": 0.3, "vertical": 0.15}
 CALIBRATION_EYES = (0.1, 0.2, 0.3)
 
 
-def zoomed(zoom: float, seed: int) -> HeadSettings:
-    """The paper's head with both focal lengths times ``zoom`` (mounts as at 1x)."""
-    base = paper_head(seed=seed)
+def zoomed(zoom: float, seed: int, fine: bool = False) -> HeadSettings:
+    """The paper's head with both focal lengths times ``zoom`` (mounts as at 1x).
+
+    ``fine``: rendered at :data:`FINE_RENDERING` (the realistic preset's) instead.
+    """
+    base = paper_head(seed=seed, **({"render": FINE_RENDERING} if fine else {}))
     cams = tuple(replace(c, kx=c.kx * zoom, ky=c.ky * zoom) for c in base.cameras)
     return replace(base, cameras=cams)  # type: ignore[arg-type]
 
@@ -127,10 +130,11 @@ def run_zoom(
     seed: int,
     goal: str,
     oracle: bool = False,
+    fine: bool = False,
 ) -> dict[str, Any]:
     """Calibrate (the layout drawn from the same seed at every zoom, where this zoom's
     cameras see it) and measure every point the reach check accepts at ``zoom``."""
-    settings = zoomed(zoom, seed)
+    settings = zoomed(zoom, seed, fine)
     accepted, refused = check_targets(settings, points_head)
     out: dict[str, Any] = {
         "zoom": zoom,
@@ -260,6 +264,9 @@ def main() -> int:
         action="store_true",
         help="diagnostic: measure with the true initial directions (calibration error removed)",
     )
+    parser.add_argument(
+        "--fine", action="store_true", help="render at FINE_RENDERING (4, 2) instead of (4, 1)"
+    )
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
     start = time.perf_counter()
@@ -269,7 +276,9 @@ def main() -> int:
     for zoom in zooms:
         print(f"  zoom {zoom}x ...", file=sys.stderr, flush=True)
         rows.append(
-            run_zoom(zoom, points_head, args.calibration, args.seed, args.goal, args.oracle)
+            run_zoom(
+                zoom, points_head, args.calibration, args.seed, args.goal, args.oracle, args.fine
+            )
         )
     ratios = {
         m: paired_ratios(rows, m, np.random.default_rng([args.seed, 11]))
