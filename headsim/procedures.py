@@ -1010,6 +1010,26 @@ class RelativeRun:
     gain_comparison: AreaComparison | None = None
 
 
+def _touching_blobs(found: dict[str, Detection], gap_px: float = 1.5) -> set[str]:
+    """Labels of blobs that touch another label's blob in the same image.
+
+    Where one ball partly hides another, both blobs meet and the hidden one's
+    centroid moves by up to its radius, which no single image can tell from a
+    shift.  Radii come from the blobs' areas (px): image-only.
+    """
+    blobs = [
+        (name, np.array(d.uv), math.sqrt(d.area_px / math.pi))
+        for name, d in found.items()
+        if d.found and d.uv is not None
+    ]
+    out = set()
+    for i, (name_a, uv_a, r_a) in enumerate(blobs):
+        for name_b, uv_b, r_b in blobs[:i]:
+            if float(np.linalg.norm(uv_a - uv_b)) < r_a + r_b + gap_px:
+                out |= {name_a, name_b}
+    return out
+
+
 def relative_positioning(
     sim: HeadSim,
     servo: EyeServo,
@@ -1020,7 +1040,9 @@ def relative_positioning(
     """Measure ``reference`` with Model 2, then place ``objects`` (body -> colour) in areas.
 
     The four images (each camera at each step) are taken again at the two
-    fixations' whole encoder steps, where the lines L11..L22 are.
+    fixations' whole encoder steps, where the lines L11..L22 are.  An object
+    whose blob touches another's in any image (one partly hides the other)
+    counts as not seen: its centroid would be biased.
     """
     knowledge = knowledge or HeadKnowledge()
     start = sim.render_count
@@ -1041,8 +1063,9 @@ def relative_positioning(
         sim.settle()
         for camera in (1, 2):
             found = find_markers(sim.render(camera), objects)
+            touching = _touching_blobs(found)
             for name, detection in found.items():
-                if detection.found and detection.uv is not None:
+                if detection.found and detection.uv is not None and name not in touching:
                     columns[name][2 * (camera - 1) + step_index] = detection.uv[0]
     seen = [name for name in objects if np.all(np.isfinite(columns[name]))]
     missing = tuple(name for name in objects if name not in seen)
