@@ -448,6 +448,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "extended": spec.extended,
             "alpha_e_rad": None,
             "alpha_e_std_rad": None,
+            "alpha_e_covariance_rad2": None,
             "alpha_e_truth_rad": truth_alpha_e,
             "alpha_e_error_rad": None,
             "alpha_e_paper_rad": list(PAPER["alpha_e_rad"]),
@@ -488,6 +489,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
         renders=run.renders,
         alpha_e_rad=list(fit.alpha_e),
         alpha_e_std_rad=list(fit.std_errors),
+        alpha_e_covariance_rad2=np.asarray(fit.covariance).tolist(),
         alpha_e_error_rad=list(run.alpha_e_error),
         converged=bool(fit.converged),
         depth_residual_rms_m=float(np.sqrt(np.mean(np.square(fit.depth_residuals)))),
@@ -539,6 +541,7 @@ def _lines_block(run: CalibrationRun, sim: HeadSim) -> dict[str, Any]:
             "offset_m": list(lines.std_errors[2:]),
         },
         "offset_truth_m": list(truth.offset_m),
+        "covariance": np.asarray(lines.covariance).tolist(),  # (alpha_e1, alpha_e2, s1, s2)
         "effective_baseline_m": lines.effective_baseline_m,
         "effective_baseline_std_m": lines.effective_baseline_std_m,
         "effective_baseline_truth_m": truth.effective_baseline_m,
