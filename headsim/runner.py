@@ -26,6 +26,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from headsim import names
+from headsim.calibration_design import near_far_depths, near_fraction
 from headsim.procedures import (
     CalibrationError,
     CalibrationRun,
@@ -418,6 +419,9 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 spec.depth_m,
                 spec.lateral,
                 spec.vertical,
+                depths_m=near_far_depths(spec.targets, spec.depth_m, spec.near_fraction)
+                if spec.layout == "near_far"
+                else None,
             )
         except ValueError as err:
             block = {"status": f"failed: {err}", "targets": spec.targets, "fixated": 0}
@@ -437,6 +441,12 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "fixated": 0,
             "renders": 0,
             "layout": {
+                "kind": spec.layout,
+                "near_fraction": (
+                    (spec.near_fraction or near_fraction(spec.depth_m))
+                    if spec.layout == "near_far"
+                    else None
+                ),
                 "depth_m": list(spec.depth_m),
                 "lateral": spec.lateral,
                 "vertical": spec.vertical,

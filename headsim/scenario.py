@@ -34,6 +34,7 @@ import mujoco
 import numpy as np
 
 from headsim import names
+from headsim.calibration_design import LAYOUTS
 from headsim.errors import BadInput
 from headsim.kinematics import head_to_world, world_to_head
 from headsim.model import eye_from_camera_rotation, load_spec
@@ -114,6 +115,10 @@ class CalibrationSpec:
     every measured coordinate of each target (x_h, y_h, z_h), m; the depth
     noise adds to it on z_h.  ``lines_of_sight``: with ``extended``, also fit
     each eye's line-of-sight offset (default: on for the realistic preset).
+    ``layout``: "uniform" (depths uniform in ``depth_m``) or "near_far" (a
+    share ``near_fraction`` of the balls at the near end of ``depth_m`` and the
+    rest at the far end; default b / (a + b), the design that pins each eye's
+    line-of-sight offset best, see :mod:`headsim.calibration_design`).
     ``source``: a calibration file (``headsim calibrate``) to use instead of
     calibrating (a relative path is relative to the scenario file's
     directory); the other fields are then not used.
@@ -128,6 +133,8 @@ class CalibrationSpec:
     position_noise_m: float = 0.0
     lines_of_sight: bool = False
     source: str | None = None
+    layout: str = "uniform"
+    near_fraction: float | None = None
 
 
 @dataclass(frozen=True)
@@ -672,8 +679,16 @@ def _read_calibration(table: _Table | None, lines_default: bool = False) -> Cali
         position_noise_m=table.number("position_noise_m", 0.0, 0.0, 0.1, unit="m"),
         lines_of_sight=table.boolean("lines_of_sight", lines_default),
         source=table.string("from", None, max_length=1000),
+        layout=table.choice("layout", LAYOUTS, "uniform"),
+        near_fraction=table.number(
+            "near_fraction", None, 0.0, 1.0, lo_open=True, hi_open=True, unit="(share of balls)"
+        ),
     )
     table.done()
+    if spec.near_fraction is not None and spec.layout != "near_far":
+        raise table.fail(
+            "near_fraction", f'given with layout = "{spec.layout}"', 'layout = "near_far"'
+        )
     if spec.extended and spec.vertical == 0.0:
         raise table.fail(
             "vertical",
