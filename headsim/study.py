@@ -1111,7 +1111,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
         "--experiment",
         choices=["compare", "budget"],
         help="compare: the Tables V/VI comparison; budget: the realistic head's error budget "
-        "(headsim.error_budget)",
+        "(headsim.error_budget; scenario realistic_field, whatever --preset)",
     )
     what.add_argument("--sweep", choices=sorted(SWEEPS), help="one sweep")
     what.add_argument(
@@ -1137,7 +1137,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
 STUDY_DESCRIPTION = (
     "Calibrated stereo against the active method: the Tables V/VI comparison, changes of "
     "focal length, principal point and distortion after calibration, and sweeps (depth, focal, "
-    "principal, k1, noise, encoder); writes CSV, JSON and PNG to --out."
+    "principal, k1, noise, encoder), and the realistic head's error budget; writes CSV, JSON "
+    "and PNG to --out."
 )
 
 
