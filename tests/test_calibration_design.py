@@ -65,7 +65,8 @@ def test_the_fit_states_and_reaches_the_designs_limit() -> None:
 
 
 def test_a_rendered_near_far_calibration_fixates_every_ball() -> None:
-    scenario = load_scenario("realistic_field", fast=True)
+    near_far = {"experiment.calibration.layout": "near_far"}
+    scenario = load_scenario("realistic_field", fast=True, overrides=near_far)
     spec = scenario.experiment.calibration
     assert spec is not None and spec.layout == "near_far"
     block = calibrate_scenario(scenario)
@@ -91,7 +92,6 @@ def test_a_bad_layout_names_its_key(field, value, message) -> None:
 
 
 def test_near_fraction_needs_the_near_far_layout() -> None:
-    overrides = {"experiment.calibration.layout": "uniform"}
-    overrides["experiment.calibration.near_fraction"] = 0.8
+    overrides = {"experiment.calibration.near_fraction": 0.8}  # the file's layout: uniform
     with pytest.raises(ScenarioError, match='near_fraction: given with layout = "uniform"'):
         load_scenario("realistic_field", overrides=overrides)
