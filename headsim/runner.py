@@ -405,6 +405,12 @@ def marker_target(name: str, body: str) -> Target:
     )
 
 
+def _told(scenario: Scenario) -> HeadKnowledge:
+    """What the scenario tells the head before any calibration: its goal columns, if given."""
+    goals = scenario.experiment.goal_columns_px
+    return HeadKnowledge() if goals is None else HeadKnowledge(u0=goals)
+
+
 def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dict[str, Any]]:
     """Sec. V in the default scene; returns the run (None if it failed) and its JSON block."""
     spec = scenario.experiment.calibration
@@ -481,6 +487,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 extended=spec.extended,
                 position_noise_m=spec.position_noise_m,
                 lines_of_sight=spec.lines_of_sight,
+                knowledge=_told(scenario),
             )
         except ValueError as err:
             outcomes = err.outcomes if isinstance(err, CalibrationError) else ()
@@ -587,7 +594,7 @@ def _run_points(
             else ObservedEyeServo(sim, config)
         )
         passes = (
-            [(HeadKnowledge(), "none"), (knowledge, label)]
+            [(_told(scenario), "none"), (knowledge, label)]
             if procedure == "calibration"
             else [(knowledge, label)]
         )
@@ -838,7 +845,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
     timing: dict[str, float] = {}
     renders = {"calibration": 0, "experiment": 0, "recording": 0}
     rendered_frames = {"calibration": 0.0, "experiment": 0.0}
-    knowledge, label = HeadKnowledge(), "none"
+    knowledge, label = _told(scenario), "none"
     calibration = None
     failures: list[str] = []
     spec = scenario.experiment.calibration

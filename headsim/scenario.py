@@ -158,6 +158,9 @@ class ExperimentSpec:
     midline_px: float = 25.0
     remedy_px: float = 120.0
     servo: ServoSpec = field(default_factory=ServoSpec)
+    #: The servo's goal column (u10, u20) of Ca1, Ca2, px, as the user tells the head
+    #: (e.g. the principal point's, found with ``headsim.principal``); None: image centres.
+    goal_columns_px: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -725,6 +728,9 @@ def _read_experiment(doc: _Table, ctx: _Context, preset_name: str = "ideal") -> 
         options["remedy_px"] = table.number(
             "remedy_px", 120.0, 0.0, 1000.0, lo_open=True, unit="px"
         )
+    goals = table.numbers("goal_columns_px", 2, None, 0.0, MAX_IMAGE_SIDE - 1.0, unit="px")
+    if goals is not None:
+        options["goal_columns_px"] = (goals[0], goals[1])
     servo_table = table.table("servo")
     servo = ServoSpec()
     if servo_table is not None:
@@ -1359,6 +1365,20 @@ def _build(
             read_calibration(source, settings)
         except CalibrationFileError as err:
             raise ctx.error("experiment.calibration.from", str(err)) from err
+    if experiment.goal_columns_px is not None and calibration and calibration.source:
+        raise ctx.error(
+            "experiment.goal_columns_px",
+            "given with experiment.calibration.from",
+            "one of the two (a calibration file carries its own goal columns)",
+        )
+    for index, u in enumerate(experiment.goal_columns_px or ()):
+        width = settings.cameras[index].width
+        if not u <= width - 1:
+            raise ctx.error(
+                f"experiment.goal_columns_px[{index}]",
+                f"{u:g} px is outside camera {index + 1}'s image",
+                f"a column in [0, {width - 1}] px",
+            )
     scene = _read_scene(top, ctx, experiment.procedure, settings, seed)
     top.has("fast")
     top.done()

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from headsim.error_budget import first_order_offsets
 from headsim.kinematics import head_to_world
@@ -85,3 +86,51 @@ def test_a_forward_offset_alone_changes_no_estimate_at_the_principal_column() ->
     assert np.abs(predicted_dz).min() > 2e-3  # millimetres: a visible effect
     np.testing.assert_allclose(centre1[:, 2] - centre0[:, 2], predicted_dz, rtol=0.15)
     assert np.abs(centre1 - centre0)[:, 2].min() > 5 * np.abs(diff[:, 2]).max()
+
+
+SCENARIO = """
+description = "Model 2 on the paper's cameras, servoing on given goal columns"
+seed = 0
+
+[head]
+preset = "paper"
+
+[experiment]
+procedure = "model2"
+goal_columns_px = [303.8, 345.1] # the paper cameras' principal points' columns
+
+[scene.random_targets]
+count = 3
+depth_m = [0.4, 1.2]
+lateral = 0.1
+vertical = 0.05
+"""
+
+
+def _scenario_estimates(path, overrides) -> np.ndarray:
+    from headsim.runner import run_scenario
+    from headsim.scenario import load_scenario
+
+    result = run_scenario(load_scenario(path, overrides=overrides))
+    assert result.ok, result.failures
+    return np.array([r.measurement.estimate_head_m for r in result.records])
+
+
+def test_goal_columns_from_a_scenario_make_a_forward_offset_change_no_estimate(tmp_path) -> None:
+    path = tmp_path / "goals.toml"
+    path.write_text(SCENARIO)
+    nodal = {"cam1.nodal_offset_m": NODAL_M, "cam2.nodal_offset_m": NODAL_M}
+    at_principal = _scenario_estimates(path, {}) - _scenario_estimates(path, nodal)
+    assert np.abs(at_principal).max() < 5e-4  # within what the servo leaves
+    centre = {"experiment.goal_columns_px": [319.5, 319.5]}  # the image centres, the paper's
+    at_centre = _scenario_estimates(path, centre) - _scenario_estimates(path, centre | nodal)
+    assert np.abs(at_centre[:, 2]).min() > 2e-3  # millimetres of depth
+
+
+def test_a_goal_column_outside_the_image_names_its_key(tmp_path) -> None:
+    from headsim.scenario import ScenarioError, load_scenario
+
+    path = tmp_path / "goals.toml"
+    path.write_text(SCENARIO.replace("[303.8, 345.1]", "[303.8, 700.0]"))
+    with pytest.raises(ScenarioError, match=r"goal_columns_px\[1\]: 700 px is outside camera 2"):
+        load_scenario(path)
