@@ -476,6 +476,7 @@ def calibration_layout(
     lateral: float = 0.16,
     vertical: float = 0.08,
     radius_m: float = 0.008,
+    depths_m: np.ndarray | None = None,
 ) -> np.ndarray:
     """World positions (count, 3) for Sec. V calibration targets, seeded.
 
@@ -485,22 +486,31 @@ def calibration_layout(
     paper's cameras.  ``lateral``/``vertical``: x_h/z_h and y_h/z_h spread; a
     vertical spread is what the extended calibration needs.  Every position is
     seen whole (ball of ``radius_m``) by both cameras at the current pose.
+    ``depths_m``: (count,) each position's depth z_h, m, kept when it is drawn
+    again (e.g. :func:`headsim.calibration_design.near_far_depths`); None:
+    uniform in ``depth_range_m``.
     """
 
-    def draw(n: int) -> np.ndarray:
-        z = rng.uniform(*depth_range_m, size=n)
+    def draw(n: int, slots: np.ndarray | None = None) -> np.ndarray:
+        z = rng.uniform(*depth_range_m, size=n) if depths_m is None else depths_m[slots]
         return np.column_stack(
             [rng.uniform(-lateral, lateral, n) * z, rng.uniform(-vertical, vertical, n) * z, z]
         )
 
-    points_world = sim.transform_points(draw(count), "head", "world")
+    if depths_m is not None:
+        depths_m = np.asarray(depths_m, dtype=float)
+        if depths_m.shape != (count,):
+            raise ValueError(f"depths_m must have shape ({count},), got {depths_m.shape}")
+    points_world = sim.transform_points(draw(count, np.arange(count)), "head", "world")
     # Placement (truth allowed): keep positions both cameras see whole from where the
     # head stands; a position that one cannot see is drawn again, a bounded number of times.
     for _ in range(500):
         unseen = ~seen_by_both(sim, points_world, radius_m)
         if not unseen.any():
             return points_world
-        points_world[unseen] = sim.transform_points(draw(int(unseen.sum())), "head", "world")
+        points_world[unseen] = sim.transform_points(
+            draw(int(unseen.sum()), np.flatnonzero(unseen)), "head", "world"
+        )
     raise ValueError(
         f"calibration layout: {int(unseen.sum())} of {count} positions stay outside a camera's "
         f"view after 500 draws: depth {depth_range_m} m, lateral {lateral}, vertical {vertical} "

@@ -26,6 +26,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from headsim import names
+from headsim.calibration_design import near_far_depths, near_fraction
 from headsim.procedures import (
     CalibrationError,
     CalibrationRun,
@@ -404,6 +405,12 @@ def marker_target(name: str, body: str) -> Target:
     )
 
 
+def _told(scenario: Scenario) -> HeadKnowledge:
+    """What the scenario tells the head before any calibration: its goal columns, if given."""
+    goals = scenario.experiment.goal_columns_px
+    return HeadKnowledge() if goals is None else HeadKnowledge(u0=goals)
+
+
 def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dict[str, Any]]:
     """Sec. V in the default scene; returns the run (None if it failed) and its JSON block."""
     spec = scenario.experiment.calibration
@@ -418,6 +425,9 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 spec.depth_m,
                 spec.lateral,
                 spec.vertical,
+                depths_m=near_far_depths(spec.targets, spec.depth_m, spec.near_fraction)
+                if spec.layout == "near_far"
+                else None,
             )
         except ValueError as err:
             block = {"status": f"failed: {err}", "targets": spec.targets, "fixated": 0}
@@ -437,6 +447,12 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "fixated": 0,
             "renders": 0,
             "layout": {
+                "kind": spec.layout,
+                "near_fraction": (
+                    (spec.near_fraction or near_fraction(spec.depth_m))
+                    if spec.layout == "near_far"
+                    else None
+                ),
                 "depth_m": list(spec.depth_m),
                 "lateral": spec.lateral,
                 "vertical": spec.vertical,
@@ -448,6 +464,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "extended": spec.extended,
             "alpha_e_rad": None,
             "alpha_e_std_rad": None,
+            "alpha_e_covariance_rad2": None,
             "alpha_e_truth_rad": truth_alpha_e,
             "alpha_e_error_rad": None,
             "alpha_e_paper_rad": list(PAPER["alpha_e_rad"]),
@@ -470,6 +487,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 extended=spec.extended,
                 position_noise_m=spec.position_noise_m,
                 lines_of_sight=spec.lines_of_sight,
+                knowledge=_told(scenario),
             )
         except ValueError as err:
             outcomes = err.outcomes if isinstance(err, CalibrationError) else ()
@@ -488,6 +506,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
         renders=run.renders,
         alpha_e_rad=list(fit.alpha_e),
         alpha_e_std_rad=list(fit.std_errors),
+        alpha_e_covariance_rad2=np.asarray(fit.covariance).tolist(),
         alpha_e_error_rad=list(run.alpha_e_error),
         converged=bool(fit.converged),
         depth_residual_rms_m=float(np.sqrt(np.mean(np.square(fit.depth_residuals)))),
@@ -539,6 +558,7 @@ def _lines_block(run: CalibrationRun, sim: HeadSim) -> dict[str, Any]:
             "offset_m": list(lines.std_errors[2:]),
         },
         "offset_truth_m": list(truth.offset_m),
+        "covariance": np.asarray(lines.covariance).tolist(),  # (alpha_e1, alpha_e2, s1, s2)
         "effective_baseline_m": lines.effective_baseline_m,
         "effective_baseline_std_m": lines.effective_baseline_std_m,
         "effective_baseline_truth_m": truth.effective_baseline_m,
@@ -574,7 +594,7 @@ def _run_points(
             else ObservedEyeServo(sim, config)
         )
         passes = (
-            [(HeadKnowledge(), "none"), (knowledge, label)]
+            [(_told(scenario), "none"), (knowledge, label)]
             if procedure == "calibration"
             else [(knowledge, label)]
         )
@@ -825,7 +845,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
     timing: dict[str, float] = {}
     renders = {"calibration": 0, "experiment": 0, "recording": 0}
     rendered_frames = {"calibration": 0.0, "experiment": 0.0}
-    knowledge, label = HeadKnowledge(), "none"
+    knowledge, label = _told(scenario), "none"
     calibration = None
     failures: list[str] = []
     spec = scenario.experiment.calibration

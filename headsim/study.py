@@ -39,10 +39,12 @@ the paper's cameras and on the paper's cameras with centred principal points.
 k1, image noise and encoder resolution.  :func:`write_experiment` writes
 ``<name>.csv`` (a row per condition and method), ``<name>_targets.csv`` (a
 row per target), ``<name>.json`` and ``<name>.png`` beside ``results.json``,
-which indexes every experiment written to the directory.
+which indexes every experiment written to the directory.  The realistic
+head's error budget (``--experiment budget``) is :mod:`headsim.error_budget`.
 
     python -m headsim.study --experiment compare --out out/study
     python -m headsim.study --sweep depth --out out/study [--fast]
+    python -m headsim.study --experiment budget --out out/study [--fast]
     python -m headsim.study --all --out out/study
 """
 
@@ -1105,9 +1107,16 @@ def print_result(result: ExperimentResult) -> None:
 def add_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
     """The study's options (shared by ``python -m headsim.study`` and ``headsim study``)."""
     what = parser.add_mutually_exclusive_group(required=True)
-    what.add_argument("--experiment", choices=["compare"], help="the Tables V/VI comparison")
+    what.add_argument(
+        "--experiment",
+        choices=["compare", "budget"],
+        help="compare: the Tables V/VI comparison; budget: the realistic head's error budget "
+        "(headsim.error_budget; scenario realistic_field, whatever --preset)",
+    )
     what.add_argument("--sweep", choices=sorted(SWEEPS), help="one sweep")
-    what.add_argument("--all", action="store_true", help="the comparison and every sweep")
+    what.add_argument(
+        "--all", action="store_true", help="the comparison, every sweep and the error budget"
+    )
     parser.add_argument("--out", required=True, help="output directory (created if missing)")
     parser.add_argument("--preset", default="paper", choices=["ideal", "paper"])
     parser.add_argument("--seed", type=int, default=0)
@@ -1128,7 +1137,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
 STUDY_DESCRIPTION = (
     "Calibrated stereo against the active method: the Tables V/VI comparison, changes of "
     "focal length, principal point and distortion after calibration, and sweeps (depth, focal, "
-    "principal, k1, noise, encoder); writes CSV, JSON and PNG to --out."
+    "principal, k1, noise, encoder), and the realistic head's error budget; writes CSV, JSON "
+    "and PNG to --out."
 )
 
 
@@ -1150,6 +1160,8 @@ def run(args: argparse.Namespace) -> int:
     config = make(preset=args.preset, seed=args.seed)
     progress: Progress = quiet if getattr(args, "quiet", False) else StderrProgress()
     cache = CalibrationCache(config, progress)
+    if args.experiment == "budget":
+        return _budget(args, progress)
     if args.all:
         experiments = [compare_experiment(config)] + [
             sweep_experiment(name, config) for name in SWEEPS
@@ -1172,7 +1184,30 @@ def run(args: argparse.Namespace) -> int:
             f"{experiment.name}: {result.seconds:.1f} s; wrote {', '.join(map(str, files.values()))}"
         )
         print_result(result)
-    return 0
+    return _budget(args, progress) if args.all else 0
+
+
+def _budget(args: argparse.Namespace, progress: Progress) -> int:
+    """The realistic head's error budget (:mod:`headsim.error_budget`); 0 on success."""
+    from headsim import error_budget
+
+    start = time.perf_counter()
+    rows = error_budget.run_budget(
+        fast=args.fast,
+        seed=args.seed,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=progress,
+    )
+    files = error_budget.write_budget(rows, args.out, args.fast)
+    progress(
+        f"budget: {time.perf_counter() - start:.1f} s; wrote {', '.join(map(str, files.values()))}"
+    )
+    print(files["md"].read_text(), end="")
+    failed = [f"{r['condition']}: {r['failures']}" for r in rows if r["failures"]]
+    for line in failed:
+        progress(f"budget: failed: {line}")
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":
