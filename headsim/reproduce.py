@@ -11,10 +11,13 @@ One head (the scenarios' ``paper`` head) is calibrated once (Sec. V, the
 - ``tracking``: the moving target with the neck (beyond Sec. VI's static tests);
 - ``tables_v_vi``: calibrated stereo against the active method (Sec. VI-B,
   Tables V-VI, Fig. 11), then the cameras zoomed 1.5x with every calibration
-  kept (the changed focal length).  The study calibrates its own methods
-  (stereo needs Zhang's chessboard calibration; its active methods calibrate
-  the study's head themselves): it does not use head.json.
+  kept (the changed focal length), on the same head with the same Sec. V
+  calibration (head.json) and one Zhang stereo calibration, made beside the
+  head's (:mod:`headsim.paper_tables`; the study's beyond-the-paper methods
+  and changes are left to ``python -m headsim.study``).
 
+The head's calibration and Zhang's run first, side by side; then the
+longest experiments first, so that the workers finish together.
 With ``--sweeps`` the study's insensitivity sweeps are added.  Every
 experiment writes its files under ``DIR/<experiment>/`` as it finishes, and
 ``DIR/report.md`` (with ``DIR/figures/*.png``) is rewritten after each one, so
@@ -51,6 +54,17 @@ SCENARIO_JOBS = {
     "tracking": ("tracking", "Tracking with the neck (Model 1), beyond the paper"),
 }
 STUDY_JOB = "tables_v_vi"
+#: What the Tables V/VI experiment measures here, and what it leaves to the study.
+TABLES_SCOPE = (
+    "Measured on this head with `head.json` (the active methods) and one Zhang calibration "
+    "(stereo): the six target positions, as calibrated and with the focal length x1.5. "
+    "The three active methods servo on the image centre and are computed from the same "
+    "images. Smaller than `python -m headsim.study --experiment compare`, which also "
+    "calibrates the zoom fixed-point methods, a second head with centred principal points, "
+    "and the 0.7x zoom, principal-point and k1 changes (beyond the paper's tables)."
+)
+#: The scenario whose head (and calibration) every experiment uses.
+TABLES_HEAD = "calibration"
 #: Paper's figures (Sec. VI).
 PAPER_ALPHA_E = (0.0578, -0.0254)
 PAPER_SIDE_MEAN_MM, PAPER_SIDE_STD_MM, TRUE_SIDE_MM = 30.3, 0.677, 30.0
@@ -144,17 +158,64 @@ def _scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) 
     }
 
 
+def _study_config(fast: bool, seed: int | None) -> Any:
+    from headsim import study
+
+    make = study.StudyConfig.quick if fast else study.StudyConfig
+    return make(seed=seed or 0)
+
+
+@_plain_errors
+def _zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
+    """Zhang's stereo calibration of the one head, once (it needs no head.json)."""
+    from headsim.paper_tables import zhang_calibration
+    from headsim.scenario import load_scenario
+
+    scenario = load_scenario(TABLES_HEAD, fast=fast, seed=seed)
+    start = time.perf_counter()
+    calibration, renders = zhang_calibration(scenario.settings, _study_config(fast, seed))
+    return {"calibration": calibration, "renders": renders, "wall_s": time.perf_counter() - start}
+
+
+@_plain_errors
+def _tables_job(
+    out: str, fast: bool, seed: int | None, head: str, zhang: dict[str, Any]
+) -> dict[str, Any]:
+    """Tables V/VI and the changed focal length with the one calibration and Zhang's."""
+    from headsim import paper_tables, study
+    from headsim.calibration_file import read_calibration
+    from headsim.scenario import load_scenario
+
+    settings = load_scenario(TABLES_HEAD, fast=fast, seed=seed).settings
+    stored = read_calibration(head, settings).knowledge
+    calibration = zhang["calibration"]
+    result = paper_tables.run_tables(settings, calibration, stored, _study_config(fast, seed))
+    files = study.write_experiment(result, Path(out) / "study")
+    own = result.seconds + zhang["wall_s"]
+    return to_jsonable(
+        {
+            "title": result.experiment.title,
+            "summary": study.summary_rows(result),
+            "figures": study.compare_figures(result),
+            "files": {k: str(p) for k, p in files.items()},
+            "seconds": own,
+            "zhang": {
+                "seconds": zhang["wall_s"],
+                "views": calibration.views,
+                "rms_px": calibration.stereo_rms_px,
+                "renders": zhang["renders"],
+            },
+            "renders": zhang["renders"] + sum(e.renders for r in result.results for e in r.errors),
+        }
+    )
+
+
 @_plain_errors
 def _study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim import study
 
-    make = study.StudyConfig.quick if fast else study.StudyConfig
-    config = make(seed=seed or 0)
-    experiment = (
-        study.compare_experiment(config)
-        if name == STUDY_JOB
-        else study.sweep_experiment(name.removeprefix("sweep_"), config)
-    )
+    config = _study_config(fast, seed)
+    experiment = study.sweep_experiment(name.removeprefix("sweep_"), config)
     result = study.run_experiment(experiment, config)
     files = study.write_experiment(result, Path(out) / "study")
     return to_jsonable(
@@ -573,6 +634,8 @@ def report_text(
         if rows:
             lines += _table(rows)
             verdicts += [r.verdict for r in rows]
+        if name == STUDY_JOB:
+            lines += ["", TABLES_SCOPE]
         if outcome is not None:
             where = f"`{name}/`" if name in SCENARIO_JOBS else "`study/`"
             lines += ["", f"{outcome.wall_s:.1f} s; files in {where}"]
@@ -638,15 +701,18 @@ def reproduce(
     outcomes: dict[str, JobOutcome] = {}
     calibration: dict[str, Any] | None = None
 
-    def write_report() -> None:
+    def write_report(figure: bool = True) -> None:
+        """report.md and report.json; the main figure (matplotlib, ~1 s) only when asked:
+        at the end, and when interrupted.  The wall time counts the figure."""
+        drawn = None
+        if figure:
+            try:
+                drawn = main_figure(outcomes, calibration, out / "figures" / "main.png")
+            except Exception as err:  # a figure must not hide the numbers
+                progress(f"main figure not drawn: {err!r}")
         state["wall_s"] = time.perf_counter() - start
         state["wall_over_render"] = state["wall_s"] / render_s
-        figure = None
-        try:
-            figure = main_figure(outcomes, calibration, out / "figures" / "main.png")
-        except Exception as err:  # a figure must not hide the numbers
-            progress(f"main figure not drawn: {err!r}")
-        write_text_atomic(out / "report.md", report_text(state, outcomes, calibration, figure))
+        write_text_atomic(out / "report.md", report_text(state, outcomes, calibration, drawn))
         write_json_atomic(
             out / "report.json",
             to_jsonable(
@@ -676,10 +742,13 @@ def reproduce(
         )
 
     pool = _pool(workers)
+    jobs: dict[futures.Future[dict[str, Any]], tuple[str, float]] = {}
     try:
-        write_report()
-        progress("calibrating the head once")
+        write_report(figure=False)
+        progress("calibrating the head once (and its stereo pair, Zhang, beside it)")
         t0 = time.perf_counter()
+        # Zhang's calibration needs no head.json: it runs beside the head's calibration.
+        zhang_job = pool.submit(_zhang_job, fast, seed)
         try:
             calibration = pool.submit(_calibrate_job, str(out), fast, seed).result()
         except Exception as err:
@@ -689,23 +758,36 @@ def reproduce(
                 time.perf_counter() - t0,
                 error=str(err) if isinstance(err, JobError) else _why(err),
             )
-        jobs: dict[futures.Future[dict[str, Any]], tuple[str, float]] = {}
         now = time.perf_counter()
+
+        def submit(name: str, job: Callable[..., dict[str, Any]], *args: Any) -> None:
+            jobs[pool.submit(job, *args)] = (name, now)
+
         # The longest first, so that the workers finish together.
-        for name in (STUDY_JOB, *state["sweeps"]):
-            jobs[pool.submit(_study_job, name, str(out), fast, seed)] = (name, now)
+        names = list(SCENARIO_JOBS)
         if calibration is not None:
-            for name in SCENARIO_JOBS:
-                jobs[
-                    pool.submit(_scenario_job, name, str(out), fast, seed, calibration["path"])
-                ] = (
-                    name,
-                    now,
+            submit(
+                "chessboard", _scenario_job, "chessboard", str(out), fast, seed, calibration["path"]
+            )
+            try:
+                zhang = zhang_job.result()
+                submit(STUDY_JOB, _tables_job, str(out), fast, seed, calibration["path"], zhang)
+            except Exception as err:
+                outcomes[STUDY_JOB] = JobOutcome(
+                    STUDY_JOB,
+                    "error",
+                    time.perf_counter() - t0,
+                    error=str(err) if isinstance(err, JobError) else _why(err),
                 )
+            for name in names:
+                if name != "chessboard":
+                    submit(name, _scenario_job, name, str(out), fast, seed, calibration["path"])
         else:
-            for name in list(SCENARIO_JOBS)[1:]:
+            for name in [*names[1:], STUDY_JOB]:
                 outcomes[name] = JobOutcome(name, "error", 0.0, error="no calibration to use")
-        write_report()
+        for name in state["sweeps"]:
+            submit(name, _study_job, name, str(out), fast, seed)
+        write_report(figure=False)
         for done in futures.as_completed(jobs):
             name, began = jobs[done]
             try:
@@ -727,7 +809,7 @@ def reproduce(
                     error=str(err) if isinstance(err, JobError) else _why(err),
                 )
             progress(f"{name}: {outcomes[name].status}")
-            write_report()
+            write_report(figure=False)
         state["status"] = (
             "ok" if calibration and all(o.status == "ok" for o in outcomes.values()) else "failed"
         )

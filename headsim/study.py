@@ -924,7 +924,7 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
     """The done-when ratios of the comparison (RMS of the 3-D error, mm)."""
     exp = result.experiment
     groups = list(exp.base)
-    paper, centred_group = groups[0], groups[1]
+    paper = groups[0]
     figures: dict[str, Any] = {}
 
     def rms(group: str, label: str, method: str) -> float:
@@ -944,7 +944,9 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
     figures["image_centre_ray_turn_mrad"] = turns
     labels = {c.label for c in exp.conditions}
     if "zoom 1.5x" in labels:
-        for group, key in ((centred_group, "zoom_1_5_centred"), (paper, "zoom_1_5_paper")):
+        # The second group (if any) is the paper's head with centred principal points.
+        keys = {paper: "zoom_1_5_paper", **{g: "zoom_1_5_centred" for g in groups[1:2]}}
+        for group, key in keys.items():
             figures[key] = {
                 f"{m}_after_over_before": rms(group, "zoom 1.5x", m)
                 / rms(group, "as calibrated", m)
