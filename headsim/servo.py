@@ -38,6 +38,38 @@ def windowed(detector: object) -> bool:
     return detector in WINDOWED_DETECTORS
 
 
+def pattern_windowed(detector: object) -> bool:
+    """Whether ``detector`` finds a feature as part of a pattern it reports the extent of
+    (``Detection.extent_px``) and names by a ``window_key`` shared by the pattern's features."""
+    while isinstance(detector, functools.partial):
+        detector = detector.func
+    return getattr(detector, "window_key", None) is not None
+
+
+def pattern_window(
+    sim: HeadSim,
+    camera: int,
+    expected_uv: tuple[float, float],
+    extent_px: tuple[float, float, float, float],
+    motion_px: float,
+    margin_px: float,
+) -> Window | None:
+    """The window to look for a pattern of ``extent_px`` around ``expected_uv`` after an
+    image motion of ``motion_px``: the extent plus the margin and a quarter of the motion
+    on every side.  None where it would be barely cheaper than the frame."""
+    settings = sim.camera_settings(camera)
+    grow = margin_px + 0.25 * abs(motion_px)
+    u, v = expected_uv
+    left, top, right, bottom = extent_px
+    x0 = max(math.floor(u + left - grow), 0)
+    y0 = max(math.floor(v + top - grow), 0)
+    x1 = min(math.ceil(u + right + grow) + 1, settings.width)
+    y1 = min(math.ceil(v + bottom + grow) + 1, settings.height)
+    if x1 <= x0 or y1 <= y0 or (x1 - x0) * (y1 - y0) >= 0.5 * settings.width * settings.height:
+        return None
+    return Window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
+
+
 def expected_window(
     sim: HeadSim,
     camera: int,
@@ -70,6 +102,19 @@ def look_in_window(
     if not seen.found or seen.uv is None:
         return None
     u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0
+    if seen.extent_px is not None:
+        # A pattern counts only if all of it lies 2 px inside the window, or runs
+        # off a side where the window's edge is the image's (the full frame ends there too).
+        left, top, right, bottom = seen.extent_px
+        settings = sim.camera_settings(camera)
+        if (
+            (window.x0 == 0 or window.x0 + 2 <= u + left)
+            and (window.x1 == settings.width or u + right <= window.x1 - 3)
+            and (window.y0 == 0 or window.y0 + 2 <= v + top)
+            and (window.y1 == settings.height or v + bottom <= window.y1 - 3)
+        ):
+            return Detection(DetectionStatus.FOUND, (u, v), seen.area_px, seen.extent_px)
+        return None
     inset = 3.0 * math.sqrt(seen.area_px / math.pi) + 2.0
     if (
         window.x0 + inset <= u <= window.x1 - 1 - inset
@@ -161,6 +206,8 @@ class EyeServo:
         self._seen: dict[
             int, tuple[object, int, tuple[float, float], int, tuple[float, float], float]
         ] = {}
+        #: Per camera, the extent of the pattern last seen (None: a blob).
+        self._extent: dict[int, tuple[float, float, float, float] | None] = {}
         #: Windows rendered, and windows that missed the target (a full frame followed).
         self.window_renders = 0
         self.window_misses = 0
@@ -188,7 +235,10 @@ class EyeServo:
         key = detector if key is None else key
         sim = self.sim
         steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
-        window = self._window(camera, key, steps, neck) if windowed(key) else None
+        pattern = pattern_windowed(key)
+        if pattern:  # a pattern's features share their windows
+            key = getattr(key, "window_key", key)
+        window = self._window(camera, key, steps, neck) if pattern or windowed(key) else None
         detection = None
         if window is not None:
             self.window_renders += 1
@@ -201,6 +251,7 @@ class EyeServo:
         # Only blob detections (a centroid and an area) predict a window.
         if isinstance(detection, Detection) and detection.found and detection.uv is not None:
             self._seen[camera] = (key, steps, neck, sim.placements, detection.uv, detection.area_px)
+            self._extent[camera] = detection.extent_px
         else:
             self._seen.pop(camera, None)
         return detection
@@ -214,9 +265,14 @@ class EyeServo:
         if not cfg.windows or seen is None or gain is None:
             return None
         seen_key, seen_steps, seen_neck, placements, uv, area = seen
-        if seen_key is not key or seen_neck != neck or placements != sim.placements:
+        if seen_key != key or seen_neck != neck or placements != sim.placements:
             return None
         motion = gain * (steps - seen_steps)
+        extent = self._extent.get(camera)
+        if extent is not None:
+            return pattern_window(
+                sim, camera, (uv[0] + motion, uv[1]), extent, motion, cfg.window_margin_px
+            )
         return expected_window(
             sim, camera, (uv[0] + motion, uv[1]), area, motion, cfg.window_margin_px
         )

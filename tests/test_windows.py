@@ -204,3 +204,35 @@ def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
     assert servo.seen == plain_servo.seen
     for a, b in zip(plain, missed, strict=True):
         np.testing.assert_array_equal(a.estimate_head_m, b.estimate_head_m)
+
+
+def test_windows_change_no_chessboard_corner() -> None:
+    # The corners of one board share windows that hold the whole board (its extent):
+    # every detection and estimate as with full frames, on the distorted paper head.
+    from headsim import names
+    from headsim.procedures import measure_chessboard
+
+    corners = [0, 1, 8, 27, 46, 47]
+    runs = {}
+    for windows in (False, True):
+        with HeadSim("chessboard", paper_head()) as sim:
+            sim.set_body_pose(
+                names.CHESSBOARD, sim.transform_points([-0.105, -0.075, 0.85], "head", "world")[0]
+            )
+            servo = LoggingServo(sim, ServoConfig(windows=windows))
+            run = measure_chessboard(sim, servo, HeadKnowledge(), corners=corners)
+            runs[windows] = (run, sim.rendered_frames, sim.render_count, servo)
+    (plain, plain_frames, plain_renders, plain_servo) = runs[False]
+    (windowed, frames, renders, servo) = runs[True]
+    assert all(m.ok for m in plain.measurements) and all(m.ok for m in windowed.measurements)
+    for a, b in zip(plain.measurements, windowed.measurements, strict=True):
+        np.testing.assert_allclose(b.estimate_head_m, a.estimate_head_m, rtol=0, atol=1e-6)
+    assert len(servo.seen) == len(plain_servo.seen)
+    for a_uv, b_uv in zip(plain_servo.seen, servo.seen, strict=True):
+        assert (a_uv is None) == (b_uv is None)
+        if a_uv is not None and b_uv is not None:
+            assert np.max(np.abs(np.subtract(a_uv, b_uv))) <= 0.01
+    assert renders == plain_renders
+    assert servo.window_misses == 0
+    assert servo.window_renders > renders / 2
+    assert frames < 0.7 * plain_frames
