@@ -178,6 +178,9 @@ class ServoConfig:
     ``windows``: render only a window around where the target is expected
     (see :meth:`EyeServo.observe`); ``window_margin_px`` is added to its
     half-side beyond the blob and a quarter of the predicted motion.
+    ``preview_binning``: where no detection predicts a blob's window (a new
+    target), find it first in the whole view binned b x b (1/b^2 of the
+    pixels), then render its window; 1: a full frame instead.
     """
 
     tolerance_px: float = 0.1
@@ -188,6 +191,7 @@ class ServoConfig:
     max_retreats: int = 3
     windows: bool = True
     window_margin_px: float = 8.0
+    preview_binning: int = 4
 
 
 class EyeServo:
@@ -208,6 +212,8 @@ class EyeServo:
         ] = {}
         #: Per camera, the extent of the pattern last seen (None: a blob).
         self._extent: dict[int, tuple[float, float, float, float] | None] = {}
+        #: Binned previews rendered to place a window (see ``ServoConfig.preview_binning``).
+        self.previews = 0
         #: Windows rendered, and windows that missed the target (a full frame followed).
         self.window_renders = 0
         self.window_misses = 0
@@ -239,6 +245,8 @@ class EyeServo:
         if pattern:  # a pattern's features share their windows
             key = getattr(key, "window_key", key)
         window = self._window(camera, key, steps, neck) if pattern or windowed(key) else None
+        if window is None and not pattern and windowed(key) and self._unseen(camera, key):
+            window = self._preview(camera, key)
         detection = None
         if window is not None:
             self.window_renders += 1
@@ -255,6 +263,30 @@ class EyeServo:
         else:
             self._seen.pop(camera, None)
         return detection
+
+    def _unseen(self, camera: int, key: object) -> bool:
+        """Whether no detection of ``key``'s target in this scene predicts where it is
+        (a new target, or one moved): a preview may find it."""
+        seen = self._seen.get(camera)
+        return seen is None or seen[0] != key or seen[3] != self.sim.placements
+
+    def _preview(self, camera: int, detector: object) -> Window | None:
+        """The window where a binned preview of the whole view shows the blob, or None
+        (previews off, or not found there: a full frame follows, as without previews)."""
+        b = self.config.preview_binning
+        if not self.config.windows or b <= 1:
+            return None
+        assert callable(detector)
+        seen = detector(self.sim.render_preview(camera, b))
+        self.previews += 1
+        if not isinstance(seen, Detection) or not seen.found or seen.uv is None:
+            return None
+        # Binned pixel i covers pixels b i .. b i + b - 1; its position is good to about b px.
+        offset = (b - 1) / 2.0
+        uv = (b * seen.uv[0] + offset, b * seen.uv[1] + offset)
+        return expected_window(
+            self.sim, camera, uv, b * b * seen.area_px, 4.0 * b, self.config.window_margin_px
+        )
 
     def _window(
         self, camera: int, key: object, steps: int, neck: tuple[float, float]
