@@ -89,6 +89,23 @@ def expected_window(
     return window
 
 
+def preview_window(
+    sim: HeadSim, camera: int, detector: object, config: ServoConfig
+) -> Window | None:
+    """Render a preview of ``camera``'s whole view binned ``config.preview_binning`` x
+    ``config.preview_binning`` and return the window where it shows the blob, or None
+    (not found, or a window barely cheaper than the frame: a full frame follows)."""
+    b = config.preview_binning
+    assert callable(detector)
+    seen = detector(sim.render_preview(camera, b))
+    if not isinstance(seen, Detection) or not seen.found or seen.uv is None:
+        return None
+    # Binned pixel i covers pixels b i .. b i + b - 1; its position is good to about b px.
+    offset = (b - 1) / 2.0
+    uv = (b * seen.uv[0] + offset, b * seen.uv[1] + offset)
+    return expected_window(sim, camera, uv, b * b * seen.area_px, 4.0 * b, config.window_margin_px)
+
+
 def look_in_window(
     sim: HeadSim, camera: int, detector: Detector, window: Window
 ) -> Detection | None:
@@ -245,7 +262,7 @@ class EyeServo:
         if pattern:  # a pattern's features share their windows
             key = getattr(key, "window_key", key)
         window = self._window(camera, key, steps, neck) if pattern or windowed(key) else None
-        if window is None and not pattern and windowed(key) and self._unseen(camera, key):
+        if window is None and not pattern and windowed(key) and self._unseen(camera, key, neck):
             window = self._preview(camera, key)
         detection = None
         if window is not None:
@@ -264,29 +281,18 @@ class EyeServo:
             self._seen.pop(camera, None)
         return detection
 
-    def _unseen(self, camera: int, key: object) -> bool:
-        """Whether no detection of ``key``'s target in this scene predicts where it is
-        (a new target, or one moved): a preview may find it."""
+    def _unseen(self, camera: int, key: object, neck: tuple[float, float]) -> bool:
+        """Whether no detection of ``key``'s target predicts where it is (a new target,
+        one moved, or the neck moved since): a preview may find it."""
         seen = self._seen.get(camera)
-        return seen is None or seen[0] != key or seen[3] != self.sim.placements
+        return seen is None or seen[0] != key or seen[2] != neck or seen[3] != self.sim.placements
 
     def _preview(self, camera: int, detector: object) -> Window | None:
-        """The window where a binned preview of the whole view shows the blob, or None
-        (previews off, or not found there: a full frame follows, as without previews)."""
-        b = self.config.preview_binning
-        if not self.config.windows or b <= 1:
+        """A preview's window for ``detector``'s blob (see :func:`preview_window`)."""
+        if not self.config.windows or self.config.preview_binning <= 1:
             return None
-        assert callable(detector)
-        seen = detector(self.sim.render_preview(camera, b))
         self.previews += 1
-        if not isinstance(seen, Detection) or not seen.found or seen.uv is None:
-            return None
-        # Binned pixel i covers pixels b i .. b i + b - 1; its position is good to about b px.
-        offset = (b - 1) / 2.0
-        uv = (b * seen.uv[0] + offset, b * seen.uv[1] + offset)
-        return expected_window(
-            self.sim, camera, uv, b * b * seen.area_px, 4.0 * b, self.config.window_margin_px
-        )
+        return preview_window(self.sim, camera, detector, self.config)
 
     def _window(
         self, camera: int, key: object, steps: int, neck: tuple[float, float]
@@ -498,6 +504,7 @@ class NeckServo:
         ) = None
         self.window_renders = 0
         self.window_misses = 0
+        self.previews = 0
         self._key: object = None
         self._current: np.ndarray | None = None  # the Jacobian as the run stands
 
@@ -559,6 +566,22 @@ class NeckServo:
                     return detection
                 self.window_misses += 1
                 return detector(sim.retake(camera))  # the same instant, whole
+        elif (
+            self.config.windows
+            and self.config.preview_binning > 1
+            and windowed(self._key)
+            and (seen is None or seen[0] is not self._key or seen[2] != sim.placements)
+        ):
+            # A new or moved target: find it in a preview, then render its window.
+            self.previews += 1
+            window = preview_window(sim, camera, self._key, self.config)
+            if window is not None:
+                self.window_renders += 1
+                detection = look_in_window(sim, camera, detector, window)
+                if detection is not None:
+                    return detection
+                self.window_misses += 1
+                return detector(sim.retake(camera))
         return detector(sim.render(camera))
 
     def _in_range(self, steps: np.ndarray) -> bool:
