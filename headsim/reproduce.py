@@ -29,10 +29,12 @@ from __future__ import annotations
 
 import concurrent.futures as futures
 import functools
+import importlib
 import math
 import multiprocessing
 import statistics
 import sys
+import threading
 import time
 import traceback
 from collections.abc import Callable
@@ -788,6 +790,10 @@ def reproduce(
         for name in state["sweeps"]:
             submit(name, _study_job, name, str(out), fast, seed)
         write_report(figure=False)
+        # matplotlib loads (about 1 s) while the workers run, not after them.
+        threading.Thread(
+            target=importlib.import_module, args=("headsim.plots",), daemon=True
+        ).start()
         for done in futures.as_completed(jobs):
             name, began = jobs[done]
             try:
