@@ -10,34 +10,53 @@ reproduction uses, calibrated once:
 - ``active_centre`` (Table VI): the one Sec. V calibration (``head.json``)'s
   initial directions, nothing else;
 - ``active_v_known`` (Table V): the same with Zhang's principal-point v;
-- ``active_extended``: ``head.json``'s whole knowledge (its extended fit).
+- ``active_extended``: ``head.json``'s whole knowledge (its extended fit);
+- ``active_fixed_point`` and ``active_refound`` (beyond the paper, but what
+  shows its insensitivity to the focal length here): the principal point
+  found as a zoom's fixed point, the servo on its column, with their own
+  Sec. V calibration on that column (:func:`fixed_point_calibration`, made
+  once beside Zhang's); ``active_refound`` finds the fixed point again on
+  the head it measures.
 
 Conditions: the six target positions as calibrated, then the cameras zoomed
 1.5x with every calibration kept.  The three active methods servo on the
 same column (the image centre) and differ only in what Model 2 computes from
 the images, so each target is servoed once and every active method's
 estimate is computed from those same images (:func:`measure_paired`; the
-renders are counted once, on ``active_centre``).  The study's beyond-the-paper
-parts (zoom fixed-point methods, a second base head with centred principal
-points, the 0.7x zoom, principal-point and k1 changes) are left to
-``python -m headsim.study``.
+renders are counted once, on ``active_centre``).  The study's other parts (a
+second base head with centred principal points, the 0.7x zoom,
+principal-point and k1 changes) are left to ``python -m headsim.study``.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from headsim import stereo
+from headsim import names, stereo
 from headsim.estimators import model2
-from headsim.principal import view_scale, zoomed
-from headsim.procedures import HeadKnowledge, Measurement, measure_model2
+from headsim.principal import (
+    PROBE_ZOOM,
+    PrincipalPointRun,
+    principal_points_by_zoom,
+    view_scale,
+    zoomed,
+)
+from headsim.procedures import (
+    CalibrationRun,
+    HeadKnowledge,
+    Measurement,
+    calibrate_head,
+    calibration_layout,
+    measure_model2,
+)
 from headsim.servo import EyeServo
 from headsim.settings import HeadSettings
 from headsim.sim import HeadSim
 from headsim.study import (
+    BALL,
     TARGET,
     Condition,
     ConditionResult,
@@ -49,8 +68,17 @@ from headsim.study import (
     table_targets,
 )
 
-#: The methods measured, in table order; the active ones share their images.
-METHODS = ("stereo", "active_v_known", "active_centre", "active_extended")
+#: The methods measured, in table order; the first three active ones share their images.
+METHODS = (
+    "stereo",
+    "active_v_known",
+    "active_centre",
+    "active_extended",
+    "active_fixed_point",
+    "active_refound",
+)
+#: The active methods that servo on the image centre's column.
+CENTRE_METHODS = METHODS[1:4]
 #: The active method whose servo runs (the others reuse its images).
 SERVOED = "active_centre"
 #: The paper's changed focal length, with every calibration kept.
@@ -71,6 +99,52 @@ def zhang_calibration(
             distance_range_m=(0.4 * scale, 1.0 * scale),
         )
         return stereo.calibrate_stereo(sim, views), views.renders
+
+
+@dataclass(frozen=True)
+class FixedPoint:
+    """The zoom fixed points of the head as calibrated and the Sec. V calibration on
+    their columns, and the renders both took."""
+
+    principal: PrincipalPointRun
+    calibration: CalibrationRun
+    renders: int
+
+    def knowledge(self, refound: PrincipalPointRun | None = None) -> HeadKnowledge:
+        """``active_fixed_point``'s knowledge, or with ``refound``'s columns and rows
+        (``active_refound``)."""
+        if refound is None:
+            return self.calibration.knowledge
+        (u1, v1), (u2, v2) = refound.principal_px
+        return replace(self.calibration.knowledge, u0=(u1, u2), v0=(v1, v2))
+
+
+def fixed_point_calibration(settings: HeadSettings, config: StudyConfig) -> FixedPoint:
+    """The fixed points of a zoom (images only) and Sec. V with the servo on their columns."""
+    scale = view_scale(settings)
+    principal = principal_points_by_zoom(
+        settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
+    )
+    with HeadSim("default", settings) as sim:
+        positions = calibration_layout(
+            sim,
+            np.random.default_rng(config.seed + 2),
+            config.calibration_targets,
+            depth_range_m=(0.25 * scale, 0.6 * scale),
+            lateral=0.16 / scale,
+        )
+        (u1, _), (u2, _) = principal.principal_px
+        start = sim.render_count
+        calibration = calibrate_head(
+            sim,
+            EyeServo(sim),
+            BALL,
+            names.CALIBRATION_BALL,
+            positions,
+            knowledge=HeadKnowledge(u0=(u1, u2)),
+        )
+        renders = principal.renders + sim.render_count - start
+    return FixedPoint(principal, calibration, renders)
 
 
 def active_knowledge(
@@ -120,9 +194,20 @@ def measure_paired(
     zhang: stereo.StereoCalibration,
     knowledges: dict[str, HeadKnowledge],
     targets_head: np.ndarray,
+    fixed: FixedPoint | None = None,
+    config: StudyConfig | None = None,
 ) -> list[TargetError]:
-    """The red marker at each of ``targets_head`` (N, 3) m: stereo, then one servo for every active method."""
+    """The red marker at each of ``targets_head`` (N, 3) m: stereo, then one servo for
+    the image-centre methods (``knowledges``), then with ``fixed`` the fixed-point
+    methods, each its own servo (``active_refound`` first finds the fixed points on
+    ``settings``, seeded as ``config``'s)."""
     out: list[TargetError] = []
+    config = config or StudyConfig()
+    refound = None
+    if fixed is not None:
+        refound = principal_points_by_zoom(
+            settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
+        )
     with HeadSim("default", settings) as sim:
         servo = EyeServo(sim)
         for index, p_head in enumerate(np.atleast_2d(np.asarray(targets_head, dtype=float))):
@@ -153,6 +238,25 @@ def measure_paired(
                 own = renders if method == SERVOED else 0
                 out.append(TargetError(method, index, truth, estimate, status, own))
             sim.move(eye=0.0)
+            if fixed is None:
+                continue
+            for method, knowledge in (
+                ("active_fixed_point", fixed.knowledge()),
+                ("active_refound", fixed.knowledge(refound)),
+            ):
+                start = sim.render_count
+                m2 = measure_model2(sim, servo, TARGET, knowledge)
+                out.append(
+                    TargetError(
+                        method,
+                        index,
+                        truth,
+                        m2.estimate_head_m,
+                        m2.status,
+                        sim.render_count - start,
+                    )
+                )
+                sim.move(eye=0.0)
     return out
 
 
@@ -179,18 +283,22 @@ def run_tables(
     zhang: stereo.StereoCalibration,
     stored: HeadKnowledge,
     config: StudyConfig,
+    fixed: FixedPoint | None = None,
 ) -> ExperimentResult:
-    """Every condition of :func:`tables_experiment`, with ``zhang`` and ``stored`` kept."""
+    """Every condition of :func:`tables_experiment`, with ``zhang``, ``stored`` and
+    ``fixed`` (None: without the fixed-point methods) kept."""
     start = time.perf_counter()
-    experiment = tables_experiment(settings, config)
+    methods = METHODS if fixed is not None else METHODS[:4]
+    experiment = replace(tables_experiment(settings, config), methods=methods)
     knowledges = active_knowledge(stored, zhang)
-    ordered = {m: knowledges[m] for m in METHODS[1:]}
+    ordered = {m: knowledges[m] for m in CENTRE_METHODS}
     results = []
     for condition in experiment.conditions:
         began = time.perf_counter()
-        errors = measure_paired(condition.head, zhang, ordered, condition.targets_head)
-        # Errors in table order: per target, every method.
-        summaries = tuple(summarise(errors, m) for m in METHODS)
+        errors = measure_paired(
+            condition.head, zhang, ordered, condition.targets_head, fixed, config
+        )
+        summaries = tuple(summarise(errors, m) for m in methods)
         results.append(
             ConditionResult(condition, tuple(errors), summaries, time.perf_counter() - began)
         )

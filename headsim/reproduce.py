@@ -12,12 +12,12 @@ One head (the scenarios' ``paper`` head) is calibrated once (Sec. V, the
 - ``tables_v_vi``: calibrated stereo against the active method (Sec. VI-B,
   Tables V-VI, Fig. 11), then the cameras zoomed 1.5x with every calibration
   kept (the changed focal length), on the same head with the same Sec. V
-  calibration (head.json) and one Zhang stereo calibration, made beside the
-  head's (:mod:`headsim.paper_tables`; the study's beyond-the-paper methods
-  and changes are left to ``python -m headsim.study``).
+  calibration (head.json), one Zhang stereo calibration and one zoom
+  fixed-point calibration (:mod:`headsim.paper_tables`; the study's other
+  heads and changes are left to ``python -m headsim.study``).
 
-The head's calibration and Zhang's run first, side by side; then the
-longest experiments first, so that the workers finish together.
+The head's calibration, Zhang's and the fixed points' run first, side by
+side; then the longest experiments first, so that the workers finish together.
 With ``--sweeps`` the study's insensitivity sweeps are added.  Every
 experiment writes its files under ``DIR/<experiment>/`` as it finishes, and
 ``DIR/report.md`` (with ``DIR/figures/*.png``) is rewritten after each one, so
@@ -58,12 +58,13 @@ SCENARIO_JOBS = {
 STUDY_JOB = "tables_v_vi"
 #: What the Tables V/VI experiment measures here, and what it leaves to the study.
 TABLES_SCOPE = (
-    "Measured on this head with `head.json` (the active methods) and one Zhang calibration "
-    "(stereo): the six target positions, as calibrated and with the focal length x1.5. "
-    "The three active methods servo on the image centre and are computed from the same "
-    "images. Smaller than `python -m headsim.study --experiment compare`, which also "
-    "calibrates the zoom fixed-point methods, a second head with centred principal points, "
-    "and the 0.7x zoom, principal-point and k1 changes (beyond the paper's tables)."
+    "Measured on this head with `head.json` (the image-centre active methods), one Zhang "
+    "calibration (stereo) and one zoom fixed-point calibration (the fixed-point methods, "
+    "beyond the paper): the six target positions, as calibrated and with the focal length "
+    "x1.5. The three image-centre methods servo once and are computed from the same images. "
+    "Smaller than `python -m headsim.study --experiment compare`, which also measures a "
+    "second head with centred principal points and the 0.7x zoom, principal-point and k1 "
+    "changes (beyond the paper's tables)."
 )
 #: The scenario whose head (and calibration) every experiment uses.
 TABLES_HEAD = "calibration"
@@ -180,8 +181,26 @@ def _zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
 
 
 @_plain_errors
+def _fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
+    """The zoom fixed points and the Sec. V calibration on their columns, once (beyond the
+    paper: the active method that the focal length's change does not move)."""
+    from headsim.paper_tables import fixed_point_calibration
+    from headsim.scenario import load_scenario
+
+    scenario = load_scenario(TABLES_HEAD, fast=fast, seed=seed)
+    start = time.perf_counter()
+    fixed = fixed_point_calibration(scenario.settings, _study_config(fast, seed))
+    return {"fixed": fixed, "wall_s": time.perf_counter() - start}
+
+
+@_plain_errors
 def _tables_job(
-    out: str, fast: bool, seed: int | None, head: str, zhang: dict[str, Any]
+    out: str,
+    fast: bool,
+    seed: int | None,
+    head: str,
+    zhang: dict[str, Any],
+    fixed: dict[str, Any],
 ) -> dict[str, Any]:
     """Tables V/VI and the changed focal length with the one calibration and Zhang's."""
     from headsim import paper_tables, study
@@ -191,9 +210,11 @@ def _tables_job(
     settings = load_scenario(TABLES_HEAD, fast=fast, seed=seed).settings
     stored = read_calibration(head, settings).knowledge
     calibration = zhang["calibration"]
-    result = paper_tables.run_tables(settings, calibration, stored, _study_config(fast, seed))
+    result = paper_tables.run_tables(
+        settings, calibration, stored, _study_config(fast, seed), fixed["fixed"]
+    )
     files = study.write_experiment(result, Path(out) / "study")
-    own = result.seconds + zhang["wall_s"]
+    own = result.seconds + zhang["wall_s"] + fixed["wall_s"]
     return to_jsonable(
         {
             "title": result.experiment.title,
@@ -207,7 +228,15 @@ def _tables_job(
                 "rms_px": calibration.stereo_rms_px,
                 "renders": zhang["renders"],
             },
-            "renders": zhang["renders"] + sum(e.renders for r in result.results for e in r.errors),
+            "fixed_point": {
+                "seconds": fixed["wall_s"],
+                "renders": fixed["fixed"].renders,
+                "principal_error_px": fixed["fixed"].principal.errors_px,
+                "alpha_e_error_mrad": [1e3 * e for e in fixed["fixed"].calibration.alpha_e_error],
+            },
+            "renders": zhang["renders"]
+            + fixed["fixed"].renders
+            + sum(e.renders for r in result.results for e in r.errors),
         }
     )
 
@@ -749,10 +778,12 @@ def reproduce(
         write_report(figure=False)
         progress("calibrating the head once (and its stereo pair, Zhang, beside it)")
         t0 = time.perf_counter()
-        # Zhang's calibration needs no head.json: it runs beside the head's calibration.
+        # Zhang's calibration and the fixed points' need no head.json: they run beside it.
+        head_job = pool.submit(_calibrate_job, str(out), fast, seed)
         zhang_job = pool.submit(_zhang_job, fast, seed)
+        fixed_job = pool.submit(_fixed_point_job, fast, seed)
         try:
-            calibration = pool.submit(_calibrate_job, str(out), fast, seed).result()
+            calibration = head_job.result()
         except Exception as err:
             outcomes["initial_directions"] = JobOutcome(
                 "initial_directions",
@@ -772,8 +803,10 @@ def reproduce(
                 "chessboard", _scenario_job, "chessboard", str(out), fast, seed, calibration["path"]
             )
             try:
-                zhang = zhang_job.result()
-                submit(STUDY_JOB, _tables_job, str(out), fast, seed, calibration["path"], zhang)
+                zhang, fixed = zhang_job.result(), fixed_job.result()
+                submit(
+                    STUDY_JOB, _tables_job, str(out), fast, seed, calibration["path"], zhang, fixed
+                )
             except Exception as err:
                 outcomes[STUDY_JOB] = JobOutcome(
                     STUDY_JOB,
