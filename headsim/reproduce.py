@@ -213,9 +213,10 @@ def _tables_job(
     result = paper_tables.run_tables(
         settings, calibration, stored, _study_config(fast, seed), fixed["fixed"]
     )
-    files = study.write_experiment(result, Path(out) / "study")
+    # The PNG is drawn by the parent, which loads matplotlib while the workers run.
+    files = study.write_experiment(result, Path(out) / "study", figure=False)
     own = result.seconds + zhang["wall_s"] + fixed["wall_s"]
-    return to_jsonable(
+    data = to_jsonable(
         {
             "title": result.experiment.title,
             "summary": study.summary_rows(result),
@@ -239,6 +240,8 @@ def _tables_job(
             + sum(e.renders for r in result.results for e in r.errors),
         }
     )
+    data["result"] = result  # for the parent to draw the PNG
+    return data
 
 
 @_plain_errors
@@ -667,6 +670,14 @@ def report_text(
             verdicts += [r.verdict for r in rows]
         if name == STUDY_JOB:
             lines += ["", TABLES_SCOPE]
+            data = outcome.data if outcome is not None else {}
+            if "renders" in data:
+                lines += [
+                    "",
+                    f"{data['renders']} renders: Zhang's calibration "
+                    f"{data['zhang']['renders']}, the fixed points and their Sec. V "
+                    f"calibration {data['fixed_point']['renders']}, the rest measuring.",
+                ]
         if outcome is not None:
             where = f"`{name}/`" if name in SCENARIO_JOBS else "`study/`"
             lines += ["", f"{outcome.wall_s:.1f} s; files in {where}"]
@@ -739,8 +750,14 @@ def reproduce(
         if figure:
             try:
                 drawn = main_figure(outcomes, calibration, out / "figures" / "main.png")
+                tables = outcomes.get(STUDY_JOB)
+                if tables is not None and "result" in tables.data:
+                    from headsim import plots
+
+                    result = tables.data.pop("result")
+                    plots.plot_experiment(result, Path(tables.data["files"]["png"]))
             except Exception as err:  # a figure must not hide the numbers
-                progress(f"main figure not drawn: {err!r}")
+                progress(f"figure not drawn: {err!r}")
         state["wall_s"] = time.perf_counter() - start
         state["wall_over_render"] = state["wall_s"] / render_s
         write_text_atomic(out / "report.md", report_text(state, outcomes, calibration, drawn))

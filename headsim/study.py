@@ -1018,10 +1018,12 @@ def target_rows(result: ExperimentResult) -> list[dict[str, Any]]:
     return rows
 
 
-def write_experiment(result: ExperimentResult, out_dir: str | Path) -> dict[str, Path]:
-    """Write ``<name>.csv``, ``<name>_targets.csv``, ``<name>.json``, ``<name>.png`` and update ``results.json``."""
-    from headsim import plots  # matplotlib loads only when figures are written
-
+def write_experiment(
+    result: ExperimentResult, out_dir: str | Path, figure: bool = True
+) -> dict[str, Path]:
+    """Write ``<name>.csv``, ``<name>_targets.csv``, ``<name>.json``, ``<name>.png`` and update
+    ``results.json``; ``figure`` False: not the PNG (its caller draws it with
+    ``headsim.plots.plot_experiment``, e.g. in a process that has matplotlib loaded)."""
     out = Path(out_dir)
     name = result.experiment.name
     summaries = summary_rows(result)
@@ -1044,8 +1046,12 @@ def write_experiment(result: ExperimentResult, out_dir: str | Path) -> dict[str,
         "csv": write_csv_atomic(out / f"{name}.csv", summaries),
         "targets_csv": write_csv_atomic(out / f"{name}_targets.csv", payload["targets"]),
         "json": write_json_atomic(out / f"{name}.json", payload),
-        "png": plots.plot_experiment(result, out / f"{name}.png"),
+        "png": out / f"{name}.png",
     }
+    if figure:
+        from headsim import plots  # matplotlib loads only when figures are written
+
+        plots.plot_experiment(result, files["png"])
     index_path = out / "results.json"
     index: dict[str, Any] = {}
     if index_path.exists():
