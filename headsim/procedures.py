@@ -45,7 +45,13 @@ from headsim.search import (
 from headsim.servo import Detector, EyeServo, NeckServo, ServoOutcome, ServoResult
 from headsim.settings import HeadBelief
 from headsim.sim import HeadSim
-from headsim.vision import Detection, DetectionStatus, find_chessboard, find_markers
+from headsim.vision import (
+    ChessboardDetection,
+    Detection,
+    DetectionStatus,
+    find_chessboard,
+    find_markers,
+)
 
 #: Centroid precision assumed for covariances, px (measured: ~0.03-0.06 px).
 NOMINAL_PIXEL_SIGMA = 0.05
@@ -857,6 +863,29 @@ def track_moving_target(
 # -- Chessboard (Sec. VI-A) ------------------------------------------------
 
 
+def board_extent(board: ChessboardDetection, index: int) -> tuple[float, float, float, float]:
+    """(left, top, right, bottom) px from corner ``index`` of what finding ``board`` needs:
+    its inner corners, the outer squares, and half a square of the border around them."""
+    corners = board.corners
+    assert corners is not None
+    columns, rows = board.pattern
+    grid = corners.reshape(rows, columns, 2)
+    spacing = float(
+        max(
+            np.linalg.norm(np.diff(grid, axis=1), axis=-1).max(),
+            np.linalg.norm(np.diff(grid, axis=0), axis=-1).max(),
+        )
+    )
+    low, high = corners.min(axis=0) - corners[index], corners.max(axis=0) - corners[index]
+    pad = 1.5 * spacing
+    return (
+        float(low[0] - pad),
+        float(low[1] - pad),
+        float(high[0] + pad),
+        float(high[1] + pad),
+    )
+
+
 def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: float) -> Target:
     """Inner corner ``index`` (row-major from the top-left) of the scene's chessboard.
 
@@ -871,7 +900,12 @@ def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: flo
         if not board.found:
             return Detection(board.status, None, 0.0)
         u, v = board.corners[index]
-        return Detection(DetectionStatus.FOUND, (float(u), float(v)), 1.0)
+        return Detection(
+            DetectionStatus.FOUND, (float(u), float(v)), 1.0, board_extent(board, index)
+        )
+
+    # Every corner of one board looks for the whole board: they share windows.
+    detect.window_key = ("chessboard", pattern, square_m)  # type: ignore[attr-defined]
 
     def truth(sim: HeadSim) -> np.ndarray:
         body = sim.data.body(names.CHESSBOARD)

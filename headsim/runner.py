@@ -133,7 +133,8 @@ class RunResult:
     failures: tuple[str, ...]
     timing_s: dict[str, float] = field(default_factory=dict, compare=False)
     #: Pixels rendered by phase, in full frames (a window counts its share), and
-    #: the servo's windows: rendered, and missed (a full frame followed).
+    #: the servo's windows: rendered, missed (a full frame followed), and the binned
+    #: previews that placed a window where no detection did.
     rendered_frames: dict[str, float] = field(default_factory=dict)
     windows: dict[str, int] = field(default_factory=dict)
 
@@ -155,6 +156,7 @@ class Hub:
         self.rendered_frames = 0.0
         self.windows = 0
         self.window_misses = 0
+        self.previews = 0
         self._watched: tuple[str, str] | None = None
         self._detector: Detector | None = None
         self._auto_label: Callable[[], str] | None = None
@@ -258,6 +260,14 @@ class ObservedSim(HeadSim):
         self.hub.rendered_frames += self.rendered_frames - before
         self._last_full[self.camera_index(camera)] = image
         self.hub.rendered(self, self.camera_index(camera) + 1, image)
+        return image
+
+    def render_preview(self, camera: CameraId, binning: int) -> np.ndarray:
+        """A binned preview: counted (pixels, previews), not shown to observers."""
+        before = self.rendered_frames
+        image = super().render_preview(camera, binning)
+        self.hub.rendered_frames += self.rendered_frames - before
+        self.hub.previews += 1
         return image
 
     def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
@@ -475,6 +485,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "knowledge": None,
         }
         start = sim.render_count
+        previews = hub.previews  # counted apart: images taken are what observers see
         try:
             run = calibrate_head(
                 sim,
@@ -493,7 +504,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             outcomes = err.outcomes if isinstance(err, CalibrationError) else ()
             block.update(
                 status=f"failed: {err}",
-                renders=sim.render_count - start,
+                renders=sim.render_count - start - (hub.previews - previews),
                 fixated=sum(o is None for o in outcomes),
                 positions=position_outcomes(outcomes),
             )
@@ -503,7 +514,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
     block.update(
         fixated=run.samples,
         positions=position_outcomes(run.outcomes),
-        renders=run.renders,
+        renders=run.renders - (hub.previews - previews),
         alpha_e_rad=list(fit.alpha_e),
         alpha_e_std_rad=list(fit.std_errors),
         alpha_e_covariance_rad2=np.asarray(fit.covariance).tolist(),
@@ -906,7 +917,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
             **rendered_frames,
             "total": rendered_frames["calibration"] + rendered_frames["experiment"],
         },
-        windows={"rendered": hub.windows, "missed": hub.window_misses},
+        windows={"rendered": hub.windows, "missed": hub.window_misses, "previews": hub.previews},
     )
     hub.finished(result)
     return result

@@ -926,7 +926,7 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
     """The done-when ratios of the comparison (RMS of the 3-D error, mm)."""
     exp = result.experiment
     groups = list(exp.base)
-    paper, centred_group = groups[0], groups[1]
+    paper = groups[0]
     figures: dict[str, Any] = {}
 
     def rms(group: str, label: str, method: str) -> float:
@@ -946,7 +946,9 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
     figures["image_centre_ray_turn_mrad"] = turns
     labels = {c.label for c in exp.conditions}
     if "zoom 1.5x" in labels:
-        for group, key in ((centred_group, "zoom_1_5_centred"), (paper, "zoom_1_5_paper")):
+        # The second group (if any) is the paper's head with centred principal points.
+        keys = {paper: "zoom_1_5_paper", **{g: "zoom_1_5_centred" for g in groups[1:2]}}
+        for group, key in keys.items():
             figures[key] = {
                 f"{m}_after_over_before": rms(group, "zoom 1.5x", m)
                 / rms(group, "as calibrated", m)
@@ -1018,10 +1020,12 @@ def target_rows(result: ExperimentResult) -> list[dict[str, Any]]:
     return rows
 
 
-def write_experiment(result: ExperimentResult, out_dir: str | Path) -> dict[str, Path]:
-    """Write ``<name>.csv``, ``<name>_targets.csv``, ``<name>.json``, ``<name>.png`` and update ``results.json``."""
-    from headsim import plots  # matplotlib loads only when figures are written
-
+def write_experiment(
+    result: ExperimentResult, out_dir: str | Path, figure: bool = True
+) -> dict[str, Path]:
+    """Write ``<name>.csv``, ``<name>_targets.csv``, ``<name>.json``, ``<name>.png`` and update
+    ``results.json``; ``figure`` False: not the PNG (its caller draws it with
+    ``headsim.plots.plot_experiment``, e.g. in a process that has matplotlib loaded)."""
     out = Path(out_dir)
     name = result.experiment.name
     summaries = summary_rows(result)
@@ -1044,8 +1048,12 @@ def write_experiment(result: ExperimentResult, out_dir: str | Path) -> dict[str,
         "csv": write_csv_atomic(out / f"{name}.csv", summaries),
         "targets_csv": write_csv_atomic(out / f"{name}_targets.csv", payload["targets"]),
         "json": write_json_atomic(out / f"{name}.json", payload),
-        "png": plots.plot_experiment(result, out / f"{name}.png"),
+        "png": out / f"{name}.png",
     }
+    if figure:
+        from headsim import plots  # matplotlib loads only when figures are written
+
+        plots.plot_experiment(result, files["png"])
     index_path = out / "results.json"
     index: dict[str, Any] = {}
     if index_path.exists():
