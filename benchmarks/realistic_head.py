@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from headsim.calibration_design import near_far_depths, offset_std_limit
 from headsim.camera_model import PinholeCamera
 from headsim.estimators import model2
 from headsim.estimators.calibration import calibrate_initial_directions, calibrate_lines_of_sight
@@ -85,9 +86,17 @@ def pct(err: np.ndarray, p: np.ndarray) -> float:
     return float(100 * np.sqrt(np.nanmean(np.sum(err**2, axis=1) / p[:, 2] ** 2)))
 
 
-def calibrate(head: StereoHead, seed: int, n: int = 60, noise: float = 1e-3):
+CALIBRATION_DEPTH_M = (0.25, 1.5)
+
+
+def calibrate(
+    head: StereoHead, seed: int, n: int = 60, noise: float = 1e-3, layout: str = "uniform"
+):
+    """The extended fit from ``n`` balls; ``layout`` as ``[experiment.calibration] layout``."""
     rng = np.random.default_rng(seed)
-    p = field(rng, n, depth=(0.25, 1.5), lateral=0.16, vertical=0.08)
+    p = field(rng, n, depth=CALIBRATION_DEPTH_M, lateral=0.16, vertical=0.08)
+    if layout == "near_far":  # the same x/z and y/z, at the design's two ranges
+        p *= (near_far_depths(n, CALIBRATION_DEPTH_M) / p[:, 2])[:, None]
     obs = observe(head, p)
     a1, a2 = (
         quantise(obs.alpha1, head.encoder_resolution),
@@ -207,6 +216,45 @@ def budget(p: np.ndarray, seeds: int, out: Path | None) -> None:
     print(f"   wrote {out / 'error_budget.csv'} and {out / 'error_budget.png'}")
 
 
+def recovery(head: StereoHead, seeds: int, layout: str) -> None:
+    """Section 3: the extended fit against the truth over ``seeds`` tape draws."""
+    s_true = head.line_of_sight_offsets()
+    half = (head.baseline - BELIEVED_D) / 2
+    exact_e = head.effective_initial_directions()
+    truth = np.r_[exact_e, s_true[0] - half, s_true[1] + half]
+    truth_b = head.baseline - s_true[0] + s_true[1]
+    ranges = (
+        near_far_depths(60, CALIBRATION_DEPTH_M)
+        if layout == "near_far"
+        else np.random.default_rng(0).uniform(*CALIBRATION_DEPTH_M, 100_000)
+    )
+    limit = offset_std_limit(ranges, 1e-3) * math.sqrt(len(ranges) / 60)
+    print(
+        f"\n3. Calibration recovery over {seeds} seeds (60 balls at 0.25-1.5 m, layout "
+        f"{layout}, 1 mm tape), realistic head; offset limit of eq. (1): {1e3 * limit:.3f} mm"
+    )
+    est, std, be, bs = [], [], [], []
+    for seed in range(seeds):
+        fit = calibrate(head, 1000 + seed, layout=layout)
+        est.append(np.r_[fit.alpha_e, fit.offset_m])
+        std.append(fit.std_errors)
+        be.append(fit.effective_baseline_m - truth_b)
+        bs.append(fit.effective_baseline_std_m)
+    est, std, be, bs = np.array(est), np.array(std), np.array(be), np.array(bs)
+    err = est - truth
+    print(f"   effective baseline error: RMS {1e3 * np.sqrt(np.mean(be**2)):.3f} mm, max {1e3 * np.max(np.abs(be)):.3f} mm; "
+          f"stated std {1e3 * np.mean(bs):.3f} mm, z-score spread {np.std(be / bs):.2f}")  # fmt: skip
+    for k, name in ((2, "s1"), (3, "s2")):
+        z = err[:, k] / std[:, k]
+        print(f"   {name} error: RMS {1e3 * np.sqrt(np.mean(err[:, k] ** 2)):.3f} mm, max {1e3 * np.max(np.abs(err[:, k])):.3f} mm; "
+              f"stated std {1e3 * np.mean(std[:, k]):.3f} mm, z-score spread {np.std(z):.2f}, "
+              f"within 1 stated std {100 * np.mean(np.abs(z) < 1):.0f} % (68 % expected)")  # fmt: skip
+    for k, name in ((0, "alpha_e1"), (1, "alpha_e2")):
+        print(
+            f"   {name} error RMS {np.sqrt(np.mean(err[:, k] ** 2)):.2e} rad; z-score spread {np.std(err[:, k] / std[:, k]):.2f}"
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=50)
@@ -239,9 +287,6 @@ def main() -> None:
     print(
         "\n2. Offsets left uncorrected (initial directions exact; line-of-sight offsets taken as 0)"
     )
-    s_true = head.line_of_sight_offsets()
-    half = (head.baseline - BELIEVED_D) / 2
-    exact_e = head.effective_initial_directions()
     for label, h in (
         (
             "n = 20 mm both, delta of the paper's cameras",
@@ -288,29 +333,8 @@ def main() -> None:
         "(y: near-midline targets switch between one camera's y and the mean)"
     )
 
-    print(
-        f"\n3. Calibration recovery over {args.seeds} seeds (60 targets at 0.25-1.5 m, 1 mm tape), realistic head"
-    )
-    truth = np.r_[exact_e, s_true[0] - half, s_true[1] + half]
-    truth_b = head.baseline - s_true[0] + s_true[1]
-    est, std, be, bs = [], [], [], []
-    for seed in range(args.seeds):
-        fit = calibrate(head, 1000 + seed)
-        est.append(np.r_[fit.alpha_e, fit.offset_m])
-        std.append(fit.std_errors)
-        be.append(fit.effective_baseline_m - truth_b)
-        bs.append(fit.effective_baseline_std_m)
-    est, std, be, bs = np.array(est), np.array(std), np.array(be), np.array(bs)
-    err = est - truth
-    print(f"   effective baseline error: RMS {1e3 * np.sqrt(np.mean(be**2)):.3f} mm, max {1e3 * np.max(np.abs(be)):.3f} mm; "
-          f"stated std {1e3 * np.mean(bs):.3f} mm, z-score spread {np.std(be / bs):.2f}")  # fmt: skip
-    for k, name in ((2, "s1"), (3, "s2")):
-        print(f"   {name} error: RMS {1e3 * np.sqrt(np.mean(err[:, k] ** 2)):.3f} mm, max {1e3 * np.max(np.abs(err[:, k])):.3f} mm; "
-              f"stated std {1e3 * np.mean(std[:, k]):.3f} mm, z-score spread {np.std(err[:, k] / std[:, k]):.2f}")  # fmt: skip
-    for k, name in ((0, "alpha_e1"), (1, "alpha_e2")):
-        print(
-            f"   {name} error RMS {np.sqrt(np.mean(err[:, k] ** 2)):.2e} rad; z-score spread {np.std(err[:, k] / std[:, k]):.2f}"
-        )
+    for layout in ("uniform", "near_far"):
+        recovery(head, args.seeds, layout)
 
     budget(p[:500], args.budget_seeds, args.out)
 

@@ -436,7 +436,8 @@ def _positive_int(text: str) -> int:
     return value
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
+    """The command line; ``with_study``: with the study's options (imports the study)."""
     from headsim import names
     from headsim.settings import PRESETS
 
@@ -582,14 +583,14 @@ def build_parser() -> argparse.ArgumentParser:
     add_recording_arguments(sweep, per_job=True)
     sweep.set_defaults(func=_sweep)
 
-    from headsim.study import STUDY_DESCRIPTION, add_arguments
-
     study = commands.add_parser(
-        "study",
-        help="the insensitivity study: stereo against the active method, sweeps, plots",
-        description=STUDY_DESCRIPTION,
+        "study", help="the insensitivity study: stereo against the active method, sweeps, plots"
     )
-    add_arguments(study)
+    if with_study:  # the study module (stereo, principal points) loads only for it
+        from headsim.study import STUDY_DESCRIPTION, add_arguments
+
+        study.description = STUDY_DESCRIPTION
+        add_arguments(study)
     study.set_defaults(func=_study)
 
     bench = commands.add_parser(
@@ -627,7 +628,7 @@ def _main(argv: list[str], *, debug: bool, quiet: bool) -> int:
     command = _command(argv)
     if command is not None and command not in RENDER_FREE_COMMANDS:
         backend.check_backend()  # MUJOCO_GL was settled when headsim was imported
-    args = build_parser().parse_args(argv)
+    args = build_parser(with_study="study" in argv).parse_args(argv)
     args.debug, args.quiet = debug, quiet
     return int(args.func(args))
 

@@ -46,7 +46,13 @@ from headsim.search import (
 from headsim.servo import Detector, EyeServo, NeckServo, ServoOutcome, ServoResult
 from headsim.settings import HeadBelief
 from headsim.sim import HeadSim
-from headsim.vision import Detection, DetectionStatus, find_chessboard, find_markers
+from headsim.vision import (
+    ChessboardDetection,
+    Detection,
+    DetectionStatus,
+    find_chessboard,
+    find_markers,
+)
 
 #: Centroid precision assumed for covariances, px (measured: ~0.03-0.06 px).
 NOMINAL_PIXEL_SIGMA = 0.05
@@ -477,6 +483,7 @@ def calibration_layout(
     lateral: float = 0.16,
     vertical: float = 0.08,
     radius_m: float = 0.008,
+    depths_m: np.ndarray | None = None,
     eye_angles_rad: Sequence[float] = (),
 ) -> np.ndarray:
     """World positions (count, 3) for Sec. V calibration targets, seeded.
@@ -491,6 +498,9 @@ def calibration_layout(
     length the near, lateral positions that separate the offsets are in the
     common view only with the eyes turned in (Model 2 finds them by search;
     the first position is always in view at the current pose).
+    ``depths_m``: (count,) each position's depth z_h, m, kept when it is drawn
+    again (e.g. :func:`headsim.calibration_design.near_far_depths`); None:
+    uniform in ``depth_range_m``.
     """
     resolution = sim.settings.encoder_resolution_rad
     eye_steps = [round(a / resolution) for a in eye_angles_rad]
@@ -507,13 +517,17 @@ def calibration_layout(
             sim.settle()
         return ok
 
-    def draw(n: int) -> np.ndarray:
-        z = rng.uniform(*depth_range_m, size=n)
+    def draw(n: int, slots: np.ndarray | None = None) -> np.ndarray:
+        z = rng.uniform(*depth_range_m, size=n) if depths_m is None else depths_m[slots]
         return np.column_stack(
             [rng.uniform(-lateral, lateral, n) * z, rng.uniform(-vertical, vertical, n) * z, z]
         )
 
-    points_world = sim.transform_points(draw(count), "head", "world")
+    if depths_m is not None:
+        depths_m = np.asarray(depths_m, dtype=float)
+        if depths_m.shape != (count,):
+            raise ValueError(f"depths_m must have shape ({count},), got {depths_m.shape}")
+    points_world = sim.transform_points(draw(count, np.arange(count)), "head", "world")
     # Placement (truth allowed): keep positions both cameras see whole from where the
     # head stands; a position that one cannot see is drawn again, a bounded number of times.
     for _ in range(500):
@@ -523,7 +537,9 @@ def calibration_layout(
         unseen[0] |= not seen_by_both(sim, points_world[:1], radius_m)[0]
         if not unseen.any():
             return points_world
-        points_world[unseen] = sim.transform_points(draw(int(unseen.sum())), "head", "world")
+        points_world[unseen] = sim.transform_points(
+            draw(int(unseen.sum()), np.flatnonzero(unseen)), "head", "world"
+        )
     raise ValueError(
         f"calibration layout: {int(unseen.sum())} of {count} positions stay outside a camera's "
         f"view after 500 draws: depth {depth_range_m} m, lateral {lateral}, vertical {vertical} "
@@ -899,6 +915,29 @@ def track_moving_target(
 # -- Chessboard (Sec. VI-A) ------------------------------------------------
 
 
+def board_extent(board: ChessboardDetection, index: int) -> tuple[float, float, float, float]:
+    """(left, top, right, bottom) px from corner ``index`` of what finding ``board`` needs:
+    its inner corners, the outer squares, and half a square of the border around them."""
+    corners = board.corners
+    assert corners is not None
+    columns, rows = board.pattern
+    grid = corners.reshape(rows, columns, 2)
+    spacing = float(
+        max(
+            np.linalg.norm(np.diff(grid, axis=1), axis=-1).max(),
+            np.linalg.norm(np.diff(grid, axis=0), axis=-1).max(),
+        )
+    )
+    low, high = corners.min(axis=0) - corners[index], corners.max(axis=0) - corners[index]
+    pad = 1.5 * spacing
+    return (
+        float(low[0] - pad),
+        float(low[1] - pad),
+        float(high[0] + pad),
+        float(high[1] + pad),
+    )
+
+
 def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: float) -> Target:
     """Inner corner ``index`` (row-major from the top-left) of the scene's chessboard.
 
@@ -913,7 +952,12 @@ def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: flo
         if not board.found:
             return Detection(board.status, None, 0.0)
         u, v = board.corners[index]
-        return Detection(DetectionStatus.FOUND, (float(u), float(v)), 1.0)
+        return Detection(
+            DetectionStatus.FOUND, (float(u), float(v)), 1.0, board_extent(board, index)
+        )
+
+    # Every corner of one board looks for the whole board: they share windows.
+    detect.window_key = ("chessboard", pattern, square_m)  # type: ignore[attr-defined]
 
     def truth(sim: HeadSim) -> np.ndarray:
         body = sim.data.body(names.CHESSBOARD)

@@ -164,6 +164,7 @@ class EyeRenderer:
         self._seed = seed
         self._noise = tuple(GaussianNoise.of(camera.noise_std) for camera in cameras)
         self._taken = [0, 0]
+        self._previews = [0, 0]
         self._cam_ids = [
             mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, name) for name in names.CAMERAS
         ]
@@ -176,8 +177,11 @@ class EyeRenderer:
         renderer._model = self._model  # the same assets; this model's cameras and bodies
         return renderer
 
-    def _draw(self, data: mujoco.MjData, index: int, rect: Window | None) -> np.ndarray:
-        """The pinhole canvas of camera ``index``, or its sub-rectangle ``rect``: (h, w, 3)."""
+    def _draw(
+        self, data: mujoco.MjData, index: int, rect: Window | None, binning: int = 1
+    ) -> np.ndarray:
+        """The pinhole canvas of camera ``index``, or its sub-rectangle ``rect``: (h, w, 3);
+        with ``binning`` b > 1 the whole canvas at 1/b of its resolution (no supersampling)."""
         canvas = self._canvases[index]
         renderer = self._renderer()
         # Supersampled k times (headsim.settings.RenderFidelity): the model's
@@ -190,7 +194,15 @@ class EyeRenderer:
         cam = self._cam_ids[index]
         model = self._model
         saved = None
-        if rect is not None and (rect.width, rect.height) != (width_c, height_c):
+        # Output pixels per canvas pixel: k, or 1/b binned (a b x b block of the sensor each).
+        if binning > 1:
+            rect = Window(0, 0, width_c - width_c % binning, height_c - height_c % binning)
+            out_w, out_h = rect.width // binning, rect.height // binning
+        elif rect is not None:
+            out_w, out_h = k * rect.width, k * rect.height
+        else:
+            out_w, out_h = full_w, full_h
+        if rect is not None and (binning > 1 or (rect.width, rect.height) != (width_c, height_c)):
             # The same camera, its image cut to ``rect``: resolution and sensor
             # shrink, the principal point moves by the window's offset.
             saved = (
@@ -206,7 +218,7 @@ class EyeRenderer:
                     (k * rect.height - full_h) / 2 + k * rect.y0,
                 ]
             )
-            model.cam_resolution[cam] = (k * rect.width, k * rect.height)
+            model.cam_resolution[cam] = (out_w, out_h)
             model.cam_sensorsize[cam] = pitch * np.array([k * rect.width, k * rect.height])
             model.cam_intrinsic[cam][2:4] = window_offset * pitch
         try:
@@ -222,15 +234,41 @@ class EyeRenderer:
         gl_context = renderer._gl_context
         if gl_context is not None:
             gl_context.make_current()
-        viewport = mujoco.MjrRect(0, 0, k * width, k * height)
+        viewport = mujoco.MjrRect(0, 0, out_w, out_h)
         mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
-        pixels = np.empty((k * height, k * width, 3), dtype=np.uint8)
+        pixels = np.empty((out_h, out_w, 3), dtype=np.uint8)
         mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
+        if binning > 1:
+            self.rendered_frames += (out_w * out_h) / (width_c * height_c)
+            return np.ascontiguousarray(pixels[::-1])
         self.rendered_frames += (width * height) / (width_c * height_c)
         pixels = np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
         if k > 1:
             pixels = cv2.resize(pixels, (width, height), interpolation=cv2.INTER_AREA)
         return pixels
+
+    def render_preview(self, data: mujoco.MjData, index: int, binning: int) -> np.ndarray:
+        """Camera ``index``'s whole view binned ``binning`` x ``binning``: (H/b, W/b, 3) uint8.
+
+        A low-resolution readout of the same camera (lens included), for finding
+        where to look; pixel (i, j) covers the image's pixels b i .. b i + b - 1.
+        Its noise (the camera's std) comes from a stream of its own, so the
+        camera's images get the same noise with and without previews.  Counted
+        as a render and as 1/b^2 of a frame's pixels.
+        """
+        camera = self._cameras[index]
+        if camera.width % binning or camera.height % binning:
+            raise ValueError(
+                f"binning {binning} must divide the {camera.width}x{camera.height} image"
+            )
+        image = apply_canvas(
+            self._draw(data, index, None, binning=binning),
+            binned_canvas(self._canvases[index], binning, (camera.width, camera.height)),
+        )
+        self.render_count += 1
+        frame = self._previews[index]
+        self._previews[index] += 1
+        return self._noise[index].apply(image, (self._seed, index, PREVIEW_STREAM), frame)
 
     def render(self, data: mujoco.MjData, index: int, retake: bool = False) -> np.ndarray:
         """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8.
@@ -292,6 +330,59 @@ class EyeRenderer:
             renderer = _POOL.pop(self._key, None)
             if renderer is not None:
                 renderer.close()
+
+
+#: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.
+PREVIEW_STREAM = 1_000_003
+
+
+#: Binned canvases by (id of the canvas, binning), with the canvas kept alive.
+_BINNED: dict[tuple[int, int], tuple[DistortionCanvas, DistortionCanvas]] = {}
+
+
+def binned_canvas(
+    canvas: DistortionCanvas, binning: int, image_size: tuple[int, int]
+) -> DistortionCanvas:
+    """``canvas`` for images binned ``binning`` x ``binning`` from a canvas binned alike
+    (made once per canvas and binning).
+
+    The remap tables' b x b blocks are averaged (the block centre's sample of a
+    smooth map) and moved to the binned canvas's pixels; a block with any pixel
+    without source has none.
+    """
+    key = (id(canvas), binning)
+    if key not in _BINNED:
+        _BINNED[key] = (canvas, _binned_canvas(canvas, binning, image_size))
+    return _BINNED[key][1]
+
+
+def _binned_canvas(
+    canvas: DistortionCanvas, binning: int, image_size: tuple[int, int]
+) -> DistortionCanvas:
+    width, height = image_size
+    size = (width // binning, height // binning)
+    width_b = (canvas.size[0] - canvas.size[0] % binning) // binning
+    height_b = (canvas.size[1] - canvas.size[1] % binning) // binning
+    if canvas.map_x is None or canvas.map_y is None:
+        return DistortionCanvas((width_b, height_b), canvas.principal, None, None, 1.0)
+    offset = (binning - 1) / 2.0
+    invalid = (
+        cv2.resize((canvas.map_x < 0).astype(np.float32), size, interpolation=cv2.INTER_AREA) > 0
+    )
+    map_x = (cv2.resize(canvas.map_x, size, interpolation=cv2.INTER_AREA) - offset) / binning
+    map_y = (cv2.resize(canvas.map_y, size, interpolation=cv2.INTER_AREA) - offset) / binning
+    invalid |= (map_x < 0) | (map_x > width_b - 1) | (map_y < 0) | (map_y > height_b - 1)
+    map_x[invalid] = -1.0
+    map_y[invalid] = -1.0
+    map_x, map_y = map_x.astype(np.float32), map_y.astype(np.float32)
+    map_x.flags.writeable = map_y.flags.writeable = False
+    return DistortionCanvas(
+        size=(width_b, height_b),
+        principal=canvas.principal,
+        map_x=map_x,
+        map_y=map_y,
+        valid_fraction=float(1.0 - invalid.mean()),
+    )
 
 
 def _canvas_region(

@@ -11,10 +11,13 @@ One head (the scenarios' ``paper`` head) is calibrated once (Sec. V, the
 - ``tracking``: the moving target with the neck (beyond Sec. VI's static tests);
 - ``tables_v_vi``: calibrated stereo against the active method (Sec. VI-B,
   Tables V-VI, Fig. 11), then the cameras zoomed 1.5x with every calibration
-  kept (the changed focal length).  The study calibrates its own methods
-  (stereo needs Zhang's chessboard calibration; its active methods calibrate
-  the study's head themselves): it does not use head.json.
+  kept (the changed focal length), on the same head with the same Sec. V
+  calibration (head.json), one Zhang stereo calibration and one zoom
+  fixed-point calibration (:mod:`headsim.paper_tables`; the study's other
+  heads and changes are left to ``python -m headsim.study``).
 
+The head's calibration, Zhang's and the fixed points' run first, side by
+side; then the longest experiments first, so that the workers finish together.
 With ``--sweeps`` the study's insensitivity sweeps are added.  Every
 experiment writes its files under ``DIR/<experiment>/`` as it finishes, and
 ``DIR/report.md`` (with ``DIR/figures/*.png``) is rewritten after each one, so
@@ -26,10 +29,12 @@ from __future__ import annotations
 
 import concurrent.futures as futures
 import functools
+import importlib
 import math
 import multiprocessing
 import statistics
 import sys
+import threading
 import time
 import traceback
 from collections.abc import Callable
@@ -51,6 +56,18 @@ SCENARIO_JOBS = {
     "tracking": ("tracking", "Tracking with the neck (Model 1), beyond the paper"),
 }
 STUDY_JOB = "tables_v_vi"
+#: What the Tables V/VI experiment measures here, and what it leaves to the study.
+TABLES_SCOPE = (
+    "Measured on this head with `head.json` (the image-centre active methods), one Zhang "
+    "calibration (stereo) and one zoom fixed-point calibration (the fixed-point methods, "
+    "beyond the paper): the six target positions, as calibrated and with the focal length "
+    "x1.5. The three image-centre methods servo once and are computed from the same images. "
+    "Smaller than `python -m headsim.study --experiment compare`, which also measures a "
+    "second head with centred principal points and the 0.7x zoom, principal-point and k1 "
+    "changes (beyond the paper's tables)."
+)
+#: The scenario whose head (and calibration) every experiment uses.
+TABLES_HEAD = "calibration"
 #: Paper's figures (Sec. VI).
 PAPER_ALPHA_E = (0.0578, -0.0254)
 PAPER_SIDE_MEAN_MM, PAPER_SIDE_STD_MM, TRUE_SIDE_MM = 30.3, 0.677, 30.0
@@ -144,17 +161,95 @@ def _scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) 
     }
 
 
+def _study_config(fast: bool, seed: int | None) -> Any:
+    from headsim import study
+
+    make = study.StudyConfig.quick if fast else study.StudyConfig
+    return make(seed=seed or 0)
+
+
+@_plain_errors
+def _zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
+    """Zhang's stereo calibration of the one head, once (it needs no head.json)."""
+    from headsim.paper_tables import zhang_calibration
+    from headsim.scenario import load_scenario
+
+    scenario = load_scenario(TABLES_HEAD, fast=fast, seed=seed)
+    start = time.perf_counter()
+    calibration, renders = zhang_calibration(scenario.settings, _study_config(fast, seed))
+    return {"calibration": calibration, "renders": renders, "wall_s": time.perf_counter() - start}
+
+
+@_plain_errors
+def _fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
+    """The zoom fixed points and the Sec. V calibration on their columns, once (beyond the
+    paper: the active method that the focal length's change does not move)."""
+    from headsim.paper_tables import fixed_point_calibration
+    from headsim.scenario import load_scenario
+
+    scenario = load_scenario(TABLES_HEAD, fast=fast, seed=seed)
+    start = time.perf_counter()
+    fixed = fixed_point_calibration(scenario.settings, _study_config(fast, seed))
+    return {"fixed": fixed, "wall_s": time.perf_counter() - start}
+
+
+@_plain_errors
+def _tables_job(
+    out: str,
+    fast: bool,
+    seed: int | None,
+    head: str,
+    zhang: dict[str, Any],
+    fixed: dict[str, Any],
+) -> dict[str, Any]:
+    """Tables V/VI and the changed focal length with the one calibration and Zhang's."""
+    from headsim import paper_tables, study
+    from headsim.calibration_file import read_calibration
+    from headsim.scenario import load_scenario
+
+    settings = load_scenario(TABLES_HEAD, fast=fast, seed=seed).settings
+    stored = read_calibration(head, settings).knowledge
+    calibration = zhang["calibration"]
+    result = paper_tables.run_tables(
+        settings, calibration, stored, _study_config(fast, seed), fixed["fixed"]
+    )
+    # The PNG is drawn by the parent, which loads matplotlib while the workers run.
+    files = study.write_experiment(result, Path(out) / "study", figure=False)
+    own = result.seconds + zhang["wall_s"] + fixed["wall_s"]
+    data = to_jsonable(
+        {
+            "title": result.experiment.title,
+            "summary": study.summary_rows(result),
+            "figures": study.compare_figures(result),
+            "files": {k: str(p) for k, p in files.items()},
+            "seconds": own,
+            "zhang": {
+                "seconds": zhang["wall_s"],
+                "views": calibration.views,
+                "rms_px": calibration.stereo_rms_px,
+                "renders": zhang["renders"],
+            },
+            "fixed_point": {
+                "seconds": fixed["wall_s"],
+                "renders": fixed["fixed"].renders,
+                "principal_error_px": fixed["fixed"].principal.errors_px,
+                "alpha_e_error_mrad": [1e3 * e for e in fixed["fixed"].calibration.alpha_e_error],
+            },
+            "renders": zhang["renders"]
+            + fixed["fixed"].renders
+            + sum(e.renders for r in result.results for e in r.errors),
+        }
+    )
+    data["result"] = result  # for the parent to draw the PNG
+    return data
+
+
 @_plain_errors
 def _study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim import study
 
-    make = study.StudyConfig.quick if fast else study.StudyConfig
-    config = make(seed=seed or 0)
-    experiment = (
-        study.compare_experiment(config)
-        if name == STUDY_JOB
-        else study.sweep_experiment(name.removeprefix("sweep_"), config)
-    )
+    config = _study_config(fast, seed)
+    experiment = study.sweep_experiment(name.removeprefix("sweep_"), config)
     result = study.run_experiment(experiment, config)
     files = study.write_experiment(result, Path(out) / "study")
     return to_jsonable(
@@ -573,6 +668,16 @@ def report_text(
         if rows:
             lines += _table(rows)
             verdicts += [r.verdict for r in rows]
+        if name == STUDY_JOB:
+            lines += ["", TABLES_SCOPE]
+            data = outcome.data if outcome is not None else {}
+            if "renders" in data:
+                lines += [
+                    "",
+                    f"{data['renders']} renders: Zhang's calibration "
+                    f"{data['zhang']['renders']}, the fixed points and their Sec. V "
+                    f"calibration {data['fixed_point']['renders']}, the rest measuring.",
+                ]
         if outcome is not None:
             where = f"`{name}/`" if name in SCENARIO_JOBS else "`study/`"
             lines += ["", f"{outcome.wall_s:.1f} s; files in {where}"]
@@ -638,15 +743,24 @@ def reproduce(
     outcomes: dict[str, JobOutcome] = {}
     calibration: dict[str, Any] | None = None
 
-    def write_report() -> None:
+    def write_report(figure: bool = True) -> None:
+        """report.md and report.json; the main figure (matplotlib, ~1 s) only when asked:
+        at the end, and when interrupted.  The wall time counts the figure."""
+        drawn = None
+        if figure:
+            try:
+                drawn = main_figure(outcomes, calibration, out / "figures" / "main.png")
+                tables = outcomes.get(STUDY_JOB)
+                if tables is not None and "result" in tables.data:
+                    from headsim import plots
+
+                    result = tables.data.pop("result")
+                    plots.plot_experiment(result, Path(tables.data["files"]["png"]))
+            except Exception as err:  # a figure must not hide the numbers
+                progress(f"figure not drawn: {err!r}")
         state["wall_s"] = time.perf_counter() - start
         state["wall_over_render"] = state["wall_s"] / render_s
-        figure = None
-        try:
-            figure = main_figure(outcomes, calibration, out / "figures" / "main.png")
-        except Exception as err:  # a figure must not hide the numbers
-            progress(f"main figure not drawn: {err!r}")
-        write_text_atomic(out / "report.md", report_text(state, outcomes, calibration, figure))
+        write_text_atomic(out / "report.md", report_text(state, outcomes, calibration, drawn))
         write_json_atomic(
             out / "report.json",
             to_jsonable(
@@ -676,12 +790,17 @@ def reproduce(
         )
 
     pool = _pool(workers)
+    jobs: dict[futures.Future[dict[str, Any]], tuple[str, float]] = {}
     try:
-        write_report()
-        progress("calibrating the head once")
+        write_report(figure=False)
+        progress("calibrating the head once (and its stereo pair, Zhang, beside it)")
         t0 = time.perf_counter()
+        # Zhang's calibration and the fixed points' need no head.json: they run beside it.
+        head_job = pool.submit(_calibrate_job, str(out), fast, seed)
+        zhang_job = pool.submit(_zhang_job, fast, seed)
+        fixed_job = pool.submit(_fixed_point_job, fast, seed)
         try:
-            calibration = pool.submit(_calibrate_job, str(out), fast, seed).result()
+            calibration = head_job.result()
         except Exception as err:
             outcomes["initial_directions"] = JobOutcome(
                 "initial_directions",
@@ -689,23 +808,42 @@ def reproduce(
                 time.perf_counter() - t0,
                 error=str(err) if isinstance(err, JobError) else _why(err),
             )
-        jobs: dict[futures.Future[dict[str, Any]], tuple[str, float]] = {}
         now = time.perf_counter()
+
+        def submit(name: str, job: Callable[..., dict[str, Any]], *args: Any) -> None:
+            jobs[pool.submit(job, *args)] = (name, now)
+
         # The longest first, so that the workers finish together.
-        for name in (STUDY_JOB, *state["sweeps"]):
-            jobs[pool.submit(_study_job, name, str(out), fast, seed)] = (name, now)
+        names = list(SCENARIO_JOBS)
         if calibration is not None:
-            for name in SCENARIO_JOBS:
-                jobs[
-                    pool.submit(_scenario_job, name, str(out), fast, seed, calibration["path"])
-                ] = (
-                    name,
-                    now,
+            submit(
+                "chessboard", _scenario_job, "chessboard", str(out), fast, seed, calibration["path"]
+            )
+            try:
+                zhang, fixed = zhang_job.result(), fixed_job.result()
+                submit(
+                    STUDY_JOB, _tables_job, str(out), fast, seed, calibration["path"], zhang, fixed
                 )
+            except Exception as err:
+                outcomes[STUDY_JOB] = JobOutcome(
+                    STUDY_JOB,
+                    "error",
+                    time.perf_counter() - t0,
+                    error=str(err) if isinstance(err, JobError) else _why(err),
+                )
+            for name in names:
+                if name != "chessboard":
+                    submit(name, _scenario_job, name, str(out), fast, seed, calibration["path"])
         else:
-            for name in list(SCENARIO_JOBS)[1:]:
+            for name in [*names[1:], STUDY_JOB]:
                 outcomes[name] = JobOutcome(name, "error", 0.0, error="no calibration to use")
-        write_report()
+        for name in state["sweeps"]:
+            submit(name, _study_job, name, str(out), fast, seed)
+        write_report(figure=False)
+        # matplotlib loads (about 1 s) while the workers run, not after them.
+        threading.Thread(
+            target=importlib.import_module, args=("headsim.plots",), daemon=True
+        ).start()
         for done in futures.as_completed(jobs):
             name, began = jobs[done]
             try:
@@ -727,7 +865,7 @@ def reproduce(
                     error=str(err) if isinstance(err, JobError) else _why(err),
                 )
             progress(f"{name}: {outcomes[name].status}")
-            write_report()
+            write_report(figure=False)
         state["status"] = (
             "ok" if calibration and all(o.status == "ok" for o in outcomes.values()) else "failed"
         )

@@ -26,6 +26,7 @@ from typing import Any, TextIO
 import numpy as np
 
 from headsim import names
+from headsim.calibration_design import near_far_depths, near_fraction
 from headsim.procedures import (
     CalibrationError,
     CalibrationRun,
@@ -132,7 +133,8 @@ class RunResult:
     failures: tuple[str, ...]
     timing_s: dict[str, float] = field(default_factory=dict, compare=False)
     #: Pixels rendered by phase, in full frames (a window counts its share), and
-    #: the servo's windows: rendered, and missed (a full frame followed).
+    #: the servo's windows: rendered, missed (a full frame followed), and the binned
+    #: previews that placed a window where no detection did.
     rendered_frames: dict[str, float] = field(default_factory=dict)
     windows: dict[str, int] = field(default_factory=dict)
 
@@ -154,6 +156,7 @@ class Hub:
         self.rendered_frames = 0.0
         self.windows = 0
         self.window_misses = 0
+        self.previews = 0
         self._watched: tuple[str, str] | None = None
         self._detector: Detector | None = None
         self._auto_label: Callable[[], str] | None = None
@@ -257,6 +260,14 @@ class ObservedSim(HeadSim):
         self.hub.rendered_frames += self.rendered_frames - before
         self._last_full[self.camera_index(camera)] = image
         self.hub.rendered(self, self.camera_index(camera) + 1, image)
+        return image
+
+    def render_preview(self, camera: CameraId, binning: int) -> np.ndarray:
+        """A binned preview: counted (pixels, previews), not shown to observers."""
+        before = self.rendered_frames
+        image = super().render_preview(camera, binning)
+        self.hub.rendered_frames += self.rendered_frames - before
+        self.hub.previews += 1
         return image
 
     def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
@@ -407,6 +418,12 @@ def marker_target(name: str, body: str) -> Target:
     )
 
 
+def _told(scenario: Scenario) -> HeadKnowledge:
+    """What the scenario tells the head before any calibration: its goal columns, if given."""
+    goals = scenario.experiment.goal_columns_px
+    return HeadKnowledge() if goals is None else HeadKnowledge(u0=goals)
+
+
 def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dict[str, Any]]:
     """Sec. V in the default scene; returns the run (None if it failed) and its JSON block."""
     spec = scenario.experiment.calibration
@@ -421,6 +438,9 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 spec.depth_m,
                 spec.lateral,
                 spec.vertical,
+                depths_m=near_far_depths(spec.targets, spec.depth_m, spec.near_fraction)
+                if spec.layout == "near_far"
+                else None,
             )
         except ValueError as err:
             block = {"status": f"failed: {err}", "targets": spec.targets, "fixated": 0}
@@ -440,6 +460,12 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "fixated": 0,
             "renders": 0,
             "layout": {
+                "kind": spec.layout,
+                "near_fraction": (
+                    (spec.near_fraction or near_fraction(spec.depth_m))
+                    if spec.layout == "near_far"
+                    else None
+                ),
                 "depth_m": list(spec.depth_m),
                 "lateral": spec.lateral,
                 "vertical": spec.vertical,
@@ -451,6 +477,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "extended": spec.extended,
             "alpha_e_rad": None,
             "alpha_e_std_rad": None,
+            "alpha_e_covariance_rad2": None,
             "alpha_e_truth_rad": truth_alpha_e,
             "alpha_e_error_rad": None,
             "alpha_e_paper_rad": list(PAPER["alpha_e_rad"]),
@@ -461,6 +488,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             "knowledge": None,
         }
         start = sim.render_count
+        previews = hub.previews  # counted apart: images taken are what observers see
         try:
             run = calibrate_head(
                 sim,
@@ -473,12 +501,13 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 extended=spec.extended,
                 position_noise_m=spec.position_noise_m,
                 lines_of_sight=spec.lines_of_sight,
+                knowledge=_told(scenario),
             )
         except ValueError as err:
             outcomes = err.outcomes if isinstance(err, CalibrationError) else ()
             block.update(
                 status=f"failed: {err}",
-                renders=sim.render_count - start,
+                renders=sim.render_count - start - (hub.previews - previews),
                 fixated=sum(o is None for o in outcomes),
                 positions=position_outcomes(outcomes),
             )
@@ -488,9 +517,10 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
     block.update(
         fixated=run.samples,
         positions=position_outcomes(run.outcomes),
-        renders=run.renders,
+        renders=run.renders - (hub.previews - previews),
         alpha_e_rad=list(fit.alpha_e),
         alpha_e_std_rad=list(fit.std_errors),
+        alpha_e_covariance_rad2=np.asarray(fit.covariance).tolist(),
         alpha_e_error_rad=list(run.alpha_e_error),
         converged=bool(fit.converged),
         depth_residual_rms_m=float(np.sqrt(np.mean(np.square(fit.depth_residuals)))),
@@ -542,6 +572,7 @@ def _lines_block(run: CalibrationRun, sim: HeadSim) -> dict[str, Any]:
             "offset_m": list(lines.std_errors[2:]),
         },
         "offset_truth_m": list(truth.offset_m),
+        "covariance": np.asarray(lines.covariance).tolist(),  # (alpha_e1, alpha_e2, s1, s2)
         "effective_baseline_m": lines.effective_baseline_m,
         "effective_baseline_std_m": lines.effective_baseline_std_m,
         "effective_baseline_truth_m": truth.effective_baseline_m,
@@ -577,7 +608,7 @@ def _run_points(
             else ObservedEyeServo(sim, config)
         )
         passes = (
-            [(HeadKnowledge(), "none"), (knowledge, label)]
+            [(_told(scenario), "none"), (knowledge, label)]
             if procedure == "calibration"
             else [(knowledge, label)]
         )
@@ -828,7 +859,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
     timing: dict[str, float] = {}
     renders = {"calibration": 0, "experiment": 0, "recording": 0}
     rendered_frames = {"calibration": 0.0, "experiment": 0.0}
-    knowledge, label = HeadKnowledge(), "none"
+    knowledge, label = _told(scenario), "none"
     calibration = None
     failures: list[str] = []
     spec = scenario.experiment.calibration
@@ -889,7 +920,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
             **rendered_frames,
             "total": rendered_frames["calibration"] + rendered_frames["experiment"],
         },
-        windows={"rendered": hub.windows, "missed": hub.window_misses},
+        windows={"rendered": hub.windows, "missed": hub.window_misses, "previews": hub.previews},
     )
     hub.finished(result)
     return result

@@ -34,6 +34,7 @@ import mujoco
 import numpy as np
 
 from headsim import names
+from headsim.calibration_design import LAYOUTS
 from headsim.errors import BadInput
 from headsim.kinematics import head_to_world, world_to_head
 from headsim.model import eye_from_camera_rotation, load_spec
@@ -114,6 +115,10 @@ class CalibrationSpec:
     every measured coordinate of each target (x_h, y_h, z_h), m; the depth
     noise adds to it on z_h.  ``lines_of_sight``: with ``extended``, also fit
     each eye's line-of-sight offset (default: on for the realistic preset).
+    ``layout``: "uniform" (depths uniform in ``depth_m``) or "near_far" (a
+    share ``near_fraction`` of the balls at the near end of ``depth_m`` and the
+    rest at the far end; default b / (a + b), the design that pins each eye's
+    line-of-sight offset best, see :mod:`headsim.calibration_design`).
     ``source``: a calibration file (``headsim calibrate``) to use instead of
     calibrating (a relative path is relative to the scenario file's
     directory); the other fields are then not used.
@@ -128,6 +133,8 @@ class CalibrationSpec:
     position_noise_m: float = 0.0
     lines_of_sight: bool = False
     source: str | None = None
+    layout: str = "uniform"
+    near_fraction: float | None = None
 
 
 @dataclass(frozen=True)
@@ -151,6 +158,9 @@ class ExperimentSpec:
     midline_px: float = 25.0
     remedy_px: float = 120.0
     servo: ServoSpec = field(default_factory=ServoSpec)
+    #: The servo's goal column (u10, u20) of Ca1, Ca2, px, as the user tells the head
+    #: (e.g. the principal point's, found with ``headsim.principal``); None: image centres.
+    goal_columns_px: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -672,8 +682,16 @@ def _read_calibration(table: _Table | None, lines_default: bool = False) -> Cali
         position_noise_m=table.number("position_noise_m", 0.0, 0.0, 0.1, unit="m"),
         lines_of_sight=table.boolean("lines_of_sight", lines_default),
         source=table.string("from", None, max_length=1000),
+        layout=table.choice("layout", LAYOUTS, "uniform"),
+        near_fraction=table.number(
+            "near_fraction", None, 0.0, 1.0, lo_open=True, hi_open=True, unit="(share of balls)"
+        ),
     )
     table.done()
+    if spec.near_fraction is not None and spec.layout != "near_far":
+        raise table.fail(
+            "near_fraction", f'given with layout = "{spec.layout}"', 'layout = "near_far"'
+        )
     if spec.extended and spec.vertical == 0.0:
         raise table.fail(
             "vertical",
@@ -710,6 +728,9 @@ def _read_experiment(doc: _Table, ctx: _Context, preset_name: str = "ideal") -> 
         options["remedy_px"] = table.number(
             "remedy_px", 120.0, 0.0, 1000.0, lo_open=True, unit="px"
         )
+    goals = table.numbers("goal_columns_px", 2, None, 0.0, MAX_IMAGE_SIDE - 1.0, unit="px")
+    if goals is not None:
+        options["goal_columns_px"] = (goals[0], goals[1])
     servo_table = table.table("servo")
     servo = ServoSpec()
     if servo_table is not None:
@@ -1367,6 +1388,20 @@ def _build(
             read_calibration(source, settings)
         except CalibrationFileError as err:
             raise ctx.error("experiment.calibration.from", str(err)) from err
+    if experiment.goal_columns_px is not None and calibration and calibration.source:
+        raise ctx.error(
+            "experiment.goal_columns_px",
+            "given with experiment.calibration.from",
+            "one of the two (a calibration file carries its own goal columns)",
+        )
+    for index, u in enumerate(experiment.goal_columns_px or ()):
+        width = settings.cameras[index].width
+        if not u <= width - 1:
+            raise ctx.error(
+                f"experiment.goal_columns_px[{index}]",
+                f"{u:g} px is outside camera {index + 1}'s image",
+                f"a column in [0, {width - 1}] px",
+            )
     scene = _read_scene(top, ctx, experiment.procedure, settings, seed)
     top.has("fast")
     top.done()

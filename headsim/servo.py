@@ -38,6 +38,38 @@ def windowed(detector: object) -> bool:
     return detector in WINDOWED_DETECTORS
 
 
+def pattern_windowed(detector: object) -> bool:
+    """Whether ``detector`` finds a feature as part of a pattern it reports the extent of
+    (``Detection.extent_px``) and names by a ``window_key`` shared by the pattern's features."""
+    while isinstance(detector, functools.partial):
+        detector = detector.func
+    return getattr(detector, "window_key", None) is not None
+
+
+def pattern_window(
+    sim: HeadSim,
+    camera: int,
+    expected_uv: tuple[float, float],
+    extent_px: tuple[float, float, float, float],
+    motion_px: float,
+    margin_px: float,
+) -> Window | None:
+    """The window to look for a pattern of ``extent_px`` around ``expected_uv`` after an
+    image motion of ``motion_px``: the extent plus the margin and a quarter of the motion
+    on every side.  None where it would be barely cheaper than the frame."""
+    settings = sim.camera_settings(camera)
+    grow = margin_px + 0.25 * abs(motion_px)
+    u, v = expected_uv
+    left, top, right, bottom = extent_px
+    x0 = max(math.floor(u + left - grow), 0)
+    y0 = max(math.floor(v + top - grow), 0)
+    x1 = min(math.ceil(u + right + grow) + 1, settings.width)
+    y1 = min(math.ceil(v + bottom + grow) + 1, settings.height)
+    if x1 <= x0 or y1 <= y0 or (x1 - x0) * (y1 - y0) >= 0.5 * settings.width * settings.height:
+        return None
+    return Window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
+
+
 def expected_window(
     sim: HeadSim,
     camera: int,
@@ -57,6 +89,23 @@ def expected_window(
     return window
 
 
+def preview_window(
+    sim: HeadSim, camera: int, detector: object, config: ServoConfig
+) -> Window | None:
+    """Render a preview of ``camera``'s whole view binned ``config.preview_binning`` x
+    ``config.preview_binning`` and return the window where it shows the blob, or None
+    (not found, or a window barely cheaper than the frame: a full frame follows)."""
+    b = config.preview_binning
+    assert callable(detector)
+    seen = detector(sim.render_preview(camera, b))
+    if not isinstance(seen, Detection) or not seen.found or seen.uv is None:
+        return None
+    # Binned pixel i covers pixels b i .. b i + b - 1; its position is good to about b px.
+    offset = (b - 1) / 2.0
+    uv = (b * seen.uv[0] + offset, b * seen.uv[1] + offset)
+    return expected_window(sim, camera, uv, b * b * seen.area_px, 4.0 * b, config.window_margin_px)
+
+
 def look_in_window(
     sim: HeadSim, camera: int, detector: Detector, window: Window
 ) -> Detection | None:
@@ -70,6 +119,19 @@ def look_in_window(
     if not seen.found or seen.uv is None:
         return None
     u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0
+    if seen.extent_px is not None:
+        # A pattern counts only if all of it lies 2 px inside the window, or runs
+        # off a side where the window's edge is the image's (the full frame ends there too).
+        left, top, right, bottom = seen.extent_px
+        settings = sim.camera_settings(camera)
+        if (
+            (window.x0 == 0 or window.x0 + 2 <= u + left)
+            and (window.x1 == settings.width or u + right <= window.x1 - 3)
+            and (window.y0 == 0 or window.y0 + 2 <= v + top)
+            and (window.y1 == settings.height or v + bottom <= window.y1 - 3)
+        ):
+            return Detection(DetectionStatus.FOUND, (u, v), seen.area_px, seen.extent_px)
+        return None
     inset = 3.0 * math.sqrt(seen.area_px / math.pi) + 2.0
     if (
         window.x0 + inset <= u <= window.x1 - 1 - inset
@@ -133,6 +195,9 @@ class ServoConfig:
     ``windows``: render only a window around where the target is expected
     (see :meth:`EyeServo.observe`); ``window_margin_px`` is added to its
     half-side beyond the blob and a quarter of the predicted motion.
+    ``preview_binning``: where no detection predicts a blob's window (a new
+    target), find it first in the whole view binned b x b (1/b^2 of the
+    pixels), then render its window; 1: a full frame instead.
     """
 
     tolerance_px: float = 0.1
@@ -143,6 +208,7 @@ class ServoConfig:
     max_retreats: int = 3
     windows: bool = True
     window_margin_px: float = 8.0
+    preview_binning: int = 4
 
 
 class EyeServo:
@@ -161,6 +227,10 @@ class EyeServo:
         self._seen: dict[
             int, tuple[object, int, tuple[float, float], int, tuple[float, float], float]
         ] = {}
+        #: Per camera, the extent of the pattern last seen (None: a blob).
+        self._extent: dict[int, tuple[float, float, float, float] | None] = {}
+        #: Binned previews rendered to place a window (see ``ServoConfig.preview_binning``).
+        self.previews = 0
         #: Windows rendered, and windows that missed the target (a full frame followed).
         self.window_renders = 0
         self.window_misses = 0
@@ -188,7 +258,12 @@ class EyeServo:
         key = detector if key is None else key
         sim = self.sim
         steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
-        window = self._window(camera, key, steps, neck) if windowed(key) else None
+        pattern = pattern_windowed(key)
+        if pattern:  # a pattern's features share their windows
+            key = getattr(key, "window_key", key)
+        window = self._window(camera, key, steps, neck) if pattern or windowed(key) else None
+        if window is None and not pattern and windowed(key) and self._unseen(camera, key, neck):
+            window = self._preview(camera, key)
         detection = None
         if window is not None:
             self.window_renders += 1
@@ -201,9 +276,23 @@ class EyeServo:
         # Only blob detections (a centroid and an area) predict a window.
         if isinstance(detection, Detection) and detection.found and detection.uv is not None:
             self._seen[camera] = (key, steps, neck, sim.placements, detection.uv, detection.area_px)
+            self._extent[camera] = detection.extent_px
         else:
             self._seen.pop(camera, None)
         return detection
+
+    def _unseen(self, camera: int, key: object, neck: tuple[float, float]) -> bool:
+        """Whether no detection of ``key``'s target predicts where it is (a new target,
+        one moved, or the neck moved since): a preview may find it."""
+        seen = self._seen.get(camera)
+        return seen is None or seen[0] != key or seen[2] != neck or seen[3] != self.sim.placements
+
+    def _preview(self, camera: int, detector: object) -> Window | None:
+        """A preview's window for ``detector``'s blob (see :func:`preview_window`)."""
+        if not self.config.windows or self.config.preview_binning <= 1:
+            return None
+        self.previews += 1
+        return preview_window(self.sim, camera, detector, self.config)
 
     def _window(
         self, camera: int, key: object, steps: int, neck: tuple[float, float]
@@ -214,9 +303,14 @@ class EyeServo:
         if not cfg.windows or seen is None or gain is None:
             return None
         seen_key, seen_steps, seen_neck, placements, uv, area = seen
-        if seen_key is not key or seen_neck != neck or placements != sim.placements:
+        if seen_key != key or seen_neck != neck or placements != sim.placements:
             return None
         motion = gain * (steps - seen_steps)
+        extent = self._extent.get(camera)
+        if extent is not None:
+            return pattern_window(
+                sim, camera, (uv[0] + motion, uv[1]), extent, motion, cfg.window_margin_px
+            )
         return expected_window(
             sim, camera, (uv[0] + motion, uv[1]), area, motion, cfg.window_margin_px
         )
@@ -410,6 +504,7 @@ class NeckServo:
         ) = None
         self.window_renders = 0
         self.window_misses = 0
+        self.previews = 0
         self._key: object = None
         self._current: np.ndarray | None = None  # the Jacobian as the run stands
 
@@ -471,6 +566,22 @@ class NeckServo:
                     return detection
                 self.window_misses += 1
                 return detector(sim.retake(camera))  # the same instant, whole
+        elif (
+            self.config.windows
+            and self.config.preview_binning > 1
+            and windowed(self._key)
+            and (seen is None or seen[0] is not self._key or seen[2] != sim.placements)
+        ):
+            # A new or moved target: find it in a preview, then render its window.
+            self.previews += 1
+            window = preview_window(sim, camera, self._key, self.config)
+            if window is not None:
+                self.window_renders += 1
+                detection = look_in_window(sim, camera, detector, window)
+                if detection is not None:
+                    return detection
+                self.window_misses += 1
+                return detector(sim.retake(camera))
         return detector(sim.render(camera))
 
     def _in_range(self, steps: np.ndarray) -> bool:

@@ -418,6 +418,11 @@ class HeadSim:
         """Only ``window`` of the camera's image: the full image's crop, (h, w, 3) uint8."""
         return self._renderer.render_window(self.data, self.camera_index(camera), window)
 
+    def render_preview(self, camera: CameraId, binning: int) -> np.ndarray:
+        """The camera's whole view binned ``binning`` x ``binning`` (for finding where to
+        look), (H/b, W/b, 3) uint8, counted as a render."""
+        return self._renderer.render_preview(self.data, self.camera_index(camera), binning)
+
     @property
     def render_count(self) -> int:
         """Images rendered so far by this simulator (full frames and windows)."""

@@ -39,10 +39,12 @@ the paper's cameras and on the paper's cameras with centred principal points.
 k1, image noise and encoder resolution.  :func:`write_experiment` writes
 ``<name>.csv`` (a row per condition and method), ``<name>_targets.csv`` (a
 row per target), ``<name>.json`` and ``<name>.png`` beside ``results.json``,
-which indexes every experiment written to the directory.
+which indexes every experiment written to the directory.  The realistic
+head's error budget (``--experiment budget``) is :mod:`headsim.error_budget`.
 
     python -m headsim.study --experiment compare --out out/study
     python -m headsim.study --sweep depth --out out/study [--fast]
+    python -m headsim.study --experiment budget --out out/study [--fast]
     python -m headsim.study --all --out out/study
 """
 
@@ -924,7 +926,7 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
     """The done-when ratios of the comparison (RMS of the 3-D error, mm)."""
     exp = result.experiment
     groups = list(exp.base)
-    paper, centred_group = groups[0], groups[1]
+    paper = groups[0]
     figures: dict[str, Any] = {}
 
     def rms(group: str, label: str, method: str) -> float:
@@ -944,7 +946,9 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
     figures["image_centre_ray_turn_mrad"] = turns
     labels = {c.label for c in exp.conditions}
     if "zoom 1.5x" in labels:
-        for group, key in ((centred_group, "zoom_1_5_centred"), (paper, "zoom_1_5_paper")):
+        # The second group (if any) is the paper's head with centred principal points.
+        keys = {paper: "zoom_1_5_paper", **{g: "zoom_1_5_centred" for g in groups[1:2]}}
+        for group, key in keys.items():
             figures[key] = {
                 f"{m}_after_over_before": rms(group, "zoom 1.5x", m)
                 / rms(group, "as calibrated", m)
@@ -1016,10 +1020,12 @@ def target_rows(result: ExperimentResult) -> list[dict[str, Any]]:
     return rows
 
 
-def write_experiment(result: ExperimentResult, out_dir: str | Path) -> dict[str, Path]:
-    """Write ``<name>.csv``, ``<name>_targets.csv``, ``<name>.json``, ``<name>.png`` and update ``results.json``."""
-    from headsim import plots  # matplotlib loads only when figures are written
-
+def write_experiment(
+    result: ExperimentResult, out_dir: str | Path, figure: bool = True
+) -> dict[str, Path]:
+    """Write ``<name>.csv``, ``<name>_targets.csv``, ``<name>.json``, ``<name>.png`` and update
+    ``results.json``; ``figure`` False: not the PNG (its caller draws it with
+    ``headsim.plots.plot_experiment``, e.g. in a process that has matplotlib loaded)."""
     out = Path(out_dir)
     name = result.experiment.name
     summaries = summary_rows(result)
@@ -1042,8 +1048,12 @@ def write_experiment(result: ExperimentResult, out_dir: str | Path) -> dict[str,
         "csv": write_csv_atomic(out / f"{name}.csv", summaries),
         "targets_csv": write_csv_atomic(out / f"{name}_targets.csv", payload["targets"]),
         "json": write_json_atomic(out / f"{name}.json", payload),
-        "png": plots.plot_experiment(result, out / f"{name}.png"),
+        "png": out / f"{name}.png",
     }
+    if figure:
+        from headsim import plots  # matplotlib loads only when figures are written
+
+        plots.plot_experiment(result, files["png"])
     index_path = out / "results.json"
     index: dict[str, Any] = {}
     if index_path.exists():
@@ -1105,9 +1115,16 @@ def print_result(result: ExperimentResult) -> None:
 def add_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
     """The study's options (shared by ``python -m headsim.study`` and ``headsim study``)."""
     what = parser.add_mutually_exclusive_group(required=True)
-    what.add_argument("--experiment", choices=["compare"], help="the Tables V/VI comparison")
+    what.add_argument(
+        "--experiment",
+        choices=["compare", "budget"],
+        help="compare: the Tables V/VI comparison; budget: the realistic head's error budget "
+        "(headsim.error_budget; scenario realistic_field, whatever --preset)",
+    )
     what.add_argument("--sweep", choices=sorted(SWEEPS), help="one sweep")
-    what.add_argument("--all", action="store_true", help="the comparison and every sweep")
+    what.add_argument(
+        "--all", action="store_true", help="the comparison, every sweep and the error budget"
+    )
     parser.add_argument("--out", required=True, help="output directory (created if missing)")
     parser.add_argument("--preset", default="paper", choices=["ideal", "paper"])
     parser.add_argument("--seed", type=int, default=0)
@@ -1128,7 +1145,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
 STUDY_DESCRIPTION = (
     "Calibrated stereo against the active method: the Tables V/VI comparison, changes of "
     "focal length, principal point and distortion after calibration, and sweeps (depth, focal, "
-    "principal, k1, noise, encoder); writes CSV, JSON and PNG to --out."
+    "principal, k1, noise, encoder), and the realistic head's error budget; writes CSV, JSON "
+    "and PNG to --out."
 )
 
 
@@ -1150,6 +1168,8 @@ def run(args: argparse.Namespace) -> int:
     config = make(preset=args.preset, seed=args.seed)
     progress: Progress = quiet if getattr(args, "quiet", False) else StderrProgress()
     cache = CalibrationCache(config, progress)
+    if args.experiment == "budget":
+        return _budget(args, progress)
     if args.all:
         experiments = [compare_experiment(config)] + [
             sweep_experiment(name, config) for name in SWEEPS
@@ -1172,7 +1192,30 @@ def run(args: argparse.Namespace) -> int:
             f"{experiment.name}: {result.seconds:.1f} s; wrote {', '.join(map(str, files.values()))}"
         )
         print_result(result)
-    return 0
+    return _budget(args, progress) if args.all else 0
+
+
+def _budget(args: argparse.Namespace, progress: Progress) -> int:
+    """The realistic head's error budget (:mod:`headsim.error_budget`); 0 on success."""
+    from headsim import error_budget
+
+    start = time.perf_counter()
+    rows = error_budget.run_budget(
+        fast=args.fast,
+        seed=args.seed,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=progress,
+    )
+    files = error_budget.write_budget(rows, args.out, args.fast)
+    progress(
+        f"budget: {time.perf_counter() - start:.1f} s; wrote {', '.join(map(str, files.values()))}"
+    )
+    print(files["md"].read_text(), end="")
+    failed = [f"{r['condition']}: {r['failures']}" for r in rows if r["failures"]]
+    for line in failed:
+        progress(f"budget: failed: {line}")
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

@@ -87,11 +87,15 @@ class Detection:
 
     ``uv`` is None unless FOUND.  ``area_px`` is the colour-weighted area of
     the blob (FOUND, OCCLUDED) or its pixel count (CUT), 0 when LOST.
+    ``extent_px``: for a feature found as part of a larger pattern (a
+    chessboard's corner), the (left, top, right, bottom) px from ``uv`` of
+    everything the detector needed to see; None for a blob.
     """
 
     status: DetectionStatus
     uv: tuple[float, float] | None
     area_px: float
+    extent_px: tuple[float, float, float, float] | None = None
 
     @property
     def found(self) -> bool:

@@ -111,7 +111,8 @@ def test_neck_servo_reports_lost_and_iteration_limit() -> None:
         sim.set_body_pose(MARKER, [0.0, -1.0, 0.2])
         lost = NeckServo(sim).run(RED)
         assert lost.outcome is ServoOutcome.TARGET_LOST
-        assert lost.renders == 2  # one look through each camera
+        # One look through each camera, after a binned preview that did not find it.
+        assert lost.renders == 4
         sim.set_body_pose(MARKER, [0.2, 0.6, 0.4])
         limited = NeckServo(sim, ServoConfig(max_iterations=1)).run(RED)
         assert limited.outcome is ServoOutcome.ITERATION_LIMIT
