@@ -41,7 +41,7 @@ OBJECT_RADIUS_M = 0.006
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per-area", type=int, default=20)
-    parser.add_argument("--preset", default="paper", choices=("paper", "ideal"))
+    parser.add_argument("--preset", default="paper", choices=("paper", "ideal", "realistic"))
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument(
         "--near-axis", type=int, default=10, help="extra layouts near Z_h (magnitude areas)"
@@ -57,15 +57,24 @@ def main() -> int:
     layout_failures = 0
     with HeadSim("blocks", preset(args.preset, seed=args.seed)) as sim:
         servo = EyeServo(sim)
-        near_layouts = args.near_axis
-        for layout in range(n_layouts + near_layouts):
-            near = layout >= n_layouts
+        seen_per_area = dict.fromkeys(range(1, 13), 0)
+        spread_layouts = 0
+        layout = -1
+        # Spread layouts until every area holds ``per_area`` objects seen in all four
+        # images (at most three times the planned count), then the near-axis ones.
+        while True:
+            layout += 1
+            near = min(seen_per_area.values()) >= args.per_area or layout >= 3 * n_layouts
+            if near and layout - spread_layouts >= args.near_axis:
+                break
             if near:  # magnitude-test areas only, within |x/z| <= 0.02 of the Z_h axis
                 wanted = [MAGNITUDE_AREAS[(layout + j) % 6] for j in range(len(objects))]
             else:
-                wanted = [(layout * len(objects) + j) % 12 + 1 for j in range(len(objects))]
+                spread_layouts += 1
+                short = sorted(seen_per_area, key=lambda a: (seen_per_area[a], a))
+                wanted = [short[j % len(short)] for j in range(len(objects))]
             placed = None
-            for _attempt in range(6):  # a reference where the wanted areas exist in view
+            for _attempt in range(12):  # a reference where the wanted areas exist in view
                 # Near the midline and not far: the step-2 lines of sight then cross
                 # within 3 m, so S1 and S2 (beyond that crossing) exist in view.
                 # Near-axis layouts put the reference aside, so that its plate hides
@@ -86,7 +95,7 @@ def main() -> int:
                         radius_m=OBJECT_RADIUS_M,
                         depth_m=(0.3, 3.0),
                         lateral=0.02 if near else 0.4,
-                        partial=near,
+                        partial=True,
                     )
                     break
                 except ValueError as err:
@@ -103,7 +112,7 @@ def main() -> int:
                 if not unplaced:
                     colours[body] = names.RELATIVE_OBJECT_COLOURS[body]
             run = relative_positioning(sim, servo, reference, colours)
-            print(f"  layout {layout + 1}/{n_layouts}", end="\r", file=sys.stderr, flush=True)
+            print(f"  layout {layout + 1}", end="\r", file=sys.stderr, flush=True)
             seen = [o for o in colours if o not in run.missing]
             margin = dict(zip(seen, run.comparison.margin, strict=True)) if run.comparison else {}
             gain_margin = (
@@ -114,6 +123,8 @@ def main() -> int:
             for body, want, p in zip(objects, wanted, placed, strict=True):
                 if body not in colours:
                     continue
+                if not near and body in seen and run.true_areas.get(body, 0):
+                    seen_per_area[run.true_areas[body]] += 1
                 rows.append(
                     {
                         "near_axis": near,
@@ -135,7 +146,8 @@ def main() -> int:
         f"{'gain agree':>10} {'>2px':>9}"
     )
     print(
-        f"Relative positioning, {args.preset} cameras: {len(rows)} objects in {n_layouts} layouts"
+        f"Relative positioning, {args.preset} cameras: {len(rows)} objects in "
+        f"{spread_layouts} spread layouts and {layout - spread_layouts} near Z_h"
     )
     print(header)
     per_area = {}

@@ -60,6 +60,31 @@ def _hides_or_hidden(
     return close
 
 
+def _overlaps(
+    points_head: np.ndarray,
+    placed_head: Sequence[np.ndarray],
+    baseline_m: float,
+    radius_m: float,
+    gap_rad: float,
+) -> np.ndarray:
+    """(N,) whether a point's image would touch an already placed object's, in either camera.
+
+    Seen from either camera centre, two balls of ``radius_m`` are apart when
+    the angle between their rays exceeds the sum of their angular radii plus
+    ``gap_rad``.  The eyes only yaw about their centres, so this holds at
+    every eye angle: one partly hiding the other would bias both centroids.
+    """
+    close = np.zeros(len(points_head), dtype=bool)
+    for other in placed_head:
+        for sign in (-1.0, 1.0):
+            centre = np.array([sign * baseline_m / 2, 0.0, 0.0])
+            to_o, to_p = other - centre, points_head - centre
+            d_o, d_p = np.linalg.norm(to_o), np.linalg.norm(to_p, axis=1)
+            angle = np.arccos(np.clip(to_p @ to_o / (d_p * d_o), -1.0, 1.0))
+            close |= angle < radius_m / d_o + radius_m / d_p + gap_rad
+    return close
+
+
 def area_layout(
     sim: HeadSim,
     reference_head: np.ndarray,
@@ -73,6 +98,7 @@ def area_layout(
     clear_m: float = 0.085,
     batches: int = 40,
     partial: bool = False,
+    gap_rad: float = 0.01,
 ) -> np.ndarray:
     """Positions in H (len(wanted), 3), m: object k in true area ``wanted[k]``, seen in all four images.
 
@@ -80,7 +106,10 @@ def area_layout(
     ``vertical``), at most ``batches`` of them; ValueError names the areas
     it could not fill (with ``partial``, their rows are NaN instead).  No object is placed where it would hide the reference
     or be hidden by it: seen from either camera, its ray is ``clear_m`` (at
-    the reference's distance) or more from the reference's.
+    the reference's distance) or more from the reference's.  Nor where its
+    image would touch another placed object's (``gap_rad`` between the balls'
+    edges, seen from either camera): a partly hidden ball's centroid moves by
+    up to its radius, which the images cannot tell from a shift.
     """
     alpha1, alpha2 = reference_angles(sim, reference_head)
     effective = (sim.effective_initial_direction(1), sim.effective_initial_direction(2))
@@ -97,7 +126,14 @@ def area_layout(
         for k, area in enumerate(wanted):
             if chosen[k] is not None:
                 continue
-            candidates = np.flatnonzero(areas == area)[:50]
+            candidates = np.flatnonzero(areas == area)
+            placed = [c for c in chosen if c is not None]
+            if placed and candidates.size:
+                apart = ~_overlaps(
+                    points[candidates], placed, sim.settings.baseline_m, radius_m, gap_rad
+                )
+                candidates = candidates[apart]
+            candidates = candidates[:50]
             if candidates.size == 0:
                 continue
             seen = seen_in_four_images(sim, world[candidates], alpha1, alpha2, radius_m)

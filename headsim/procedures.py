@@ -37,6 +37,7 @@ from headsim.search import (
     Failure,
     FailureCause,
     detection_failure,
+    find_neck_view,
     find_view,
     nearest_seen,
     neck_failure,
@@ -483,6 +484,7 @@ def calibration_layout(
     vertical: float = 0.08,
     radius_m: float = 0.008,
     depths_m: np.ndarray | None = None,
+    eye_angles_rad: Sequence[float] = (),
 ) -> np.ndarray:
     """World positions (count, 3) for Sec. V calibration targets, seeded.
 
@@ -491,11 +493,29 @@ def calibration_layout(
     close): 60 targets at 0.25-0.6 m recover them to about 1e-4 rad with the
     paper's cameras.  ``lateral``/``vertical``: x_h/z_h and y_h/z_h spread; a
     vertical spread is what the extended calibration needs.  Every position is
-    seen whole (ball of ``radius_m``) by both cameras at the current pose.
+    seen whole (ball of ``radius_m``) by both cameras at the current pose, or
+    at one of ``eye_angles_rad`` (encoder angles, neck still): at a long focal
+    length the near, lateral positions that separate the offsets are in the
+    common view only with the eyes turned in (Model 2 finds them by search;
+    the first position is always in view at the current pose).
     ``depths_m``: (count,) each position's depth z_h, m, kept when it is drawn
     again (e.g. :func:`headsim.calibration_design.near_far_depths`); None:
     uniform in ``depth_range_m``.
     """
+    resolution = sim.settings.encoder_resolution_rad
+    eye_steps = [round(a / resolution) for a in eye_angles_rad]
+
+    def seen(points: np.ndarray) -> np.ndarray:
+        ok = seen_by_both(sim, points, radius_m)
+        if eye_steps:
+            before = sim.eye_encoder_steps()
+            for steps in eye_steps:
+                sim.command_eye_steps(steps)
+                sim.settle()
+                ok |= seen_by_both(sim, points, radius_m)
+            sim.command_eye_steps(before)
+            sim.settle()
+        return ok
 
     def draw(n: int, slots: np.ndarray | None = None) -> np.ndarray:
         z = rng.uniform(*depth_range_m, size=n) if depths_m is None else depths_m[slots]
@@ -511,7 +531,10 @@ def calibration_layout(
     # Placement (truth allowed): keep positions both cameras see whole from where the
     # head stands; a position that one cannot see is drawn again, a bounded number of times.
     for _ in range(500):
-        unseen = ~seen_by_both(sim, points_world, radius_m)
+        unseen = ~seen(points_world)
+        # The first position in view from where the head stands: the servo learns
+        # its gains there, which the search for the others needs.
+        unseen[0] |= not seen_by_both(sim, points_world[:1], radius_m)[0]
         if not unseen.any():
             return points_world
         points_world[unseen] = sim.transform_points(
@@ -588,6 +611,10 @@ def calibrate_head(
     for position in np.atleast_2d(positions_world):
         sim.set_body_pose(body, position)
         m = measure_model2(sim, servo, target, base, plain)
+        if m.failure is not None and m.failure.cause is FailureCause.ESTIMATOR:
+            # Near the midline the y images hold almost no x offset (NO_Y): take
+            # them again at an intermediate eye angle, the near-midline remedy.
+            m = measure_model2(sim, servo, target, base, Model2Config())
         outcomes.append(m.failure)
         if not m.ok:
             continue
@@ -779,21 +806,40 @@ def measure_model1(
     target: Target,
     knowledge: HeadKnowledge | None = None,
     interpolate: bool = True,
+    last_seen: Sequence[tuple[int, int, int]] = (),
 ) -> Measurement:
-    """Model 1: fixate with neck and eyes, then eqs. (2)-(3) (Sec. II-B)."""
+    """Model 1: fixate with neck and eyes, then eqs. (2)-(3) (Sec. II-B).
+
+    ``last_seen``: (yaw, pitch, eye) steps of the last fixations of this same
+    target, oldest first (tracking).  If both cameras do not see it where the
+    neck was left, the head looks around the last of them (and where the last
+    two predict it), then from the start pose; every look is counted in
+    ``search_renders``.
+    """
     knowledge = knowledge or HeadKnowledge()
     start = sim.render_count
     (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
     goals = (u10, u20, (v10 + v20) / 2)
     result = servo.run(target.detector, goals=goals)
     search = 0
-    if result.outcome is ServoOutcome.TARGET_LOST and result.iterations == 0 and any(result.steps):
-        # Not in both views where the neck was left (the last target's pose):
-        # back to the start pose and fixate from there.
+    if result.outcome is ServoOutcome.TARGET_LOST and result.iterations == 0:
         search = result.renders  # the look that did not find it
-        sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
-        sim.settle()
-        result = servo.run(target.detector, goals=goals)
+        found = None
+        if last_seen:
+            # A tracked target left the view: look around its last fixation.
+            before = sim.render_count
+            found = find_neck_view(servo, target.detector, last_seen)
+            search += sim.render_count - before
+            if found is not None:
+                result = servo.run(target.detector, goals=goals)
+        if found is None and any(servo.steps()):
+            # Not in both views where the neck was left (the last target's pose),
+            # nor around it: back to the start pose and fixate from there.
+            sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
+            sim.settle()
+            result = servo.run(target.detector, goals=goals)
+        elif found is None:
+            search = 0  # nothing else was tried: the first look's failure stands
     residual = (result.residual_px,)
     if not result.converged:
         return _failed(
@@ -851,12 +897,18 @@ def track_moving_target(
     """Move ``body`` along ``trajectory(t)`` (world, m) and fixate it at each time with Model 1.
 
     The servo's Jacobian carries from one fixation to the next, so after the
-    first fixation each one starts from the last and takes few renders.
+    first fixation each one starts from the last and takes few renders.  A
+    target that left both views since is searched for around the last
+    fixation (:func:`headsim.search.find_neck_view`), then from the start pose.
     """
     measurements = []
+    fixations: list[tuple[int, int, int]] = []  # where the target was seen, in steps
     for t in times_s:
         sim.set_body_pose(body, trajectory(float(t)))
-        measurements.append(measure_model1(sim, servo, target, knowledge))
+        m = measure_model1(sim, servo, target, knowledge, last_seen=fixations[-2:])
+        measurements.append(m)
+        if m.ok:
+            fixations.append(servo.steps())
     return TrackingRun(np.asarray(times_s, dtype=float), tuple(measurements))
 
 
@@ -1002,6 +1054,26 @@ class RelativeRun:
     gain_comparison: AreaComparison | None = None
 
 
+def _touching_blobs(found: dict[str, Detection], gap_px: float = 1.5) -> set[str]:
+    """Labels of blobs that touch another label's blob in the same image.
+
+    Where one ball partly hides another, both blobs meet and the hidden one's
+    centroid moves by up to its radius, which no single image can tell from a
+    shift.  Radii come from the blobs' areas (px): image-only.
+    """
+    blobs = [
+        (name, np.array(d.uv), math.sqrt(d.area_px / math.pi))
+        for name, d in found.items()
+        if d.found and d.uv is not None
+    ]
+    out = set()
+    for i, (name_a, uv_a, r_a) in enumerate(blobs):
+        for name_b, uv_b, r_b in blobs[:i]:
+            if float(np.linalg.norm(uv_a - uv_b)) < r_a + r_b + gap_px:
+                out |= {name_a, name_b}
+    return out
+
+
 def relative_positioning(
     sim: HeadSim,
     servo: EyeServo,
@@ -1012,7 +1084,9 @@ def relative_positioning(
     """Measure ``reference`` with Model 2, then place ``objects`` (body -> colour) in areas.
 
     The four images (each camera at each step) are taken again at the two
-    fixations' whole encoder steps, where the lines L11..L22 are.
+    fixations' whole encoder steps, where the lines L11..L22 are.  An object
+    whose blob touches another's in any image (one partly hides the other)
+    counts as not seen: its centroid would be biased.
     """
     knowledge = knowledge or HeadKnowledge()
     start = sim.render_count
@@ -1020,9 +1094,11 @@ def relative_positioning(
     if not ref.ok:
         return RelativeRun(ref, {}, {}, {}, tuple(objects), None, sim.render_count - start)
     resolution = sim.settings.encoder_resolution_rad
+    # The lines L11..L22 are the cameras' lines of sight at the two fixations
+    # (not where a search took a y image).
     steps = (
-        round(ref.details["gamma2_rad"] / resolution),
-        round(ref.details["gamma1_rad"] / resolution),
+        round(ref.details["step1_encoder_rad"] / resolution),
+        round(ref.details["step2_encoder_rad"] / resolution),
     )
     columns: dict[str, list[float]] = {name: [math.nan] * 4 for name in objects}
     # Order of the four columns: u11 (Ca1, step 1), u12 (Ca1, step 2), u21, u22.
@@ -1031,8 +1107,9 @@ def relative_positioning(
         sim.settle()
         for camera in (1, 2):
             found = find_markers(sim.render(camera), objects)
+            touching = _touching_blobs(found)
             for name, detection in found.items():
-                if detection.found and detection.uv is not None:
+                if detection.found and detection.uv is not None and name not in touching:
                     columns[name][2 * (camera - 1) + step_index] = detection.uv[0]
     seen = [name for name in objects if np.all(np.isfinite(columns[name]))]
     missing = tuple(name for name in objects if name not in seen)

@@ -331,6 +331,9 @@ class ObservedNeckServo(NeckServo):
         self.sim.hub.window_misses += self.window_misses - misses
         return result
 
+    def look_from(self, steps: tuple[int, int, int], detector: Detector) -> bool:
+        return super().look_from(steps, self.sim.hub.detector(self.sim, detector))
+
 
 class Progress(Observer):
     """A one-line text progress bar: fixations done of ``total``, rate, time left.

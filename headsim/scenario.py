@@ -25,7 +25,7 @@ import re
 import tomllib
 from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
-from functools import cache
+from functools import cache, lru_cache
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -1230,6 +1230,29 @@ def model1_refusal(
     return None
 
 
+@lru_cache(maxsize=8)
+def _head_of(settings: HeadSettings) -> _Head:
+    return _Head.of(settings)
+
+
+def reach_refusal(
+    settings: HeadSettings,
+    p_world: np.ndarray,
+    what: str = "target",
+    radius_m: float = 0.0,
+) -> tuple[str, str] | None:
+    """The scenario's reach check for one first target, for Model 2 and Model 1 alike.
+
+    (message, what is allowed) from the first model that refuses the world
+    point ``p_world``, m, or None: both procedures can measure it from the
+    start pose.  The same criterion ``within = "reach"`` applies.
+    """
+    head = _head_of(settings)
+    return model2_refusal(head, p_world, what, radius_m) or model1_refusal(
+        head, p_world, what, True, radius_m
+    )
+
+
 def _check_model1_reach(
     ctx: _Context,
     head: _Head,
@@ -1635,6 +1658,7 @@ __all__ = [
     "ServoSpec",
     "describe_scenarios",
     "load_scenario",
+    "reach_refusal",
     "resolve_path",
     "scenario_files",
 ]

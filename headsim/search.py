@@ -10,10 +10,19 @@ render, counted by the caller through ``HeadSim.render_count``.
 from __future__ import annotations
 
 import enum
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-from headsim.servo import Detector, EyeServo, NeckServoResult, ServoOutcome, ServoResult
+import numpy as np
+
+from headsim.servo import (
+    Detector,
+    EyeServo,
+    NeckServo,
+    NeckServoResult,
+    ServoOutcome,
+    ServoResult,
+)
 from headsim.vision import Detection, DetectionStatus
 
 
@@ -154,6 +163,73 @@ def find_view(
     return None
 
 
+def neck_search_poses(
+    servo: NeckServo,
+    last: Sequence[tuple[int, int, int]],
+    size_px: tuple[int, int],
+    rings: int = 2,
+) -> list[tuple[int, int, int]]:
+    """Neck poses to look from for a target lost since the last fixation, best first.
+
+    ``last``: the fixations' (yaw, pitch, eye) steps where the target was seen,
+    oldest first.  Around the most recent one, a grid of neck (yaw, pitch)
+    offsets in strides of 0.7 of the field of view in steps (image width and
+    height over the learnt Jacobian's px per step: no focal length), out to
+    ``rings`` strides; ordered by distance from where the last two fixations
+    predict it (a constant velocity in steps), so that a target moving on
+    steadily is found first.  Within the joints' ranges; the eye stays.
+    """
+    jac = servo.jacobian
+    if not last or jac is None:
+        return []
+    centre = np.array(last[-1], dtype=float)
+    predicted = 2 * centre - np.array(last[-2], dtype=float) if len(last) > 1 else centre
+    width, height = size_px
+    per_yaw = float(max(abs(jac[0, 0]), abs(jac[1, 0])))
+    per_pitch = float(abs(jac[2, 1]))
+    if per_yaw <= 0 or per_pitch <= 0:
+        return []
+    stride = np.array([max(1, int(0.7 * width / per_yaw)), max(1, int(0.7 * height / per_pitch))])
+    poses = {
+        (int(centre[0] + i * stride[0]), int(centre[1] + j * stride[1]), int(centre[2]))
+        for i in range(-rings, rings + 1)
+        for j in range(-rings, rings + 1)
+        if (i, j) != (0, 0)
+    }
+    if len(last) > 1:  # the prediction itself, to the whole step
+        poses.add(tuple(round(float(x)) for x in predicted))  # type: ignore[arg-type]
+    ranges = servo.step_ranges
+    here = servo.steps()
+    scale = np.array([stride[0], stride[1], 1.0])
+    inside = [
+        p
+        for p in poses
+        if p != here and all(lo <= s <= hi for s, (lo, hi) in zip(p, ranges, strict=True))
+    ]
+    return sorted(
+        inside, key=lambda p: (float(np.linalg.norm((np.array(p) - predicted) / scale)), p)
+    )
+
+
+def find_neck_view(
+    servo: NeckServo,
+    detector: Detector,
+    last: Sequence[tuple[int, int, int]],
+    max_poses: int = 12,
+) -> tuple[tuple[int, int, int], int] | None:
+    """Look from each of :func:`neck_search_poses` until both cameras see the target.
+
+    Two renders per pose; at most ``max_poses``.  Returns the pose and the
+    number of poses tried, or None (the caller names the failure).
+    """
+    cam = servo.sim.camera_settings(1)
+    poses = neck_search_poses(servo, last, (cam.width, cam.height))[:max_poses]
+    for tried, pose in enumerate(poses, start=1):
+        if servo.look_from(pose, detector):
+            return pose, tried
+    return None
+
+
 def nearest_seen(
     seen: Iterable[tuple[int, float, float]], steps: int, goal_u: float, midline_px: float
 ) -> tuple[int, float, float] | None:
@@ -173,9 +249,11 @@ __all__ = [
     "FailureCause",
     "Found",
     "detection_failure",
+    "find_neck_view",
     "find_view",
     "nearest_seen",
     "neck_failure",
+    "neck_search_poses",
     "search_poses",
     "servo_failure",
 ]

@@ -587,6 +587,23 @@ class NeckServo:
     def _in_range(self, steps: np.ndarray) -> bool:
         return all(lo <= s <= hi for s, (lo, hi) in zip(steps, self._ranges, strict=True))
 
+    @property
+    def step_ranges(self) -> tuple[tuple[int, int], ...]:
+        """(low, high) encoder steps of neck yaw, neck pitch and the eye motor."""
+        return tuple(self._ranges)
+
+    def steps(self) -> tuple[int, int, int]:
+        """The encoders' (neck yaw, neck pitch, eye) now, whole steps."""
+        yaw, pitch, eye = (int(s) for s in self._steps())
+        return yaw, pitch, eye
+
+    def look_from(self, steps: tuple[int, int, int], detector: Detector) -> bool:
+        """Move to ``steps`` and look with both cameras (two renders): both see it whole."""
+        self._key = detector
+        self._move(np.asarray(steps))
+        seen = [self._look(camera, detector) for camera in (1, 2)]
+        return all(d.found and d.uv is not None for d in seen)
+
     def run(
         self,
         detector: Detector,

@@ -7,6 +7,7 @@ from functools import partial
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 
 from headsim import names
 from headsim.procedures import (
@@ -20,6 +21,7 @@ from headsim.procedures import (
     measure_model1,
     measure_model2,
     relative_positioning,
+    seen_by_both,
     track_moving_target,
 )
 from headsim.search import FailureCause
@@ -106,6 +108,23 @@ def test_calibration_recovers_effective_initial_directions_and_corrects_measurem
         assert before.error_pct_of_depth > 3 * after.error_pct_of_depth
 
 
+def test_calibration_fixates_a_position_on_the_midline_with_the_near_midline_remedy() -> None:
+    with HeadSim("default", paper_head()) as sim:
+        e1, e2 = (sim.effective_initial_direction(c) for c in (1, 2))
+        half, z = sim.settings.baseline_m / 2, 0.4
+        # Where both eyes fixate at the same angle: each camera's y image then
+        # shows P on its goal column (NO_Y), unless taken at another eye angle.
+        x = brentq(lambda x: np.arctan2(x + half, z) - e1 - np.arctan2(half - x, z) + e2, -0.2, 0.2)
+        layout = np.array([[x, 0.01, z], [-0.05, -0.02, 0.3], [0.06, 0.03, 0.5], [0.0, 0.0, 0.35]])
+        world = sim.transform_points(layout, "head", "world")
+        sim.set_body_pose(names.CALIBRATION_BALL, world[0])
+        plain = measure_model2(sim, EyeServo(sim), BALL, config=Model2Config(midline_px=0.0))
+        assert plain.failure is not None and plain.failure.cause is FailureCause.ESTIMATOR
+        run = calibrate_head(sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, world)
+    assert run.outcomes == (None, None, None, None) and run.samples == 4
+    assert np.abs(run.alpha_e_error).max() < 1e-3
+
+
 def test_calibration_with_too_few_visible_targets_says_so() -> None:
     with (
         HeadSim("default") as sim,
@@ -178,6 +197,28 @@ def test_tracking_follows_a_moving_target_with_fewer_renders_after_the_first() -
         assert np.all(run.errors_world_m < 0.006)
         renders = [m.renders for m in run.measurements]
         assert max(renders[1:]) < renders[0]
+
+
+def test_tracking_searches_around_its_last_fixation_for_a_target_that_left_both_views() -> None:
+    # Twice the focal length: the view at 0.8 m is about +-0.2 m wide, and the
+    # target moves 0.25 m between fixations, out of both views and out of the
+    # start pose's view too (the old fallback).
+    base = replace(HeadSettings(), seed=1)
+    cams = tuple(replace(c, kx=c.kx * 2, ky=c.ky * 2) for c in base.cameras)
+    with HeadSim("default", replace(base, cameras=cams)) as sim:  # type: ignore[arg-type]
+
+        def path(t: float) -> np.ndarray:
+            return np.array([0.25 * t, 0.8, 0.3])
+
+        assert not seen_by_both(sim, path(1.0)[None], 0.01)[0]  # not from the start pose
+        servo = NeckServo(sim)
+        run = track_moving_target(sim, servo, RED, "marker_red", path, [0.0, 1.0, 2.0, 2.6])
+    assert all(m.ok for m in run.measurements), [m.status for m in run.measurements]
+    searched = [m.search_renders for m in run.measurements]
+    assert searched[0] == 0 and searched[1] > 0
+    # The first look (2 renders) and at most 3 poses of 2 renders each.
+    assert max(searched) <= 8
+    assert all(m.error_pct_of_depth < 0.2 for m in run.measurements)
 
 
 def test_paper_cameras_after_calibration_measure_within_the_papers_accuracy() -> None:

@@ -9,17 +9,20 @@ import numpy as np
 import pytest
 
 from headsim import names
+from headsim.kinematics import head_to_world
 from headsim.procedures import (
     CalibrationError,
     HeadKnowledge,
     Model2Config,
     body_target,
     calibrate_head,
+    calibration_layout,
     measure_model1,
     measure_model2,
+    seen_by_both,
 )
-from headsim.scenario import _Head, model2_refusal
-from headsim.search import FailureCause
+from headsim.scenario import _Head, model2_refusal, reach_refusal
+from headsim.search import FailureCause, neck_search_poses
 from headsim.servo import EyeServo, NeckServo, ServoConfig
 from headsim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim import HeadSim
@@ -175,3 +178,56 @@ def test_calibration_failures_name_their_cause() -> None:
             calibrate_head(
                 sim, servo, BALL, names.CALIBRATION_BALL, np.array([ahead, beside, near])
             )
+
+
+def test_neck_search_looks_first_where_the_last_two_fixations_predict_the_target() -> None:
+    with HeadSim("default", HeadSettings()) as sim:
+        servo = NeckServo(sim)
+        assert neck_search_poses(servo, [(0, 0, 0)], (640, 480)) == []  # no gains learnt yet
+        # px per step: yaw moves both u by 2, pitch moves v by 2 (a learnt Jacobian).
+        servo.jacobian = np.array([[2.0, 0.0, 1.0], [2.0, 0.0, -1.0], [0.0, 2.0, 0.0]])
+        last = [(0, 0, 40), (100, 20, 40)]
+        poses = neck_search_poses(servo, last, (640, 480))
+    assert poses[0] == (200, 40, 40)  # constant velocity in steps
+    # The rest: a grid around the last fixation in strides of 0.7 of the view.
+    stride = (int(0.7 * 640 / 2), int(0.7 * 480 / 2))
+    assert (100 + stride[0], 20, 40) in poses and (100, 20 - stride[1], 40) in poses
+    assert (100, 20, 40) not in poses and len(poses) == len(set(poses))
+    yaw_range, pitch_range, _ = servo.step_ranges
+    assert all(yaw_range[0] <= p[0] <= yaw_range[1] for p in poses)
+    assert all(pitch_range[0] <= p[1] <= pitch_range[1] for p in poses)
+
+
+def test_a_calibration_layout_with_the_eyes_turned_in_spreads_wider_and_is_all_fixated() -> None:
+    # Twice the paper's focal length: from the start pose both cameras share
+    # only a narrow view of the near range that separates the two offsets.
+    base = paper_head()
+    cams = tuple(replace(c, kx=c.kx * 2, ky=c.ky * 2) for c in base.cameras)
+    with HeadSim("default", replace(base, cameras=cams)) as sim:  # type: ignore[arg-type]
+        narrow = calibration_layout(sim, np.random.default_rng(5), 16)
+        wide = calibration_layout(sim, np.random.default_rng(5), 16, eye_angles_rad=(0.1, 0.2, 0.3))
+        assert seen_by_both(sim, wide[:1], 0.008)[0]  # the first one from the start pose
+        assert not seen_by_both(sim, wide, 0.008).all()  # others need the eyes turned in
+
+        def spread(p: np.ndarray) -> float:
+            p_head = sim.transform_points(p, "world", "head")
+            return float(np.std(p_head[:, 0] / p_head[:, 2]))
+
+        assert spread(wide) > 2 * spread(narrow)
+        run = calibrate_head(sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, wide)
+    assert run.outcomes == (None,) * 16
+    assert np.abs(run.alpha_e_error).max() < 5e-4
+
+
+def test_reach_refusal_is_the_scenario_check_for_both_models() -> None:
+    settings = paper_head()
+    ahead = head_to_world(
+        np.array([0.0, 0.0, 0.8]), 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m
+    )
+    aside = head_to_world(
+        np.array([0.6, 0.0, 0.8]), 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m
+    )
+    assert reach_refusal(settings, ahead) is None
+    refusal = reach_refusal(settings, aside, "ball")
+    assert refusal is not None and refusal[0].startswith("ball at ")
+    assert refusal == model2_refusal(_Head.of(settings), aside, "ball")
