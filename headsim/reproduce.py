@@ -34,6 +34,7 @@ import importlib
 import math
 import multiprocessing
 import os
+import resource
 import statistics
 import sys
 import threading
@@ -110,13 +111,18 @@ class JobError(RuntimeError):
 def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str, Any]]:
     @functools.wraps(job)
     def run(*args: Any) -> dict[str, Any]:
-        began = time.time()
+        began, cpu = time.time(), time.process_time()
         try:
             data = job(*args)
         except Exception as err:
             raise JobError(_why(err)) from None
         # Where and when it ran (report.json's timeline: the critical path).
-        data["worker"] = {"pid": os.getpid(), "start": began, "end": time.time()}
+        data["worker"] = {
+            "pid": os.getpid(),
+            "start": began,
+            "end": time.time(),
+            "cpu_s": time.process_time() - cpu,
+        }
         return data
 
     return run
@@ -279,6 +285,14 @@ def _study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, A
     )
 
 
+def _cpu_s() -> float:
+    """CPU time, user and system, of this process and its children that ended, s."""
+    own, children = (
+        resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)
+    )
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
 class RenderClock:
     """Times 640x480 renders of the default scene in this process, while no worker of
     the run exists: the unit before they start, and a few after they ended, which
@@ -293,14 +307,17 @@ class RenderClock:
         for camera in (1, 2):
             self._sim.render(camera)
         self.times_s: list[float] = []
+        #: CPU time of each render (all of this process's threads: llvmpipe's too), s.
+        self.cpu_s: list[float] = []
 
     def sample(self, renders: int) -> float:
-        """Time ``renders`` more renders; their median, s."""
+        """Time ``renders`` more renders; their median wall time, s."""
         times = []
         for _ in range(renders):
-            start = time.perf_counter()
+            start, cpu = time.perf_counter(), time.process_time()
             self._sim.render(1 + len(self.times_s) % 2)
             times.append(time.perf_counter() - start)
+            self.cpu_s.append(time.process_time() - cpu)
         self.times_s += times
         return statistics.median(times)
 
@@ -681,8 +698,15 @@ def report_text(
             if state.get("render_after_s")
             else ")"
         ),
-        "",
     ]
+    if state.get("cpu_over_render_cpu"):
+        lines.append(
+            f"- CPU time {state['cpu_s']:.1f} s (this process and its workers) = "
+            f"{state['cpu_over_render_cpu']:.0f} x one render's CPU time "
+            f"({1e3 * state['render_cpu_s']:.1f} ms): the wall ratio on an idle machine "
+            "whose CPUs both the run and the render use"
+        )
+    lines.append("")
     if figure is not None:
         lines += [f"![the paper's figures beside ours]({figure.relative_to(state['out'])})", ""]
     verdicts = []
@@ -801,7 +825,7 @@ def reproduce(
     }
     outcomes: dict[str, JobOutcome] = {}
     calibration: dict[str, Any] | None = None
-    #: Each job's worker and times since the start, s: {"pid", "start", "end"}.
+    #: Each job's worker, times since the start and CPU time, s: {"pid", "start", "end", "cpu_s"}.
     timeline: dict[str, dict[str, float]] = {"render_time": {"pid": os.getpid(), "start": 0.0}}
     timeline["render_time"]["end"] = time.time() - epoch
 
@@ -812,6 +836,7 @@ def reproduce(
                 "pid": worker["pid"],
                 "start": worker["start"] - epoch,
                 "end": worker["end"] - epoch,
+                "cpu_s": worker["cpu_s"],
             }
 
     def draw_tables() -> None:
@@ -847,6 +872,9 @@ def reproduce(
                     "wall_s": state["wall_s"],
                     "render_s": state["render_s"],
                     "render_after_s": state.get("render_after_s"),
+                    "render_cpu_s": state.get("render_cpu_s"),
+                    "cpu_s": state.get("cpu_s"),
+                    "cpu_over_render_cpu": state.get("cpu_over_render_cpu"),
                     "render_samples_s": clock.times_s,
                     "wall_over_render": state["wall_over_render"],
                     "experiments": {
@@ -975,6 +1003,12 @@ def reproduce(
         try:
             if state["status"] != "interrupted":
                 state["render_after_s"] = clock.sample(CLOCK_RENDERS[1])
+                # CPU time of the whole run (this process and its ended workers) over
+                # one render's: the wall ratio on an idle machine where the run and
+                # the render use every CPU; the machine's other load moves it little.
+                state["render_cpu_s"] = statistics.median(clock.cpu_s[: CLOCK_RENDERS[0]])
+                state["cpu_s"] = _cpu_s()
+                state["cpu_over_render_cpu"] = state["cpu_s"] / state["render_cpu_s"]
         finally:
             clock.close()
         timeline["render_time_end"] = {"pid": os.getpid(), "start": 0.0, "end": time.time() - epoch}
