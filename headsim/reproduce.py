@@ -1029,7 +1029,7 @@ COSTS = {
     "chessboard": 298.0,
     "relative_positioning": 43.0,
     "tracking": 72.0,
-    STUDY_JOB: 148.0,
+    STUDY_JOB: 115.0,
 }
 SWEEP_COST = 1000.0
 

@@ -177,7 +177,7 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
         return job(name, _echo, needs, lambda done, n=name: (n, log))
 
     # calibration (225) -> chessboard (298) is the longest path; zhang (148) and
-    # fixed_point (110) lead to tables (148); "broken" fails and its dependent is skipped.
+    # fixed_point (110) lead to tables (115); "broken" fails and its dependent is skipped.
     plan = [
         make("zhang"),
         make("fixed_point"),
@@ -190,7 +190,7 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
     ]
     level = reproduce.critical_order(plan)
     assert level["calibration"] == 225.0 + 298.0
-    assert level["zhang"] == 148.0 + 148.0 and level["fixed_point"] == 110.0 + 148.0
+    assert level["zhang"] == 148.0 + 115.0 and level["fixed_point"] == 110.0 + 115.0
     finished, skipped, ran = [], [], []
     with futures.ThreadPoolExecutor(max_workers=1) as pool:
         ended = reproduce._schedule(
