@@ -28,6 +28,7 @@ reported as such beside the others.
 from __future__ import annotations
 
 import concurrent.futures as futures
+import contextlib
 import dataclasses
 import functools
 import importlib
@@ -35,12 +36,13 @@ import math
 import multiprocessing
 import os
 import resource
+import signal
 import statistics
 import sys
 import threading
 import time
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -770,6 +772,8 @@ def _render_threads(workers: int) -> int:
 
 
 def _init_worker(threads: int) -> None:
+    # Ctrl-C is the parent's to handle: it stops the workers and keeps the report.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     # Mesa's llvmpipe renders with one thread per CPU by default: N workers, each
     # with as many threads as the machine has CPUs, would oversubscribe it.  Read
     # when the worker's first OpenGL context is made; a user's own setting is kept.
@@ -993,7 +997,10 @@ def reproduce(
         # Stop the workers now: their experiments are lost, the finished ones are kept.
         processes = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
-        for process in processes:
+        # With a worker caught half-started (Ctrl-C while the pool spawned it, which
+        # the pool does not know of yet), the exit would wait for it forever: every
+        # child of this process is one of the pool's workers.
+        for process in {*processes, *multiprocessing.active_children()}:
             process.terminate()
         write_report()
         raise
@@ -1070,6 +1077,24 @@ def _topological(plan: list[_Job]) -> list[_Job]:
     )
 
 
+@contextlib.contextmanager
+def _interrupt_deferred() -> Iterator[None]:
+    """Ctrl-C waits until the block ends (then KeyboardInterrupt): a worker the pool
+    is spawning is never left half-started (it would print a traceback and stay
+    unknown to the pool).  Only in the main thread; elsewhere it does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if caught:
+        raise KeyboardInterrupt
+
+
 def _schedule(
     pool: futures.Executor,
     workers: int,
@@ -1099,7 +1124,9 @@ def _schedule(
                 skipped(job.name, missing)
             elif len(running) < workers and all(n in done for n in job.needs):
                 waiting.remove(job)
-                running[pool.submit(job.run, *job.args(done))] = (job.name, time.perf_counter())
+                with _interrupt_deferred():
+                    future = pool.submit(job.run, *job.args(done))
+                running[future] = (job.name, time.perf_counter())
         for report in ended:
             finished(*report)
         ended.clear()
