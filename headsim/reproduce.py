@@ -705,8 +705,8 @@ def report_text(
         lines.append(
             f"- CPU time {state['cpu_s']:.1f} s (this process and its workers) = "
             f"{state['cpu_over_render_cpu']:.0f} x one render's CPU time "
-            f"({1e3 * state['render_cpu_s']:.1f} ms): the least wall ratio an idle machine "
-            "could give when one render keeps every CPU busy, as llvmpipe's does"
+            f"({1e3 * state['render_cpu_s']:.1f} ms); the wall ratio is this times the "
+            "cores one render keeps busy over the cores the run keeps busy"
         )
     lines.append("")
     if figure is not None:
@@ -1011,9 +1011,9 @@ def reproduce(
             if state["status"] != "interrupted":
                 state["render_after_s"] = clock.sample(CLOCK_RENDERS[1])
                 # CPU time of the whole run (this process and its ended workers) over
-                # one render's: on an idle machine where one render keeps every CPU
-                # busy, the least wall ratio the run could reach; the machine's other
-                # load moves it little (the wall ratio it moves a lot).
+                # one render's: the machine's other load moves it less than the wall
+                # ratio, which is this times the cores a render keeps busy over the
+                # cores the run keeps busy.
                 state["render_cpu_s"] = statistics.median(clock.cpu_s[: CLOCK_RENDERS[0]])
                 state["cpu_s"] = _cpu_s()
                 state["cpu_over_render_cpu"] = state["cpu_s"] / state["render_cpu_s"]
