@@ -109,6 +109,9 @@ class FixedPoint:
     principal: PrincipalPointRun
     calibration: CalibrationRun
     renders: int
+    #: The head and seed the fixed points were found on (None: not recorded).
+    settings: HeadSettings | None = None
+    seed: int | None = None
 
     def knowledge(self, refound: PrincipalPointRun | None = None) -> HeadKnowledge:
         """``active_fixed_point``'s knowledge, or with ``refound``'s columns and rows
@@ -122,9 +125,7 @@ class FixedPoint:
 def fixed_point_calibration(settings: HeadSettings, config: StudyConfig) -> FixedPoint:
     """The fixed points of a zoom (images only) and Sec. V with the servo on their columns."""
     scale = view_scale(settings)
-    principal = principal_points_by_zoom(
-        settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
-    )
+    principal = _fixed_points(settings, config)
     with HeadSim("default", settings) as sim:
         positions = calibration_layout(
             sim,
@@ -144,7 +145,14 @@ def fixed_point_calibration(settings: HeadSettings, config: StudyConfig) -> Fixe
             knowledge=HeadKnowledge(u0=(u1, u2)),
         )
         renders = principal.renders + sim.render_count - start
-    return FixedPoint(principal, calibration, renders)
+    return FixedPoint(principal, calibration, renders, settings, config.seed)
+
+
+def _fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:
+    """The zoom fixed points of ``settings``' cameras, seeded as ``config``'s."""
+    return principal_points_by_zoom(
+        settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
+    )
 
 
 def active_knowledge(
@@ -205,8 +213,12 @@ def measure_paired(
     config = config or StudyConfig()
     refound = None
     if fixed is not None:
-        refound = principal_points_by_zoom(
-            settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
+        # On the head they were calibrated on, found again they are the same images
+        # and the same answer (deterministic from the seed): taken from ``fixed``.
+        refound = (
+            fixed.principal
+            if fixed.settings == settings and fixed.seed == config.seed
+            else _fixed_points(settings, config)
         )
     with HeadSim("default", settings) as sim:
         servo = EyeServo(sim)

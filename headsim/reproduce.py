@@ -28,16 +28,21 @@ reported as such beside the others.
 from __future__ import annotations
 
 import concurrent.futures as futures
+import contextlib
+import dataclasses
 import functools
 import importlib
 import math
 import multiprocessing
+import os
+import resource
+import signal
 import statistics
 import sys
 import threading
 import time
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -60,12 +65,17 @@ STUDY_JOB = "tables_v_vi"
 TABLES_SCOPE = (
     "Measured on this head with `head.json` (the image-centre active methods), one Zhang "
     "calibration (stereo) and one zoom fixed-point calibration (the fixed-point methods, "
-    "beyond the paper): the six target positions, as calibrated and with the focal length "
+    "beyond the paper, fewer ball positions than head.json): the six target positions, as calibrated and with the focal length "
     "x1.5. The three image-centre methods servo once and are computed from the same images. "
     "Smaller than `python -m headsim.study --experiment compare`, which also measures a "
     "second head with centred principal points and the 0.7x zoom, principal-point and k1 "
     "changes (beyond the paper's tables)."
 )
+#: Ball positions of the fixed-point methods' Sec. V calibration (beyond the paper), at
+#: most: half of head.json's 60.  Their rows are the zoom's after/before ratios, which
+#: the calibration's precision hardly moves (seed 0: 0.82 -> 0.85 and 1.51 -> 1.65
+#: with 60 -> 30), and it halves the run's third-longest job (524 -> 248 renders).
+FIXED_POINT_TARGETS = 30
 #: The scenario whose head (and calibration) every experiment uses.
 TABLES_HEAD = "calibration"
 #: Paper's figures (Sec. VI).
@@ -103,10 +113,19 @@ class JobError(RuntimeError):
 def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str, Any]]:
     @functools.wraps(job)
     def run(*args: Any) -> dict[str, Any]:
+        began, cpu = time.time(), time.process_time()
         try:
-            return job(*args)
+            data = job(*args)
         except Exception as err:
             raise JobError(_why(err)) from None
+        # Where and when it ran (report.json's timeline: the critical path).
+        data["worker"] = {
+            "pid": os.getpid(),
+            "start": began,
+            "end": time.time(),
+            "cpu_s": time.process_time() - cpu,
+        }
+        return data
 
     return run
 
@@ -189,8 +208,12 @@ def _fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
 
     scenario = load_scenario(TABLES_HEAD, fast=fast, seed=seed)
     start = time.perf_counter()
-    fixed = fixed_point_calibration(scenario.settings, _study_config(fast, seed))
-    return {"fixed": fixed, "wall_s": time.perf_counter() - start}
+    config = _study_config(fast, seed)
+    targets = min(config.calibration_targets, FIXED_POINT_TARGETS)
+    fixed = fixed_point_calibration(
+        scenario.settings, dataclasses.replace(config, calibration_targets=targets)
+    )
+    return {"fixed": fixed, "targets": targets, "wall_s": time.perf_counter() - start}
 
 
 @_plain_errors
@@ -232,6 +255,7 @@ def _tables_job(
             "fixed_point": {
                 "seconds": fixed["wall_s"],
                 "renders": fixed["fixed"].renders,
+                "targets": fixed["targets"],
                 "principal_error_px": fixed["fixed"].principal.errors_px,
                 "alpha_e_error_mrad": [1e3 * e for e in fixed["fixed"].calibration.alpha_e_error],
             },
@@ -263,21 +287,48 @@ def _study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, A
     )
 
 
-def _render_time_s() -> float:
-    """Median time of one 640x480 render of the default scene (this process), s."""
-    from headsim.settings import HeadSettings
-    from headsim.sim import HeadSim
+def _cpu_s() -> float:
+    """CPU time, user and system, of this process and its children that ended, s."""
+    own, children = (
+        resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)
+    )
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
-    with HeadSim("default", HeadSettings()) as sim:
-        sim.move(eye=0.05)
+
+class RenderClock:
+    """Times 640x480 renders of the default scene in this process, while no worker of
+    the run exists: the unit before they start, and a few after they ended, which
+    show how the machine's load moved (reported, not used in the ratio)."""
+
+    def __init__(self) -> None:
+        from headsim.settings import HeadSettings
+        from headsim.sim import HeadSim
+
+        self._sim = HeadSim("default", HeadSettings())
+        self._sim.move(eye=0.05)
         for camera in (1, 2):
-            sim.render(camera)
+            self._sim.render(camera)
+        self.times_s: list[float] = []
+        #: CPU time of each render (all of this process's threads: llvmpipe's too), s.
+        self.cpu_s: list[float] = []
+
+    def sample(self, renders: int) -> float:
+        """Time ``renders`` more renders; their median wall time, s."""
         times = []
-        for i in range(21):
-            start = time.perf_counter()
-            sim.render(1 + i % 2)
+        for _ in range(renders):
+            start, cpu = time.perf_counter(), time.process_time()
+            self._sim.render(1 + len(self.times_s) % 2)
             times.append(time.perf_counter() - start)
-    return statistics.median(times)
+            self.cpu_s.append(time.process_time() - cpu)
+        self.times_s += times
+        return statistics.median(times)
+
+    def close(self) -> None:
+        self._sim.close()
+
+
+#: Renders timed before the workers start (the unit) and after they end (the load's drift).
+CLOCK_RENDERS = (21, 7)
 
 
 # -- verdicts --------------------------------------------------------------------------
@@ -642,9 +693,22 @@ def report_text(
             else "(not made)"
         ),
         f"- wall time {state['wall_s']:.1f} s = {state['wall_over_render']:.0f} x the median "
-        f"640x480 render ({1e3 * state['render_s']:.1f} ms, measured in this run)",
-        "",
+        f"640x480 render ({1e3 * state['render_s']:.1f} ms, measured in this run, "
+        f"{CLOCK_RENDERS[0]} renders before the workers start"
+        + (
+            f"; {1e3 * state['render_after_s']:.1f} ms after they ended)"
+            if state.get("render_after_s")
+            else ")"
+        ),
     ]
+    if state.get("cpu_over_render_cpu"):
+        lines.append(
+            f"- CPU time {state['cpu_s']:.1f} s (this process and its workers) = "
+            f"{state['cpu_over_render_cpu']:.0f} x one render's CPU time "
+            f"({1e3 * state['render_cpu_s']:.1f} ms); the wall ratio is this times the "
+            "cores one render keeps busy over the cores the run keeps busy"
+        )
+    lines.append("")
     if figure is not None:
         lines += [f"![the paper's figures beside ours]({figure.relative_to(state['out'])})", ""]
     verdicts = []
@@ -676,7 +740,11 @@ def report_text(
                     "",
                     f"{data['renders']} renders: Zhang's calibration "
                     f"{data['zhang']['renders']}, the fixed points and their Sec. V "
-                    f"calibration {data['fixed_point']['renders']}, the rest measuring.",
+                    f"calibration {data['fixed_point']['renders']}, the rest measuring. "
+                    "The fixed-point methods' Sec. V calibration uses "
+                    f"{data['fixed_point'].get('targets', '?')} ball positions, fewer than "
+                    "head.json's (their rows are the zoom's after/before ratios; "
+                    "`python -m headsim.study` calibrates them with as many as the head).",
                 ]
         if outcome is not None:
             where = f"`{name}/`" if name in SCENARIO_JOBS else "`study/`"
@@ -697,10 +765,28 @@ def report_text(
 # -- running -------------------------------------------------------------------------------
 
 
+def _render_threads(workers: int) -> int:
+    """llvmpipe threads per worker: the CPUs shared among the workers (at least 1)."""
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    return max(1, (cpus or 1) // workers)
+
+
+def _init_worker(threads: int) -> None:
+    # Ctrl-C is the parent's to handle: it stops the workers and keeps the report.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # Mesa's llvmpipe renders with one thread per CPU by default: N workers, each
+    # with as many threads as the machine has CPUs, would oversubscribe it.  Read
+    # when the worker's first OpenGL context is made; a user's own setting is kept.
+    os.environ.setdefault("LP_NUM_THREADS", str(threads))
+
+
 def _pool(workers: int) -> futures.Executor:
     # Spawned, not forked: a fork after OpenGL was used hangs (platform notes).
     return futures.ProcessPoolExecutor(
-        max_workers=workers, mp_context=multiprocessing.get_context("spawn")
+        max_workers=workers,
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=_init_worker,
+        initargs=(_render_threads(workers),),
     )
 
 
@@ -727,8 +813,9 @@ def reproduce(
         out.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise OutputNotWritable(f"--out: cannot create {out}: {err.strerror}") from err
-    start = time.perf_counter()
-    render_s = _render_time_s()
+    start, epoch = time.perf_counter(), time.time()
+    clock = RenderClock()
+    render_s = clock.sample(CLOCK_RENDERS[0])
     state: dict[str, Any] = {
         "status": "running",
         "out": out,
@@ -742,6 +829,28 @@ def reproduce(
     }
     outcomes: dict[str, JobOutcome] = {}
     calibration: dict[str, Any] | None = None
+    #: Each job's worker, times since the start and CPU time, s: {"pid", "start", "end", "cpu_s"}.
+    timeline: dict[str, dict[str, float]] = {"render_time": {"pid": os.getpid(), "start": 0.0}}
+    timeline["render_time"]["end"] = time.time() - epoch
+
+    def ran(name: str, data: dict[str, Any]) -> None:
+        worker = data.get("worker")
+        if worker:
+            timeline[name] = {
+                "pid": worker["pid"],
+                "start": worker["start"] - epoch,
+                "end": worker["end"] - epoch,
+                "cpu_s": worker["cpu_s"],
+            }
+
+    def draw_tables() -> None:
+        """The Tables V/VI PNG, once (drawn here, while the other workers run)."""
+        tables = outcomes.get(STUDY_JOB)
+        if tables is not None and "result" in tables.data:
+            from headsim import plots
+
+            result = tables.data.pop("result")
+            plots.plot_experiment(result, Path(tables.data["files"]["png"]))
 
     def write_report(figure: bool = True) -> None:
         """report.md and report.json; the main figure (matplotlib, ~1 s) only when asked:
@@ -750,16 +859,11 @@ def reproduce(
         if figure:
             try:
                 drawn = main_figure(outcomes, calibration, out / "figures" / "main.png")
-                tables = outcomes.get(STUDY_JOB)
-                if tables is not None and "result" in tables.data:
-                    from headsim import plots
-
-                    result = tables.data.pop("result")
-                    plots.plot_experiment(result, Path(tables.data["files"]["png"]))
+                draw_tables()
             except Exception as err:  # a figure must not hide the numbers
                 progress(f"figure not drawn: {err!r}")
         state["wall_s"] = time.perf_counter() - start
-        state["wall_over_render"] = state["wall_s"] / render_s
+        state["wall_over_render"] = state["wall_s"] / state["render_s"]
         write_text_atomic(out / "report.md", report_text(state, outcomes, calibration, drawn))
         write_json_atomic(
             out / "report.json",
@@ -770,12 +874,18 @@ def reproduce(
                     "fast": fast,
                     "workers": workers,
                     "wall_s": state["wall_s"],
-                    "render_s": render_s,
+                    "render_s": state["render_s"],
+                    "render_after_s": state.get("render_after_s"),
+                    "render_cpu_s": state.get("render_cpu_s"),
+                    "cpu_s": state.get("cpu_s"),
+                    "cpu_over_render_cpu": state.get("cpu_over_render_cpu"),
+                    "render_samples_s": clock.times_s,
                     "wall_over_render": state["wall_over_render"],
                     "experiments": {
                         n: {"status": o.status, "wall_s": o.wall_s, "error": o.error}
                         for n, o in outcomes.items()
                     },
+                    "timeline": timeline,
                     "rows": {
                         name: None
                         if rows is None
@@ -790,82 +900,95 @@ def reproduce(
         )
 
     pool = _pool(workers)
-    jobs: dict[futures.Future[dict[str, Any]], tuple[str, float]] = {}
     try:
         write_report(figure=False)
         progress("calibrating the head once (and its stereo pair, Zhang, beside it)")
-        t0 = time.perf_counter()
-        # Zhang's calibration and the fixed points' need no head.json: they run beside it.
-        head_job = pool.submit(_calibrate_job, str(out), fast, seed)
-        zhang_job = pool.submit(_zhang_job, fast, seed)
-        fixed_job = pool.submit(_fixed_point_job, fast, seed)
-        try:
-            calibration = head_job.result()
-        except Exception as err:
-            outcomes["initial_directions"] = JobOutcome(
-                "initial_directions",
-                "error",
-                time.perf_counter() - t0,
-                error=str(err) if isinstance(err, JobError) else _why(err),
-            )
-        now = time.perf_counter()
-
-        def submit(name: str, job: Callable[..., dict[str, Any]], *args: Any) -> None:
-            jobs[pool.submit(job, *args)] = (name, now)
-
-        # The longest first, so that the workers finish together.
-        names = list(SCENARIO_JOBS)
-        if calibration is not None:
-            submit(
-                "chessboard", _scenario_job, "chessboard", str(out), fast, seed, calibration["path"]
-            )
-            try:
-                zhang, fixed = zhang_job.result(), fixed_job.result()
-                submit(
-                    STUDY_JOB, _tables_job, str(out), fast, seed, calibration["path"], zhang, fixed
-                )
-            except Exception as err:
-                outcomes[STUDY_JOB] = JobOutcome(
-                    STUDY_JOB,
-                    "error",
-                    time.perf_counter() - t0,
-                    error=str(err) if isinstance(err, JobError) else _why(err),
-                )
-            for name in names:
-                if name != "chessboard":
-                    submit(name, _scenario_job, name, str(out), fast, seed, calibration["path"])
-        else:
-            for name in [*names[1:], STUDY_JOB]:
-                outcomes[name] = JobOutcome(name, "error", 0.0, error="no calibration to use")
-        for name in state["sweeps"]:
-            submit(name, _study_job, name, str(out), fast, seed)
-        write_report(figure=False)
         # matplotlib loads (about 1 s) while the workers run, not after them.
         threading.Thread(
             target=importlib.import_module, args=("headsim.plots",), daemon=True
         ).start()
-        for done in futures.as_completed(jobs):
-            name, began = jobs[done]
-            try:
-                data = done.result()
+        path = str(out)
+        head = lambda done: done["calibration"]["path"]  # noqa: E731
+        plan = [
+            _Job("calibration", _calibrate_job, (), lambda done: (path, fast, seed)),
+            _Job("zhang", _zhang_job, (), lambda done: (fast, seed)),
+            _Job("fixed_point", _fixed_point_job, (), lambda done: (fast, seed)),
+            *(
+                _Job(
+                    name,
+                    _scenario_job,
+                    ("calibration",),
+                    functools.partial(
+                        lambda done, name: (name, path, fast, seed, head(done)), name=name
+                    ),
+                )
+                for name in SCENARIO_JOBS
+            ),
+            _Job(
+                STUDY_JOB,
+                _tables_job,
+                ("calibration", "zhang", "fixed_point"),
+                lambda done: (
+                    path,
+                    fast,
+                    seed,
+                    head(done),
+                    done["zhang"],
+                    done["fixed_point"],
+                ),
+            ),
+            *(
+                _Job(
+                    name,
+                    _study_job,
+                    (),
+                    functools.partial(lambda d, n: (n, path, fast, seed), n=name),
+                )
+                for name in state["sweeps"]
+            ),
+        ]
+
+        def finished(name: str, data: dict[str, Any] | None, error: str, wall_s: float) -> None:
+            nonlocal calibration
+            if name == "calibration":
+                calibration = data
+                if data is None:
+                    outcomes["initial_directions"] = JobOutcome(
+                        "initial_directions", "error", wall_s, error=error
+                    )
+                return
+            if name in ("zhang", "fixed_point"):
+                if data is None and STUDY_JOB not in outcomes:
+                    outcomes[STUDY_JOB] = JobOutcome(STUDY_JOB, "error", wall_s, error=error)
+                return
+            if data is None:
+                outcomes[name] = JobOutcome(name, "error", wall_s, error=error)
+            else:
                 failed = bool(data.get("results", {}).get("failures"))
                 # The job's own time, not the time it waited for a worker.
                 own = data.get("wall_s", data.get("seconds"))
                 outcomes[name] = JobOutcome(
-                    name,
-                    "failed" if failed else "ok",
-                    float(own) if own is not None else time.perf_counter() - began,
-                    data,
-                )
-            except Exception as err:
-                outcomes[name] = JobOutcome(
-                    name,
-                    "error",
-                    time.perf_counter() - began,
-                    error=str(err) if isinstance(err, JobError) else _why(err),
+                    name, "failed" if failed else "ok", float(own) if own else wall_s, data
                 )
             progress(f"{name}: {outcomes[name].status}")
+            if name == STUDY_JOB:
+                try:
+                    draw_tables()
+                except Exception as err:  # a figure must not hide the numbers
+                    progress(f"figure not drawn: {err!r}")
             write_report(figure=False)
+
+        def skipped(name: str, missing: str) -> None:
+            if name not in outcomes:
+                why = "no calibration to use" if missing == "calibration" else f"no {missing}"
+                outcomes[name] = JobOutcome(name, "error", 0.0, error=why)
+
+        ended = _schedule(pool, workers, plan, finished, skipped, ran)
+        progress(f"scheduler: {ended}")
+        # Every job ended and its files are written: the idle workers are stopped
+        # rather than left to tear down their interpreters and GL contexts (~0.5 s).
+        for process in list((getattr(pool, "_processes", None) or {}).values()):
+            process.terminate()
         state["status"] = (
             "ok" if calibration and all(o.status == "ok" for o in outcomes.values()) else "failed"
         )
@@ -874,14 +997,159 @@ def reproduce(
         # Stop the workers now: their experiments are lost, the finished ones are kept.
         processes = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
-        for process in processes:
+        # With a worker caught half-started (Ctrl-C while the pool spawned it, which
+        # the pool does not know of yet), the exit would wait for it forever: every
+        # child of this process is one of the pool's workers.
+        for process in {*processes, *multiprocessing.active_children()}:
             process.terminate()
         write_report()
         raise
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+        timeline["shutdown"] = {"pid": os.getpid(), "start": 0.0, "end": time.time() - epoch}
+        try:
+            if state["status"] != "interrupted":
+                state["render_after_s"] = clock.sample(CLOCK_RENDERS[1])
+                # CPU time of the whole run (this process and its ended workers) over
+                # one render's: the machine's other load moves it less than the wall
+                # ratio, which is this times the cores a render keeps busy over the
+                # cores the run keeps busy.
+                state["render_cpu_s"] = statistics.median(clock.cpu_s[: CLOCK_RENDERS[0]])
+                state["cpu_s"] = _cpu_s()
+                state["cpu_over_render_cpu"] = state["cpu_s"] / state["render_cpu_s"]
+        finally:
+            clock.close()
+        timeline["render_time_end"] = {"pid": os.getpid(), "start": 0.0, "end": time.time() - epoch}
     write_report()
     return state
+
+
+# -- scheduling ------------------------------------------------------------------------------
+
+#: What each job costs, in 640x480 render-times at full size (measured one after the
+#: other on this machine, Dec 2026): the scheduler starts the ready job with the
+#: longest path to the end first.  Sweeps are the longest.
+COSTS = {
+    "calibration": 225.0,
+    "zhang": 148.0,
+    "fixed_point": 110.0,
+    "initial_directions": 11.0,
+    "chessboard": 298.0,
+    "relative_positioning": 43.0,
+    "tracking": 72.0,
+    STUDY_JOB: 115.0,
+}
+SWEEP_COST = 1000.0
+
+
+@dataclass(frozen=True)
+class _Job:
+    """A job of the run: what it runs, the jobs it needs, and its arguments from their data."""
+
+    name: str
+    run: Callable[..., dict[str, Any]]
+    needs: tuple[str, ...]
+    args: Callable[[dict[str, dict[str, Any]]], tuple[Any, ...]]
+
+
+def critical_order(plan: list[_Job]) -> dict[str, float]:
+    """Each job's longest path to the end of the run (its cost and its dependents'), in
+    render-times: the priority of list scheduling."""
+    level: dict[str, float] = {}
+    for job in reversed(_topological(plan)):
+        after = [level[j.name] for j in plan if job.name in j.needs]
+        level[job.name] = COSTS.get(job.name, SWEEP_COST) + max(after, default=0.0)
+    return level
+
+
+def _topological(plan: list[_Job]) -> list[_Job]:
+    order: list[_Job] = []
+    placed: set[str] = set()
+    for _ in range(len(plan)):  # bounded: one job placed per pass at least
+        for job in plan:
+            if job.name not in placed and all(n in placed for n in job.needs):
+                order.append(job)
+                placed.add(job.name)
+        if len(order) == len(plan):
+            return order
+    raise ValueError(
+        f"jobs with unmet or circular needs: {sorted({j.name for j in plan} - placed)}"
+    )
+
+
+@contextlib.contextmanager
+def _interrupt_deferred() -> Iterator[None]:
+    """Ctrl-C waits until the block ends (then KeyboardInterrupt): a worker the pool
+    is spawning is never left half-started (it would print a traceback and stay
+    unknown to the pool).  Only in the main thread; elsewhere it does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if caught:
+        raise KeyboardInterrupt
+
+
+def _schedule(
+    pool: futures.Executor,
+    workers: int,
+    plan: list[_Job],
+    finished: Callable[[str, dict[str, Any] | None, str, float], None],
+    skipped: Callable[[str, str], None],
+    ran: Callable[[str, dict[str, Any]], None],
+) -> str:
+    """Run ``plan`` on ``pool``, at most ``workers`` jobs at a time: of the jobs whose
+    needs are done, the one with the longest path to the end first (the pool
+    would otherwise start them in the order they were queued, whatever frees
+    first).  A job whose need failed is skipped.  Returns why it ended."""
+    level = critical_order(plan)
+    waiting = sorted(plan, key=lambda j: -level[j.name])
+    done: dict[str, dict[str, Any]] = {}
+    failed: set[str] = set()
+    running: dict[futures.Future[dict[str, Any]], tuple[str, float]] = {}
+    # Ended jobs are reported after the next jobs started: a report (a figure) must
+    # not keep a worker idle.
+    ended: list[tuple[str, dict[str, Any] | None, str, float]] = []
+    for _ in range(2 * len(plan) + 1):  # each pass starts or ends a job at least
+        for job in list(waiting):
+            missing = next((n for n in job.needs if n in failed), None)
+            if missing is not None:
+                waiting.remove(job)
+                failed.add(job.name)
+                skipped(job.name, missing)
+            elif len(running) < workers and all(n in done for n in job.needs):
+                waiting.remove(job)
+                with _interrupt_deferred():
+                    future = pool.submit(job.run, *job.args(done))
+                running[future] = (job.name, time.perf_counter())
+        for report in ended:
+            finished(*report)
+        ended.clear()
+        if not running:
+            return (
+                "every job ended"
+                if not waiting
+                else f"stuck: {[j.name for j in waiting]} wait for jobs that never ran"
+            )
+        ready, _ = futures.wait(running, return_when=futures.FIRST_COMPLETED)
+        for future in ready:
+            name, began = running.pop(future)
+            try:
+                data = future.result()
+            except Exception as err:
+                failed.add(name)
+                error = str(err) if isinstance(err, JobError) else _why(err)
+                ended.append((name, None, error, time.perf_counter() - began))
+                continue
+            ran(name, data)
+            done[name] = data
+            ended.append((name, data, "", time.perf_counter() - began))
+    return "stopped: more passes than jobs allow"
 
 
 def _why(err: BaseException) -> str:

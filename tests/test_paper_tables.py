@@ -47,3 +47,17 @@ def test_the_calibration_must_servo_on_the_image_centre() -> None:
     stored = HeadKnowledge(alpha_e=(0.05, -0.02), u0=(300.0, 320.0))
     with pytest.raises(ValueError, match="image centre"):
         paper_tables.active_knowledge(stored, None)  # type: ignore[arg-type]
+
+
+def test_the_fixed_points_found_again_on_their_own_head_are_the_calibrations() -> None:
+    # measure_paired takes them from the FixedPoint on the head it was made on: that
+    # holds only because finding them again gives the same images and answer.
+    from headsim.study import StudyConfig
+
+    settings = preset("paper")
+    config = StudyConfig.quick(calibration_targets=4)
+    fixed = paper_tables.fixed_point_calibration(settings, config)
+    again = paper_tables._fixed_points(settings, config)
+    assert fixed.settings == settings and fixed.seed == config.seed
+    assert again.principal_px == fixed.principal.principal_px
+    assert again.renders == fixed.principal.renders
