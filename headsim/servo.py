@@ -560,12 +560,7 @@ class NeckServo:
                 self.config.window_margin_px,
             )
             if window is not None:
-                self.window_renders += 1
-                detection = look_in_window(sim, camera, detector, window)
-                if detection is not None:
-                    return detection
-                self.window_misses += 1
-                return detector(sim.retake(camera))  # the same instant, whole
+                return self._look_in(window, camera, detector)
         elif (
             self.config.windows
             and self.config.preview_binning > 1
@@ -576,13 +571,17 @@ class NeckServo:
             self.previews += 1
             window = preview_window(sim, camera, self._key, self.config)
             if window is not None:
-                self.window_renders += 1
-                detection = look_in_window(sim, camera, detector, window)
-                if detection is not None:
-                    return detection
-                self.window_misses += 1
-                return detector(sim.retake(camera))
+                return self._look_in(window, camera, detector)
         return detector(sim.render(camera))
+
+    def _look_in(self, window: Window, camera: int, detector: Detector) -> Detection:
+        """Detect in a rendered window; a miss costs the same instant's whole frame."""
+        self.window_renders += 1
+        detection = look_in_window(self.sim, camera, detector, window)
+        if detection is not None:
+            return detection
+        self.window_misses += 1
+        return detector(self.sim.retake(camera))
 
     def _in_range(self, steps: np.ndarray) -> bool:
         return all(lo <= s <= hi for s, (lo, hi) in zip(steps, self._ranges, strict=True))
