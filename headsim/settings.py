@@ -37,6 +37,24 @@ def _finite(name: str, value: float) -> None:
     )
 
 
+#: A camera's focal lengths, px.
+FOCAL_FIELDS = ("kx", "ky")
+#: A camera's numeric settings, each checked to be finite; their order is also the
+#: order in which the Gymnasium environment draws them (headsim.envs.fixate).
+CAMERA_NUMBER_FIELDS = (
+    *FOCAL_FIELDS,
+    "k1",
+    "k2",
+    "mount_yaw_rad",
+    "mount_pitch_rad",
+    "mount_roll_rad",
+    "noise_std",
+    "nodal_offset_m",
+    "side_offset_m",
+    "eye_axis_tilt_rad",
+)
+
+
 @dataclass(frozen=True)
 class CameraSettings:
     """One eye camera: image size, pinhole intrinsics, lens and mount.
@@ -83,21 +101,11 @@ class CameraSettings:
                 f"camera {name} = {value} px is larger than the off-screen buffer allows "
                 f"(at most {MAX_IMAGE_SIDE} px)",
             )
-        for name in ("kx", "ky"):
+        for name in FOCAL_FIELDS:
             value = getattr(self, name)
             _finite(name, value)
             _check(value > 0, f"focal length {name} must be > 0 px, got {value}")
-        for name in (
-            "k1",
-            "k2",
-            "mount_yaw_rad",
-            "mount_pitch_rad",
-            "mount_roll_rad",
-            "noise_std",
-            "nodal_offset_m",
-            "side_offset_m",
-            "eye_axis_tilt_rad",
-        ):
+        for name in CAMERA_NUMBER_FIELDS[len(FOCAL_FIELDS) :]:
             _finite(name, getattr(self, name))
         _check(
             -0.05 <= self.nodal_offset_m <= 0.1,

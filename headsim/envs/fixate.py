@@ -43,25 +43,19 @@ from gymnasium import spaces
 from headsim.kinematics import head_to_world
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
-from headsim.settings import IDEAL_FOCAL_PX, CameraSettings, HeadSettings, SettingsError
+from headsim.settings import (
+    CAMERA_NUMBER_FIELDS,
+    IDEAL_FOCAL_PX,
+    CameraSettings,
+    HeadSettings,
+    SettingsError,
+)
 from headsim.sim import HeadSim
 from headsim.vision import find_marker
 
 TARGET_BODY = "marker_red"
 TARGET_COLOUR = "red"
-CAMERA_FIELDS = (
-    "kx",
-    "ky",
-    "k1",
-    "k2",
-    "mount_yaw_rad",
-    "mount_pitch_rad",
-    "mount_roll_rad",
-    "noise_std",
-    "nodal_offset_m",
-    "side_offset_m",
-    "eye_axis_tilt_rad",
-)
+CAMERA_FIELDS = CAMERA_NUMBER_FIELDS  # their order fixes the random draws
 HEAD_FIELDS = ("baseline_m",)
 TARGET_FIELDS = ("depth_m", "bearing_rad", "speed_m_s")
 REWARDS = ("offsets", "position")
