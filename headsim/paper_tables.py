@@ -37,19 +37,12 @@ import numpy as np
 
 from headsim import names, stereo
 from headsim.estimators import model2
-from headsim.principal import (
-    PROBE_ZOOM,
-    PrincipalPointRun,
-    principal_points_by_zoom,
-    view_scale,
-    zoomed,
-)
+from headsim.principal import PrincipalPointRun, zoomed
 from headsim.procedures import (
     CalibrationRun,
     HeadKnowledge,
     Measurement,
     calibrate_head,
-    calibration_layout,
     measure_model2,
 )
 from headsim.servo import EyeServo
@@ -64,8 +57,11 @@ from headsim.study import (
     ExperimentResult,
     StudyConfig,
     TargetError,
+    calibration_positions,
     summarise,
     table_targets,
+    zhang_stereo,
+    zoom_fixed_points,
 )
 
 #: The methods measured, in table order; the first three active ones share their images.
@@ -88,17 +84,10 @@ ZOOM = 1.5
 def zhang_calibration(
     settings: HeadSettings, config: StudyConfig
 ) -> tuple[stereo.StereoCalibration, int]:
-    """Zhang's calibration of ``settings``' pair from ``config.board_poses`` chessboard poses,
+    """Zhang's calibration of ``settings``' pair (as :func:`headsim.study.zhang_stereo`),
     and the renders it took."""
-    scale = view_scale(settings)
-    with HeadSim("chessboard", settings) as sim:
-        views = stereo.chessboard_views(
-            sim,
-            config.board_poses,
-            np.random.default_rng(config.seed),
-            distance_range_m=(0.4 * scale, 1.0 * scale),
-        )
-        return stereo.calibrate_stereo(sim, views), views.renders
+    calibration, views = zhang_stereo(settings, config)
+    return calibration, views.renders
 
 
 @dataclass(frozen=True)
@@ -124,16 +113,9 @@ class FixedPoint:
 
 def fixed_point_calibration(settings: HeadSettings, config: StudyConfig) -> FixedPoint:
     """The fixed points of a zoom (images only) and Sec. V with the servo on their columns."""
-    scale = view_scale(settings)
-    principal = _fixed_points(settings, config)
+    principal = zoom_fixed_points(settings, config)
     with HeadSim("default", settings) as sim:
-        positions = calibration_layout(
-            sim,
-            np.random.default_rng(config.seed + 2),
-            config.calibration_targets,
-            depth_range_m=(0.25 * scale, 0.6 * scale),
-            lateral=0.16 / scale,
-        )
+        positions = calibration_positions(sim, settings, config)
         (u1, _), (u2, _) = principal.principal_px
         start = sim.render_count
         calibration = calibrate_head(
@@ -146,13 +128,6 @@ def fixed_point_calibration(settings: HeadSettings, config: StudyConfig) -> Fixe
         )
         renders = principal.renders + sim.render_count - start
     return FixedPoint(principal, calibration, renders, settings, config.seed)
-
-
-def _fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:
-    """The zoom fixed points of ``settings``' cameras, seeded as ``config``'s."""
-    return principal_points_by_zoom(
-        settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
-    )
 
 
 def active_knowledge(
@@ -218,7 +193,7 @@ def measure_paired(
         refound = (
             fixed.principal
             if fixed.settings == settings and fixed.seed == config.seed
-            else _fixed_points(settings, config)
+            else zoom_fixed_points(settings, config)
         )
     with HeadSim("default", settings) as sim:
         servo = EyeServo(sim)

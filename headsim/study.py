@@ -288,11 +288,11 @@ class Calibrations:
         }
 
 
-def calibrate_methods(
-    settings: HeadSettings, config: StudyConfig, progress: Progress = quiet
-) -> Calibrations:
-    """Calibrate every method on the head ``settings`` (seeded by ``config.seed``)."""
-    start = time.perf_counter()
+def zhang_stereo(
+    settings: HeadSettings, config: StudyConfig
+) -> tuple[stereo.StereoCalibration, stereo.ChessboardViews]:
+    """Zhang's calibration of ``settings``' pair from ``config.board_poses`` chessboard
+    poses (seeded by ``config.seed``), and the views it used."""
     scale = view_scale(settings)
     with HeadSim("chessboard", settings) as sim:
         views = stereo.chessboard_views(
@@ -301,15 +301,40 @@ def calibrate_methods(
             np.random.default_rng(config.seed),
             distance_range_m=(0.4 * scale, 1.0 * scale),
         )
-        stereo_calibration = stereo.calibrate_stereo(sim, views)
-        renders = views.renders
+        return stereo.calibrate_stereo(sim, views), views
+
+
+def zoom_fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:
+    """The zoom fixed points of ``settings``' cameras, seeded by ``config.seed``."""
+    return principal_points_by_zoom(
+        settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
+    )
+
+
+def calibration_positions(sim: HeadSim, settings: HeadSettings, config: StudyConfig) -> np.ndarray:
+    """The Sec. V ball positions of every method (seeded by ``config.seed``)."""
+    scale = view_scale(settings)
+    return calibration_layout(
+        sim,
+        np.random.default_rng(config.seed + 2),
+        config.calibration_targets,
+        depth_range_m=(0.25 * scale, 0.6 * scale),
+        lateral=0.16 / scale,
+    )
+
+
+def calibrate_methods(
+    settings: HeadSettings, config: StudyConfig, progress: Progress = quiet
+) -> Calibrations:
+    """Calibrate every method on the head ``settings`` (seeded by ``config.seed``)."""
+    start = time.perf_counter()
+    stereo_calibration, views = zhang_stereo(settings, config)
+    renders = views.renders
     progress(
         f"  stereo: {views.count} views, RMS {stereo_calibration.stereo_rms_px:.3f} px, "
         f"focal errors {', '.join(f'{100 * e:+.2f} %' for e in stereo_calibration.cam1.focal_rel_errors)}"
     )
-    principal = principal_points_by_zoom(
-        settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
-    )
+    principal = zoom_fixed_points(settings, config)
     renders += principal.renders
     progress(
         "  zoom fixed point: error "
@@ -317,13 +342,7 @@ def calibrate_methods(
         + " px"
     )
     with HeadSim("default", settings) as sim:
-        positions = calibration_layout(
-            sim,
-            np.random.default_rng(config.seed + 2),
-            config.calibration_targets,
-            depth_range_m=(0.25 * scale, 0.6 * scale),
-            lateral=0.16 / scale,
-        )
+        positions = calibration_positions(sim, settings, config)
         active = calibrate_head(sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, positions)
         progress(
             f"  Sec. V, image centre: {active.samples} samples, alpha_e error "

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim import paper_tables
+from headsim import paper_tables, study
 from headsim.procedures import HeadKnowledge, measure_model2
 from headsim.servo import EyeServo
 from headsim.settings import preset
@@ -57,7 +57,7 @@ def test_the_fixed_points_found_again_on_their_own_head_are_the_calibrations() -
     settings = preset("paper")
     config = StudyConfig.quick(calibration_targets=4)
     fixed = paper_tables.fixed_point_calibration(settings, config)
-    again = paper_tables._fixed_points(settings, config)
+    again = study.zoom_fixed_points(settings, config)
     assert fixed.settings == settings and fixed.seed == config.seed
     assert again.principal_px == fixed.principal.principal_px
     assert again.renders == fixed.principal.renders
