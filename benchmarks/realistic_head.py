@@ -15,7 +15,6 @@ those).  Whole shared field: |x/z| <= 0.15, |y/z| <= 0.1, 0.3-1.5 m.
 from __future__ import annotations
 
 import argparse
-import io
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -24,9 +23,10 @@ import numpy as np
 
 from headsim.calibration_design import near_far_depths, offset_std_limit
 from headsim.camera_model import PinholeCamera
+from headsim.error_budget import plot_budget
 from headsim.estimators import model2
 from headsim.estimators.calibration import calibrate_initial_directions, calibrate_lines_of_sight
-from headsim.results import write_bytes_atomic, write_csv_atomic
+from headsim.results import write_csv_atomic
 from headsim.settings import PAPER_INITIAL_DIRECTIONS, PAPER_INTRINSICS, REALISTIC_BUDGET
 from headsim.synthetic import StereoHead, observe, quantise
 
@@ -193,26 +193,16 @@ def budget(p: np.ndarray, seeds: int, out: Path | None) -> None:
         return
     out.mkdir(parents=True, exist_ok=True)
     write_csv_atomic(out / "error_budget.csv", conditions)
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(8, 4))
-    y = np.arange(len(conditions))
-    for k, (key, label) in enumerate((("rms_3d_pct", "3-D RMS (measured)"), ("rms_depth_pct", "depth RMS (measured)"),
-                                      ("predicted_depth_pct", "depth, eqs. 15-18"))):  # fmt: skip
-        ax.barh(y + (k - 1) * 0.27, [c[key] for c in conditions], height=0.27, label=label)
-    ax.set_yticks(y, [str(c["condition"]).strip() for c in conditions])
-    ax.invert_yaxis()
-    ax.set_xlabel("error, % of depth (whole field, 0.3-1.5 m)")
-    ax.set_title("Realistic head: error budget (exact forward model)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=120)
-    plt.close(fig)
-    write_bytes_atomic(out / "error_budget.png", buffer.getvalue())
+    plot_budget(
+        conditions,
+        out / "error_budget.png",
+        bars=(
+            ("rms_3d_pct", "3-D RMS (measured)"),
+            ("rms_depth_pct", "depth RMS (measured)"),
+            ("predicted_depth_pct", "depth, eqs. 15-18"),
+        ),
+        title="Realistic head: error budget (exact forward model)",
+    )
     print(f"   wrote {out / 'error_budget.csv'} and {out / 'error_budget.png'}")
 
 

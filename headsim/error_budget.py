@@ -354,8 +354,22 @@ def markdown_table(rows: Sequence[dict[str, Any]], fast: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
-def plot_budget(rows: Sequence[dict[str, Any]], path: Path) -> Path:
-    """A horizontal bar chart: measured 3-D, measured x-z and predicted x-z, per condition."""
+#: The budget chart's bars: a row's key and the legend's label.
+BUDGET_BARS = (
+    ("rms_3d_pct", "3-D RMS, measured"),
+    ("rms_xz_pct", "x-z RMS, measured"),
+    ("predicted_xz_pct", "x-z, eqs. 17/19"),
+)
+
+
+def plot_budget(
+    rows: Sequence[dict[str, Any]],
+    path: Path,
+    bars: Sequence[tuple[str, str]] = BUDGET_BARS,
+    title: str = "Realistic head: error budget (rendered, scenario realistic_field)",
+) -> Path:
+    """A horizontal bar chart of ``bars`` (default: measured 3-D, measured x-z and
+    predicted x-z), per condition, written atomically to ``path``."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -363,18 +377,13 @@ def plot_budget(rows: Sequence[dict[str, Any]], path: Path) -> Path:
 
     fig, ax = plt.subplots(figsize=(9, 0.45 * len(rows) + 1.6))
     y = np.arange(len(rows))
-    bars = (
-        ("rms_3d_pct", "3-D RMS, measured"),
-        ("rms_xz_pct", "x-z RMS, measured"),
-        ("predicted_xz_pct", "x-z, eqs. 17/19"),
-    )
     for k, (key, label) in enumerate(bars):
         values = [0.0 if math.isnan(r[key]) else r[key] for r in rows]
         ax.barh(y + (k - 1) * 0.27, values, height=0.27, label=label)
-    ax.set_yticks(y, [str(r["condition"]) for r in rows])
+    ax.set_yticks(y, [str(r["condition"]).strip() for r in rows])
     ax.invert_yaxis()
     ax.set_xlabel("error RMS, % of depth (whole field, 0.3-1.5 m)")
-    ax.set_title("Realistic head: error budget (rendered, scenario realistic_field)")
+    ax.set_title(title)
     ax.legend(fontsize=8)
     fig.tight_layout()
     buffer = io.BytesIO()
