@@ -1,0 +1,146 @@
+"""Byte-identity check for refactors: every scenario's results.json, fast and full.
+
+A change that should alter no behaviour (a restructuring) must leave every
+scenario's results.json byte-identical, and the bench's accuracy metrics equal.
+
+    python benchmarks/identity.py collect OUT_DIR [--jobs N] [--only NAME ...]
+    python benchmarks/identity.py compare BEFORE_DIR AFTER_DIR
+
+`collect` runs `headsim run NAME --out ...` for every scenario shipped in
+headsim's scenarios folder, with and without --fast, plus `headsim bench --json`
+and `headsim reproduce --fast`, and keeps the JSON outputs. `compare` prints a
+sha256 per file, the differing files, and the bench metrics that differ apart
+from the speed ones (timings are not deterministic). Exit status 1 on a
+difference.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENARIOS = ROOT / "headsim" / "scenarios"
+HEADSIM = [sys.executable, "-m", "headsim.cli"]
+# Outputs of `reproduce` that carry wall times, worker ids or CPU ratios.
+_TIMING_KEYS = ("seconds", "wall", "cpu", "time", "worker", "render_ms", "frame")
+
+
+def _run(args: list[str], out: Path) -> None:
+    out.parent.mkdir(parents=True, exist_ok=True)
+    env = dict(os.environ, MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"))
+    proc = subprocess.run(args, cwd=ROOT, env=env, capture_output=True, text=True)
+    (out.parent / (out.name + ".log")).write_text(proc.stdout + proc.stderr)
+    if proc.returncode not in (0, 1):
+        raise SystemExit(f"{' '.join(args)}: exit {proc.returncode}\n{proc.stderr[-2000:]}")
+
+
+def _scenario_job(name: str, fast: bool, dest: Path) -> str:
+    tag = f"{name}{'-fast' if fast else ''}"
+    with tempfile.TemporaryDirectory() as tmp:
+        args = [*HEADSIM, "--quiet", "run", name, "--out", tmp]
+        if fast:
+            args.append("--fast")
+        _run(args, dest / tag)
+        shutil.copy(Path(tmp) / "results.json", dest / f"{tag}.results.json")
+    return tag
+
+
+def collect(dest: Path, jobs: int, only: list[str]) -> None:
+    dest.mkdir(parents=True, exist_ok=True)
+    names = sorted(p.stem for p in SCENARIOS.glob("*.toml"))
+    if only:
+        names = [n for n in names if n in only]
+    work = [(n, f) for n in names for f in (True, False)]
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        for tag in pool.map(lambda nf: _scenario_job(nf[0], nf[1], dest), work):
+            print("ran", tag, flush=True)
+    if not only:
+        _run([*HEADSIM, "--quiet", "bench", "--json", str(dest / "bench.json")], dest / "bench")
+        print("ran bench", flush=True)
+        with tempfile.TemporaryDirectory() as tmp:
+            _run(
+                [*HEADSIM, "--quiet", "reproduce", "--fast", "--workers", "2", "--out", tmp],
+                dest / "reproduce",
+            )
+            shutil.copy(Path(tmp) / "report.json", dest / "reproduce.report.json")
+        print("ran reproduce --fast", flush=True)
+
+
+def _strip_timing(value: object) -> object:
+    if isinstance(value, dict):
+        return {
+            k: _strip_timing(v)
+            for k, v in value.items()
+            if not any(t in k.lower() for t in _TIMING_KEYS)
+        }
+    if isinstance(value, list):
+        return [_strip_timing(v) for v in value]
+    return value
+
+
+def compare(before: Path, after: Path) -> int:
+    bad = 0
+    for path in sorted(before.glob("*.results.json")):
+        other = after / path.name
+        a = hashlib.sha256(path.read_bytes()).hexdigest()
+        b = hashlib.sha256(other.read_bytes()).hexdigest() if other.exists() else "missing"
+        same = a == b
+        bad += not same
+        print(f"{'same' if same else 'DIFF'}  {a[:16]}  {b[:16]}  {path.name}")
+    for name in ("bench.json", "reproduce.report.json"):
+        pa, pb = before / name, after / name
+        if not pa.exists():
+            continue
+        if not pb.exists():
+            print(f"DIFF  {name} missing after")
+            bad += 1
+            continue
+        a_doc, b_doc = json.loads(pa.read_text()), json.loads(pb.read_text())
+        if name == "bench.json":
+            a_doc = {
+                k: v
+                for k, v in a_doc.get("metrics", a_doc).items()
+                if "speed" not in k and "ratio" not in k
+            }
+            b_doc = {
+                k: v
+                for k, v in b_doc.get("metrics", b_doc).items()
+                if "speed" not in k and "ratio" not in k
+            }
+        same = _strip_timing(a_doc) == _strip_timing(b_doc)
+        bad += not same
+        print(f"{'same' if same else 'DIFF'}  {name} (timings left out)")
+    print(f"{bad} difference(s)")
+    return 1 if bad else 0
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    sub = parser.add_subparsers(dest="verb", required=True)
+    c = sub.add_parser("collect")
+    c.add_argument("dest", type=Path)
+    c.add_argument("--jobs", type=int, default=2)
+    c.add_argument("--only", nargs="*", default=[])
+    d = sub.add_parser("compare")
+    d.add_argument("before", type=Path)
+    d.add_argument("after", type=Path)
+    args = parser.parse_args()
+    if args.verb == "collect":
+        collect(args.dest, args.jobs, args.only)
+        return 0
+    return compare(args.before, args.after)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
