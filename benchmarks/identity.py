@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = ROOT / "headsim" / "scenarios"
 HEADSIM = [sys.executable, "-m", "headsim.cli"]
 # Outputs of `reproduce` that carry wall times, worker ids or CPU ratios.
-_TIMING_KEYS = ("seconds", "wall", "cpu", "time", "worker", "render_ms", "frame")
+_TIMING_KEYS = ("seconds", "wall", "cpu", "time", "worker", "render", "samples", "frame")
 
 
 def _run(args: list[str], out: Path) -> None:
