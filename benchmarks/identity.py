@@ -30,8 +30,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 SCENARIOS = ROOT / "headsim" / "scenarios"
 HEADSIM = [sys.executable, "-m", "headsim.cli"]
-# Outputs of `reproduce` that carry wall times, worker ids or CPU ratios.
-_TIMING_KEYS = ("seconds", "wall", "cpu", "time", "worker", "render", "samples", "frame")
+# Keys of `reproduce`'s report that carry clock readings, worker ids or CPU ratios
+# (seconds end in _s); render counts and every result stay in the comparison.
+_TIMING_KEYS = ("wall", "cpu", "render_time", "timeline", "pid", "start", "end", "shutdown")
 
 
 def _run(args: list[str], out: Path) -> None:
