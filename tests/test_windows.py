@@ -81,7 +81,13 @@ def test_simulators_of_one_head_share_one_renderer_and_render_alike() -> None:
     with HeadSim("default", other) as sim:
         _pose(sim)
         shared = sim.render(1)
-        own = render.EyeRenderer(sim.model, other.cameras, sim.built.canvases, seed=11)
+        own = render.EyeRenderer(
+            sim.model,
+            other.cameras,
+            sim.built.canvases,
+            seed=11,
+            supersample=other.render.supersample,
+        )
         try:
             np.testing.assert_array_equal(own.render(sim.data, 0), shared)
         finally:
