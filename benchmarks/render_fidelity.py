@@ -2,9 +2,11 @@
 multisampling (``offsamples``) and against supersampling with area averaging.
 
 Run: .venv/bin/python benchmarks/render_fidelity.py [--poses 200] [--boards 20] [--only 4,1 4,2]
+         [--preset ideal|paper|realistic]
 
 For each setting (``headsim.settings.RenderFidelity``), ``--poses`` random
-sub-pixel poses of a red marker (ideal camera, no noise) give the distance of
+sub-pixel poses of a red marker (``--preset``'s cameras, ideal by default: no
+noise, no lens; paper and realistic: their lens and image noise) give the distance of
 the detected centroid from the true projection (px), and ``--boards`` random
 poses of the chessboard the same for all 48 detected inner corners.  It prints
 the median and 95th percentile, and the render time per frame as a ratio to
@@ -20,7 +22,7 @@ import time
 import numpy as np
 
 from headsim.procedures import chessboard_corner_target
-from headsim.settings import HeadSettings, RenderFidelity
+from headsim.settings import PRESETS, RenderFidelity, preset
 from headsim.sim import HeadSim
 from headsim.vision import find_chessboard, find_marker
 
@@ -36,10 +38,12 @@ SETTINGS = (
 )
 
 
-def marker_floor(fidelity: RenderFidelity, poses: int, seed: int) -> tuple[np.ndarray, float]:
+def marker_floor(
+    fidelity: RenderFidelity, poses: int, seed: int, head: str = "ideal"
+) -> tuple[np.ndarray, float]:
     rng = np.random.default_rng(seed)
     errors, seconds = [], 0.0
-    with HeadSim("default", HeadSettings(render=fidelity)) as sim:
+    with HeadSim("default", preset(head, render=fidelity)) as sim:
         sim.render(1)  # warm the renderer
         for _ in range(poses):
             target = [
@@ -58,11 +62,13 @@ def marker_floor(fidelity: RenderFidelity, poses: int, seed: int) -> tuple[np.nd
     return np.array(errors), 1e3 * seconds / poses
 
 
-def corner_floor(fidelity: RenderFidelity, boards: int, seed: int) -> np.ndarray:
+def corner_floor(
+    fidelity: RenderFidelity, boards: int, seed: int, head: str = "ideal"
+) -> np.ndarray:
     rng = np.random.default_rng(seed)
     errors = []
     corners = [chessboard_corner_target(k, (8, 6), 0.03) for k in range(48)]
-    with HeadSim("chessboard", HeadSettings(render=fidelity)) as sim:
+    with HeadSim("chessboard", preset(head, render=fidelity)) as sim:
         home = sim.position("chessboard")
         for _ in range(boards):
             sim.set_body_pose(
@@ -91,6 +97,9 @@ def main() -> None:
         metavar="OFF,SUPER",
         help="measure only these settings, e.g. 4,1 4,2 (the first is the time ratio's base)",
     )
+    parser.add_argument(
+        "--preset", choices=sorted(PRESETS), default="ideal", help="the head's cameras"
+    )
     args = parser.parse_args()
     settings = SETTINGS
     if args.only:
@@ -103,8 +112,8 @@ def main() -> None:
     )
     base_ms = None
     for fidelity in settings:
-        marker, ms = marker_floor(fidelity, args.poses, 0)
-        corner = corner_floor(fidelity, args.boards, 1)
+        marker, ms = marker_floor(fidelity, args.poses, 0, args.preset)
+        corner = corner_floor(fidelity, args.boards, 1, args.preset)
         base_ms = base_ms or ms
         print(
             f"{fidelity.offsamples:>10} {fidelity.supersample:>5} |            "
