@@ -235,21 +235,18 @@ class EyeRenderer:
         # Supersampled k times (headsim.settings.RenderFidelity): the model's
         # camera renders k x the canvas, and each canvas pixel is the area
         # average of a k x k block; a window is cut on whole blocks.
-        viewport = mujoco.MjrRect(0, 0, full_w, full_h)
         if rect is None or (rect.width, rect.height) == (width_c, height_c):
             rect = Window(0, 0, width_c, height_c)
+            viewport = mujoco.MjrRect(0, 0, full_w, full_h)
             mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
+            pixels = np.empty((full_h, full_w, 3), dtype=np.uint8)
+            mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
         else:
             # A window is drawn as the whole frame (the same projection and
             # viewport: every vertex lands where it does in the frame, so its
             # pixels are the frame's crop), with geometry clipped a few pixels
             # outside it, so that only the window's pixels are rasterised.
-            with _clipped_to(renderer.scene, rect, k, (full_w, full_h)):
-                mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
-        out_w, out_h = k * rect.width, k * rect.height
-        pixels = np.empty((out_h, out_w, 3), dtype=np.uint8)
-        read = mujoco.MjrRect(k * rect.x0, full_h - k * rect.y1, out_w, out_h)  # GL: rows bottom-up
-        mujoco.mjr_readPixels(pixels, None, read, renderer._mjr_context)
+            pixels = _draw_window(renderer, rect, k, (full_w, full_h))
         self.rendered_frames += (rect.width * rect.height) / (width_c * height_c)
         pixels = np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
         if k > 1:
@@ -395,6 +392,100 @@ def _clipped_to(
     finally:
         for n in _CLIP_PLANES:
             GL.glDisable(GL.GL_CLIP_PLANE0 + n)
+
+
+#: Off-screen buffers for windows kept per OpenGL context (the least recently used goes).
+WINDOW_BUFFERS = 6
+#: Their sizes are rounded up to this many raster pixels (llvmpipe's tile), to reuse them.
+_BUFFER_STEP = 64
+
+
+class _WindowBuffer:
+    """A multisampled off-screen buffer like the context's own (same formats and
+    samples), of another size, and its single-sample resolve buffer."""
+
+    def __init__(self, context: mujoco.MjrContext, size: tuple[int, int]) -> None:
+        from OpenGL import GL
+
+        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, context.offColor)
+        colour = GL.glGetRenderbufferParameteriv(
+            GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_INTERNAL_FORMAT
+        )
+        samples = GL.glGetRenderbufferParameteriv(GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_SAMPLES)
+        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, context.offDepthStencil)
+        depth = GL.glGetRenderbufferParameteriv(
+            GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_INTERNAL_FORMAT
+        )
+        width, height = size
+        self.renderbuffers = [int(r) for r in GL.glGenRenderbuffers(3)]
+        self.framebuffers = [int(f) for f in GL.glGenFramebuffers(2)]
+        storage = (
+            (samples, colour, GL.GL_COLOR_ATTACHMENT0, 0),
+            (samples, depth, GL.GL_DEPTH_STENCIL_ATTACHMENT, 0),
+            (0, colour, GL.GL_COLOR_ATTACHMENT0, 1),
+        )
+        for renderbuffer, (n, fmt, attachment, framebuffer) in zip(
+            self.renderbuffers, storage, strict=True
+        ):
+            GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, renderbuffer)
+            GL.glRenderbufferStorageMultisample(GL.GL_RENDERBUFFER, n, fmt, width, height)
+            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffers[framebuffer])
+            GL.glFramebufferRenderbuffer(
+                GL.GL_FRAMEBUFFER, attachment, GL.GL_RENDERBUFFER, renderbuffer
+            )
+        for framebuffer in self.framebuffers:
+            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
+            status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
+            if status != GL.GL_FRAMEBUFFER_COMPLETE:
+                raise RenderBackendError(f"window buffer {size} incomplete (status {status})")
+
+
+def _draw_window(
+    renderer: mujoco.Renderer, rect: Window, k: int, full_size: tuple[int, int]
+) -> np.ndarray:
+    """Raster pixels (k h, k w, 3) of ``rect`` (canvas pixels, supersampled ``k``
+    times) of the scene, drawn as the whole frame of ``full_size`` raster pixels
+    clipped to the window (:func:`_clipped_to`).
+
+    The frame is drawn into a buffer only as large as the window's far corner
+    from the frame's origin needs (rounded up to a tile), not the context's:
+    ``mjr_render`` clears all of its viewport, and a whole frame's
+    multisampled buffer costs more to clear than the window to draw.
+    """
+    from OpenGL import GL
+
+    full_w, full_h = full_size
+    context = renderer._mjr_context
+    step, margin = _BUFFER_STEP, CLIP_MARGIN_PX
+    size = (
+        min(full_w, step * math.ceil((k * rect.x1 + margin) / step)),
+        min(full_h, step * math.ceil((full_h - k * rect.y0 + margin) / step)),
+    )
+    buffers = renderer.__dict__.setdefault("_headsim_window_buffers", OrderedDict())
+    buffer = buffers.pop(size, None) or _WindowBuffer(context, size)
+    buffers[size] = buffer
+    while len(buffers) > WINDOW_BUFFERS:
+        _, oldest = buffers.popitem(last=False)
+        GL.glDeleteFramebuffers(len(oldest.framebuffers), oldest.framebuffers)
+        GL.glDeleteRenderbuffers(len(oldest.renderbuffers), oldest.renderbuffers)
+    x, y = k * rect.x0, full_h - k * rect.y1  # OpenGL's rows run bottom-up
+    width, height = k * rect.width, k * rect.height
+    try:
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, buffer.framebuffers[0])
+        with _clipped_to(renderer.scene, rect, k, full_size):
+            mujoco.mjr_render(mujoco.MjrRect(0, 0, full_w, full_h), renderer.scene, context)
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, buffer.framebuffers[0])
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, buffer.framebuffers[1])
+        GL.glBlitFramebuffer(
+            x, y, x + width, y + height, x, y, x + width, y + height,
+            GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST,
+        )  # fmt: skip
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, buffer.framebuffers[1])
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        raw = GL.glReadPixels(x, y, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
+    finally:
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, context)
+    return np.frombuffer(raw, dtype=np.uint8).reshape(height, width, 3).copy()
 
 
 #: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.
