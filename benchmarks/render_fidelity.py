@@ -1,14 +1,17 @@
 """Rendering fidelity: the marker-centroid and chessboard-corner floor against MuJoCo's
 multisampling (``offsamples``) and against supersampling with area averaging.
 
-Run: .venv/bin/python benchmarks/render_fidelity.py [--poses 200] [--boards 20]
+Run: .venv/bin/python benchmarks/render_fidelity.py [--poses 200] [--boards 20] [--only 4,1 4,2]
+         [--preset ideal|paper|realistic]
 
 For each setting (``headsim.settings.RenderFidelity``), ``--poses`` random
-sub-pixel poses of a red marker (ideal camera, no noise) give the distance of
+sub-pixel poses of a red marker (``--preset``'s cameras, ideal by default: no
+noise, no lens; paper and realistic: their lens and image noise) give the distance of
 the detected centroid from the true projection (px), and ``--boards`` random
 poses of the chessboard the same for all 48 detected inner corners.  It prints
 the median and 95th percentile, and the render time per frame as a ratio to
-today's default (offsamples 4, no supersampling), measured in the same run.
+the first setting, (offsamples 4, no supersampling), measured in the same run.
+The default, every preset's, is (4, 2).
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ import time
 import numpy as np
 
 from headsim.procedures import chessboard_corner_target
-from headsim.settings import HeadSettings, RenderFidelity
+from headsim.settings import PRESETS, RenderFidelity, preset
 from headsim.sim import HeadSim
 from headsim.vision import find_chessboard, find_marker
 
@@ -35,10 +38,12 @@ SETTINGS = (
 )
 
 
-def marker_floor(fidelity: RenderFidelity, poses: int, seed: int) -> tuple[np.ndarray, float]:
+def marker_floor(
+    fidelity: RenderFidelity, poses: int, seed: int, head: str = "ideal"
+) -> tuple[np.ndarray, float]:
     rng = np.random.default_rng(seed)
     errors, seconds = [], 0.0
-    with HeadSim("default", HeadSettings(render=fidelity)) as sim:
+    with HeadSim("default", preset(head, render=fidelity)) as sim:
         sim.render(1)  # warm the renderer
         for _ in range(poses):
             target = [
@@ -57,11 +62,13 @@ def marker_floor(fidelity: RenderFidelity, poses: int, seed: int) -> tuple[np.nd
     return np.array(errors), 1e3 * seconds / poses
 
 
-def corner_floor(fidelity: RenderFidelity, boards: int, seed: int) -> np.ndarray:
+def corner_floor(
+    fidelity: RenderFidelity, boards: int, seed: int, head: str = "ideal"
+) -> np.ndarray:
     rng = np.random.default_rng(seed)
     errors = []
     corners = [chessboard_corner_target(k, (8, 6), 0.03) for k in range(48)]
-    with HeadSim("chessboard", HeadSettings(render=fidelity)) as sim:
+    with HeadSim("chessboard", preset(head, render=fidelity)) as sim:
         home = sim.position("chessboard")
         for _ in range(boards):
             sim.set_body_pose(
@@ -84,14 +91,29 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--poses", type=int, default=200)
     parser.add_argument("--boards", type=int, default=20)
+    parser.add_argument(
+        "--only",
+        nargs="+",
+        metavar="OFF,SUPER",
+        help="measure only these settings, e.g. 4,1 4,2 (the first is the time ratio's base)",
+    )
+    parser.add_argument(
+        "--preset", choices=sorted(PRESETS), default="ideal", help="the head's cameras"
+    )
     args = parser.parse_args()
+    settings = SETTINGS
+    if args.only:
+        try:
+            settings = tuple(RenderFidelity(*map(int, item.split(","))) for item in args.only)
+        except (ValueError, TypeError) as exc:
+            parser.error(f"--only takes offsamples,supersample pairs such as 4,2: {exc}")
     print(
-        f"{'offsamples':>10} {'super':>5} | marker px: median   p95  lost | corner px: median   p95  n | ms/frame  x default"
+        f"{'offsamples':>10} {'super':>5} | marker px: median   p95  lost | corner px: median   p95  n | ms/frame  x first"
     )
     base_ms = None
-    for fidelity in SETTINGS:
-        marker, ms = marker_floor(fidelity, args.poses, 0)
-        corner = corner_floor(fidelity, args.boards, 1)
+    for fidelity in settings:
+        marker, ms = marker_floor(fidelity, args.poses, 0, args.preset)
+        corner = corner_floor(fidelity, args.boards, 1, args.preset)
         base_ms = base_ms or ms
         print(
             f"{fidelity.offsamples:>10} {fidelity.supersample:>5} |            "

@@ -168,16 +168,16 @@ class RenderFidelity:
     4 puts edges on a quarter-pixel grid).  ``supersample``: each image is
     rendered at this many times its resolution (focal lengths scaled, pixel
     centres kept) and area-averaged back down (1 = off).  Windowed renderers
-    must render at the same ratio.  The class default (4, 1) is what the ideal
-    and paper presets have always rendered with (their regression figures);
-    :data:`FINE_RENDERING` (4, 2), the realistic preset's, has a marker-centroid
-    floor of 0.032 px (95th percentile over 200 sub-pixel poses; 0.078 px
-    at (4, 1)) and a chessboard-corner floor of 0.082 px (0.158), at about
-    1.4x the render time of (4, 1): benchmarks/render_fidelity.py.
+    must render at the same ratio.  The default, (4, 2), is every preset's:
+    a marker-centroid floor of 0.032 px (95th percentile over 200 sub-pixel
+    poses; 0.078 px at (4, 1)) and a chessboard-corner floor of 0.082 px
+    (0.158), at about 1.4x the render time of (4, 1):
+    benchmarks/render_fidelity.py.  ``RenderFidelity(4, 1)`` is the earlier,
+    faster default.
     """
 
     offsamples: int = 4
-    supersample: int = 1
+    supersample: int = 2
 
     def __post_init__(self) -> None:
         _check(
@@ -190,7 +190,7 @@ class RenderFidelity:
         )
 
 
-#: Rendering whose marker-centroid floor is <= 0.05 px (see :class:`RenderFidelity`).
+#: Rendering whose marker-centroid floor is <= 0.05 px: the default (see :class:`RenderFidelity`).
 FINE_RENDERING = RenderFidelity(offsamples=4, supersample=2)
 
 

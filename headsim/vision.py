@@ -48,10 +48,12 @@ Sub-pixel accuracy is limited by the renderer: MuJoCo's 4x multisampling
 quantises an edge's coverage to quarter pixels, so an edge parallel to the
 pixel rows or columns is placed only to +-0.125 px, whatever the detector
 (a corner of two such edges: 0.10 px RMS, up to 0.18 px).  Measured on
-renders of both presets (tests/test_vision.py): marker centroids 0.04-0.06 px
-RMS, also with noise_std = 2; chessboard corners 0.05 px RMS on a board
-turned in the image, 0.10 px on one square to the pixel grid; cross points
-0.065 px RMS, max 0.18 px.
+renders of both presets at (offsamples 4, supersample 1)
+(tests/test_vision.py): marker centroids 0.04-0.06 px RMS, also with
+noise_std = 2; chessboard corners 0.05 px RMS on a board turned in the
+image, 0.10 px on one square to the pixel grid; cross points 0.065 px RMS,
+max 0.18 px.  The default rendering, (4, 2), renders twice as large and
+area-averages back, which halves the floor (README, rendering fidelity).
 """
 
 from __future__ import annotations

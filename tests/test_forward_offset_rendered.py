@@ -75,7 +75,8 @@ def test_a_forward_offset_alone_changes_no_estimate_at_the_principal_column() ->
     diff = est1 - est0
     assert (np.abs(diff[:, 2]) <= dz_allowed).all(), (diff, dz_allowed)
     assert (np.abs(diff[:, 0]) <= dx_allowed).all(), (diff, dx_allowed)
-    assert np.abs(diff).max() < 5e-4  # under half a millimetre, out to 1.3 m
+    # Under 0.1 % of depth, out to 1.3 m (a 0.1 px residual there allows 1.3 mm in z).
+    assert (np.abs(diff).max(axis=1) < 1e-3 * TARGETS_HEAD_M[:, 2]).all(), diff
 
     # The paper's goal columns, off the principal point: the same offset now acts as
     # a baseline change, and moves every depth by the first-order amount.
@@ -85,7 +86,8 @@ def test_a_forward_offset_alone_changes_no_estimate_at_the_principal_column() ->
     predicted_dz = z * (s1 - s2) / big_d
     assert np.abs(predicted_dz).min() > 2e-3  # millimetres: a visible effect
     np.testing.assert_allclose(centre1[:, 2] - centre0[:, 2], predicted_dz, rtol=0.15)
-    assert np.abs(centre1 - centre0)[:, 2].min() > 5 * np.abs(diff[:, 2]).max()
+    # Target by target, the offset's effect stands well clear of the servo's residual.
+    assert (np.abs(centre1 - centre0)[:, 2] > 5 * np.abs(diff[:, 2])).all()
 
 
 SCENARIO = """

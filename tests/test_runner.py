@@ -97,7 +97,7 @@ def test_every_scenario_runs_in_its_fast_variant(
         assert re.search(r"alpha_e1 \(rad\)\s+\S+\s+\S+\s+\S+\s+\S+\s+0\.0578", out)
     experiment = results["experiment"]
     if path.stem == "chessboard":
-        assert re.search(r"all sides\s+\d+\s+30\.\d+\s+0\.\d+\s+30\.000\s+30\.3\s+0\.677", out)
+        assert re.search(r"all sides\s+\d+\s+(29|30)\.\d+\s+0\.\d+\s+30\.000\s+30\.3\s+0\.677", out)
         assert abs(experiment["side_mean_m"] - 0.030) < 5e-4
     if path.stem == "relative_positioning":
         assert re.search(r"alpha1 \(rad\)\s+0\.0800\s+0\.0800", out)
