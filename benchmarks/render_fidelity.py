@@ -3,7 +3,7 @@ multisampling (``offsamples``) and against supersampling with area averaging.
 
 Run: .venv/bin/python benchmarks/render_fidelity.py [--poses 200] [--boards 20]
 
-For each setting (``headsim.settings.RenderFidelity``), ``--poses`` random
+For each setting (``headsim.sim.settings.RenderFidelity``), ``--poses`` random
 sub-pixel poses of a red marker (ideal camera, no noise) give the distance of
 the detected centroid from the true projection (px), and ``--boards`` random
 poses of the chessboard the same for all 48 detected inner corners.  It prints
@@ -18,10 +18,10 @@ import time
 
 import numpy as np
 
-from headsim.procedures import chessboard_corner_target
-from headsim.settings import HeadSettings, RenderFidelity
-from headsim.sim import HeadSim
-from headsim.vision import find_chessboard, find_marker
+from headsim.active.procedures import chessboard_corner_target
+from headsim.sim.settings import HeadSettings, RenderFidelity
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import find_chessboard, find_marker
 
 #: offsamples 8 and 16 render exactly like 4 here (Mesa's llvmpipe caps the
 #: samples at 4: same centroids to 1e-3 px in a 30-pose run), so they are left out.

@@ -1,0 +1,400 @@
+"""Off-screen rendering of the eye cameras: MuJoCo pinhole render, lens, noise.
+
+One :class:`mujoco.Renderer` (an OpenGL context) per scene (its assets and
+off-screen buffer size, :func:`context_key`) is kept in a small process-wide
+pool and reused by every simulator of that scene, whatever its head, within a
+run and across the jobs of a worker: creating one costs about 0.2 s.  Images are drawn into a viewport of its off-screen buffer, so one
+context serves every canvas size and every window.
+
+A *window* is a sub-rectangle of a camera's image, rendered as the same
+camera with a shifted principal point (for a distorted camera: the region of
+its pinhole canvas that the window's pixels sample).  Its pixels are the full
+frame's crop, noise included (the noise of image k of a camera is drawn for
+the whole frame and cropped).  The head's own geoms (group
+``names.HEAD_VISUAL_GROUP``) are hidden from the eye cameras.  Every image is
+one render and is counted, with its pixels in full-frame equivalents.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections import OrderedDict
+from collections.abc import Hashable
+from dataclasses import dataclass
+
+import cv2
+import mujoco
+import numpy as np
+
+from headsim.sim import names
+from headsim.sim.backend import INSTALL_HINT, RenderBackendError, check_backend
+from headsim.sim.optics import DistortionCanvas, GaussianNoise, apply_canvas
+from headsim.sim.settings import CameraSettings
+
+#: Renderers kept per process (one per head and scene); the least recently used goes first.
+POOL_SIZE = 4
+_POOL: OrderedDict[Hashable, mujoco.Renderer] = OrderedDict()
+#: Renderers created in this process (the pool's misses), for the bench and tests.
+created = 0
+
+
+@dataclass(frozen=True)
+class Window:
+    """A sub-rectangle of a camera's output image: top-left (x0, y0) and size, px."""
+
+    x0: int
+    y0: int
+    width: int
+    height: int
+
+    @property
+    def x1(self) -> int:
+        return self.x0 + self.width
+
+    @property
+    def y1(self) -> int:
+        return self.y0 + self.height
+
+    @classmethod
+    def around(
+        cls, centre_uv: tuple[float, float], half_px: float, image_size: tuple[int, int]
+    ) -> Window:
+        """The square of half-side ``half_px`` around ``centre_uv``, moved inside the image."""
+        width, height = image_size
+        side_u = min(width, 2 * math.ceil(half_px) + 1)
+        side_v = min(height, 2 * math.ceil(half_px) + 1)
+        x0 = min(max(round(centre_uv[0] - side_u / 2), 0), width - side_u)
+        y0 = min(max(round(centre_uv[1] - side_v / 2), 0), height - side_v)
+        return cls(int(x0), int(y0), int(side_u), int(side_v))
+
+
+#: What an OpenGL context holds of a model (uploaded once): meshes, textures, height
+#: fields, skins.  Everything else (cameras, bodies, geom sizes and colours) is read
+#: from the model and data at every render.
+_CONTEXT_ARRAYS = ("mesh_vert", "mesh_face", "mesh_normal", "tex_data", "hfield_data", "skin_vert")
+
+
+def context_key(scene: str, model: mujoco.MjModel) -> tuple[str, str]:
+    """What identifies the OpenGL context a model needs: its scene and a digest of the
+    assets the context uploads.  Heads that differ only in their settings (cameras,
+    baseline, mounts) share one context; its off-screen buffer grows to the largest
+    canvas asked of it."""
+    digest = hashlib.sha1()
+    digest.update(f"offsamples={int(model.vis.quality.offsamples)}".encode())
+    for name in _CONTEXT_ARRAYS:
+        array = getattr(model, name, None)
+        if array is not None:
+            digest.update(name.encode())
+            digest.update(np.ascontiguousarray(array).tobytes())
+    return (str(scene), digest.hexdigest())
+
+
+def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
+    """The pooled renderer of ``key``, with a buffer at least ``model``'s off-screen size."""
+    global created
+    need = (int(model.vis.global_.offwidth), int(model.vis.global_.offheight))
+    renderer = _POOL.pop(key, None)
+    if renderer is not None and (renderer.width < need[0] or renderer.height < need[1]):
+        need = (max(need[0], renderer.width), max(need[1], renderer.height))
+        renderer.close()
+        renderer = None
+    if renderer is None:
+        backend = check_backend()
+        width, height = need
+        saved = (model.vis.global_.offwidth, model.vis.global_.offheight)
+        # The context's buffer is sized from the model it is made with.
+        model.vis.global_.offwidth, model.vis.global_.offheight = width, height
+        try:
+            renderer = mujoco.Renderer(model, height=height, width=width)
+        except ValueError as err:  # larger than the model's off-screen buffer
+            raise ValueError(f"cannot render {width}x{height}: {err}") from err
+        except Exception as err:  # GL context creation failed
+            raise RenderBackendError(
+                f"could not create an off-screen OpenGL context with MUJOCO_GL={backend}: {err}. "
+                f"{INSTALL_HINT}"
+            ) from err
+        finally:
+            model.vis.global_.offwidth, model.vis.global_.offheight = saved
+        created += 1
+    _POOL[key] = renderer
+    while len(_POOL) > POOL_SIZE:
+        _, oldest = _POOL.popitem(last=False)
+        oldest.close()
+    return renderer
+
+
+def release_renderers() -> None:
+    """Close every pooled renderer (their OpenGL contexts)."""
+    while _POOL:
+        _, renderer = _POOL.popitem()
+        renderer.close()
+
+
+class EyeRenderer:
+    """Renders the two eye cameras of one compiled model to 8-bit RGB arrays.
+
+    ``key``: what identifies the OpenGL context the model needs
+    (:func:`context_key`); models with equal keys share one.  None: a context
+    of its own.
+    """
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        cameras: tuple[CameraSettings, CameraSettings],
+        canvases: tuple[DistortionCanvas, DistortionCanvas],
+        seed: int = 0,
+        key: Hashable | None = None,
+        supersample: int = 1,
+    ) -> None:
+        """``supersample``: the model's cameras render at this many times each
+        canvas's size (``headsim.sim.settings.RenderFidelity``); images are area-averaged
+        back to the canvas."""
+        self._model = model
+        self._supersample = supersample
+        self._cameras = cameras
+        self._canvases = canvases
+        self._key: Hashable = key if key is not None else ("own", id(self))
+        self._own = key is None
+        self._option = mujoco.MjvOption()
+        self._option.geomgroup[names.HEAD_VISUAL_GROUP] = 0
+        # One noise stream per camera: image k of camera i gets the noise drawn
+        # from (seed, i, k), whatever else was rendered.
+        self._seed = seed
+        self._noise = tuple(GaussianNoise.of(camera.noise_std) for camera in cameras)
+        self._taken = [0, 0]
+        self._previews = [0, 0]
+        self._cam_ids = [
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, name) for name in names.CAMERAS
+        ]
+        self.render_count = 0
+        #: Pixels rendered, in full frames of the camera that rendered them.
+        self.rendered_frames = 0.0
+
+    def _renderer(self) -> mujoco.Renderer:
+        renderer = _acquire(self._key, self._model)
+        renderer._model = self._model  # the same assets; this model's cameras and bodies
+        return renderer
+
+    def _draw(
+        self, data: mujoco.MjData, index: int, rect: Window | None, binning: int = 1
+    ) -> np.ndarray:
+        """The pinhole canvas of camera ``index``, or its sub-rectangle ``rect``: (h, w, 3);
+        with ``binning`` b > 1 the whole canvas at 1/b of its resolution (no supersampling)."""
+        canvas = self._canvases[index]
+        renderer = self._renderer()
+        # Supersampled k times (headsim.sim.settings.RenderFidelity): the model's
+        # camera renders k x the canvas, and each canvas pixel is the area
+        # average of a k x k block; a window is cut on whole blocks, so its
+        # pixels are the full frame's crop.
+        k = self._supersample
+        width_c, height_c = canvas.size
+        full_w, full_h = k * width_c, k * height_c
+        cam = self._cam_ids[index]
+        model = self._model
+        saved = None
+        # Output pixels per canvas pixel: k, or 1/b binned (a b x b block of the sensor each).
+        if binning > 1:
+            rect = Window(0, 0, width_c - width_c % binning, height_c - height_c % binning)
+            out_w, out_h = rect.width // binning, rect.height // binning
+        elif rect is not None:
+            out_w, out_h = k * rect.width, k * rect.height
+        else:
+            out_w, out_h = full_w, full_h
+        if rect is not None and (binning > 1 or (rect.width, rect.height) != (width_c, height_c)):
+            # The same camera, its image cut to ``rect``: resolution and sensor
+            # shrink, the principal point moves by the window's offset.
+            saved = (
+                model.cam_resolution[cam].copy(),
+                model.cam_sensorsize[cam].copy(),
+                model.cam_intrinsic[cam].copy(),
+            )
+            pitch = model.cam_sensorsize[cam] / model.cam_resolution[cam]
+            offset_px = model.cam_intrinsic[cam][2:4] / pitch
+            window_offset = offset_px + np.array(
+                [
+                    (k * rect.width - full_w) / 2 + k * rect.x0,
+                    (k * rect.height - full_h) / 2 + k * rect.y0,
+                ]
+            )
+            model.cam_resolution[cam] = (out_w, out_h)
+            model.cam_sensorsize[cam] = pitch * np.array([k * rect.width, k * rect.height])
+            model.cam_intrinsic[cam][2:4] = window_offset * pitch
+        try:
+            renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
+        finally:
+            if saved is not None:
+                (
+                    model.cam_resolution[cam],
+                    model.cam_sensorsize[cam],
+                    model.cam_intrinsic[cam],
+                ) = saved
+        width, height = (width_c, height_c) if rect is None else (rect.width, rect.height)
+        gl_context = renderer._gl_context
+        if gl_context is not None:
+            gl_context.make_current()
+        viewport = mujoco.MjrRect(0, 0, out_w, out_h)
+        mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
+        pixels = np.empty((out_h, out_w, 3), dtype=np.uint8)
+        mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
+        if binning > 1:
+            self.rendered_frames += (out_w * out_h) / (width_c * height_c)
+            return np.ascontiguousarray(pixels[::-1])
+        self.rendered_frames += (width * height) / (width_c * height_c)
+        pixels = np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
+        if k > 1:
+            pixels = cv2.resize(pixels, (width, height), interpolation=cv2.INTER_AREA)
+        return pixels
+
+    def render_preview(self, data: mujoco.MjData, index: int, binning: int) -> np.ndarray:
+        """Camera ``index``'s whole view binned ``binning`` x ``binning``: (H/b, W/b, 3) uint8.
+
+        A low-resolution readout of the same camera (lens included), for finding
+        where to look; pixel (i, j) covers the image's pixels b i .. b i + b - 1.
+        Its noise (the camera's std) comes from a stream of its own, so the
+        camera's images get the same noise with and without previews.  Counted
+        as a render and as 1/b^2 of a frame's pixels.
+        """
+        camera = self._cameras[index]
+        if camera.width % binning or camera.height % binning:
+            raise ValueError(
+                f"binning {binning} must divide the {camera.width}x{camera.height} image"
+            )
+        image = apply_canvas(
+            self._draw(data, index, None, binning=binning),
+            binned_canvas(self._canvases[index], binning, (camera.width, camera.height)),
+        )
+        self.render_count += 1
+        frame = self._previews[index]
+        self._previews[index] += 1
+        return self._noise[index].apply(image, (self._seed, index, PREVIEW_STREAM), frame)
+
+    def render(self, data: mujoco.MjData, index: int, retake: bool = False) -> np.ndarray:
+        """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8.
+
+        ``retake``: the whole of the image just taken as a window (the same
+        instant: the same noise); it is still a render and is counted.
+        """
+        image = apply_canvas(self._draw(data, index, None), self._canvases[index])
+        return self._add_noise(image, index, None, retake)
+
+    def render_window(self, data: mujoco.MjData, index: int, window: Window) -> np.ndarray:
+        """Render only ``window`` of camera ``index``: the full frame's crop, (h, w, 3) uint8."""
+        camera, canvas = self._cameras[index], self._canvases[index]
+        if not (
+            0 <= window.x0 < window.x1 <= camera.width
+            and 0 <= window.y0 < window.y1 <= camera.height
+        ):
+            raise ValueError(
+                f"window {window} is not inside the {camera.width}x{camera.height} image"
+            )
+        if canvas.identity:
+            image = self._draw(data, index, window)
+        else:
+            assert canvas.map_x is not None and canvas.map_y is not None
+            map_x = canvas.map_x[window.y0 : window.y1, window.x0 : window.x1]
+            map_y = canvas.map_y[window.y0 : window.y1, window.x0 : window.x1]
+            source = _canvas_region(map_x, map_y, canvas.size)
+            if source is None:  # nothing of the canvas is seen through this window
+                image = np.zeros((window.height, window.width, 3), dtype=np.uint8)
+            else:
+                region = self._draw(data, index, source)
+                # Shifting float32 maps by whole pixels is exact: the same samples.
+                shifted = DistortionCanvas(
+                    size=(source.width, source.height),
+                    principal=canvas.principal,
+                    map_x=np.where(map_x >= 0, map_x - np.float32(source.x0), np.float32(-1)),
+                    map_y=np.where(map_y >= 0, map_y - np.float32(source.y0), np.float32(-1)),
+                    valid_fraction=canvas.valid_fraction,
+                )
+                image = apply_canvas(region, shifted)
+        return self._add_noise(image, index, window)
+
+    def _add_noise(
+        self, image: np.ndarray, index: int, window: Window | None, retake: bool = False
+    ) -> np.ndarray:
+        self.render_count += 1
+        if retake and self._taken[index] > 0:
+            frame = self._taken[index] - 1
+        else:
+            frame = self._taken[index]
+            self._taken[index] += 1
+        camera = self._cameras[index]
+        crop = None if window is None else (window.x0, window.y0, camera.width, camera.height)
+        return self._noise[index].apply(image, (self._seed, index), frame, crop=crop)
+
+    def close(self) -> None:
+        """Give the OpenGL context back to the pool (closed if it was this renderer's own)."""
+        if self._own:
+            renderer = _POOL.pop(self._key, None)
+            if renderer is not None:
+                renderer.close()
+
+
+#: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.
+PREVIEW_STREAM = 1_000_003
+
+
+#: Binned canvases by (id of the canvas, binning), with the canvas kept alive.
+_BINNED: dict[tuple[int, int], tuple[DistortionCanvas, DistortionCanvas]] = {}
+
+
+def binned_canvas(
+    canvas: DistortionCanvas, binning: int, image_size: tuple[int, int]
+) -> DistortionCanvas:
+    """``canvas`` for images binned ``binning`` x ``binning`` from a canvas binned alike
+    (made once per canvas and binning).
+
+    The remap tables' b x b blocks are averaged (the block centre's sample of a
+    smooth map) and moved to the binned canvas's pixels; a block with any pixel
+    without source has none.
+    """
+    key = (id(canvas), binning)
+    if key not in _BINNED:
+        _BINNED[key] = (canvas, _binned_canvas(canvas, binning, image_size))
+    return _BINNED[key][1]
+
+
+def _binned_canvas(
+    canvas: DistortionCanvas, binning: int, image_size: tuple[int, int]
+) -> DistortionCanvas:
+    width, height = image_size
+    size = (width // binning, height // binning)
+    width_b = (canvas.size[0] - canvas.size[0] % binning) // binning
+    height_b = (canvas.size[1] - canvas.size[1] % binning) // binning
+    if canvas.map_x is None or canvas.map_y is None:
+        return DistortionCanvas((width_b, height_b), canvas.principal, None, None, 1.0)
+    offset = (binning - 1) / 2.0
+    invalid = (
+        cv2.resize((canvas.map_x < 0).astype(np.float32), size, interpolation=cv2.INTER_AREA) > 0
+    )
+    map_x = (cv2.resize(canvas.map_x, size, interpolation=cv2.INTER_AREA) - offset) / binning
+    map_y = (cv2.resize(canvas.map_y, size, interpolation=cv2.INTER_AREA) - offset) / binning
+    invalid |= (map_x < 0) | (map_x > width_b - 1) | (map_y < 0) | (map_y > height_b - 1)
+    map_x[invalid] = -1.0
+    map_y[invalid] = -1.0
+    map_x, map_y = map_x.astype(np.float32), map_y.astype(np.float32)
+    map_x.flags.writeable = map_y.flags.writeable = False
+    return DistortionCanvas(
+        size=(width_b, height_b),
+        principal=canvas.principal,
+        map_x=map_x,
+        map_y=map_y,
+        valid_fraction=float(1.0 - invalid.mean()),
+    )
+
+
+def _canvas_region(
+    map_x: np.ndarray, map_y: np.ndarray, canvas_size: tuple[int, int]
+) -> Window | None:
+    """The canvas rectangle that bilinear sampling at (map_x, map_y) reads (None: no valid source)."""
+    valid = map_x >= 0
+    if not valid.any():
+        return None
+    xs, ys = map_x[valid], map_y[valid]
+    x0 = max(math.floor(float(xs.min())) - 1, 0)
+    y0 = max(math.floor(float(ys.min())) - 1, 0)
+    x1 = min(math.floor(float(xs.max())) + 3, canvas_size[0])
+    y1 = min(math.floor(float(ys.max())) + 3, canvas_size[1])
+    return Window(x0, y0, x1 - x0, y1 - y0)
