@@ -2,7 +2,7 @@
 
 Each run prints progress on stderr, a table per experiment on stdout, and
 writes ``<name>.csv``, ``<name>_targets.csv``, ``<name>.json`` and
-``<name>.png`` beside ``results.json`` in --out (see ``headsim.study``):
+``<name>.png`` beside ``results.json`` in --out (see ``headsim.studies.study``):
 
     python benchmarks/insensitivity_study.py --experiment compare --out out/study
     python benchmarks/insensitivity_study.py --sweep depth --out out/study
@@ -15,7 +15,7 @@ calibrations and two values per sweep (a smoke run of about a minute).
 from __future__ import annotations
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.study import main
+from headsim.studies.study import main
 
 if __name__ == "__main__":
     raise SystemExit(main())

@@ -29,10 +29,10 @@ import numpy as np
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Sinusoid, Waypoints
 from headsim.live.gaze import GazeConfig, SaccadeProfile, acquire, pursue
-from headsim.results import write_json_atomic
-from headsim.settings import HeadSettings
-from headsim.sim import HeadSim
-from headsim.vision import find_marker
+from headsim.run.results import write_json_atomic
+from headsim.sim.settings import HeadSettings
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import find_marker
 
 RED = partial(find_marker, colour="red")
 EYE_HEIGHT = 0.21  # m, d1 + a2 of the default head

@@ -2,7 +2,7 @@
 
 One set of random points over the whole field in front of the head is drawn
 once; at each focal length (0.5x ... 2x the paper's, mounts unchanged) the
-scenario's reach check (``headsim.scenario.reach_refusal``) accepts or
+scenario's reach check (``headsim.scenario.schema.reach_refusal``) accepts or
 refuses each one (with its reason), the head calibrates on a layout drawn
 from the same seed (``calibration_layout`` with the eyes allowed to turn in,
 every position's outcome recorded), and every accepted point is measured
@@ -30,9 +30,8 @@ from typing import Any
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim import names
-from headsim.principal import principal_points_by_zoom
-from headsim.procedures import (
+from headsim.active.principal import principal_points_by_zoom
+from headsim.active.procedures import (
     CalibrationError,
     HeadKnowledge,
     Measurement,
@@ -41,12 +40,13 @@ from headsim.procedures import (
     measure_model1,
     measure_model2,
 )
-from headsim.results import write_json_atomic
-from headsim.runner import marker_target
-from headsim.scenario import reach_refusal
-from headsim.servo import EyeServo, NeckServo
-from headsim.settings import FINE_RENDERING, HeadSettings, paper_head
-from headsim.sim import HeadSim
+from headsim.active.servo import EyeServo, NeckServo
+from headsim.run.results import write_json_atomic
+from headsim.run.runner import marker_target
+from headsim.scenario.schema import reach_refusal
+from headsim.sim import names
+from headsim.sim.settings import FINE_RENDERING, HeadSettings, paper_head
+from headsim.sim.simulator import HeadSim
 
 ZOOMS = (0.5, 0.7, 1.0, 1.3, 1.6, 2.0)
 BODY = names.MARKERS[0]
@@ -94,7 +94,7 @@ def check_targets(
 
 
 def _head_to_world(settings: HeadSettings, p_head: np.ndarray) -> np.ndarray:
-    from headsim.kinematics import head_to_world
+    from headsim.geometry.kinematics import head_to_world
 
     return head_to_world(p_head, 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m)
 

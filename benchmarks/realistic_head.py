@@ -2,8 +2,8 @@
 
 Run: .venv/bin/python benchmarks/realistic_head.py [--seeds 50]
 
-Everything here is the exact synthetic model (headsim.synthetic) with the
-realistic preset's tolerances (headsim.settings.REALISTIC_BUDGET): the paper's
+Everything here is the exact synthetic model (headsim.geometry.synthetic) with the
+realistic preset's tolerances (headsim.sim.settings.REALISTIC_BUDGET): the paper's
 cameras (intrinsics, distortion, initial directions), optical centres 20 mm
 forward and 1 / -0.5 mm sideways, a baseline 0.3 mm longer than believed,
 encoder readings with the true angle anywhere within the count, a 1 mm
@@ -21,14 +21,14 @@ from pathlib import Path
 
 import numpy as np
 
-from headsim.calibration_design import near_far_depths, offset_std_limit
-from headsim.camera_model import PinholeCamera
-from headsim.error_budget import plot_budget
 from headsim.estimators import model2
 from headsim.estimators.calibration import calibrate_initial_directions, calibrate_lines_of_sight
-from headsim.results import write_csv_atomic
-from headsim.settings import PAPER_INITIAL_DIRECTIONS, PAPER_INTRINSICS, REALISTIC_BUDGET
-from headsim.synthetic import StereoHead, observe, quantise
+from headsim.geometry.camera_model import PinholeCamera
+from headsim.geometry.synthetic import StereoHead, observe, quantise
+from headsim.run.results import write_csv_atomic
+from headsim.scenario.calibration_design import near_far_depths, offset_std_limit
+from headsim.sim.settings import PAPER_INITIAL_DIRECTIONS, PAPER_INTRINSICS, REALISTIC_BUDGET
+from headsim.studies.error_budget import plot_budget
 
 BELIEVED_D = 0.150
 BANDS = ((0.3, 0.6), (0.6, 1.0), (1.0, 1.5))

@@ -1,7 +1,7 @@
 """Relative positioning on all twelve areas (Sec. III), the paper's test beside a gain-normalised one.
 
 Layouts place the six objects of the blocks scene so that every area S1..S12
-gets at least ``--per-area`` objects (``headsim.area_layouts``: rejection from
+gets at least ``--per-area`` objects (``headsim.scenario.area_layouts``: rejection from
 the true geometry, all four images seeing each object), around a reference
 drawn at 0.7-1.4 m.  Each layout runs ``relative_positioning`` (the reference
 with Model 2, four images, eq. 12).  Prints per true area: objects, and for
@@ -24,15 +24,15 @@ from typing import Any
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim import names
-from headsim.area_layouts import area_layout
-from headsim.procedures import body_target, relative_positioning
-from headsim.results import write_json_atomic
-from headsim.runner import PARKED_WORLD_M
-from headsim.servo import EyeServo
-from headsim.settings import preset
-from headsim.sim import HeadSim
-from headsim.vision import find_cross_point
+from headsim.active.procedures import body_target, relative_positioning
+from headsim.active.servo import EyeServo
+from headsim.run.results import write_json_atomic
+from headsim.run.runner import PARKED_WORLD_M
+from headsim.scenario.area_layouts import area_layout
+from headsim.sim import names
+from headsim.sim.settings import preset
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import find_cross_point
 
 MAGNITUDE_AREAS = (1, 2, 3, 4, 7, 8)
 OBJECT_RADIUS_M = 0.006

@@ -4,7 +4,7 @@ multisampling (``offsamples``) and against supersampling with area averaging.
 Run: .venv/bin/python benchmarks/render_fidelity.py [--poses 200] [--boards 20] [--only 4,1 4,2]
          [--preset ideal|paper|realistic]
 
-For each setting (``headsim.settings.RenderFidelity``), ``--poses`` random
+For each setting (``headsim.sim.settings.RenderFidelity``), ``--poses`` random
 sub-pixel poses of a red marker (``--preset``'s cameras, ideal by default: no
 noise, no lens; paper and realistic: their lens and image noise) give the distance of
 the detected centroid from the true projection (px), and ``--boards`` random
@@ -21,10 +21,10 @@ import time
 
 import numpy as np
 
-from headsim.procedures import chessboard_corner_target
-from headsim.settings import PRESETS, RenderFidelity, preset
-from headsim.sim import HeadSim
-from headsim.vision import find_chessboard, find_marker
+from headsim.active.procedures import chessboard_corner_target
+from headsim.sim.settings import PRESETS, RenderFidelity, preset
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import find_chessboard, find_marker
 
 #: offsamples 8 and 16 render exactly like 4 here (Mesa's llvmpipe caps the
 #: samples at 4: same centroids to 1e-3 px in a 30-pose run), so they are left out.

@@ -17,10 +17,10 @@ import time
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.optics import GaussianNoise
-from headsim.results import write_json_atomic
-from headsim.settings import CameraSettings, HeadSettings, paper_head
-from headsim.sim import HeadSim
+from headsim.run.results import write_json_atomic
+from headsim.sim.optics import GaussianNoise
+from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
+from headsim.sim.simulator import HeadSim
 
 CASES = {
     "640x480 ideal": HeadSettings(),

@@ -18,10 +18,11 @@ import time
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim import names, stereo
-from headsim.results import write_json_atomic
-from headsim.settings import HeadSettings, preset
-from headsim.sim import HeadSim
+from headsim.run.results import write_json_atomic
+from headsim.sim import names
+from headsim.sim.settings import HeadSettings, preset
+from headsim.sim.simulator import HeadSim
+from headsim.stereo import zhang as stereo
 
 #: Marker positions in H, m: 0.4-1.5 m deep, off the axis in x and y.
 MARKER_POSITIONS_HEAD = (

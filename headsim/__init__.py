@@ -21,7 +21,7 @@ _COMMAND = _os.path.basename(_sys.argv[0]) == "headsim" or _sys.orig_argv[1:3] i
 if _COMMAND and _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler:
     _signal.signal(_signal.SIGINT, _interrupted_during_start_up)
 
-from headsim.backend import choose_default_backend  # noqa: E402
+from headsim.sim.backend import choose_default_backend  # noqa: E402
 
 # MuJoCo picks its OpenGL backend when first imported: choose before that.
 choose_default_backend()

@@ -22,7 +22,6 @@ from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
 
-from headsim import backend
 from headsim.errors import (
     EXIT_CODES_HELP,
     NO_SPACE_ERRNOS,
@@ -33,7 +32,8 @@ from headsim.errors import (
     guarded,
     interrupt_handler,
 )
-from headsim.outputs import Outputs
+from headsim.run.outputs import Outputs
+from headsim.sim import backend
 
 #: Commands that never render: they run without any GL backend (so does ``--help``).
 RENDER_FREE_COMMANDS = frozenset({"list"})
@@ -42,8 +42,8 @@ GLOBAL_FLAGS = ("--debug", "--quiet")
 
 
 def _snapshot(args: argparse.Namespace) -> int:
-    from headsim.settings import preset
-    from headsim.snapshot import take_snapshot
+    from headsim.sim.settings import preset
+    from headsim.sim.snapshot import take_snapshot
 
     settings = preset(args.preset, seed=args.seed)
     outputs = Outputs()
@@ -106,10 +106,10 @@ RUN_FILES = ("results.json", "summary.txt", "timing.json")
 
 
 def _run(args: argparse.Namespace) -> int:
-    from headsim.report import results_payload, summary_text
-    from headsim.rerun_cli import recording_target
-    from headsim.runner import Observer, run_scenario
-    from headsim.scenario import load_scenario
+    from headsim.run.report import results_payload, summary_text
+    from headsim.run.rerun_cli import recording_target
+    from headsim.run.runner import Observer, run_scenario
+    from headsim.scenario.schema import load_scenario
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
     target = recording_target(args)  # a bad --url or port is bad input (exit 2)
@@ -126,7 +126,7 @@ def _run(args: argparse.Namespace) -> int:
             observers.append(progress)
         recorder = None
         if target.wanted:
-            from headsim.recording import Recorder
+            from headsim.run.recording import Recorder
 
             try:
                 recorder = Recorder(rrd, scenario, target=target)
@@ -187,21 +187,21 @@ def _run(args: argparse.Namespace) -> int:
 
 def _progress_observer(args: argparse.Namespace, total: int, unit: str) -> Any:
     """The run's progress on stderr: a bar on a terminal, plain lines otherwise; none when quiet."""
-    from headsim.runner import Progress
+    from headsim.run.runner import Progress
 
     if getattr(args, "no_progress", False) or getattr(args, "quiet", False):
         return None
     if sys.stderr.isatty():
         return Progress(total, sys.stderr)
-    from headsim.progress import LineProgress
+    from headsim.run.progress import LineProgress
 
     return LineProgress(total, sys.stderr, unit=unit)
 
 
 def _write_all(files: dict[Path, object]) -> None:
     """Write the result files atomically; on a full disk remove the ones this call wrote."""
-    from headsim.outputs import disk_full
-    from headsim.results import write_json_atomic, write_text_atomic
+    from headsim.run.outputs import disk_full
+    from headsim.run.results import write_json_atomic, write_text_atomic
 
     written: list[Path] = []
     for path, content in files.items():
@@ -224,7 +224,7 @@ def _write_all(files: dict[Path, object]) -> None:
 def _json_size(payload: object) -> int:
     import json
 
-    from headsim.results import to_jsonable
+    from headsim.run.results import to_jsonable
 
     return len(json.dumps(to_jsonable(payload), indent=2).encode()) + 1
 
@@ -242,7 +242,7 @@ def _recording_failed(err: BaseException) -> bool:
 
 
 def _recording_disk_full(rrd: Path, err: BaseException) -> Exception:
-    from headsim.outputs import disk_full
+    from headsim.run.outputs import disk_full
 
     size = rrd.stat().st_size if rrd.is_file() else None
     return disk_full(rrd, None, err if isinstance(err, OSError) else None, written_bytes=size)
@@ -259,9 +259,9 @@ def _close_recorder(recorder, rrd: Path | None) -> None:
 
 
 def _calibrate(args: argparse.Namespace) -> int:
-    from headsim.calibration_file import head_hash, write_calibration
-    from headsim.runner import calibrate_scenario
-    from headsim.scenario import ScenarioError, load_scenario
+    from headsim.active.calibration_file import head_hash, write_calibration
+    from headsim.run.runner import calibrate_scenario
+    from headsim.scenario.schema import ScenarioError, load_scenario
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
     spec = scenario.experiment.calibration
@@ -314,7 +314,7 @@ def _calibrate(args: argparse.Namespace) -> int:
 
 
 def _reproduce(args: argparse.Namespace) -> int:
-    from headsim import reproduce
+    from headsim.studies import reproduce
 
     try:
         with _sigterm_interrupts():  # SIGTERM too leaves the report so far
@@ -337,7 +337,7 @@ def _serve_until_interrupted(recorder: object, url: str) -> None:
 
 
 def _list(args: argparse.Namespace) -> int:
-    from headsim.scenario import SCENARIOS_DIR, describe_scenarios
+    from headsim.scenario.schema import SCENARIOS_DIR, describe_scenarios
 
     directory = Path(args.dir) if args.dir else SCENARIOS_DIR
     rows = list(describe_scenarios(directory))
@@ -352,7 +352,7 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _study(args: argparse.Namespace) -> int:
-    from headsim import study
+    from headsim.studies import study
 
     outputs = Outputs()
     try:
@@ -363,7 +363,7 @@ def _study(args: argparse.Namespace) -> int:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from headsim import bench
+    from headsim.studies import bench
 
     args.baseline = args.baseline or str(bench.BASELINE)
     args.tolerances = args.tolerances or str(bench.TOLERANCES)
@@ -379,10 +379,10 @@ def _bench(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from headsim import sweep
+    from headsim.studies import sweep
 
     spec = sweep.load_sweep(args.sweep)
-    from headsim.rerun_cli import recording_target
+    from headsim.run.rerun_cli import recording_target
 
     target = recording_target(args, per_job=True)
     outputs = Outputs()
@@ -438,8 +438,8 @@ def _positive_int(text: str) -> int:
 
 def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     """The command line; ``with_study``: with the study's options (imports the study)."""
-    from headsim import names
-    from headsim.settings import PRESETS
+    from headsim.sim import names
+    from headsim.sim.settings import PRESETS
 
     parser = argparse.ArgumentParser(
         prog="headsim",
@@ -481,7 +481,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     run.add_argument(
         "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"
     )
-    from headsim.rerun_cli import add_recording_arguments
+    from headsim.run.rerun_cli import add_recording_arguments
 
     add_recording_arguments(run)
     run.set_defaults(func=_run)
@@ -578,7 +578,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         help="run the jobs on this Dask scheduler instead (pip install 'headsim[dask]')",
     )
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
-    from headsim.rerun_cli import add_recording_arguments
+    from headsim.run.rerun_cli import add_recording_arguments
 
     add_recording_arguments(sweep, per_job=True)
     sweep.set_defaults(func=_sweep)
@@ -587,7 +587,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         "study", help="the insensitivity study: stereo against the active method, sweeps, plots"
     )
     if with_study:  # the study module (stereo, principal points) loads only for it
-        from headsim.study import STUDY_DESCRIPTION, add_arguments
+        from headsim.studies.study import STUDY_DESCRIPTION, add_arguments
 
         study.description = STUDY_DESCRIPTION
         add_arguments(study)

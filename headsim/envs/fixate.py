@@ -40,18 +40,18 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from headsim.kinematics import head_to_world
+from headsim.geometry.kinematics import head_to_world
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
-from headsim.settings import (
+from headsim.sim.settings import (
     CAMERA_NUMBER_FIELDS,
     IDEAL_FOCAL_PX,
     CameraSettings,
     HeadSettings,
     SettingsError,
 )
-from headsim.sim import HeadSim
-from headsim.vision import find_marker
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import find_marker
 
 TARGET_BODY = "marker_red"
 TARGET_COLOUR = "red"

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from headsim.kinematics import ENCODER_RESOLUTION, world_from_head
+from headsim.geometry.kinematics import ENCODER_RESOLUTION, world_from_head
 
 __all__ = ["Flag", "PositionEstimate", "Uncertainty"]
 

@@ -12,7 +12,7 @@ from collections.abc import Callable
 import numpy as np
 
 from headsim.estimators import Uncertainty, model2
-from headsim.synthetic import StereoHead, observe
+from headsim.geometry.synthetic import StereoHead, observe
 
 D = 0.15
 CENTRE = (319.5, 239.5)

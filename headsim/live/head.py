@@ -25,8 +25,8 @@ import numpy as np
 
 from headsim.live.motors import MOTOR_JOINTS, MotorDriver, MotorLimits
 from headsim.live.paths import Path, Visibility
-from headsim.settings import SettingsError
-from headsim.sim import HeadSim
+from headsim.sim.settings import SettingsError
+from headsim.sim.simulator import HeadSim
 
 #: Where a target that is not present is parked (world, m): under the table, out of view.
 PARKED_WORLD_M = np.array([0.0, 0.5, -5.0])

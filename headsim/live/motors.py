@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from headsim import names
-from headsim.settings import SettingsError
+from headsim.sim import names
+from headsim.sim.settings import SettingsError
 
 #: The motors in the order of every 3-vector here: (neck yaw, neck pitch, eye).
 MOTORS = ("neck_yaw", "neck_pitch", "eye")

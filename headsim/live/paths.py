@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from headsim.settings import SettingsError
+from headsim.sim.settings import SettingsError
 
 #: Gravity, m/s^2, along world -z.
 GRAVITY = 9.81

@@ -18,10 +18,10 @@ from typing import Any
 
 import numpy as np
 
+from headsim.active.procedures import HeadKnowledge
 from headsim.live.gaze import FrameRecord, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
 from headsim.live.spec import PursuitSpec, describe
-from headsim.procedures import HeadKnowledge
 
 
 def figures(run: PursuitRun, spec: PursuitSpec) -> dict[str, Any]:
@@ -69,7 +69,7 @@ def run_pursuit(
     scenario: Any, hub: Any, knowledge: HeadKnowledge, label: str
 ) -> tuple[list[Any], dict[str, Any]]:
     """The runner's entry for ``procedure = "pursuit"``: (no point records, the experiment block)."""
-    from headsim.runner import ObservedSim, marker_target
+    from headsim.run.runner import ObservedSim, marker_target
 
     spec: PursuitSpec = scenario.scene.pursuit
     target = marker_target(spec.name, spec.body)

@@ -30,10 +30,10 @@ from headsim.live.gaze import GazeConfig, GazeMode, SaccadeProfile
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, LiveConfig
 from headsim.live.motors import MotorLimits
 from headsim.live.paths import Path, RandomWalk, Sinusoid, Static, Throw, Visibility, Waypoints
-from headsim.settings import SettingsError
+from headsim.sim.settings import SettingsError
 
 if TYPE_CHECKING:
-    from headsim.scenario import _Table
+    from headsim.scenario.schema import _Table
 
 PATH_KINDS = ("waypoints", "sinusoid", "random_walk", "throw", "static")
 #: Largest coordinate of a path point, m.

@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.camera_model import PinholeCamera, paper_cam1, paper_cam2
 from headsim.estimators import (
     Q1Side,
     areas_from_geometry,
@@ -14,7 +13,8 @@ from headsim.estimators import (
     q1_columns,
     q1_side,
 )
-from headsim.synthetic import StereoHead, fixation_angles, image_points
+from headsim.geometry.camera_model import PinholeCamera, paper_cam1, paper_cam2
+from headsim.geometry.synthetic import StereoHead, fixation_angles, image_points
 
 D = 0.15
 MAGNITUDE_PAIRS = {(1, 2), (2, 1), (3, 4), (4, 3), (7, 8), (8, 7)}

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.camera_model import PinholeCamera, ideal
 from headsim.estimators import calibrate_initial_directions, calibration_coefficients
-from headsim.synthetic import StereoHead, fixation_angles
+from headsim.geometry.camera_model import PinholeCamera, ideal
+from headsim.geometry.synthetic import StereoHead, fixation_angles
 
 D = 0.15
 PAPER_OFFSETS = (0.0578, -0.0254)

@@ -19,7 +19,7 @@ from headsim.estimators import (
     rel_dz_model2,
     rel_dz_model2_small_angle,
 )
-from headsim.synthetic import StereoHead, observe
+from headsim.geometry.synthetic import StereoHead, observe
 
 from .helpers import random_points
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from headsim.estimators import Flag, Uncertainty, model1
-from headsim.kinematics import head_to_world, world_to_head
-from headsim.synthetic import StereoHead, image_points, neck_fixation
+from headsim.geometry.kinematics import head_to_world, world_to_head
+from headsim.geometry.synthetic import StereoHead, image_points, neck_fixation
 
 from .helpers import random_points
 

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from headsim.camera_model import PinholeCamera, ideal, paper_cam1, paper_cam2
 from headsim.estimators import Flag, model2, model2_jacobian
-from headsim.kinematics import head_to_world
-from headsim.synthetic import StereoHead, observe
+from headsim.geometry.camera_model import PinholeCamera, ideal, paper_cam1, paper_cam2
+from headsim.geometry.kinematics import head_to_world
+from headsim.geometry.synthetic import StereoHead, observe
 
 from .helpers import random_points, remedy_gammas
 

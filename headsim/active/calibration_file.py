@@ -1,0 +1,155 @@
+"""Calibrate once, measure all day: what a head learnt, in a file (``head.json``).
+
+``headsim calibrate SCENARIO --out head.json`` runs a scenario's Sec. V
+calibration and writes what the head learnt (initial directions, the extended
+fit, standard errors: the results.json ``calibration`` block and the
+:class:`HeadKnowledge` built from it) with the head settings it holds for.
+A scenario uses it with ``[experiment.calibration] from = "head.json"``
+(a path relative to the scenario file's directory) and calibrates no more; a file
+made for another head is refused, naming the settings that differ.
+
+The head a calibration holds for is every field of
+:class:`~headsim.sim.settings.HeadSettings` except the seed and the cameras'
+image noise (they change the images, not the head), flattened to dotted
+names (``cam1.kx``) and hashed (SHA-256 of their JSON).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from headsim.active.procedures import HeadKnowledge
+from headsim.run.results import to_jsonable, write_json_atomic
+from headsim.sim.settings import HeadSettings
+
+FORMAT = "headsim-calibration/1"
+#: Settings that do not change the head a calibration holds for.
+NOT_THE_HEAD = ("seed", "noise_std")
+
+
+class CalibrationFileError(ValueError):
+    """A calibration file cannot be used: unreadable, malformed, or for another head."""
+
+
+def head_fields(settings: HeadSettings) -> dict[str, Any]:
+    """The head's settings that a calibration depends on, by dotted name (``cam1.kx``)."""
+    flat: dict[str, Any] = {}
+
+    def walk(prefix: str, value: Any) -> None:
+        if isinstance(value, dict):
+            for key, item in value.items():
+                if key not in NOT_THE_HEAD:
+                    walk(f"{prefix}{key}.", item)
+        else:
+            flat[prefix[:-1]] = to_jsonable(value)
+
+    raw = asdict(settings)
+    cameras = raw.pop("cameras")
+    walk("", raw)
+    for index, camera in enumerate(cameras):
+        walk(f"cam{index + 1}.", camera)
+    return dict(sorted(flat.items()))
+
+
+def head_hash(settings: HeadSettings) -> str:
+    """SHA-256 of :func:`head_fields` as canonical JSON."""
+    text = json.dumps(head_fields(settings), sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class StoredCalibration:
+    """A calibration read from a file: what the head knows, and the run that found it."""
+
+    path: Path
+    knowledge: HeadKnowledge
+    block: dict[str, Any]
+    scenario: str
+    seed: int
+    head_hash: str
+
+
+def knowledge_from_block(block: dict[str, Any]) -> HeadKnowledge:
+    """The :class:`HeadKnowledge` of a results.json ``calibration`` block's ``knowledge``."""
+    known = block["knowledge"]
+    return HeadKnowledge(
+        alpha_e=tuple(float(a) for a in known["alpha_e_rad"]),  # type: ignore[arg-type]
+        v0=tuple(None if v is None else float(v) for v in known["v0_px"]),  # type: ignore[arg-type]
+        kx_over_ky=tuple(float(r) for r in known["kx_over_ky"]),  # type: ignore[arg-type]
+        u0=tuple(None if u is None else float(u) for u in known.get("u0_px", [None, None])),  # type: ignore[arg-type]
+        los_offset_m=None
+        if known.get("los_offset_m") is None
+        else tuple(float(o) for o in known["los_offset_m"]),  # type: ignore[arg-type]
+    )
+
+
+def write_calibration(
+    path: str | Path, settings: HeadSettings, block: dict[str, Any], scenario: str, seed: int
+) -> Path:
+    """Write a successful calibration ``block`` (results.json form) for the head ``settings``."""
+    if block.get("knowledge") is None:
+        raise CalibrationFileError(
+            f"calibration did not succeed ({block.get('status')}): nothing to write"
+        )
+    path = Path(path)
+    write_json_atomic(
+        path,
+        {
+            "format": FORMAT,
+            "scenario": scenario,
+            "seed": seed,
+            "head": {"hash": head_hash(settings), "settings": head_fields(settings)},
+            "calibration": block,
+        },
+    )
+    return path
+
+
+def _differences(stored: dict[str, Any], current: dict[str, Any]) -> list[str]:
+    lines = []
+    for name in sorted(set(stored) | set(current)):
+        a, b = stored.get(name, "absent"), current.get(name, "absent")
+        if a != b:
+            lines.append(f"{name} (file {a!r}, this head {b!r})")
+    return lines
+
+
+def read_calibration(path: str | Path, settings: HeadSettings) -> StoredCalibration:
+    """Read ``path`` and check it holds for the head ``settings`` (else CalibrationFileError)."""
+    path = Path(path)
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as err:
+        raise CalibrationFileError(f"cannot read {path}: {err}") from err
+    except json.JSONDecodeError as err:
+        raise CalibrationFileError(f"{path} is not JSON: {err}") from err
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        raise CalibrationFileError(
+            f"{path} is not a calibration file (format {FORMAT!r}; write one with "
+            "`headsim calibrate SCENARIO --out FILE`)"
+        )
+    try:
+        head, block = doc["head"], doc["calibration"]
+        knowledge = knowledge_from_block(block)
+        stored_fields, stored_hash = dict(head["settings"]), str(head["hash"])
+    except (KeyError, TypeError, ValueError) as err:
+        raise CalibrationFileError(f"{path} is malformed: {err!r} missing or wrong") from err
+    if stored_hash != head_hash(settings):
+        differ = _differences(stored_fields, head_fields(settings))
+        detail = "; ".join(differ) if differ else "its settings were edited after it was written"
+        raise CalibrationFileError(
+            f"{path} was made for a different head: {detail}. Calibrate this head with "
+            "`headsim calibrate SCENARIO --out FILE`"
+        )
+    return StoredCalibration(
+        path=path,
+        knowledge=knowledge,
+        block=block,
+        scenario=str(doc.get("scenario", "")),
+        seed=int(doc.get("seed", 0)),
+        head_hash=stored_hash,
+    )

@@ -1,0 +1,259 @@
+"""Why a measurement failed, and finding a lost target again from images alone.
+
+A search uses only what a real head knows: the eye steps at which a camera
+last saw the target (the servo's memory), the start pose, and the gains the
+servo has learnt (px per encoder step: the image width over the gain is the
+field of view in steps, with no focal length).  Every image it takes is a
+render, counted by the caller through ``HeadSim.render_count``.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from headsim.active.servo import (
+    Detector,
+    EyeServo,
+    NeckServo,
+    NeckServoResult,
+    ServoOutcome,
+    ServoResult,
+)
+from headsim.vision.detect import Detection, DetectionStatus
+
+
+class FailureCause(enum.Enum):
+    """Why a measurement (or one calibration position) failed."""
+
+    LOST = "lost"  # nothing of the target in the camera's image
+    CUT = "cut"  # the target runs off the image border
+    OCCLUDED = "occluded"  # partly hidden
+    JOINT_LIMIT = "joint limit"  # the fixation needs a joint beyond its range
+    ITERATION_LIMIT = "iteration limit"  # the servo's bound on moves
+    ESTIMATOR = "estimator"  # the estimator flagged the point invalid
+
+
+_FROM_DETECTION = {
+    DetectionStatus.LOST: FailureCause.LOST,
+    DetectionStatus.CUT: FailureCause.CUT,
+    DetectionStatus.OCCLUDED: FailureCause.OCCLUDED,
+}
+_FROM_OUTCOME = {
+    ServoOutcome.JOINT_LIMIT: FailureCause.JOINT_LIMIT,
+    ServoOutcome.ITERATION_LIMIT: FailureCause.ITERATION_LIMIT,
+}
+
+
+@dataclass(frozen=True)
+class Failure:
+    """A failure's cause, where it happened (``stage``: "step 1", "step 2",
+    "search", "fixation", "estimate"), in which camera (1, 2; None: not one
+    camera's), and any detail."""
+
+    cause: FailureCause
+    stage: str
+    camera: int | None = None
+    detail: str = ""
+
+    @property
+    def message(self) -> str:
+        where = f"Ca{self.camera} at {self.stage}" if self.camera else self.stage
+        what = (
+            f"target {self.cause.value}"
+            if self.cause in _FROM_DETECTION.values()
+            else (self.cause.value)
+        )
+        return f"{where}: {what}" + (f" ({self.detail})" if self.detail else "")
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "cause": self.cause.value,
+            "stage": self.stage,
+            "camera": self.camera,
+            "detail": self.detail,
+        }
+
+
+def detection_failure(detection: Detection, stage: str, camera: int, detail: str = "") -> Failure:
+    """The failure of a detection that did not find the target."""
+    cause = _FROM_DETECTION.get(detection.status, FailureCause.LOST)
+    return Failure(cause, stage, camera, detail)
+
+
+def servo_failure(result: ServoResult, stage: str, camera: int) -> Failure:
+    """The failure of an eye servo run that did not converge."""
+    if result.outcome is ServoOutcome.TARGET_LOST:
+        cause = _FROM_DETECTION.get(result.lost_status or DetectionStatus.LOST, FailureCause.LOST)
+    else:
+        cause = _FROM_OUTCOME[result.outcome]
+    detail = f"after {result.iterations} moves" if result.iterations else "in its first image"
+    return Failure(cause, stage, camera, detail)
+
+
+def neck_failure(result: NeckServoResult, stage: str = "fixation") -> Failure:
+    """The failure of a neck servo run (Model 1) that did not converge."""
+    if result.outcome is ServoOutcome.TARGET_LOST:
+        cause = _FROM_DETECTION.get(result.lost_status or DetectionStatus.LOST, FailureCause.LOST)
+        return Failure(cause, stage, result.lost_camera, f"after {result.iterations} moves")
+    return Failure(_FROM_OUTCOME[result.outcome], stage, None, f"after {result.iterations} moves")
+
+
+@dataclass(frozen=True)
+class Found:
+    """Where a search found the target: eye steps, the detection there, poses tried."""
+
+    steps: int
+    detection: Detection
+    tried: int
+
+
+def search_poses(
+    servo: EyeServo,
+    camera: int,
+    remembered: Iterable[int],
+    width_px: int,
+    max_sweep: int = 8,
+) -> list[int]:
+    """Eye steps to look at for ``camera``, best first, within the eye range.
+
+    The poses where it last saw the target (most recent first), the start pose
+    (eye 0), then a sweep out from the current pose in strides of 0.7 of the
+    field of view in steps (image width over the learnt gain), both ways.
+    """
+    low, high = servo.step_range
+    current = servo.sim.eye_encoder_steps()
+    poses: list[int] = [*reversed(list(remembered)), 0]
+    gain = servo.gains.get(camera) or servo.gains.get(3 - camera)
+    if gain:
+        stride = max(1, int(0.7 * width_px / abs(gain)))
+        for k in range(1, max_sweep + 1):
+            poses += [current + sign * k * stride for sign in (1, -1)]
+    unique = []
+    for p in poses:
+        if low <= p <= high and p != current and p not in unique:
+            unique.append(p)
+    return unique
+
+
+def find_view(
+    servo: EyeServo,
+    camera: int,
+    detector: Detector,
+    remembered: Iterable[int] = (),
+    max_poses: int = 12,
+) -> Found | None:
+    """Turn the eyes to each of :func:`search_poses` in turn until ``camera`` sees the target.
+
+    One render per pose; at most ``max_poses``.  None: not found (the caller
+    names the failure).
+    """
+    sim = servo.sim
+    width = sim.camera_settings(camera).width
+    poses = search_poses(servo, camera, remembered, width)[:max_poses]
+    for tried, steps in enumerate(poses, start=1):
+        sim.command_eye_steps(steps)
+        sim.settle()
+        detection = servo.observe(camera, detector)
+        if detection.found and detection.uv is not None:
+            return Found(steps, detection, tried)
+    return None
+
+
+def neck_search_poses(
+    servo: NeckServo,
+    last: Sequence[tuple[int, int, int]],
+    size_px: tuple[int, int],
+    rings: int = 2,
+) -> list[tuple[int, int, int]]:
+    """Neck poses to look from for a target lost since the last fixation, best first.
+
+    ``last``: the fixations' (yaw, pitch, eye) steps where the target was seen,
+    oldest first.  Around the most recent one, a grid of neck (yaw, pitch)
+    offsets in strides of 0.7 of the field of view in steps (image width and
+    height over the learnt Jacobian's px per step: no focal length), out to
+    ``rings`` strides; ordered by distance from where the last two fixations
+    predict it (a constant velocity in steps), so that a target moving on
+    steadily is found first.  Within the joints' ranges; the eye stays.
+    """
+    jac = servo.jacobian
+    if not last or jac is None:
+        return []
+    centre = np.array(last[-1], dtype=float)
+    predicted = 2 * centre - np.array(last[-2], dtype=float) if len(last) > 1 else centre
+    width, height = size_px
+    per_yaw = float(max(abs(jac[0, 0]), abs(jac[1, 0])))
+    per_pitch = float(abs(jac[2, 1]))
+    if per_yaw <= 0 or per_pitch <= 0:
+        return []
+    stride = np.array([max(1, int(0.7 * width / per_yaw)), max(1, int(0.7 * height / per_pitch))])
+    poses = {
+        (int(centre[0] + i * stride[0]), int(centre[1] + j * stride[1]), int(centre[2]))
+        for i in range(-rings, rings + 1)
+        for j in range(-rings, rings + 1)
+        if (i, j) != (0, 0)
+    }
+    if len(last) > 1:  # the prediction itself, to the whole step
+        poses.add(tuple(round(float(x)) for x in predicted))  # type: ignore[arg-type]
+    ranges = servo.step_ranges
+    here = servo.steps()
+    scale = np.array([stride[0], stride[1], 1.0])
+    inside = [
+        p
+        for p in poses
+        if p != here and all(lo <= s <= hi for s, (lo, hi) in zip(p, ranges, strict=True))
+    ]
+    return sorted(
+        inside, key=lambda p: (float(np.linalg.norm((np.array(p) - predicted) / scale)), p)
+    )
+
+
+def find_neck_view(
+    servo: NeckServo,
+    detector: Detector,
+    last: Sequence[tuple[int, int, int]],
+    max_poses: int = 12,
+) -> tuple[tuple[int, int, int], int] | None:
+    """Look from each of :func:`neck_search_poses` until both cameras see the target.
+
+    Two renders per pose; at most ``max_poses``.  Returns the pose and the
+    number of poses tried, or None (the caller names the failure).
+    """
+    cam = servo.sim.camera_settings(1)
+    poses = neck_search_poses(servo, last, (cam.width, cam.height))[:max_poses]
+    for tried, pose in enumerate(poses, start=1):
+        if servo.look_from(pose, detector):
+            return pose, tried
+    return None
+
+
+def nearest_seen(
+    seen: Iterable[tuple[int, float, float]], steps: int, goal_u: float, midline_px: float
+) -> tuple[int, float, float] | None:
+    """From a servo's memory, the image nearest eye step ``steps`` whose target is at least
+    ``midline_px`` off the goal column (else the one farthest off it)."""
+    memory = list(seen)
+    if not memory:
+        return None
+    off = [m for m in memory if abs(m[1] - goal_u) >= midline_px]
+    if off:
+        return min(off, key=lambda m: abs(m[0] - steps))
+    return max(memory, key=lambda m: abs(m[1] - goal_u))
+
+
+__all__ = [
+    "Failure",
+    "FailureCause",
+    "Found",
+    "detection_failure",
+    "find_neck_view",
+    "find_view",
+    "nearest_seen",
+    "neck_failure",
+    "neck_search_poses",
+    "search_poses",
+    "servo_failure",
+]

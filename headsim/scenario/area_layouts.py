@@ -1,0 +1,155 @@
+"""Object layouts that populate chosen areas S1..S12 of Sec. III (placement, truth allowed).
+
+Random layouts rarely reach the areas split by the magnitude test (S1-S4,
+S7, S8): they lie in thin wedges around the lines of sight.  Here objects are
+drawn by rejection from the true geometry (``areas_from_geometry`` at the
+reference's true fixation angles) and kept only where all four images (each
+camera at each fixation) see them whole.  This is placement, like putting an
+object on a bench: the measurement still uses images alone.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from headsim.active.procedures import seen_by_both
+from headsim.estimators.areas import areas_from_geometry
+from headsim.sim.simulator import HeadSim
+
+
+def reference_angles(sim: HeadSim, reference_head: np.ndarray) -> tuple[float, float]:
+    """True encoder angles (alpha1, alpha2) at which Ca1, Ca2 fixate a point in H, rad."""
+    half = sim.settings.baseline_m / 2
+    x, _, z = reference_head
+    alpha1 = math.atan2(x + half, z) - sim.effective_initial_direction(1)
+    alpha2 = math.atan2(half - x, z) - sim.effective_initial_direction(2)
+    return alpha1, alpha2
+
+
+def seen_in_four_images(
+    sim: HeadSim, points_world: np.ndarray, alpha1: float, alpha2: float, radius_m: float
+) -> np.ndarray:
+    """(N,) whether both cameras see each point whole at both eye angles (no render)."""
+    before = sim.eye_encoder_steps()
+    resolution = sim.settings.encoder_resolution_rad
+    ok = np.ones(len(points_world), dtype=bool)
+    for alpha in (alpha1, alpha2):
+        sim.command_eye_steps(round(alpha / resolution))
+        sim.settle()
+        ok &= seen_by_both(sim, points_world, radius_m)
+    sim.command_eye_steps(before)
+    sim.settle()
+    return ok
+
+
+def _hides_or_hidden(
+    points_head: np.ndarray, reference_head: np.ndarray, baseline_m: float, clear_m: float
+) -> np.ndarray:
+    """(N,) whether a point's ray from a camera centre passes within ``clear_m`` of the reference."""
+    close = np.zeros(len(points_head), dtype=bool)
+    for sign in (-1.0, 1.0):
+        centre = np.array([sign * baseline_m / 2, 0.0, 0.0])
+        to_ref = reference_head - centre
+        to_p = points_head - centre
+        cos = to_p @ to_ref / (np.linalg.norm(to_p, axis=1) * np.linalg.norm(to_ref))
+        angle = np.arccos(np.clip(cos, -1.0, 1.0))
+        close |= angle < clear_m / np.linalg.norm(to_ref)
+    return close
+
+
+def _overlaps(
+    points_head: np.ndarray,
+    placed_head: Sequence[np.ndarray],
+    baseline_m: float,
+    radius_m: float,
+    gap_rad: float,
+) -> np.ndarray:
+    """(N,) whether a point's image would touch an already placed object's, in either camera.
+
+    Seen from either camera centre, two balls of ``radius_m`` are apart when
+    the angle between their rays exceeds the sum of their angular radii plus
+    ``gap_rad``.  The eyes only yaw about their centres, so this holds at
+    every eye angle: one partly hiding the other would bias both centroids.
+    """
+    close = np.zeros(len(points_head), dtype=bool)
+    for other in placed_head:
+        for sign in (-1.0, 1.0):
+            centre = np.array([sign * baseline_m / 2, 0.0, 0.0])
+            to_o, to_p = other - centre, points_head - centre
+            d_o, d_p = np.linalg.norm(to_o), np.linalg.norm(to_p, axis=1)
+            angle = np.arccos(np.clip(to_p @ to_o / (d_p * d_o), -1.0, 1.0))
+            close |= angle < radius_m / d_o + radius_m / d_p + gap_rad
+    return close
+
+
+def area_layout(
+    sim: HeadSim,
+    reference_head: np.ndarray,
+    wanted: Sequence[int],
+    rng: np.random.Generator,
+    *,
+    depth_m: tuple[float, float] = (0.3, 2.5),
+    lateral: float = 0.4,
+    vertical: tuple[float, float] = (-0.12, 0.08),
+    radius_m: float = 0.004,
+    clear_m: float = 0.085,
+    batches: int = 40,
+    partial: bool = False,
+    gap_rad: float = 0.01,
+) -> np.ndarray:
+    """Positions in H (len(wanted), 3), m: object k in true area ``wanted[k]``, seen in all four images.
+
+    Draws batches of 4000 candidates (depth, then |x/z| <= ``lateral``, y/z in
+    ``vertical``), at most ``batches`` of them; ValueError names the areas
+    it could not fill (with ``partial``, their rows are NaN instead).  No object is placed where it would hide the reference
+    or be hidden by it: seen from either camera, its ray is ``clear_m`` (at
+    the reference's distance) or more from the reference's.  Nor where its
+    image would touch another placed object's (``gap_rad`` between the balls'
+    edges, seen from either camera): a partly hidden ball's centroid moves by
+    up to its radius, which the images cannot tell from a shift.
+    """
+    alpha1, alpha2 = reference_angles(sim, reference_head)
+    effective = (sim.effective_initial_direction(1), sim.effective_initial_direction(2))
+    chosen: list[np.ndarray | None] = [None] * len(wanted)
+    for _ in range(batches):
+        n = 4000
+        z = rng.uniform(*depth_m, size=n)
+        points = np.column_stack(
+            [rng.uniform(-lateral, lateral, n) * z, rng.uniform(*vertical, size=n) * z, z]
+        )
+        areas = areas_from_geometry(points, alpha1, alpha2, sim.settings.baseline_m, effective)
+        areas[_hides_or_hidden(points, reference_head, sim.settings.baseline_m, clear_m)] = 0
+        world = sim.transform_points(points, "head", "world")
+        for k, area in enumerate(wanted):
+            if chosen[k] is not None:
+                continue
+            candidates = np.flatnonzero(areas == area)
+            placed = [c for c in chosen if c is not None]
+            if placed and candidates.size:
+                apart = ~_overlaps(
+                    points[candidates], placed, sim.settings.baseline_m, radius_m, gap_rad
+                )
+                candidates = candidates[apart]
+            candidates = candidates[:50]
+            if candidates.size == 0:
+                continue
+            seen = seen_in_four_images(sim, world[candidates], alpha1, alpha2, radius_m)
+            if seen.any():
+                pick = int(candidates[np.flatnonzero(seen)[0]])
+                chosen[k] = points[pick]
+                areas[pick] = 0  # not twice
+        if all(c is not None for c in chosen):
+            return np.array(chosen)
+    if partial:
+        return np.array([np.full(3, np.nan) if c is None else c for c in chosen])
+    missing = sorted({wanted[k] for k, c in enumerate(chosen) if c is None})
+    raise ValueError(
+        f"area layout: no position seen in all four images found for areas {missing} "
+        f"in {batches} batches"
+    )
+
+
+__all__ = ["area_layout", "reference_angles", "seen_in_four_images"]

@@ -1,0 +1,556 @@
+"""Off-screen rendering of the eye cameras: MuJoCo pinhole render, lens, noise.
+
+One :class:`mujoco.Renderer` (an OpenGL context) per scene (its assets and
+off-screen buffer size, :func:`context_key`) is kept in a small process-wide
+pool and reused by every simulator of that scene, whatever its head, within a
+run and across the jobs of a worker: creating one costs about 0.2 s.  Images are drawn into a viewport of its off-screen buffer, so one
+context serves every canvas size and every window.
+
+A *window* is a sub-rectangle of a camera's image (for a distorted camera:
+the region of its pinhole canvas that the window's pixels sample), drawn as
+the whole frame, with the same projection and viewport, its geometry clipped
+a few pixels outside the window so that only the window is rasterised.  Every
+vertex lands where it does in the frame, to the bit, so the window's pixels
+are the full frame's crop (a window drawn as a camera of its own, with a
+shifted principal point, rounds its projection otherwise and flips an MSAA
+sample now and then).  Noise included: the noise of image k of a camera is
+drawn for the whole frame and cropped.  The head's own geoms (group
+``names.HEAD_VISUAL_GROUP``) are hidden from the eye cameras.  Every image is
+one render and is counted, with its pixels in full-frame equivalents.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+from collections import OrderedDict
+from collections.abc import Hashable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import cv2
+import mujoco
+import numpy as np
+
+from headsim.sim import names
+from headsim.sim.backend import INSTALL_HINT, RenderBackendError, check_backend
+from headsim.sim.optics import DistortionCanvas, GaussianNoise, apply_canvas
+from headsim.sim.settings import CameraSettings
+
+#: Renderers kept per process (one per head and scene); the least recently used goes first.
+POOL_SIZE = 4
+_POOL: OrderedDict[Hashable, mujoco.Renderer] = OrderedDict()
+#: Renderers created in this process (the pool's misses), for the bench and tests.
+created = 0
+
+
+@dataclass(frozen=True)
+class Window:
+    """A sub-rectangle of a camera's output image: top-left (x0, y0) and size, px."""
+
+    x0: int
+    y0: int
+    width: int
+    height: int
+
+    @property
+    def x1(self) -> int:
+        return self.x0 + self.width
+
+    @property
+    def y1(self) -> int:
+        return self.y0 + self.height
+
+    @classmethod
+    def around(
+        cls, centre_uv: tuple[float, float], half_px: float, image_size: tuple[int, int]
+    ) -> Window:
+        """The square of half-side ``half_px`` around ``centre_uv``, moved inside the image."""
+        width, height = image_size
+        side_u = min(width, 2 * math.ceil(half_px) + 1)
+        side_v = min(height, 2 * math.ceil(half_px) + 1)
+        x0 = min(max(round(centre_uv[0] - side_u / 2), 0), width - side_u)
+        y0 = min(max(round(centre_uv[1] - side_v / 2), 0), height - side_v)
+        return cls(int(x0), int(y0), int(side_u), int(side_v))
+
+
+#: What an OpenGL context holds of a model (uploaded once): meshes, textures, height
+#: fields, skins.  Everything else (cameras, bodies, geom sizes and colours) is read
+#: from the model and data at every render.
+_CONTEXT_ARRAYS = ("mesh_vert", "mesh_face", "mesh_normal", "tex_data", "hfield_data", "skin_vert")
+
+
+def context_key(scene: str, model: mujoco.MjModel) -> tuple[str, str]:
+    """What identifies the OpenGL context a model needs: its scene and a digest of the
+    assets the context uploads.  Heads that differ only in their settings (cameras,
+    baseline, mounts) share one context; its off-screen buffer grows to the largest
+    canvas asked of it."""
+    digest = hashlib.sha1()
+    digest.update(f"offsamples={int(model.vis.quality.offsamples)}".encode())
+    for name in _CONTEXT_ARRAYS:
+        array = getattr(model, name, None)
+        if array is not None:
+            digest.update(name.encode())
+            digest.update(np.ascontiguousarray(array).tobytes())
+    return (str(scene), digest.hexdigest())
+
+
+def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
+    """The pooled renderer of ``key``, with a buffer at least ``model``'s off-screen size."""
+    global created
+    need = (int(model.vis.global_.offwidth), int(model.vis.global_.offheight))
+    renderer = _POOL.pop(key, None)
+    if renderer is not None and (renderer.width < need[0] or renderer.height < need[1]):
+        need = (max(need[0], renderer.width), max(need[1], renderer.height))
+        renderer.close()
+        renderer = None
+    if renderer is None:
+        backend = check_backend()
+        width, height = need
+        saved = (model.vis.global_.offwidth, model.vis.global_.offheight)
+        # The context's buffer is sized from the model it is made with.
+        model.vis.global_.offwidth, model.vis.global_.offheight = width, height
+        try:
+            renderer = mujoco.Renderer(model, height=height, width=width)
+        except ValueError as err:  # larger than the model's off-screen buffer
+            raise ValueError(f"cannot render {width}x{height}: {err}") from err
+        except Exception as err:  # GL context creation failed
+            raise RenderBackendError(
+                f"could not create an off-screen OpenGL context with MUJOCO_GL={backend}: {err}. "
+                f"{INSTALL_HINT}"
+            ) from err
+        finally:
+            model.vis.global_.offwidth, model.vis.global_.offheight = saved
+        created += 1
+    _POOL[key] = renderer
+    while len(_POOL) > POOL_SIZE:
+        _, oldest = _POOL.popitem(last=False)
+        oldest.close()
+    return renderer
+
+
+def release_renderers() -> None:
+    """Close every pooled renderer (their OpenGL contexts)."""
+    while _POOL:
+        _, renderer = _POOL.popitem()
+        renderer.close()
+
+
+class EyeRenderer:
+    """Renders the two eye cameras of one compiled model to 8-bit RGB arrays.
+
+    ``key``: what identifies the OpenGL context the model needs
+    (:func:`context_key`); models with equal keys share one.  None: a context
+    of its own.
+    """
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        cameras: tuple[CameraSettings, CameraSettings],
+        canvases: tuple[DistortionCanvas, DistortionCanvas],
+        seed: int = 0,
+        key: Hashable | None = None,
+        supersample: int = 1,
+    ) -> None:
+        """``supersample``: the model's cameras render at this many times each
+        canvas's size (``headsim.sim.settings.RenderFidelity``); images are area-averaged
+        back to the canvas."""
+        self._model = model
+        self._supersample = supersample
+        self._cameras = cameras
+        self._canvases = canvases
+        self._key: Hashable = key if key is not None else ("own", id(self))
+        self._own = key is None
+        self._option = mujoco.MjvOption()
+        self._option.geomgroup[names.HEAD_VISUAL_GROUP] = 0
+        # One noise stream per camera: image k of camera i gets the noise drawn
+        # from (seed, i, k), whatever else was rendered.
+        self._seed = seed
+        self._noise = tuple(GaussianNoise.of(camera.noise_std) for camera in cameras)
+        self._taken = [0, 0]
+        self._previews = [0, 0]
+        self._cam_ids = [
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, name) for name in names.CAMERAS
+        ]
+        self.render_count = 0
+        #: Pixels rendered, in full frames of the camera that rendered them.
+        self.rendered_frames = 0.0
+
+    def _renderer(self) -> mujoco.Renderer:
+        renderer = _acquire(self._key, self._model)
+        renderer._model = self._model  # the same assets; this model's cameras and bodies
+        return renderer
+
+    def _draw(
+        self, data: mujoco.MjData, index: int, rect: Window | None, binning: int = 1
+    ) -> np.ndarray:
+        """The pinhole canvas of camera ``index``, or its sub-rectangle ``rect``: (h, w, 3);
+        with ``binning`` b > 1 the whole canvas at 1/b of its resolution (no supersampling)."""
+        canvas = self._canvases[index]
+        renderer = self._renderer()
+        k = self._supersample
+        width_c, height_c = canvas.size
+        full_w, full_h = k * width_c, k * height_c
+        cam = self._cam_ids[index]
+        model = self._model
+        saved = None
+        if binning > 1:
+            # A preview: the same camera at 1/b of the resolution (the sensor binned
+            # b x b), no supersampling; the canvas cut to a multiple of b.
+            rect = Window(0, 0, width_c - width_c % binning, height_c - height_c % binning)
+            out_w, out_h = rect.width // binning, rect.height // binning
+            pitch = model.cam_sensorsize[cam] / model.cam_resolution[cam]
+            offset_px = model.cam_intrinsic[cam][2:4] / pitch
+            window_offset = offset_px + np.array(
+                [(k * rect.width - full_w) / 2, (k * rect.height - full_h) / 2]
+            )
+            saved = (
+                model.cam_resolution[cam].copy(),
+                model.cam_sensorsize[cam].copy(),
+                model.cam_intrinsic[cam].copy(),
+            )
+            model.cam_resolution[cam] = (out_w, out_h)
+            model.cam_sensorsize[cam] = pitch * np.array([k * rect.width, k * rect.height])
+            model.cam_intrinsic[cam][2:4] = window_offset * pitch
+        try:
+            renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
+        finally:
+            if saved is not None:
+                (
+                    model.cam_resolution[cam],
+                    model.cam_sensorsize[cam],
+                    model.cam_intrinsic[cam],
+                ) = saved
+        gl_context = renderer._gl_context
+        if gl_context is not None:
+            gl_context.make_current()
+        if binning > 1:
+            viewport = mujoco.MjrRect(0, 0, out_w, out_h)
+            mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
+            pixels = np.empty((out_h, out_w, 3), dtype=np.uint8)
+            mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
+            self.rendered_frames += (out_w * out_h) / (width_c * height_c)
+            return np.ascontiguousarray(pixels[::-1])
+        # Supersampled k times (headsim.sim.settings.RenderFidelity): the model's
+        # camera renders k x the canvas, and each canvas pixel is the area
+        # average of a k x k block; a window is cut on whole blocks.
+        if rect is None or (rect.width, rect.height) == (width_c, height_c):
+            rect = Window(0, 0, width_c, height_c)
+            viewport = mujoco.MjrRect(0, 0, full_w, full_h)
+            mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
+            pixels = np.empty((full_h, full_w, 3), dtype=np.uint8)
+            mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
+        else:
+            # A window is drawn as the whole frame (the same projection and
+            # viewport: every vertex lands where it does in the frame, so its
+            # pixels are the frame's crop), with geometry clipped a few pixels
+            # outside it, so that only the window's pixels are rasterised.
+            pixels = _draw_window(renderer, rect, k, (full_w, full_h))
+        self.rendered_frames += (rect.width * rect.height) / (width_c * height_c)
+        pixels = np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
+        if k > 1:
+            pixels = cv2.resize(pixels, (rect.width, rect.height), interpolation=cv2.INTER_AREA)
+        return pixels
+
+    def render_preview(self, data: mujoco.MjData, index: int, binning: int) -> np.ndarray:
+        """Camera ``index``'s whole view binned ``binning`` x ``binning``: (H/b, W/b, 3) uint8.
+
+        A low-resolution readout of the same camera (lens included), for finding
+        where to look; pixel (i, j) covers the image's pixels b i .. b i + b - 1.
+        Its noise (the camera's std) comes from a stream of its own, so the
+        camera's images get the same noise with and without previews.  Counted
+        as a render and as 1/b^2 of a frame's pixels.
+        """
+        camera = self._cameras[index]
+        if camera.width % binning or camera.height % binning:
+            raise ValueError(
+                f"binning {binning} must divide the {camera.width}x{camera.height} image"
+            )
+        image = apply_canvas(
+            self._draw(data, index, None, binning=binning),
+            binned_canvas(self._canvases[index], binning, (camera.width, camera.height)),
+        )
+        self.render_count += 1
+        frame = self._previews[index]
+        self._previews[index] += 1
+        return self._noise[index].apply(image, (self._seed, index, PREVIEW_STREAM), frame)
+
+    def render(self, data: mujoco.MjData, index: int, retake: bool = False) -> np.ndarray:
+        """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8.
+
+        ``retake``: the whole of the image just taken as a window (the same
+        instant: the same noise); it is still a render and is counted.
+        """
+        image = apply_canvas(self._draw(data, index, None), self._canvases[index])
+        return self._add_noise(image, index, None, retake)
+
+    def render_window(self, data: mujoco.MjData, index: int, window: Window) -> np.ndarray:
+        """Render only ``window`` of camera ``index``: the full frame's crop, (h, w, 3) uint8."""
+        camera, canvas = self._cameras[index], self._canvases[index]
+        if not (
+            0 <= window.x0 < window.x1 <= camera.width
+            and 0 <= window.y0 < window.y1 <= camera.height
+        ):
+            raise ValueError(
+                f"window {window} is not inside the {camera.width}x{camera.height} image"
+            )
+        if canvas.identity:
+            image = self._draw(data, index, window)
+        else:
+            assert canvas.map_x is not None and canvas.map_y is not None
+            map_x = canvas.map_x[window.y0 : window.y1, window.x0 : window.x1]
+            map_y = canvas.map_y[window.y0 : window.y1, window.x0 : window.x1]
+            source = _canvas_region(map_x, map_y, canvas.size)
+            if source is None:  # nothing of the canvas is seen through this window
+                image = np.zeros((window.height, window.width, 3), dtype=np.uint8)
+            else:
+                region = self._draw(data, index, source)
+                # Shifting float32 maps by whole pixels is exact: the same samples.
+                shifted = DistortionCanvas(
+                    size=(source.width, source.height),
+                    principal=canvas.principal,
+                    map_x=np.where(map_x >= 0, map_x - np.float32(source.x0), np.float32(-1)),
+                    map_y=np.where(map_y >= 0, map_y - np.float32(source.y0), np.float32(-1)),
+                    valid_fraction=canvas.valid_fraction,
+                )
+                image = apply_canvas(region, shifted)
+        return self._add_noise(image, index, window)
+
+    def _add_noise(
+        self, image: np.ndarray, index: int, window: Window | None, retake: bool = False
+    ) -> np.ndarray:
+        self.render_count += 1
+        if retake and self._taken[index] > 0:
+            frame = self._taken[index] - 1
+        else:
+            frame = self._taken[index]
+            self._taken[index] += 1
+        camera = self._cameras[index]
+        crop = None if window is None else (window.x0, window.y0, camera.width, camera.height)
+        return self._noise[index].apply(image, (self._seed, index), frame, crop=crop)
+
+    def close(self) -> None:
+        """Give the OpenGL context back to the pool (closed if it was this renderer's own)."""
+        if self._own:
+            renderer = _POOL.pop(self._key, None)
+            if renderer is not None:
+                renderer.close()
+
+
+#: Raster pixels kept around a window by the clip planes of :func:`_clipped_to`: the
+#: edges that clipping makes lie this far outside the window's pixels.
+CLIP_MARGIN_PX = 4
+#: The OpenGL user clip planes the windows use (MuJoCo uses plane 0 for reflections).
+_CLIP_PLANES = (1, 2, 3, 4)
+
+
+@contextmanager
+def _clipped_to(
+    scene: mujoco.MjvScene, rect: Window, k: int, full_size: tuple[int, int]
+) -> Iterator[None]:
+    """Clip the scene's geometry to ``rect`` (canvas pixels, supersampled ``k`` times, in a
+    frame of ``full_size`` raster pixels) plus :data:`CLIP_MARGIN_PX`, for the next
+    ``mjr_render`` of the whole frame.
+
+    Four planes through the camera's centre, in eye coordinates, from the frustum
+    that ``mjr_render`` will use: geometry outside them is not rasterised, and
+    every vertex inside keeps its place in the frame.
+    """
+    from OpenGL import GL  # mujoco's own dependency (its EGL and GLFW contexts)
+
+    full_w, full_h = full_size
+    camera = scene.camera[0]
+    near = float(camera.frustum_near)
+    half_w = float(camera.frustum_width) or 0.5 * full_w / full_h * float(
+        camera.frustum_top - camera.frustum_bottom
+    )
+    left = float(camera.frustum_center) - half_w
+    right = float(camera.frustum_center) + half_w
+    bottom, top = float(camera.frustum_bottom), float(camera.frustum_top)
+    # x_ndc = (sx x + ox z) / (-z), likewise y (glFrustum), eye coordinates.
+    sx, ox = 2 * near / (right - left), (right + left) / (right - left)
+    sy, oy = 2 * near / (top - bottom), (top + bottom) / (top - bottom)
+    m = CLIP_MARGIN_PX
+    x_lo = 2 * (k * rect.x0 - m) / full_w - 1
+    x_hi = 2 * (k * rect.x1 + m) / full_w - 1
+    y_lo = 2 * (full_h - k * rect.y1 - m) / full_h - 1  # OpenGL's y runs up
+    y_hi = 2 * (full_h - k * rect.y0 + m) / full_h - 1
+    planes = (  # a point is kept where plane . (x, y, z, 1) >= 0
+        (sx, 0.0, ox + x_lo, 0.0),
+        (-sx, 0.0, -(ox + x_hi), 0.0),
+        (0.0, sy, oy + y_lo, 0.0),
+        (0.0, -sy, -(oy + y_hi), 0.0),
+    )
+    GL.glMatrixMode(GL.GL_MODELVIEW)
+    GL.glLoadIdentity()  # the planes are given in eye coordinates
+    for n, plane in zip(_CLIP_PLANES, planes, strict=True):
+        GL.glClipPlane(GL.GL_CLIP_PLANE0 + n, np.array(plane, dtype=np.float64))
+        GL.glEnable(GL.GL_CLIP_PLANE0 + n)
+    try:
+        yield
+    finally:
+        for n in _CLIP_PLANES:
+            GL.glDisable(GL.GL_CLIP_PLANE0 + n)
+
+
+#: Off-screen buffers for windows kept per OpenGL context (the least recently used goes).
+WINDOW_BUFFERS = 6
+#: Their sizes are rounded up to this many raster pixels (llvmpipe's tile), to reuse them.
+_BUFFER_STEP = 64
+
+
+class _WindowBuffer:
+    """A multisampled off-screen buffer like the context's own (same formats and
+    samples), of another size, and its single-sample resolve buffer."""
+
+    def __init__(self, context: mujoco.MjrContext, size: tuple[int, int]) -> None:
+        from OpenGL import GL
+
+        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, context.offColor)
+        colour = GL.glGetRenderbufferParameteriv(
+            GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_INTERNAL_FORMAT
+        )
+        samples = GL.glGetRenderbufferParameteriv(GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_SAMPLES)
+        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, context.offDepthStencil)
+        depth = GL.glGetRenderbufferParameteriv(
+            GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_INTERNAL_FORMAT
+        )
+        width, height = size
+        self.renderbuffers = [int(r) for r in GL.glGenRenderbuffers(3)]
+        self.framebuffers = [int(f) for f in GL.glGenFramebuffers(2)]
+        storage = (
+            (samples, colour, GL.GL_COLOR_ATTACHMENT0, 0),
+            (samples, depth, GL.GL_DEPTH_STENCIL_ATTACHMENT, 0),
+            (0, colour, GL.GL_COLOR_ATTACHMENT0, 1),
+        )
+        for renderbuffer, (n, fmt, attachment, framebuffer) in zip(
+            self.renderbuffers, storage, strict=True
+        ):
+            GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, renderbuffer)
+            GL.glRenderbufferStorageMultisample(GL.GL_RENDERBUFFER, n, fmt, width, height)
+            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffers[framebuffer])
+            GL.glFramebufferRenderbuffer(
+                GL.GL_FRAMEBUFFER, attachment, GL.GL_RENDERBUFFER, renderbuffer
+            )
+        for framebuffer in self.framebuffers:
+            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
+            status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
+            if status != GL.GL_FRAMEBUFFER_COMPLETE:
+                raise RenderBackendError(f"window buffer {size} incomplete (status {status})")
+
+
+def _draw_window(
+    renderer: mujoco.Renderer, rect: Window, k: int, full_size: tuple[int, int]
+) -> np.ndarray:
+    """Raster pixels (k h, k w, 3) of ``rect`` (canvas pixels, supersampled ``k``
+    times) of the scene, drawn as the whole frame of ``full_size`` raster pixels
+    clipped to the window (:func:`_clipped_to`).
+
+    The frame is drawn into a buffer only as large as the window's far corner
+    from the frame's origin needs (rounded up to a tile), not the context's:
+    ``mjr_render`` clears all of its viewport, and a whole frame's
+    multisampled buffer costs more to clear than the window to draw.
+    """
+    from OpenGL import GL
+
+    full_w, full_h = full_size
+    context = renderer._mjr_context
+    step, margin = _BUFFER_STEP, CLIP_MARGIN_PX
+    size = (
+        min(full_w, step * math.ceil((k * rect.x1 + margin) / step)),
+        min(full_h, step * math.ceil((full_h - k * rect.y0 + margin) / step)),
+    )
+    buffers = renderer.__dict__.setdefault("_headsim_window_buffers", OrderedDict())
+    buffer = buffers.pop(size, None) or _WindowBuffer(context, size)
+    buffers[size] = buffer
+    while len(buffers) > WINDOW_BUFFERS:
+        _, oldest = buffers.popitem(last=False)
+        GL.glDeleteFramebuffers(len(oldest.framebuffers), oldest.framebuffers)
+        GL.glDeleteRenderbuffers(len(oldest.renderbuffers), oldest.renderbuffers)
+    x, y = k * rect.x0, full_h - k * rect.y1  # OpenGL's rows run bottom-up
+    width, height = k * rect.width, k * rect.height
+    try:
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, buffer.framebuffers[0])
+        with _clipped_to(renderer.scene, rect, k, full_size):
+            mujoco.mjr_render(mujoco.MjrRect(0, 0, full_w, full_h), renderer.scene, context)
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, buffer.framebuffers[0])
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, buffer.framebuffers[1])
+        GL.glBlitFramebuffer(
+            x, y, x + width, y + height, x, y, x + width, y + height,
+            GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST,
+        )  # fmt: skip
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, buffer.framebuffers[1])
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        raw = GL.glReadPixels(x, y, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
+    finally:
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, context)
+    return np.frombuffer(raw, dtype=np.uint8).reshape(height, width, 3).copy()
+
+
+#: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.
+PREVIEW_STREAM = 1_000_003
+
+
+#: Binned canvases by (id of the canvas, binning), with the canvas kept alive.
+_BINNED: dict[tuple[int, int], tuple[DistortionCanvas, DistortionCanvas]] = {}
+
+
+def binned_canvas(
+    canvas: DistortionCanvas, binning: int, image_size: tuple[int, int]
+) -> DistortionCanvas:
+    """``canvas`` for images binned ``binning`` x ``binning`` from a canvas binned alike
+    (made once per canvas and binning).
+
+    The remap tables' b x b blocks are averaged (the block centre's sample of a
+    smooth map) and moved to the binned canvas's pixels; a block with any pixel
+    without source has none.
+    """
+    key = (id(canvas), binning)
+    if key not in _BINNED:
+        _BINNED[key] = (canvas, _binned_canvas(canvas, binning, image_size))
+    return _BINNED[key][1]
+
+
+def _binned_canvas(
+    canvas: DistortionCanvas, binning: int, image_size: tuple[int, int]
+) -> DistortionCanvas:
+    width, height = image_size
+    size = (width // binning, height // binning)
+    width_b = (canvas.size[0] - canvas.size[0] % binning) // binning
+    height_b = (canvas.size[1] - canvas.size[1] % binning) // binning
+    if canvas.map_x is None or canvas.map_y is None:
+        return DistortionCanvas((width_b, height_b), canvas.principal, None, None, 1.0)
+    offset = (binning - 1) / 2.0
+    invalid = (
+        cv2.resize((canvas.map_x < 0).astype(np.float32), size, interpolation=cv2.INTER_AREA) > 0
+    )
+    map_x = (cv2.resize(canvas.map_x, size, interpolation=cv2.INTER_AREA) - offset) / binning
+    map_y = (cv2.resize(canvas.map_y, size, interpolation=cv2.INTER_AREA) - offset) / binning
+    invalid |= (map_x < 0) | (map_x > width_b - 1) | (map_y < 0) | (map_y > height_b - 1)
+    map_x[invalid] = -1.0
+    map_y[invalid] = -1.0
+    map_x, map_y = map_x.astype(np.float32), map_y.astype(np.float32)
+    map_x.flags.writeable = map_y.flags.writeable = False
+    return DistortionCanvas(
+        size=(width_b, height_b),
+        principal=canvas.principal,
+        map_x=map_x,
+        map_y=map_y,
+        valid_fraction=float(1.0 - invalid.mean()),
+    )
+
+
+def _canvas_region(
+    map_x: np.ndarray, map_y: np.ndarray, canvas_size: tuple[int, int]
+) -> Window | None:
+    """The canvas rectangle that bilinear sampling at (map_x, map_y) reads (None: no valid source)."""
+    valid = map_x >= 0
+    if not valid.any():
+        return None
+    xs, ys = map_x[valid], map_y[valid]
+    x0 = max(math.floor(float(xs.min())) - 1, 0)
+    y0 = max(math.floor(float(ys.min())) - 1, 0)
+    x1 = min(math.floor(float(xs.max())) + 3, canvas_size[0])
+    y1 = min(math.floor(float(ys.max())) + 3, canvas_size[1])
+    return Window(x0, y0, x1 - x0, y1 - y0)

@@ -1,0 +1,434 @@
+"""The simulated head: commands, settling, encoders, ground truth and images.
+
+Frames (README "Frames"): W world, H head, and per camera its OpenCV frame
+(x right, y down, z along the optical axis).  Transforms are 4 x 4 homogeneous
+matrices named ``dst_from_src``: ``p_world = world_from_head @ p_head``.
+
+Settling has two modes.  ``"kinematic"`` (default) puts the joints exactly at
+their commanded angles and runs forward kinematics: the paper's procedures
+measure a head at rest, so this is exact, deterministic and costs nothing.
+``"physics"`` drives the position actuators and steps the dynamics until the
+joints are still (bounded; the outcome says why it stopped), for studies of
+settling error and moving heads.
+
+Joint errors (``HeadSettings.backlash_rad``, ``count_error``): each motor's
+encoder reads its commanded count, while the joint settles (in either mode)
+at the command plus a seeded offset within that count and minus half the
+backlash on the side it came from.  The true angles are ground truth only.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from headsim.sim import names
+from headsim.sim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
+from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
+from headsim.sim.render import EyeRenderer, Window, context_key
+from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
+
+#: A camera: 1 or 2 (the paper's Ca1, Ca2) or its MJCF name "cam1"/"cam2".
+CameraId = int | str
+
+
+class SettleOutcome(enum.Enum):
+    SETTLED = "settled"
+    TIMEOUT = "timeout"
+    KINEMATIC = "kinematic"
+
+
+@dataclass(frozen=True)
+class SettleResult:
+    """How a settle ended: outcome, physics steps taken, worst joint error (rad)."""
+
+    outcome: SettleOutcome
+    steps: int
+    max_error_rad: float
+
+
+class JointLimitError(ValueError):
+    """A command outside a joint's range."""
+
+
+@dataclass
+class _Commands:
+    neck_yaw: float = 0.0
+    neck_pitch: float = 0.0
+    eye: float = 0.0
+    pending: set[str] = field(default_factory=set)
+    #: Direction each joint last moved in (+1, -1; 0 before any move): backlash side.
+    approach: dict[str, float] = field(
+        default_factory=lambda: {"neck_yaw": 0.0, "neck_pitch": 0.0, "eye": 0.0}
+    )
+
+
+#: Index of each motor in the seeded count-error draw.
+_MOTOR_INDEX = {"neck_yaw": 0, "neck_pitch": 1, "eye": 2}
+
+
+def _homogeneous(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
+    transform = np.eye(4)
+    transform[:3, :3] = rotation
+    transform[:3, 3] = translation
+    return transform
+
+
+def invert_transform(transform: np.ndarray) -> np.ndarray:
+    """Inverse of a rigid 4 x 4 transform."""
+    rotation, translation = transform[:3, :3], transform[:3, 3]
+    return _homogeneous(rotation.T, -rotation.T @ translation)
+
+
+class HeadSim:
+    """A head in a scene: command joints, settle, read encoders, render, read truth."""
+
+    def __init__(
+        self,
+        scene: str | Path = "default",
+        settings: HeadSettings | None = None,
+        settle_mode: str = "kinematic",
+        settle_tolerance_rad: float = 1e-6,
+        max_settle_steps: int = 5000,
+    ) -> None:
+        if settle_mode not in ("kinematic", "physics"):
+            raise SettingsError(
+                f"settle_mode must be 'kinematic' or 'physics', got {settle_mode!r}"
+            )
+        self.settings = settings or HeadSettings()
+        self.settle_mode = settle_mode
+        self.settle_tolerance_rad = settle_tolerance_rad
+        self.max_settle_steps = max_settle_steps
+        self.built: BuiltModel = build_model(scene, self.settings)
+        self.model = self.built.model
+        self.data = mujoco.MjData(self.model)
+        self._qadr = {
+            joint: int(self.model.joint(joint).qposadr[0])
+            for joint in (names.NECK_YAW, names.NECK_PITCH, *names.EYE_JOINTS)
+        }
+        self._dofadr = {joint: int(self.model.joint(joint).dofadr[0]) for joint in self._qadr}
+        self._actuator = {
+            key: int(self.model.actuator(name).id)
+            for key, name in (
+                ("neck_yaw", names.NECK_YAW_MOTOR),
+                ("neck_pitch", names.NECK_PITCH_MOTOR),
+                ("eye", names.EYE_MOTOR),
+            )
+        }
+        self._commands = _Commands()
+        #: Bodies placed so far (targets moved: earlier images are out of date).
+        self.placements = 0
+        self._renderer = EyeRenderer(
+            self.model,
+            self.settings.cameras,
+            self.built.canvases,
+            seed=self.settings.seed,
+            key=context_key(str(scene), self.model),
+            supersample=self.settings.render.supersample,
+        )
+        self.reset()
+
+    # -- lifecycle -------------------------------------------------------
+    def reset(self) -> None:
+        """Back to the ``home`` keyframe (all joints 0)."""
+        mujoco.mj_resetDataKeyframe(self.model, self.data, self.model.key(names.HOME).id)
+        self._commands = _Commands()
+        mujoco.mj_forward(self.model, self.data)
+
+    def close(self) -> None:
+        """Free the OpenGL contexts."""
+        self._renderer.close()
+
+    def __enter__(self) -> HeadSim:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- commands ----------------------------------------------------------
+    def joint_range(self, joint: str) -> tuple[float, float]:
+        """Range of a joint (``names.NECK_YAW``, ...), rad."""
+        low, high = self.model.joint(joint).range
+        return float(low), float(high)
+
+    def _checked(self, joint: str, angle: float) -> float:
+        if not math.isfinite(angle):
+            raise JointLimitError(f"command for {joint} must be finite, got {angle}")
+        low, high = self.joint_range(joint)
+        if not low <= angle <= high:
+            raise JointLimitError(
+                f"command {angle:.6f} rad for {joint} is outside its range [{low}, {high}] rad"
+            )
+        return float(angle)
+
+    def command(
+        self,
+        *,
+        neck_yaw: float | None = None,
+        neck_pitch: float | None = None,
+        eye: float | None = None,
+    ) -> None:
+        """Set joint targets, rad (eye: the eye-motor angle, positive inward)."""
+        previous = {
+            "neck_yaw": self._commands.neck_yaw,
+            "neck_pitch": self._commands.neck_pitch,
+            "eye": self._commands.eye,
+        }
+        if neck_yaw is not None:
+            self._commands.neck_yaw = self._checked(names.NECK_YAW, neck_yaw)
+        if neck_pitch is not None:
+            self._commands.neck_pitch = self._checked(names.NECK_PITCH, neck_pitch)
+        if eye is not None:
+            self._commands.eye = self._checked(names.EYE_MOTOR_JOINT, eye)
+        for motor, old in previous.items():
+            new = getattr(self._commands, motor)
+            if new != old:
+                self._commands.approach[motor] = 1.0 if new > old else -1.0
+        true = self._true_targets()
+        for motor in ("neck_yaw", "neck_pitch", "eye"):
+            self.data.ctrl[self._actuator[motor]] = true[motor]
+
+    def command_eye_steps(self, steps: int) -> None:
+        """Command the eye motor to a whole number of encoder steps."""
+        self.command(eye=int(steps) * self.settings.encoder_resolution_rad)
+
+    def move(self, **targets: float) -> SettleResult:
+        """``command(**targets)`` then ``settle()``."""
+        self.command(**targets)
+        return self.settle()
+
+    def _joint_offset(self, motor: str, command: float) -> float:
+        """True minus commanded angle of a motor's joint, rad (0 on an ideal head)."""
+        settings = self.settings
+        offset = -0.5 * settings.backlash_rad * self._commands.approach[motor]
+        if settings.count_error:
+            resolution = settings.encoder_resolution_rad
+            count = round(command / resolution)
+            rng = np.random.default_rng(
+                [settings.seed, _MOTOR_INDEX[motor], count & 0xFFFFFFFF, count < 0]
+            )
+            offset += float(rng.uniform(-0.5, 0.5)) * resolution
+        return offset
+
+    def _true_targets(self) -> dict[str, float]:
+        """Where each motor's joint truly settles, rad, by motor name."""
+        c = self._commands
+        commands = {"neck_yaw": c.neck_yaw, "neck_pitch": c.neck_pitch, "eye": c.eye}
+        if not self.settings.joint_errors:
+            return commands
+        return {m: a + self._joint_offset(m, a) for m, a in commands.items()}
+
+    def _targets(self) -> dict[str, float]:
+        true = self._true_targets()
+        return {
+            names.NECK_YAW: true["neck_yaw"],
+            names.NECK_PITCH: true["neck_pitch"],
+            names.EYE_JOINTS[0]: true["eye"],
+            names.EYE_JOINTS[1]: true["eye"],
+        }
+
+    def settle(self) -> SettleResult:
+        """Bring the joints to their targets (see the module docstring for modes)."""
+        targets = self._targets()
+        if self.settle_mode == "kinematic":
+            for joint, angle in targets.items():
+                self.data.qpos[self._qadr[joint]] = angle
+                self.data.qvel[self._dofadr[joint]] = 0.0
+            mujoco.mj_forward(self.model, self.data)
+            return SettleResult(SettleOutcome.KINEMATIC, 0, 0.0)
+        error = math.inf
+        for step in range(1, self.max_settle_steps + 1):
+            mujoco.mj_step(self.model, self.data)
+            error = max(abs(self.data.qpos[self._qadr[j]] - a) for j, a in targets.items())
+            speed = max(abs(self.data.qvel[self._dofadr[j]]) for j in targets)
+            if error < self.settle_tolerance_rad and speed < self.settle_tolerance_rad * 10:
+                mujoco.mj_forward(self.model, self.data)
+                return SettleResult(SettleOutcome.SETTLED, step, float(error))
+        mujoco.mj_forward(self.model, self.data)
+        return SettleResult(SettleOutcome.TIMEOUT, self.max_settle_steps, float(error))
+
+    def step(self, n: int = 1) -> None:
+        """Advance the physics ``n`` steps with the current commands."""
+        for _ in range(n):
+            mujoco.mj_step(self.model, self.data)
+
+    # -- encoders ----------------------------------------------------------
+    def _quantise(self, angle: float) -> float:
+        resolution = self.settings.encoder_resolution_rad
+        return round(angle / resolution) * resolution
+
+    def _read(self, motor: str, joint: str) -> float:
+        """What a motor's encoder sees, rad, before quantisation: the joint, or with
+        joint errors the motor shaft (its command), since the errors lie beyond it."""
+        if self.settings.joint_errors:
+            return float(getattr(self._commands, motor))
+        return float(self.data.qpos[self._qadr[joint]])
+
+    def eye_encoder(self) -> float:
+        """Eye-motor encoder reading, rad, a whole multiple of the resolution."""
+        return self._quantise(self._read("eye", names.EYE_MOTOR_JOINT))
+
+    def eye_encoder_steps(self) -> int:
+        """Eye-motor encoder reading, whole steps."""
+        return round(
+            self._read("eye", names.EYE_MOTOR_JOINT) / self.settings.encoder_resolution_rad
+        )
+
+    def neck_encoders(self) -> tuple[float, float]:
+        """Neck (yaw, pitch) encoder readings, rad, quantised like the eye encoder."""
+        return (
+            self._quantise(self._read("neck_yaw", names.NECK_YAW)),
+            self._quantise(self._read("neck_pitch", names.NECK_PITCH)),
+        )
+
+    @property
+    def belief(self) -> HeadBelief:
+        """What the head believes of its own geometry (its design); see ``HeadSettings.believed``."""
+        return self.settings.believed
+
+    # -- ground truth ------------------------------------------------------
+    def true_joint_angles(self) -> dict[str, float]:
+        """True joint angles by joint name, rad (not quantised)."""
+        return {joint: float(self.data.qpos[adr]) for joint, adr in self._qadr.items()}
+
+    def camera_index(self, camera: CameraId) -> int:
+        """Position in ``settings.cameras`` (0, 1) of camera 1 or 2 (the paper's Ca1, Ca2) or its name."""
+        if isinstance(camera, int) and not isinstance(camera, bool) and camera in (1, 2):
+            return camera - 1
+        if camera in names.CAMERAS:
+            return names.CAMERAS.index(str(camera))
+        raise SettingsError(f"unknown camera {camera!r}; allowed: 1, 2, {', '.join(names.CAMERAS)}")
+
+    def camera_settings(self, camera: CameraId) -> CameraSettings:
+        return self.settings.cameras[self.camera_index(camera)]
+
+    def world_from_head(self) -> np.ndarray:
+        """Pose of H in W, 4 x 4 (eq. (1) of the paper)."""
+        body = self.data.body(names.HEAD)
+        return _homogeneous(body.xmat.reshape(3, 3), body.xpos)
+
+    def world_from_camera(self, camera: CameraId) -> np.ndarray:
+        """Pose of a camera's OpenCV frame in W, 4 x 4."""
+        cam = self.data.camera(names.CAMERAS[self.camera_index(camera)])
+        return _homogeneous(cam.xmat.reshape(3, 3) @ CV_FROM_MJCAM, cam.xpos)
+
+    def head_from_camera(self, camera: CameraId) -> np.ndarray:
+        """Pose of a camera's OpenCV frame in H, 4 x 4."""
+        return invert_transform(self.world_from_head()) @ self.world_from_camera(camera)
+
+    def frame_from_world(self, frame: str) -> np.ndarray:
+        """Transform from W to ``frame``: "world", "head", "cam1" or "cam2"."""
+        if frame == "world":
+            return np.eye(4)
+        if frame == "head":
+            return invert_transform(self.world_from_head())
+        if frame in names.CAMERAS:
+            return invert_transform(self.world_from_camera(frame))
+        raise SettingsError(
+            f"unknown frame {frame!r}; allowed: world, head, {', '.join(names.CAMERAS)}"
+        )
+
+    def position(self, name: str, frame: str = "world") -> np.ndarray:
+        """Position of a body or site named ``name`` in ``frame``, m."""
+        if mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name) >= 0:
+            p_world = self.data.body(name).xpos
+        elif mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, name) >= 0:
+            p_world = self.data.site(name).xpos
+        else:
+            raise SettingsError(f"no body or site named {name!r} in this scene")
+        return self.transform_points(p_world, "world", frame)[0]
+
+    def transform_points(self, points: np.ndarray, src: str, dst: str) -> np.ndarray:
+        """Map points (N, 3) from frame ``src`` to frame ``dst``, m."""
+        points = np.atleast_2d(np.asarray(points, dtype=float))
+        transform = self.frame_from_world(dst) @ invert_transform(self.frame_from_world(src))
+        return points @ transform[:3, :3].T + transform[:3, 3]
+
+    def set_body_pose(
+        self, name: str, position_world_m: np.ndarray, quat_world: np.ndarray | None = None
+    ) -> None:
+        """Place a mocap body (a target) in the world; takes effect at once."""
+        self._move_mocap(name, position_world_m, quat_world)
+
+    def park_body(self, name: str, position_world_m: np.ndarray) -> None:
+        """Put a prop back out of the way after a procedure used it (not a new target placement)."""
+        self._move_mocap(name, position_world_m, None)
+
+    def _move_mocap(
+        self, name: str, position_world_m: np.ndarray, quat_world: np.ndarray | None
+    ) -> None:
+        body_id = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
+        mocap_id = int(self.model.body_mocapid[body_id]) if body_id >= 0 else -1
+        if mocap_id < 0:
+            raise SettingsError(f"{name!r} is not a movable (mocap) body in this scene")
+        self.placements += 1
+        self.data.mocap_pos[mocap_id] = position_world_m
+        if quat_world is not None:
+            self.data.mocap_quat[mocap_id] = quat_world
+        mujoco.mj_forward(self.model, self.data)
+
+    def camera_matrix(self, camera: CameraId) -> np.ndarray:
+        """True intrinsic matrix K of a camera's output image, px."""
+        return camera_matrix(self.camera_settings(camera))
+
+    def dist_coeffs(self, camera: CameraId) -> np.ndarray:
+        """True OpenCV distortion vector (k1, k2, 0, 0, 0)."""
+        return dist_coeffs(self.camera_settings(camera))
+
+    def project(self, points_world: np.ndarray, camera: CameraId) -> np.ndarray:
+        """True pixel coordinates (N, 2) of world points in a camera's image (with distortion)."""
+        cam_points = self.transform_points(
+            points_world, "world", names.CAMERAS[self.camera_index(camera)]
+        )
+        return project_points(cam_points, self.camera_settings(camera))
+
+    def effective_initial_direction(self, camera: CameraId, goal_u: float | None = None) -> float:
+        """The eye's effective initial direction, rad (what Sec. V calibration finds).
+
+        The horizontal angle, in the eye frame at eye angle 0, of the ray through
+        the servo's goal column ``goal_u`` (default: the image centre's) at the
+        image centre row, positive inward: the mount yaw plus the angle by which
+        that column's ray is off the optical axis.  At the principal point's
+        column it is the mount yaw, on every row.
+        """
+        index = self.camera_index(camera)
+        cam = self.settings.cameras[index]
+        u_c, v_c = cam.image_centre
+        pixel = np.array([u_c if goal_u is None else goal_u, v_c])
+        xy = cam.pinhole().normalise(pixel)  # raises if no ray
+        ray_eye = eye_from_camera_rotation(cam, index) @ np.array([xy[0], xy[1], 1.0])
+        yaw = math.atan2(ray_eye[0], ray_eye[2])
+        return yaw if index == 0 else -yaw
+
+    # -- images ------------------------------------------------------------
+    def render(self, camera: CameraId) -> np.ndarray:
+        """The camera's current image, (H, W, 3) uint8, with its lens and noise."""
+        return self._renderer.render(self.data, self.camera_index(camera))
+
+    def retake(self, camera: CameraId) -> np.ndarray:
+        """The whole image of the instant just taken as a window (same noise), counted."""
+        return self._renderer.render(self.data, self.camera_index(camera), retake=True)
+
+    def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
+        """Only ``window`` of the camera's image: the full image's crop, (h, w, 3) uint8."""
+        return self._renderer.render_window(self.data, self.camera_index(camera), window)
+
+    def render_preview(self, camera: CameraId, binning: int) -> np.ndarray:
+        """The camera's whole view binned ``binning`` x ``binning`` (for finding where to
+        look), (H/b, W/b, 3) uint8, counted as a render."""
+        return self._renderer.render_preview(self.data, self.camera_index(camera), binning)
+
+    @property
+    def render_count(self) -> int:
+        """Images rendered so far by this simulator (full frames and windows)."""
+        return self._renderer.render_count
+
+    @property
+    def rendered_frames(self) -> float:
+        """Pixels rendered so far by this simulator, in full frames."""
+        return self._renderer.rendered_frames

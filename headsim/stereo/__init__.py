@@ -1,0 +1,1 @@
+"""The baseline: Zhang-calibrated stereo (OpenCV) on the same rendered scenes."""

@@ -1,0 +1,473 @@
+"""Regression benchmarks: a fixed suite, one metrics file, a comparison with a stored baseline.
+
+Metrics are chosen to survive a faster or slower machine: accuracy (errors in
+% of depth, mm, rad), effort (renders per point) and speed as ratios (wall
+time per point over the time of one render; estimator throughput over a bare
+numpy reference on the same arrays).  ``benchmarks/baseline.json`` holds the
+reference values and why they were last set; ``benchmarks/tolerances.json``
+how far each metric may move, and in which direction is worse.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import platform
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import headsim
+from headsim.active.procedures import (
+    HeadKnowledge,
+    calibrate_head,
+    calibration_layout,
+    line_of_sight_truth,
+    measure_model2,
+)
+from headsim.active.servo import EyeServo, ServoConfig
+from headsim.estimators.throughput import run as estimator_throughput
+from headsim.run.results import write_json_atomic
+from headsim.sim import names
+from headsim.sim.settings import HeadSettings, paper_head, preset
+from headsim.sim.simulator import HeadSim
+from headsim.studies import experiments
+
+BENCH_DIR = Path(__file__).resolve().parents[2] / "benchmarks"
+BASELINE = BENCH_DIR / "baseline.json"
+TOLERANCES = BENCH_DIR / "tolerances.json"
+
+Metrics = dict[str, float]
+Progress = Callable[[str], None]
+
+
+def _quiet(_: str) -> None:
+    pass
+
+
+@dataclass(frozen=True)
+class Faults:
+    """Regressions injected on purpose, to prove the comparison catches them.
+
+    ``mount_sign``: the calibrated initial directions are used with the wrong
+    sign (a sign slip in an eye's mount offset).  ``double_renders``: every
+    servo observation renders twice (a servo that needs twice the renders).
+    """
+
+    mount_sign: bool = False
+    double_renders: bool = False
+
+
+def _measure_points(
+    settings: HeadSettings,
+    knowledge: HeadKnowledge,
+    points_head: np.ndarray,
+    faults: Faults,
+    windows: bool = True,
+) -> tuple[list[Any], float, float, list[Any], float]:
+    """Model 2 on each point; returns the measurements, the median render time, s, the
+    pixels rendered for the points in full frames, every detection the servo made, and
+    the wall time of the points alone, s (not the simulator's set-up or the render timing)."""
+    with HeadSim("default", settings) as sim:
+        servo = EyeServo(sim, ServoConfig(windows=windows))
+        seen: list[Any] = []
+        look = servo.observe
+
+        def logged(camera: int, detector: Any, key: object = None) -> Any:
+            detection = look(camera, detector, key)
+            seen.append(detection.uv)
+            return detection
+
+        servo.observe = logged  # type: ignore[method-assign]
+        if faults.double_renders:
+            observe = servo.observe
+
+            def twice(camera: int, detector: Any, key: object = None) -> Any:
+                sim.render(camera)
+                return observe(camera, detector, key)
+
+            servo.observe = twice  # type: ignore[method-assign]
+        render_s = experiments.render_time_s(sim)
+        frames = sim.rendered_frames
+        start = time.perf_counter()
+        out = []
+        for p in points_head:
+            sim.set_body_pose("marker_red", sim.transform_points(p, "head", "world")[0])
+            out.append(measure_model2(sim, servo, experiments.RED, knowledge))
+        wall = time.perf_counter() - start
+        frames = sim.rendered_frames - frames
+        # Timed again after the points: the machine's load moves while they run.
+        render_s = (render_s + experiments.render_time_s(sim)) / 2
+    return out, render_s, frames, seen, wall
+
+
+#: The suite's parts, in order; ``suite(parts=...)`` runs a subset (tests do).
+PARTS = ("ideal", "paper", "realistic", "scenarios", "speed")
+
+
+def suite(
+    seed: int = 0,
+    faults: Faults | None = None,
+    progress: Progress = _quiet,
+    parts: tuple[str, ...] = PARTS,
+) -> Metrics:
+    """Run the fixed suite; metrics by name (see ``benchmarks/tolerances.json``)."""
+    unknown = set(parts) - set(PARTS)
+    if unknown:
+        raise ValueError(f"unknown bench parts {sorted(unknown)}; allowed: {', '.join(PARTS)}")
+    faults = faults or Faults()
+    metrics: Metrics = {}
+    if "ideal" in parts:
+        metrics.update(_ideal_part(seed, faults, progress))
+    if "paper" in parts:
+        metrics.update(_paper_part(seed, faults, progress))
+    if "realistic" in parts:
+        metrics.update(_realistic_part(seed, faults, progress))
+    if "scenarios" in parts:
+        for name in PAPER_SCENARIOS:
+            progress(f"scenario {name} (fast)")
+            metrics.update(scenario_metrics(name))
+    if "speed" in parts:
+        progress("estimator throughput")
+        speed = estimator_throughput(200_000, repeats=3, seed=seed)
+        metrics["speed.model2_over_numpy"] = speed["model2_over_numpy_eq4_11"]
+        progress("quick start, full size")
+        metrics["speed.quickstart_over_render"] = _quickstart_over_render()
+    return metrics
+
+
+def _ideal_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
+    rng = np.random.default_rng(seed)
+    metrics: Metrics = {}
+    progress("ideal cameras, Model 2")
+    points = np.concatenate(
+        [
+            experiments.random_targets_head(rng, 4, band, vertical=(-0.15, 0.15))
+            for band in experiments.DEPTH_BANDS_M
+        ]
+    )
+    ideal, render_s, frames, seen, wall = _measure_points(
+        HeadSettings(), HeadKnowledge(), points, faults
+    )
+    wall /= len(points)
+    # The same points with full frames only: windows must change no answer.
+    plain, _, _, plain_seen, _ = _measure_points(
+        HeadSettings(), HeadKnowledge(), points, faults, windows=False
+    )
+    fig = experiments.error_figures(ideal)
+    metrics["ideal.model2.rms_3d_pct_depth"] = fig["rms_3d_pct_depth"]
+    metrics["ideal.model2.failed"] = float(fig["failed"])
+    metrics["ideal.model2.renders_per_point"] = float(np.mean([m.renders for m in ideal[1:]]))
+    metrics["ideal.model2.servo_residual_px_mean"] = float(
+        np.mean([abs(r) for m in ideal if m.ok for r in m.servo_residual_px])
+    )
+    metrics["speed.wall_per_point_over_render"] = wall / render_s
+    metrics["ideal.model2.rendered_frames_per_point"] = frames / len(points)
+    metrics["windows.max_estimate_change_m"] = max(
+        (
+            float(np.max(np.abs(a.estimate_head_m - b.estimate_head_m)))
+            for a, b in zip(ideal, plain, strict=True)
+            if a.ok and b.ok
+        ),
+        default=math.inf,
+    )
+    same_sequence = len(seen) == len(plain_seen) and all(
+        (a is None) == (b is None) for a, b in zip(seen, plain_seen, strict=True)
+    )
+    metrics["windows.max_detection_change_px"] = (
+        max(
+            (
+                float(np.max(np.abs(np.subtract(a, b))))
+                for a, b in zip(seen, plain_seen, strict=True)
+                if a is not None and b is not None
+            ),
+            default=0.0,
+        )
+        if same_sequence
+        else math.inf
+    )
+    return metrics
+
+
+def _quickstart_over_render() -> float:
+    """Wall time of the quick start scenario at full size over one 640x480 render,
+    the render timed just before and just after it."""
+    from headsim.run.runner import run_scenario
+    from headsim.scenario.schema import load_scenario
+
+    scenario = load_scenario("quickstart")
+    with HeadSim("default", HeadSettings()) as sim:
+        sim.move(eye=0.05)
+        before = experiments.render_time_s(sim)
+        start = time.perf_counter()
+        run_scenario(scenario)
+        wall = time.perf_counter() - start
+        after = experiments.render_time_s(sim)
+    return wall / ((before + after) / 2)
+
+
+def _paper_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
+    rng = np.random.default_rng(seed + 1)
+    metrics: Metrics = {}
+    progress("paper's cameras: Sec. V calibration")
+    settings = paper_head()
+    with HeadSim("default", settings) as sim:
+        run = calibrate_head(
+            sim,
+            EyeServo(sim),
+            experiments.BALL,
+            names.CALIBRATION_BALL,
+            calibration_layout(sim, rng, 30),
+        )
+    knowledge = run.knowledge
+    if faults.mount_sign:
+        knowledge = HeadKnowledge(
+            alpha_e=(-knowledge.alpha_e[0], knowledge.alpha_e[1]),
+            v0=knowledge.v0,
+            kx_over_ky=knowledge.kx_over_ky,
+        )
+    metrics["paper.calibration.max_error_rad"] = float(np.abs(run.alpha_e_error).max())
+
+    progress("paper's cameras: Model 2 near the centre row")
+    low, high = experiments.visible_vertical_range(settings)
+    near = np.concatenate(
+        [
+            experiments.random_targets_head(
+                rng, 3, band, vertical=(max(low, -0.05), min(high, 0.03))
+            )
+            for band in experiments.DEPTH_BANDS_M
+        ]
+    )
+    paper, _, _, _, _ = _measure_points(settings, knowledge, near, faults)
+    fig = experiments.error_figures(paper)
+    x, y, z = fig.get("rms_pct_depth_xyz", [math.nan] * 3)
+    metrics["paper.model2.x_rms_pct_depth"] = x
+    metrics["paper.model2.y_rms_pct_depth"] = y
+    metrics["paper.model2.z_rms_pct_depth"] = z
+    metrics["paper.model2.failed"] = float(fig["failed"])
+
+    progress("chessboard")
+    board = experiments.chessboard_accuracy(settings, knowledge, corners=[18, 19, 20, 26, 27, 28])[
+        "extended calibration"
+    ]
+    metrics["chessboard.width_error_mm"] = (
+        abs(board["width_mean_mm"] - 30.0) if board["width_mean_mm"] else math.inf
+    )
+    metrics["chessboard.height_error_mm"] = (
+        abs(board["height_mean_mm"] - 30.0) if board["height_mean_mm"] else math.inf
+    )
+    metrics["chessboard.corners_missed"] = float(board["corners"] - board["corners_measured"])
+    metrics["chessboard.width_std_mm"] = board["width_std_mm"] or math.inf
+    metrics["chessboard.height_std_mm"] = board["height_std_mm"] or math.inf
+
+    progress("relative positioning")
+    areas = experiments.relative_areas(rng, layouts=2)
+    metrics["areas.correct_pct"] = areas["outside_margin_correct_pct"] or 0.0
+    progress("relative positioning, the paper's cameras")
+    areas = experiments.relative_areas(rng, layouts=2, settings=settings)
+    metrics["areas.paper.correct_pct"] = areas["outside_margin_correct_pct"] or 0.0
+    return metrics
+
+
+def _realistic_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
+    """The realistic preset over the whole shared field after the extended calibration."""
+    rng = np.random.default_rng(seed + 2)
+    metrics: Metrics = {}
+    progress("realistic head: extended calibration (30 balls, 1 mm tape)")
+    settings = preset("realistic")
+    with HeadSim("default", settings) as sim:
+        run = calibrate_head(
+            sim,
+            EyeServo(sim),
+            experiments.BALL,
+            names.CALIBRATION_BALL,
+            calibration_layout(sim, rng, 30, depth_range_m=(0.25, 1.5)),
+            position_noise_m=0.001,
+            rng=np.random.default_rng([seed, 7]),
+            lines_of_sight=True,
+        )
+        truth = line_of_sight_truth(sim, run.knowledge)
+    knowledge = run.knowledge
+    if faults.mount_sign:
+        knowledge = replace(knowledge, alpha_e=(-knowledge.alpha_e[0], knowledge.alpha_e[1]))
+    lines = run.lines
+    metrics["realistic.calibration.effective_baseline_error_mm"] = (
+        abs(1e3 * (lines.effective_baseline_m - truth.effective_baseline_m)) if lines else math.inf
+    )
+    progress("realistic head: Model 2 over the whole field")
+    points = np.concatenate(
+        [
+            experiments.random_targets_head(rng, 4, band, lateral=0.15, vertical=(-0.1, 0.1))
+            for band in experiments.DEPTH_BANDS_M
+        ]
+    )
+    measured, *_ = _measure_points(settings, knowledge, points, faults)
+    fig = experiments.error_figures(measured)
+    near = experiments.error_figures([m for m in measured if m.depth_m < 0.6])
+    metrics["realistic.model2.rms_3d_pct_depth"] = fig.get("rms_3d_pct_depth", math.inf)
+    metrics["realistic.model2.near_rms_3d_pct_depth"] = near.get("rms_3d_pct_depth", math.inf)
+    metrics["realistic.model2.failed"] = float(fig["failed"])
+    metrics["realistic.model2.renders_per_point"] = float(
+        np.mean([m.renders for m in measured[1:]])
+    )
+    return metrics
+
+
+#: The paper scenarios whose fast variants the suite runs.
+PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "tracking")
+
+
+def scenario_metrics(name: str) -> Metrics:
+    """Run a scenario's fast variant: failures, RMS error (% of depth) and renders."""
+    from headsim.run.runner import run_scenario
+    from headsim.scenario.schema import load_scenario
+
+    scenario = load_scenario(name, fast=True)
+    result = run_scenario(scenario)
+    # Measurements made without the scenario's calibration (its "before" checks) do not count.
+    calibrated = result.calibration is not None
+    errors = [
+        r.measurement.error_pct_of_depth
+        for r in result.records
+        if r.measurement.ok and (r.knowledge != "none" or not calibrated)
+    ]
+    metrics = {
+        f"scenario.{name}.failures": float(len(result.failures)),
+        f"scenario.{name}.rms_error_pct_depth": float(np.sqrt(np.mean(np.square(errors))))
+        if errors
+        else math.inf,
+        # Per fixation, so that +0.5 renders per point is one tolerance everywhere.
+        f"scenario.{name}.renders_per_point": float(result.renders["total"])
+        / max(scenario.fixations, 1),
+    }
+    if result.calibration and "alpha_e_error_rad" in result.calibration:
+        metrics[f"scenario.{name}.calibration_max_error_rad"] = float(
+            np.max(np.abs(result.calibration["alpha_e_error_rad"]))
+        )
+    return metrics
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """One metric compared with its baseline."""
+
+    metric: str
+    baseline: float | None
+    now: float
+    change: float | None
+    allowed: float | None
+    regressed: bool
+
+    @property
+    def label(self) -> str:
+        if self.baseline is None:
+            return "new"
+        return "REGRESSED" if self.regressed else "ok"
+
+
+def compare(
+    metrics: Metrics, baseline: Metrics, tolerances: dict[str, dict[str, Any]]
+) -> list[Verdict]:
+    """Each metric against the baseline: worse by more than ``abs + rel * |baseline|`` regresses.
+
+    ``tolerances[metric]`` = {"worse": "higher" or "lower", "abs": float, "rel": float}.
+    A metric without a tolerance entry is reported, never failed.
+    """
+    verdicts = []
+    for metric, now in metrics.items():
+        base = baseline.get(metric)
+        rule = tolerances.get(metric)
+        if base is None or rule is None:
+            verdicts.append(Verdict(metric, base, now, None, None, False))
+            continue
+        allowed = float(rule.get("abs", 0.0)) + float(rule.get("rel", 0.0)) * abs(base)
+        worse_by = (now - base) if rule["worse"] == "higher" else (base - now)
+        regressed = not math.isfinite(now) or worse_by > allowed
+        verdicts.append(Verdict(metric, base, now, now - base, allowed, regressed))
+    return verdicts
+
+
+def format_table(verdicts: list[Verdict]) -> str:
+    """The comparison as a readable table."""
+    lines = [
+        f"{'metric':54s} {'baseline':>12s} {'now':>12s} {'change':>11s} {'allowed':>10s}  verdict"
+    ]
+    for v in verdicts:
+        base = "-" if v.baseline is None else f"{v.baseline:12.5g}"
+        change = "-" if v.change is None else f"{v.change:+11.3g}"
+        allowed = "-" if v.allowed is None else f"{v.allowed:10.3g}"
+        lines.append(
+            f"{v.metric:54s} {base:>12s} {v.now:12.5g} {change:>11s} {allowed:>10s}  {v.label}"
+        )
+    return "\n".join(lines)
+
+
+def load_json(path: Path) -> dict[str, Any]:
+    return json.loads(path.read_text()) if path.exists() else {}
+
+
+def environment() -> dict[str, str]:
+    import mujoco
+
+    return {
+        "headsim": headsim.__version__,
+        "mujoco": mujoco.__version__,
+        "numpy": np.__version__,
+        "python": platform.python_version(),
+        "machine": platform.machine(),
+    }
+
+
+def main(args: Any) -> int:
+    """``headsim bench``: run the suite, compare, print, maybe update the baseline."""
+
+    terminal = sys.stderr.isatty()
+    quiet = getattr(args, "quiet", False)
+    start = time.perf_counter()
+
+    def progress(message: str) -> None:
+        if quiet:
+            return
+        if terminal:
+            print(f"\r  bench: {message:60s}", end="", file=sys.stderr, flush=True)
+        else:  # a log: one plain line per phase, no carriage returns
+            elapsed = time.perf_counter() - start
+            print(f"headsim bench: [{elapsed:6.1f} s] {message}", file=sys.stderr, flush=True)
+
+    metrics = suite(seed=args.seed, progress=progress)
+    wall = time.perf_counter() - start
+    if terminal and not quiet:
+        print("\r" + " " * 72 + "\r", end="", file=sys.stderr)
+    baseline_path = Path(args.baseline)
+    stored = load_json(baseline_path)
+    verdicts = compare(metrics, stored.get("metrics", {}), load_json(Path(args.tolerances)))
+    print(format_table(verdicts))
+    print(f"suite wall time {wall:.0f} s")
+    if args.json:
+        write_json_atomic(
+            args.json, {"metrics": metrics, "wall_s": wall, "environment": environment()}
+        )
+    if args.update_baseline:
+        if not args.reason:
+            print(
+                "headsim bench: --update-baseline needs --reason 'why the figures changed'",
+                file=sys.stderr,
+            )
+            return 2
+        history = stored.get("history", [])
+        history.append({"reason": args.reason, "environment": environment()})
+        write_json_atomic(
+            baseline_path, {"metrics": metrics, "seed": args.seed, "history": history}
+        )
+        print(f"baseline written to {baseline_path}")
+        return 0
+    regressions = [v for v in verdicts if v.regressed]
+    if regressions:
+        print(f"{len(regressions)} metric(s) regressed: {', '.join(v.metric for v in regressions)}")
+        return 1
+    return 0

@@ -1,0 +1,299 @@
+"""Tables V/VI on the reproduction's one head, with its one calibration (``headsim reproduce``).
+
+:mod:`headsim.studies.study` calibrates every method itself, on two base heads, for
+ten conditions.  ``headsim reproduce`` measures what the paper's Tables V
+and VI and its changed focal length need, on the one head the rest of the
+reproduction uses, calibrated once:
+
+- ``stereo``: Zhang's chessboard calibration of this head at eye angle 0
+  (:func:`zhang_calibration`, made once and kept for every condition);
+- ``active_centre`` (Table VI): the one Sec. V calibration (``head.json``)'s
+  initial directions, nothing else;
+- ``active_v_known`` (Table V): the same with Zhang's principal-point v;
+- ``active_extended``: ``head.json``'s whole knowledge (its extended fit);
+- ``active_fixed_point`` and ``active_refound`` (beyond the paper, but what
+  shows its insensitivity to the focal length here): the principal point
+  found as a zoom's fixed point, the servo on its column, with their own
+  Sec. V calibration on that column (:func:`fixed_point_calibration`, made
+  once beside Zhang's); ``active_refound`` finds the fixed point again on
+  the head it measures.
+
+Conditions: the six target positions as calibrated, then the cameras zoomed
+1.5x with every calibration kept.  The three active methods servo on the
+same column (the image centre) and differ only in what Model 2 computes from
+the images, so each target is servoed once and every active method's
+estimate is computed from those same images (:func:`measure_paired`; the
+renders are counted once, on ``active_centre``).  The study's other parts (a
+second base head with centred principal points, the 0.7x zoom,
+principal-point and k1 changes) are left to ``python -m headsim.studies.study``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from headsim.active.principal import PrincipalPointRun, zoomed
+from headsim.active.procedures import (
+    CalibrationRun,
+    HeadKnowledge,
+    Measurement,
+    calibrate_head,
+    measure_model2,
+)
+from headsim.active.servo import EyeServo
+from headsim.estimators import model2
+from headsim.sim import names
+from headsim.sim.settings import HeadSettings
+from headsim.sim.simulator import HeadSim
+from headsim.stereo import zhang as stereo
+from headsim.studies.study import (
+    BALL,
+    TARGET,
+    Condition,
+    ConditionResult,
+    Experiment,
+    ExperimentResult,
+    StudyConfig,
+    TargetError,
+    calibration_positions,
+    summarise,
+    table_targets,
+    zhang_stereo,
+    zoom_fixed_points,
+)
+
+#: The methods measured, in table order; the first three active ones share their images.
+METHODS = (
+    "stereo",
+    "active_v_known",
+    "active_centre",
+    "active_extended",
+    "active_fixed_point",
+    "active_refound",
+)
+#: The active methods that servo on the image centre's column.
+CENTRE_METHODS = METHODS[1:4]
+#: The active method whose servo runs (the others reuse its images).
+SERVOED = "active_centre"
+#: The paper's changed focal length, with every calibration kept.
+ZOOM = 1.5
+
+
+def zhang_calibration(
+    settings: HeadSettings, config: StudyConfig
+) -> tuple[stereo.StereoCalibration, int]:
+    """Zhang's calibration of ``settings``' pair (as :func:`headsim.studies.study.zhang_stereo`),
+    and the renders it took."""
+    calibration, views = zhang_stereo(settings, config)
+    return calibration, views.renders
+
+
+@dataclass(frozen=True)
+class FixedPoint:
+    """The zoom fixed points of the head as calibrated and the Sec. V calibration on
+    their columns, and the renders both took."""
+
+    principal: PrincipalPointRun
+    calibration: CalibrationRun
+    renders: int
+    #: The head and seed the fixed points were found on (None: not recorded).
+    settings: HeadSettings | None = None
+    seed: int | None = None
+
+    def knowledge(self, refound: PrincipalPointRun | None = None) -> HeadKnowledge:
+        """``active_fixed_point``'s knowledge, or with ``refound``'s columns and rows
+        (``active_refound``)."""
+        if refound is None:
+            return self.calibration.knowledge
+        (u1, v1), (u2, v2) = refound.principal_px
+        return replace(self.calibration.knowledge, u0=(u1, u2), v0=(v1, v2))
+
+
+def fixed_point_calibration(settings: HeadSettings, config: StudyConfig) -> FixedPoint:
+    """The fixed points of a zoom (images only) and Sec. V with the servo on their columns."""
+    principal = zoom_fixed_points(settings, config)
+    with HeadSim("default", settings) as sim:
+        positions = calibration_positions(sim, settings, config)
+        (u1, _), (u2, _) = principal.principal_px
+        start = sim.render_count
+        calibration = calibrate_head(
+            sim,
+            EyeServo(sim),
+            BALL,
+            names.CALIBRATION_BALL,
+            positions,
+            knowledge=HeadKnowledge(u0=(u1, u2)),
+        )
+        renders = principal.renders + sim.render_count - start
+    return FixedPoint(principal, calibration, renders, settings, config.seed)
+
+
+def active_knowledge(
+    stored: HeadKnowledge, zhang: stereo.StereoCalibration
+) -> dict[str, HeadKnowledge]:
+    """Each active method's knowledge: from the one Sec. V calibration and Zhang's v0."""
+    if stored.u0 != (None, None):
+        raise ValueError("the calibration's servo column is not the image centre's")
+    return {
+        "active_v_known": HeadKnowledge(
+            alpha_e=stored.alpha_e, v0=(zhang.cam1.K[1, 2], zhang.cam2.K[1, 2])
+        ),
+        "active_centre": HeadKnowledge(alpha_e=stored.alpha_e),
+        "active_extended": stored,
+    }
+
+
+def recompute(sim: HeadSim, measured: Measurement, knowledge: HeadKnowledge) -> np.ndarray:
+    """Model 2's estimate in H, m, from ``measured``'s fixations and images with ``knowledge``.
+
+    ``knowledge`` must have ``measured``'s servo column (u0); only what Model
+    2 computes differs (alpha_e, v0, kx/ky, line-of-sight offsets).
+    """
+    d = measured.details
+    (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+    estimate = model2(
+        [d["alpha1_rad"]],
+        [d["alpha2_rad"]],
+        np.array([[d["u11_px"], d["v11_px"]]]),
+        np.array([[d["u21_px"], d["v21_px"]]]),
+        knowledge.head_belief(sim).baseline_m,
+        uv10=(u10, v10),
+        uv20=(u20, v20),
+        alpha_e=knowledge.alpha_e,
+        gamma1=[d["gamma1_rad"]],
+        gamma2=[d["gamma2_rad"]],
+        kx_over_ky=knowledge.kx_over_ky,
+        los_offset_m=knowledge.line_of_sight_offsets(sim),
+    )
+    if not bool(estimate.valid[0]):
+        return np.full(3, np.nan)
+    return np.asarray(estimate.positions[0], dtype=float)
+
+
+def measure_paired(
+    settings: HeadSettings,
+    zhang: stereo.StereoCalibration,
+    knowledges: dict[str, HeadKnowledge],
+    targets_head: np.ndarray,
+    fixed: FixedPoint | None = None,
+    config: StudyConfig | None = None,
+) -> list[TargetError]:
+    """The red marker at each of ``targets_head`` (N, 3) m: stereo, then one servo for
+    the image-centre methods (``knowledges``), then with ``fixed`` the fixed-point
+    methods, each its own servo (``active_refound`` first finds the fixed points on
+    ``settings``, seeded as ``config``'s)."""
+    out: list[TargetError] = []
+    config = config or StudyConfig()
+    refound = None
+    if fixed is not None:
+        # On the head they were calibrated on, found again they are the same images
+        # and the same answer (deterministic from the seed): taken from ``fixed``.
+        refound = (
+            fixed.principal
+            if fixed.settings == settings and fixed.seed == config.seed
+            else zoom_fixed_points(settings, config)
+        )
+    with HeadSim("default", settings) as sim:
+        servo = EyeServo(sim)
+        for index, p_head in enumerate(np.atleast_2d(np.asarray(targets_head, dtype=float))):
+            sim.set_body_pose(TARGET.name, sim.transform_points(p_head, "head", "world")[0])
+            truth = sim.position(TARGET.name, "head")
+            start = sim.render_count
+            try:
+                m = stereo.measure_point_stereo(sim, zhang, TARGET.name)
+                estimate, status = m.p_head, "ok"
+            except stereo.StereoError as error:
+                estimate, status = np.full(3, np.nan), str(error)
+            out.append(
+                TargetError("stereo", index, truth, estimate, status, sim.render_count - start)
+            )
+            sim.move(eye=0.0)
+            start = sim.render_count
+            measured = measure_model2(sim, servo, TARGET, knowledges[SERVOED])
+            renders = sim.render_count - start
+            for method, knowledge in knowledges.items():
+                if not measured.ok:
+                    estimate, status = np.full(3, np.nan), measured.status
+                elif method == SERVOED:
+                    estimate, status = measured.estimate_head_m, "ok"
+                else:
+                    estimate = recompute(sim, measured, knowledge)
+                    finite = bool(np.all(np.isfinite(estimate)))
+                    status = "ok" if finite else "estimate invalid"
+                own = renders if method == SERVOED else 0
+                out.append(TargetError(method, index, truth, estimate, status, own))
+            sim.move(eye=0.0)
+            if fixed is None:
+                continue
+            for method, knowledge in (
+                ("active_fixed_point", fixed.knowledge()),
+                ("active_refound", fixed.knowledge(refound)),
+            ):
+                start = sim.render_count
+                m2 = measure_model2(sim, servo, TARGET, knowledge)
+                out.append(
+                    TargetError(
+                        method,
+                        index,
+                        truth,
+                        m2.estimate_head_m,
+                        m2.status,
+                        sim.render_count - start,
+                    )
+                )
+                sim.move(eye=0.0)
+    return out
+
+
+def tables_experiment(settings: HeadSettings, config: StudyConfig) -> Experiment:
+    """The conditions: the table targets as calibrated, then zoomed :data:`ZOOM` x (kept)."""
+    targets = table_targets(config.table_targets)
+    group = config.preset
+    return Experiment(
+        name="tables_v_vi",
+        title="Tables V/VI on the reproduction's head, then the focal length x1.5",
+        kind="compare",
+        parameter="condition",
+        base={group: settings},
+        conditions=(
+            Condition(group, "as calibrated", 0.0, settings, "kept", targets),
+            Condition(group, f"zoom {ZOOM:g}x", ZOOM, zoomed(settings, ZOOM), "kept", targets),
+        ),
+        methods=METHODS,
+    )
+
+
+def run_tables(
+    settings: HeadSettings,
+    zhang: stereo.StereoCalibration,
+    stored: HeadKnowledge,
+    config: StudyConfig,
+    fixed: FixedPoint | None = None,
+) -> ExperimentResult:
+    """Every condition of :func:`tables_experiment`, with ``zhang``, ``stored`` and
+    ``fixed`` (None: without the fixed-point methods) kept."""
+    start = time.perf_counter()
+    methods = METHODS if fixed is not None else METHODS[:4]
+    experiment = replace(tables_experiment(settings, config), methods=methods)
+    knowledges = active_knowledge(stored, zhang)
+    ordered = {m: knowledges[m] for m in CENTRE_METHODS}
+    results = []
+    for condition in experiment.conditions:
+        began = time.perf_counter()
+        errors = measure_paired(
+            condition.head, zhang, ordered, condition.targets_head, fixed, config
+        )
+        summaries = tuple(summarise(errors, m) for m in methods)
+        results.append(
+            ConditionResult(condition, tuple(errors), summaries, time.perf_counter() - began)
+        )
+    return ExperimentResult(
+        experiment=experiment,
+        config=replace(config),
+        results=tuple(results),
+        calibrations=(),
+        seconds=time.perf_counter() - start,
+    )

@@ -1,0 +1,1 @@
+"""Feature detection in rendered images: markers, cross points, chessboard corners."""

@@ -1,0 +1,118 @@
+"""Calibrate once: ``headsim calibrate`` writes a head file that scenarios use, for that head only."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from headsim.active.calibration_file import (
+    CalibrationFileError,
+    head_fields,
+    head_hash,
+    read_calibration,
+)
+from headsim.cli import main
+from headsim.run.runner import run_scenario
+from headsim.scenario.schema import ScenarioError, load_scenario
+from headsim.sim.settings import HeadSettings, paper_head
+
+SCENARIO = """description = "measure with a stored calibration"
+[head]
+preset = "realistic"
+{extra}
+[cam1]
+noise_std = 1.0
+[cam2]
+noise_std = 1.0
+[experiment]
+procedure = "model2"
+[experiment.calibration]
+from = "{head}"
+[[scene.targets]]
+name = "near"
+position_head_m = [0.04, 0.02, 0.5]
+"""
+
+
+def test_the_head_a_calibration_holds_for_leaves_out_seed_and_noise() -> None:
+    head = paper_head()
+    fields = head_fields(head)
+    assert fields["cam1.kx"] == head.cameras[0].kx
+    assert fields["baseline_m"] == head.baseline_m
+    assert not any(name.endswith(("seed", "noise_std")) for name in fields)
+    noisy = replace(head, seed=9, cameras=tuple(replace(c, noise_std=3.0) for c in head.cameras))
+    assert head_hash(noisy) == head_hash(head)
+    other = replace(head, cameras=(replace(head.cameras[0], kx=800.0), head.cameras[1]))
+    assert head_hash(other) != head_hash(head)
+    assert head_hash(HeadSettings()) != head_hash(head)
+
+
+def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
+    head_file = tmp_path / "head.json"
+    assert main(["calibrate", "quickstart", "--fast", "--out", str(head_file)]) == 0
+    assert "alpha_e1" in capsys.readouterr().out
+    stored = json.loads(head_file.read_text())
+    assert stored["format"] == "headsim-calibration/1"
+    assert stored["head"]["hash"] == head_hash(load_scenario("quickstart").settings)
+    block = stored["calibration"]
+    assert block["status"] == "ok" and block["renders"] > 0
+    assert len(block["alpha_e_std_rad"]) == 2 and block["vertical_reference"] is not None
+
+    scenario_file = tmp_path / "measure.toml"
+    scenario_file.write_text(SCENARIO.format(head=head_file, extra=""))
+    result = run_scenario(load_scenario(scenario_file))
+    assert result.ok
+    assert result.renders["calibration"] == 0 and result.renders["total"] > 0
+    assert result.calibration is not None
+    assert result.calibration["from"]["path"] == str(head_file)
+    assert result.calibration["alpha_e_rad"] == block["alpha_e_rad"]
+    assert result.records[0].knowledge == "calibrated"
+    # The measurement used the stored directions: millimetres at 0.5 m.
+    assert result.records[0].measurement.error_pct_of_depth < 0.2
+
+    # A relative path is relative to the scenario file, wherever the run starts.
+    scenario_file.write_text(SCENARIO.format(head="head.json", extra=""))
+    relative = load_scenario(scenario_file).experiment.calibration
+    assert relative is not None and relative.source == str(head_file)
+
+    # Another head refuses the file and says which setting differs (exit 2).
+    other = tmp_path / "other.toml"
+    other.write_text(SCENARIO.format(head=head_file, extra="baseline_m = 0.16"))
+    with pytest.raises(ScenarioError, match=r"different head: baseline_m \(file 0.15"):
+        load_scenario(other)
+    assert main(["run", str(other), "--out", str(tmp_path / "out")]) == 2
+    assert "baseline_m" in capsys.readouterr().err
+
+
+def test_unusable_calibration_files_are_refused(tmp_path: Path) -> None:
+    head = paper_head()
+    missing = tmp_path / "missing.json"
+    with pytest.raises(CalibrationFileError, match="cannot read"):
+        read_calibration(missing, head)
+    broken = tmp_path / "broken.json"
+    broken.write_text("{")
+    with pytest.raises(CalibrationFileError, match="not JSON"):
+        read_calibration(broken, head)
+    foreign = tmp_path / "foreign.json"
+    foreign.write_text(json.dumps({"metrics": {}}))
+    with pytest.raises(CalibrationFileError, match="not a calibration file"):
+        read_calibration(foreign, head)
+    partial = tmp_path / "partial.json"
+    partial.write_text(json.dumps({"format": "headsim-calibration/1", "head": {}}))
+    with pytest.raises(CalibrationFileError, match="malformed"):
+        read_calibration(partial, head)
+
+
+def test_calibrate_refuses_bad_input(tmp_path: Path, capsys) -> None:
+    # A scenario without a calibration to run, and an output that is a directory.
+    plain = tmp_path / "plain.toml"
+    plain.write_text(
+        SCENARIO.replace('[experiment.calibration]\nfrom = "{head}"\n', "").format(extra="")
+    )
+    assert main(["calibrate", str(plain), "--out", str(tmp_path / "h.json")]) == 2
+    assert "experiment.calibration" in capsys.readouterr().err
+    assert main(["calibrate", "quickstart", "--fast", "--out", str(tmp_path)]) == 2
+    assert "is a directory" in capsys.readouterr().err

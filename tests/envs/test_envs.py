@@ -1,0 +1,120 @@
+"""headsim/Fixate-v0: Gymnasium's API check, seeding, spawned vector envs, reference policies."""
+
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import headsim.envs
+from headsim.envs.policies import RandomPolicy, ServoPolicy
+from headsim.sim.settings import SettingsError
+
+ID = headsim.envs.FIXATE_ID
+
+
+@pytest.mark.filterwarnings("ignore:.*symmetric and normalized space")  # rad/s by design
+def test_env_passes_gymnasiums_checker() -> None:
+    env = gymnasium.make(ID)
+    check_env(env.unwrapped)
+    env.close()
+
+
+def test_same_seed_gives_identical_observations_and_another_seed_does_not() -> None:
+    env = gymnasium.make(
+        ID,
+        randomise={
+            "kx": (100.0, 130.0),
+            "mount_yaw_rad": (-0.02, 0.02),
+            "nodal_offset_m": (0.01, 0.03),  # the realistic head's optical centres
+        },
+    )
+    first, _ = env.reset(seed=7)
+    drawn = [c.nodal_offset_m for c in env.unwrapped._settings.cameras]
+    assert all(0.01 <= n <= 0.03 for n in drawn) and drawn[0] != drawn[1]
+    action = np.array([0.3, -0.2, 1.0], np.float32)
+    after_first = env.step(action)[0]
+    other, _ = env.reset(seed=8)
+    second, _ = env.reset(seed=7)
+    after_second = env.step(action)[0]
+    for key in ("cam1", "cam2", "encoders"):
+        np.testing.assert_array_equal(first[key], second[key])
+        np.testing.assert_array_equal(after_first[key], after_second[key])
+    assert not np.array_equal(first["cam1"], other["cam1"])
+    assert first["cam1"].shape == (96, 128, 3) and first["cam1"].dtype == np.uint8
+    env.close()
+
+
+def test_paper_servo_policy_fixates_and_the_episode_terminates() -> None:
+    env = gymnasium.make(ID)
+    policy = ServoPolicy(env.action_space, env.unwrapped.period_s)
+    lengths = []
+    for seed in range(4):
+        obs, info = env.reset(seed=seed)
+        policy.reset()
+        step = 0
+        while step < 30:
+            step += 1
+            obs, reward, terminated, truncated, info = env.step(policy(obs))
+            if terminated or truncated:
+                break
+        assert terminated and not truncated, f"seed {seed}: not fixated in {step} steps"
+        assert np.all(np.abs(info["offsets_px"]) <= 1.0)
+        assert reward > -0.02
+        lengths.append(step)
+    assert max(lengths[1:]) <= 10  # the first episode also probes the Jacobian
+    env.close()
+
+
+def test_random_policy_truncates_at_the_step_limit_and_rewards_are_bounded() -> None:
+    env = gymnasium.make(ID, max_steps=5, reward="position")
+    policy = RandomPolicy(env.action_space, seed=1)
+    obs, _ = env.reset(seed=0)
+    for _ in range(5):
+        obs, reward, terminated, truncated, _ = env.step(policy(obs))
+        assert -1.0 <= reward <= 0.0
+        assert env.observation_space.contains(obs)
+        if terminated:
+            break
+    assert truncated or terminated
+    env.close()
+
+
+def test_position_reward_is_small_when_fixated() -> None:
+    env = gymnasium.make(ID, reward="position")
+    policy = ServoPolicy(env.action_space, env.unwrapped.period_s)
+    obs, _ = env.reset(seed=3)
+    first = env.step(np.zeros(3, np.float32))[1]
+    reward, terminated = first, False
+    for _ in range(30):
+        obs, reward, terminated, _, _ = env.step(policy(obs))
+        if terminated:
+            break
+    assert terminated
+    assert first < -0.5  # eyes parallel: no estimate yet
+    # 1 px at 128 x 96 is 8.6 mrad of vergence: Model 1 within 10 % of the distance.
+    assert -0.1 < reward <= 0.0
+    env.close()
+
+
+def test_bad_options_name_the_field() -> None:
+    with pytest.raises(SettingsError, match="unknown field 'focal'"):
+        gymnasium.make(ID, randomise={"focal": (1, 2)})
+    with pytest.raises(SettingsError, match="reward must be one of offsets, position"):
+        gymnasium.make(ID, reward="distance")
+
+
+def test_vector_env_runs_two_spawned_workers() -> None:
+    envs = gymnasium.make_vec(
+        ID, num_envs=2, vectorization_mode="async", vector_kwargs={"context": "spawn"}
+    )
+    try:
+        obs, _ = envs.reset(seed=[1, 2])
+        assert obs["cam1"].shape == (2, 96, 128, 3)
+        assert not np.array_equal(obs["cam1"][0], obs["cam1"][1])
+        for _ in range(3):
+            obs, rewards, _, _, _ = envs.step(envs.action_space.sample())
+        assert rewards.shape == (2,) and obs["encoders"].shape == (2, 3)
+    finally:
+        envs.close()

@@ -1,0 +1,187 @@
+"""``headsim run``: every scenario runs in its fast variant; results.json keeps its documented shape."""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import re
+from pathlib import Path
+
+import pytest
+
+from headsim.cli import main
+from headsim.run.report import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
+from headsim.run.runner import Progress
+from headsim.scenario.schema import load_scenario, scenario_files
+
+README = Path(__file__).resolve().parents[2] / "README.md"
+FILES = scenario_files()
+
+
+def _run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]:
+    code = main(["run", *args, "--no-progress"])
+    return code, capsys.readouterr().out
+
+
+def _documented_keys(heading: str) -> list[str]:
+    """The first-column keys of the table under ``heading`` in the README."""
+    text = README.read_text()
+    section = text[text.index(heading) :]
+    table = section[section.index("| key |") :]
+    keys = []
+    for line in table.splitlines()[2:]:
+        if not line.startswith("|"):
+            break
+        keys.append(re.match(r"\| `([a-z_0-9]+)` \|", line).group(1))  # type: ignore[union-attr]
+    return keys
+
+
+def test_the_readme_documents_every_key_of_results_json() -> None:
+    assert _documented_keys("### results.json") == list(RESULTS_KEYS)
+    assert _documented_keys("Each measurement:") == list(MEASUREMENT_KEYS)
+
+
+def _check_schema(results: dict, scenario_name: str) -> None:
+    assert list(results) == list(RESULTS_KEYS)
+    assert results["schema"] == RESULTS_SCHEMA
+    assert results["scenario"]["name"] == scenario_name and results["scenario"]["fast"] is True
+    assert results["status"] == "ok" and results["failures"] == []
+    assert {"headsim", "mujoco", "numpy", "opencv", "rerun-sdk", "python"} <= set(
+        results["software"]
+    )
+    assert len(results["settings"]["cameras"]) == 2
+    renders = results["renders"]
+    assert renders["total"] == renders["calibration"] + renders["experiment"] > 0
+    assert renders["recording"] == 0
+    steps = []
+    for m in results["measurements"]:
+        assert list(m) == list(MEASUREMENT_KEYS)
+        assert m["status"] == "ok" and m["knowledge"] in ("none", "calibrated")
+        for key in ("estimate_head_m", "truth_head_m", "estimate_world_m", "truth_world_m"):
+            assert len(m[key]) == 3 and all(math.isfinite(v) for v in m[key])
+        assert len(m["covariance_head_m2"]) == 3 and all(
+            len(row) == 3 for row in m["covariance_head_m2"]
+        )
+        assert m["error_m"] == pytest.approx(
+            math.dist(m["estimate_head_m"], m["truth_head_m"]), rel=1e-9
+        )
+        assert m["renders"] > 0 and all(abs(r) < 1.0 for r in m["servo_residual_px"])
+        steps.append(m["step"])
+    assert steps == sorted(steps) and len(set(steps)) == len(steps)
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
+def test_every_scenario_runs_in_its_fast_variant(
+    path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code, out = _run([path.stem, "--fast", "--out", str(tmp_path)], capsys)
+    assert code == 0, out
+    results = json.loads((tmp_path / "results.json").read_text())
+    _check_schema(results, path.stem)
+    assert (tmp_path / "summary.txt").read_text().strip() in out
+    assert json.loads((tmp_path / "timing.json").read_text())["wall_s"] > 0
+    scenario = load_scenario(path, fast=True)
+    calibration = results["calibration"]
+    if scenario.experiment.calibration is not None:
+        assert calibration["status"] == "ok" and calibration["fixated"] >= 3
+        spec = scenario.experiment.calibration
+        if spec.position_noise_m == 0 and spec.depth_noise_m == 0:
+            # Even the fast calibration finds the offsets to a few 1e-4 rad.
+            assert max(abs(e) for e in calibration["alpha_e_error_rad"]) < 1e-3
+        else:  # a tape measure: within four of the fit's stated standard errors
+            errors, stds = calibration["alpha_e_error_rad"], calibration["alpha_e_std_rad"]
+            assert all(abs(e) < 4 * s for e, s in zip(errors, stds, strict=True))
+    if scenario.paper_cameras:
+        # The paper's figures beside ours in the summary.
+        assert re.search(r"alpha_e1 \(rad\)\s+\S+\s+\S+\s+\S+\s+\S+\s+0\.0578", out)
+    experiment = results["experiment"]
+    if path.stem == "chessboard":
+        assert re.search(r"all sides\s+\d+\s+(29|30)\.\d+\s+0\.\d+\s+30\.000\s+30\.3\s+0\.677", out)
+        assert abs(experiment["side_mean_m"] - 0.030) < 5e-4
+    if path.stem == "relative_positioning":
+        assert re.search(r"alpha1 \(rad\)\s+0\.0800\s+0\.0800", out)
+        assert re.search(r"alpha2 \(rad\)\s+0\.0349\s+0\.0349", out)
+        assert experiment["agree"] == 6 and experiment["missing"] == []
+        assert len({o["area"] for o in experiment["objects"]}) == 6
+    if path.stem == "calibration":
+        check = experiment["check_targets"][0]
+        assert check["error_m_calibrated"] < 0.01 * check["error_m_uncalibrated"]
+    if path.stem == "tracking":
+        assert len(experiment["errors_world_m"]) == scenario.scene.moving.steps  # type: ignore[union-attr]
+        assert max(experiment["errors_world_m"]) < 0.003
+    if path.stem == "pursuit":
+        frames = experiment["per_frame"]
+        assert experiment["frames"] == len(frames["time_s"]) >= 15  # 0.5 s at 30 Hz
+        assert experiment["losses"] == 0 and all(frames["found"])
+        assert experiment["position_rms_pct_of_depth"] < 1.0
+        assert "position error RMS along the path" in out
+
+
+def test_the_same_seed_gives_identical_results_with_or_without_a_recording(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    runs = []
+    for name, seed, rrd in (("a", "3", True), ("b", "3", False), ("c", "4", False)):
+        out = tmp_path / name
+        args = ["quickstart", "--fast", "--seed", seed, "--out", str(out)]
+        args += ["--rrd", str(out / "run.rrd")] if rrd else []
+        assert _run(args, capsys)[0] == 0
+        runs.append((out / "results.json").read_bytes())
+    assert runs[0] == runs[1]  # the recording observes, it does not perturb
+    assert runs[0] != runs[2]
+    assert json.loads(runs[2])["seed"] == 4
+
+
+def test_a_failed_measurement_exits_1_and_still_writes_results(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # Within reach, but the servo may make only three moves: for the first target
+    # (its gain still unknown) that is an iteration limit.
+    path = tmp_path / "unseen.toml"
+    path.write_text(
+        'description = "a servo cut short"\n[experiment]\nprocedure = "model2"\n'
+        "[experiment.servo]\nmax_iterations = 3\n"
+        "[[scene.targets]]\nname = 'right'\nposition_head_m = [0.1, 0.0, 0.5]\n"
+        "[[scene.targets]]\nname = 'ahead'\nposition_head_m = [0.0, 0.02, 0.7]\n"
+    )
+    code, out = _run([str(path), "--out", str(tmp_path / "out")], capsys)
+    assert code == 1
+    line = "right: Ca1 at step 1: iteration limit (after 3 moves)"
+    assert f"FAILED: 1 problem(s)\n  {line}" in out
+    assert "failures by cause: 1 iteration limit" in out
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert results["status"] == "failed" and results["failures"] == [line]
+    assert results["measurements"][0]["failure"] == {
+        "cause": "iteration limit",
+        "stage": "step 1",
+        "camera": 1,
+        "detail": "after 3 moves",
+    }
+    assert results["summary"]["none"]["failure_causes"] == {"iteration limit": 1}
+    right, ahead = results["measurements"]
+    assert right["estimate_head_m"] == [None, None, None] and right["error_m"] is None
+    assert ahead["status"] == "ok"
+    assert results["summary"]["none"]["failed"] == 1
+
+
+def test_help_is_available_for_every_command(capsys: pytest.CaptureFixture[str]) -> None:
+    for command in (["--help"], ["run", "--help"], ["list", "--help"], ["snapshot", "--help"]):
+        with pytest.raises(SystemExit) as stop:
+            main(command)
+        assert stop.value.code == 0
+    out = capsys.readouterr().out
+    assert "--rrd FILE" in out and "--fast" in out and "--seed N" in out
+
+
+def test_progress_shows_count_rate_and_time_left() -> None:
+    now = [0.0]
+    stream = io.StringIO()
+    progress = Progress(10, stream, width=10, interval_s=0.0, clock=lambda: now[0])
+    now[0] = 2.0
+    progress.step(4, "corner_3_0")
+    assert progress.line() == "[####------] 4/10 fixations  2.0/s  0:03 left  corner_3_0"
+    now[0] = 5.0
+    progress.finished(None)  # type: ignore[arg-type]
+    last = stream.getvalue().split("\r")[-1]
+    assert last.rstrip() == "[##########] 10/10 fixations  2.0/s  5.0 s" and last.endswith("\n")

@@ -1,0 +1,78 @@
+"""Bad settings and a missing OpenGL backend fail early with a message naming the problem."""
+
+from __future__ import annotations
+
+import ctypes.util
+import os
+import subprocess
+import sys
+
+import pytest
+
+from headsim.sim.settings import CameraSettings, HeadSettings, SettingsError, paper_head, preset
+from headsim.sim.simulator import HeadSim
+
+
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (lambda: HeadSettings(baseline_m=-0.15), "baseline_m must be > 0"),
+        (lambda: HeadSettings(baseline_m=float("nan")), "baseline_m must be a finite number"),
+        (lambda: CameraSettings(width=5000), "larger than the off-screen buffer allows"),
+        (lambda: CameraSettings(height=0), "height must be a positive integer"),
+        (lambda: CameraSettings(kx=-5.0), "focal length kx must be > 0"),
+        (lambda: CameraSettings(cx=700.0), "principal point cx = 700.0 px lies outside the image"),
+        (lambda: CameraSettings(noise_std=-1.0), "noise_std must be >= 0"),
+        (lambda: HeadSettings(encoder_resolution_rad=0.0), "encoder_resolution_rad must be > 0"),
+        (lambda: HeadSettings(cameras=(CameraSettings(),)), "cameras must be a pair"),
+        (lambda: preset("fisheye"), "unknown preset 'fisheye'; allowed: ideal, paper"),
+    ],
+)
+def test_bad_settings_name_the_field(make, message: str) -> None:
+    with pytest.raises(SettingsError, match=message):
+        make()
+
+
+def test_unknown_scene_lists_the_scenes() -> None:
+    with pytest.raises(
+        SettingsError, match="unknown scene 'kitchen'; allowed: base, blocks, chessboard, default"
+    ):
+        HeadSim("kitchen")
+
+
+def test_zoom_scales_both_focal_lengths() -> None:
+    cam = paper_head().cameras[0].with_zoom(1.5)
+    assert cam.kx == pytest.approx(834.83 * 1.5)
+    assert cam.ky == pytest.approx(815.42 * 1.5)
+    assert cam.principal == (303.8, 306.3)
+
+
+def _render_in_subprocess(backend: str) -> subprocess.CompletedProcess[str]:
+    code = (
+        "from headsim.sim.simulator import HeadSim\nHeadSim('default').render(1)\nprint('rendered')"
+    )
+    env = {**os.environ, "MUJOCO_GL": backend}
+    return subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120
+    )
+
+
+def test_an_invalid_backend_names_the_allowed_ones() -> None:
+    result = _render_in_subprocess("vulkan")
+    assert result.returncode != 0
+    assert (
+        "MUJOCO_GL='vulkan' is not a backend headsim can render with; allowed: egl, osmesa, glfw"
+        in result.stderr
+    )
+    assert "apt-get install" in result.stderr
+
+
+def test_osmesa_renders_or_says_what_to_install() -> None:
+    result = _render_in_subprocess("osmesa")
+    if ctypes.util.find_library("OSMesa") is None:
+        assert result.returncode != 0
+        assert "libOSMesa is not installed" in result.stderr
+        assert "apt-get install libosmesa6" in result.stderr
+    else:
+        assert result.returncode == 0, result.stderr
+        assert "rendered" in result.stdout

@@ -1,0 +1,143 @@
+"""Sweeps on a local process pool and on a local Dask cluster: same answers, resumable, crash-proof."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from headsim.cli import main
+from headsim.studies.sweep import CRASH_ENV, SweepError, load_sweep, read_log, run_sweep
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+
+
+@pytest.fixture
+def grid(tmp_path: Path) -> Path:
+    for name in ("sweep_base.toml", "sweep_grid.toml"):
+        shutil.copy(DATA / name, tmp_path / name)
+    return tmp_path / "sweep_grid.toml"
+
+
+def _rows(path: Path) -> list[dict[str, str]]:
+    with path.open() as handle:
+        return list(csv.DictReader(handle))
+
+
+def test_grid_expands_to_every_combination(grid: Path) -> None:
+    spec = load_sweep(grid)
+    assert [j.params for j in spec.jobs] == [
+        {"head.baseline_m": 0.12, "cam1.noise_std": 0.0},
+        {"head.baseline_m": 0.12, "cam1.noise_std": 2.0},
+        {"head.baseline_m": 0.18, "cam1.noise_std": 0.0},
+        {"head.baseline_m": 0.18, "cam1.noise_std": 2.0},
+    ]
+    assert len({j.id for j in spec.jobs}) == 4
+    assert load_sweep(grid).jobs == spec.jobs  # ids are stable
+
+
+def test_random_sample_is_seeded(tmp_path: Path) -> None:
+    shutil.copy(DATA / "sweep_base.toml", tmp_path / "sweep_base.toml")
+    text = 'description = "r"\nscenario = "sweep_base.toml"\n[random]\ncount = 5\nseed = 3\n[random.fields]\n"head.baseline_m" = [0.1, 0.2]\nseed = [0, 99]\n'
+    (tmp_path / "r.toml").write_text(text)
+    first, second = load_sweep(tmp_path / "r.toml"), load_sweep(tmp_path / "r.toml")
+    assert [j.params for j in first.jobs] == [j.params for j in second.jobs]
+    assert all(0.1 <= j.params["head.baseline_m"] <= 0.2 for j in first.jobs)
+    assert all(isinstance(j.params["seed"], int) for j in first.jobs)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\n[grid]\nfoo = 1\n',
+            "grid.foo: must be a non-empty list",
+        ),
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\n[grid]\n"cam1.bogus" = [1]\n',
+            "cam1.bogus: unknown key",
+        ),
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\n[grid]\n"head.baseline_m" = [-1.0]\n',
+            "head.baseline_m",
+        ),
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\nworkers = 3\n[grid]\nseed = [1]\n',
+            "workers: unknown key",
+        ),
+        (
+            'description = "x"\nscenario = "nowhere"\n[grid]\nseed = [1]\n',
+            "scenario: .*no such scenario file",
+        ),
+        ('description = "x"\nscenario = "sweep_base.toml"\n', "needs exactly one of"),
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\n[random]\ncount = 2\n[random.fields]\nseed = [5, 1]\n',
+            "not a range",
+        ),
+    ],
+)
+def test_bad_sweep_files_name_the_field(tmp_path: Path, text: str, message: str) -> None:
+    shutil.copy(DATA / "sweep_base.toml", tmp_path / "sweep_base.toml")
+    (tmp_path / "bad.toml").write_text(text)
+    with pytest.raises(SweepError, match=message):
+        load_sweep(tmp_path / "bad.toml")
+
+
+def test_local_pool_and_dask_cluster_give_the_same_aggregate(grid: Path, tmp_path: Path) -> None:
+    from dask.distributed import LocalCluster
+
+    spec = load_sweep(grid)
+    local = run_sweep(spec, tmp_path / "local", workers=2, progress=False)
+    assert local.ran == 4 and not local.failed
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
+    ) as cluster:
+        dask = run_sweep(
+            spec, tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False
+        )
+    assert dask.ran == 4
+    assert (tmp_path / "local" / "aggregate.csv").read_text() == (
+        tmp_path / "dask" / "aggregate.csv"
+    ).read_text()
+    rows = _rows(tmp_path / "local" / "aggregate.csv")
+    assert [r["status"] for r in rows] == ["ok"] * 4
+    assert all(float(r["rms_error_pct_depth"]) < 0.5 for r in rows)
+    assert (tmp_path / "local" / "error_vs_head_baseline_m.png").stat().st_size > 1000
+
+
+def test_an_interrupted_sweep_resumes_without_redoing_jobs(grid: Path, tmp_path: Path) -> None:
+    spec = load_sweep(grid)
+    out = tmp_path / "out"
+    first = run_sweep(spec, out, workers=1, progress=False, stop_after=2)
+    assert first.ran == 2 and not (out / "aggregate.csv").exists()
+    done_before = read_log(out / "jobs.jsonl")
+    assert len(done_before) == 2
+    # A writer killed mid-line leaves a torn last line: it is ignored.
+    with (out / "jobs.jsonl").open("a") as handle:
+        handle.write('{"id": "torn')
+    second = run_sweep(spec, out, workers=1, progress=False)
+    assert second.skipped == 2 and second.ran == 2
+    log = read_log(out / "jobs.jsonl")
+    assert len(log) == 4
+    for job_id, record in done_before.items():
+        assert log[job_id] == record  # not redone
+    assert len(_rows(out / "aggregate.csv")) == 4
+
+
+def test_a_crashing_job_is_retried_once_reported_and_the_rest_complete(
+    grid: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv(CRASH_ENV, "1")
+    out = tmp_path / "out"
+    code = main(["sweep", str(grid), "--out", str(out), "--workers", "1", "--no-progress"])
+    assert code == 1
+    records = {
+        r["index"]: r for r in map(json.loads, (out / "jobs.jsonl").read_text().splitlines())
+    }
+    assert records[1]["status"] == "crashed" and records[1]["attempts"] == 2
+    assert [records[i]["status"] for i in (0, 2, 3)] == ["ok"] * 3
+    rows = _rows(out / "aggregate.csv")
+    assert [r["status"] for r in rows] == ["ok", "crashed", "ok", "ok"]
