@@ -14,6 +14,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from headsim.geometry.transforms import rotation_x, rotation_y, rotation_z
 from headsim.sim import names
 from headsim.sim.optics import DistortionCanvas, distortion_canvas
 from headsim.sim.settings import MAX_IMAGE_SIDE, CameraSettings, HeadSettings, SettingsError
@@ -34,21 +35,6 @@ def scene_path(scene: str | Path) -> Path:
     raise SettingsError(
         f"unknown scene {str(scene)!r}; allowed: {', '.join(sorted(names.SCENES))} or a path to an MJCF .xml file"
     )
-
-
-def rotation_x(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def rotation_y(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def rotation_z(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 #: MuJoCo camera axes (x right, y up, looking down -z) in OpenCV camera axes, and back.
