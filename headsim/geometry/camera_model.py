@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from headsim.geometry._roots import solve_increasing
+from headsim.paper import IMAGE_SIZE_PX, INTRINSICS
 
 __all__ = [
     "PinholeCamera",
@@ -180,12 +181,12 @@ def ideal() -> PinholeCamera:
 
 def paper_cam1() -> PinholeCamera:
     """Ca1 of the paper (Zhang calibration, Sec. VI-B; equations.md's last table), k2 = 0."""
-    return PinholeCamera(640, 480, 834.83, 815.42, 303.8, 306.3, k1=-0.38741)
+    return PinholeCamera(*IMAGE_SIZE_PX, **INTRINSICS[0])
 
 
 def paper_cam2() -> PinholeCamera:
     """Ca2 of the paper (Zhang calibration, Sec. VI-B; equations.md's last table), k2 = 0."""
-    return PinholeCamera(640, 480, 850.46, 833.29, 345.1, 197.3, k1=-0.30938)
+    return PinholeCamera(*IMAGE_SIZE_PX, **INTRINSICS[1])
 
 
 def _pairs(a: ArrayLike, name: str) -> np.ndarray:

@@ -29,8 +29,8 @@ from headsim.scenario.spec import (
 )
 from headsim.scenario.tables import Context
 from headsim.sim import names
+from headsim.sim.forward import effective_directions
 from headsim.sim.model import eye_from_camera_rotation, load_spec
-from headsim.sim.optics import centre_ray_yaw
 from headsim.sim.settings import HeadSettings
 
 
@@ -59,16 +59,13 @@ class ReachHead:
             lo, hi = model.joint(joint).range
             return float(lo), float(hi)
 
-        directions = tuple(
-            camera.mount_yaw_rad + sign * centre_ray_yaw(camera)
-            for camera, sign in zip(settings.cameras, (1.0, -1.0), strict=True)
-        )
+        directions = effective_directions(settings)
         return cls(
             settings,
             rng(names.EYE_MOTOR_JOINT),
             rng(names.NECK_YAW),
             rng(names.NECK_PITCH),
-            directions,  # type: ignore[arg-type]
+            directions,
         )
 
     def effective_direction(self, index: int) -> float:

@@ -13,6 +13,8 @@ import math
 from dataclasses import replace
 from typing import Any
 
+from headsim.geometry.synthetic import mount_yaw_for_direction
+from headsim.paper import INITIAL_DIRECTIONS_RAD
 from headsim.scenario.calibration_design import LAYOUTS
 from headsim.scenario.spec import (
     MAX_DEPTH_M,
@@ -28,7 +30,6 @@ from headsim.sim import names
 from headsim.sim.optics import centre_ray_yaw
 from headsim.sim.settings import (
     MAX_IMAGE_SIDE,
-    PAPER_INITIAL_DIRECTIONS,
     CameraSettings,
     HeadBelief,
     HeadSettings,
@@ -165,16 +166,15 @@ def read_head(doc: Table, ctx: Context) -> tuple[HeadSettings, str, str]:
     for index, key in enumerate(names.CAMERAS):
         camera, camera_preset = _read_camera(doc.table(key), index, preset_name)
         if initial is None and yaw is None and camera_preset in ("paper", "realistic"):
-            direction = PAPER_INITIAL_DIRECTIONS[index]
+            direction = INITIAL_DIRECTIONS_RAD[index]
         elif initial is not None:
             direction = initial[index]
         else:
             direction = None
-        sign = 1.0 if index == 0 else -1.0
         mount_yaw = (
             (yaw[index] if yaw is not None else 0.0)
             if direction is None
-            else direction - sign * centre_ray_yaw(camera)
+            else mount_yaw_for_direction(index + 1, direction, camera.pinhole())
         )
         field_name = "head.initial_direction_rad" if direction is not None else "head.mount_yaw_rad"
         if not abs(mount_yaw) < 0.5:

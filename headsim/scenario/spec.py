@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from headsim import paper
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 
@@ -43,7 +44,7 @@ MARKER_BODIES = {**names.MARKER_COLOURS, names.CALIBRATION_BALL: "yellow"}
 CHESSBOARD_PATTERN = (8, 6)
 
 
-CHESSBOARD_SQUARE_M = 0.030
+CHESSBOARD_SQUARE_M = paper.CHESSBOARD_SQUARE_M
 
 
 #: Nearest a target may be to the head, m (z_h at the start pose).

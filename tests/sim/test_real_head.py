@@ -27,7 +27,6 @@ from headsim.geometry.synthetic import (
 from headsim.sim import names
 from headsim.sim.settings import (
     FINE_RENDERING,
-    REALISTIC_BUDGET,
     CameraSettings,
     HeadBelief,
     HeadSettings,
@@ -36,6 +35,7 @@ from headsim.sim.settings import (
     preset,
 )
 from headsim.sim.simulator import HeadSim
+from headsim.sim.tolerances import REALISTIC_BUDGET
 from headsim.vision.detect import find_marker
 
 PAPER1 = PinholeCamera(640, 480, 834.83, 815.42, 303.8, 306.3, -0.38741, 0.0)
