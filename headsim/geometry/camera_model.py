@@ -22,6 +22,7 @@ __all__ = [
     "PinholeCamera",
     "UndistortionError",
     "ideal",
+    "image_centre",
     "paper_cam1",
     "paper_cam2",
 ]
@@ -72,7 +73,7 @@ class PinholeCamera:
     @property
     def image_centre(self) -> tuple[float, float]:
         """Geometric centre of the image ((W-1)/2, (H-1)/2), px."""
-        return ((self.width - 1) / 2.0, (self.height - 1) / 2.0)
+        return image_centre(self.width, self.height)
 
     @property
     def is_distorted(self) -> bool:
@@ -171,6 +172,11 @@ class PinholeCamera:
         u = np.asarray(u, dtype=float)
         v = np.full_like(u, self.image_centre[1]) if v is None else np.asarray(v, dtype=float)
         return np.arctan(self.normalise(np.stack(np.broadcast_arrays(u, v), axis=-1))[..., 0])
+
+
+def image_centre(width: int, height: int) -> tuple[float, float]:
+    """Geometric centre ((W-1)/2, (H-1)/2), px, of a W x H image (pixel centres at integers)."""
+    return ((width - 1) / 2.0, (height - 1) / 2.0)
 
 
 def ideal() -> PinholeCamera:

@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass, field, replace
 
 from headsim.errors import BadInput
-from headsim.geometry.camera_model import PinholeCamera
+from headsim.geometry.camera_model import PinholeCamera, image_centre
 from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import BASELINE_M, ENCODER_RESOLUTION_RAD, INITIAL_DIRECTIONS_RAD, INTRINSICS
 from headsim.sim.tolerances import REALISTIC_BUDGET
@@ -72,6 +72,8 @@ class CameraSettings:
     along the camera's x (right) (mounting: typically |.| <= 0.002 m);
     ``eye_axis_tilt_rad`` leans the eye's yaw axis forward, about H's x
     (typically |.| <= 0.005 rad).  All default to 0, the paper's ideal eye.
+    The lens itself is :meth:`pinhole`'s :class:`PinholeCamera` (projection,
+    distortion, image centre): this class adds the mount, noise and checks.
     """
 
     width: int = 640
@@ -144,11 +146,7 @@ class CameraSettings:
     @property
     def image_centre(self) -> tuple[float, float]:
         """Geometric centre of the image, px: ((W - 1) / 2, (H - 1) / 2)."""
-        return ((self.width - 1) / 2, (self.height - 1) / 2)
-
-    @property
-    def distorted(self) -> bool:
-        return self.k1 != 0.0 or self.k2 != 0.0
+        return image_centre(self.width, self.height)
 
     def pinhole(self) -> PinholeCamera:
         """The camera's true intrinsics as a :class:`headsim.geometry.camera_model.PinholeCamera`."""
