@@ -82,7 +82,7 @@ class ReachHead:
         the detector needs not to call it cut).
         """
         camera = self.settings.cameras[index]
-        sign = 1.0 if index == 0 else -1.0
+        sign = names.EYE_CAMERAS[index].inward
         centre = np.array([sign * -self.settings.baseline_m / 2, 0.0, 0.0])
         c, s = math.cos(sign * eye), math.sin(sign * eye)
         eye_rotation = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])

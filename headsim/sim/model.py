@@ -48,7 +48,7 @@ def eye_from_camera_rotation(camera: CameraSettings, index: int) -> np.ndarray:
     eye angle (about +y for Ca1, -y for Ca2); pitch turns it up (about its x);
     roll turns it about its optical axis.
     """
-    inward = 1.0 if index == 0 else -1.0
+    inward = names.EYE_CAMERAS[index].inward
     return (
         rotation_y(inward * camera.mount_yaw_rad)
         @ rotation_x(camera.mount_pitch_rad)
@@ -112,7 +112,7 @@ def apply_settings(
         mj_cam.pos = eye_from_camera_rotation(cam, index) @ offset_cv
         # Yaw axis leaning forward about H's x (eye2's axis is -y, mirrored).
         tilt = cam.eye_axis_tilt_rad
-        axis_sign = 1.0 if index == 0 else -1.0
+        axis_sign = names.EYE_CAMERAS[index].inward
         spec.joint(names.EYE_JOINTS[index]).axis = [
             0.0,
             axis_sign * np.cos(tilt),
