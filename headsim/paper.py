@@ -10,6 +10,18 @@ own: the presets, studies and reports read the paper's figures from here.
 from __future__ import annotations
 
 import math
+from typing import TypedDict
+
+
+class Intrinsics(TypedDict):
+    """One camera's Zhang intrinsics: kx, ky, px; principal point cx, cy, px; radial k1."""
+
+    kx: float
+    ky: float
+    cx: float
+    cy: float
+    k1: float
+
 
 #: Distance between the two cameras' optical centres, m (Sec. VI: "150 mm").
 BASELINE_M = 0.150
@@ -21,7 +33,7 @@ IMAGE_SIZE_PX = (640, 480)
 INITIAL_DIRECTIONS_RAD = (0.0578, -0.0254)
 #: Zhang intrinsics of Ca1 and Ca2 (Sec. VI-B): focal lengths kx, ky, px (rounded to 0.01
 #: as in equations.md), principal point (cx, cy), px, radial distortion k1 (the paper's kc).
-INTRINSICS = (
+INTRINSICS: tuple[Intrinsics, Intrinsics] = (
     {"kx": 834.83, "ky": 815.42, "cx": 303.8, "cy": 306.3, "k1": -0.38741},
     {"kx": 850.46, "ky": 833.29, "cx": 345.1, "cy": 197.3, "k1": -0.30938},
 )
@@ -48,4 +60,5 @@ __all__ = [
     "RELATIVE_ALPHA1_RAD",
     "RELATIVE_ALPHA2_RAD",
     "RELATIVE_OBJECTS",
+    "Intrinsics",
 ]

@@ -84,7 +84,9 @@ class PinholeCamera:
     def fold_radius(self) -> float:
         """Normalised radius where ``r (1 + k1 r^2 + k2 r^4)`` stops increasing (inf if never)."""
         # Slope 1 + 3 k1 s + 5 k2 s^2 in s = r^2: its smallest positive root.
-        roots = np.roots([5.0 * self.k2, 3.0 * self.k1, 1.0]) if self.is_distorted else []
+        roots: np.ndarray | list[complex] = (
+            np.roots([5.0 * self.k2, 3.0 * self.k1, 1.0]) if self.is_distorted else []
+        )
         positive = [z.real for z in roots if abs(z.imag) < 1e-12 and z.real > 0.0]
         return math.sqrt(min(positive)) if positive else math.inf
 

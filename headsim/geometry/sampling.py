@@ -31,9 +31,12 @@ def sample_points_head(
     ``lateral_centre``: a slope added to each drawn x_h / z_h before it is
     scaled by the depth (the direction the eyes look along); None adds nothing.
     """
-    if (depth_range_m is None) == (depths_m is None):
+    if depth_range_m is not None and depths_m is None:
+        z = rng.uniform(*depth_range_m, size=count)
+    elif depth_range_m is None and depths_m is not None:
+        z = depths_m
+    else:
         raise ValueError("give exactly one of depth_range_m and depths_m")
-    z = rng.uniform(*depth_range_m, size=count) if depths_m is None else depths_m
     slope_x = rng.uniform(*lateral, size=count)
     if lateral_centre is not None:
         slope_x = lateral_centre + slope_x

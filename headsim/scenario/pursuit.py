@@ -67,19 +67,18 @@ def _points(table: Table, key: str, minimum: int) -> tuple[tuple[float, float, f
     allowed = f"an array of at least {minimum} [x, y, z] points, m"
     if not isinstance(value, list) or len(value) < minimum or len(value) > 1000:
         raise table.fail(key, "missing" if value is None else "wrong length or type", allowed)
-    points = []
+    points: list[tuple[float, float, float]] = []
     for i, p in enumerate(value):
         if not (isinstance(p, list) and len(p) == 3):
             raise table.fail(f"{key}[{i}]", "must be [x, y, z]", allowed)
-        points.append(
-            tuple(
-                table._check_number(
-                    f"{key}[{i}]", c, -MAX_COORDINATE_M, MAX_COORDINATE_M, False, False, allowed
-                )
-                for c in p
+        x, y, z = (
+            table._check_number(
+                f"{key}[{i}]", c, -MAX_COORDINATE_M, MAX_COORDINATE_M, False, False, allowed
             )
+            for c in p
         )
-    return tuple(points)  # type: ignore[return-value]
+        points.append((x, y, z))
+    return tuple(points)
 
 
 def _path(table: Table, seed: int, duration_s: float) -> tuple[str, Path, Visibility]:

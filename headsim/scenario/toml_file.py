@@ -47,9 +47,9 @@ def read_toml(path: Path) -> dict[str, Any]:
     except RecursionError as err:
         raise ScenarioError(source, "", "nested too deeply for the TOML parser") from err
     except ValueError as err:  # int() refuses more than 4300 digits
-        line = _long_number_line(text)
+        where = _long_number_line(text)
         raise ScenarioError(
-            source, "", f"{line}a number with too many digits ({err})",
+            source, "", f"{where}a number with too many digits ({err})",
             f"integers of at most {MAX_DIGITS} digits",
         ) from err  # fmt: skip
 
