@@ -12,13 +12,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from headsim import paper
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
+
+if TYPE_CHECKING:
+    from headsim.scenario.pursuit import PursuitSpec
 
 #: The narrowest baseline a scenario may set, m: below it vergence carries no depth.
 MIN_BASELINE_M = 0.01
@@ -32,7 +35,7 @@ PROCEDURES = {
     "tracking": "default",
     "chessboard": "chessboard",
     "relative_positioning": "blocks",
-    "pursuit": "default",  # the live head (headsim.live.spec)
+    "pursuit": "default",  # the live head (headsim.scenario.pursuit)
 }
 
 
@@ -166,7 +169,7 @@ class SceneSpec:
     objects: tuple[Placement, ...] = ()
     parked: tuple[str, ...] = ()
     moving: MovingTarget | None = None
-    pursuit: Any = None  # headsim.live.spec.PursuitSpec for the pursuit procedure
+    pursuit: PursuitSpec | None = None  # for the pursuit procedure
 
 
 @dataclass(frozen=True)
@@ -203,6 +206,7 @@ class Scenario:
             return count + (self.scene.moving.steps if self.scene.moving else 0)
         if procedure == "pursuit":  # one step per camera frame
             pursuit = self.scene.pursuit
+            assert pursuit is not None  # the reader sets it for this procedure
             return count + math.ceil(pursuit.duration_s * pursuit.live.frame_rate_hz)
         per_target = 2 if procedure == "calibration" else 1
         return count + per_target * len(self.scene.targets)
