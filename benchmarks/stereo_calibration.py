@@ -18,6 +18,7 @@ import time
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
+from headsim.geometry.transforms import frame_deviation
 from headsim.run.results import write_json_atomic
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, preset
@@ -116,9 +117,7 @@ def measure_markers(
                             "error_pct_depth": m.error_rel_depth * 100,
                         }
                     )
-            rotation, translation = stereo.frame_deviation(
-                head_from_cam1, calib.true_head_from_cam1
-            )
+            rotation, translation = frame_deviation(head_from_cam1, calib.true_head_from_cam1)
             summary[label] = {
                 "frame_rotation_error_mrad": rotation * 1e3,
                 "frame_translation_error_mm": translation * 1e3,

@@ -13,8 +13,9 @@ import numpy as np
 
 from headsim.estimators import Uncertainty, model2
 from headsim.geometry.synthetic import StereoHead, observe
+from headsim.paper import BASELINE_M, INITIAL_DIRECTIONS_RAD
 
-D = 0.15
+D = BASELINE_M
 CENTRE = (319.5, 239.5)
 
 
@@ -49,7 +50,7 @@ def run(n_points: int, repeats: int, seed: int = 0) -> dict[str, float]:
     points = np.stack(
         [r * np.cos(el) * np.sin(az), r * np.sin(el), r * np.cos(el) * np.cos(az)], -1
     )
-    head = StereoHead(D, alpha_e1=0.0578, alpha_e2=-0.0254)
+    head = StereoHead(D, alpha_e1=INITIAL_DIRECTIONS_RAD[0], alpha_e2=INITIAL_DIRECTIONS_RAD[1])
     obs = observe(head, points)
     a1, a2, uv1, uv2 = obs.alpha1, obs.alpha2, obs.uv1, obs.uv2
     e = head.effective_initial_directions()

@@ -1,1 +1,2 @@
-"""Pure geometry: transforms, the head's kinematics, the camera model and the forward model."""
+"""Pure geometry: transforms, the head's kinematics, the camera model, the forward model
+(``synthetic``, ``synthetic_neck``) and the random-target sampler."""

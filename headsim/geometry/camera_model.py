@@ -16,11 +16,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from headsim.geometry._roots import solve_increasing
+from headsim.paper import IMAGE_SIZE_PX, INTRINSICS
 
 __all__ = [
     "PinholeCamera",
     "UndistortionError",
     "ideal",
+    "image_centre",
     "paper_cam1",
     "paper_cam2",
 ]
@@ -71,7 +73,7 @@ class PinholeCamera:
     @property
     def image_centre(self) -> tuple[float, float]:
         """Geometric centre of the image ((W-1)/2, (H-1)/2), px."""
-        return ((self.width - 1) / 2.0, (self.height - 1) / 2.0)
+        return image_centre(self.width, self.height)
 
     @property
     def is_distorted(self) -> bool:
@@ -82,7 +84,9 @@ class PinholeCamera:
     def fold_radius(self) -> float:
         """Normalised radius where ``r (1 + k1 r^2 + k2 r^4)`` stops increasing (inf if never)."""
         # Slope 1 + 3 k1 s + 5 k2 s^2 in s = r^2: its smallest positive root.
-        roots = np.roots([5.0 * self.k2, 3.0 * self.k1, 1.0]) if self.is_distorted else []
+        roots: np.ndarray | list[complex] = (
+            np.roots([5.0 * self.k2, 3.0 * self.k1, 1.0]) if self.is_distorted else []
+        )
         positive = [z.real for z in roots if abs(z.imag) < 1e-12 and z.real > 0.0]
         return math.sqrt(min(positive)) if positive else math.inf
 
@@ -172,6 +176,11 @@ class PinholeCamera:
         return np.arctan(self.normalise(np.stack(np.broadcast_arrays(u, v), axis=-1))[..., 0])
 
 
+def image_centre(width: int, height: int) -> tuple[float, float]:
+    """Geometric centre ((W-1)/2, (H-1)/2), px, of a W x H image (pixel centres at integers)."""
+    return ((width - 1) / 2.0, (height - 1) / 2.0)
+
+
 def ideal() -> PinholeCamera:
     """640 x 480, square pixels, fovy 45 deg (f = 240 / tan 22.5 deg = 579.41 px), centred."""
     f = 240.0 / math.tan(math.radians(22.5))
@@ -180,12 +189,12 @@ def ideal() -> PinholeCamera:
 
 def paper_cam1() -> PinholeCamera:
     """Ca1 of the paper (Zhang calibration, Sec. VI-B; equations.md's last table), k2 = 0."""
-    return PinholeCamera(640, 480, 834.83, 815.42, 303.8, 306.3, k1=-0.38741)
+    return PinholeCamera(*IMAGE_SIZE_PX, **INTRINSICS[0])
 
 
 def paper_cam2() -> PinholeCamera:
     """Ca2 of the paper (Zhang calibration, Sec. VI-B; equations.md's last table), k2 = 0."""
-    return PinholeCamera(640, 480, 850.46, 833.29, 345.1, 197.3, k1=-0.30938)
+    return PinholeCamera(*IMAGE_SIZE_PX, **INTRINSICS[1])
 
 
 def _pairs(a: ArrayLike, name: str) -> np.ndarray:

@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from headsim.paper import ENCODER_RESOLUTION_RAD
+
 __all__ = [
     "ENCODER_RESOLUTION",
     "camera_centre",
@@ -22,8 +24,8 @@ __all__ = [
     "world_to_head",
 ]
 
-#: Eye-motor encoder step of the paper's head, rad (2 pi / 25600, Sec. VI).
-ENCODER_RESOLUTION = 2.0 * np.pi / 25600.0
+#: The geometry's default eye-motor encoder step: the paper's head's, rad (Sec. VI).
+ENCODER_RESOLUTION = ENCODER_RESOLUTION_RAD
 
 
 def world_from_head(theta1: ArrayLike, theta2: ArrayLike, d1: float, a2: float) -> np.ndarray:

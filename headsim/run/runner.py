@@ -25,6 +25,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
+from headsim import paper
 from headsim.active.procedures import (
     CalibrationError,
     CalibrationRun,
@@ -44,7 +45,7 @@ from headsim.active.procedures import (
 from headsim.active.search import Failure
 from headsim.active.servo import Detector, EyeServo, NeckServo, NeckServoResult, ServoConfig
 from headsim.scenario.calibration_design import near_far_depths, near_fraction
-from headsim.scenario.schema import (
+from headsim.scenario.spec import (
     CHESSBOARD_PATTERN,
     CHESSBOARD_SQUARE_M,
     MARKER_BODIES,
@@ -54,7 +55,6 @@ from headsim.scenario.schema import (
 )
 from headsim.sim import names
 from headsim.sim.render import Window
-from headsim.sim.settings import PAPER_INITIAL_DIRECTIONS
 from headsim.sim.simulator import CameraId, HeadSim
 from headsim.vision.detect import find_cross_point, find_marker
 
@@ -62,12 +62,12 @@ from headsim.vision.detect import find_cross_point, find_marker
 PARKED_WORLD_M = (0.0, 0.5, -1.0)
 #: What the paper reports for each experiment (Sec. VI).
 PAPER = {
-    "alpha_e_rad": PAPER_INITIAL_DIRECTIONS,
-    "chessboard_side_mean_m": 0.0303,
-    "chessboard_side_std_m": 0.000677,
-    "relative_alpha1_rad": 0.08,
-    "relative_alpha2_rad": 0.0349,
-    "relative_objects": 6,
+    "alpha_e_rad": paper.INITIAL_DIRECTIONS_RAD,
+    "chessboard_side_mean_m": paper.CHESSBOARD_SIDE_MEAN_M,
+    "chessboard_side_std_m": paper.CHESSBOARD_SIDE_STD_M,
+    "relative_alpha1_rad": paper.RELATIVE_ALPHA1_RAD,
+    "relative_alpha2_rad": paper.RELATIVE_ALPHA2_RAD,
+    "relative_objects": paper.RELATIVE_OBJECTS,
 }
 
 

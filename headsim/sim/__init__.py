@@ -1,4 +1,5 @@
-"""The simulated head: MJCF names, settings, model building, optics, rendering, the simulator.
+"""The simulated head: MJCF names, settings, model building, optics, rendering, the simulator,
+and the settings as the exact forward model sees them (``forward``).
 
 ``HeadSim`` is importable from here; it loads MuJoCo only when first used, so
 that ``headsim.sim.settings`` stays light.

@@ -14,6 +14,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from headsim.geometry.transforms import rotation_x, rotation_y, rotation_z
 from headsim.sim import names
 from headsim.sim.optics import DistortionCanvas, distortion_canvas
 from headsim.sim.settings import MAX_IMAGE_SIDE, CameraSettings, HeadSettings, SettingsError
@@ -36,21 +37,6 @@ def scene_path(scene: str | Path) -> Path:
     )
 
 
-def rotation_x(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
-def rotation_y(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def rotation_z(angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
 #: MuJoCo camera axes (x right, y up, looking down -z) in OpenCV camera axes, and back.
 CV_FROM_MJCAM = np.diag([1.0, -1.0, -1.0])
 
@@ -62,7 +48,7 @@ def eye_from_camera_rotation(camera: CameraSettings, index: int) -> np.ndarray:
     eye angle (about +y for Ca1, -y for Ca2); pitch turns it up (about its x);
     roll turns it about its optical axis.
     """
-    inward = 1.0 if index == 0 else -1.0
+    inward = names.EYE_CAMERAS[index].inward
     return (
         rotation_y(inward * camera.mount_yaw_rad)
         @ rotation_x(camera.mount_pitch_rad)
@@ -126,7 +112,7 @@ def apply_settings(
         mj_cam.pos = eye_from_camera_rotation(cam, index) @ offset_cv
         # Yaw axis leaning forward about H's x (eye2's axis is -y, mirrored).
         tilt = cam.eye_axis_tilt_rad
-        axis_sign = 1.0 if index == 0 else -1.0
+        axis_sign = names.EYE_CAMERAS[index].inward
         spec.joint(names.EYE_JOINTS[index]).axis = [
             0.0,
             axis_sign * np.cos(tilt),

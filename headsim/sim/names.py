@@ -1,6 +1,9 @@
-"""Every MJCF name the Python code uses, in one place (headsim/models/*.xml)."""
+"""Every MJCF name the Python code uses, in one place (headsim/models/*.xml), and the
+:class:`Camera` type that ties each eye camera's number, name and inward sign together."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 # Bodies and frames.
 NECK_BASE = "neck_base"
@@ -17,6 +20,37 @@ EYE_MOTOR_JOINT = EYE_JOINTS[0]  # the motor shaft and its encoder sit on eye 1
 
 # Cameras, indexed 0 -> Ca1 (left, x = -D/2 in H), 1 -> Ca2 (right).
 CAMERAS = ("cam1", "cam2")
+
+
+@dataclass(frozen=True)
+class Camera:
+    """One eye camera: ``index`` into ``settings.cameras`` (0, 1), its MJCF ``name``, and
+    ``inward``: the sign of a yaw that turns it inward, about H's +y (equations.md:
+    +1 for Ca1, whose inward direction is its +x; -1 for Ca2)."""
+
+    index: int
+    name: str
+    inward: float
+
+    @property
+    def number(self) -> int:
+        """The paper's camera number: 1 (Ca1) or 2 (Ca2)."""
+        return self.index + 1
+
+    @classmethod
+    def of(cls, camera: int | str | Camera) -> Camera:
+        """The camera given as 1 or 2 (the paper's Ca1, Ca2), its MJCF name, or itself."""
+        if isinstance(camera, Camera):
+            return camera
+        if isinstance(camera, int) and not isinstance(camera, bool) and camera in (1, 2):
+            return EYE_CAMERAS[camera - 1]
+        if camera in CAMERAS:
+            return EYE_CAMERAS[CAMERAS.index(str(camera))]
+        raise ValueError(f"unknown camera {camera!r}; allowed: 1, 2, {', '.join(CAMERAS)}")
+
+
+#: Ca1 and Ca2, in the order of ``settings.cameras``.
+EYE_CAMERAS = (Camera(0, CAMERAS[0], 1.0), Camera(1, CAMERAS[1], -1.0))
 
 # Actuators.
 NECK_YAW_MOTOR = "neck_yaw_motor"

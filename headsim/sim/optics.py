@@ -84,7 +84,7 @@ def distortion_canvas(
     the tables are shared: read-only)."""
     w, h = camera.width, camera.height
     cx, cy = camera.principal
-    if not camera.distorted:
+    if not camera.pinhole().is_distorted:
         return DistortionCanvas((w, h), (cx, cy), None, None, 1.0)
     us, vs = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
     xy = camera.pinhole().normalise(np.stack([us, vs], axis=-1), strict=False, tol_px=1e-6)

@@ -11,12 +11,13 @@ import math
 from dataclasses import dataclass, field, replace
 
 from headsim.errors import BadInput
-from headsim.geometry.camera_model import PinholeCamera
+from headsim.geometry.camera_model import PinholeCamera, image_centre
+from headsim.geometry.synthetic import mount_yaw_for_direction
+from headsim.paper import BASELINE_M, ENCODER_RESOLUTION_RAD, INITIAL_DIRECTIONS_RAD, INTRINSICS
+from headsim.sim.tolerances import REALISTIC_BUDGET
 
 #: Largest image side the off-screen buffer is allowed to grow to, px.
 MAX_IMAGE_SIDE = 4096
-#: Eye-motor encoder resolution of the paper's head, rad (Sec. VI).
-PAPER_ENCODER_RESOLUTION = 2 * math.pi / 25600
 #: Focal length of the ideal camera: 640 x 480 with a 45 degree vertical field, px.
 IDEAL_FOCAL_PX = 240.0 / math.tan(math.radians(22.5))
 
@@ -71,6 +72,8 @@ class CameraSettings:
     along the camera's x (right) (mounting: typically |.| <= 0.002 m);
     ``eye_axis_tilt_rad`` leans the eye's yaw axis forward, about H's x
     (typically |.| <= 0.005 rad).  All default to 0, the paper's ideal eye.
+    The lens itself is :meth:`pinhole`'s :class:`PinholeCamera` (projection,
+    distortion, image centre): this class adds the mount, noise and checks.
     """
 
     width: int = 640
@@ -143,11 +146,7 @@ class CameraSettings:
     @property
     def image_centre(self) -> tuple[float, float]:
         """Geometric centre of the image, px: ((W - 1) / 2, (H - 1) / 2)."""
-        return ((self.width - 1) / 2, (self.height - 1) / 2)
-
-    @property
-    def distorted(self) -> bool:
-        return self.k1 != 0.0 or self.k2 != 0.0
+        return image_centre(self.width, self.height)
 
     def pinhole(self) -> PinholeCamera:
         """The camera's true intrinsics as a :class:`headsim.geometry.camera_model.PinholeCamera`."""
@@ -206,7 +205,7 @@ class HeadBelief:
     a calibration measures it (the forward one needs the intrinsics to act).
     """
 
-    baseline_m: float = 0.150
+    baseline_m: float = BASELINE_M
     neck_d1_m: float = 0.12
     neck_a2_m: float = 0.09
     nodal_offset_m: tuple[float, float] = (0.0, 0.0)
@@ -249,10 +248,10 @@ class HeadSettings:
     encoder count that is read (uniform, seeded per joint and count), not on it.
     """
 
-    baseline_m: float = 0.150
+    baseline_m: float = BASELINE_M
     neck_d1_m: float = 0.12
     neck_a2_m: float = 0.09
-    encoder_resolution_rad: float = PAPER_ENCODER_RESOLUTION
+    encoder_resolution_rad: float = ENCODER_RESOLUTION_RAD
     cameras: tuple[CameraSettings, CameraSettings] = field(
         default_factory=lambda: (CameraSettings(), CameraSettings())
     )
@@ -319,15 +318,6 @@ class HeadSettings:
         return self.backlash_rad > 0.0 or self.count_error
 
 
-#: The paper's Zhang intrinsics (Sec. VI, equations.md last table).
-PAPER_INTRINSICS = (
-    {"kx": 834.83, "ky": 815.42, "cx": 303.8, "cy": 306.3, "k1": -0.38741},
-    {"kx": 850.46, "ky": 833.29, "cx": 345.1, "cy": 197.3, "k1": -0.30938},
-)
-#: The paper's calibrated initial directions alpha_e1, alpha_e2, rad (Sec. VI-B).
-PAPER_INITIAL_DIRECTIONS = (0.0578, -0.0254)
-
-
 def ideal_head(**overrides: object) -> HeadSettings:
     """Ideal pinhole cameras (640 x 480, fovy 45 deg, centred), no offsets."""
     return HeadSettings(**overrides)  # type: ignore[arg-type]
@@ -341,73 +331,14 @@ def paper_head(**overrides: object) -> HeadSettings:
     what the paper's Sec. V calibration measures) equals the paper's calibrated
     0.0578 and -0.0254 rad.
     """
-    from headsim.sim.optics import centre_ray_yaw
-
     cams = []
-    for index, (intr, effective) in enumerate(
-        zip(PAPER_INTRINSICS, PAPER_INITIAL_DIRECTIONS, strict=True)
-    ):
+    for index, (intr, effective) in enumerate(zip(INTRINSICS, INITIAL_DIRECTIONS_RAD, strict=True)):
         cam = CameraSettings(**intr)
         # Ca1's inward direction is its +x, Ca2's its -x (equations.md).
-        sign = 1.0 if index == 0 else -1.0
-        cams.append(replace(cam, mount_yaw_rad=effective - sign * centre_ray_yaw(cam)))
+        cams.append(
+            replace(cam, mount_yaw_rad=mount_yaw_for_direction(index + 1, effective, cam.pinhole()))
+        )
     return HeadSettings(cameras=(cams[0], cams[1]), **overrides)  # type: ignore[arg-type]
-
-
-#: The realistic preset's tolerance budget: value, unit and where it comes from.
-#: Each entry is one imperfection of a real head beside the paper's cameras.
-REALISTIC_BUDGET: dict[str, tuple[float, str, str]] = {
-    "nodal_offset_m": (
-        0.020,
-        "m",
-        "entrance pupil in front of the yaw axis: C-mount lenses of 6-16 mm focal length "
-        "have their entrance pupil 10-30 mm in front of the sensor-side flange, and eye "
-        "mechanisms put the axis near the sensor (engineering assumption, middle of 10-30 mm)",
-    ),
-    "side_offset_m": (
-        0.001,
-        "m",
-        "camera mounting: sensor-to-housing placement tolerance of industrial board cameras "
-        "is about +-0.1-0.2 mm, the bracket's machined +-0.1 mm, a hand-assembled mount "
-        "1 mm (stated engineering assumption); Ca1 +1 mm, Ca2 -0.5 mm",
-    ),
-    "baseline_error_m": (
-        0.0003,
-        "m",
-        "two bearing bores on one machined plate: ISO 2768-m general tolerance for 30-120 mm "
-        "is +-0.3 mm; the true baseline is 150.3 mm, the head believes 150 mm",
-    ),
-    "neck_error_m": (
-        0.0005,
-        "m",
-        "D-H lengths d1, a2 of an assembled neck (stack of 3-4 parts, +-0.2 mm each, "
-        "ISO 2768-m): +0.5 mm on d1, -0.5 mm on a2",
-    ),
-    "backlash_rad": (
-        2.9e-4,
-        "rad",
-        "one arcminute: a zero-backlash harmonic drive is < 1 arcmin (Harmonic Drive CSF "
-        "catalogue); a precision planetary head 1-3 arcmin",
-    ),
-    "count_error": (
-        1.0,
-        "count",
-        "the true angle is anywhere within the count read (the encoder's quantisation: "
-        "the paper's 2 pi / 25600 rad)",
-    ),
-    "eye_axis_tilt_rad": (
-        0.002,
-        "rad",
-        "bearing bores perpendicular to the plate within 0.1 mm over 50 mm (ISO 1101 "
-        "perpendicularity, machined part): 2 mrad; Ca1 +2, Ca2 -1 mrad",
-    ),
-    "position_noise_m": (
-        0.001,
-        "m",
-        "a tape measure or ruler read to 1 mm (EC class II tape: +-0.3 mm per metre plus "
-        "reading), on every coordinate of every calibration target",
-    ),
-}
 
 
 def realistic_head(**overrides: object) -> HeadSettings:
@@ -431,7 +362,7 @@ def realistic_head(**overrides: object) -> HeadSettings:
         ),
     )
     values: dict[str, object] = {
-        "baseline_m": 0.150 + b["baseline_error_m"][0],
+        "baseline_m": BASELINE_M + b["baseline_error_m"][0],
         "neck_d1_m": 0.12 + b["neck_error_m"][0],
         "neck_a2_m": 0.09 - b["neck_error_m"][0],
         "cameras": cams,

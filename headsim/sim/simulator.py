@@ -27,6 +27,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from headsim.geometry.transforms import homogeneous, invert_transform
 from headsim.sim import names
 from headsim.sim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
 from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
@@ -70,19 +71,6 @@ class _Commands:
 
 #: Index of each motor in the seeded count-error draw.
 _MOTOR_INDEX = {"neck_yaw": 0, "neck_pitch": 1, "eye": 2}
-
-
-def _homogeneous(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
-    transform = np.eye(4)
-    transform[:3, :3] = rotation
-    transform[:3, 3] = translation
-    return transform
-
-
-def invert_transform(transform: np.ndarray) -> np.ndarray:
-    """Inverse of a rigid 4 x 4 transform."""
-    rotation, translation = transform[:3, :3], transform[:3, 3]
-    return _homogeneous(rotation.T, -rotation.T @ translation)
 
 
 class HeadSim:
@@ -310,12 +298,12 @@ class HeadSim:
     def world_from_head(self) -> np.ndarray:
         """Pose of H in W, 4 x 4 (eq. (1) of the paper)."""
         body = self.data.body(names.HEAD)
-        return _homogeneous(body.xmat.reshape(3, 3), body.xpos)
+        return homogeneous(body.xmat.reshape(3, 3), body.xpos)
 
     def world_from_camera(self, camera: CameraId) -> np.ndarray:
         """Pose of a camera's OpenCV frame in W, 4 x 4."""
         cam = self.data.camera(names.CAMERAS[self.camera_index(camera)])
-        return _homogeneous(cam.xmat.reshape(3, 3) @ CV_FROM_MJCAM, cam.xpos)
+        return homogeneous(cam.xmat.reshape(3, 3) @ CV_FROM_MJCAM, cam.xpos)
 
     def head_from_camera(self, camera: CameraId) -> np.ndarray:
         """Pose of a camera's OpenCV frame in H, 4 x 4."""

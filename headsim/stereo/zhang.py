@@ -35,9 +35,16 @@ import cv2
 import mujoco
 import numpy as np
 
+from headsim.geometry.transforms import (
+    invert_transform,
+    rotation_angle,
+    rotation_x,
+    rotation_y,
+    rotation_z,
+)
 from headsim.sim import names
 from headsim.sim.optics import project_points, undistort_pixels
-from headsim.sim.simulator import HeadSim, invert_transform
+from headsim.sim.simulator import HeadSim
 from headsim.vision.detect import Detection, find_chessboard, find_marker
 
 #: Inner corners of the scene's chessboard (columns, rows): headsim/models/scene_chessboard.xml.
@@ -106,15 +113,6 @@ class ChessboardViews:
                 np.linalg.norm(self.image_points2 - self.true_points2, axis=-1),
             ]
         )
-
-
-def _rotation(axis: int, angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    i, j = [(1, 2), (2, 0), (0, 1)][axis]
-    rotation = np.eye(3)
-    rotation[i, i] = rotation[j, j] = c
-    rotation[i, j], rotation[j, i] = -s, s
-    return rotation
 
 
 def _board_outline() -> np.ndarray:
@@ -190,9 +188,9 @@ def sample_board_pose(
         centre_head = distance * ray / np.linalg.norm(ray)
         # Board axes start parallel to H (x right, y down, z away from the head).
         rotation = (
-            _rotation(2, rng.uniform(-max_roll_rad, max_roll_rad))
-            @ _rotation(0, rng.uniform(-max_tilt_rad, max_tilt_rad))
-            @ _rotation(1, rng.uniform(-max_tilt_rad, max_tilt_rad))
+            rotation_z(rng.uniform(-max_roll_rad, max_roll_rad))
+            @ rotation_x(rng.uniform(-max_tilt_rad, max_tilt_rad))
+            @ rotation_y(rng.uniform(-max_tilt_rad, max_tilt_rad))
         )
         head_from_board = np.eye(4)
         head_from_board[:3, :3] = rotation
@@ -385,12 +383,6 @@ class StereoCalibration:
         return head_from_cam1_from_extrinsics(self.cam2_from_cam1)
 
 
-def rotation_angle(rotation: np.ndarray) -> float:
-    """Angle of a rotation matrix, rad."""
-    cos = (float(np.trace(rotation)) - 1.0) / 2.0
-    return math.acos(min(1.0, max(-1.0, cos)))
-
-
 def _calibrate_camera(
     views: ChessboardViews, index: int, true_K: np.ndarray, true_dist: np.ndarray
 ) -> CameraCalibration:
@@ -515,15 +507,9 @@ def head_from_cam1_from_eye(initial_direction_rad: float, baseline_m: float) -> 
     from it first.
     """
     head_from_cam1 = np.eye(4)
-    head_from_cam1[:3, :3] = _rotation(1, initial_direction_rad)
+    head_from_cam1[:3, :3] = rotation_y(initial_direction_rad)
     head_from_cam1[:3, 3] = [-baseline_m / 2, 0.0, 0.0]
     return head_from_cam1
-
-
-def frame_deviation(estimate: np.ndarray, truth: np.ndarray) -> tuple[float, float]:
-    """(rotation angle rad, translation distance m) between two poses of one frame (4, 4)."""
-    delta = invert_transform(truth) @ estimate
-    return rotation_angle(delta[:3, :3]), float(np.linalg.norm(delta[:3, 3]))
 
 
 # -- triangulation -------------------------------------------------------------

@@ -82,7 +82,7 @@ from headsim.active.servo import EyeServo
 from headsim.errors import BadInput, JobFailed
 from headsim.run.results import to_jsonable, write_csv_atomic, write_json_atomic
 from headsim.sim import names
-from headsim.sim.optics import centre_ray_yaw
+from headsim.sim.forward import effective_directions
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
 from headsim.stereo import zhang as stereo
@@ -713,11 +713,7 @@ def image_centre_directions(settings: HeadSettings) -> tuple[float, float]:
     (``HeadSim.effective_initial_direction`` without mount pitch or roll);
     for explaining the errors, never given to a method.
     """
-    yaws = [
-        c.mount_yaw_rad + s * centre_ray_yaw(c)
-        for s, c in zip((1, -1), settings.cameras, strict=True)
-    ]
-    return (yaws[0], yaws[1])
+    return effective_directions(settings)
 
 
 def table_targets(count: int = len(TABLE_TARGETS_HEAD)) -> np.ndarray:

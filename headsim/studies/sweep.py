@@ -113,7 +113,8 @@ def _values(source: str, key: str, value: Any) -> list[Any]:
 
 def load_sweep(path: str | Path) -> SweepSpec:
     """Read and check a sweep file; every job's scenario is validated before anything runs."""
-    from headsim.scenario.schema import ScenarioError, load_scenario, resolve_path
+    from headsim.scenario.loading import load_scenario, resolve_path
+    from headsim.scenario.tables import ScenarioError
 
     path = Path(path)
     source = str(path)
@@ -233,7 +234,7 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
     record: dict[str, Any] = {"id": job.id, "index": job.index, "params": job.params}
     try:
         from headsim.run.runner import run_scenario
-        from headsim.scenario.schema import load_scenario
+        from headsim.scenario.loading import load_scenario
 
         overrides = {k: v for k, v in job.params.items() if k != "seed"}
         scenario = load_scenario(

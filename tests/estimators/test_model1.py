@@ -9,7 +9,8 @@ import pytest
 
 from headsim.estimators import Flag, Uncertainty, model1
 from headsim.geometry.kinematics import head_to_world, world_to_head
-from headsim.geometry.synthetic import StereoHead, image_points, neck_fixation
+from headsim.geometry.synthetic import StereoHead, image_points
+from headsim.geometry.synthetic_neck import neck_fixation
 
 from .helpers import random_points
 

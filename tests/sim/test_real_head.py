@@ -27,7 +27,6 @@ from headsim.geometry.synthetic import (
 from headsim.sim import names
 from headsim.sim.settings import (
     FINE_RENDERING,
-    REALISTIC_BUDGET,
     CameraSettings,
     HeadBelief,
     HeadSettings,
@@ -36,6 +35,7 @@ from headsim.sim.settings import (
     preset,
 )
 from headsim.sim.simulator import HeadSim
+from headsim.sim.tolerances import REALISTIC_BUDGET
 from headsim.vision.detect import find_marker
 
 PAPER1 = PinholeCamera(640, 480, 834.83, 815.42, 303.8, 306.3, -0.38741, 0.0)
@@ -327,7 +327,7 @@ position_head_m = [0.02, 0.01, 0.6]
 
 
 def _scenario(tmp_path, head: str):
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
 
     path = tmp_path / "s.toml"
     path.write_text(_SCENARIO.format(head=head))
@@ -359,7 +359,7 @@ def test_the_belief_differs_from_the_truth_only_where_the_scenario_says(tmp_path
     ],
 )
 def test_a_bad_new_key_in_a_scenario_is_named_with_its_range(tmp_path, head, field) -> None:
-    from headsim.scenario.schema import ScenarioError
+    from headsim.scenario.tables import ScenarioError
 
     with pytest.raises(ScenarioError, match=re.escape(f"{field}:") + ".*allowed"):
         _scenario(tmp_path, head)

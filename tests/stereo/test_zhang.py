@@ -9,10 +9,11 @@ import cv2
 import numpy as np
 import pytest
 
+from headsim.geometry.transforms import frame_deviation, invert_transform
 from headsim.sim import names
 from headsim.sim.optics import camera_matrix, dist_coeffs
 from headsim.sim.settings import CameraSettings, HeadSettings, ideal_head, paper_head
-from headsim.sim.simulator import HeadSim, invert_transform
+from headsim.sim.simulator import HeadSim
 from headsim.stereo import zhang as stereo
 
 PRESETS = {"ideal": ideal_head, "paper": paper_head}
@@ -49,7 +50,7 @@ def test_calibration_reaches_the_reprojection_and_focal_length_bounds(calibrated
         assert abs(cam.k1_error) < 0.02, (name, cam.dist)
     assert abs(calib.baseline_m - calib.true_baseline_m) < 1e-3
     assert calib.rotation_error_rad < 3e-3
-    rotation, translation = stereo.frame_deviation(calib.head_from_cam1, calib.true_head_from_cam1)
+    rotation, translation = frame_deviation(calib.head_from_cam1, calib.true_head_from_cam1)
     assert rotation < 5e-3 and translation < 1e-3
 
 
@@ -161,7 +162,7 @@ def test_head_frame_from_extrinsics_is_exact_for_mount_yaws_and_reports_other_of
         )
         # ... and is off by the centre ray's angle when given the effective direction,
         effective = sim.effective_initial_direction(1)
-        rotation, _ = stereo.frame_deviation(
+        rotation, _ = frame_deviation(
             stereo.head_from_cam1_from_eye(effective, sim.settings.baseline_m), truth
         )
         assert rotation == pytest.approx(abs(effective - yaw), abs=1e-12)
@@ -173,7 +174,7 @@ def test_head_frame_from_extrinsics_is_exact_for_mount_yaws_and_reports_other_of
     pitched = HeadSettings(cameras=(CameraSettings(mount_pitch_rad=0.02), CameraSettings()))
     with HeadSim("default", pitched) as sim:
         cam2_from_cam1 = invert_transform(sim.world_from_camera(2)) @ sim.world_from_camera(1)
-        rotation, translation = stereo.frame_deviation(
+        rotation, translation = frame_deviation(
             stereo.head_from_cam1_from_extrinsics(cam2_from_cam1), sim.head_from_camera(1)
         )
     assert rotation == pytest.approx(0.01, abs=1e-9)  # half the pitch: y is the mean of both

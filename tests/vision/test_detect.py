@@ -16,8 +16,9 @@ import mujoco
 import numpy as np
 import pytest
 
+from headsim.geometry.transforms import rotation_x, rotation_y, rotation_z
 from headsim.sim import names
-from headsim.sim.model import MODELS_DIR, rotation_x, rotation_y, rotation_z
+from headsim.sim.model import MODELS_DIR
 from headsim.sim.settings import (
     CameraSettings,
     HeadSettings,

@@ -1,0 +1,115 @@
+"""Loading scenario files: every shipped file validates in both variants; the fast table, missing or broken files and the CLI's list say what is wrong."""
+
+from __future__ import annotations
+
+import re
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from headsim.cli import main
+from headsim.scenario.loading import load_scenario, scenario_files
+from headsim.scenario.tables import ScenarioError
+
+FILES = scenario_files()
+
+
+PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "tracking")
+
+
+MINIMAL = """
+description = "a test"
+
+[experiment]
+procedure = "model2"
+
+[[scene.targets]]
+position_head_m = [0.02, 0.01, 0.6]
+"""
+
+
+def _write(tmp_path: Path, text: str, name: str = "bad.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def test_there_is_a_scenario_for_each_experiment_and_a_quick_start() -> None:
+    assert {"quickstart", *PAPER_SCENARIOS} <= {p.stem for p in FILES}
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
+def test_every_scenario_file_validates_in_both_variants(path: Path) -> None:
+    full, fast = load_scenario(path), load_scenario(path, fast=True)
+    assert full.description == fast.description and "\n" not in full.description
+    assert not full.fast and fast.fast
+    assert fast.fixations < full.fixations
+    if path.stem in (*PAPER_SCENARIOS, "quickstart"):
+        # The paper's cameras, and the initial directions calibrated before measuring.
+        assert full.preset == fast.preset == ("realistic" if path.stem == "quickstart" else "paper")
+        assert full.experiment.calibration is not None and fast.experiment.calibration is not None
+
+
+def test_a_scenario_is_found_by_name_and_the_seed_draws_only_the_random_parts() -> None:
+    one, other = load_scenario("quickstart"), load_scenario("quickstart", seed=7)
+    assert one.seed == 0 and other.seed == other.settings.seed == 7
+    explicit = [t for t in one.scene.targets if not t.name.startswith("random")]
+    assert explicit == [t for t in other.scene.targets if not t.name.startswith("random")]
+    randoms = [t.position_world_m for t in one.scene.targets if t.name.startswith("random")]
+    assert randoms and randoms != [
+        t.position_world_m for t in other.scene.targets if t.name.startswith("random")
+    ]
+    assert load_scenario("quickstart", seed=0) == one  # drawn again, the same
+
+
+def test_the_fast_table_is_checked_and_named(tmp_path: Path) -> None:
+    path = _write(tmp_path, MINIMAL + "[fast]\nexperiment.calibration.targets = 1\n")
+    with pytest.raises(
+        ScenarioError,
+        match=re.escape(f"{path}: fast.experiment.calibration.targets: 1 is out of range"),
+    ):
+        load_scenario(path)  # the full variant is fine, but both are checked
+    path = _write(tmp_path, MINIMAL + "[fast]\ndescription = 'short'\n")
+    with pytest.raises(ScenarioError, match=r"fast.description: unknown key"):
+        load_scenario(path)
+
+
+def test_a_file_that_is_not_toml_or_not_there_says_so(tmp_path: Path) -> None:
+    with pytest.raises(ScenarioError, match=re.escape(f"{tmp_path / 'bad.toml'}: not valid TOML")):
+        load_scenario(_write(tmp_path, "description = \n"))
+    with pytest.raises(
+        ScenarioError, match=r"no such scenario file .allowed: a .toml path or one of: .*quickstart"
+    ):
+        load_scenario("kitchen")
+
+
+def test_run_with_a_bad_file_exits_2_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _write(tmp_path, MINIMAL.replace("0.6]", "-0.6]"))
+    out, rrd = tmp_path / "out", tmp_path / "rec" / "run.rrd"
+    assert main(["run", str(path), "--out", str(out), "--rrd", str(rrd)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"headsim: error: {path}: scene.targets[0]: target at")
+    assert not out.exists() and not rrd.parent.exists()
+    assert main(["run", "quickstart", "--seed", "-3", "--out", str(out)]) == 2
+    assert "seed: -3 is out of range" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_list_shows_every_scenario_with_its_description(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for path in FILES:
+        description = load_scenario(path).description
+        assert re.search(rf"^  {path.stem}\s+{re.escape(description)}$", out, re.M)
+
+
+def test_list_flags_an_invalid_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _write(tmp_path, MINIMAL, "good.toml")
+    _write(tmp_path, MINIMAL + "[head]\nbaseline_m = 0\n", "broken.toml")
+    assert main(["list", "--dir", str(tmp_path)]) == 2
+    out = capsys.readouterr().out
+    assert "good" in out and "a test" in out
+    assert "broken  INVALID:" in out and "head.baseline_m: 0 is out of range" in out
