@@ -6,15 +6,8 @@ import math
 
 import pytest
 
-from headsim.studies.bench import (
-    BASELINE,
-    TOLERANCES,
-    Faults,
-    compare,
-    format_table,
-    load_json,
-    suite,
-)
+from headsim.studies.bench import Faults, suite
+from headsim.studies.bench_compare import BASELINE, TOLERANCES, compare, format_table, load_json
 
 RULES = {
     "err": {"worse": "higher", "abs": 0.1, "rel": 0.5},

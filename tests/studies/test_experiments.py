@@ -7,7 +7,8 @@ import pytest
 
 from headsim.active.procedures import Measurement
 from headsim.sim.settings import HeadSettings, paper_head
-from headsim.studies.experiments import error_figures, random_targets_head, visible_vertical_range
+from headsim.studies.experiments import error_figures
+from headsim.studies.targets import random_targets_head, visible_vertical_range
 
 
 def _measurement(error_m, depth_m: float, status: str = "ok") -> Measurement:

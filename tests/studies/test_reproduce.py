@@ -16,8 +16,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from check_reproduce import problems
 
 from headsim.cli import main
-from headsim.studies import reproduce
-from headsim.studies.reproduce import JobOutcome, report_sections, report_text
+from headsim.studies.jobs import render_pool
+from headsim.studies.reproduce_experiments import STUDY_JOB, JobOutcome
+from headsim.studies.reproduce_jobs import JobError, scenario_job
+from headsim.studies.reproduce_report import report_sections, report_text
+from headsim.studies.reproduce_rows import chessboard_rows, initial_direction_rows, study_rows
+from headsim.studies.reproduce_schedule import PlannedJob, critical_order, schedule
 
 
 def _state(tmp_path: Path, status: str = "ok") -> dict:
@@ -59,14 +63,14 @@ BOARD = {
 
 
 def test_rows_compare_with_the_papers_figures() -> None:
-    rows = reproduce.initial_direction_rows(CALIBRATION, None)
+    rows = initial_direction_rows(CALIBRATION, None)
     assert [r.verdict for r in rows] == ["reproduced", "reproduced"]
     far = {**CALIBRATION, "block": {**CALIBRATION["block"], "alpha_e_rad": [0.0600, -0.0254]}}
-    assert reproduce.initial_direction_rows(far, None)[0].verdict.startswith("differs by +2.2e-03")
-    board = reproduce.chessboard_rows(BOARD)
+    assert initial_direction_rows(far, None)[0].verdict.startswith("differs by +2.2e-03")
+    board = chessboard_rows(BOARD)
     assert board[0].ours == "30.030" and board[0].verdict.startswith("reproduced")
     worse = {"results": {"experiment": {**BOARD["results"]["experiment"], "side_mean_m": 0.0306}}}
-    assert reproduce.chessboard_rows(worse)[0].verdict == "not reproduced"
+    assert chessboard_rows(worse)[0].verdict == "not reproduced"
     study = {
         "figures": {
             "tables_v_vi": {"stereo_rms_mm": 0.6, "active_v_known_over_stereo": 1.3},
@@ -76,7 +80,7 @@ def test_rows_compare_with_the_papers_figures() -> None:
             },
         }
     }
-    verdicts = [r.verdict for r in reproduce.study_rows(study)]
+    verdicts = [r.verdict for r in study_rows(study)]
     assert verdicts == ["reference", "reproduced", "reproduced (stereo degrades)", "reproduced"]
 
 
@@ -148,13 +152,11 @@ def test_an_interrupted_run_leaves_a_readable_partial_report(tmp_path: Path) -> 
 def test_a_failing_job_says_why_and_leaves_the_pool_working(tmp_path: Path) -> None:
     # A scenario error cannot be unpickled as such: it must not break the pool.
     missing = str(tmp_path / "missing.json")
-    pool = reproduce._pool(1)
+    pool = render_pool(1)
     try:
         for _ in range(2):
-            job = pool.submit(
-                reproduce._scenario_job, "chessboard", str(tmp_path), True, None, missing
-            )
-            with pytest.raises(reproduce.JobError, match=r"ScenarioError: .*cannot read"):
+            job = pool.submit(scenario_job, "chessboard", str(tmp_path), True, None, missing)
+            with pytest.raises(JobError, match=r"ScenarioError: .*cannot read"):
                 job.result(timeout=300)
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
@@ -171,9 +173,9 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
     import concurrent.futures as futures
 
     log: list[str] = []
-    job = reproduce._Job
+    job = PlannedJob
 
-    def make(name: str, needs: tuple[str, ...] = ()) -> reproduce._Job:
+    def make(name: str, needs: tuple[str, ...] = ()) -> PlannedJob:
         return job(name, _echo, needs, lambda done, n=name: (n, log))
 
     # calibration (225) -> chessboard (298) is the longest path; zhang (148) and
@@ -182,18 +184,18 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
         make("zhang"),
         make("fixed_point"),
         make("tracking", ("calibration",)),
-        make(reproduce.STUDY_JOB, ("calibration", "zhang", "fixed_point")),
+        make(STUDY_JOB, ("calibration", "zhang", "fixed_point")),
         make("calibration"),
         make("chessboard", ("calibration",)),
         make("broken"),
         make("relative_positioning", ("broken",)),
     ]
-    level = reproduce.critical_order(plan)
+    level = critical_order(plan)
     assert level["calibration"] == 225.0 + 298.0
     assert level["zhang"] == 148.0 + 115.0 and level["fixed_point"] == 110.0 + 115.0
     finished, skipped, ran = [], [], []
     with futures.ThreadPoolExecutor(max_workers=1) as pool:
-        ended = reproduce._schedule(
+        ended = schedule(
             pool,
             1,
             plan,
@@ -209,7 +211,7 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
         "chessboard",
         "zhang",
         "fixed_point",
-        reproduce.STUDY_JOB,
+        STUDY_JOB,
         "tracking",
     ]
     assert ("broken", True, "RuntimeError: no board") in finished
@@ -218,6 +220,6 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
 
 
 def test_a_plan_with_a_need_that_no_job_meets_is_refused() -> None:
-    plan = [reproduce._Job("chessboard", _echo, ("calibration",), lambda done: ())]
+    plan = [PlannedJob("chessboard", _echo, ("calibration",), lambda done: ())]
     with pytest.raises(ValueError, match="unmet or circular needs: \\['chessboard'\\]"):
-        reproduce.critical_order(plan)
+        critical_order(plan)

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
-from headsim.studies.sweep import CRASH_ENV, SweepError, load_sweep, read_log, run_sweep
+from headsim.studies.sweep import CRASH_ENV, read_log, run_sweep
+from headsim.studies.sweep_spec import SweepError, load_sweep
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 
