@@ -2,7 +2,7 @@
 
 One set of random points over the whole field in front of the head is drawn
 once; at each focal length (0.5x ... 2x the paper's, mounts unchanged) the
-scenario's reach check (``headsim.scenario.schema.reach_refusal``) accepts or
+scenario's reach check (``headsim.scenario.reach.reach_refusal``) accepts or
 refuses each one (with its reason), the head calibrates on a layout drawn
 from the same seed (``calibration_layout`` with the eyes allowed to turn in,
 every position's outcome recorded), and every accepted point is measured
@@ -43,7 +43,7 @@ from headsim.active.procedures import (
 from headsim.active.servo import EyeServo, NeckServo
 from headsim.run.results import write_json_atomic
 from headsim.run.runner import marker_target
-from headsim.scenario.schema import reach_refusal
+from headsim.scenario.reach import reach_refusal
 from headsim.sim import names
 from headsim.sim.settings import FINE_RENDERING, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim

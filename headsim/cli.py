@@ -109,7 +109,7 @@ def _run(args: argparse.Namespace) -> int:
     from headsim.run.report import results_payload, summary_text
     from headsim.run.rerun_cli import recording_target
     from headsim.run.runner import Observer, run_scenario
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
     target = recording_target(args)  # a bad --url or port is bad input (exit 2)
@@ -261,7 +261,8 @@ def _close_recorder(recorder, rrd: Path | None) -> None:
 def _calibrate(args: argparse.Namespace) -> int:
     from headsim.active.calibration_file import head_hash, write_calibration
     from headsim.run.runner import calibrate_scenario
-    from headsim.scenario.schema import ScenarioError, load_scenario
+    from headsim.scenario.loading import load_scenario
+    from headsim.scenario.tables import ScenarioError
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
     spec = scenario.experiment.calibration
@@ -337,7 +338,7 @@ def _serve_until_interrupted(recorder: object, url: str) -> None:
 
 
 def _list(args: argparse.Namespace) -> int:
-    from headsim.scenario.schema import SCENARIOS_DIR, describe_scenarios
+    from headsim.scenario.loading import SCENARIOS_DIR, describe_scenarios
 
     directory = Path(args.dir) if args.dir else SCENARIOS_DIR
     rows = list(describe_scenarios(directory))

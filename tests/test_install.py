@@ -61,7 +61,7 @@ def test_pip_install_runs_the_quick_start_from_another_folder(tmp_path: Path) ->
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     env.setdefault("MUJOCO_GL", "egl")
     where = _run(
-        [str(python), "-c", "import headsim.sim.model as m, headsim.scenario.schema as s; "
+        [str(python), "-c", "import headsim.sim.model as m, headsim.scenario.loading as s; "
          "print(m.__file__); print(m.MODELS_DIR); print(s.SCENARIOS_DIR)"],
         cwd=elsewhere, env=env,
     ).stdout.split()  # fmt: skip

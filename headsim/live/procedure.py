@@ -21,7 +21,7 @@ import numpy as np
 from headsim.active.procedures import HeadKnowledge
 from headsim.live.gaze import FrameRecord, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
-from headsim.live.spec import PursuitSpec, describe
+from headsim.scenario.pursuit import PursuitSpec, describe
 
 
 def figures(run: PursuitRun, spec: PursuitSpec) -> dict[str, Any]:

@@ -57,7 +57,7 @@ from headsim.run import mjcf_rerun
 from headsim.run.report import summary_text
 from headsim.run.rerun_cli import RecordingTarget
 from headsim.run.runner import MeasurementRecord, Observer, RunResult
-from headsim.scenario.schema import Scenario
+from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.optics import camera_matrix
 from headsim.sim.simulator import HeadSim

@@ -44,7 +44,7 @@ from headsim.active.procedures import (
 from headsim.active.search import Failure
 from headsim.active.servo import Detector, EyeServo, NeckServo, NeckServoResult, ServoConfig
 from headsim.scenario.calibration_design import near_far_depths, near_fraction
-from headsim.scenario.schema import (
+from headsim.scenario.spec import (
     CHESSBOARD_PATTERN,
     CHESSBOARD_SQUARE_M,
     MARKER_BODIES,

@@ -193,7 +193,7 @@ def _quickstart_over_render() -> float:
     """Wall time of the quick start scenario at full size over one 640x480 render,
     the render timed just before and just after it."""
     from headsim.run.runner import run_scenario
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario("quickstart")
     with HeadSim("default", HeadSettings()) as sim:
@@ -318,7 +318,7 @@ PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "trackin
 def scenario_metrics(name: str) -> Metrics:
     """Run a scenario's fast variant: failures, RMS error (% of depth) and renders."""
     from headsim.run.runner import run_scenario
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario(name, fast=True)
     result = run_scenario(scenario)

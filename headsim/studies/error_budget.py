@@ -221,7 +221,7 @@ def run_condition(
 ) -> dict[str, Any]:
     """Run the scenario with ``condition``'s fields set; one row of the budget."""
     from headsim.run.runner import run_scenario
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
 
     overrides = dict(condition.overrides)
     if fast:

@@ -45,7 +45,7 @@ def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str,
 def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.active.calibration_file import head_hash, write_calibration
     from headsim.run.runner import calibrate_scenario
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario("calibration", fast=fast, seed=seed)
     start = time.perf_counter()
@@ -69,7 +69,7 @@ def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
 def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
     from headsim.run.report import results_payload, summary_text
     from headsim.run.runner import run_scenario
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
 
     scenario_name, _ = SCENARIO_JOBS[name]
     scenario = load_scenario(
@@ -101,7 +101,7 @@ def _study_config(fast: bool, seed: int | None) -> Any:
 @_plain_errors
 def zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
     """Zhang's stereo calibration of the one head, once (it needs no head.json)."""
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
     from headsim.studies.paper_tables import zhang_calibration
 
     scenario = load_scenario(TABLES_HEAD, fast=fast, seed=seed)
@@ -114,7 +114,7 @@ def zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
 def fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
     """The zoom fixed points and the Sec. V calibration on their columns, once (beyond the
     paper: the active method that the focal length's change does not move)."""
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
     from headsim.studies.paper_tables import fixed_point_calibration
 
     scenario = load_scenario(TABLES_HEAD, fast=fast, seed=seed)
@@ -138,7 +138,7 @@ def tables_job(
 ) -> dict[str, Any]:
     """Tables V/VI and the changed focal length with the one calibration and Zhang's."""
     from headsim.active.calibration_file import read_calibration
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
     from headsim.studies import paper_tables
     from headsim.studies.study_experiments import compare_figures
     from headsim.studies.study_output import summary_rows, write_experiment

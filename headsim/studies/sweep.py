@@ -72,7 +72,7 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
     record: dict[str, Any] = {"id": job.id, "index": job.index, "params": job.params}
     try:
         from headsim.run.runner import run_scenario
-        from headsim.scenario.schema import load_scenario
+        from headsim.scenario.loading import load_scenario
 
         overrides = {k: v for k, v in job.params.items() if k != "seed"}
         scenario = load_scenario(

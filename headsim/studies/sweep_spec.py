@@ -63,7 +63,8 @@ def _values(source: str, key: str, value: Any) -> list[Any]:
 
 def load_sweep(path: str | Path) -> SweepSpec:
     """Read and check a sweep file; every job's scenario is validated before anything runs."""
-    from headsim.scenario.schema import ScenarioError, load_scenario, resolve_path
+    from headsim.scenario.loading import load_scenario, resolve_path
+    from headsim.scenario.tables import ScenarioError
 
     path = Path(path)
     source = str(path)

@@ -16,7 +16,8 @@ from headsim.active.calibration_file import (
 )
 from headsim.cli import main
 from headsim.run.runner import run_scenario
-from headsim.scenario.schema import ScenarioError, load_scenario
+from headsim.scenario.loading import load_scenario
+from headsim.scenario.tables import ScenarioError
 from headsim.sim.settings import HeadSettings, paper_head
 
 SCENARIO = """description = "measure with a stored calibration"

@@ -109,7 +109,7 @@ vertical = 0.05
 
 def _scenario_estimates(path, overrides) -> np.ndarray:
     from headsim.run.runner import run_scenario
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
 
     result = run_scenario(load_scenario(path, overrides=overrides))
     assert result.ok, result.failures
@@ -128,7 +128,8 @@ def test_goal_columns_from_a_scenario_make_a_forward_offset_change_no_estimate(t
 
 
 def test_a_goal_column_outside_the_image_names_its_key(tmp_path) -> None:
-    from headsim.scenario.schema import ScenarioError, load_scenario
+    from headsim.scenario.loading import load_scenario
+    from headsim.scenario.tables import ScenarioError
 
     path = tmp_path / "goals.toml"
     path.write_text(SCENARIO.replace("[303.8, 345.1]", "[303.8, 700.0]"))

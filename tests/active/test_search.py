@@ -22,7 +22,7 @@ from headsim.active.procedures import (
 from headsim.active.search import FailureCause, neck_search_poses
 from headsim.active.servo import EyeServo, NeckServo, ServoConfig
 from headsim.geometry.kinematics import head_to_world
-from headsim.scenario.schema import _Head, model2_refusal, reach_refusal
+from headsim.scenario.reach import ReachHead, model2_refusal, reach_refusal
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
@@ -51,7 +51,7 @@ def test_model2_finds_ca2_again_when_ca1_fixation_turns_it_away() -> None:
     p_head = [0.12, 0.0, 0.6]
     with HeadSim("default", settings) as sim:
         p_world = _place_in_head(sim, "marker_red", p_head)
-        assert model2_refusal(_Head.of(settings), p_world, "target", 0.004) is None
+        assert model2_refusal(ReachHead.of(settings), p_world, "target", 0.004) is None
         servo = EyeServo(sim)
         # A calibrated head (the initial directions Sec. V would find).
         known = HeadKnowledge(
@@ -230,4 +230,4 @@ def test_reach_refusal_is_the_scenario_check_for_both_models() -> None:
     assert reach_refusal(settings, ahead) is None
     refusal = reach_refusal(settings, aside, "ball")
     assert refusal is not None and refusal[0].startswith("ball at ")
-    assert refusal == model2_refusal(_Head.of(settings), aside, "ball")
+    assert refusal == model2_refusal(ReachHead.of(settings), aside, "ball")

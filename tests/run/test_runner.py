@@ -13,7 +13,7 @@ import pytest
 from headsim.cli import main
 from headsim.run.report import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
 from headsim.run.runner import Progress
-from headsim.scenario.schema import load_scenario, scenario_files
+from headsim.scenario.loading import load_scenario, scenario_files
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 FILES = scenario_files()

@@ -13,7 +13,8 @@ from headsim.geometry.kinematics import world_to_head
 from headsim.geometry.synthetic import StereoHead, observe, quantise
 from headsim.run.runner import calibrate_scenario
 from headsim.scenario.calibration_design import near_far_depths, near_fraction, offset_std_limit
-from headsim.scenario.schema import ScenarioError, load_scenario
+from headsim.scenario.loading import load_scenario
+from headsim.scenario.tables import ScenarioError
 
 RANGE_M = (0.25, 1.5)
 

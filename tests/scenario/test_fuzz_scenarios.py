@@ -16,7 +16,9 @@ import re
 import time
 from pathlib import Path
 
-from headsim.scenario.schema import Scenario, ScenarioError, load_scenario, scenario_files
+from headsim.scenario.loading import load_scenario, scenario_files
+from headsim.scenario.spec import Scenario
+from headsim.scenario.tables import ScenarioError
 
 #: Mutated files per test run (the issue asks for at least 2000 per CI run).
 CASES = 2000

@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
-from headsim.scenario.schema import SCENARIOS_DIR, ScenarioError, load_scenario
+from headsim.scenario.loading import SCENARIOS_DIR, load_scenario
+from headsim.scenario.tables import ScenarioError
 
 PAPER_MODEL2 = """\
 description = "a test"

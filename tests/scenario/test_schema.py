@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from headsim.cli import main
-from headsim.scenario.schema import ScenarioError, load_scenario, scenario_files
+from headsim.scenario.loading import load_scenario, scenario_files
+from headsim.scenario.tables import ScenarioError
 
 FILES = scenario_files()
 PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "tracking")

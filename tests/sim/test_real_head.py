@@ -327,7 +327,7 @@ position_head_m = [0.02, 0.01, 0.6]
 
 
 def _scenario(tmp_path, head: str):
-    from headsim.scenario.schema import load_scenario
+    from headsim.scenario.loading import load_scenario
 
     path = tmp_path / "s.toml"
     path.write_text(_SCENARIO.format(head=head))
@@ -359,7 +359,7 @@ def test_the_belief_differs_from_the_truth_only_where_the_scenario_says(tmp_path
     ],
 )
 def test_a_bad_new_key_in_a_scenario_is_named_with_its_range(tmp_path, head, field) -> None:
-    from headsim.scenario.schema import ScenarioError
+    from headsim.scenario.tables import ScenarioError
 
     with pytest.raises(ScenarioError, match=re.escape(f"{field}:") + ".*allowed"):
         _scenario(tmp_path, head)

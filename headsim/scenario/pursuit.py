@@ -22,7 +22,7 @@ present; none: always).  ``[scene.pursuit.live]``: ``frame_rate_hz``,
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -30,10 +30,8 @@ from headsim.live.gaze import GazeConfig, GazeMode, SaccadeProfile
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, LiveConfig
 from headsim.live.motors import MotorLimits
 from headsim.live.paths import Path, RandomWalk, Sinusoid, Static, Throw, Visibility, Waypoints
+from headsim.scenario.tables import Table
 from headsim.sim.settings import SettingsError
-
-if TYPE_CHECKING:
-    from headsim.scenario.schema import _Table
 
 PATH_KINDS = ("waypoints", "sinusoid", "random_walk", "throw", "static")
 #: Largest coordinate of a path point, m.
@@ -58,12 +56,12 @@ class PursuitSpec:
         return np.linspace(0.0, self.duration_s, max(2, round(self.duration_s / step_s) + 1))
 
 
-def _point(table: _Table, key: str) -> tuple[float, float, float]:
+def _point(table: Table, key: str) -> tuple[float, float, float]:
     value = table.numbers(key, 3, lo=-MAX_COORDINATE_M, hi=MAX_COORDINATE_M, unit="m")
     return (value[0], value[1], value[2])
 
 
-def _points(table: _Table, key: str, minimum: int) -> tuple[tuple[float, float, float], ...]:
+def _points(table: Table, key: str, minimum: int) -> tuple[tuple[float, float, float], ...]:
     value = table.data.get(key)
     table.has(key)
     allowed = f"an array of at least {minimum} [x, y, z] points, m"
@@ -84,7 +82,7 @@ def _points(table: _Table, key: str, minimum: int) -> tuple[tuple[float, float, 
     return tuple(points)  # type: ignore[return-value]
 
 
-def _path(table: _Table, seed: int, duration_s: float) -> tuple[str, Path, Visibility]:
+def _path(table: Table, seed: int, duration_s: float) -> tuple[str, Path, Visibility]:
     kind = table.choice("kind", PATH_KINDS)
     path: Path
     if kind == "waypoints":
@@ -140,7 +138,7 @@ def _path(table: _Table, seed: int, duration_s: float) -> tuple[str, Path, Visib
     return kind, path, visibility
 
 
-def read_pursuit(scene: _Table, seed: int, bodies: tuple[str, ...]) -> PursuitSpec:
+def read_pursuit(scene: Table, seed: int, bodies: tuple[str, ...]) -> PursuitSpec:
     """``[scene.pursuit]`` of a scenario, checked (raises the scenario's ScenarioError)."""
     table = scene.table("pursuit")
     if table is None:
@@ -158,7 +156,7 @@ def read_pursuit(scene: _Table, seed: int, bodies: tuple[str, ...]) -> PursuitSp
     return PursuitSpec(name, body, path, kind, visibility, duration, live, gaze)
 
 
-def _live(table: _Table | None) -> LiveConfig:
+def _live(table: Table | None) -> LiveConfig:
     if table is None:
         return LiveConfig()
     rate = table.number("frame_rate_hz", 30.0, 1.0, 1000.0, unit="Hz")
@@ -188,7 +186,7 @@ def _live(table: _Table | None) -> LiveConfig:
     return config
 
 
-def _gaze(table: _Table | None) -> GazeConfig:
+def _gaze(table: Table | None) -> GazeConfig:
     if table is None:
         return GazeConfig()
     config = GazeConfig(

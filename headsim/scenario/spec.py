@@ -1,0 +1,211 @@
+"""The checked scenario: its frozen dataclasses and the constants of the schema.
+
+What :func:`headsim.scenario.loading.load_scenario` returns: a :class:`Scenario`
+(the head's settings, the scene's :class:`SceneSpec`, the experiment's
+:class:`ExperimentSpec`), random parts already drawn from its seed.  Positions
+in metres (world frame W unless named otherwise), angles in radians, pixels as
+OpenCV's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from headsim.sim import names
+from headsim.sim.settings import HeadSettings
+
+#: The narrowest baseline a scenario may set, m: below it vergence carries no depth.
+MIN_BASELINE_M = 0.01
+
+
+#: Procedure -> the scene (``names.SCENES``) it runs in.
+PROCEDURES = {
+    "model2": "default",
+    "model1": "default",
+    "calibration": "default",
+    "tracking": "default",
+    "chessboard": "chessboard",
+    "relative_positioning": "blocks",
+    "pursuit": "default",  # the live head (headsim.live.spec)
+}
+
+
+#: Bodies of the default scene that can be measured, and the colour each is found by.
+MARKER_BODIES = {**names.MARKER_COLOURS, names.CALIBRATION_BALL: "yellow"}
+
+
+#: The chessboard of ``headsim/models/scene_chessboard.xml``: inner corners (columns, rows), square, m.
+CHESSBOARD_PATTERN = (8, 6)
+
+
+CHESSBOARD_SQUARE_M = 0.030
+
+
+#: Nearest a target may be to the head, m (z_h at the start pose).
+MIN_DEPTH_M = 0.1
+
+
+#: Farthest a target may be, m: beyond it one encoder step is centimetres of depth.
+MAX_DEPTH_M = 10.0
+
+
+#: Independent random streams drawn from the scenario seed.
+STREAM_CALIBRATION, STREAM_TARGETS, STREAM_OBJECTS, STREAM_MOVING, STREAM_DEPTH_NOISE = range(1, 6)
+
+
+@dataclass(frozen=True)
+class Placement:
+    """A body put at a world position, m; ``source`` is the field it came from."""
+
+    name: str
+    body: str
+    position_world_m: tuple[float, float, float]
+    source: str
+
+
+@dataclass(frozen=True)
+class CalibrationSpec:
+    """Sec. V calibration of the initial directions, before the experiment (default scene).
+
+    ``targets`` ball positions drawn by ``procedures.calibration_layout``:
+    depth z_h in ``depth_m``, |x_h/z_h| <= ``lateral``, |y_h/z_h| <= ``vertical``.
+    ``depth_noise_m``: error of the tape-measured depth.  ``extended``: also
+    fit each camera's vertical reference row and kx/ky, initial directions and
+    line-of-sight offsets (beyond the paper).  ``position_noise_m``: error of
+    every measured coordinate of each target (x_h, y_h, z_h), m; the depth
+    noise adds to it on z_h.  ``lines_of_sight``: with ``extended``, also fit
+    each eye's line-of-sight offset (default: on for the realistic preset).
+    ``layout``: "uniform" (depths uniform in ``depth_m``) or "near_far" (a
+    share ``near_fraction`` of the balls at the near end of ``depth_m`` and the
+    rest at the far end; default b / (a + b), the design that pins each eye's
+    line-of-sight offset best, see :mod:`headsim.scenario.calibration_design`).
+    ``source``: a calibration file (``headsim calibrate``) to use instead of
+    calibrating (a relative path is relative to the scenario file's
+    directory); the other fields are then not used.
+    """
+
+    targets: int = 60
+    depth_m: tuple[float, float] = (0.25, 0.6)
+    lateral: float = 0.16
+    vertical: float = 0.08
+    depth_noise_m: float = 0.0
+    extended: bool = True
+    position_noise_m: float = 0.0
+    lines_of_sight: bool = False
+    source: str | None = None
+    layout: str = "uniform"
+    near_fraction: float | None = None
+
+
+@dataclass(frozen=True)
+class ServoSpec:
+    """The servo's bounds and tolerances (``headsim.active.servo.ServoConfig``)."""
+
+    tolerance_px: float = 0.1
+    max_iterations: int = 25
+    probe_steps: int = 16
+    min_probe_px: float = 2.0
+    min_secant_steps: int = 8
+
+
+@dataclass(frozen=True)
+class ExperimentSpec:
+    """Which procedure, the calibration before it, and its options."""
+
+    procedure: str
+    calibration: CalibrationSpec | None
+    interpolate: bool = True
+    midline_px: float = 25.0
+    remedy_px: float = 120.0
+    servo: ServoSpec = field(default_factory=ServoSpec)
+    #: The servo's goal column (u10, u20) of Ca1, Ca2, px, as the user tells the head
+    #: (e.g. the principal point's, found with ``headsim.active.principal``); None: image centres.
+    goal_columns_px: tuple[float, float] | None = None
+
+
+@dataclass(frozen=True)
+class MovingTarget:
+    """A body moved through ``waypoints_world_m`` (piecewise linear, equal times) over
+    ``duration_s``, fixated ``steps`` times at equal intervals from t = 0."""
+
+    name: str
+    body: str
+    waypoints_world_m: tuple[tuple[float, float, float], ...]
+    duration_s: float
+    steps: int
+
+    @property
+    def times_s(self) -> np.ndarray:
+        return np.linspace(0.0, self.duration_s, self.steps) if self.steps > 1 else np.zeros(1)
+
+    def position(self, t: float) -> np.ndarray:
+        """World position at time ``t``, s, m."""
+        points = np.asarray(self.waypoints_world_m)
+        knots = np.linspace(0.0, self.duration_s, len(points))
+        return np.array([np.interp(t, knots, points[:, k]) for k in range(3)])
+
+
+@dataclass(frozen=True)
+class SceneSpec:
+    """What is where: ``scene`` is the MJCF scene; ``targets`` to measure (or check
+    targets after a calibration); ``chessboard``/``blocks`` the board's top-left inner
+    corner or the cross point; ``objects`` for relative positioning; ``parked``
+    bodies moved out of sight; ``corners`` the chessboard corners to measure."""
+
+    scene: str
+    targets: tuple[Placement, ...] = ()
+    chessboard: Placement | None = None
+    corners: tuple[int, ...] | None = None
+    blocks: Placement | None = None
+    objects: tuple[Placement, ...] = ()
+    parked: tuple[str, ...] = ()
+    moving: MovingTarget | None = None
+    pursuit: Any = None  # headsim.live.spec.PursuitSpec for the pursuit procedure
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A checked scenario, ready to run (random parts already drawn from ``seed``)."""
+
+    name: str
+    path: Path
+    description: str
+    seed: int
+    fast: bool
+    preset: str
+    settings: HeadSettings
+    settle_mode: str
+    scene: SceneSpec
+    experiment: ExperimentSpec
+
+    @property
+    def paper_cameras(self) -> bool:
+        """Whether the head is the paper's preset (its figures are shown beside ours)."""
+        return self.preset in ("paper", "realistic")
+
+    @property
+    def fixations(self) -> int:
+        """How many fixations the run makes (for the progress bar)."""
+        calibration = self.experiment.calibration
+        count = calibration.targets if calibration else 0
+        procedure = self.experiment.procedure
+        if procedure == "chessboard":
+            return count + len(self.scene.corners or range(corner_count()))
+        if procedure == "relative_positioning":
+            return count + 1
+        if procedure == "tracking":
+            return count + (self.scene.moving.steps if self.scene.moving else 0)
+        if procedure == "pursuit":  # one step per camera frame
+            pursuit = self.scene.pursuit
+            return count + math.ceil(pursuit.duration_s * pursuit.live.frame_rate_hz)
+        per_target = 2 if procedure == "calibration" else 1
+        return count + per_target * len(self.scene.targets)
+
+
+def corner_count() -> int:
+    return CHESSBOARD_PATTERN[0] * CHESSBOARD_PATTERN[1]
