@@ -1,5 +1,6 @@
 """Target positions for the orchestrators, in the head frame H, m: the Tables V/VI targets,
-the seeded samplers, and placing a body at a point given in H."""
+the seeded samplers (both draw with :func:`headsim.geometry.sampling.sample_points_head`),
+and placing a body at a point given in H."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import math
 
 import numpy as np
 
+from headsim.geometry.sampling import sample_points_head
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 
@@ -50,12 +52,13 @@ def depth_targets(
     place targets only), y/z within ``vertical`` of 0.
     """
     look = math.tan((settings.cameras[0].mount_yaw_rad - settings.cameras[1].mount_yaw_rad) / 2)
-    return np.column_stack(
-        [
-            (look + rng.uniform(-lateral, lateral, count)) * depth_m,
-            rng.uniform(-vertical, vertical, count) * depth_m,
-            np.full(count, depth_m),
-        ]
+    return sample_points_head(
+        rng,
+        count,
+        (-lateral, lateral),
+        (-vertical, vertical),
+        depths_m=np.full(count, depth_m),
+        lateral_centre=look,
     )
 
 
@@ -67,9 +70,8 @@ def random_targets_head(
     vertical: tuple[float, float] = (-0.25, 0.25),
 ) -> np.ndarray:
     """Points (count, 3) in H: depth uniform in the range, x/z and y/z uniform."""
-    z = rng.uniform(*depth_range_m, size=count)
-    return np.column_stack(
-        [rng.uniform(-lateral, lateral, count) * z, rng.uniform(*vertical, size=count) * z, z]
+    return sample_points_head(
+        rng, count, (-lateral, lateral), vertical, depth_range_m=depth_range_m
     )
 
 
