@@ -67,7 +67,7 @@ class StudyConfig:
     @classmethod
     def quick(cls, **overrides: Any) -> StudyConfig:
         """The smallest study that still calibrates every method (tests, smoke runs)."""
-        values = {
+        values: dict[str, Any] = {
             "board_poses": 8,
             "calibration_targets": 16,
             "principal_poses": 1,

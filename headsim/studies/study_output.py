@@ -84,7 +84,7 @@ def write_experiment(
     out = Path(out_dir)
     name = result.experiment.name
     summaries = summary_rows(result)
-    payload = {
+    payload: dict[str, Any] = {
         "experiment": name,
         "title": result.experiment.title,
         "parameter": result.experiment.parameter,

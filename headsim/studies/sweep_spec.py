@@ -133,7 +133,7 @@ def _random_params(source: str, table: Any) -> tuple[list[dict[str, Any]], tuple
     if not isinstance(fields, dict) or not fields:
         raise SweepError(source, "random.fields", "missing", "a table of field = [low, high]")
     rng = np.random.default_rng(seed)
-    columns = {}
+    columns: dict[str, list[Any]] = {}
     for key, bounds in fields.items():
         ok = (
             isinstance(bounds, list)
