@@ -34,10 +34,9 @@ from headsim.sim import names
 from headsim.sim.settings import HeadSettings, paper_head, preset
 from headsim.sim.simulator import HeadSim
 from headsim.studies import experiments
-from headsim.studies.bench_compare import compare, environment, format_table, load_json
+from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
 from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
 
-Metrics = dict[str, float]
 Progress = Callable[[str], None]
 
 

@@ -1,6 +1,6 @@
-"""Figures of the study (:mod:`headsim.studies.study`) with matplotlib's Agg backend, written atomically.
+"""Every figure of the orchestrators, with matplotlib's Agg backend, written atomically.
 
-One PNG per experiment:
+The study (:mod:`headsim.studies.study`) draws one PNG per experiment:
 
 - the comparison: per group (a head), the Tables V/VI errors target by target
   (left) and the RMS error of every method in every condition (right), on a
@@ -10,20 +10,22 @@ One PNG per experiment:
   changed head), and for the depth sweep a second panel in mm.
 
 Every method keeps one colour and marker in every figure (:data:`STYLE`).
+A sweep draws a metric against each swept field (:func:`plot_metric`), the
+error budget its bar chart (:func:`plot_budget`).  Callers import this module
+only when they draw, so that matplotlib loads only then.
 """
 
 from __future__ import annotations
 
 import io
+import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import matplotlib
 
 matplotlib.use("Agg")  # no display; must precede pyplot
-import math
-from collections.abc import Sequence
-
 import matplotlib.pyplot as plt
 import numpy as np
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from headsim.studies import head_changes
 from headsim.studies.methods import METHODS, StudyConfig
 from headsim.studies.study_experiments import compare_experiment
 
@@ -15,4 +16,4 @@ def test_the_comparison_figures_are_ratios_of_rms_errors(calibrations) -> None:
     assert experiment.methods == METHODS
     # Two heads only differ in their principal points.
     paper, centred = experiment.base.values()
-    assert centred == centred(paper)
+    assert centred == head_changes.centred(paper)
