@@ -30,7 +30,7 @@ from headsim.paper import INTRINSICS as PAPER_INTRINSICS
 from headsim.run.results import write_csv_atomic
 from headsim.scenario.calibration_design import near_far_depths, offset_std_limit
 from headsim.sim.tolerances import REALISTIC_BUDGET
-from headsim.studies.error_budget import plot_budget
+from headsim.studies.plots import plot_budget
 
 BELIEVED_D = 0.150
 BANDS = ((0.3, 0.6), (0.6, 1.0), (1.0, 1.5))

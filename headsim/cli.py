@@ -365,9 +365,10 @@ def _study(args: argparse.Namespace) -> int:
 
 def _bench(args: argparse.Namespace) -> int:
     from headsim.studies import bench
+    from headsim.studies.bench_compare import BASELINE, TOLERANCES
 
-    args.baseline = args.baseline or str(bench.BASELINE)
-    args.tolerances = args.tolerances or str(bench.TOLERANCES)
+    args.baseline = args.baseline or str(BASELINE)
+    args.tolerances = args.tolerances or str(TOLERANCES)
     outputs = Outputs()
     try:
         if args.json:
@@ -381,8 +382,10 @@ def _bench(args: argparse.Namespace) -> int:
 
 def _sweep(args: argparse.Namespace) -> int:
     from headsim.studies import sweep
+    from headsim.studies.sweep_output import summary_table
+    from headsim.studies.sweep_spec import load_sweep
 
-    spec = sweep.load_sweep(args.sweep)
+    spec = load_sweep(args.sweep)
     from headsim.run.rerun_cli import recording_target
 
     target = recording_target(args, per_job=True)
@@ -415,7 +418,7 @@ def _sweep(args: argparse.Namespace) -> int:
                 return ExitCode.INTERRUPTED
     finally:
         outputs.remove_empty_created()
-    print(sweep.summary_table(spec, outcome.records.values()))
+    print(summary_table(spec, outcome.records.values()))
     rate = 60 * outcome.ran / outcome.wall_s if outcome.wall_s > 0 else 0.0
     print(
         f"{outcome.ran} jobs run ({outcome.skipped} already done) in {outcome.wall_s:.1f} s, "

@@ -10,9 +10,7 @@ how far each metric may move, and in which direction is worse.
 
 from __future__ import annotations
 
-import json
 import math
-import platform
 import sys
 import time
 from collections.abc import Callable
@@ -22,7 +20,6 @@ from typing import Any
 
 import numpy as np
 
-import headsim
 from headsim.active.procedures import (
     HeadKnowledge,
     calibrate_head,
@@ -37,12 +34,9 @@ from headsim.sim import names
 from headsim.sim.settings import HeadSettings, paper_head, preset
 from headsim.sim.simulator import HeadSim
 from headsim.studies import experiments
+from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
+from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
 
-BENCH_DIR = Path(__file__).resolve().parents[2] / "benchmarks"
-BASELINE = BENCH_DIR / "baseline.json"
-TOLERANCES = BENCH_DIR / "tolerances.json"
-
-Metrics = dict[str, float]
 Progress = Callable[[str], None]
 
 
@@ -97,7 +91,7 @@ def _measure_points(
         start = time.perf_counter()
         out = []
         for p in points_head:
-            sim.set_body_pose("marker_red", sim.transform_points(p, "head", "world")[0])
+            place_in_head(sim, "marker_red", p)
             out.append(measure_model2(sim, servo, experiments.RED, knowledge))
         wall = time.perf_counter() - start
         frames = sim.rendered_frames - frames
@@ -147,7 +141,7 @@ def _ideal_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     progress("ideal cameras, Model 2")
     points = np.concatenate(
         [
-            experiments.random_targets_head(rng, 4, band, vertical=(-0.15, 0.15))
+            random_targets_head(rng, 4, band, vertical=(-0.15, 0.15))
             for band in experiments.DEPTH_BANDS_M
         ]
     )
@@ -234,12 +228,10 @@ def _paper_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     metrics["paper.calibration.max_error_rad"] = float(np.abs(run.alpha_e_error).max())
 
     progress("paper's cameras: Model 2 near the centre row")
-    low, high = experiments.visible_vertical_range(settings)
+    low, high = visible_vertical_range(settings)
     near = np.concatenate(
         [
-            experiments.random_targets_head(
-                rng, 3, band, vertical=(max(low, -0.05), min(high, 0.03))
-            )
+            random_targets_head(rng, 3, band, vertical=(max(low, -0.05), min(high, 0.03)))
             for band in experiments.DEPTH_BANDS_M
         ]
     )
@@ -302,7 +294,7 @@ def _realistic_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     progress("realistic head: Model 2 over the whole field")
     points = np.concatenate(
         [
-            experiments.random_targets_head(rng, 4, band, lateral=0.15, vertical=(-0.1, 0.1))
+            random_targets_head(rng, 4, band, lateral=0.15, vertical=(-0.1, 0.1))
             for band in experiments.DEPTH_BANDS_M
         ]
     )
@@ -350,77 +342,6 @@ def scenario_metrics(name: str) -> Metrics:
             np.max(np.abs(result.calibration["alpha_e_error_rad"]))
         )
     return metrics
-
-
-@dataclass(frozen=True)
-class Verdict:
-    """One metric compared with its baseline."""
-
-    metric: str
-    baseline: float | None
-    now: float
-    change: float | None
-    allowed: float | None
-    regressed: bool
-
-    @property
-    def label(self) -> str:
-        if self.baseline is None:
-            return "new"
-        return "REGRESSED" if self.regressed else "ok"
-
-
-def compare(
-    metrics: Metrics, baseline: Metrics, tolerances: dict[str, dict[str, Any]]
-) -> list[Verdict]:
-    """Each metric against the baseline: worse by more than ``abs + rel * |baseline|`` regresses.
-
-    ``tolerances[metric]`` = {"worse": "higher" or "lower", "abs": float, "rel": float}.
-    A metric without a tolerance entry is reported, never failed.
-    """
-    verdicts = []
-    for metric, now in metrics.items():
-        base = baseline.get(metric)
-        rule = tolerances.get(metric)
-        if base is None or rule is None:
-            verdicts.append(Verdict(metric, base, now, None, None, False))
-            continue
-        allowed = float(rule.get("abs", 0.0)) + float(rule.get("rel", 0.0)) * abs(base)
-        worse_by = (now - base) if rule["worse"] == "higher" else (base - now)
-        regressed = not math.isfinite(now) or worse_by > allowed
-        verdicts.append(Verdict(metric, base, now, now - base, allowed, regressed))
-    return verdicts
-
-
-def format_table(verdicts: list[Verdict]) -> str:
-    """The comparison as a readable table."""
-    lines = [
-        f"{'metric':54s} {'baseline':>12s} {'now':>12s} {'change':>11s} {'allowed':>10s}  verdict"
-    ]
-    for v in verdicts:
-        base = "-" if v.baseline is None else f"{v.baseline:12.5g}"
-        change = "-" if v.change is None else f"{v.change:+11.3g}"
-        allowed = "-" if v.allowed is None else f"{v.allowed:10.3g}"
-        lines.append(
-            f"{v.metric:54s} {base:>12s} {v.now:12.5g} {change:>11s} {allowed:>10s}  {v.label}"
-        )
-    return "\n".join(lines)
-
-
-def load_json(path: Path) -> dict[str, Any]:
-    return json.loads(path.read_text()) if path.exists() else {}
-
-
-def environment() -> dict[str, str]:
-    import mujoco
-
-    return {
-        "headsim": headsim.__version__,
-        "mujoco": mujoco.__version__,
-        "numpy": np.__version__,
-        "python": platform.python_version(),
-        "machine": platform.machine(),
-    }
 
 
 def main(args: Any) -> int:

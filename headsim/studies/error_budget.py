@@ -34,7 +34,6 @@ and ``error_budget.png`` (bar chart).
 
 from __future__ import annotations
 
-import io
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -46,12 +45,7 @@ import numpy as np
 
 from headsim.geometry.kinematics import world_to_head
 from headsim.run.report import DEPTH_BANDS_M
-from headsim.run.results import (
-    write_bytes_atomic,
-    write_csv_atomic,
-    write_json_atomic,
-    write_text_atomic,
-)
+from headsim.run.results import write_csv_atomic, write_json_atomic, write_text_atomic
 from headsim.sim.settings import HeadSettings
 
 #: The scenario the budget runs: the realistic head over the whole shared field.
@@ -274,7 +268,7 @@ def run_condition(
 
 @dataclass(frozen=True)
 class BudgetJob:
-    """One condition as a job for :func:`headsim.studies.sweep.map_jobs`."""
+    """One condition as a job for :func:`headsim.studies.jobs.map_jobs`."""
 
     index: int
     id: str
@@ -311,7 +305,7 @@ def run_budget(
             rows.append(run_job(job)["row"])
             progress(f"  {job.condition.name}: {rows[-1]['rms_3d_pct']:.3f} % of depth")
         return rows
-    from headsim.studies.sweep import map_jobs
+    from headsim.studies.jobs import map_jobs
 
     records = map_jobs(run_job, jobs, workers=workers, scheduler=scheduler)
     bad = [r for r in records if r.get("status") != "ok"]
@@ -354,45 +348,6 @@ def markdown_table(rows: Sequence[dict[str, Any]], fast: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
-#: The budget chart's bars: a row's key and the legend's label.
-BUDGET_BARS = (
-    ("rms_3d_pct", "3-D RMS, measured"),
-    ("rms_xz_pct", "x-z RMS, measured"),
-    ("predicted_xz_pct", "x-z, eqs. 17/19"),
-)
-
-
-def plot_budget(
-    rows: Sequence[dict[str, Any]],
-    path: Path,
-    bars: Sequence[tuple[str, str]] = BUDGET_BARS,
-    title: str = "Realistic head: error budget (rendered, scenario realistic_field)",
-) -> Path:
-    """A horizontal bar chart of ``bars`` (default: measured 3-D, measured x-z and
-    predicted x-z), per condition, written atomically to ``path``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(9, 0.45 * len(rows) + 1.6))
-    y = np.arange(len(rows))
-    for k, (key, label) in enumerate(bars):
-        values = [0.0 if math.isnan(r[key]) else r[key] for r in rows]
-        ax.barh(y + (k - 1) * 0.27, values, height=0.27, label=label)
-    ax.set_yticks(y, [str(r["condition"]).strip() for r in rows])
-    ax.invert_yaxis()
-    ax.set_xlabel("error RMS, % of depth (whole field, 0.3-1.5 m)")
-    ax.set_title(title)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110)
-    plt.close(fig)
-    write_bytes_atomic(path, buffer.getvalue())
-    return path
-
-
 def write_budget(
     rows: Sequence[dict[str, Any]], out_dir: str | Path, fast: bool
 ) -> dict[str, Path]:
@@ -408,5 +363,7 @@ def write_budget(
     write_csv_atomic(paths["csv"], list(rows))
     write_text_atomic(paths["md"], markdown_table(rows, fast))
     write_json_atomic(paths["json"], {"scenario": SCENARIO, "fast": fast, "rows": list(rows)})
+    from headsim.studies.plots import plot_budget  # matplotlib loads only for the chart
+
     plot_budget(rows, paths["png"])
     return paths

@@ -32,6 +32,7 @@ from headsim.active.servo import EyeServo, NeckServo
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
+from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
 from headsim.vision.detect import find_cross_point, find_marker
 
 RED = body_target("marker_red", partial(find_marker, colour="red"))
@@ -55,30 +56,6 @@ def render_time_s(sim: HeadSim, repeats: int = 10) -> float:
         sim.render(1)
         times.append(time.perf_counter() - start)
     return statistics.median(times)
-
-
-def random_targets_head(
-    rng: np.random.Generator,
-    count: int,
-    depth_range_m: tuple[float, float],
-    lateral: float = 0.12,
-    vertical: tuple[float, float] = (-0.25, 0.25),
-) -> np.ndarray:
-    """Points (count, 3) in H: depth uniform in the range, x/z and y/z uniform."""
-    z = rng.uniform(*depth_range_m, size=count)
-    return np.column_stack(
-        [rng.uniform(-lateral, lateral, count) * z, rng.uniform(*vertical, size=count) * z, z]
-    )
-
-
-def visible_vertical_range(settings: HeadSettings, margin: float = 0.85) -> tuple[float, float]:
-    """y/z range both cameras see (with a margin), from their true intrinsics.
-
-    For placing test targets only; the method itself never reads intrinsics.
-    """
-    up = min(c.principal[1] / c.ky for c in settings.cameras)
-    down = min((c.height - 1 - c.principal[1]) / c.ky for c in settings.cameras)
-    return (-margin * up, margin * down)
 
 
 def centre_row_offset_px(sim: HeadSim, m: Measurement) -> float:
@@ -105,10 +82,6 @@ def error_figures(measurements: Sequence[Measurement]) -> dict[str, Any]:
         "rms_pct_depth_xyz": [float(v) for v in np.sqrt(np.mean(pct**2, axis=0))],
         "max_3d_pct_depth": float(np.max(np.linalg.norm(pct, axis=1))),
     }
-
-
-def _place(sim: HeadSim, body: str, p_head: np.ndarray) -> None:
-    sim.set_body_pose(body, sim.transform_points(p_head, "head", "world")[0])
 
 
 def model2_accuracy(
@@ -167,7 +140,7 @@ def model2_accuracy(
             for p_head in random_targets_head(
                 rng, targets_per_band, (low, high), vertical=vertical
             ):
-                _place(sim, "marker_red", p_head)
+                place_in_head(sim, "marker_red", p_head)
                 m = measure_model2(sim, servo, RED, knowledge)
                 bands[key].append(m)
                 measurements.append(m)
@@ -302,7 +275,7 @@ def relative_areas(
             for name in names.RELATIVE_OBJECTS:
                 z = rng.uniform(0.8, 1.9)
                 p_head = np.array([rng.uniform(-0.3, 0.3) * z, rng.uniform(-0.15, 0.1) * z, z])
-                _place(sim, name, p_head)
+                place_in_head(sim, name, p_head)
             run = relative_positioning(sim, servo, reference, names.RELATIVE_OBJECT_COLOURS)
             progress(f"relative positioning: layout {layout + 1}/{layouts}")
             renders.append(run.renders)
@@ -349,7 +322,7 @@ def servo_robustness(
             servo = EyeServo(sim)
             ms = []
             for p_head in random_targets_head(rng, points, (0.4, 1.4), vertical=(-0.1, 0.1)):
-                _place(sim, "marker_red", p_head)
+                place_in_head(sim, "marker_red", p_head)
                 ms.append(measure_model2(sim, servo, RED))
         progress(f"servo: {label}")
         ok = [m for m in ms if m.ok]

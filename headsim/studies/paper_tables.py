@@ -49,21 +49,12 @@ from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.stereo import zhang as stereo
-from headsim.studies.study import (
-    BALL,
-    TARGET,
-    Condition,
-    ConditionResult,
-    Experiment,
-    ExperimentResult,
-    StudyConfig,
-    TargetError,
-    calibration_positions,
-    summarise,
-    table_targets,
-    zhang_stereo,
-    zoom_fixed_points,
-)
+from headsim.studies.calibrations import calibration_positions, zhang_stereo, zoom_fixed_points
+from headsim.studies.conditions import Condition, ConditionResult
+from headsim.studies.methods import BALL, TARGET, StudyConfig
+from headsim.studies.study_experiments import Experiment, ExperimentResult
+from headsim.studies.target_errors import TargetError, summarise
+from headsim.studies.targets import place_in_head, table_targets
 
 #: The methods measured, in table order; the first three active ones share their images.
 METHODS = (
@@ -85,7 +76,7 @@ ZOOM = 1.5
 def zhang_calibration(
     settings: HeadSettings, config: StudyConfig
 ) -> tuple[stereo.StereoCalibration, int]:
-    """Zhang's calibration of ``settings``' pair (as :func:`headsim.studies.study.zhang_stereo`),
+    """Zhang's calibration of ``settings``' pair (as :func:`headsim.studies.calibrations.zhang_stereo`),
     and the renders it took."""
     calibration, views = zhang_stereo(settings, config)
     return calibration, views.renders
@@ -199,7 +190,7 @@ def measure_paired(
     with HeadSim("default", settings) as sim:
         servo = EyeServo(sim)
         for index, p_head in enumerate(np.atleast_2d(np.asarray(targets_head, dtype=float))):
-            sim.set_body_pose(TARGET.name, sim.transform_points(p_head, "head", "world")[0])
+            place_in_head(sim, TARGET.name, p_head)
             truth = sim.position(TARGET.name, "head")
             start = sim.render_count
             try:

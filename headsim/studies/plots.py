@@ -1,6 +1,6 @@
-"""Figures of the study (:mod:`headsim.studies.study`) with matplotlib's Agg backend, written atomically.
+"""Every figure of the orchestrators, with matplotlib's Agg backend, written atomically.
 
-One PNG per experiment:
+The study (:mod:`headsim.studies.study`) draws one PNG per experiment:
 
 - the comparison: per group (a head), the Tables V/VI errors target by target
   (left) and the RMS error of every method in every condition (right), on a
@@ -10,11 +10,16 @@ One PNG per experiment:
   changed head), and for the depth sweep a second panel in mm.
 
 Every method keeps one colour and marker in every figure (:data:`STYLE`).
+A sweep draws a metric against each swept field (:func:`plot_metric`), the
+error budget its bar chart (:func:`plot_budget`).  Callers import this module
+only when they draw, so that matplotlib loads only then.
 """
 
 from __future__ import annotations
 
 import io
+import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -25,9 +30,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from headsim.run.results import write_bytes_atomic
+from headsim.studies.methods import METHOD_LABELS
 
 if TYPE_CHECKING:
-    from headsim.studies.study import ExperimentResult
+    from headsim.studies.study_experiments import ExperimentResult
 
 #: Colour and marker per method.
 STYLE: dict[str, dict[str, Any]] = {
@@ -67,8 +73,6 @@ def plot_experiment(result: ExperimentResult, path: str | Path) -> Path:
 
 def plot_compare(result: ExperimentResult, path: str | Path) -> Path:
     """Per group: Tables V/VI target by target, and RMS per condition (both % of depth, log)."""
-    from headsim.studies.study import METHOD_LABELS
-
     methods = _methods(result)
     groups = list(result.experiment.base)
     fig, axes = plt.subplots(
@@ -132,8 +136,6 @@ def plot_compare(result: ExperimentResult, path: str | Path) -> Path:
 
 def plot_sweep(result: ExperimentResult, path: str | Path) -> Path:
     """RMS error against the swept value, a panel per calibration mode (depth: % and mm)."""
-    from headsim.studies.study import METHOD_LABELS
-
     exp = result.experiment
     methods = _methods(result)
     modes = list(dict.fromkeys(r.condition.calibration for r in result.results))
@@ -175,3 +177,75 @@ def plot_sweep(result: ExperimentResult, path: str | Path) -> Path:
         f"{len(runs[0].condition.targets_head) if runs else 0} targets per point)"
     )
     return _save(fig, path)
+
+
+def plot_metric(rows: list[dict[str, Any]], x: str, y: str, path: Path, title: str) -> Path | None:
+    """Scatter of ``y`` against ``x`` with the mean per x value; None if x is not numeric."""
+    points = [
+        (row[x], row[y])
+        for row in rows
+        if isinstance(row.get(x), int | float) and isinstance(row.get(y), int | float)
+    ]
+    if len(points) < 2:
+        return None
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    xs, ys = np.array(points, dtype=float).T
+    fig, ax = plt.subplots(figsize=(6, 4), dpi=100)
+    ax.scatter(xs, ys, s=18, alpha=0.6, label="jobs")
+    unique = np.unique(xs)
+    if len(unique) < len(xs):
+        ax.plot(unique, [ys[xs == u].mean() for u in unique], "o-", color="C3", label="mean")
+    ax.set_xlabel(x)
+    ax.set_ylabel("3-D error RMS, % of depth" if y == "rms_error_pct_depth" else y)
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png")
+    plt.close(fig)
+    write_bytes_atomic(path, buffer.getvalue())
+    return path
+
+
+#: The budget chart's bars: a row's key and the legend's label.
+BUDGET_BARS = (
+    ("rms_3d_pct", "3-D RMS, measured"),
+    ("rms_xz_pct", "x-z RMS, measured"),
+    ("predicted_xz_pct", "x-z, eqs. 17/19"),
+)
+
+
+def plot_budget(
+    rows: Sequence[dict[str, Any]],
+    path: Path,
+    bars: Sequence[tuple[str, str]] = BUDGET_BARS,
+    title: str = "Realistic head: error budget (rendered, scenario realistic_field)",
+) -> Path:
+    """A horizontal bar chart of ``bars`` (default: measured 3-D, measured x-z and
+    predicted x-z), per condition, written atomically to ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(9, 0.45 * len(rows) + 1.6))
+    y = np.arange(len(rows))
+    for k, (key, label) in enumerate(bars):
+        values = [0.0 if math.isnan(r[key]) else r[key] for r in rows]
+        ax.barh(y + (k - 1) * 0.27, values, height=0.27, label=label)
+    ax.set_yticks(y, [str(r["condition"]).strip() for r in rows])
+    ax.invert_yaxis()
+    ax.set_xlabel("error RMS, % of depth (whole field, 0.3-1.5 m)")
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=110)
+    plt.close(fig)
+    write_bytes_atomic(path, buffer.getvalue())
+    return path

@@ -25,187 +25,25 @@ end ``DIR/aggregate.csv``, ``DIR/aggregate.json`` and a plot per swept field.
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import functools
-import hashlib
-import io
-import itertools
 import json
 import math
-import multiprocessing
 import os
 import sys
 import time
-import tomllib
 import traceback
-from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from headsim.errors import BadInput
-from headsim.run.results import write_bytes_atomic, write_csv_atomic, write_json_atomic
+from headsim.studies.jobs import dask_client, execute, local_pool
+from headsim.studies.sweep_output import write_aggregate
+from headsim.studies.sweep_spec import Job, SweepSpec
 
 #: Fault injection for tests: job indices (comma-separated) whose process dies.
 CRASH_ENV = "HEADSIM_SWEEP_CRASH_JOBS"
-#: Attempts per job: the first and one retry.
-ATTEMPTS = 2
-#: Columns of aggregate.csv after the swept fields.
-METRICS = (
-    "status",
-    "failures",
-    "measurements_ok",
-    "measurements",
-    "rms_error_pct_depth",
-    "mean_error_mm",
-    "max_error_mm",
-    "renders",
-    "calibration_max_error_rad",
-    "attempts",
-)
-
-
-class SweepError(BadInput, ValueError):
-    """A bad sweep file: the message names the file, the field and what is allowed."""
-
-    def __init__(self, source: str, path: str, message: str, allowed: str | None = None) -> None:
-        text = f"{source}: {path}: {message}" if path else f"{source}: {message}"
-        super().__init__(text + (f" (allowed: {allowed})" if allowed else ""))
-
-
-@dataclass(frozen=True)
-class Job:
-    """One scenario run: its position, a stable id, and the fields it sets."""
-
-    index: int
-    id: str
-    scenario: str
-    fast: bool
-    params: dict[str, Any]
-
-
-@dataclass(frozen=True)
-class SweepSpec:
-    """A checked sweep file."""
-
-    path: Path
-    description: str
-    scenario: str
-    fast: bool
-    fields: tuple[str, ...]
-    jobs: tuple[Job, ...]
-
-
-def _job_id(scenario: str, fast: bool, params: dict[str, Any]) -> str:
-    text = json.dumps({"scenario": scenario, "fast": fast, "params": params}, sort_keys=True)
-    return hashlib.sha1(text.encode()).hexdigest()[:12]
-
-
-def _values(source: str, key: str, value: Any) -> list[Any]:
-    if not isinstance(value, list) or not value:
-        raise SweepError(
-            source, f"grid.{key}", f"must be a non-empty list, got {value!r}", "a list of values"
-        )
-    return value
-
-
-def load_sweep(path: str | Path) -> SweepSpec:
-    """Read and check a sweep file; every job's scenario is validated before anything runs."""
-    from headsim.scenario.loading import load_scenario, resolve_path
-    from headsim.scenario.tables import ScenarioError
-
-    path = Path(path)
-    source = str(path)
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError as err:
-        raise SweepError(source, "", "no such sweep file") from err
-    except tomllib.TOMLDecodeError as err:
-        raise SweepError(source, "", f"not valid TOML: {err}") from err
-    allowed_top = ("description", "scenario", "fast", "grid", "random")
-    for key in doc:
-        if key not in allowed_top:
-            raise SweepError(source, key, "unknown key", ", ".join(allowed_top))
-    description = doc.get("description")
-    if not isinstance(description, str) or not description.strip():
-        raise SweepError(source, "description", "missing", "a one-line string")
-    scenario = doc.get("scenario")
-    if not isinstance(scenario, str):
-        raise SweepError(source, "scenario", "missing", "a scenario name or a path to a .toml file")
-    candidate = (path.parent / scenario).resolve()
-    scenario_path = str(candidate) if candidate.is_file() else scenario
-    try:
-        scenario_path = str(resolve_path(scenario_path))
-    except ScenarioError as err:
-        raise SweepError(source, "scenario", str(err)) from err
-    fast = doc.get("fast", False)
-    if not isinstance(fast, bool):
-        raise SweepError(source, "fast", f"must be true or false, got {fast!r}", "true, false")
-    if ("grid" in doc) == ("random" in doc):
-        raise SweepError(source, "", "needs exactly one of [grid] and [random]", "[grid], [random]")
-    if "grid" in doc:
-        grid = doc["grid"]
-        if not isinstance(grid, dict) or not grid:
-            raise SweepError(source, "grid", "must be a table of field = [values]")
-        fields = tuple(grid)
-        combos = itertools.product(*(_values(source, k, grid[k]) for k in fields))
-        params_list = [dict(zip(fields, combo, strict=True)) for combo in combos]
-    else:
-        params_list, fields = _random_params(source, doc["random"])
-    jobs = []
-    for index, params in enumerate(params_list):
-        overrides = {k: v for k, v in params.items() if k != "seed"}
-        seed = params.get("seed")
-        try:
-            load_scenario(scenario_path, fast=fast, seed=seed, overrides=overrides)
-        except ScenarioError as err:
-            raise SweepError(source, f"job {index} {params}", str(err)) from err
-        jobs.append(Job(index, _job_id(scenario_path, fast, params), scenario_path, fast, params))
-    return SweepSpec(path, description.strip(), scenario_path, fast, fields, tuple(jobs))
-
-
-def _random_params(source: str, table: Any) -> tuple[list[dict[str, Any]], tuple[str, ...]]:
-    if not isinstance(table, dict):
-        raise SweepError(source, "random", "must be a table")
-    for key in table:
-        if key not in ("count", "seed", "fields"):
-            raise SweepError(source, f"random.{key}", "unknown key", "count, seed, fields")
-    count, seed = table.get("count"), table.get("seed", 0)
-    if not isinstance(count, int) or not 1 <= count <= 100_000:
-        raise SweepError(
-            source, "random.count", f"{count!r} is not allowed", "an integer from 1 to 100000"
-        )
-    if not isinstance(seed, int) or seed < 0:
-        raise SweepError(source, "random.seed", f"{seed!r} is not allowed", "an integer >= 0")
-    fields = table.get("fields")
-    if not isinstance(fields, dict) or not fields:
-        raise SweepError(source, "random.fields", "missing", "a table of field = [low, high]")
-    rng = np.random.default_rng(seed)
-    columns = {}
-    for key, bounds in fields.items():
-        ok = (
-            isinstance(bounds, list)
-            and len(bounds) == 2
-            and all(isinstance(b, int | float) and math.isfinite(b) for b in bounds)
-            and bounds[0] <= bounds[1]
-        )
-        if not ok:
-            raise SweepError(
-                source,
-                f"random.fields.{key}",
-                f"{bounds!r} is not a range",
-                "[low, high] with low <= high",
-            )
-        if key == "seed":
-            columns[key] = [
-                int(v) for v in rng.integers(int(bounds[0]), int(bounds[1]) + 1, size=count)
-            ]
-        else:
-            columns[key] = [float(v) for v in rng.uniform(bounds[0], bounds[1], size=count)]
-    names = tuple(fields)
-    return [{k: columns[k][i] for k in names} for i in range(count)], names
 
 
 def run_job(job: Job, marker_dir: str | None = None, recording: Any = None) -> dict[str, Any]:
@@ -363,77 +201,6 @@ class _Progress:
             print(file=sys.stderr)
 
 
-def _execute(
-    jobs: list[Any],
-    make_executor: Callable[[], cf.Executor],
-    on_record: Callable[[dict[str, Any]], None],
-    stop_after: int | None,
-    marker_dir: Path | None = None,
-    function: Callable[..., dict[str, Any]] | None = None,
-) -> int:
-    """Run ``jobs`` with one retry each; survive a broken pool by building a new one.
-
-    ``function(job, marker_dir)`` runs one job (default :func:`run_job`) and
-    returns its record, a dict with at least ``status``; a job is anything
-    with an ``id`` and an ``index``.
-
-    When a local pool breaks, every job still queued in it fails with it; only
-    those whose marker shows they were running count an attempt.
-    """
-    attempts = dict.fromkeys((job.id for job in jobs), 0)
-    queue = list(jobs)
-    finished = 0
-    while queue:
-        executor = make_executor()
-        broken = False
-        try:
-            futures = {}
-            for job in queue:
-                attempts[job.id] += 1
-                marker = str(marker_dir) if marker_dir is not None else None
-                futures[executor.submit(function or run_job, job, marker)] = job
-            queue = []
-            for future in cf.as_completed(futures):
-                job = futures[future]
-                try:
-                    record = future.result()
-                except Exception as err:  # the worker died (BrokenProcessPool, KilledWorker, ...)
-                    if isinstance(err, cf.process.BrokenProcessPool):
-                        broken = True
-                        was_running = True
-                        if marker_dir is not None:
-                            was_running = (marker_dir / job.id).exists()
-                            (marker_dir / job.id).unlink(missing_ok=True)
-                        if not was_running:  # an innocent bystander of another job's crash
-                            attempts[job.id] -= 1
-                            queue.append(job)
-                            continue
-                    record = {
-                        "id": job.id,
-                        "index": job.index,
-                        "params": getattr(job, "params", {}),
-                        "status": "crashed",
-                        "error": f"{type(err).__name__}: {err}",
-                    }
-                if record.get("status") in ("error", "crashed") and attempts[job.id] < ATTEMPTS:
-                    queue.append(job)
-                    continue
-                record["attempts"] = attempts[job.id]
-                on_record(record)
-                finished += 1
-                if stop_after is not None and finished >= stop_after:
-                    for other in futures:
-                        other.cancel()
-                    return finished
-        finally:
-            try:
-                executor.shutdown(wait=not broken, cancel_futures=True)
-            except TypeError:  # Dask's executor takes no cancel_futures
-                executor.shutdown(wait=not broken)
-        queue.sort(key=lambda job: job.index)
-    return finished
-
-
 def run_sweep(
     spec: SweepSpec,
     out_dir: str | Path,
@@ -466,24 +233,21 @@ def run_sweep(
         bar.step(record.get("status") != "ok")
 
     if scheduler is not None:
-        client = _dask_client(scheduler)
+        client = dask_client(scheduler)
         try:
-            ran = _execute(
-                remaining, client.get_executor, on_record, stop_after, None, job_function
-            )
+            ran = execute(remaining, client.get_executor, on_record, stop_after, None, job_function)
         finally:
             client.close()
     else:
         if workers < 1:
             raise ValueError(f"workers must be >= 1, got {workers}")
-        context = multiprocessing.get_context("spawn")  # EGL in forked children hangs
         markers = out / ".running"
         markers.mkdir(exist_ok=True)
         for stale in markers.iterdir():
             stale.unlink()
-        ran = _execute(
+        ran = execute(
             remaining,
-            lambda: cf.ProcessPoolExecutor(max_workers=workers, mp_context=context),
+            lambda: local_pool(workers),
             on_record,
             stop_after,
             markers,
@@ -500,157 +264,3 @@ def run_sweep(
     if len(outcome.records) == len(spec.jobs):
         outcome.files = write_aggregate(spec, outcome.records, out)
     return outcome
-
-
-def map_jobs(
-    function: Callable[..., dict[str, Any]],
-    jobs: list[Any],
-    *,
-    workers: int = 1,
-    scheduler: str | None = None,
-    on_record: Callable[[dict[str, Any]], None] | None = None,
-) -> list[dict[str, Any]]:
-    """Run ``function(job, None)`` for every job on local processes or Dask; records in job order.
-
-    The same machinery as :func:`run_sweep` (spawned processes, one retry,
-    crash-proof) for any picklable jobs with ``id`` and ``index``, such as the
-    insensitivity study's conditions.
-    """
-    records: dict[str, dict[str, Any]] = {}
-
-    def keep(record: dict[str, Any]) -> None:
-        records[record["id"]] = record
-        if on_record is not None:
-            on_record(record)
-
-    if scheduler is not None:
-        client = _dask_client(scheduler)
-        try:
-            _execute(jobs, client.get_executor, keep, None, None, function)
-        finally:
-            client.close()
-    else:
-        context = multiprocessing.get_context("spawn")
-        _execute(
-            jobs,
-            lambda: cf.ProcessPoolExecutor(max_workers=workers, mp_context=context),
-            keep,
-            None,
-            None,
-            function,
-        )
-    return [records[job.id] for job in jobs]
-
-
-def _dask_client(scheduler: str) -> Any:
-    try:
-        from dask.distributed import Client
-    except ImportError as err:
-        raise RuntimeError(
-            "--scheduler needs Dask: pip install 'headsim[dask]' (dask[distributed])"
-        ) from err
-    return Client(scheduler)
-
-
-def aggregate_rows(spec: SweepSpec, records: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
-    """One row per job, in job order: the swept fields, then ``METRICS``."""
-    rows = []
-    for job in spec.jobs:
-        record = records[job.id]
-        row = {"job": job.index, **{f: job.params.get(f) for f in spec.fields}}
-        row.update({m: record.get(m) for m in METRICS})
-        rows.append(row)
-    return rows
-
-
-def write_aggregate(
-    spec: SweepSpec, records: dict[str, dict[str, Any]], out: Path
-) -> dict[str, Path]:
-    """aggregate.csv, aggregate.json and one PNG per numeric swept field."""
-    rows = aggregate_rows(spec, records)
-    files = {"csv": out / "aggregate.csv", "json": out / "aggregate.json"}
-    write_csv_atomic(files["csv"], rows)
-    write_json_atomic(
-        files["json"], {"sweep": spec.description, "scenario": spec.scenario, "rows": rows}
-    )
-    for name in spec.fields:
-        if name == "seed":  # an error against the seed says nothing
-            continue
-        png = plot_metric(
-            rows, name, "rms_error_pct_depth", out / f"error_vs_{_slug(name)}.png", spec.description
-        )
-        if png is not None:
-            files[f"plot {name}"] = png
-    return files
-
-
-def _slug(name: str) -> str:
-    return "".join(c if c.isalnum() else "_" for c in name)
-
-
-def plot_metric(rows: list[dict[str, Any]], x: str, y: str, path: Path, title: str) -> Path | None:
-    """Scatter of ``y`` against ``x`` with the mean per x value; None if x is not numeric."""
-    points = [
-        (row[x], row[y])
-        for row in rows
-        if isinstance(row.get(x), int | float) and isinstance(row.get(y), int | float)
-    ]
-    if len(points) < 2:
-        return None
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    xs, ys = np.array(points, dtype=float).T
-    fig, ax = plt.subplots(figsize=(6, 4), dpi=100)
-    ax.scatter(xs, ys, s=18, alpha=0.6, label="jobs")
-    unique = np.unique(xs)
-    if len(unique) < len(xs):
-        ax.plot(unique, [ys[xs == u].mean() for u in unique], "o-", color="C3", label="mean")
-    ax.set_xlabel(x)
-    ax.set_ylabel("3-D error RMS, % of depth" if y == "rms_error_pct_depth" else y)
-    ax.set_title(title, fontsize=9)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png")
-    plt.close(fig)
-    write_bytes_atomic(path, buffer.getvalue())
-    return path
-
-
-def _cell(value: Any) -> str:
-    return f"{value:.6g}" if isinstance(value, float) else str(value)
-
-
-def summary_table(spec: SweepSpec, records: Iterable[dict[str, Any]]) -> str:
-    """A readable table of the jobs."""
-    lines = [
-        "  ".join(
-            [
-                f"{'job':>4s}",
-                *(f"{f:>16s}" for f in spec.fields),
-                f"{'status':>8s}",
-                f"{'err %z':>8s}",
-                f"{'renders':>7s}",
-            ]
-        )
-    ]
-    by_index = sorted(records, key=lambda r: r["index"])
-    for r in by_index:
-        values = [f"{_cell(r['params'].get(f)):>16s}" for f in spec.fields]
-        err = r.get("rms_error_pct_depth")
-        lines.append(
-            "  ".join(
-                [
-                    f"{r['index']:4d}",
-                    *values,
-                    f"{r.get('status', '?'):>8s}",
-                    f"{err:8.3f}" if err is not None else f"{'-':>8s}",
-                    f"{r.get('renders', '-')!s:>7s}",
-                ]
-            )
-        )
-    return "\n".join(lines)

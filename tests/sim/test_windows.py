@@ -13,6 +13,7 @@ from headsim.sim.render import Window
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
 from headsim.studies import experiments
+from headsim.studies.targets import random_targets_head
 
 HEADS = {
     "ideal": HeadSettings(cameras=(CameraSettings(noise_std=2.0),) * 2, seed=3),
@@ -115,7 +116,7 @@ def test_windows_change_no_measurement(head: str) -> None:
     rng = np.random.default_rng(5)
     points = np.concatenate(
         [
-            experiments.random_targets_head(rng, 2, band, vertical=(-0.1, 0.1))
+            random_targets_head(rng, 2, band, vertical=(-0.1, 0.1))
             for band in experiments.DEPTH_BANDS_M
         ]
     )
@@ -170,7 +171,7 @@ class LoggingNeckServo(NeckServo):
 def test_windows_change_no_fixation_with_the_neck() -> None:
     settings = paper_head()
     rng = np.random.default_rng(8)
-    points = experiments.random_targets_head(rng, 4, (0.5, 1.2), vertical=(-0.1, 0.1))
+    points = random_targets_head(rng, 4, (0.5, 1.2), vertical=(-0.1, 0.1))
     runs = {}
     for windows in (False, True):
         with HeadSim("default", settings) as sim:
@@ -200,7 +201,7 @@ def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
     follow are the same images, noise included, so nothing changes but the cost."""
     settings = HeadSettings(cameras=(CameraSettings(noise_std=3.0),) * 2, seed=4)
     rng = np.random.default_rng(9)
-    points = experiments.random_targets_head(rng, 3, (0.5, 1.0), vertical=(-0.1, 0.1))
+    points = random_targets_head(rng, 3, (0.5, 1.0), vertical=(-0.1, 0.1))
 
     def far_away(sim, camera, expected_uv, area_px, motion_px, margin_px):  # type: ignore[no-untyped-def]
         return Window(0, 0, 24, 24) if expected_uv[0] > 100 else Window(600, 440, 24, 24)

@@ -9,8 +9,10 @@ from headsim.active.procedures import HeadKnowledge, measure_model2
 from headsim.active.servo import EyeServo
 from headsim.sim.settings import preset
 from headsim.sim.simulator import HeadSim
-from headsim.studies import paper_tables, study
-from headsim.studies.study import TARGET, table_targets
+from headsim.studies import paper_tables
+from headsim.studies.calibrations import zoom_fixed_points
+from headsim.studies.methods import TARGET
+from headsim.studies.targets import table_targets
 
 
 def test_a_method_computed_from_shared_images_equals_its_own_measurement() -> None:
@@ -52,12 +54,12 @@ def test_the_calibration_must_servo_on_the_image_centre() -> None:
 def test_the_fixed_points_found_again_on_their_own_head_are_the_calibrations() -> None:
     # measure_paired takes them from the FixedPoint on the head it was made on: that
     # holds only because finding them again gives the same images and answer.
-    from headsim.studies.study import StudyConfig
+    from headsim.studies.methods import StudyConfig
 
     settings = preset("paper")
     config = StudyConfig.quick(calibration_targets=4)
     fixed = paper_tables.fixed_point_calibration(settings, config)
-    again = study.zoom_fixed_points(settings, config)
+    again = zoom_fixed_points(settings, config)
     assert fixed.settings == settings and fixed.seed == config.seed
     assert again.principal_px == fixed.principal.principal_px
     assert again.renders == fixed.principal.renders

@@ -1,0 +1,67 @@
+"""Heads the study measures on: the cameras changed after calibration (zoom, principal
+point, k1, noise, encoder) and each eye's true image-centre direction, rad."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import replace
+
+from headsim.active.principal import zoomed
+from headsim.sim.forward import effective_directions
+from headsim.sim.settings import HeadSettings
+
+
+def centred(settings: HeadSettings) -> HeadSettings:
+    """The same head with both principal points at the image centre."""
+    return replace(settings, cameras=tuple(replace(c, cx=None, cy=None) for c in settings.cameras))
+
+
+def principal_shifted(settings: HeadSettings, shift_px: float) -> HeadSettings:
+    """Principal points moved ``shift_px``: Ca1's u by +shift, Ca2's u by -shift, both v by +shift.
+
+    Mirror images in u, so that the image centre's rays of both eyes turn
+    the same way relative to their inward directions and their effect on
+    the depth adds up instead of cancelling.
+    """
+    cams = []
+    for sign, cam in zip((1.0, -1.0), settings.cameras, strict=True):
+        cx, cy = cam.principal
+        cams.append(replace(cam, cx=cx + sign * shift_px, cy=cy + shift_px))
+    return replace(settings, cameras=(cams[0], cams[1]))
+
+
+def k1_changed(settings: HeadSettings, change: float) -> HeadSettings:
+    """Both cameras' k1 changed by ``change`` (positive: less barrel distortion)."""
+    return replace(settings, cameras=tuple(replace(c, k1=c.k1 + change) for c in settings.cameras))
+
+
+def with_noise(settings: HeadSettings, noise_std: float) -> HeadSettings:
+    """Both cameras with Gaussian image noise of ``noise_std`` grey levels."""
+    return replace(
+        settings, cameras=tuple(replace(c, noise_std=noise_std) for c in settings.cameras)
+    )
+
+
+def with_encoder(settings: HeadSettings, steps_per_turn: float) -> HeadSettings:
+    """The eye encoder with ``steps_per_turn`` steps per revolution."""
+    return replace(settings, encoder_resolution_rad=2 * math.pi / steps_per_turn)
+
+
+#: The changes after calibration of the comparison: label -> (x value, change).
+CHANGES: dict[str, tuple[float, Callable[[HeadSettings], HeadSettings]]] = {
+    "zoom 1.5x": (1.5, lambda s: zoomed(s, 1.5)),
+    "zoom 0.7x": (0.7, lambda s: zoomed(s, 0.7)),
+    "principal point moved 5 px": (5.0, lambda s: principal_shifted(s, 5.0)),
+    "k1 + 0.1": (0.1, lambda s: k1_changed(s, 0.1)),
+}
+
+
+def image_centre_directions(settings: HeadSettings) -> tuple[float, float]:
+    """Each eye's true effective initial direction, rad: mount yaw plus the image centre's ray.
+
+    What the Sec. V calibration with the servo on the image centre finds
+    (``HeadSim.effective_initial_direction`` without mount pitch or roll);
+    for explaining the errors, never given to a method.
+    """
+    return effective_directions(settings)

@@ -1,0 +1,52 @@
+"""Timing 640x480 renders in this process, the unit of ``headsim reproduce``'s wall and
+CPU ratios, s."""
+
+from __future__ import annotations
+
+import resource
+import statistics
+import time
+
+
+def cpu_s() -> float:
+    """CPU time, user and system, of this process and its children that ended, s."""
+    own, children = (
+        resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN)
+    )
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+class RenderClock:
+    """Times 640x480 renders of the default scene in this process, while no worker of
+    the run exists: the unit before they start, and a few after they ended, which
+    show how the machine's load moved (reported, not used in the ratio)."""
+
+    def __init__(self) -> None:
+        from headsim.sim.settings import HeadSettings
+        from headsim.sim.simulator import HeadSim
+
+        self._sim = HeadSim("default", HeadSettings())
+        self._sim.move(eye=0.05)
+        for camera in (1, 2):
+            self._sim.render(camera)
+        self.times_s: list[float] = []
+        #: CPU time of each render (all of this process's threads: llvmpipe's too), s.
+        self.cpu_s: list[float] = []
+
+    def sample(self, renders: int) -> float:
+        """Time ``renders`` more renders; their median wall time, s."""
+        times = []
+        for _ in range(renders):
+            start, cpu = time.perf_counter(), time.process_time()
+            self._sim.render(1 + len(self.times_s) % 2)
+            times.append(time.perf_counter() - start)
+            self.cpu_s.append(time.process_time() - cpu)
+        self.times_s += times
+        return statistics.median(times)
+
+    def close(self) -> None:
+        self._sim.close()
+
+
+#: Renders timed before the workers start (the unit) and after they end (the load's drift).
+CLOCK_RENDERS = (21, 7)

@@ -1,0 +1,206 @@
+"""The jobs of ``headsim reproduce``, run in worker processes (module-level, so they pickle):
+the head's calibration, Zhang's, the fixed points', the scenarios, Tables V/VI, the sweeps."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import os
+import time
+import traceback
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from headsim.run.results import to_jsonable, write_json_atomic, write_text_atomic
+from headsim.studies.reproduce_experiments import FIXED_POINT_TARGETS, SCENARIO_JOBS, TABLES_HEAD
+
+
+class JobError(RuntimeError):
+    """An experiment failed in its worker; the message says why (picklable, unlike
+    some of the errors it stands for: a worker must not break the pool)."""
+
+
+def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str, Any]]:
+    @functools.wraps(job)
+    def run(*args: Any) -> dict[str, Any]:
+        began, cpu = time.time(), time.process_time()
+        try:
+            data = job(*args)
+        except Exception as err:
+            raise JobError(why(err)) from None
+        # Where and when it ran (report.json's timeline: the critical path).
+        data["worker"] = {
+            "pid": os.getpid(),
+            "start": began,
+            "end": time.time(),
+            "cpu_s": time.process_time() - cpu,
+        }
+        return data
+
+    return run
+
+
+@_plain_errors
+def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
+    from headsim.active.calibration_file import head_hash, write_calibration
+    from headsim.run.runner import calibrate_scenario
+    from headsim.scenario.loading import load_scenario
+
+    scenario = load_scenario("calibration", fast=fast, seed=seed)
+    start = time.perf_counter()
+    block = calibrate_scenario(scenario)
+    wall = time.perf_counter() - start
+    if block["status"] != "ok":
+        raise RuntimeError(f"calibration failed: {block['status']}")
+    path = write_calibration(
+        (Path(out) / "head.json").resolve(), scenario.settings, block, "calibration", scenario.seed
+    )
+    return {
+        "path": str(path),
+        "block": block,
+        "head_hash": head_hash(scenario.settings),
+        "seed": scenario.seed,
+        "wall_s": wall,
+    }
+
+
+@_plain_errors
+def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
+    from headsim.run.report import results_payload, summary_text
+    from headsim.run.runner import run_scenario
+    from headsim.scenario.loading import load_scenario
+
+    scenario_name, _ = SCENARIO_JOBS[name]
+    scenario = load_scenario(
+        scenario_name, fast=fast, seed=seed, overrides={"experiment.calibration.from": head}
+    )
+    start = time.perf_counter()
+    result = run_scenario(scenario)
+    wall = time.perf_counter() - start
+    payload = to_jsonable(results_payload(result))
+    directory = Path(out) / name
+    write_json_atomic(directory / "results.json", payload)
+    write_text_atomic(directory / "summary.txt", summary_text(result) + "\n")
+    return {
+        "results": payload,
+        "wall_s": wall,
+        "renders": result.renders,
+        "rendered_frames": result.rendered_frames,
+        "points": len(result.records),
+    }
+
+
+def _study_config(fast: bool, seed: int | None) -> Any:
+    from headsim.studies.methods import StudyConfig
+
+    make = StudyConfig.quick if fast else StudyConfig
+    return make(seed=seed or 0)
+
+
+@_plain_errors
+def zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
+    """Zhang's stereo calibration of the one head, once (it needs no head.json)."""
+    from headsim.scenario.loading import load_scenario
+    from headsim.studies.paper_tables import zhang_calibration
+
+    scenario = load_scenario(TABLES_HEAD, fast=fast, seed=seed)
+    start = time.perf_counter()
+    calibration, renders = zhang_calibration(scenario.settings, _study_config(fast, seed))
+    return {"calibration": calibration, "renders": renders, "wall_s": time.perf_counter() - start}
+
+
+@_plain_errors
+def fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
+    """The zoom fixed points and the Sec. V calibration on their columns, once (beyond the
+    paper: the active method that the focal length's change does not move)."""
+    from headsim.scenario.loading import load_scenario
+    from headsim.studies.paper_tables import fixed_point_calibration
+
+    scenario = load_scenario(TABLES_HEAD, fast=fast, seed=seed)
+    start = time.perf_counter()
+    config = _study_config(fast, seed)
+    targets = min(config.calibration_targets, FIXED_POINT_TARGETS)
+    fixed = fixed_point_calibration(
+        scenario.settings, dataclasses.replace(config, calibration_targets=targets)
+    )
+    return {"fixed": fixed, "targets": targets, "wall_s": time.perf_counter() - start}
+
+
+@_plain_errors
+def tables_job(
+    out: str,
+    fast: bool,
+    seed: int | None,
+    head: str,
+    zhang: dict[str, Any],
+    fixed: dict[str, Any],
+) -> dict[str, Any]:
+    """Tables V/VI and the changed focal length with the one calibration and Zhang's."""
+    from headsim.active.calibration_file import read_calibration
+    from headsim.scenario.loading import load_scenario
+    from headsim.studies import paper_tables
+    from headsim.studies.study_experiments import compare_figures
+    from headsim.studies.study_output import summary_rows, write_experiment
+
+    settings = load_scenario(TABLES_HEAD, fast=fast, seed=seed).settings
+    stored = read_calibration(head, settings).knowledge
+    calibration = zhang["calibration"]
+    result = paper_tables.run_tables(
+        settings, calibration, stored, _study_config(fast, seed), fixed["fixed"]
+    )
+    # The PNG is drawn by the parent, which loads matplotlib while the workers run.
+    files = write_experiment(result, Path(out) / "study", figure=False)
+    own = result.seconds + zhang["wall_s"] + fixed["wall_s"]
+    data = to_jsonable(
+        {
+            "title": result.experiment.title,
+            "summary": summary_rows(result),
+            "figures": compare_figures(result),
+            "files": {k: str(p) for k, p in files.items()},
+            "seconds": own,
+            "zhang": {
+                "seconds": zhang["wall_s"],
+                "views": calibration.views,
+                "rms_px": calibration.stereo_rms_px,
+                "renders": zhang["renders"],
+            },
+            "fixed_point": {
+                "seconds": fixed["wall_s"],
+                "renders": fixed["fixed"].renders,
+                "targets": fixed["targets"],
+                "principal_error_px": fixed["fixed"].principal.errors_px,
+                "alpha_e_error_mrad": [1e3 * e for e in fixed["fixed"].calibration.alpha_e_error],
+            },
+            "renders": zhang["renders"]
+            + fixed["fixed"].renders
+            + sum(e.renders for r in result.results for e in r.errors),
+        }
+    )
+    data["result"] = result  # for the parent to draw the PNG
+    return data
+
+
+@_plain_errors
+def study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, Any]:
+    from headsim.studies.study_experiments import compare_figures, run_experiment, sweep_experiment
+    from headsim.studies.study_output import summary_rows, write_experiment
+
+    config = _study_config(fast, seed)
+    experiment = sweep_experiment(name.removeprefix("sweep_"), config)
+    result = run_experiment(experiment, config)
+    files = write_experiment(result, Path(out) / "study")
+    return to_jsonable(
+        {
+            "title": experiment.title,
+            "summary": summary_rows(result),
+            "figures": compare_figures(result) if experiment.kind == "compare" else None,
+            "files": {k: str(p) for k, p in files.items()},
+            "seconds": result.seconds,
+        }
+    )
+
+
+def why(err: BaseException) -> str:
+    text = "".join(traceback.format_exception_only(type(err), err)).strip()
+    return text.splitlines()[-1] if text else repr(err)
