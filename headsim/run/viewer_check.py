@@ -30,7 +30,7 @@ import tempfile
 import time
 import urllib.parse
 import urllib.request
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -256,7 +256,7 @@ def screenshot(
     *,
     settle_s: float = 20.0,
     timeout_s: float = 240.0,
-    ready: callable | None = None,
+    ready: Callable[[np.ndarray], bool] | None = None,
     executable: str | None = None,
 ) -> np.ndarray:
     """Open ``url`` in headless Chromium and return the page as an RGB image (H, W, 3).

@@ -227,7 +227,9 @@ def detect_chessboard(image: np.ndarray) -> np.ndarray | None:
     (k % 8, k // 8) * 30 mm, the first one top-left in the image.
     """
     detection = find_chessboard(image, CHESSBOARD_PATTERN)
-    return detection.corners.astype(float) if detection.found else None
+    if not detection.found or detection.corners is None:  # FOUND carries corners
+        return None
+    return detection.corners.astype(float)
 
 
 def chessboard_views(
