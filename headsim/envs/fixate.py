@@ -51,7 +51,7 @@ from headsim.sim.settings import (
     SettingsError,
 )
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_marker
+from headsim.vision.markers import find_marker
 
 TARGET_BODY = "marker_red"
 TARGET_COLOUR = "red"

@@ -1,6 +1,6 @@
 """Calibrated stereo against the active method, after calibration and after the cameras change.
 
-Pure orchestration over :mod:`headsim.stereo.zhang`, :mod:`headsim.active.procedures` and
+Pure orchestration over :mod:`headsim.stereo`, :mod:`headsim.active.procedures` and
 :mod:`headsim.active.principal`; every error is estimate minus the simulator's truth
 in the head frame H, and "% of depth" divides by the true z_h.
 
@@ -85,8 +85,10 @@ from headsim.sim import names
 from headsim.sim.optics import centre_ray_yaw
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
-from headsim.stereo import zhang as stereo
-from headsim.vision.detect import find_marker
+from headsim.stereo.calibration import StereoCalibration, calibrate_stereo
+from headsim.stereo.triangulation import measure_point_stereo
+from headsim.stereo.views import ChessboardViews, StereoError, chessboard_views
+from headsim.vision.markers import find_marker
 
 METHODS = (
     "stereo",
@@ -195,7 +197,7 @@ class Calibrations:
     """
 
     settings: HeadSettings
-    stereo: stereo.StereoCalibration
+    stereo: StereoCalibration
     active: CalibrationRun
     principal: PrincipalPointRun
     fixed_point: CalibrationRun
@@ -291,18 +293,18 @@ class Calibrations:
 
 def zhang_stereo(
     settings: HeadSettings, config: StudyConfig
-) -> tuple[stereo.StereoCalibration, stereo.ChessboardViews]:
+) -> tuple[StereoCalibration, ChessboardViews]:
     """Zhang's calibration of ``settings``' pair from ``config.board_poses`` chessboard
     poses (seeded by ``config.seed``), and the views it used."""
     scale = view_scale(settings)
     with HeadSim("chessboard", settings) as sim:
-        views = stereo.chessboard_views(
+        views = chessboard_views(
             sim,
             config.board_poses,
             np.random.default_rng(config.seed),
             distance_range_m=(0.4 * scale, 1.0 * scale),
         )
-        return stereo.calibrate_stereo(sim, views), views
+        return calibrate_stereo(sim, views), views
 
 
 def zoom_fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:
@@ -445,9 +447,9 @@ def measure_methods(
                 start = sim.render_count
                 if method == "stereo":
                     try:
-                        m = stereo.measure_point_stereo(sim, calibrations.stereo, TARGET.name)
+                        m = measure_point_stereo(sim, calibrations.stereo, TARGET.name)
                         estimate, status = m.p_head, "ok"
-                    except stereo.StereoError as error:
+                    except StereoError as error:
                         estimate, status = np.full(3, np.nan), str(error)
                 else:
                     m2 = measure_model2(sim, servo, TARGET, calibrations.knowledge(method, refound))
