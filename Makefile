@@ -23,6 +23,7 @@ demo: setup
 test: setup
 	$(BIN)/ruff check headsim tests benchmarks
 	$(BIN)/ruff format --check headsim tests benchmarks
+	$(BIN)/mypy
 	$(BIN)/python -m pytest -q
 
 # The regression suite CI runs after the tests: exits 1 on a regression.

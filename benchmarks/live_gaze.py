@@ -32,7 +32,7 @@ from headsim.live.gaze import GazeConfig, SaccadeProfile, acquire, pursue
 from headsim.run.results import write_json_atomic
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_marker
+from headsim.vision.markers import find_marker
 
 RED = partial(find_marker, colour="red")
 EYE_HEIGHT = 0.21  # m, d1 + a2 of the default head

@@ -32,7 +32,7 @@ from headsim.scenario.area_layouts import area_layout
 from headsim.sim import names
 from headsim.sim.settings import preset
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_cross_point
+from headsim.vision.crosses import find_cross_point
 
 MAGNITUDE_AREAS = (1, 2, 3, 4, 7, 8)
 OBJECT_RADIUS_M = 0.006

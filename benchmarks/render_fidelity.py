@@ -24,7 +24,8 @@ import numpy as np
 from headsim.active.procedures import chessboard_corner_target
 from headsim.sim.settings import PRESETS, RenderFidelity, preset
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_chessboard, find_marker
+from headsim.vision.chessboard import find_chessboard
+from headsim.vision.markers import find_marker
 
 #: offsamples 8 and 16 render exactly like 4 here (Mesa's llvmpipe caps the
 #: samples at 4: same centroids to 1e-3 px in a 30-pose run), so they are left out.

@@ -23,7 +23,10 @@ from headsim.run.results import write_json_atomic
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
-from headsim.stereo import zhang as stereo
+from headsim.stereo.calibration import StereoCalibration, calibrate_stereo
+from headsim.stereo.frames import head_from_cam1_from_eye
+from headsim.stereo.triangulation import measure_point_stereo
+from headsim.stereo.views import chessboard_views
 
 #: Marker positions in H, m: 0.4-1.5 m deep, off the axis in x and y.
 MARKER_POSITIONS_HEAD = (
@@ -38,7 +41,7 @@ RMS_BOUND_PX = 0.2
 FOCAL_BOUND = 0.005
 
 
-def camera_table(calib: stereo.StereoCalibration) -> list[dict[str, dict[str, float]]]:
+def camera_table(calib: StereoCalibration) -> list[dict[str, dict[str, float]]]:
     """Per camera: estimate (mono and stereo-refined) beside the truth for kx, ky, cx, cy, k1, k2."""
     tables = []
     for mono, final in ((calib.mono1, calib.cam1), (calib.mono2, calib.cam2)):
@@ -62,7 +65,7 @@ def camera_table(calib: stereo.StereoCalibration) -> list[dict[str, dict[str, fl
     return tables
 
 
-def head_frames(sim: HeadSim, calib: stereo.StereoCalibration) -> dict[str, np.ndarray]:
+def head_frames(sim: HeadSim, calib: StereoCalibration) -> dict[str, np.ndarray]:
     """Ways to place camera 1 in H: from the extrinsics, and the paper's eye-geometry ones.
 
     The eye-geometry ones turn camera 1 by an angle about H's y: the true
@@ -73,22 +76,22 @@ def head_frames(sim: HeadSim, calib: stereo.StereoCalibration) -> dict[str, np.n
     baseline = sim.settings.baseline_m
     return {
         "from extrinsics": calib.head_from_cam1,
-        "eye, true mount yaw": stereo.head_from_cam1_from_eye(
+        "eye, true mount yaw": head_from_cam1_from_eye(
             sim.settings.cameras[0].mount_yaw_rad, baseline
         ),
-        "eye, effective direction": stereo.head_from_cam1_from_eye(
+        "eye, effective direction": head_from_cam1_from_eye(
             sim.effective_initial_direction(1), baseline
         ),
-        "eye, effective - centre ray": stereo.head_from_cam1_from_eye(
+        "eye, effective - centre ray": head_from_cam1_from_eye(
             sim.effective_initial_direction(1) - calib.cam1.centre_ray_yaw_rad, baseline
         ),
-        "parallel (yaw 0)": stereo.head_from_cam1_from_eye(0.0, baseline),
+        "parallel (yaw 0)": head_from_cam1_from_eye(0.0, baseline),
         "truth": calib.true_head_from_cam1,
     }
 
 
 def measure_markers(
-    settings: HeadSettings, calib: stereo.StereoCalibration
+    settings: HeadSettings, calib: StereoCalibration
 ) -> tuple[list[dict[str, object]], dict[str, dict[str, float]]]:
     """3-D errors of markers at MARKER_POSITIONS_HEAD, per head-frame construction."""
     rows: list[dict[str, object]] = []
@@ -102,7 +105,7 @@ def measure_markers(
             for p_head in MARKER_POSITIONS_HEAD:
                 p_world = world_from_head[:3, :3] @ np.array(p_head) + world_from_head[:3, 3]
                 sim.set_body_pose(names.MARKERS[0], p_world)
-                m = stereo.measure_point_stereo(
+                m = measure_point_stereo(
                     sim, calib, names.MARKERS[0], head_from_cam1=head_from_cam1
                 )
                 errors_mm.append(m.error_norm_m * 1e3)
@@ -132,9 +135,9 @@ def run_preset(name: str, poses: int, seed: int) -> dict[str, object]:
     settings = preset(name)
     start = time.perf_counter()
     with HeadSim("chessboard", settings) as sim:
-        views = stereo.chessboard_views(sim, poses, np.random.default_rng(seed))
+        views = chessboard_views(sim, poses, np.random.default_rng(seed))
         views_s = time.perf_counter() - start
-        calib = stereo.calibrate_stereo(sim, views)
+        calib = calibrate_stereo(sim, views)
     calib_s = time.perf_counter() - start - views_s
     corner_errors = views.corner_errors_px()
     rows, frames = measure_markers(settings, calib)

@@ -1,4 +1,4 @@
-"""Milliseconds per call of each detector in headsim.vision.detect on rendered 640x480 images.
+"""Milliseconds per call of each detector in headsim.vision on rendered 640x480 images.
 
 Each detector runs on an image of its own scene (ideal cameras; the target in
 view) and, where it matters, on one without its target (the LOST path can
@@ -23,7 +23,9 @@ from headsim.run.results import write_json_atomic
 from headsim.sim import names
 from headsim.sim.settings import ideal_head
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_chessboard, find_cross_point, find_marker, find_markers
+from headsim.vision.chessboard import find_chessboard
+from headsim.vision.crosses import find_cross_point
+from headsim.vision.markers import find_marker, find_markers
 
 OBJECT_COLOURS = dict(
     zip(names.RELATIVE_OBJECTS, ("red", "green", "blue", "yellow", "magenta", "cyan"), strict=True)

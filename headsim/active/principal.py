@@ -35,11 +35,7 @@ import numpy as np
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
-from headsim.stereo.zhang import (
-    detect_chessboard,
-    place_chessboard,
-    sample_board_pose,
-)
+from headsim.stereo.views import detect_chessboard, place_chessboard, sample_board_pose
 
 #: Zoom used to find the principal point when the study needs one (f' = 1.3 f).
 PROBE_ZOOM = 1.3

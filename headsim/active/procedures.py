@@ -46,13 +46,9 @@ from headsim.geometry.kinematics import head_to_world
 from headsim.sim import names
 from headsim.sim.settings import HeadBelief
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import (
-    ChessboardDetection,
-    Detection,
-    DetectionStatus,
-    find_chessboard,
-    find_markers,
-)
+from headsim.vision.chessboard import ChessboardDetection, find_chessboard
+from headsim.vision.detection import Detection, DetectionStatus
+from headsim.vision.markers import find_markers
 
 #: Centroid precision assumed for covariances, px (measured: ~0.03-0.06 px).
 NOMINAL_PIXEL_SIGMA = 0.05

@@ -23,7 +23,7 @@ from headsim.active.servo import (
     ServoOutcome,
     ServoResult,
 )
-from headsim.vision.detect import Detection, DetectionStatus
+from headsim.vision.detection import Detection, DetectionStatus
 
 
 class FailureCause(enum.Enum):

@@ -21,7 +21,8 @@ import numpy as np
 from headsim.sim import names
 from headsim.sim.render import Window
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import Detection, DetectionStatus, find_marker
+from headsim.vision.detection import Detection, DetectionStatus
+from headsim.vision.markers import find_marker
 
 Detector = Callable[[np.ndarray], Detection]
 

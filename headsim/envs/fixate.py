@@ -34,14 +34,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import Any, ClassVar
+from typing import Any
 
 import gymnasium
 import numpy as np
 from gymnasium import spaces
 
 from headsim.geometry.kinematics import head_to_world
-from headsim.live.head import EYE_LIMITS, NECK_LIMITS, LiveConfig, LiveHead
+from headsim.live.head import EYE_LIMITS, NECK_LIMITS, Frame, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
 from headsim.sim.settings import (
     CAMERA_NUMBER_FIELDS,
@@ -51,7 +51,7 @@ from headsim.sim.settings import (
     SettingsError,
 )
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_marker
+from headsim.vision.markers import find_marker
 
 TARGET_BODY = "marker_red"
 TARGET_COLOUR = "red"
@@ -79,7 +79,7 @@ def _check_ranges(randomise: dict[str, Any]) -> dict[str, tuple[float, float]]:
 class FixateEnv(gymnasium.Env):
     """Fixate a marker with the live head (see the module docstring)."""
 
-    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"], "render_fps": 30}
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 30}  # noqa: RUF012 (gymnasium.Env declares it an instance attribute)
 
     def __init__(
         self,
@@ -135,11 +135,11 @@ class FixateEnv(gymnasium.Env):
         limits = np.array(
             [NECK_LIMITS.max_speed, NECK_LIMITS.max_speed, EYE_LIMITS.max_speed], np.float32
         )
-        self.action_space = spaces.Box(-limits, limits, (3,), np.float32)
+        self.action_space: spaces.Box = spaces.Box(-limits, limits, (3,), np.float32)
         self._sim: HeadSim | None = None
         self._settings: HeadSettings | None = None
         self._live: LiveHead | None = None
-        self._frame = None
+        self._frame: Frame | None = None
         self._steps = 0
 
     # -- episodes --------------------------------------------------------------
@@ -159,9 +159,11 @@ class FixateEnv(gymnasium.Env):
         ranges = {**self.defaults, **self.randomise, **_check_ranges(options.get("randomise", {}))}
         cameras = []
         for cam in self.base_settings.cameras:
-            changes = {f: self._draw(ranges, f) for f in CAMERA_FIELDS if f in ranges}
+            changes: dict[str, Any] = {
+                f: self._draw(ranges, f) for f in CAMERA_FIELDS if f in ranges
+            }
             cameras.append(replace(cam, **changes))
-        head = {f: self._draw(ranges, f) for f in HEAD_FIELDS if f in ranges}
+        head: dict[str, Any] = {f: self._draw(ranges, f) for f in HEAD_FIELDS if f in ranges}
         seed_noise = int(self.np_random.integers(0, 2**31 - 1))
         if all(c.noise_std == 0 for c in cameras):
             seed_noise = 0  # noiseless images do not depend on it: keep the renderer
@@ -188,6 +190,7 @@ class FixateEnv(gymnasium.Env):
         if "target_world_m" in options:
             start = np.asarray(options["target_world_m"], float)
         speed = self._draw(ranges, "speed_m_s")
+        path: Waypoints | Static
         if speed > 0:
             direction = self.np_random.normal(size=3)
             direction /= np.linalg.norm(direction)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from gymnasium import spaces
 
-from headsim.vision.detect import find_marker
+from headsim.vision.markers import find_marker
 
 #: Probe size per joint, rad.
 PROBE_RAD = 0.02

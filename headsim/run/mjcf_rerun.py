@@ -30,6 +30,7 @@ by :class:`BodyPoses` whenever a body moved since it was last logged.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -138,7 +139,7 @@ def _batched_shape(model: mujoco.MjModel, archetype: str, geoms: list[int]) -> r
     # Every column costs about 0.7 kB in the file: identity rotations and zero
     # centres are left out (the archetypes' defaults), names are in the entity path,
     # and the solid fill mode is the 3-D view's default (:func:`view_defaults`).
-    common: dict[str, object] = {"colors": colours}
+    common: dict[str, Any] = {"colors": colours}  # keyword arguments of several archetypes
     if not np.allclose(quats_wxyz, [1.0, 0.0, 0.0, 0.0]):
         common["quaternions"] = quaternions
     kinds = [_shape_kind(model, g) for g in geoms]
@@ -171,7 +172,7 @@ def _batched_shape(model: mujoco.MjModel, archetype: str, geoms: list[int]) -> r
     )
 
 
-def _centres(centres: np.ndarray) -> dict[str, np.ndarray]:
+def _centres(centres: np.ndarray) -> dict[str, Any]:
     """``centers=`` unless all are at the origin (the default)."""
     return {"centers": centres} if np.any(centres) else {}
 
@@ -249,7 +250,7 @@ def log_model_geometry(
                 path,
                 rr.Transform3D(
                     translation=model.geom_pos[geom_id],
-                    quaternion=_xyzw(model.geom_quat[geom_id]),
+                    quaternion=rr.Quaternion(xyzw=_xyzw(model.geom_quat[geom_id])),
                 ),
                 _mesh_shape(model, geom_id),
                 static=static,
@@ -310,7 +311,9 @@ class BodyPoses:
             self._last[body] = pose
             rec.log(
                 self.paths[body],
-                rr.Transform3D(translation=pose[:3], quaternion=_xyzw(pose[3:])),
+                rr.Transform3D(
+                    translation=pose[:3], quaternion=rr.Quaternion(xyzw=_xyzw(pose[3:]))
+                ),
             )
             count += 1
         return count

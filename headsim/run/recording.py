@@ -61,7 +61,7 @@ from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.optics import camera_matrix
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_markers
+from headsim.vision.markers import find_markers
 
 APP_ID = "headsim"
 #: JPEG quality of the recorded images (the experiment's own images are exact; these are for people).

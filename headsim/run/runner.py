@@ -56,7 +56,8 @@ from headsim.scenario.spec import (
 from headsim.sim import names
 from headsim.sim.render import Window
 from headsim.sim.simulator import CameraId, HeadSim
-from headsim.vision.detect import find_cross_point, find_marker
+from headsim.vision.crosses import find_cross_point
+from headsim.vision.markers import find_marker
 
 #: Where unused bodies are parked: under the table, out of every camera's view (W, m).
 PARKED_WORLD_M = (0.0, 0.5, -1.0)

@@ -228,7 +228,7 @@ class EyeRenderer:
         if binning > 1:
             viewport = mujoco.MjrRect(0, 0, out_w, out_h)
             mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
-            pixels = np.empty((out_h, out_w, 3), dtype=np.uint8)
+            pixels: np.ndarray = np.empty((out_h, out_w, 3), dtype=np.uint8)
             mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
             self.rendered_frames += (out_w * out_h) / (width_c * height_c)
             return np.ascontiguousarray(pixels[::-1])

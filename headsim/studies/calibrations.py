@@ -25,7 +25,8 @@ from headsim.active.servo import EyeServo
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
-from headsim.stereo import zhang as stereo
+from headsim.stereo.calibration import StereoCalibration, calibrate_stereo
+from headsim.stereo.views import ChessboardViews, chessboard_views
 from headsim.studies.methods import BALL, METHODS, Progress, StudyConfig, quiet
 
 
@@ -40,7 +41,7 @@ class Calibrations:
     """
 
     settings: HeadSettings
-    stereo: stereo.StereoCalibration
+    stereo: StereoCalibration
     active: CalibrationRun
     principal: PrincipalPointRun
     fixed_point: CalibrationRun
@@ -136,18 +137,18 @@ class Calibrations:
 
 def zhang_stereo(
     settings: HeadSettings, config: StudyConfig
-) -> tuple[stereo.StereoCalibration, stereo.ChessboardViews]:
+) -> tuple[StereoCalibration, ChessboardViews]:
     """Zhang's calibration of ``settings``' pair from ``config.board_poses`` chessboard
     poses (seeded by ``config.seed``), and the views it used."""
     scale = view_scale(settings)
     with HeadSim("chessboard", settings) as sim:
-        views = stereo.chessboard_views(
+        views = chessboard_views(
             sim,
             config.board_poses,
             np.random.default_rng(config.seed),
             distance_range_m=(0.4 * scale, 1.0 * scale),
         )
-        return stereo.calibrate_stereo(sim, views), views
+        return calibrate_stereo(sim, views), views
 
 
 def zoom_fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:

@@ -33,7 +33,8 @@ from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
 from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
-from headsim.vision.detect import find_cross_point, find_marker
+from headsim.vision.crosses import find_cross_point
+from headsim.vision.markers import find_marker
 
 RED = body_target("marker_red", partial(find_marker, colour="red"))
 BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))

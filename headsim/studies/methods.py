@@ -10,7 +10,7 @@ from typing import Any
 
 from headsim.active.procedures import body_target
 from headsim.sim import names
-from headsim.vision.detect import find_marker
+from headsim.vision.markers import find_marker
 
 METHODS = (
     "stereo",

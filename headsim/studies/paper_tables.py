@@ -48,7 +48,9 @@ from headsim.estimators import model2
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
-from headsim.stereo import zhang as stereo
+from headsim.stereo.calibration import StereoCalibration
+from headsim.stereo.triangulation import measure_point_stereo
+from headsim.stereo.views import StereoError
 from headsim.studies.calibrations import calibration_positions, zhang_stereo, zoom_fixed_points
 from headsim.studies.conditions import Condition, ConditionResult
 from headsim.studies.methods import BALL, TARGET, StudyConfig
@@ -73,9 +75,7 @@ SERVOED = "active_centre"
 ZOOM = 1.5
 
 
-def zhang_calibration(
-    settings: HeadSettings, config: StudyConfig
-) -> tuple[stereo.StereoCalibration, int]:
+def zhang_calibration(settings: HeadSettings, config: StudyConfig) -> tuple[StereoCalibration, int]:
     """Zhang's calibration of ``settings``' pair (as :func:`headsim.studies.calibrations.zhang_stereo`),
     and the renders it took."""
     calibration, views = zhang_stereo(settings, config)
@@ -122,9 +122,7 @@ def fixed_point_calibration(settings: HeadSettings, config: StudyConfig) -> Fixe
     return FixedPoint(principal, calibration, renders, settings, config.seed)
 
 
-def active_knowledge(
-    stored: HeadKnowledge, zhang: stereo.StereoCalibration
-) -> dict[str, HeadKnowledge]:
+def active_knowledge(stored: HeadKnowledge, zhang: StereoCalibration) -> dict[str, HeadKnowledge]:
     """Each active method's knowledge: from the one Sec. V calibration and Zhang's v0."""
     if stored.u0 != (None, None):
         raise ValueError("the calibration's servo column is not the image centre's")
@@ -166,7 +164,7 @@ def recompute(sim: HeadSim, measured: Measurement, knowledge: HeadKnowledge) -> 
 
 def measure_paired(
     settings: HeadSettings,
-    zhang: stereo.StereoCalibration,
+    zhang: StereoCalibration,
     knowledges: dict[str, HeadKnowledge],
     targets_head: np.ndarray,
     fixed: FixedPoint | None = None,
@@ -194,9 +192,9 @@ def measure_paired(
             truth = sim.position(TARGET.name, "head")
             start = sim.render_count
             try:
-                m = stereo.measure_point_stereo(sim, zhang, TARGET.name)
+                m = measure_point_stereo(sim, zhang, TARGET.name)
                 estimate, status = m.p_head, "ok"
-            except stereo.StereoError as error:
+            except StereoError as error:
                 estimate, status = np.full(3, np.nan), str(error)
             out.append(
                 TargetError("stereo", index, truth, estimate, status, sim.render_count - start)
@@ -259,7 +257,7 @@ def tables_experiment(settings: HeadSettings, config: StudyConfig) -> Experiment
 
 def run_tables(
     settings: HeadSettings,
-    zhang: stereo.StereoCalibration,
+    zhang: StereoCalibration,
     stored: HeadKnowledge,
     config: StudyConfig,
     fixed: FixedPoint | None = None,

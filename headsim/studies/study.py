@@ -1,6 +1,6 @@
 """Calibrated stereo against the active method, after calibration and after the cameras change.
 
-Pure orchestration over :mod:`headsim.stereo.zhang`, :mod:`headsim.active.procedures` and
+Pure orchestration over :mod:`headsim.stereo`, :mod:`headsim.active.procedures` and
 :mod:`headsim.active.principal`; every error is estimate minus the simulator's truth
 in the head frame H, and "% of depth" divides by the true z_h.
 

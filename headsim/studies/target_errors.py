@@ -14,7 +14,8 @@ from headsim.active.procedures import measure_model2
 from headsim.active.servo import EyeServo
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
-from headsim.stereo import zhang as stereo
+from headsim.stereo.triangulation import measure_point_stereo
+from headsim.stereo.views import StereoError
 from headsim.studies.calibrations import Calibrations
 from headsim.studies.methods import METHODS, SWEEP_METHODS, TARGET, StudyConfig
 from headsim.studies.targets import place_in_head
@@ -82,9 +83,9 @@ def measure_methods(
                 start = sim.render_count
                 if method == "stereo":
                     try:
-                        m = stereo.measure_point_stereo(sim, calibrations.stereo, TARGET.name)
+                        m = measure_point_stereo(sim, calibrations.stereo, TARGET.name)
                         estimate, status = m.p_head, "ok"
-                    except stereo.StereoError as error:
+                    except StereoError as error:
                         estimate, status = np.full(3, np.nan), str(error)
                 else:
                     m2 = measure_model2(sim, servo, TARGET, calibrations.knowledge(method, refound))

@@ -10,7 +10,7 @@ import pytest
 from headsim.active.servo import EyeServo, ServoConfig, ServoOutcome
 from headsim.sim.settings import CameraSettings, HeadSettings
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_marker
+from headsim.vision.markers import find_marker
 
 RED = partial(find_marker, colour="red")
 MARKER = "marker_red"

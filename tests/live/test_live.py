@@ -21,7 +21,7 @@ from headsim.live.gaze import GazeConfig, acquire, pursue
 from headsim.live.motors import bang_bang_duration, min_jerk, min_jerk_duration
 from headsim.sim.settings import IDEAL_FOCAL_PX, CameraSettings, HeadSettings, SettingsError
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import colour_weight, find_marker
+from headsim.vision.markers import colour_weight, find_marker
 
 RED = partial(find_marker, colour="red")
 

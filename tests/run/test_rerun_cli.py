@@ -13,13 +13,13 @@ import pytest
 from rerun.chunk import RrdReader
 
 from headsim.cli import main
-from headsim.run import viewer_check
 from headsim.run.rerun_cli import (
     DEFAULT_URL,
     RecordingArgumentError,
     add_recording_arguments,
     recording_target,
 )
+from headsim.run.viewer_browser import free_port, rerun_executable, wait_for_port
 
 
 def _target(*argv: str):
@@ -67,13 +67,13 @@ def test_run_refuses_a_bad_url_before_running(
 
 
 def test_connect_streams_to_a_viewer_and_still_writes_the_file(tmp_path: Path) -> None:
-    port = viewer_check.free_port()
+    port = free_port()
     received = tmp_path / "received.rrd"
     # A real Rerun gRPC server that saves what it receives.
-    command = [viewer_check.rerun_executable(), "--port", str(port), "--save", str(received)]
+    command = [rerun_executable(), "--port", str(port), "--save", str(received)]
     viewer = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        viewer_check.wait_for_port(port, 60, viewer)
+        wait_for_port(port, 60, viewer)
         rrd = tmp_path / "run.rrd"
         url = f"rerun+http://127.0.0.1:{port}/proxy"
         argv = ["run", "quickstart", "--fast", "--out", str(tmp_path), "--rrd", str(rrd)]

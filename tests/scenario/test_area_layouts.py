@@ -11,7 +11,7 @@ from headsim.scenario.area_layouts import area_layout, reference_angles
 from headsim.sim import names
 from headsim.sim.settings import paper_head
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_cross_point
+from headsim.vision.crosses import find_cross_point
 
 
 def test_objects_placed_in_the_magnitude_areas_are_classified_by_both_tests() -> None:

@@ -36,7 +36,7 @@ from headsim.sim.settings import (
 )
 from headsim.sim.simulator import HeadSim
 from headsim.sim.tolerances import REALISTIC_BUDGET
-from headsim.vision.detect import find_marker
+from headsim.vision.markers import find_marker
 
 PAPER1 = PinholeCamera(640, 480, 834.83, 815.42, 303.8, 306.3, -0.38741, 0.0)
 PAPER2 = PinholeCamera(640, 480, 850.46, 833.29, 345.1, 197.3, -0.30938, 0.0)

@@ -8,7 +8,8 @@ import pytest
 from headsim.sim.optics import undistort_pixels
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import DetectionStatus, find_marker
+from headsim.vision.detection import DetectionStatus
+from headsim.vision.markers import find_marker
 
 MARKER = "marker_red"
 

@@ -261,7 +261,7 @@ def test_windows_change_no_chessboard_corner() -> None:
 def test_a_preview_is_the_binned_view_and_leaves_the_cameras_noise_alone(head: str) -> None:
     import cv2
 
-    from headsim.vision.detect import find_marker
+    from headsim.vision.markers import find_marker
 
     settings = HEADS[head]
     with HeadSim("default", settings) as sim, HeadSim("default", settings) as plain:

@@ -25,7 +25,7 @@ from headsim.active.servo import EyeServo
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detect import find_marker
+from headsim.vision.markers import find_marker
 
 RED = body_target("marker_red", partial(find_marker, colour="red"))
 BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))

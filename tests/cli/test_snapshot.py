@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 
 from headsim.cli import main
-from headsim.vision.detect import find_marker
+from headsim.vision.markers import find_marker
 
 
 def test_snapshot_writes_images_and_ground_truth(tmp_path: Path) -> None:

@@ -181,7 +181,7 @@ def test_no_space_on_the_device_itself_is_exit_3(tmp_path: Path) -> None:
 
 
 def test_workers_0_is_bad_input_and_creates_nothing(tmp_path: Path) -> None:
-    sweep = Path(__file__).resolve().parent.parent / "sweeps" / "focal.toml"
+    sweep = Path(__file__).resolve().parents[2] / "sweeps" / "focal.toml"
     result = headsim("sweep", str(sweep), "--out", str(tmp_path / "sw"), "--workers", "0")
     assert result.returncode == 2
     assert "Traceback" not in result.stderr

@@ -1,4 +1,4 @@
-"""headsim/Fixate-v0: Gymnasium's API check, seeding, spawned vector envs, reference policies."""
+"""headsim/Fixate-v0: Gymnasium's API check, seeding, rewards, bad options, spawned vector envs."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import headsim.envs
-from headsim.envs.policies import RandomPolicy, ServoPolicy
+from headsim.envs.policies import ServoPolicy
 from headsim.sim.settings import SettingsError
 
 ID = headsim.envs.FIXATE_ID
@@ -43,41 +43,6 @@ def test_same_seed_gives_identical_observations_and_another_seed_does_not() -> N
         np.testing.assert_array_equal(after_first[key], after_second[key])
     assert not np.array_equal(first["cam1"], other["cam1"])
     assert first["cam1"].shape == (96, 128, 3) and first["cam1"].dtype == np.uint8
-    env.close()
-
-
-def test_paper_servo_policy_fixates_and_the_episode_terminates() -> None:
-    env = gymnasium.make(ID)
-    policy = ServoPolicy(env.action_space, env.unwrapped.period_s)
-    lengths = []
-    for seed in range(4):
-        obs, info = env.reset(seed=seed)
-        policy.reset()
-        step = 0
-        while step < 30:
-            step += 1
-            obs, reward, terminated, truncated, info = env.step(policy(obs))
-            if terminated or truncated:
-                break
-        assert terminated and not truncated, f"seed {seed}: not fixated in {step} steps"
-        assert np.all(np.abs(info["offsets_px"]) <= 1.0)
-        assert reward > -0.02
-        lengths.append(step)
-    assert max(lengths[1:]) <= 10  # the first episode also probes the Jacobian
-    env.close()
-
-
-def test_random_policy_truncates_at_the_step_limit_and_rewards_are_bounded() -> None:
-    env = gymnasium.make(ID, max_steps=5, reward="position")
-    policy = RandomPolicy(env.action_space, seed=1)
-    obs, _ = env.reset(seed=0)
-    for _ in range(5):
-        obs, reward, terminated, truncated, _ = env.step(policy(obs))
-        assert -1.0 <= reward <= 0.0
-        assert env.observation_space.contains(obs)
-        if terminated:
-            break
-    assert truncated or terminated
     env.close()
 
 

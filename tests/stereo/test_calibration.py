@@ -1,0 +1,51 @@
+"""Zhang calibration of rendered chessboard views beside the simulator's truth."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+
+from headsim.geometry.transforms import frame_deviation
+from headsim.sim.optics import camera_matrix, dist_coeffs
+from headsim.sim.settings import ideal_head, paper_head
+from headsim.sim.simulator import HeadSim
+from headsim.stereo.calibration import (
+    calibrate_stereo,
+    undistort_normalized_points,
+)
+from headsim.stereo.views import StereoError, chessboard_views
+
+
+def test_calibration_reaches_the_reprojection_and_focal_length_bounds(calibrated) -> None:
+    name, _, calib = calibrated
+    assert calib.mono1.rms_px <= 0.2 and calib.mono2.rms_px <= 0.2
+    assert calib.stereo_rms_px <= 0.2
+    for cam in (calib.cam1, calib.cam2, calib.mono1, calib.mono2):
+        assert max(abs(e) for e in cam.focal_rel_errors) < 0.005, (name, cam.focal_rel_errors)
+        assert max(abs(e) for e in cam.principal_errors_px) < 3.0, (name, cam.principal_errors_px)
+        assert abs(cam.k1_error) < 0.02, (name, cam.dist)
+    assert abs(calib.baseline_m - calib.true_baseline_m) < 1e-3
+    assert calib.rotation_error_rad < 3e-3
+    rotation, translation = frame_deviation(calib.head_from_cam1, calib.true_head_from_cam1)
+    assert rotation < 5e-3 and translation < 1e-3
+
+
+def test_too_few_views_is_a_clear_error() -> None:
+    with HeadSim("chessboard", ideal_head()) as sim:
+        views = chessboard_views(sim, 3, np.random.default_rng(0))
+        assert views.renders == 6
+        with pytest.raises(StereoError, match=r"need at least 5 views .* got 3 of 3 poses"):
+            calibrate_stereo(sim, views)
+
+
+def test_undistortion_converges_over_the_whole_image_where_opencv_defaults_do_not() -> None:
+    cam = paper_head().cameras[0]  # k1 = -0.387
+    K, dist = camera_matrix(cam), dist_coeffs(cam)
+    us, vs = np.meshgrid(np.arange(0.0, cam.width, 8.0), np.arange(0.0, cam.height, 8.0))
+    uv = np.column_stack([us.ravel(), vs.ravel()])
+    reference = cam.pinhole().normalise(uv)  # raises if any pixel has no ray
+    ours = undistort_normalized_points(uv, K, dist)
+    assert np.abs(ours - reference).max() * cam.kx < 1e-6  # px
+    default = cv2.undistortPoints(uv.reshape(-1, 1, 2), K, dist).reshape(-1, 2)
+    assert np.abs(default - reference).max() * cam.kx > 0.3  # px, in the image corners
