@@ -187,15 +187,11 @@ def _run(args: argparse.Namespace) -> int:
 
 def _progress_observer(args: argparse.Namespace, total: int, unit: str) -> Any:
     """The run's progress on stderr: a bar on a terminal, plain lines otherwise; none when quiet."""
-    from headsim.run.runner import Progress
-
     if getattr(args, "no_progress", False) or getattr(args, "quiet", False):
         return None
-    if sys.stderr.isatty():
-        return Progress(total, sys.stderr)
-    from headsim.run.progress import LineProgress
+    from headsim.run.progress import Counter, RunProgress
 
-    return LineProgress(total, sys.stderr, unit=unit)
+    return RunProgress(Counter(total, unit=unit))
 
 
 def _write_all(files: dict[Path, object]) -> None:
@@ -289,8 +285,8 @@ def _calibrate(args: argparse.Namespace) -> int:
             print(f"\nheadsim: interrupted: nothing written to {out}", file=sys.stderr)
             return 130
     wall = time.perf_counter() - start
-    if observers:
-        print(file=sys.stderr)
+    if progress is not None:
+        progress.counter.close(block["fixated"])
     if block["status"] != "ok" or block.get("knowledge") is None:
         print(f"headsim: calibration failed: {block['status']}; nothing written", file=sys.stderr)
         return 1

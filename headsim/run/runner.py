@@ -16,12 +16,11 @@ the experiment's own images.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from functools import partial
-from typing import Any, TextIO
+from typing import Any
 
 import numpy as np
 
@@ -333,70 +332,6 @@ class ObservedNeckServo(NeckServo):
 
     def look_from(self, steps: tuple[int, int, int], detector: Detector) -> bool:
         return super().look_from(steps, self.sim.hub.detector(self.sim, detector))
-
-
-class Progress(Observer):
-    """A one-line text progress bar: fixations done of ``total``, rate, time left.
-
-    Drawn on ``stream`` (stderr by the CLI, which keeps stdout for the
-    summary) at most every ``interval_s``, and once more at the end.
-    """
-
-    def __init__(
-        self,
-        total: int,
-        stream: TextIO,
-        *,
-        width: int = 24,
-        interval_s: float = 0.25,
-        clock: Callable[[], float] = time.monotonic,
-    ) -> None:
-        self.total = max(int(total), 1)
-        self.stream = stream
-        self.width = width
-        self.interval_s = interval_s
-        self.clock = clock
-        self.start = clock()
-        self.done = 0
-        self.label = ""
-        self._drawn_at = -math.inf
-        self._length = 0
-
-    def line(self) -> str:
-        """The bar as it stands, e.g. ``[######------] 12/48 fixations  3.1/s  0:11 left  corner_3_1``."""
-        done = min(self.done, self.total)
-        filled = round(self.width * done / self.total)
-        elapsed = max(self.clock() - self.start, 1e-9)
-        rate = done / elapsed
-        if done >= self.total:
-            left = f"{elapsed:.1f} s"
-        elif rate > 0:
-            seconds = round((self.total - done) / rate)
-            left = f"{seconds // 60}:{seconds % 60:02d} left"
-        else:
-            left = "-:-- left"
-        bar = "#" * filled + "-" * (self.width - filled)
-        return f"[{bar}] {done}/{self.total} fixations  {rate:.1f}/s  {left}  {self.label}".rstrip()
-
-    def _draw(self, force: bool = False) -> None:
-        now = self.clock()
-        if not force and now - self._drawn_at < self.interval_s:
-            return
-        self._drawn_at = now
-        text = self.line()
-        self.stream.write("\r" + text.ljust(self._length))
-        self.stream.flush()
-        self._length = len(text)
-
-    def step(self, step: int, label: str) -> None:
-        self.done, self.label = step, label
-        self._draw()
-
-    def finished(self, result: RunResult) -> None:
-        self.done, self.label = self.total, ""
-        self._draw(force=True)
-        self.stream.write("\n")
-        self.stream.flush()
 
 
 # -- phases ----------------------------------------------------------------------
@@ -934,7 +869,6 @@ __all__ = [
     "ObservedNeckServo",
     "ObservedSim",
     "Observer",
-    "Progress",
     "RunResult",
     "calibrate_scenario",
     "marker_target",
