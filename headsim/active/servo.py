@@ -639,8 +639,12 @@ class NeckServo:
         return yaw, pitch, eye
 
     def look_from(self, steps: tuple[int, int, int], detector: Detector) -> bool:
-        """Move to ``steps`` and look with both cameras (two renders): both see it whole."""
-        self._key = detector
+        """Move to ``steps`` and look with both cameras (two renders): both see it whole.
+
+        Whole frames, no window or preview: a search's look is keyed to no earlier
+        detection (as the runner's servo has always looked, its detector wrapped).
+        """
+        self._key = None
         self._move(np.asarray(steps))
         seen = [self._look(camera, detector) for camera in (1, 2)]
         return all(d.found and d.uv is not None for d in seen)
