@@ -106,9 +106,10 @@ RUN_FILES = ("results.json", "summary.txt", "timing.json")
 
 
 def _run(args: argparse.Namespace) -> int:
+    from headsim.run.events import Subscriber
     from headsim.run.report import results_payload, summary_text
     from headsim.run.rerun_cli import recording_target
-    from headsim.run.runner import Observer, run_scenario
+    from headsim.run.runner import run_scenario
     from headsim.scenario.schema import load_scenario
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
@@ -120,7 +121,7 @@ def _run(args: argparse.Namespace) -> int:
         for name in RUN_FILES:
             outputs.file(out / name, "--out")
         rrd = outputs.file(target.rrd, "--rrd", atomic=False) if target.rrd else None
-        observers: list[Observer] = []
+        observers: list[Subscriber] = []
         progress = _progress_observer(args, scenario.fixations, "fixations")
         if progress is not None:
             observers.append(progress)

@@ -6,8 +6,8 @@
   return runs every update together on one line, it prints plain lines: one
   at each phase, at most one per ``interval_s`` in between (or one per item),
   and one at the end.
-- :class:`RunProgress`: a :class:`Counter` of a run's fixations, fed by the
-  run's events.
+- :class:`RunProgress`: a :class:`Counter` of a run's fixations, subscribed
+  to the run's events (:mod:`headsim.run.events`).
 - :class:`Status`: a command's phase messages (``headsim study``, ``bench``,
   ``reproduce``), each a line with the seconds since the start; a transient
   status is one redrawn tqdm line on a terminal instead.
@@ -26,7 +26,8 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TextIO
 
-from headsim.run.runner import Observer
+from headsim.active.events import FixationStarted, PhaseStarted
+from headsim.run.events import RunFinished, Stamp
 
 if TYPE_CHECKING:
     from tqdm import tqdm
@@ -157,20 +158,20 @@ class Counter:
         self._print(f"{self.name}: finished: {self.done} {self.unit} in {elapsed:.1f} s")
 
 
-class RunProgress(Observer):
-    """A run's fixations as a :class:`Counter`: a line (or the bar's title) at each phase."""
+class RunProgress:
+    """A run's fixations as a :class:`Counter`, following the run's events (a
+    :class:`headsim.run.events.Subscriber`): a line, or the bar's title, at each phase."""
 
     def __init__(self, counter: Counter) -> None:
         self.counter = counter
 
-    def phase(self, name: str, sim: Any, knowledge: Any, truth: Any) -> None:
-        self.counter.phase(name)
-
-    def step(self, step: int, label: str) -> None:
-        self.counter.update(step, label)
-
-    def finished(self, result: Any) -> None:
-        self.counter.close(self.counter.total)
+    def notify(self, event: object, at: Stamp) -> None:
+        if isinstance(event, PhaseStarted):
+            self.counter.phase(event.name)
+        elif isinstance(event, FixationStarted):
+            self.counter.update(at.step, event.label)
+        elif isinstance(event, RunFinished):
+            self.counter.close(self.counter.total)
 
 
 class Status:

@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from headsim.active.events import FixationStarted, PhaseStarted
+from headsim.run.events import Hub, RunFinished
 from headsim.run.progress import Counter, RunProgress, Status, time_left
 
 DATA = Path(__file__).resolve().parents[1] / "data"
@@ -37,14 +39,16 @@ def test_counter_prints_a_line_per_phase_and_at_most_one_per_interval_in_a_log()
     stream = io.StringIO()
     counter = Counter(10, unit="fixations", stream=stream, interval_s=5.0, clock=lambda: now[0])
     progress = RunProgress(counter)
-    progress.phase("calibration", None, None, None)
+    hub = Hub([progress])
+    hub.emit(PhaseStarted("calibration", None, None, {}))  # type: ignore[arg-type]
     for step in range(1, 5):
-        now[0] = float(step)
-        progress.step(step, "x")  # within 5 s of the phase line: silent
+        hub.emit(FixationStarted(f"calibration {step}"))
+    now[0] = 1.0  # within 5 s of the phase line: silent
+    hub.emit(FixationStarted("calibration 5"))
     now[0] = 6.0
-    progress.step(5, "x")
-    progress.phase("measurement", None, None, None)
-    progress.finished(None)
+    hub.emit(FixationStarted("calibration 6"))  # step 5: five fixations done
+    hub.emit(PhaseStarted("measurement", None, None, {}))  # type: ignore[arg-type]
+    hub.emit(RunFinished(None))  # type: ignore[arg-type]
     lines = stream.getvalue().splitlines()
     assert lines == [
         "headsim: calibration: 0/10 fixations, 0.0/s, time left unknown",
