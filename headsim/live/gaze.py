@@ -30,8 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from headsim.active.procedures import HeadKnowledge
-from headsim.active.servo import Detector
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.servo_types import Detector
 from headsim.geometry.kinematics import head_to_world
 from headsim.live.head import Frame, LiveHead
 from headsim.live.motors import MotorDriver, bang_bang_duration, min_jerk_duration
@@ -373,7 +373,7 @@ def acquire(
     the servo's probes and moves settle kinematically, as the at-rest
     procedures do.  None when the servo did not converge.
     """
-    from headsim.active.servo import NeckServo
+    from headsim.active.neck_servo import NeckServo
 
     sim = live.sim
     knowledge = knowledge or HeadKnowledge()

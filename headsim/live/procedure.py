@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.live.gaze import FrameRecord, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
 from headsim.live.spec import PursuitSpec, describe

@@ -51,7 +51,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.geometry.kinematics import head_to_world
 from headsim.run import mjcf_rerun
 from headsim.run.report import summary_text

@@ -25,24 +25,23 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from headsim.active.procedures import (
+from headsim.active.calibration import (
     CalibrationError,
     CalibrationRun,
-    HeadKnowledge,
-    Measurement,
-    Model2Config,
-    Target,
     calibrate_head,
-    calibration_layout,
     line_of_sight_truth,
-    measure_chessboard,
-    measure_model1,
-    measure_model2,
-    relative_positioning,
-    track_moving_target,
 )
-from headsim.active.search import Failure
-from headsim.active.servo import Detector, EyeServo, NeckServo, NeckServoResult, ServoConfig
+from headsim.active.chessboard import measure_chessboard
+from headsim.active.eye_servo import EyeServo
+from headsim.active.failure import Failure
+from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.active.model1 import measure_model1
+from headsim.active.model2 import Model2Config, measure_model2
+from headsim.active.neck_servo import NeckServo
+from headsim.active.placement import calibration_layout
+from headsim.active.relative import relative_positioning
+from headsim.active.servo_types import Detector, NeckServoResult, ServoConfig
+from headsim.active.tracking import track_moving_target
 from headsim.scenario.calibration_design import near_far_depths, near_fraction
 from headsim.scenario.schema import (
     CHESSBOARD_PATTERN,
