@@ -9,6 +9,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from headsim.geometry.sampling import sample_points_head
 from headsim.sim import names
 from headsim.sim.simulator import HeadSim
 
@@ -56,9 +57,13 @@ def calibration_layout(
         return ok
 
     def draw(n: int, slots: np.ndarray | None = None) -> np.ndarray:
-        z = rng.uniform(*depth_range_m, size=n) if depths_m is None else depths_m[slots]
-        return np.column_stack(
-            [rng.uniform(-lateral, lateral, n) * z, rng.uniform(-vertical, vertical, n) * z, z]
+        return sample_points_head(
+            rng,
+            n,
+            (-lateral, lateral),
+            (-vertical, vertical),
+            depth_range_m=depth_range_m if depths_m is None else None,
+            depths_m=None if depths_m is None else depths_m[slots],
         )
 
     if depths_m is not None:
