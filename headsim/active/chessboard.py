@@ -64,6 +64,7 @@ def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: flo
         board = find_chessboard(image, pattern)
         if not board.found:
             return Detection(board.status, None, 0.0)
+        assert board.corners is not None  # found: the corners are there
         u, v = board.corners[index]
         return Detection(
             DetectionStatus.FOUND, (float(u), float(v)), 1.0, board_extent(board, index)
@@ -123,7 +124,10 @@ def measure_chessboard(
         sink.emit(FixationStarted(corner.name))
         measured[k] = measure_model2(sim, servo, corner, knowledge, config)
         sink.emit(MeasurementDone(measured[k]))
-    widths, heights, true_widths, true_heights = [], [], [], []
+    widths: list[float] = []
+    heights: list[float] = []
+    true_widths: list[float] = []
+    true_heights: list[float] = []
     for k, m in measured.items():
         for neighbour, out, out_true in (
             (k + 1, widths, true_widths),

@@ -64,6 +64,8 @@ class NeckServo:
         self.window_renders = 0
         self.window_misses = 0
         self.previews = 0
+        #: Where the target was lost in the current run: (camera, what the detector said).
+        self._lost: tuple[int, DetectionStatus] | None = None
         self._key: object = None
         self._current: np.ndarray | None = None  # the Jacobian as the run stands
 
@@ -186,7 +188,7 @@ class NeckServo:
             goals = (u10, u20, (v10 + v20) / 2)
         goal = np.asarray(goals, dtype=float)
         start = sim.render_count
-        self._lost: tuple[int, DetectionStatus] | None = None
+        self._lost = None
         self._retreats = 0
         steps = self._steps()
         error = self._error(detector, goal)
@@ -271,22 +273,25 @@ class NeckServo:
         iterations: int,
         jac: np.ndarray | None = None,
     ) -> NeckServoResult:
-        whole = tuple(int(s) for s in steps)
+        yaw, pitch, eye = (int(s) for s in steps)
+        whole = (yaw, pitch, eye)
         if error is None:
-            err = (math.nan,) * 3
-            sub = tuple(float(s) for s in whole)
+            err = (math.nan, math.nan, math.nan)
+            sub = (float(yaw), float(pitch), float(eye))
         else:
-            err = tuple(float(e) for e in error)
-            sub = tuple(
+            e1, e2, e3 = (float(e) for e in error)
+            err = (e1, e2, e3)
+            s1, s2, s3 = (
                 float(s)
                 for s in (steps - np.linalg.solve(jac, error) if jac is not None else steps)
             )
+            sub = (s1, s2, s3)
         lost = self._lost if outcome is ServoOutcome.TARGET_LOST else None
         return NeckServoResult(
             outcome,
             whole,
-            err,  # type: ignore[arg-type]
-            sub,  # type: ignore[arg-type]
+            err,
+            sub,
             jac,
             self.sim.render_count - start,
             iterations,

@@ -129,21 +129,25 @@ def relative_positioning(
     gain_areas: dict[str, int] = {}
     if seen:
         cols = np.array([columns[name] for name in seen])
-        pixel_areas = areas_from_pixels(*cols.T, u10, u20, alpha1=alpha1, alpha2=alpha2)
+        u11, u12, u21, u22 = cols.T
+        pixel_areas = areas_from_pixels(u11, u12, u21, u22, u10, u20, alpha1=alpha1, alpha2=alpha2)
         truth_h = np.array([sim.position(name, "head") for name in seen])
         effective = (sim.effective_initial_direction(1), sim.effective_initial_direction(2))
         truth = areas_from_geometry(truth_h, alpha1, alpha2, sim.settings.baseline_m, effective)
-        comparison = compare_areas(pixel_areas, truth, *cols.T, u10, u20)
+        comparison = compare_areas(pixel_areas, truth, u11, u12, u21, u22, u10, u20)
         areas.update(zip(seen, (int(a) for a in pixel_areas), strict=True))
         true_areas.update(zip(seen, (int(a) for a in truth), strict=True))
         g1, g2 = (abs(servo.gains.get(camera) or 0.0) for camera in (1, 2))
         if g1 > 0 and g2 > 0:
-            gain = areas_from_pixels(*cols.T, u10, u20, alpha1=alpha1, alpha2=alpha2, kx=(g1, g2))
+            gain = areas_from_pixels(
+                u11, u12, u21, u22, u10, u20, alpha1=alpha1, alpha2=alpha2, kx=(g1, g2)
+            )
             mean = (g1 + g2) / 2
             scaled = cols.copy()
             scaled[:, :2] = u10 + (cols[:, :2] - u10) * mean / g1
             scaled[:, 2:] = u20 + (cols[:, 2:] - u20) * mean / g2
-            gain_comparison = compare_areas(gain, truth, *scaled.T, u10, u20)
+            s11, s12, s21, s22 = scaled.T
+            gain_comparison = compare_areas(gain, truth, s11, s12, s21, s22, u10, u20)
             gain_areas = dict(zip(seen, (int(a) for a in gain), strict=True))
     return RelativeRun(
         reference=ref,
