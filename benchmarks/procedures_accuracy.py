@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.run.results import write_json_atomic
 from headsim.sim.settings import HeadSettings, paper_head
 from headsim.studies import experiments

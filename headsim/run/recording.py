@@ -52,7 +52,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from headsim.active.events import Detected, FixationStarted, PhaseStarted
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.geometry.kinematics import head_to_world
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp

@@ -1,6 +1,6 @@
 """Running a scenario: calibrate if asked, run the procedure, collect the results.
 
-The procedures of :mod:`headsim.active.procedures` run unchanged.  What a run
+The procedures of :mod:`headsim.active` run unchanged.  What a run
 shows while it goes (progress, the Rerun recording) follows its events: the
 runner gives the simulator (and through it the servos and the procedures) a
 :class:`headsim.run.events.Hub` as event sink, and the hub passes every event
@@ -17,25 +17,24 @@ from typing import Any
 
 import numpy as np
 
-from headsim.active.events import PhaseStarted
-from headsim.active.procedures import (
+from headsim.active.calibration import (
     CalibrationError,
     CalibrationRun,
-    HeadKnowledge,
-    Measurement,
-    Model2Config,
-    Target,
     calibrate_head,
-    calibration_layout,
     line_of_sight_truth,
-    measure_chessboard,
-    measure_model1,
-    measure_model2,
-    relative_positioning,
-    track_moving_target,
 )
-from headsim.active.search import Failure
-from headsim.active.servo import EyeServo, NeckServo, ServoConfig
+from headsim.active.chessboard import measure_chessboard
+from headsim.active.events import PhaseStarted
+from headsim.active.eye_servo import EyeServo
+from headsim.active.failure import Failure
+from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.active.model1 import measure_model1
+from headsim.active.model2 import Model2Config, measure_model2
+from headsim.active.neck_servo import NeckServo
+from headsim.active.placement import calibration_layout
+from headsim.active.relative import relative_positioning
+from headsim.active.servo_types import ServoConfig
+from headsim.active.tracking import track_moving_target
 from headsim.run.events import CalibrationDone, Hub, MeasurementRecorded, RunFinished, Subscriber
 from headsim.run.targets import marker_target
 from headsim.scenario.calibration_design import near_far_depths, near_fraction
