@@ -39,7 +39,7 @@ from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import calibration_layout
 from headsim.active.principal import principal_points_by_zoom
 from headsim.run.results import write_json_atomic
-from headsim.run.runner import marker_target
+from headsim.run.targets import marker_target
 from headsim.scenario.schema import reach_refusal
 from headsim.sim import names
 from headsim.sim.settings import FINE_RENDERING, HeadSettings, paper_head
