@@ -249,11 +249,36 @@ class TrackingResult:
 
 
 @dataclass(frozen=True)
-class PursuitResult:
-    """The live pursuit: its block as :mod:`headsim.live.procedure` builds it (keys in order),
-    and why the run failed (e.g. the target lost), one line each."""
+class PursuitFigures:
+    """The figures that score a live pursuit, over the frames on which the target was present.
 
-    block: dict[str, Any]
+    Times in s, offsets in px, position errors in W, m; NaN where undefined.
+    ``ended``: why the loop ended.
+    """
+
+    frames: int
+    frames_present: int
+    frames_lost: int
+    losses: int
+    reacquisitions: int
+    saccades: int
+    time_to_fixation_s: float
+    lag_s: float
+    offset_rms_px: float
+    position_rms_m: float
+    position_rms_pct_of_depth: float
+    position_max_m: float
+    ended: str
+
+
+@dataclass(frozen=True)
+class PursuitResult:
+    """The live pursuit (:mod:`headsim.live.procedure`): the spec as run, its figures and
+    each frame (None when it never started), and why it failed, one line each."""
+
+    pursuit: dict[str, Any]
+    figures: PursuitFigures | None = None
+    per_frame: dict[str, Any] | None = None
     failures: tuple[str, ...] = ()
 
 
@@ -313,6 +338,7 @@ __all__ = [
     "MeasurementRecord",
     "PointsResult",
     "PositionOutcome",
+    "PursuitFigures",
     "PursuitResult",
     "RelativeObject",
     "RelativePaper",

@@ -22,6 +22,7 @@ from headsim.run.outcomes import (
     RunResult,
     TrackingResult,
 )
+from headsim.run.serialise import experiment_block
 
 # -- the summary table ------------------------------------------------------------
 
@@ -333,13 +334,13 @@ def summary_text(result: RunResult) -> str:
         lines += [*_tracking_lines(e), ""]
     elif isinstance(e, PointsResult) and e.check_targets is not None:
         lines += [*_check_lines(e), ""]
-    elif isinstance(e, PursuitResult) and "frames" in e.block:
+    elif isinstance(e, PursuitResult) and e.figures is not None:
         from headsim.live.procedure import summary_lines
 
-        lines += [*summary_lines({"procedure": procedure, **e.block}), ""]
+        lines += [*summary_lines(experiment_block(procedure, e)), ""]
     if result.ok and procedure == "pursuit":
-        frames = e.block.get("frames", 0) if isinstance(e, PursuitResult) else 0
-        lines.append(f"OK: {frames} frames, the target never lost")
+        figures = e.figures if isinstance(e, PursuitResult) else None
+        lines.append(f"OK: {figures.frames if figures else 0} frames, the target never lost")
     elif result.ok:
         count = len(result.records)
         lines.append(f"OK: {count} measurement{'' if count == 1 else 's'}, none failed")

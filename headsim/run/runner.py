@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, replace
+from dataclasses import asdict, fields, replace
 from functools import partial
 from typing import Any, TextIO
 
@@ -57,6 +57,7 @@ from headsim.run.outcomes import (
     MeasurementRecord,
     PointsResult,
     PositionOutcome,
+    PursuitFigures,
     PursuitResult,
     RelativeObject,
     RelativePaper,
@@ -806,8 +807,18 @@ def _run_pursuit(
     from headsim.live.procedure import run_pursuit
 
     records, block = run_pursuit(scenario, hub, knowledge, label)
-    failures = block.pop("failures", [])
-    return records, PursuitResult(block, tuple(failures))
+    known = {"pursuit", "per_frame", "failures", *(f.name for f in fields(PursuitFigures))}
+    if set(block) - known:  # a new figure must get its field, or it would not be written
+        raise KeyError(f"pursuit figures without a PursuitFigures field: {set(block) - known}")
+    figures = None
+    if "frames" in block:
+        figures = PursuitFigures(**{f.name: block[f.name] for f in fields(PursuitFigures)})
+    return records, PursuitResult(
+        pursuit=block["pursuit"],
+        figures=figures,
+        per_frame=block.get("per_frame"),
+        failures=tuple(block.get("failures", ())),
+    )
 
 
 RUNNERS = {

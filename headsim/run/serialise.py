@@ -304,7 +304,12 @@ def _experiment_fields(experiment: Experiment) -> dict[str, Any]:
     if isinstance(experiment, TrackingResult):
         return asdict(experiment)
     assert isinstance(experiment, PursuitResult)
-    return dict(experiment.block)
+    block: dict[str, Any] = {"pursuit": experiment.pursuit}
+    if experiment.figures is not None:
+        block.update(asdict(experiment.figures))
+    if experiment.per_frame is not None:
+        block["per_frame"] = experiment.per_frame
+    return block
 
 
 def experiment_block(procedure: str, experiment: Experiment | None) -> dict[str, Any]:
