@@ -8,7 +8,6 @@ in the names: m, rad, px; positions in W unless named otherwise.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -31,7 +30,8 @@ class CalibrationLayout:
     depth_m: list[float]
     lateral: float
     vertical: float
-    positions_world_m: Sequence[Any]
+    #: (N, 3) as drawn, or as read back from JSON
+    positions_world_m: np.ndarray | list[list[float]]
 
 
 @dataclass(frozen=True)
@@ -72,9 +72,9 @@ class KnowledgeReport:
     """What the calibration taught the head (its :class:`HeadKnowledge`, as numbers)."""
 
     alpha_e_rad: list[float]
-    v0_px: list[float]
+    v0_px: list[float | None]
     kx_over_ky: list[float]
-    u0_px: list[float]
+    u0_px: list[float | None]
     los_offset_m: list[float] | None
 
 

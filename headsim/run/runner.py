@@ -85,7 +85,7 @@ from headsim.vision.detect import find_cross_point, find_marker
 #: Where unused bodies are parked: under the table, out of every camera's view (W, m).
 PARKED_WORLD_M = (0.0, 0.5, -1.0)
 #: What the paper reports for each experiment (Sec. VI).
-PAPER = {
+PAPER: dict[str, Any] = {
     "alpha_e_rad": PAPER_INITIAL_DIRECTIONS,
     "chessboard_side_mean_m": 0.0303,
     "chessboard_side_std_m": 0.000677,
@@ -821,7 +821,9 @@ def _run_pursuit(
     )
 
 
-RUNNERS = {
+RUNNERS: dict[
+    str, Callable[[Scenario, Hub, HeadKnowledge, str], tuple[list[MeasurementRecord], Experiment]]
+] = {
     "model2": _run_points,
     "model1": _run_points,
     "calibration": _run_points,

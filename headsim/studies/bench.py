@@ -347,7 +347,7 @@ def scenario_metrics(name: str) -> Metrics:
     }
     if result.calibration and result.calibration.layout is not None:
         metrics[f"scenario.{name}.calibration_max_error_rad"] = float(
-            np.max(np.abs(result.calibration.alpha_e_error_rad))
+            np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
         )
     return metrics
 

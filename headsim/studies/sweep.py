@@ -268,7 +268,9 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
             mean_error_mm=float(np.mean(errors_mm)) if errors_mm else None,
             max_error_mm=float(np.max(errors_mm)) if errors_mm else None,
             renders=int(result.renders["total"]),
-            calibration_max_error_rad=float(np.max(np.abs(result.calibration.alpha_e_error_rad)))
+            calibration_max_error_rad=float(
+                np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
+            )
             if result.calibration is not None and result.calibration.layout is not None
             else None,
         )
