@@ -10,7 +10,6 @@ import pytest
 from headsim.active.procedures import Measurement
 from headsim.active.search import Failure, FailureCause
 from headsim.estimators.result import Method, Status
-from headsim.run.accuracy import summaries
 from headsim.run.outcomes import (
     CalibrationLayout,
     CalibrationReport,
@@ -117,21 +116,6 @@ def test_a_measurement_writes_its_method_status_and_failure_as_documented() -> N
         "camera": 2,
         "detail": "and at 12 eye angles searched",
     }
-
-
-def test_summaries_count_by_knowledge_and_depth_band() -> None:
-    records = [
-        MeasurementRecord(_measurement(0.001, 0.5), "none", 0),
-        MeasurementRecord(_measurement(0.004, 0.8), "calibrated", 1),
-        MeasurementRecord(_measurement(0.0, 1.2, LOST), "calibrated", 2),
-    ]
-    by_knowledge = summaries(records)
-    assert list(by_knowledge) == ["none", "calibrated"]
-    calibrated = by_knowledge["calibrated"]
-    assert (calibrated.count, calibrated.ok, calibrated.failed) == (2, 1, 1)
-    assert calibrated.failure_causes == {"lost": 1}
-    assert [b.count for b in calibrated.by_depth] == [0, 1, 0]  # the failed one counts nowhere
-    assert calibrated.error_pct_of_depth_rms == pytest.approx(0.5)
 
 
 def test_a_calibration_that_could_not_lay_out_its_positions_writes_five_keys() -> None:
