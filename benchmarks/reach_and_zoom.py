@@ -42,7 +42,7 @@ from headsim.active.procedures import (
 )
 from headsim.active.servo import EyeServo, NeckServo
 from headsim.run.results import write_json_atomic
-from headsim.run.runner import marker_target
+from headsim.run.targets import marker_target
 from headsim.scenario.schema import reach_refusal
 from headsim.sim import names
 from headsim.sim.settings import FINE_RENDERING, HeadSettings, paper_head

@@ -106,9 +106,10 @@ RUN_FILES = ("results.json", "summary.txt", "timing.json")
 
 
 def _run(args: argparse.Namespace) -> int:
+    from headsim.run.events import Subscriber
     from headsim.run.report import summary_text
     from headsim.run.rerun_cli import recording_target
-    from headsim.run.runner import Observer, run_scenario
+    from headsim.run.runner import run_scenario
     from headsim.run.serialise import results_payload
     from headsim.scenario.schema import load_scenario
 
@@ -121,7 +122,7 @@ def _run(args: argparse.Namespace) -> int:
         for name in RUN_FILES:
             outputs.file(out / name, "--out")
         rrd = outputs.file(target.rrd, "--rrd", atomic=False) if target.rrd else None
-        observers: list[Observer] = []
+        observers: list[Subscriber] = []
         progress = _progress_observer(args, scenario.fixations, "fixations")
         if progress is not None:
             observers.append(progress)
@@ -188,15 +189,11 @@ def _run(args: argparse.Namespace) -> int:
 
 def _progress_observer(args: argparse.Namespace, total: int, unit: str) -> Any:
     """The run's progress on stderr: a bar on a terminal, plain lines otherwise; none when quiet."""
-    from headsim.run.runner import Progress
-
     if getattr(args, "no_progress", False) or getattr(args, "quiet", False):
         return None
-    if sys.stderr.isatty():
-        return Progress(total, sys.stderr)
-    from headsim.run.progress import LineProgress
+    from headsim.run.progress import Counter, RunProgress
 
-    return LineProgress(total, sys.stderr, unit=unit)
+    return RunProgress(Counter(total, unit=unit))
 
 
 def _write_all(files: dict[Path, object]) -> None:
@@ -291,8 +288,8 @@ def _calibrate(args: argparse.Namespace) -> int:
             print(f"\nheadsim: interrupted: nothing written to {out}", file=sys.stderr)
             return 130
     wall = time.perf_counter() - start
-    if observers:
-        print(file=sys.stderr)
+    if progress is not None:
+        progress.counter.close(report.fixated)
     if not report.ok or report.knowledge is None:
         print(
             f"headsim: calibration failed: {report.status_text}; nothing written", file=sys.stderr

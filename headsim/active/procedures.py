@@ -17,6 +17,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from headsim.active.events import CalibrationPosition, FixationStarted, MeasurementDone
 from headsim.active.search import (
     Failure,
     FailureCause,
@@ -45,6 +46,7 @@ from headsim.estimators.result import Method, Status
 from headsim.estimators.vertical import VerticalCalibration, calibrate_vertical_reference
 from headsim.geometry.kinematics import head_to_world
 from headsim.sim import names
+from headsim.sim.events import EventSink
 from headsim.sim.settings import HeadBelief
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detect import (
@@ -593,6 +595,7 @@ def calibrate_head(
     knowledge: HeadKnowledge | None = None,
     position_noise_m: float = 0.0,
     lines_of_sight: bool = False,
+    sink: EventSink | None = None,
 ) -> CalibrationRun:
     """Fixate ``target`` (moved with body ``body``) at each position and calibrate.
 
@@ -609,7 +612,10 @@ def calibrate_head(
     initial direction and line-of-sight offset are fitted jointly from the measured positions
     (:func:`calibrate_lines_of_sight`) and replace Sec. V's directions, unless
     the layout cannot separate them (``lines.separable`` False, with its message).
+    ``sink``: where each position's fixation is reported ("calibration 1", ...; None:
+    the simulator's sink).
     """
+    sink = sim.sink if sink is None else sink
     base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0), los_offset_m=None)
     rng = rng or np.random.default_rng(0)
     start = sim.render_count
@@ -617,13 +623,15 @@ def calibrate_head(
     alpha1, alpha2, depths, rows = [], [], [], []
     outcomes: list[Failure | None] = []
     plain = Model2Config(midline_px=0.0)
-    for position in np.atleast_2d(positions_world):
+    for index, position in enumerate(np.atleast_2d(positions_world)):
+        sink.emit(FixationStarted(f"calibration {index + 1}"))
         sim.set_body_pose(body, position)
         m = measure_model2(sim, servo, target, base, plain)
         if m.failure is not None and m.failure.cause is FailureCause.ESTIMATOR:
             # Near the midline the y images hold almost no x offset (NO_Y): take
             # them again at an intermediate eye angle, the near-midline remedy.
             m = measure_model2(sim, servo, target, base, Model2Config())
+        sink.emit(CalibrationPosition(index, position, m))
         outcomes.append(m.failure)
         if not m.ok:
             continue
@@ -902,6 +910,7 @@ def track_moving_target(
     trajectory: Callable[[float], np.ndarray],
     times_s: Sequence[float],
     knowledge: HeadKnowledge | None = None,
+    sink: EventSink | None = None,
 ) -> TrackingRun:
     """Move ``body`` along ``trajectory(t)`` (world, m) and fixate it at each time with Model 1.
 
@@ -909,12 +918,17 @@ def track_moving_target(
     first fixation each one starts from the last and takes few renders.  A
     target that left both views since is searched for around the last
     fixation (:func:`headsim.active.search.find_neck_view`), then from the start pose.
+    ``sink``: where each fixation ("<target> 1", ...) and measurement is reported
+    (None: the simulator's sink).
     """
+    sink = sim.sink if sink is None else sink
     measurements = []
     fixations: list[tuple[int, int, int]] = []  # where the target was seen, in steps
-    for t in times_s:
+    for k, t in enumerate(times_s):
+        sink.emit(FixationStarted(f"{target.name} {k + 1}"))
         sim.set_body_pose(body, trajectory(float(t)))
         m = measure_model1(sim, servo, target, knowledge, last_seen=fixations[-2:])
+        sink.emit(MeasurementDone(m, float(t)))
         measurements.append(m)
         if m.ok:
             fixations.append(servo.steps())
@@ -1003,16 +1017,22 @@ def measure_chessboard(
     pattern: tuple[int, int] = (8, 6),
     square_m: float = 0.030,
     corners: Sequence[int] | None = None,
+    sink: EventSink | None = None,
 ) -> ChessboardRun:
-    """Measure the chessboard's cross points (all, or ``corners``) and its squares' sides."""
+    """Measure the chessboard's cross points (all, or ``corners``) and its squares' sides.
+
+    ``sink``: where each corner's fixation ("corner_i_j") and measurement is
+    reported (None: the simulator's sink).
+    """
+    sink = sim.sink if sink is None else sink
     columns, rows = pattern
     indices = list(range(columns * rows)) if corners is None else list(corners)
-    measured = {
-        k: measure_model2(
-            sim, servo, chessboard_corner_target(k, pattern, square_m), knowledge, config
-        )
-        for k in indices
-    }
+    measured: dict[int, Measurement] = {}
+    for k in indices:
+        corner = chessboard_corner_target(k, pattern, square_m)
+        sink.emit(FixationStarted(corner.name))
+        measured[k] = measure_model2(sim, servo, corner, knowledge, config)
+        sink.emit(MeasurementDone(measured[k]))
     widths, heights, true_widths, true_heights = [], [], [], []
     for k, m in measured.items():
         for neighbour, out, out_true in (
@@ -1089,6 +1109,7 @@ def relative_positioning(
     reference: Target,
     objects: dict[str, str],
     knowledge: HeadKnowledge | None = None,
+    sink: EventSink | None = None,
 ) -> RelativeRun:
     """Measure ``reference`` with Model 2, then place ``objects`` (body -> colour) in areas.
 
@@ -1096,10 +1117,15 @@ def relative_positioning(
     fixations' whole encoder steps, where the lines L11..L22 are.  An object
     whose blob touches another's in any image (one partly hides the other)
     counts as not seen: its centroid would be biased.
+    ``sink``: where the reference's fixation and measurement are reported (None:
+    the simulator's sink).
     """
+    sink = sim.sink if sink is None else sink
     knowledge = knowledge or HeadKnowledge()
     start = sim.render_count
+    sink.emit(FixationStarted(reference.name))
     ref = measure_model2(sim, servo, reference, knowledge, Model2Config(midline_px=0.0))
+    sink.emit(MeasurementDone(ref))
     if not ref.ok:
         return RelativeRun(ref, {}, {}, {}, tuple(objects), None, sim.render_count - start)
     resolution = sim.settings.encoder_resolution_rad

@@ -18,7 +18,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from headsim.active.events import Detected, ServoKind, ServoStep
 from headsim.sim import names
+from headsim.sim.events import EventSink
 from headsim.sim.render import Window
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detect import Detection, DetectionStatus, find_marker
@@ -44,6 +46,23 @@ def pattern_windowed(detector: object) -> bool:
     while isinstance(detector, functools.partial):
         detector = detector.func
     return getattr(detector, "window_key", None) is not None
+
+
+def reporting(
+    detector: Detector, sink: EventSink, camera: int, window: Window | None = None
+) -> Detector:
+    """``detector``, reporting to ``sink`` each detection it makes in camera ``camera``'s
+    image (:class:`headsim.active.events.Detected`; in a ``window``, its offset added)."""
+
+    def detect(image: np.ndarray) -> Detection:
+        detection = detector(image)
+        uv = detection.uv if detection.found else None
+        if uv is not None and window is not None:  # in the full frame's pixels
+            uv = (uv[0] + window.x0, uv[1] + window.y0)
+        sink.emit(Detected(camera, detection.status, uv))
+        return detection
+
+    return detect
 
 
 def pattern_window(
@@ -214,9 +233,13 @@ class ServoConfig:
 class EyeServo:
     """Servo the eye motor so that one camera's target column reaches a goal u."""
 
-    def __init__(self, sim: HeadSim, config: ServoConfig | None = None) -> None:
+    def __init__(
+        self, sim: HeadSim, config: ServoConfig | None = None, sink: EventSink | None = None
+    ) -> None:
         self.sim = sim
         self.config = config or ServoConfig()
+        #: Where detections and moves are reported (None: the simulator's sink).
+        self.sink = sim.sink if sink is None else sink
         low, high = sim.joint_range(names.EYE_MOTOR_JOINT)
         resolution = sim.settings.encoder_resolution_rad
         self._step_range = (math.ceil(low / resolution), math.floor(high / resolution))
@@ -267,12 +290,15 @@ class EyeServo:
         detection = None
         if window is not None:
             self.window_renders += 1
-            detection = look_in_window(sim, camera, detector, window)
+            detection = look_in_window(
+                sim, camera, reporting(detector, self.sink, camera, window), window
+            )
             if detection is None:
                 self.window_misses += 1
-                detection = detector(sim.retake(camera))  # the same instant, whole
+                # the same instant, whole
+                detection = reporting(detector, self.sink, camera)(sim.retake(camera))
         if detection is None:
-            detection = detector(sim.render(camera))
+            detection = reporting(detector, self.sink, camera)(sim.render(camera))
         # Only blob detections (a centroid and an area) predict a window.
         if isinstance(detection, Detection) and detection.found and detection.uv is not None:
             self._seen[camera] = (key, steps, neck, sim.placements, detection.uv, detection.area_px)
@@ -378,6 +404,16 @@ class EyeServo:
             sim.settle()
             detection = self.observe(camera, detector)
             self._renders += 1
+            self.sink.emit(
+                ServoStep(
+                    ServoKind.EYE,
+                    iteration,
+                    (target,),
+                    None
+                    if not detection.found or detection.uv is None
+                    else (detection.uv[0] - goal,),
+                )
+            )
             if not detection.found or detection.uv is None:
                 if self._retreats >= cfg.max_retreats or abs(move) <= 1:
                     return self._result(
@@ -487,9 +523,13 @@ class NeckServo:
 
     JOINTS = (names.NECK_YAW, names.NECK_PITCH, names.EYE_MOTOR_JOINT)
 
-    def __init__(self, sim: HeadSim, config: ServoConfig | None = None) -> None:
+    def __init__(
+        self, sim: HeadSim, config: ServoConfig | None = None, sink: EventSink | None = None
+    ) -> None:
         self.sim = sim
         self.config = config or ServoConfig()
+        #: Where detections and moves are reported (None: the simulator's sink).
+        self.sink = sim.sink if sink is None else sink
         resolution = sim.settings.encoder_resolution_rad
         self._ranges = [
             (math.ceil(lo / resolution), math.floor(hi / resolution))
@@ -572,16 +612,18 @@ class NeckServo:
             window = preview_window(sim, camera, self._key, self.config)
             if window is not None:
                 return self._look_in(window, camera, detector)
-        return detector(sim.render(camera))
+        return reporting(detector, self.sink, camera)(sim.render(camera))
 
     def _look_in(self, window: Window, camera: int, detector: Detector) -> Detection:
         """Detect in a rendered window; a miss costs the same instant's whole frame."""
         self.window_renders += 1
-        detection = look_in_window(self.sim, camera, detector, window)
+        detection = look_in_window(
+            self.sim, camera, reporting(detector, self.sink, camera, window), window
+        )
         if detection is not None:
             return detection
         self.window_misses += 1
-        return detector(self.sim.retake(camera))
+        return reporting(detector, self.sink, camera)(self.sim.retake(camera))
 
     def _in_range(self, steps: np.ndarray) -> bool:
         return all(lo <= s <= hi for s, (lo, hi) in zip(steps, self._ranges, strict=True))
@@ -597,8 +639,12 @@ class NeckServo:
         return yaw, pitch, eye
 
     def look_from(self, steps: tuple[int, int, int], detector: Detector) -> bool:
-        """Move to ``steps`` and look with both cameras (two renders): both see it whole."""
-        self._key = detector
+        """Move to ``steps`` and look with both cameras (two renders): both see it whole.
+
+        Whole frames, no window or preview: a search's look is keyed to no earlier
+        detection (as the runner's servo has always looked, its detector wrapped).
+        """
+        self._key = None
         self._move(np.asarray(steps))
         seen = [self._look(camera, detector) for camera in (1, 2)]
         return all(d.found and d.uv is not None for d in seen)
@@ -667,6 +713,14 @@ class NeckServo:
                 )
             self._move(target)
             new_error = self._error(detector, goal)
+            self.sink.emit(
+                ServoStep(
+                    ServoKind.NECK,
+                    iteration,
+                    tuple(int(s) for s in target),
+                    None if new_error is None else tuple(float(e) for e in new_error),
+                )
+            )
             if new_error is None:
                 if self._retreats >= cfg.max_retreats or np.abs(move).max() <= 1:
                     return self._result(

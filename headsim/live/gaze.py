@@ -134,6 +134,14 @@ class FrameRecord:
 
 
 @dataclass(frozen=True)
+class PursuitFrame:
+    """The event the live pursuit reports at each frame it measured (see
+    :mod:`headsim.active.events`): the frame's record."""
+
+    record: FrameRecord
+
+
+@dataclass(frozen=True)
 class PursuitRun:
     """A live run of the gaze controller: per-frame records and the figures that score it."""
 

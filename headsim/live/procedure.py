@@ -7,8 +7,8 @@ servo's image Jacobian then serves the live gaze controller
 Results (the ``experiment`` block of results.json): the figures of the run
 (time to fixation, pursuit lag, position error RMS along the path, losses and
 re-acquisitions) and, per frame, time, found, image offsets, estimate, truth
-and error.  Observers see every render, each frame is a step (``Observer.step``)
-and its record goes to ``Observer.pursued``.
+and error.  Subscribers see every render; each frame is a step (``FixationStarted``) and
+its record a ``PursuitFrame`` event.
 """
 
 from __future__ import annotations
@@ -69,11 +69,14 @@ def run_pursuit(
     scenario: Any, hub: Any, knowledge: HeadKnowledge, label: str
 ) -> tuple[list[Any], dict[str, Any]]:
     """The runner's entry for ``procedure = "pursuit"``: (no point records, the experiment block)."""
-    from headsim.run.runner import ObservedSim, marker_target
+    from headsim.active.events import PhaseStarted
+    from headsim.live.gaze import PursuitFrame
+    from headsim.run.targets import marker_target
+    from headsim.sim.simulator import HeadSim
 
     spec: PursuitSpec = scenario.scene.pursuit
     target = marker_target(spec.name, spec.body)
-    with ObservedSim(hub, "default", scenario) as sim:
+    with HeadSim("default", scenario.settings, settle_mode=scenario.settle_mode, sink=hub) as sim:
         live = LiveHead(sim, spec.live, spec.body, spec.path, spec.visibility)
         first = next(
             (
@@ -84,18 +87,20 @@ def run_pursuit(
             None,
         )
         truth = {} if first is None else {spec.name: spec.path.position(first)}
-        hub.phase("measurement", sim, knowledge, truth)
+        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         experiment: dict[str, Any] = {"pursuit": describe(spec)}
         if first is None:
             return [], {**experiment, "failures": [f"{spec.name}: never present in the run"]}
         live.advance_to(first)
-        estimator = acquire(live, hub.detector(sim, target.detector), knowledge)
+        # A plain callable, not the marker detector itself: acquiring looks at whole
+        # frames (no windows), as it always has; the servo reports its detections.
+        estimator = acquire(live, lambda image: target.detector(image), knowledge)
         if estimator is None:
             return [], {**experiment, "failures": [f"{spec.name}: not acquired at rest"]}
 
         def on_frame(record: FrameRecord) -> None:
             hub.begin(f"{spec.name} t={record.time_s:.3f}s")  # a step per frame
-            hub.pursued(record)
+            hub.emit(PursuitFrame(record))
 
         run = pursue(live, target.detector, estimator, spec.duration_s, spec.gaze, on_frame)
     experiment.update(figures(run, spec))

@@ -1,6 +1,6 @@
 """Recording a run to a Rerun ``.rrd`` file, replayed with ``rerun FILE.rrd``.
 
-A :class:`Recorder` is a :class:`headsim.run.runner.Observer`: it logs the
+A :class:`Recorder` is a :class:`headsim.run.events.Subscriber`: it logs the
 experiment's own images and detections as the procedures make them (no
 render is made for the record) and the results as they come.  Entity paths
 and timelines (README "Scenarios and results" lists them):
@@ -51,15 +51,17 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.procedures import HeadKnowledge
 from headsim.geometry.kinematics import head_to_world
 from headsim.run import mjcf_rerun
+from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
 from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RelativeResult, RunResult
 from headsim.run.report import summary_text
 from headsim.run.rerun_cli import RecordingTarget
-from headsim.run.runner import Observer
 from headsim.scenario.schema import Scenario
 from headsim.sim import names
+from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.optics import camera_matrix
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detect import find_markers
@@ -169,7 +171,7 @@ def recording_id(scenario: Scenario) -> str:
     return f"{scenario.name}{'-fast' if scenario.fast else ''}-seed{scenario.seed}"
 
 
-class Recorder(Observer):
+class Recorder:
     """Logs a run to ``path`` as it goes; :meth:`close` writes the footer."""
 
     def __init__(
@@ -234,6 +236,9 @@ class Recorder(Observer):
         self.objects: dict[str, str] = {}
         self.closed = False
         self._pursuit_trail: list[np.ndarray] = []
+        self.sim: HeadSim | None = None  # the current phase's simulator
+        #: Each camera's last whole image in the phase, the backdrop of the windows after it.
+        self._last_full: dict[int, np.ndarray] = {}
         self._scene_key: tuple[str, ...] | None = None
         self._body_poses: mjcf_rerun.BodyPoses | None = None
         # Geometry is static when the whole run is in one scene; else logged per phase.
@@ -403,7 +408,49 @@ class Recorder(Observer):
         for key, value in (("eye_rad", eye), ("neck_yaw_rad", yaw), ("neck_pitch_rad", pitch)):
             self.rec.log(f"/joints/{key}", rr.Scalars([value]))
 
-    # -- the observer -------------------------------------------------------------
+    # -- the subscriber -----------------------------------------------------------
+    def notify(self, event: object, at: Stamp) -> None:
+        """Log ``event`` (see :mod:`headsim.run.events`) at ``at``'s frame and step."""
+        from headsim.live.gaze import PursuitFrame  # the live pursuit's frames
+
+        if isinstance(event, PhaseStarted):
+            self.sim, self._last_full = event.sim, {}
+            self.phase(event.name, event.sim, event.knowledge, dict(event.truth_world_m))
+        elif isinstance(event, FixationStarted):
+            self.step(at.step, event.label)
+        elif isinstance(event, ImageTaken) and event.kind is not ImageKind.PREVIEW:
+            assert self.sim is not None
+            self.rendered(self.sim, event.camera, self._frame_image(event), at.frame)
+        elif isinstance(event, Detected):
+            assert self.sim is not None
+            status = event.status.value
+            self.detected(self.sim, event.camera, event.uv_px, status, at.frame)
+        elif isinstance(event, MeasurementRecorded):
+            self.measured(event.record)
+        elif isinstance(event, PursuitFrame):
+            self.pursued(event.record, at.frame)
+        elif isinstance(event, CalibrationDone):
+            self.calibrated(event.report)
+        elif isinstance(event, RunFinished):
+            self.finished(event.result)
+
+    def _frame_image(self, event: ImageTaken) -> np.ndarray:
+        """The image as shown: a window in a full-size frame, around it the camera's last
+        whole image at half brightness (not rendered now), or black before there is one."""
+        if event.kind is not ImageKind.WINDOW or event.window is None:
+            self._last_full[event.camera] = event.image
+            return event.image
+        assert self.sim is not None
+        settings = self.sim.camera_settings(event.camera)
+        last = self._last_full.get(event.camera)
+        if last is not None and last.shape == (settings.height, settings.width, 3):
+            frame = last // 2
+        else:
+            frame = np.zeros((settings.height, settings.width, 3), dtype=np.uint8)
+        window = event.window
+        frame[window.y0 : window.y1, window.x0 : window.x1] = event.image
+        return frame
+
     def phase(
         self, name: str, sim: HeadSim, knowledge: HeadKnowledge, truth: dict[str, np.ndarray]
     ) -> None:

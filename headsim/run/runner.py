@@ -1,30 +1,23 @@
 """Running a scenario: calibrate if asked, run the procedure, collect the results.
 
-The procedures of :mod:`headsim.active.procedures` run unchanged.  What a run shows
-while it goes (progress, the Rerun recording) hooks in from outside them:
-
-- :class:`ObservedSim` is a :class:`HeadSim` that reports every image it
-  renders and every body it moves;
-- :class:`ObservedEyeServo` and :class:`ObservedNeckServo` wrap the detector
-  they are given, so every detection is reported with the image it was made in.
-
-Both report to a :class:`Hub`, which numbers images (``frame``) and
-fixations (``step``) over the whole run and passes them on to
-:class:`Observer` objects.  Nothing is rendered for the observers: they see
-the experiment's own images.
+The procedures of :mod:`headsim.active.procedures` run unchanged.  What a run
+shows while it goes (progress, the Rerun recording) follows its events: the
+runner gives the simulator (and through it the servos and the procedures) a
+:class:`headsim.run.events.Hub` as event sink, and the hub passes every event
+on to the run's subscribers.  The runner adds its own events: each recorded
+measurement, the calibration block and the finished run.
 """
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, fields, replace
-from functools import partial
-from typing import Any, TextIO
+from typing import Any
 
 import numpy as np
 
+from headsim.active.events import PhaseStarted
 from headsim.active.procedures import (
     CalibrationError,
     CalibrationRun,
@@ -42,8 +35,9 @@ from headsim.active.procedures import (
     track_moving_target,
 )
 from headsim.active.search import Failure
-from headsim.active.servo import Detector, EyeServo, NeckServo, NeckServoResult, ServoConfig
+from headsim.active.servo import EyeServo, NeckServo, ServoConfig
 from headsim.estimators.result import Status
+from headsim.run.events import CalibrationDone, Hub, MeasurementRecorded, RunFinished, Subscriber
 from headsim.run.outcomes import (
     CalibrationLayout,
     CalibrationReport,
@@ -67,20 +61,19 @@ from headsim.run.outcomes import (
     VerticalReference,
 )
 from headsim.run.serialise import calibration_from_block
+from headsim.run.targets import marker_target
 from headsim.scenario.calibration_design import near_far_depths, near_fraction
 from headsim.scenario.schema import (
     CHESSBOARD_PATTERN,
     CHESSBOARD_SQUARE_M,
-    MARKER_BODIES,
     STREAM_CALIBRATION,
     STREAM_DEPTH_NOISE,
     Scenario,
 )
 from headsim.sim import names
-from headsim.sim.render import Window
 from headsim.sim.settings import PAPER_INITIAL_DIRECTIONS
-from headsim.sim.simulator import CameraId, HeadSim
-from headsim.vision.detect import find_cross_point, find_marker
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import find_cross_point
 
 #: Where unused bodies are parked: under the table, out of every camera's view (W, m).
 PARKED_WORLD_M = (0.0, 0.5, -1.0)
@@ -95,298 +88,6 @@ PAPER: dict[str, Any] = {
 }
 
 
-class Observer:
-    """What a run reports as it goes; every method is a no-op here.
-
-    ``frame`` numbers the images rendered over the whole run, from 0; ``step``
-    numbers the fixations (calibration samples first, then measurements), from 0.
-    """
-
-    def phase(
-        self, name: str, sim: HeadSim, knowledge: HeadKnowledge, truth: dict[str, np.ndarray]
-    ) -> None:
-        """A phase ("calibration", "measurement") starts in ``sim``; ``truth``: label -> W, m."""
-
-    def step(self, step: int, label: str) -> None:
-        """Fixation ``step`` begins (target ``label``)."""
-
-    def rendered(self, sim: HeadSim, camera: int, image: np.ndarray, frame: int) -> None:
-        """Camera 1 or 2 rendered ``image`` (the experiment's own image)."""
-
-    def detected(
-        self, sim: HeadSim, camera: int, uv: tuple[float, float] | None, status: str, frame: int
-    ) -> None:
-        """The target was looked for in ``frame`` (camera ``camera``): where, or why not."""
-
-    def measured(self, record: MeasurementRecord) -> None:
-        """A measurement is finished."""
-
-    def calibrated(self, calibration: CalibrationReport) -> None:
-        """The calibration is finished."""
-
-    def pursued(self, record: Any, frame: int) -> None:
-        """A live frame of the pursuit procedure (``headsim.live.gaze.FrameRecord``) is measured."""
-
-    def finished(self, result: RunResult) -> None:
-        """The run is over."""
-
-
-class Hub:
-    """Numbers frames and steps and passes every event on to the observers."""
-
-    def __init__(self, observers: Sequence[Observer] = ()) -> None:
-        self.observers = list(observers)
-        self.frame = 0
-        self.step = -1
-        self.steps: list[int] = []  # steps begun in the current phase, in order
-        self.camera = 0
-        self.offset_px = (0, 0)
-        self.rendered_frames = 0.0
-        self.windows = 0
-        self.window_misses = 0
-        self.previews = 0
-        self._watched: tuple[str, str] | None = None
-        self._detector: Detector | None = None
-        self._auto_label: Callable[[], str] | None = None
-
-    def phase(
-        self, name: str, sim: HeadSim, knowledge: HeadKnowledge, truth: dict[str, np.ndarray]
-    ) -> None:
-        self.steps = []
-        self._watched, self._detector, self._auto_label = None, None, None
-        for o in self.observers:
-            o.phase(name, sim, knowledge, truth)
-
-    def begin(self, label: str) -> int:
-        """A new fixation begins; returns its step."""
-        self.step += 1
-        self.steps.append(self.step)
-        for o in self.observers:
-            o.step(self.step, label)
-        return self.step
-
-    def watch(self, body: str, label: str) -> None:
-        """Begin a step each time ``body`` is moved (a procedure placing its target)."""
-        self._watched = (body, label)
-
-    def step_per_target(self, label: Callable[[], str]) -> None:
-        """Begin a step each time the servo is handed a new target's detector."""
-        self._auto_label = label
-
-    def placed(self, body: str) -> None:
-        if self._watched is not None and body == self._watched[0]:
-            self.begin(f"{self._watched[1]} {len(self.steps) + 1}")
-
-    def rendered(
-        self,
-        sim: HeadSim,
-        camera: int,
-        image: np.ndarray,
-        offset_px: tuple[int, int] = (0, 0),
-    ) -> None:
-        """An image was rendered; ``offset_px``: where the detector's image (a window) starts."""
-        self.camera = camera
-        self.offset_px = offset_px
-        for o in self.observers:
-            o.rendered(sim, camera, image, self.frame)
-        self.frame += 1
-
-    def detector(self, sim: HeadSim, detector: Detector) -> Detector:
-        """``detector``, reporting each detection (made in the image rendered last)."""
-        if self._auto_label is not None and detector is not self._detector:
-            self._detector = detector
-            self.begin(self._auto_label())
-
-        def observed(image: np.ndarray) -> Any:
-            detection = detector(image)
-            uv = detection.uv if detection.found else None
-            if uv is not None:  # in the full frame's pixels
-                uv = (uv[0] + self.offset_px[0], uv[1] + self.offset_px[1])
-            for o in self.observers:
-                o.detected(sim, self.camera, uv, detection.status.value, self.frame - 1)
-            return detection
-
-        return observed
-
-    def measured(self, record: MeasurementRecord) -> None:
-        for o in self.observers:
-            o.measured(record)
-
-    def calibrated(self, calibration: CalibrationReport) -> None:
-        for o in self.observers:
-            o.calibrated(calibration)
-
-    def pursued(self, record: Any) -> None:
-        for o in self.observers:
-            o.pursued(record, self.frame - 1)
-
-    def finished(self, result: RunResult) -> None:
-        for o in self.observers:
-            o.finished(result)
-
-
-class ObservedSim(HeadSim):
-    """A :class:`HeadSim` that reports its renders and body moves to a :class:`Hub`."""
-
-    def __init__(self, hub: Hub, scene: str, scenario: Scenario) -> None:
-        super().__init__(scene, scenario.settings, settle_mode=scenario.settle_mode)
-        self.hub = hub
-        #: Each camera's last whole image, the backdrop of the windows that follow it.
-        self._last_full: dict[int, np.ndarray] = {}
-
-    def render(self, camera: CameraId) -> np.ndarray:
-        before = self.rendered_frames
-        image = super().render(camera)
-        self.hub.rendered_frames += self.rendered_frames - before
-        self._last_full[self.camera_index(camera)] = image
-        self.hub.rendered(self, self.camera_index(camera) + 1, image)
-        return image
-
-    def retake(self, camera: CameraId) -> np.ndarray:
-        before = self.rendered_frames
-        image = super().retake(camera)
-        self.hub.rendered_frames += self.rendered_frames - before
-        self._last_full[self.camera_index(camera)] = image
-        self.hub.rendered(self, self.camera_index(camera) + 1, image)
-        return image
-
-    def render_preview(self, camera: CameraId, binning: int) -> np.ndarray:
-        """A binned preview: counted (pixels, previews), not shown to observers."""
-        before = self.rendered_frames
-        image = super().render_preview(camera, binning)
-        self.hub.rendered_frames += self.rendered_frames - before
-        self.hub.previews += 1
-        return image
-
-    def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
-        """The window; observers see it in a full-size frame: around it the camera's last
-        whole image at half brightness (not rendered now), or black before there is one."""
-        before = self.rendered_frames
-        image = super().render_window(camera, window)
-        self.hub.rendered_frames += self.rendered_frames - before
-        self.hub.windows += 1
-        if not self.hub.observers:  # nobody looks at the frame: only count the render
-            self.hub.rendered(self, self.camera_index(camera) + 1, image, (window.x0, window.y0))
-            return image
-        settings = self.camera_settings(camera)
-        last = self._last_full.get(self.camera_index(camera))
-        if last is not None and last.shape == (settings.height, settings.width, 3):
-            frame = last // 2
-        else:
-            frame = np.zeros((settings.height, settings.width, 3), dtype=np.uint8)
-        frame[window.y0 : window.y1, window.x0 : window.x1] = image
-        self.hub.rendered(self, self.camera_index(camera) + 1, frame, (window.x0, window.y0))
-        return image
-
-    def set_body_pose(
-        self, name: str, position_world_m: np.ndarray, quat_world: np.ndarray | None = None
-    ) -> None:
-        super().set_body_pose(name, position_world_m, quat_world)
-        self.hub.placed(name)
-
-
-class ObservedEyeServo(EyeServo):
-    """An :class:`EyeServo` whose detections are reported to the sim's hub.
-
-    Every image the eye servo looks at goes through :meth:`EyeServo.observe`
-    (also inside :meth:`EyeServo.run`), so wrapping it there catches them all.
-    """
-
-    sim: ObservedSim
-
-    def observe(self, camera: int, detector: Detector, key: object = None) -> Any:
-        key = detector if key is None else key
-        misses = self.window_misses
-        detection = super().observe(camera, self.sim.hub.detector(self.sim, detector), key)
-        self.sim.hub.window_misses += self.window_misses - misses
-        return detection
-
-
-class ObservedNeckServo(NeckServo):
-    """A :class:`NeckServo` whose detections are reported to the sim's hub."""
-
-    sim: ObservedSim
-
-    def run(
-        self,
-        detector: Detector,
-        goals: tuple[float, float, float] | None = None,
-        key: object = None,
-    ) -> NeckServoResult:
-        key = detector if key is None else key
-        misses = self.window_misses
-        result = super().run(self.sim.hub.detector(self.sim, detector), goals, key)
-        self.sim.hub.window_misses += self.window_misses - misses
-        return result
-
-    def look_from(self, steps: tuple[int, int, int], detector: Detector) -> bool:
-        return super().look_from(steps, self.sim.hub.detector(self.sim, detector))
-
-
-class Progress(Observer):
-    """A one-line text progress bar: fixations done of ``total``, rate, time left.
-
-    Drawn on ``stream`` (stderr by the CLI, which keeps stdout for the
-    summary) at most every ``interval_s``, and once more at the end.
-    """
-
-    def __init__(
-        self,
-        total: int,
-        stream: TextIO,
-        *,
-        width: int = 24,
-        interval_s: float = 0.25,
-        clock: Callable[[], float] = time.monotonic,
-    ) -> None:
-        self.total = max(int(total), 1)
-        self.stream = stream
-        self.width = width
-        self.interval_s = interval_s
-        self.clock = clock
-        self.start = clock()
-        self.done = 0
-        self.label = ""
-        self._drawn_at = -math.inf
-        self._length = 0
-
-    def line(self) -> str:
-        """The bar as it stands, e.g. ``[######------] 12/48 fixations  3.1/s  0:11 left  corner_3_1``."""
-        done = min(self.done, self.total)
-        filled = round(self.width * done / self.total)
-        elapsed = max(self.clock() - self.start, 1e-9)
-        rate = done / elapsed
-        if done >= self.total:
-            left = f"{elapsed:.1f} s"
-        elif rate > 0:
-            seconds = round((self.total - done) / rate)
-            left = f"{seconds // 60}:{seconds % 60:02d} left"
-        else:
-            left = "-:-- left"
-        bar = "#" * filled + "-" * (self.width - filled)
-        return f"[{bar}] {done}/{self.total} fixations  {rate:.1f}/s  {left}  {self.label}".rstrip()
-
-    def _draw(self, force: bool = False) -> None:
-        now = self.clock()
-        if not force and now - self._drawn_at < self.interval_s:
-            return
-        self._drawn_at = now
-        text = self.line()
-        self.stream.write("\r" + text.ljust(self._length))
-        self.stream.flush()
-        self._length = len(text)
-
-    def step(self, step: int, label: str) -> None:
-        self.done, self.label = step, label
-        self._draw()
-
-    def finished(self, result: RunResult) -> None:
-        self.done, self.label = self.total, ""
-        self._draw(force=True)
-        self.stream.write("\n")
-        self.stream.flush()
-
-
 # -- phases ----------------------------------------------------------------------
 
 
@@ -399,11 +100,10 @@ def _model2_config(scenario: Scenario) -> Model2Config:
     return Model2Config(interpolate=e.interpolate, midline_px=e.midline_px, remedy_px=e.remedy_px)
 
 
-def marker_target(name: str, body: str) -> Target:
-    """A marker body of the default scene, found by its colour, named ``name``."""
-    return Target(
-        name, partial(find_marker, colour=MARKER_BODIES[body]), lambda sim: sim.position(body)
-    )
+def _simulator(hub: Hub, scene: str, scenario: Scenario) -> HeadSim:
+    """The scenario's simulator in ``scene``, reporting to ``hub`` (so do its servos and
+    the procedures working with it)."""
+    return HeadSim(scene, scenario.settings, settle_mode=scenario.settle_mode, sink=hub)
 
 
 def _told(scenario: Scenario) -> HeadKnowledge:
@@ -417,7 +117,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cal
     spec = scenario.experiment.calibration
     assert spec is not None
     seed = scenario.seed
-    with ObservedSim(hub, "default", scenario) as sim:
+    with _simulator(hub, "default", scenario) as sim:
         try:
             positions = calibration_layout(
                 sim,
@@ -439,11 +139,10 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cal
                 renders=0,
                 positions=(),
             )
-            hub.calibrated(report)
+            hub.emit(CalibrationDone(report))
             return None, report
         truth = {f"calibration {k + 1}": p for k, p in enumerate(positions)}
-        hub.phase("calibration", sim, HeadKnowledge(), truth)
-        hub.watch(names.CALIBRATION_BALL, "calibration")
+        hub.emit(PhaseStarted("calibration", sim, HeadKnowledge(), truth))
         ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
         truth_alpha_e = [sim.effective_initial_direction(c) for c in (1, 2)]
         truth_v0 = [sim.camera_settings(c).principal[1] for c in (1, 2)]
@@ -475,11 +174,11 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cal
             alpha_e_paper_rad=list(PAPER["alpha_e_rad"]),
         )
         start = sim.render_count
-        previews = hub.previews  # counted apart: images taken are what observers see
+        previews = hub.previews  # counted apart: images taken are what subscribers see
         try:
             run = calibrate_head(
                 sim,
-                ObservedEyeServo(sim, _servo_config(scenario)),
+                EyeServo(sim, _servo_config(scenario)),
                 ball,
                 names.CALIBRATION_BALL,
                 positions,
@@ -500,7 +199,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cal
                 fixated=sum(o is None for o in outcomes),
                 positions=position_outcomes(outcomes),
             )
-            hub.calibrated(report)
+            hub.emit(CalibrationDone(report))
             return None, report
     fit, knowledge = run.fit, run.knowledge
     report = replace(
@@ -533,7 +232,7 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cal
             los_offset_m=None if knowledge.los_offset_m is None else list(knowledge.los_offset_m),
         ),
     )
-    hub.calibrated(report)
+    hub.emit(CalibrationDone(report))
     return run, report
 
 
@@ -566,7 +265,7 @@ def _record(
     hub: Hub, m: Measurement, knowledge: str, step: int, time_s: float | None = None
 ) -> MeasurementRecord:
     record = MeasurementRecord(m, knowledge, step, time_s)
-    hub.measured(record)
+    hub.emit(MeasurementRecorded(record))
     return record
 
 
@@ -577,17 +276,12 @@ def _run_points(
     procedure = scenario.experiment.procedure
     targets = scenario.scene.targets
     records = []
-    with ObservedSim(hub, "default", scenario) as sim:
-        hub.phase(
-            "measurement", sim, knowledge, {t.name: np.array(t.position_world_m) for t in targets}
-        )
+    with _simulator(hub, "default", scenario) as sim:
+        truth = {t.name: np.array(t.position_world_m) for t in targets}
+        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         config = _servo_config(scenario)
         servo: EyeServo | NeckServo
-        servo = (
-            ObservedNeckServo(sim, config)
-            if procedure == "model1"
-            else ObservedEyeServo(sim, config)
-        )
+        servo = NeckServo(sim, config) if procedure == "model1" else EyeServo(sim, config)
         passes = (
             [(_told(scenario), "none"), (knowledge, label)]
             if procedure == "calibration"
@@ -641,7 +335,7 @@ def _run_chessboard(
         if scene.corners is not None
         else list(range(columns * CHESSBOARD_PATTERN[1]))
     )
-    with ObservedSim(hub, "chessboard", scenario) as sim:
+    with _simulator(hub, "chessboard", scenario) as sim:
         sim.set_body_pose(names.CHESSBOARD, np.array(scene.chessboard.position_world_m))
         body = sim.data.body(names.CHESSBOARD)
         rotation = body.xmat.reshape(3, 3)
@@ -653,12 +347,10 @@ def _run_chessboard(
             )
             for k in indices
         }
-        hub.phase("measurement", sim, knowledge, truth)
-        labels = iter(truth)
-        hub.step_per_target(lambda: next(labels, "corner"))
+        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         run = measure_chessboard(
             sim,
-            ObservedEyeServo(sim, _servo_config(scenario)),
+            EyeServo(sim, _servo_config(scenario)),
             knowledge,
             _model2_config(scenario),
             CHESSBOARD_PATTERN,
@@ -701,18 +393,18 @@ def _run_relative(
     scene = scenario.scene
     assert scene.blocks is not None
     colours = {o.body: names.RELATIVE_OBJECT_COLOURS[o.body] for o in scene.objects}
-    with ObservedSim(hub, "blocks", scenario) as sim:
+    with _simulator(hub, "blocks", scenario) as sim:
         for placement in (scene.blocks, *scene.objects):
             sim.set_body_pose(placement.body, np.array(placement.position_world_m))
         for body in scene.parked:
             sim.set_body_pose(body, np.array(PARKED_WORLD_M))
         truth = {p.name: np.array(p.position_world_m) for p in (scene.blocks, *scene.objects)}
-        hub.phase("measurement", sim, knowledge, truth)
-        step = hub.begin(names.BLOCKS)
+        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         reference = Target(names.BLOCKS, find_cross_point, lambda s: s.position(names.BLOCKS))
         run = relative_positioning(
-            sim, ObservedEyeServo(sim, _servo_config(scenario)), reference, colours, knowledge
-        )
+            sim, EyeServo(sim, _servo_config(scenario)), reference, colours, knowledge
+        )  # the reference's fixation is the phase's one step
+        (step,) = hub.steps
         positions_head = {o.body: sim.position(o.body, "head") for o in scene.objects}
     records = [_record(hub, run.reference, label, step)]
     resolution = scenario.settings.encoder_resolution_rad
@@ -769,14 +461,13 @@ def _run_tracking(
     moving = scenario.scene.moving
     assert moving is not None
     times = moving.times_s
-    with ObservedSim(hub, "default", scenario) as sim:
+    with _simulator(hub, "default", scenario) as sim:
         truth = {f"{moving.name} {k + 1}": moving.position(float(t)) for k, t in enumerate(times)}
-        hub.phase("measurement", sim, knowledge, truth)
-        hub.watch(moving.body, moving.name)
+        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         target = marker_target(moving.name, moving.body)
         run = track_moving_target(
             sim,
-            ObservedNeckServo(sim, _servo_config(scenario)),
+            NeckServo(sim, _servo_config(scenario)),
             target,
             moving.body,
             moving.position,
@@ -834,7 +525,9 @@ RUNNERS: dict[
 }
 
 
-def calibrate_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> CalibrationReport:
+def calibrate_scenario(
+    scenario: Scenario, subscribers: Sequence[Subscriber] = ()
+) -> CalibrationReport:
     """Only the scenario's Sec. V calibration (``headsim calibrate``): its report.
 
     ``status`` is OK or why it failed; ``rendered_frames`` the pixels it
@@ -843,14 +536,14 @@ def calibrate_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -
     spec = scenario.experiment.calibration
     if spec is None or spec.source is not None:
         raise ValueError("the scenario has no calibration to run ([experiment.calibration])")
-    hub = Hub(observers)
+    hub = Hub(subscribers)
     _, report = _calibrate(scenario, hub)
     return replace(report, rendered_frames=hub.rendered_frames)
 
 
-def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunResult:
-    """Run a checked scenario; the observers see every image, detection and result."""
-    hub = Hub(observers)
+def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> RunResult:
+    """Run a checked scenario; the subscribers see every image, detection and result."""
+    hub = Hub(subscribers)
     timing: dict[str, float] = {}
     renders = {"calibration": 0, "experiment": 0, "recording": 0}
     rendered_frames = {"calibration": 0.0, "experiment": 0.0}
@@ -873,7 +566,7 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
                 renders=stored.block.get("renders"),
             ),
         )
-        hub.calibrated(calibration)
+        hub.emit(CalibrationDone(calibration))
         knowledge, label = stored.knowledge, "calibrated"
     elif spec is not None:
         start = time.perf_counter()
@@ -889,12 +582,12 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
     experiment: Experiment | None = None
     if not failures:
         start = time.perf_counter()
-        frames = hub.frame
+        frames = hub.images
         records, experiment = RUNNERS[scenario.experiment.procedure](
             scenario, hub, knowledge, label
         )
         timing["experiment"] = time.perf_counter() - start
-        renders["experiment"] = hub.frame - frames
+        renders["experiment"] = hub.images - frames
         rendered_frames["experiment"] = hub.rendered_frames - rendered_frames["calibration"]
     failures += [
         f"{r.measurement.name}: {r.measurement.status_text}"
@@ -921,19 +614,13 @@ def run_scenario(scenario: Scenario, observers: Sequence[Observer] = ()) -> RunR
         },
         windows={"rendered": hub.windows, "missed": hub.window_misses, "previews": hub.previews},
     )
-    hub.finished(result)
+    hub.emit(RunFinished(result))
     return result
 
 
 __all__ = [
     "PAPER",
     "Hub",
-    "ObservedEyeServo",
-    "ObservedNeckServo",
-    "ObservedSim",
-    "Observer",
-    "Progress",
     "calibrate_scenario",
-    "marker_target",
     "run_scenario",
 ]

@@ -28,6 +28,7 @@ import mujoco
 import numpy as np
 
 from headsim.sim import names
+from headsim.sim.events import NO_EVENTS, EventSink, ImageKind, ImageTaken
 from headsim.sim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
 from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
 from headsim.sim.render import EyeRenderer, Window, context_key
@@ -95,6 +96,7 @@ class HeadSim:
         settle_mode: str = "kinematic",
         settle_tolerance_rad: float = 1e-6,
         max_settle_steps: int = 5000,
+        sink: EventSink | None = None,
     ) -> None:
         if settle_mode not in ("kinematic", "physics"):
             raise SettingsError(
@@ -104,6 +106,9 @@ class HeadSim:
         self.settle_mode = settle_mode
         self.settle_tolerance_rad = settle_tolerance_rad
         self.max_settle_steps = max_settle_steps
+        #: Where this simulator reports every image it takes (and the servos and
+        #: procedures working with it report theirs, unless given another sink).
+        self.sink: EventSink = NO_EVENTS if sink is None else sink
         self.built: BuiltModel = build_model(scene, self.settings)
         self.model = self.built.model
         self.data = mujoco.MjData(self.model)
@@ -406,22 +411,45 @@ class HeadSim:
         return yaw if index == 0 else -yaw
 
     # -- images ------------------------------------------------------------
+    def _taken(
+        self,
+        index: int,
+        image: np.ndarray,
+        kind: ImageKind,
+        before: float,
+        window: Window | None = None,
+        binning: int = 1,
+    ) -> np.ndarray:
+        """Report ``image`` (camera ``index`` + 1, rendered since ``before`` frames) to the sink."""
+        self.sink.emit(
+            ImageTaken(index + 1, image, kind, self.rendered_frames - before, window, binning)
+        )
+        return image
+
     def render(self, camera: CameraId) -> np.ndarray:
         """The camera's current image, (H, W, 3) uint8, with its lens and noise."""
-        return self._renderer.render(self.data, self.camera_index(camera))
+        index, before = self.camera_index(camera), self.rendered_frames
+        image = self._renderer.render(self.data, index)
+        return self._taken(index, image, ImageKind.FULL, before)
 
     def retake(self, camera: CameraId) -> np.ndarray:
         """The whole image of the instant just taken as a window (same noise), counted."""
-        return self._renderer.render(self.data, self.camera_index(camera), retake=True)
+        index, before = self.camera_index(camera), self.rendered_frames
+        image = self._renderer.render(self.data, index, retake=True)
+        return self._taken(index, image, ImageKind.RETAKE, before)
 
     def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
         """Only ``window`` of the camera's image: the full image's crop, (h, w, 3) uint8."""
-        return self._renderer.render_window(self.data, self.camera_index(camera), window)
+        index, before = self.camera_index(camera), self.rendered_frames
+        image = self._renderer.render_window(self.data, index, window)
+        return self._taken(index, image, ImageKind.WINDOW, before, window)
 
     def render_preview(self, camera: CameraId, binning: int) -> np.ndarray:
         """The camera's whole view binned ``binning`` x ``binning`` (for finding where to
         look), (H/b, W/b, 3) uint8, counted as a render."""
-        return self._renderer.render_preview(self.data, self.camera_index(camera), binning)
+        index, before = self.camera_index(camera), self.rendered_frames
+        image = self._renderer.render_preview(self.data, index, binning)
+        return self._taken(index, image, ImageKind.PREVIEW, before, binning=binning)
 
     @property
     def render_count(self) -> int:

@@ -32,6 +32,7 @@ from headsim.active.procedures import (
 )
 from headsim.active.servo import EyeServo, ServoConfig
 from headsim.estimators.throughput import run as estimator_throughput
+from headsim.run.progress import Status
 from headsim.run.results import write_json_atomic
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, paper_head, preset
@@ -426,23 +427,13 @@ def environment() -> dict[str, str]:
 def main(args: Any) -> int:
     """``headsim bench``: run the suite, compare, print, maybe update the baseline."""
 
-    terminal = sys.stderr.isatty()
     quiet = getattr(args, "quiet", False)
     start = time.perf_counter()
-
-    def progress(message: str) -> None:
-        if quiet:
-            return
-        if terminal:
-            print(f"\r  bench: {message:60s}", end="", file=sys.stderr, flush=True)
-        else:  # a log: one plain line per phase, no carriage returns
-            elapsed = time.perf_counter() - start
-            print(f"headsim bench: [{elapsed:6.1f} s] {message}", file=sys.stderr, flush=True)
-
-    metrics = suite(seed=args.seed, progress=progress)
+    status = None if quiet else Status("headsim bench", transient=True)
+    metrics = suite(seed=args.seed, progress=_quiet if status is None else status)
     wall = time.perf_counter() - start
-    if terminal and not quiet:
-        print("\r" + " " * 72 + "\r", end="", file=sys.stderr)
+    if status is not None:
+        status.close()
     baseline_path = Path(args.baseline)
     stored = load_json(baseline_path)
     verdicts = compare(metrics, stored.get("metrics", {}), load_json(Path(args.tolerances)))

@@ -48,6 +48,7 @@ from pathlib import Path
 from typing import Any
 
 from headsim.errors import BadInput, OutputNotWritable
+from headsim.run.progress import Status, quiet
 from headsim.run.results import to_jsonable, write_json_atomic, write_text_atomic
 
 #: The scenarios run with the one calibration, and what each reproduces.
@@ -1162,10 +1163,7 @@ def _why(err: BaseException) -> str:
 
 def main(args: Any) -> int:
     """``headsim reproduce``: exit 0 all ran, 1 an experiment failed, 2 bad input, 130 interrupted."""
-
-    def progress(message: str) -> None:
-        print(f"  reproduce: {message}", file=sys.stderr, flush=True)
-
+    progress = quiet if getattr(args, "quiet", False) else Status("headsim reproduce")
     try:
         state = reproduce(
             args.out,

@@ -53,7 +53,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import sys
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field, replace
@@ -80,6 +79,7 @@ from headsim.active.procedures import (
 )
 from headsim.active.servo import EyeServo
 from headsim.errors import BadInput, JobFailed
+from headsim.run.progress import Status
 from headsim.run.results import to_jsonable, write_csv_atomic, write_json_atomic
 from headsim.sim import names
 from headsim.sim.optics import centre_ray_yaw
@@ -130,16 +130,6 @@ Progress = Callable[[str], None]
 
 def quiet(_: str) -> None:
     """A progress callback that says nothing."""
-
-
-class StderrProgress:
-    """Progress lines on stderr, each with the seconds since it was made."""
-
-    def __init__(self) -> None:
-        self.start = time.perf_counter()
-
-    def __call__(self, message: str) -> None:
-        print(f"[{time.perf_counter() - self.start:7.1f} s] {message}", file=sys.stderr, flush=True)
 
 
 # -- configuration ---------------------------------------------------------------
@@ -1188,7 +1178,7 @@ def run(args: argparse.Namespace) -> int:
         raise BadInput(f"--workers must be >= 1, got {args.workers}")
     make = StudyConfig.quick if args.fast else StudyConfig
     config = make(preset=args.preset, seed=args.seed)
-    progress: Progress = quiet if getattr(args, "quiet", False) else StderrProgress()
+    progress: Progress = quiet if getattr(args, "quiet", False) else Status("headsim study")
     cache = CalibrationCache(config, progress)
     if args.experiment == "budget":
         return _budget(args, progress)

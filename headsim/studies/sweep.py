@@ -34,7 +34,6 @@ import json
 import math
 import multiprocessing
 import os
-import sys
 import time
 import tomllib
 import traceback
@@ -46,6 +45,7 @@ from typing import Any
 import numpy as np
 
 from headsim.errors import BadInput
+from headsim.run.progress import Counter
 from headsim.run.results import write_bytes_atomic, write_csv_atomic, write_json_atomic
 
 #: Fault injection for tests: job indices (comma-separated) whose process dies.
@@ -324,45 +324,6 @@ def _append(path: Path, record: dict[str, Any]) -> None:
         os.fsync(handle.fileno())
 
 
-class _Progress:
-    def __init__(self, total: int, enabled: bool) -> None:
-        self.total, self.enabled = total, enabled
-        self.done = 0
-        self.start = time.perf_counter()
-
-    def step(self, failed: bool) -> None:
-        self.done += 1
-        if not self.enabled:
-            return
-        elapsed = time.perf_counter() - self.start
-        rate = self.done / elapsed if elapsed > 0 else 0.0
-        eta = (self.total - self.done) / rate if rate > 0 else math.inf
-        if not sys.stderr.isatty():  # a log: one plain line per job, no carriage returns
-            left = f"about {eta:.0f} s left" if math.isfinite(eta) else "time left unknown"
-            print(
-                f"headsim sweep: {self.done}/{self.total} jobs done"
-                + (" (this one failed)" if failed else "")
-                + f", {60 * rate:.1f}/min, {left}",
-                file=sys.stderr,
-                flush=True,
-            )
-            return
-        width = 30
-        filled = round(width * self.done / max(self.total, 1))
-        bar = "#" * filled + "-" * (width - filled)
-        print(
-            f"\r[{bar}] {self.done}/{self.total} jobs, {60 * rate:.1f}/min, ETA {eta:4.0f} s"
-            + (" (a job failed)" if failed else ""),
-            end="",
-            file=sys.stderr,
-            flush=True,
-        )
-
-    def close(self) -> None:
-        if self.enabled and self.total and sys.stderr.isatty():
-            print(file=sys.stderr)
-
-
 def _execute(
     jobs: list[Any],
     make_executor: Callable[[], cf.Executor],
@@ -456,14 +417,26 @@ def run_sweep(
     log = out / "jobs.jsonl"
     done = read_log(log)
     remaining = [job for job in spec.jobs if job.id not in done]
-    bar = _Progress(len(remaining), progress)
+    bar = (
+        Counter(
+            len(remaining),
+            unit="jobs",
+            name="headsim sweep",
+            interval_s=0.0,
+            per_minute=True,
+            notes_in_lines=True,
+        )
+        if progress and remaining
+        else None
+    )
     start = time.perf_counter()
     job_function = functools.partial(run_job, recording=recording) if recording else run_job
 
     def on_record(record: dict[str, Any]) -> None:
         _append(log, record)
         done[record["id"]] = record
-        bar.step(record.get("status") != "ok")
+        if bar is not None:
+            bar.update(note="" if record.get("status") == "ok" else "(this one failed)")
 
     if scheduler is not None:
         client = _dask_client(scheduler)
@@ -489,7 +462,8 @@ def run_sweep(
             markers,
             job_function,
         )
-    bar.close()
+    if bar is not None:
+        bar.close()
     wall = time.perf_counter() - start
     outcome = SweepOutcome(
         records={job.id: done[job.id] for job in spec.jobs if job.id in done},

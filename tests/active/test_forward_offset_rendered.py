@@ -19,7 +19,7 @@ import pytest
 from headsim.active.procedures import HeadKnowledge, measure_model2
 from headsim.active.servo import EyeServo
 from headsim.geometry.kinematics import head_to_world
-from headsim.run.runner import marker_target
+from headsim.run.targets import marker_target
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
 from headsim.studies.error_budget import first_order_offsets
