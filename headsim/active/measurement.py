@@ -18,6 +18,7 @@ import numpy as np
 from headsim.active.failure import Failure, FailureCause
 from headsim.active.servo_types import Detector
 from headsim.estimators import PositionEstimate
+from headsim.estimators.result import Method, Status
 from headsim.geometry.kinematics import head_to_world
 from headsim.sim.settings import HeadBelief
 from headsim.sim.simulator import HeadSim
@@ -86,7 +87,8 @@ def body_target(name: str, detector: Detector) -> Target:
 class Measurement:
     """One measured point: estimate and truth in H and W, m; covariance in H, m^2.
 
-    ``status``: "ok", or why it failed (``failure.message``).
+    ``status``: :attr:`Status.OK` or :attr:`Status.FAILED`; ``detail``: why it
+    failed (``failure.message``), "" when ok; ``status_text``: results.json's "status".
     ``renders``: images this measurement took, ``search_renders`` of them
     spent finding a lost target again.  ``servo_residual_px``: the final
     |u - u_i0| of each servo.  ``details``: angles and pixels used.
@@ -94,8 +96,8 @@ class Measurement:
     """
 
     name: str
-    method: str
-    status: str
+    method: Method
+    status: Status
     estimate_head_m: np.ndarray
     truth_head_m: np.ndarray
     estimate_world_m: np.ndarray
@@ -106,10 +108,16 @@ class Measurement:
     details: dict[str, float] = field(default_factory=dict)
     failure: Failure | None = None
     search_renders: int = 0
+    detail: str = ""
 
     @property
     def ok(self) -> bool:
-        return self.status == "ok"
+        return self.status is Status.OK
+
+    @property
+    def status_text(self) -> str:
+        """ "ok", or why it failed."""
+        return "ok" if self.ok else self.detail
 
     @property
     def error_head_m(self) -> np.ndarray:
@@ -143,8 +151,9 @@ def failed_measurement(
     truth_world = target.truth_world(sim)
     return Measurement(
         name=target.name,
-        method=method,
-        status=failure.message,
+        method=Method(method),
+        status=Status.FAILED,
+        detail=failure.message,
         failure=failure,
         search_renders=search_renders,
         estimate_head_m=_nan3(),
@@ -179,8 +188,8 @@ def estimated_measurement(
     covariance = estimate.covariance
     return Measurement(
         name=target.name,
-        method=method,
-        status="ok",
+        method=Method(method),
+        status=Status.OK,
         estimate_head_m=estimate_head,
         truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
         estimate_world_m=to_world(sim, estimate_head, neck_rad, belief),

@@ -9,20 +9,20 @@ rendered for the subscribers: they see the experiment's own images.
 
 The runner adds three events of its own: :class:`MeasurementRecorded` (a
 measurement with what the head knew and its step), :class:`CalibrationDone`
-(the results.json ``calibration`` block) and :class:`RunFinished`.
+(the calibration's report) and :class:`RunFinished`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from headsim.active.events import FixationStarted, PhaseStarted
 from headsim.sim.events import ImageKind, ImageTaken
 
 if TYPE_CHECKING:
-    from headsim.run.runner import MeasurementRecord, RunResult
+    from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RunResult
 
 
 @dataclass(frozen=True)
@@ -44,9 +44,9 @@ class MeasurementRecorded:
 
 @dataclass(frozen=True)
 class CalibrationDone:
-    """The calibration is finished, or failed: the results.json ``calibration`` block."""
+    """The calibration is finished, or failed: its report."""
 
-    block: dict[str, Any]
+    report: CalibrationReport
 
 
 @dataclass(frozen=True)

@@ -56,9 +56,9 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.geometry.kinematics import head_to_world
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
+from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RelativeResult, RunResult
 from headsim.run.report import summary_text
 from headsim.run.rerun_cli import RecordingTarget
-from headsim.run.runner import MeasurementRecord, RunResult
 from headsim.scenario.schema import Scenario
 from headsim.sim import names
 from headsim.sim.events import ImageKind, ImageTaken
@@ -430,7 +430,7 @@ class Recorder:
         elif isinstance(event, PursuitFrame):
             self.pursued(event.record, at.frame)
         elif isinstance(event, CalibrationDone):
-            self.calibrated(event.block)
+            self.calibrated(event.report)
         elif isinstance(event, RunFinished):
             self.finished(event.result)
 
@@ -596,7 +596,7 @@ class Recorder:
         if residuals:
             self.rec.log("/measurements/servo_residual_px", rr.Scalars([max(residuals)]))
         self._rows.append(
-            f"| {record.step} | {label} | {m.status} | {error * 1000.0:.2f} | "
+            f"| {record.step} | {label} | {m.status_text} | {error * 1000.0:.2f} | "
             f"{m.error_pct_of_depth:.3f} | {m.renders} | "
             f"{max(residuals) if residuals else float('nan'):.2f} |"
         )
@@ -661,7 +661,7 @@ class Recorder:
             depth = float(np.linalg.norm(truth - self.world_from_head_start[:3, 3]))
             self.rec.log("/measurements/error_pct_of_depth", rr.Scalars([100.0 * error / depth]))
 
-    def calibrated(self, calibration: dict[str, Any]) -> None:
+    def calibrated(self, calibration: CalibrationReport) -> None:
         self._time()
         self.rec.log(
             "/results/calibration",
@@ -671,10 +671,7 @@ class Recorder:
 
     def finished(self, result: RunResult) -> None:
         self._time()
-        if (
-            result.experiment.get("procedure") == "relative_positioning"
-            and "objects" in result.experiment
-        ):
+        if isinstance(result.experiment, RelativeResult):
             self._log_areas(result.experiment)
         text = summary_text(result)
         self.rec.log(
@@ -682,13 +679,13 @@ class Recorder:
             rr.TextDocument(f"```\n{text}\n```", media_type=rr.MediaType.MARKDOWN),
         )
 
-    def _log_areas(self, e: dict[str, Any]) -> None:
+    def _log_areas(self, e: RelativeResult) -> None:
         """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
         baseline = self.scenario.settings.baseline_m
         s = self.scenario.settings
         strips, labels = [], []
         far = 2.0
-        for step_index, alpha in enumerate((e["alpha1_rad"], e["alpha2_rad"])):
+        for step_index, alpha in enumerate((e.alpha1_rad, e.alpha2_rad)):
             if not math.isfinite(alpha):
                 return
             for camera in (1, 2):
@@ -703,15 +700,15 @@ class Recorder:
         self.rec.log(
             "/world/areas/lines", rr.LineStrips3D(strips, colors=[_ORANGE] * 4, labels=labels)
         )
-        objects = e["objects"]
-        positions = [self.truth[o["name"]] for o in objects if o["name"] in self.truth]
+        objects = e.objects
+        positions = [self.truth[o.name] for o in objects if o.name in self.truth]
         self.rec.log(
             "/world/areas/objects",
             rr.Points3D(
                 positions,
                 radii=0.008,
-                colors=[_GREEN if o["agree"] else _RED for o in objects],
-                labels=[f"{o['name']}: S{o['area']} (true S{o['true_area']})" for o in objects],
+                colors=[_GREEN if o.agree else _RED for o in objects],
+                labels=[f"{o.name}: S{o.area} (true S{o.true_area})" for o in objects],
             ),
         )
 
@@ -729,24 +726,29 @@ class Recorder:
         self.close()
 
 
-def _calibration_markdown(block: dict[str, Any]) -> str:
-    if block.get("status") != "ok":
-        return f"# Calibration\n\n{block.get('status')}\n"
+def _calibration_markdown(report: CalibrationReport) -> str:
+    if not report.ok:
+        return f"# Calibration\n\n{report.status_text}\n"
+    alpha_e, truth_e, paper_e = (
+        report.alpha_e_rad,
+        report.alpha_e_truth_rad,
+        report.alpha_e_paper_rad,
+    )
+    assert alpha_e is not None and truth_e is not None and paper_e is not None
     rows = "\n".join(
-        f"| alpha_e{k + 1} | {block['alpha_e_rad'][k]:.5f} | {block['alpha_e_truth_rad'][k]:.5f} | "
-        f"{block['alpha_e_paper_rad'][k]:.4f} |"
+        f"| alpha_e{k + 1} | {alpha_e[k]:.5f} | {truth_e[k]:.5f} | {paper_e[k]:.4f} |"
         for k in range(2)
     )
     text = (
         "# Calibration of the initial directions (Sec. V)\n\n"
-        f"{block['fixated']} of {block['targets']} positions fixated, {block['renders']} renders\n\n"
+        f"{report.fixated} of {report.targets} positions fixated, {report.renders} renders\n\n"
         "| rad | ours | truth | paper |\n|---|---|---|---|\n" + rows + "\n"
     )
-    vertical = block.get("vertical_reference")
+    vertical = report.vertical_reference
     if vertical:
         text += "\n| extended | ours | truth |\n|---|---|---|\n" + "\n".join(
-            f"| v{k + 1}0 px | {vertical['v0_px'][k]:.2f} | {vertical['v0_truth_px'][k]:.2f} |\n"
-            f"| kx{k + 1}/ky{k + 1} | {vertical['kx_over_ky'][k]:.4f} | {vertical['kx_over_ky_truth'][k]:.4f} |"
+            f"| v{k + 1}0 px | {vertical.v0_px[k]:.2f} | {vertical.v0_truth_px[k]:.2f} |\n"
+            f"| kx{k + 1}/ky{k + 1} | {vertical.kx_over_ky[k]:.4f} | {vertical.kx_over_ky_truth[k]:.4f} |"
             for k in range(2)
         )
     return text

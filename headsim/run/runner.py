@@ -11,8 +11,8 @@ measurement, the calibration block and the finished run.
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, fields, replace
 from typing import Any
 
 import numpy as np
@@ -35,7 +35,31 @@ from headsim.active.placement import calibration_layout
 from headsim.active.relative import relative_positioning
 from headsim.active.servo_types import ServoConfig
 from headsim.active.tracking import track_moving_target
+from headsim.estimators.result import Status
 from headsim.run.events import CalibrationDone, Hub, MeasurementRecorded, RunFinished, Subscriber
+from headsim.run.outcomes import (
+    CalibrationLayout,
+    CalibrationReport,
+    CalibrationSource,
+    CheckTarget,
+    ChessboardPaper,
+    ChessboardResult,
+    Experiment,
+    KnowledgeReport,
+    LinesOfSightFit,
+    MeasurementRecord,
+    PointsResult,
+    PositionOutcome,
+    PursuitFigures,
+    PursuitResult,
+    RelativeObject,
+    RelativePaper,
+    RelativeResult,
+    RunResult,
+    TrackingResult,
+    VerticalReference,
+)
+from headsim.run.serialise import calibration_from_block
 from headsim.run.targets import marker_target
 from headsim.scenario.calibration_design import near_far_depths, near_fraction
 from headsim.scenario.schema import (
@@ -53,7 +77,7 @@ from headsim.vision.detect import find_cross_point
 #: Where unused bodies are parked: under the table, out of every camera's view (W, m).
 PARKED_WORLD_M = (0.0, 0.5, -1.0)
 #: What the paper reports for each experiment (Sec. VI).
-PAPER = {
+PAPER: dict[str, Any] = {
     "alpha_e_rad": PAPER_INITIAL_DIRECTIONS,
     "chessboard_side_mean_m": 0.0303,
     "chessboard_side_std_m": 0.000677,
@@ -61,42 +85,6 @@ PAPER = {
     "relative_alpha2_rad": 0.0349,
     "relative_objects": 6,
 }
-
-
-@dataclass(frozen=True)
-class MeasurementRecord:
-    """A measurement with what the head knew (``"none"``, ``"calibrated"``), its step and time."""
-
-    measurement: Measurement
-    knowledge: str
-    step: int
-    time_s: float | None = None
-
-
-@dataclass(frozen=True)
-class RunResult:
-    """Everything a run found.  ``failures``: why the run failed, one line each (empty: ok).
-
-    ``experiment``: the procedure's own results, JSON-ready.  ``renders``:
-    images taken by phase.  ``timing_s``: wall time by phase (not in results.json).
-    """
-
-    scenario: Scenario
-    calibration: dict[str, Any] | None
-    records: tuple[MeasurementRecord, ...]
-    experiment: dict[str, Any]
-    renders: dict[str, int]
-    failures: tuple[str, ...]
-    timing_s: dict[str, float] = field(default_factory=dict, compare=False)
-    #: Pixels rendered by phase, in full frames (a window counts its share), and
-    #: the servo's windows: rendered, missed (a full frame followed), and the binned
-    #: previews that placed a window where no detection did.
-    rendered_frames: dict[str, float] = field(default_factory=dict)
-    windows: dict[str, int] = field(default_factory=dict)
-
-    @property
-    def ok(self) -> bool:
-        return not self.failures
 
 
 # -- phases ----------------------------------------------------------------------
@@ -123,8 +111,8 @@ def _told(scenario: Scenario) -> HeadKnowledge:
     return HeadKnowledge() if goals is None else HeadKnowledge(u0=goals)
 
 
-def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dict[str, Any]]:
-    """Sec. V in the default scene; returns the run (None if it failed) and its JSON block."""
+def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, CalibrationReport]:
+    """Sec. V in the default scene; returns the run (None if it failed) and its report."""
     spec = scenario.experiment.calibration
     assert spec is not None
     seed = scenario.seed
@@ -142,49 +130,48 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
                 else None,
             )
         except ValueError as err:
-            block = {"status": f"failed: {err}", "targets": spec.targets, "fixated": 0}
-            block.update(renders=0, positions=[])
-            hub.emit(CalibrationDone(block))
-            return None, block
+            report = CalibrationReport(
+                status=Status.FAILED,
+                detail=f"failed: {err}",
+                targets=spec.targets,
+                fixated=0,
+                renders=0,
+                positions=(),
+            )
+            hub.emit(CalibrationDone(report))
+            return None, report
         truth = {f"calibration {k + 1}": p for k, p in enumerate(positions)}
         hub.emit(PhaseStarted("calibration", sim, HeadKnowledge(), truth))
         ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
         truth_alpha_e = [sim.effective_initial_direction(c) for c in (1, 2)]
         truth_v0 = [sim.camera_settings(c).principal[1] for c in (1, 2)]
         truth_ratio = [sim.camera_settings(c).kx / sim.camera_settings(c).ky for c in (1, 2)]
-        block: dict[str, Any] = {
-            "status": "ok",
-            "targets": spec.targets,
-            "fixated": 0,
-            "renders": 0,
-            "layout": {
-                "kind": spec.layout,
-                "near_fraction": (
+        planned = CalibrationReport(
+            status=Status.OK,
+            detail="",
+            targets=spec.targets,
+            fixated=0,
+            renders=0,
+            positions=(),
+            layout=CalibrationLayout(
+                kind=spec.layout,
+                near_fraction=(
                     (spec.near_fraction or near_fraction(spec.depth_m))
                     if spec.layout == "near_far"
                     else None
                 ),
-                "depth_m": list(spec.depth_m),
-                "lateral": spec.lateral,
-                "vertical": spec.vertical,
-                "positions_world_m": positions,
-            },
-            "depth_noise_m": spec.depth_noise_m,
-            "position_noise_m": spec.position_noise_m,
-            "lines_of_sight_fit": spec.lines_of_sight,
-            "extended": spec.extended,
-            "alpha_e_rad": None,
-            "alpha_e_std_rad": None,
-            "alpha_e_covariance_rad2": None,
-            "alpha_e_truth_rad": truth_alpha_e,
-            "alpha_e_error_rad": None,
-            "alpha_e_paper_rad": list(PAPER["alpha_e_rad"]),
-            "converged": False,
-            "depth_residual_rms_m": None,
-            "vertical_reference": None,
-            "lines_of_sight": None,
-            "knowledge": None,
-        }
+                depth_m=list(spec.depth_m),
+                lateral=spec.lateral,
+                vertical=spec.vertical,
+                positions_world_m=positions,
+            ),
+            depth_noise_m=spec.depth_noise_m,
+            position_noise_m=spec.position_noise_m,
+            lines_of_sight_fit=spec.lines_of_sight,
+            extended=spec.extended,
+            alpha_e_truth_rad=truth_alpha_e,
+            alpha_e_paper_rad=list(PAPER["alpha_e_rad"]),
+        )
         start = sim.render_count
         previews = hub.previews  # counted apart: images taken are what subscribers see
         try:
@@ -203,16 +190,19 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
             )
         except ValueError as err:
             outcomes = err.outcomes if isinstance(err, CalibrationError) else ()
-            block.update(
-                status=f"failed: {err}",
+            report = replace(
+                planned,
+                status=Status.FAILED,
+                detail=f"failed: {err}",
                 renders=sim.render_count - start - (hub.previews - previews),
                 fixated=sum(o is None for o in outcomes),
                 positions=position_outcomes(outcomes),
             )
-            hub.emit(CalibrationDone(block))
-            return None, block
+            hub.emit(CalibrationDone(report))
+            return None, report
     fit, knowledge = run.fit, run.knowledge
-    block.update(
+    report = replace(
+        planned,
         fixated=run.samples,
         positions=position_outcomes(run.outcomes),
         renders=run.renders - (hub.previews - previews),
@@ -224,59 +214,50 @@ def _calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, dic
         depth_residual_rms_m=float(np.sqrt(np.mean(np.square(fit.depth_residuals)))),
         vertical_reference=None
         if run.vertical is None
-        else {
-            "v0_px": [v.v0 for v in run.vertical],
-            "v0_std_px": [v.v0_std for v in run.vertical],
-            "v0_truth_px": truth_v0,
-            "kx_over_ky": [v.kx_over_ky for v in run.vertical],
-            "kx_over_ky_std": [v.kx_over_ky_std for v in run.vertical],
-            "kx_over_ky_truth": truth_ratio,
-        },
-        lines_of_sight=None if run.lines is None else _lines_block(run, sim),
-        knowledge={
-            "alpha_e_rad": list(knowledge.alpha_e),
-            "v0_px": list(knowledge.v0),
-            "kx_over_ky": list(knowledge.kx_over_ky),
-            "u0_px": list(knowledge.u0),
-            "los_offset_m": None
-            if knowledge.los_offset_m is None
-            else list(knowledge.los_offset_m),
-        },
+        else VerticalReference(
+            v0_px=[v.v0 for v in run.vertical],
+            v0_std_px=[v.v0_std for v in run.vertical],
+            v0_truth_px=truth_v0,
+            kx_over_ky=[v.kx_over_ky for v in run.vertical],
+            kx_over_ky_std=[v.kx_over_ky_std for v in run.vertical],
+            kx_over_ky_truth=truth_ratio,
+        ),
+        lines_of_sight=None if run.lines is None else _lines_fit(run, sim),
+        knowledge=KnowledgeReport(
+            alpha_e_rad=list(knowledge.alpha_e),
+            v0_px=list(knowledge.v0),
+            kx_over_ky=list(knowledge.kx_over_ky),
+            u0_px=list(knowledge.u0),
+            los_offset_m=None if knowledge.los_offset_m is None else list(knowledge.los_offset_m),
+        ),
     )
-    hub.emit(CalibrationDone(block))
-    return run, block
+    hub.emit(CalibrationDone(report))
+    return run, report
 
 
-def position_outcomes(outcomes: Sequence[Failure | None]) -> list[dict[str, Any]]:
-    """Each calibration position's outcome: status "ok" or the failure and its cause."""
-    return [
-        {"status": "ok", "failure": None}
-        if o is None
-        else {"status": o.message, "failure": o.as_dict()}
-        for o in outcomes
-    ]
+def position_outcomes(outcomes: Sequence[Failure | None]) -> tuple[PositionOutcome, ...]:
+    """Each calibration position's outcome: fixated (no failure) or the failure."""
+    return tuple(PositionOutcome(o) for o in outcomes)
 
 
-def _lines_block(run: CalibrationRun, sim: HeadSim) -> dict[str, Any]:
-    """The extended line-of-sight fit beside the truth, for results.json."""
+def _lines_fit(run: CalibrationRun, sim: HeadSim) -> LinesOfSightFit:
+    """The extended line-of-sight fit beside the truth."""
     lines = run.lines
     assert lines is not None
     truth = line_of_sight_truth(sim, run.knowledge)
-    return {
-        "alpha_e_rad": list(lines.alpha_e),
-        "offset_m": list(lines.offset_m),
-        "std_errors": {
-            "alpha_e_rad": list(lines.std_errors[:2]),
-            "offset_m": list(lines.std_errors[2:]),
-        },
-        "offset_truth_m": list(truth.offset_m),
-        "covariance": np.asarray(lines.covariance).tolist(),  # (alpha_e1, alpha_e2, s1, s2)
-        "effective_baseline_m": lines.effective_baseline_m,
-        "effective_baseline_std_m": lines.effective_baseline_std_m,
-        "effective_baseline_truth_m": truth.effective_baseline_m,
-        "separable": lines.separable,
-        "message": lines.message,
-    }
+    return LinesOfSightFit(
+        alpha_e_rad=list(lines.alpha_e),
+        offset_m=list(lines.offset_m),
+        std_errors_alpha_e_rad=list(lines.std_errors[:2]),
+        std_errors_offset_m=list(lines.std_errors[2:]),
+        offset_truth_m=list(truth.offset_m),
+        covariance=np.asarray(lines.covariance).tolist(),  # (alpha_e1, alpha_e2, s1, s2)
+        effective_baseline_m=lines.effective_baseline_m,
+        effective_baseline_std_m=lines.effective_baseline_std_m,
+        effective_baseline_truth_m=truth.effective_baseline_m,
+        separable=lines.separable,
+        message=lines.message,
+    )
 
 
 def _record(
@@ -289,7 +270,7 @@ def _record(
 
 def _run_points(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
-) -> tuple[list[MeasurementRecord], dict[str, Any]]:
+) -> tuple[list[MeasurementRecord], PointsResult]:
     """Model 2 or Model 1 on each target in turn; after a calibration, also uncalibrated."""
     procedure = scenario.experiment.procedure
     targets = scenario.scene.targets
@@ -317,17 +298,17 @@ def _run_points(
                     assert isinstance(servo, EyeServo)
                     m = measure_model2(sim, servo, target, known, _model2_config(scenario))
                 records.append(_record(hub, m, known_label, step))
-    experiment: dict[str, Any] = {}
-    if procedure == "calibration":
-        experiment["check_targets"] = [
-            {
-                "name": before.measurement.name,
-                "error_m_uncalibrated": _error(before.measurement),
-                "error_m_calibrated": _error(after.measurement),
-            }
-            for before, after in zip(records[::2], records[1::2], strict=True)
-        ]
-    return records, experiment
+    if procedure != "calibration":
+        return records, PointsResult()
+    checks = tuple(
+        CheckTarget(
+            name=before.measurement.name,
+            error_m_uncalibrated=_error(before.measurement),
+            error_m_calibrated=_error(after.measurement),
+        )
+        for before, after in zip(records[::2], records[1::2], strict=True)
+    )
+    return records, PointsResult(check_targets=checks)
 
 
 def _error(m: Measurement) -> float:
@@ -343,7 +324,7 @@ def _stats(values: np.ndarray) -> tuple[float, float]:
 
 def _run_chessboard(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
-) -> tuple[list[MeasurementRecord], dict[str, Any]]:
+) -> tuple[list[MeasurementRecord], ChessboardResult]:
     """Every chosen inner corner with Model 2 (Sec. VI-A), and the squares they give."""
     scene = scenario.scene
     assert scene.chessboard is not None
@@ -381,32 +362,32 @@ def _run_chessboard(
     ]
     sides = np.concatenate([run.widths_m, run.heights_m])
     width, height, side = _stats(run.widths_m), _stats(run.heights_m), _stats(sides)
-    experiment = {
-        "pattern": list(CHESSBOARD_PATTERN),
-        "square_m": CHESSBOARD_SQUARE_M,
-        "corners": len(indices),
-        "corners_measured": run.measured,
-        "widths_m": run.widths_m,
-        "heights_m": run.heights_m,
-        "true_widths_m": run.true_widths_m,
-        "true_heights_m": run.true_heights_m,
-        "width_mean_m": width[0],
-        "width_std_m": width[1],
-        "height_mean_m": height[0],
-        "height_std_m": height[1],
-        "side_mean_m": side[0],
-        "side_std_m": side[1],
-        "paper": {
-            "side_mean_m": PAPER["chessboard_side_mean_m"],
-            "side_std_m": PAPER["chessboard_side_std_m"],
-        },
-    }
+    experiment = ChessboardResult(
+        pattern=list(CHESSBOARD_PATTERN),
+        square_m=CHESSBOARD_SQUARE_M,
+        corners=len(indices),
+        corners_measured=run.measured,
+        widths_m=run.widths_m,
+        heights_m=run.heights_m,
+        true_widths_m=run.true_widths_m,
+        true_heights_m=run.true_heights_m,
+        width_mean_m=width[0],
+        width_std_m=width[1],
+        height_mean_m=height[0],
+        height_std_m=height[1],
+        side_mean_m=side[0],
+        side_std_m=side[1],
+        paper=ChessboardPaper(
+            side_mean_m=PAPER["chessboard_side_mean_m"],
+            side_std_m=PAPER["chessboard_side_std_m"],
+        ),
+    )
     return records, experiment
 
 
 def _run_relative(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
-) -> tuple[list[MeasurementRecord], dict[str, Any]]:
+) -> tuple[list[MeasurementRecord], RelativeResult]:
     """The cross point with Model 2, then each object's area S1..S12 (Sec. III, VI-C)."""
     scene = scenario.scene
     assert scene.blocks is not None
@@ -430,51 +411,51 @@ def _run_relative(
     comparison = run.comparison
     seen = [name for name in colours if name not in run.missing]
     margins = dict(zip(seen, comparison.margin, strict=True)) if comparison is not None else {}
-    objects = [
-        {
-            "name": name,
-            "colour": colour,
-            "area": run.areas.get(name, 0),
-            "true_area": run.true_areas.get(name, 0),
-            "agree": name in margins and run.areas[name] == run.true_areas[name],
-            "margin_px": margins.get(name, float("nan")),
-            "gain_area": run.gain_areas.get(name, 0),
-            "gain_agree": name in run.gain_areas and run.gain_areas[name] == run.true_areas[name],
-            "columns_px": list(run.columns.get(name, (float("nan"),) * 4)),
-            "position_head_m": positions_head[name],
-        }
+    objects = tuple(
+        RelativeObject(
+            name=name,
+            colour=colour,
+            area=run.areas.get(name, 0),
+            true_area=run.true_areas.get(name, 0),
+            agree=name in margins and run.areas[name] == run.true_areas[name],
+            margin_px=margins.get(name, float("nan")),
+            gain_area=run.gain_areas.get(name, 0),
+            gain_agree=name in run.gain_areas and run.gain_areas[name] == run.true_areas[name],
+            columns_px=list(run.columns.get(name, (float("nan"),) * 4)),
+            position_head_m=positions_head[name],
+        )
         for name, colour in colours.items()
-    ]
-    experiment = {
+    )
+    experiment = RelativeResult(
         # The whole encoder steps of the two fixations, where the lines L11..L22 are.
-        "alpha1_rad": round(details["gamma2_rad"] / resolution) * resolution
+        alpha1_rad=round(details["gamma2_rad"] / resolution) * resolution
         if details
         else float("nan"),
-        "alpha2_rad": round(details["gamma1_rad"] / resolution) * resolution
+        alpha2_rad=round(details["gamma1_rad"] / resolution) * resolution
         if details
         else float("nan"),
-        "objects": objects,
-        "missing": list(run.missing),
-        "agree": sum(o["agree"] for o in objects),
-        "disagree_outside_margin": comparison.n_disagree_outside if comparison else None,
-        "gain_agree": sum(o["gain_agree"] for o in objects),
-        "gain_disagree_outside_margin": run.gain_comparison.n_disagree_outside
+        objects=objects,
+        missing=list(run.missing),
+        agree=sum(o.agree for o in objects),
+        disagree_outside_margin=comparison.n_disagree_outside if comparison else None,
+        gain_agree=sum(o.gain_agree for o in objects),
+        gain_disagree_outside_margin=run.gain_comparison.n_disagree_outside
         if run.gain_comparison
         else None,
-        "margin_threshold_px": comparison.threshold_px if comparison else None,
-        "renders": run.renders,
-        "paper": {
-            "alpha1_rad": PAPER["relative_alpha1_rad"],
-            "alpha2_rad": PAPER["relative_alpha2_rad"],
-            "objects": PAPER["relative_objects"],
-        },
-    }
+        margin_threshold_px=comparison.threshold_px if comparison else None,
+        renders=run.renders,
+        paper=RelativePaper(
+            alpha1_rad=PAPER["relative_alpha1_rad"],
+            alpha2_rad=PAPER["relative_alpha2_rad"],
+            objects=PAPER["relative_objects"],
+        ),
+    )
     return records, experiment
 
 
 def _run_tracking(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
-) -> tuple[list[MeasurementRecord], dict[str, Any]]:
+) -> tuple[list[MeasurementRecord], TrackingResult]:
     """Follow the moving target with Model 1 (neck and eyes), one fixation per time."""
     moving = scenario.scene.moving
     assert moving is not None
@@ -499,26 +480,40 @@ def _run_tracking(
     ]
     errors = run.errors_world_m
     renders = [m.renders for m in run.measurements]
-    experiment = {
-        "times_s": times,
-        "waypoints_world_m": list(moving.waypoints_world_m),
-        "errors_world_m": errors,
-        "renders_first": renders[0] if renders else 0,
-        "renders_after_mean": float(np.mean(renders[1:])) if len(renders) > 1 else float("nan"),
-    }
+    experiment = TrackingResult(
+        times_s=times,
+        waypoints_world_m=list(moving.waypoints_world_m),
+        errors_world_m=errors,
+        renders_first=renders[0] if renders else 0,
+        renders_after_mean=float(np.mean(renders[1:])) if len(renders) > 1 else float("nan"),
+    )
     return records, experiment
 
 
 def _run_pursuit(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
-) -> tuple[list[MeasurementRecord], dict[str, Any]]:
+) -> tuple[list[MeasurementRecord], PursuitResult]:
     """The live head pursues a moving target (headsim.live.procedure)."""
     from headsim.live.procedure import run_pursuit
 
-    return run_pursuit(scenario, hub, knowledge, label)
+    records, block = run_pursuit(scenario, hub, knowledge, label)
+    known = {"pursuit", "per_frame", "failures", *(f.name for f in fields(PursuitFigures))}
+    if set(block) - known:  # a new figure must get its field, or it would not be written
+        raise KeyError(f"pursuit figures without a PursuitFigures field: {set(block) - known}")
+    figures = None
+    if "frames" in block:
+        figures = PursuitFigures(**{f.name: block[f.name] for f in fields(PursuitFigures)})
+    return records, PursuitResult(
+        pursuit=block["pursuit"],
+        figures=figures,
+        per_frame=block.get("per_frame"),
+        failures=tuple(block.get("failures", ())),
+    )
 
 
-RUNNERS = {
+RUNNERS: dict[
+    str, Callable[[Scenario, Hub, HeadKnowledge, str], tuple[list[MeasurementRecord], Experiment]]
+] = {
     "model2": _run_points,
     "model1": _run_points,
     "calibration": _run_points,
@@ -531,18 +526,18 @@ RUNNERS = {
 
 def calibrate_scenario(
     scenario: Scenario, subscribers: Sequence[Subscriber] = ()
-) -> dict[str, Any]:
-    """Only the scenario's Sec. V calibration (``headsim calibrate``): its results.json block.
+) -> CalibrationReport:
+    """Only the scenario's Sec. V calibration (``headsim calibrate``): its report.
 
-    ``status`` is "ok" or why it failed; ``rendered_frames`` the pixels it
+    ``status`` is OK or why it failed; ``rendered_frames`` the pixels it
     rendered, in full frames.
     """
     spec = scenario.experiment.calibration
     if spec is None or spec.source is not None:
         raise ValueError("the scenario has no calibration to run ([experiment.calibration])")
     hub = Hub(subscribers)
-    _, block = _calibrate(scenario, hub)
-    return {**block, "rendered_frames": hub.rendered_frames}
+    _, report = _calibrate(scenario, hub)
+    return replace(report, rendered_frames=hub.rendered_frames)
 
 
 def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> RunResult:
@@ -559,31 +554,31 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
         from headsim.active.calibration_file import read_calibration
 
         stored = read_calibration(spec.source, scenario.settings)
-        calibration = {
-            **stored.block,
-            "renders": 0,
-            "from": {
-                "path": str(stored.path),
-                "scenario": stored.scenario,
-                "seed": stored.seed,
-                "head_hash": stored.head_hash,
-                "renders": stored.block.get("renders"),
-            },
-        }
+        calibration = calibration_from_block(
+            stored.block,
+            renders=0,
+            source=CalibrationSource(
+                path=str(stored.path),
+                scenario=stored.scenario,
+                seed=stored.seed,
+                head_hash=stored.head_hash,
+                renders=stored.block.get("renders"),
+            ),
+        )
         hub.emit(CalibrationDone(calibration))
         knowledge, label = stored.knowledge, "calibrated"
     elif spec is not None:
         start = time.perf_counter()
         run, calibration = _calibrate(scenario, hub)
         timing["calibration"] = time.perf_counter() - start
-        renders["calibration"] = calibration["renders"]
+        renders["calibration"] = calibration.renders
         rendered_frames["calibration"] = hub.rendered_frames
         if run is None:
-            failures.append(f"calibration: {calibration['status']}")
+            failures.append(f"calibration: {calibration.status_text}")
         else:
             knowledge, label = run.knowledge, "calibrated"
     records: list[MeasurementRecord] = []
-    experiment: dict[str, Any] = {}
+    experiment: Experiment | None = None
     if not failures:
         start = time.perf_counter()
         frames = hub.images
@@ -594,17 +589,21 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
         renders["experiment"] = hub.images - frames
         rendered_frames["experiment"] = hub.rendered_frames - rendered_frames["calibration"]
     failures += [
-        f"{r.measurement.name}: {r.measurement.status}" for r in records if not r.measurement.ok
+        f"{r.measurement.name}: {r.measurement.status_text}"
+        for r in records
+        if not r.measurement.ok
     ]
-    failures += [f"{name}: not seen in all four images" for name in experiment.get("missing", [])]
-    failures += list(experiment.pop("failures", []))
+    if isinstance(experiment, RelativeResult):
+        failures += [f"{name}: not seen in all four images" for name in experiment.missing]
+    if isinstance(experiment, PursuitResult):
+        failures += list(experiment.failures)
     renders["total"] = renders["calibration"] + renders["experiment"]
     timing["total"] = sum(timing.values())
     result = RunResult(
         scenario=scenario,
         calibration=calibration,
         records=tuple(records),
-        experiment={"procedure": scenario.experiment.procedure, **experiment},
+        experiment=experiment,
         renders=renders,
         failures=tuple(failures),
         timing_s=timing,
@@ -621,8 +620,6 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
 __all__ = [
     "PAPER",
     "Hub",
-    "MeasurementRecord",
-    "RunResult",
     "calibrate_scenario",
     "run_scenario",
 ]

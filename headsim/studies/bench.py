@@ -344,9 +344,9 @@ def scenario_metrics(name: str) -> Metrics:
         f"scenario.{name}.renders_per_point": float(result.renders["total"])
         / max(scenario.fixations, 1),
     }
-    if result.calibration and "alpha_e_error_rad" in result.calibration:
+    if result.calibration and result.calibration.layout is not None:
         metrics[f"scenario.{name}.calibration_max_error_rad"] = float(
-            np.max(np.abs(result.calibration["alpha_e_error_rad"]))
+            np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
         )
     return metrics
 

@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from headsim.geometry.kinematics import world_to_head
-from headsim.run.report import DEPTH_BANDS_M
+from headsim.run.accuracy import DEPTH_BANDS_M
 from headsim.run.results import (
     write_bytes_atomic,
     write_csv_atomic,
@@ -227,6 +227,7 @@ def run_condition(
 ) -> dict[str, Any]:
     """Run the scenario with ``condition``'s fields set; one row of the budget."""
     from headsim.run.runner import run_scenario
+    from headsim.run.serialise import calibration_block
     from headsim.scenario.schema import load_scenario
 
     overrides = dict(condition.overrides)
@@ -241,7 +242,7 @@ def run_condition(
     depth = truth[:, 2]
     pct = 100 * np.linalg.norm(error, axis=1) / depth if ok else np.zeros(0)
     pct_xz = 100 * np.linalg.norm(error[:, [0, 2]], axis=1) / depth if ok else np.zeros(0)
-    calibration = result.calibration or {}
+    calibration = calibration_block(result.calibration) if result.calibration else {}
     lines = calibration.get("lines_of_sight")
     row: dict[str, Any] = {
         "condition": condition.name,

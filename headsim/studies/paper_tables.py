@@ -212,7 +212,7 @@ def measure_paired(
             renders = sim.render_count - start
             for method, knowledge in knowledges.items():
                 if not measured.ok:
-                    estimate, status = np.full(3, np.nan), measured.status
+                    estimate, status = np.full(3, np.nan), measured.status_text
                 elif method == SERVOED:
                     estimate, status = measured.estimate_head_m, "ok"
                 else:
@@ -236,7 +236,7 @@ def measure_paired(
                         index,
                         truth,
                         m2.estimate_head_m,
-                        m2.status,
+                        m2.status_text,
                         sim.render_count - start,
                     )
                 )

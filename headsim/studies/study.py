@@ -437,7 +437,7 @@ def measure_methods(
                         estimate, status = np.full(3, np.nan), str(error)
                 else:
                     m2 = measure_model2(sim, servo, TARGET, calibrations.knowledge(method, refound))
-                    estimate, status = m2.estimate_head_m, m2.status
+                    estimate, status = m2.estimate_head_m, m2.status_text
                 out.append(
                     TargetError(method, index, truth, estimate, status, sim.render_count - start)
                 )

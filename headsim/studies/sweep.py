@@ -258,7 +258,6 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
         ]
         errors_mm = [1000 * float(np.linalg.norm(m.error_head_m)) for m in used]
         pct = [m.error_pct_of_depth for m in used]
-        cal = result.calibration or {}
         record.update(
             status="ok" if result.ok else "failed",
             failures=len(result.failures),
@@ -269,8 +268,10 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
             mean_error_mm=float(np.mean(errors_mm)) if errors_mm else None,
             max_error_mm=float(np.max(errors_mm)) if errors_mm else None,
             renders=int(result.renders["total"]),
-            calibration_max_error_rad=float(np.max(np.abs(cal["alpha_e_error_rad"])))
-            if "alpha_e_error_rad" in cal
+            calibration_max_error_rad=float(
+                np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
+            )
+            if result.calibration is not None and result.calibration.layout is not None
             else None,
         )
     except Exception as err:  # a job's error must not take the sweep down

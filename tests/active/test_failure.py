@@ -53,13 +53,13 @@ def test_each_failure_names_its_cause() -> None:
         _place_in_head(sim, "marker_red", [0.0, 0.03, 0.6])
         flat = measure_model2(sim, EyeServo(sim), RED, config=Model2Config(midline_px=0.0))
         assert flat.failure is not None and flat.failure.cause is FailureCause.ESTIMATOR
-        assert "NO_Y" in flat.status
+        assert "NO_Y" in flat.detail
         # Iteration limit: one move allowed.
         _place_in_head(sim, "marker_red", [0.1, 0.0, 0.5])
         short = measure_model2(sim, EyeServo(sim, ServoConfig(max_iterations=1)), RED)
         assert short.failure is not None
         assert short.failure.cause is FailureCause.ITERATION_LIMIT
-        assert short.status == "Ca1 at step 1: iteration limit (after 1 moves)"
+        assert short.detail == "Ca1 at step 1: iteration limit (after 1 moves)"
     # Joint limit: a wide-angle head sees a near target that Ca1 would need 0.9 rad to fixate.
     wide = CameraSettings(kx=200.0, ky=200.0)
     with HeadSim("default", HeadSettings(cameras=(wide, wide))) as sim:

@@ -60,7 +60,7 @@ def test_a_target_out_of_view_fails_cleanly() -> None:
         m = measure_model2(sim, EyeServo(sim), RED)
         assert m.failure is not None and m.failure.cause is FailureCause.LOST
         assert (m.failure.camera, m.failure.stage) == (1, "step 1")
-        assert m.status.startswith("Ca1 at step 1: target lost")
+        assert m.detail.startswith("Ca1 at step 1: target lost")
         assert np.all(np.isnan(m.estimate_head_m))
         assert np.all(np.isfinite(m.truth_head_m))
 

@@ -13,7 +13,8 @@ from headsim.run.events import (
     RunFinished,
     Stamp,
 )
-from headsim.run.runner import RunResult, run_scenario
+from headsim.run.outcomes import RunResult
+from headsim.run.runner import run_scenario
 from headsim.scenario.schema import load_scenario
 from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.simulator import HeadSim

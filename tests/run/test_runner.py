@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
-from headsim.run.report import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
+from headsim.run.serialise import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
 from headsim.scenario.schema import load_scenario, scenario_files
 
 README = Path(__file__).resolve().parents[2] / "README.md"
