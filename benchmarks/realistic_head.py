@@ -3,7 +3,7 @@
 Run: .venv/bin/python benchmarks/realistic_head.py [--seeds 50]
 
 Everything here is the exact synthetic model (headsim.geometry.synthetic) with the
-realistic preset's tolerances (headsim.sim.settings.REALISTIC_BUDGET): the paper's
+realistic preset's tolerances (headsim.sim.tolerances.REALISTIC_BUDGET): the paper's
 cameras (intrinsics, distortion, initial directions), optical centres 20 mm
 forward and 1 / -0.5 mm sideways, a baseline 0.3 mm longer than believed,
 encoder readings with the true angle anywhere within the count, a 1 mm

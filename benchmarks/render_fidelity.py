@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from headsim.active.procedures import chessboard_corner_target
+from headsim.active.chessboard import chessboard_corner_target
 from headsim.sim.settings import PRESETS, RenderFidelity, preset
 from headsim.sim.simulator import HeadSim
 from headsim.vision.chessboard import find_chessboard

@@ -32,9 +32,11 @@ RUN_FILES = ("results.json", "summary.txt", "timing.json")
 
 
 def run_command(args: argparse.Namespace) -> int:
-    from headsim.run.report import results_payload, summary_text
+    from headsim.run.events import Subscriber
+    from headsim.run.report import summary_text
     from headsim.run.rerun_cli import recording_target
-    from headsim.run.runner import Observer, run_scenario
+    from headsim.run.runner import run_scenario
+    from headsim.run.serialise import results_payload
     from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
@@ -46,7 +48,7 @@ def run_command(args: argparse.Namespace) -> int:
         for name in RUN_FILES:
             outputs.file(out / name, "--out")
         rrd = outputs.file(target.rrd, "--rrd", atomic=False) if target.rrd else None
-        observers: list[Observer] = []
+        observers: list[Subscriber] = []
         progress = progress_observer(args, scenario.fixations, "fixations")
         if progress is not None:
             observers.append(progress)
@@ -113,20 +115,17 @@ def run_command(args: argparse.Namespace) -> int:
 
 def progress_observer(args: argparse.Namespace, total: int, unit: str) -> Any:
     """The run's progress on stderr: a bar on a terminal, plain lines otherwise; none when quiet."""
-    from headsim.run.runner import Progress
+    from headsim.run.progress import Counter, RunProgress
 
     if getattr(args, "no_progress", False) or getattr(args, "quiet", False):
         return None
-    if sys.stderr.isatty():
-        return Progress(total, sys.stderr)
-    from headsim.run.progress import LineProgress
-
-    return LineProgress(total, sys.stderr, unit=unit)
+    return RunProgress(Counter(total, unit=unit))
 
 
 def calibrate_command(args: argparse.Namespace) -> int:
     from headsim.active.calibration_file import head_hash, write_calibration
     from headsim.run.runner import calibrate_scenario
+    from headsim.run.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
     from headsim.scenario.tables import ScenarioError
 
@@ -151,30 +150,35 @@ def calibrate_command(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     with sigterm_interrupts():
         try:
-            block = calibrate_scenario(scenario, observers)
+            report = calibrate_scenario(scenario, observers)
         except KeyboardInterrupt:
             print(f"\nheadsim: interrupted: nothing written to {out}", file=sys.stderr)
             return 130
     wall = time.perf_counter() - start
-    if observers:
-        print(file=sys.stderr)
-    if block["status"] != "ok" or block.get("knowledge") is None:
-        print(f"headsim: calibration failed: {block['status']}; nothing written", file=sys.stderr)
+    if progress is not None:
+        progress.counter.close(report.fixated)
+    if not report.ok or report.knowledge is None:
+        print(
+            f"headsim: calibration failed: {report.status_text}; nothing written", file=sys.stderr
+        )
         return 1
     try:
-        write_calibration(out, scenario.settings, block, scenario.name, scenario.seed)
+        write_calibration(
+            out, scenario.settings, calibration_block(report), scenario.name, scenario.seed
+        )
     except OSError as err:
         raise OutputNotWritable(f"cannot write {out}: {err.strerror or err}") from err
-    alpha, std = block["alpha_e_rad"], block["alpha_e_std_rad"]
+    alpha, std = report.alpha_e_rad, report.alpha_e_std_rad
+    assert alpha is not None and std is not None and report.rendered_frames is not None
     print(
-        f"{scenario.name}{' (fast)' if scenario.fast else ''}: {block['fixated']} of "
-        f"{block['targets']} ball positions fixated, {block['renders']} renders "
-        f"({block['rendered_frames']:.1f} full frames of pixels) in {wall:.1f} s"
+        f"{scenario.name}{' (fast)' if scenario.fast else ''}: {report.fixated} of "
+        f"{report.targets} ball positions fixated, {report.renders} renders "
+        f"({report.rendered_frames:.1f} full frames of pixels) in {wall:.1f} s"
     )
     for index in (0, 1):
         print(f"  alpha_e{index + 1} = {alpha[index]:+.5f} rad (std {std[index]:.1e})")
-    known = block["knowledge"]
-    print(f"  v0 = {known['v0_px']} px; kx/ky = {known['kx_over_ky']}")
+    known = report.knowledge
+    print(f"  v0 = {known.v0_px} px; kx/ky = {known.kx_over_ky}")
     print(f"head {head_hash(scenario.settings)[:12]}; written to {out}")
     print(f'use it with  [experiment.calibration] from = "{out.resolve()}"')
     return 0

@@ -2,7 +2,7 @@
 
 Both see only what an agent sees: the observation (images, encoders) and the
 action space.  :class:`ServoPolicy` is the paper's uncalibrated servo
-(``headsim.active.servo.NeckServo``) recast for velocity commands: it measures its
+(``headsim.active.neck_servo.NeckServo``) recast for velocity commands: it measures its
 image Jacobian (px per rad) by probing each joint once, moves by
 ``-J^-1 e`` in one frame period, and refines J with Broyden's rule from every
 frame's measured joint motion (encoders) and image motion.  J is kept across

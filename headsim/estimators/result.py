@@ -11,7 +11,23 @@ from numpy.typing import ArrayLike
 
 from headsim.geometry.kinematics import ENCODER_RESOLUTION, world_from_head
 
-__all__ = ["Flag", "PositionEstimate", "Uncertainty"]
+__all__ = ["Flag", "Method", "PositionEstimate", "Status", "Uncertainty"]
+
+
+class Method(enum.Enum):
+    """Which estimator measured a point; the value is its name in results.json."""
+
+    #: Model 1 (:mod:`headsim.estimators.model1`), fixated by the neck servo
+    MODEL1 = "model1"
+    #: Model 2 (:mod:`headsim.estimators.model2`), fixated by the eye servo
+    MODEL2 = "model2"
+
+
+class Status(enum.Enum):
+    """Whether a measurement (or a calibration) succeeded; why not is its ``detail`` text."""
+
+    OK = "ok"
+    FAILED = "failed"
 
 
 class Flag(enum.IntFlag):

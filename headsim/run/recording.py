@@ -1,6 +1,6 @@
 """Recording a run to a Rerun ``.rrd`` file, replayed with ``rerun FILE.rrd``.
 
-A :class:`Recorder` is a :class:`headsim.run.runner.Observer`: it logs the
+A :class:`Recorder` is a :class:`headsim.run.events.Subscriber`: it logs the
 experiment's own images and detections as the procedures make them (no
 render is made for the record) and the results as they come.  Entity paths
 and timelines (README "Scenarios and results" lists them):
@@ -51,14 +51,17 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.events import Detected, FixationStarted, PhaseStarted
+from headsim.active.measurement import HeadKnowledge
 from headsim.geometry.kinematics import head_to_world
 from headsim.run import mjcf_rerun
+from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
+from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RelativeResult, RunResult
 from headsim.run.report import summary_text
 from headsim.run.rerun_cli import RecordingTarget
-from headsim.run.runner import MeasurementRecord, Observer, RunResult
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
+from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.optics import camera_matrix
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import find_markers
@@ -168,7 +171,7 @@ def recording_id(scenario: Scenario) -> str:
     return f"{scenario.name}{'-fast' if scenario.fast else ''}-seed{scenario.seed}"
 
 
-class Recorder(Observer):
+class Recorder:
     """Logs a run to ``path`` as it goes; :meth:`close` writes the footer."""
 
     def __init__(
@@ -233,6 +236,9 @@ class Recorder(Observer):
         self.objects: dict[str, str] = {}
         self.closed = False
         self._pursuit_trail: list[np.ndarray] = []
+        self.sim: HeadSim | None = None  # the current phase's simulator
+        #: Each camera's last whole image in the phase, the backdrop of the windows after it.
+        self._last_full: dict[int, np.ndarray] = {}
         self._scene_key: tuple[str, ...] | None = None
         self._body_poses: mjcf_rerun.BodyPoses | None = None
         # Geometry is static when the whole run is in one scene; else logged per phase.
@@ -402,7 +408,49 @@ class Recorder(Observer):
         for key, value in (("eye_rad", eye), ("neck_yaw_rad", yaw), ("neck_pitch_rad", pitch)):
             self.rec.log(f"/joints/{key}", rr.Scalars([value]))
 
-    # -- the observer -------------------------------------------------------------
+    # -- the subscriber -----------------------------------------------------------
+    def notify(self, event: object, at: Stamp) -> None:
+        """Log ``event`` (see :mod:`headsim.run.events`) at ``at``'s frame and step."""
+        from headsim.live.gaze import PursuitFrame  # the live pursuit's frames
+
+        if isinstance(event, PhaseStarted):
+            self.sim, self._last_full = event.sim, {}
+            self.phase(event.name, event.sim, event.knowledge, dict(event.truth_world_m))
+        elif isinstance(event, FixationStarted):
+            self.step(at.step, event.label)
+        elif isinstance(event, ImageTaken) and event.kind is not ImageKind.PREVIEW:
+            assert self.sim is not None
+            self.rendered(self.sim, event.camera, self._frame_image(event), at.frame)
+        elif isinstance(event, Detected):
+            assert self.sim is not None
+            status = event.status.value
+            self.detected(self.sim, event.camera, event.uv_px, status, at.frame)
+        elif isinstance(event, MeasurementRecorded):
+            self.measured(event.record)
+        elif isinstance(event, PursuitFrame):
+            self.pursued(event.record, at.frame)
+        elif isinstance(event, CalibrationDone):
+            self.calibrated(event.report)
+        elif isinstance(event, RunFinished):
+            self.finished(event.result)
+
+    def _frame_image(self, event: ImageTaken) -> np.ndarray:
+        """The image as shown: a window in a full-size frame, around it the camera's last
+        whole image at half brightness (not rendered now), or black before there is one."""
+        if event.kind is not ImageKind.WINDOW or event.window is None:
+            self._last_full[event.camera] = event.image
+            return event.image
+        assert self.sim is not None
+        settings = self.sim.camera_settings(event.camera)
+        last = self._last_full.get(event.camera)
+        if last is not None and last.shape == (settings.height, settings.width, 3):
+            frame = last // 2
+        else:
+            frame = np.zeros((settings.height, settings.width, 3), dtype=np.uint8)
+        window = event.window
+        frame[window.y0 : window.y1, window.x0 : window.x1] = event.image
+        return frame
+
     def phase(
         self, name: str, sim: HeadSim, knowledge: HeadKnowledge, truth: dict[str, np.ndarray]
     ) -> None:
@@ -548,7 +596,7 @@ class Recorder(Observer):
         if residuals:
             self.rec.log("/measurements/servo_residual_px", rr.Scalars([max(residuals)]))
         self._rows.append(
-            f"| {record.step} | {label} | {m.status} | {error * 1000.0:.2f} | "
+            f"| {record.step} | {label} | {m.status_text} | {error * 1000.0:.2f} | "
             f"{m.error_pct_of_depth:.3f} | {m.renders} | "
             f"{max(residuals) if residuals else float('nan'):.2f} |"
         )
@@ -613,7 +661,7 @@ class Recorder(Observer):
             depth = float(np.linalg.norm(truth - self.world_from_head_start[:3, 3]))
             self.rec.log("/measurements/error_pct_of_depth", rr.Scalars([100.0 * error / depth]))
 
-    def calibrated(self, calibration: dict[str, Any]) -> None:
+    def calibrated(self, calibration: CalibrationReport) -> None:
         self._time()
         self.rec.log(
             "/results/calibration",
@@ -623,10 +671,7 @@ class Recorder(Observer):
 
     def finished(self, result: RunResult) -> None:
         self._time()
-        if (
-            result.experiment.get("procedure") == "relative_positioning"
-            and "objects" in result.experiment
-        ):
+        if isinstance(result.experiment, RelativeResult):
             self._log_areas(result.experiment)
         text = summary_text(result)
         self.rec.log(
@@ -634,13 +679,13 @@ class Recorder(Observer):
             rr.TextDocument(f"```\n{text}\n```", media_type=rr.MediaType.MARKDOWN),
         )
 
-    def _log_areas(self, e: dict[str, Any]) -> None:
+    def _log_areas(self, e: RelativeResult) -> None:
         """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
         baseline = self.scenario.settings.baseline_m
         s = self.scenario.settings
         strips, labels = [], []
         far = 2.0
-        for step_index, alpha in enumerate((e["alpha1_rad"], e["alpha2_rad"])):
+        for step_index, alpha in enumerate((e.alpha1_rad, e.alpha2_rad)):
             if not math.isfinite(alpha):
                 return
             for camera in (1, 2):
@@ -655,15 +700,15 @@ class Recorder(Observer):
         self.rec.log(
             "/world/areas/lines", rr.LineStrips3D(strips, colors=[_ORANGE] * 4, labels=labels)
         )
-        objects = e["objects"]
-        positions = [self.truth[o["name"]] for o in objects if o["name"] in self.truth]
+        objects = e.objects
+        positions = [self.truth[o.name] for o in objects if o.name in self.truth]
         self.rec.log(
             "/world/areas/objects",
             rr.Points3D(
                 positions,
                 radii=0.008,
-                colors=[_GREEN if o["agree"] else _RED for o in objects],
-                labels=[f"{o['name']}: S{o['area']} (true S{o['true_area']})" for o in objects],
+                colors=[_GREEN if o.agree else _RED for o in objects],
+                labels=[f"{o.name}: S{o.area} (true S{o.true_area})" for o in objects],
             ),
         )
 
@@ -681,24 +726,29 @@ class Recorder(Observer):
         self.close()
 
 
-def _calibration_markdown(block: dict[str, Any]) -> str:
-    if block.get("status") != "ok":
-        return f"# Calibration\n\n{block.get('status')}\n"
+def _calibration_markdown(report: CalibrationReport) -> str:
+    if not report.ok:
+        return f"# Calibration\n\n{report.status_text}\n"
+    alpha_e, truth_e, paper_e = (
+        report.alpha_e_rad,
+        report.alpha_e_truth_rad,
+        report.alpha_e_paper_rad,
+    )
+    assert alpha_e is not None and truth_e is not None and paper_e is not None
     rows = "\n".join(
-        f"| alpha_e{k + 1} | {block['alpha_e_rad'][k]:.5f} | {block['alpha_e_truth_rad'][k]:.5f} | "
-        f"{block['alpha_e_paper_rad'][k]:.4f} |"
+        f"| alpha_e{k + 1} | {alpha_e[k]:.5f} | {truth_e[k]:.5f} | {paper_e[k]:.4f} |"
         for k in range(2)
     )
     text = (
         "# Calibration of the initial directions (Sec. V)\n\n"
-        f"{block['fixated']} of {block['targets']} positions fixated, {block['renders']} renders\n\n"
+        f"{report.fixated} of {report.targets} positions fixated, {report.renders} renders\n\n"
         "| rad | ours | truth | paper |\n|---|---|---|---|\n" + rows + "\n"
     )
-    vertical = block.get("vertical_reference")
+    vertical = report.vertical_reference
     if vertical:
         text += "\n| extended | ours | truth |\n|---|---|---|\n" + "\n".join(
-            f"| v{k + 1}0 px | {vertical['v0_px'][k]:.2f} | {vertical['v0_truth_px'][k]:.2f} |\n"
-            f"| kx{k + 1}/ky{k + 1} | {vertical['kx_over_ky'][k]:.4f} | {vertical['kx_over_ky_truth'][k]:.4f} |"
+            f"| v{k + 1}0 px | {vertical.v0_px[k]:.2f} | {vertical.v0_truth_px[k]:.2f} |\n"
+            f"| kx{k + 1}/ky{k + 1} | {vertical.kx_over_ky[k]:.4f} | {vertical.kx_over_ky_truth[k]:.4f} |"
             for k in range(2)
         )
     return text

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from headsim.active.procedures import seen_by_both
+from headsim.active.placement import seen_by_both
 from headsim.estimators.areas import areas_from_geometry
 from headsim.geometry.sampling import sample_points_head
 from headsim.sim.simulator import HeadSim

@@ -137,7 +137,7 @@ def model2_refusal(
 ) -> tuple[str, str] | None:
     """Why Model 2 cannot measure a point (message, what is allowed), or None: it can.
 
-    The criterion the procedure meets (``headsim.active.procedures.measure_model2``
+    The criterion the procedure meets (``headsim.active.model2.measure_model2``
     searches the start pose when a camera loses the target): in front of the
     head, each camera's fixation angle within the eye range, and the target
     seen whole by both cameras at the start pose (neck and eyes at 0).

@@ -108,7 +108,7 @@ class CalibrationSpec:
 
 @dataclass(frozen=True)
 class ServoSpec:
-    """The servo's bounds and tolerances (``headsim.active.servo.ServoConfig``)."""
+    """The servo's bounds and tolerances (``headsim.active.servo_types.ServoConfig``)."""
 
     tolerance_px: float = 0.1
     max_iterations: int = 25

@@ -20,15 +20,14 @@ from typing import Any
 
 import numpy as np
 
-from headsim.active.procedures import (
-    HeadKnowledge,
-    calibrate_head,
-    calibration_layout,
-    line_of_sight_truth,
-    measure_model2,
-)
-from headsim.active.servo import EyeServo, ServoConfig
+from headsim.active.calibration import calibrate_head, line_of_sight_truth
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.model2 import measure_model2
+from headsim.active.placement import calibration_layout
+from headsim.active.servo_types import ServoConfig
 from headsim.estimators.throughput import run as estimator_throughput
+from headsim.run.progress import Status
 from headsim.run.results import write_json_atomic
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, paper_head, preset
@@ -337,9 +336,9 @@ def scenario_metrics(name: str) -> Metrics:
         f"scenario.{name}.renders_per_point": float(result.renders["total"])
         / max(scenario.fixations, 1),
     }
-    if result.calibration and "alpha_e_error_rad" in result.calibration:
+    if result.calibration and result.calibration.layout is not None:
         metrics[f"scenario.{name}.calibration_max_error_rad"] = float(
-            np.max(np.abs(result.calibration["alpha_e_error_rad"]))
+            np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
         )
     return metrics
 
@@ -347,23 +346,13 @@ def scenario_metrics(name: str) -> Metrics:
 def main(args: Any) -> int:
     """``headsim bench``: run the suite, compare, print, maybe update the baseline."""
 
-    terminal = sys.stderr.isatty()
     quiet = getattr(args, "quiet", False)
     start = time.perf_counter()
-
-    def progress(message: str) -> None:
-        if quiet:
-            return
-        if terminal:
-            print(f"\r  bench: {message:60s}", end="", file=sys.stderr, flush=True)
-        else:  # a log: one plain line per phase, no carriage returns
-            elapsed = time.perf_counter() - start
-            print(f"headsim bench: [{elapsed:6.1f} s] {message}", file=sys.stderr, flush=True)
-
-    metrics = suite(seed=args.seed, progress=progress)
+    status = None if quiet else Status("headsim bench", transient=True)
+    metrics = suite(seed=args.seed, progress=_quiet if status is None else status)
     wall = time.perf_counter() - start
-    if terminal and not quiet:
-        print("\r" + " " * 72 + "\r", end="", file=sys.stderr)
+    if status is not None:
+        status.close()
     baseline_path = Path(args.baseline)
     stored = load_json(baseline_path)
     verdicts = compare(metrics, stored.get("metrics", {}), load_json(Path(args.tolerances)))

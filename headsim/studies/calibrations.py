@@ -9,19 +9,16 @@ from typing import Any
 
 import numpy as np
 
+from headsim.active.calibration import CalibrationRun, calibrate_head
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.placement import calibration_layout
 from headsim.active.principal import (
     PROBE_ZOOM,
     PrincipalPointRun,
     principal_points_by_zoom,
     view_scale,
 )
-from headsim.active.procedures import (
-    CalibrationRun,
-    HeadKnowledge,
-    calibrate_head,
-    calibration_layout,
-)
-from headsim.active.servo import EyeServo
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim

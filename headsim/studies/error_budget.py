@@ -44,8 +44,12 @@ from typing import Any
 import numpy as np
 
 from headsim.geometry.kinematics import world_to_head
-from headsim.run.report import DEPTH_BANDS_M
-from headsim.run.results import write_csv_atomic, write_json_atomic, write_text_atomic
+from headsim.run.accuracy import DEPTH_BANDS_M
+from headsim.run.results import (
+    write_csv_atomic,
+    write_json_atomic,
+    write_text_atomic,
+)
 from headsim.sim.settings import HeadSettings
 
 #: The scenario the budget runs: the realistic head over the whole shared field.
@@ -221,6 +225,7 @@ def run_condition(
 ) -> dict[str, Any]:
     """Run the scenario with ``condition``'s fields set; one row of the budget."""
     from headsim.run.runner import run_scenario
+    from headsim.run.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
 
     overrides = dict(condition.overrides)
@@ -235,7 +240,7 @@ def run_condition(
     depth = truth[:, 2]
     pct = 100 * np.linalg.norm(error, axis=1) / depth if ok else np.zeros(0)
     pct_xz = 100 * np.linalg.norm(error[:, [0, 2]], axis=1) / depth if ok else np.zeros(0)
-    calibration = result.calibration or {}
+    calibration = calibration_block(result.calibration) if result.calibration else {}
     lines = calibration.get("lines_of_sight")
     row: dict[str, Any] = {
         "condition": condition.name,

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
-from headsim.active.procedures import body_target
+from headsim.active.measurement import body_target
 from headsim.sim import names
 from headsim.vision.markers import find_marker
 

@@ -35,15 +35,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from headsim.active.calibration import CalibrationRun, calibrate_head
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge, Measurement
+from headsim.active.model2 import measure_model2
 from headsim.active.principal import PrincipalPointRun, zoomed
-from headsim.active.procedures import (
-    CalibrationRun,
-    HeadKnowledge,
-    Measurement,
-    calibrate_head,
-    measure_model2,
-)
-from headsim.active.servo import EyeServo
 from headsim.estimators import model2
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
@@ -205,7 +201,7 @@ def measure_paired(
             renders = sim.render_count - start
             for method, knowledge in knowledges.items():
                 if not measured.ok:
-                    estimate, status = np.full(3, np.nan), measured.status
+                    estimate, status = np.full(3, np.nan), measured.status_text
                 elif method == SERVOED:
                     estimate, status = measured.estimate_head_m, "ok"
                 else:
@@ -229,7 +225,7 @@ def measure_paired(
                         index,
                         truth,
                         m2.estimate_head_m,
-                        m2.status,
+                        m2.status_text,
                         sim.render_count - start,
                     )
                 )

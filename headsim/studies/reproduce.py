@@ -40,6 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from headsim.errors import OutputNotWritable
+from headsim.run.progress import Status, quiet
 from headsim.run.results import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.studies.jobs import render_pool
 from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
@@ -298,8 +299,7 @@ def reproduce(
 def main(args: Any) -> int:
     """``headsim reproduce``: exit 0 all ran, 1 an experiment failed, 2 bad input, 130 interrupted."""
 
-    def progress(message: str) -> None:
-        print(f"  reproduce: {message}", file=sys.stderr, flush=True)
+    progress = quiet if getattr(args, "quiet", False) else Status("headsim reproduce")
 
     try:
         state = reproduce(

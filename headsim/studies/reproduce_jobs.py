@@ -45,14 +45,16 @@ def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str,
 def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.active.calibration_file import head_hash, write_calibration
     from headsim.run.runner import calibrate_scenario
+    from headsim.run.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario("calibration", fast=fast, seed=seed)
     start = time.perf_counter()
-    block = calibrate_scenario(scenario)
+    report = calibrate_scenario(scenario)
     wall = time.perf_counter() - start
-    if block["status"] != "ok":
-        raise RuntimeError(f"calibration failed: {block['status']}")
+    if not report.ok:
+        raise RuntimeError(f"calibration failed: {report.status_text}")
+    block = calibration_block(report)
     path = write_calibration(
         (Path(out) / "head.json").resolve(), scenario.settings, block, "calibration", scenario.seed
     )
@@ -67,8 +69,9 @@ def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
 
 @_plain_errors
 def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
-    from headsim.run.report import results_payload, summary_text
+    from headsim.run.report import summary_text
     from headsim.run.runner import run_scenario
+    from headsim.run.serialise import results_payload
     from headsim.scenario.loading import load_scenario
 
     scenario_name, _ = SCENARIO_JOBS[name]

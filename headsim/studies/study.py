@@ -1,6 +1,6 @@
 """Calibrated stereo against the active method, after calibration and after the cameras change.
 
-Pure orchestration over :mod:`headsim.stereo`, :mod:`headsim.active.procedures` and
+Pure orchestration over :mod:`headsim.stereo`, :mod:`headsim.active` and
 :mod:`headsim.active.principal`; every error is estimate minus the simulator's truth
 in the head frame H, and "% of depth" divides by the true z_h.
 
@@ -51,11 +51,11 @@ head's error budget (``--experiment budget``) is :mod:`headsim.studies.error_bud
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from collections.abc import Sequence
 
 from headsim.errors import BadInput
+from headsim.run.progress import Status
 from headsim.studies.calibrations import CalibrationCache
 from headsim.studies.methods import Progress, StudyConfig, quiet
 from headsim.studies.study_experiments import (
@@ -65,17 +65,6 @@ from headsim.studies.study_experiments import (
     sweep_experiment,
 )
 from headsim.studies.study_output import print_result, write_experiment
-
-
-class StderrProgress:
-    """Progress lines on stderr, each with the seconds since it was made."""
-
-    def __init__(self) -> None:
-        self.start = time.perf_counter()
-
-    def __call__(self, message: str) -> None:
-        print(f"[{time.perf_counter() - self.start:7.1f} s] {message}", file=sys.stderr, flush=True)
-
 
 # -- command line ------------------------------------------------------------------------
 
@@ -136,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
         raise BadInput(f"--workers must be >= 1, got {args.workers}")
     make = StudyConfig.quick if args.fast else StudyConfig
     config = make(preset=args.preset, seed=args.seed)
-    progress: Progress = quiet if getattr(args, "quiet", False) else StderrProgress()
+    progress: Progress = quiet if getattr(args, "quiet", False) else Status("headsim study")
     cache = CalibrationCache(config, progress)
     if args.experiment == "budget":
         return _budget(args, progress)

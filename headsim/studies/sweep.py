@@ -27,9 +27,7 @@ from __future__ import annotations
 
 import functools
 import json
-import math
 import os
-import sys
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -38,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from headsim.run.progress import Counter
 from headsim.studies.jobs import dask_client, execute, local_pool
 from headsim.studies.sweep_output import write_aggregate
 from headsim.studies.sweep_spec import Job, SweepSpec
@@ -97,7 +96,6 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
         ]
         errors_mm = [1000 * float(np.linalg.norm(m.error_head_m)) for m in used]
         pct = [m.error_pct_of_depth for m in used]
-        cal = result.calibration or {}
         record.update(
             status="ok" if result.ok else "failed",
             failures=len(result.failures),
@@ -108,8 +106,10 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
             mean_error_mm=float(np.mean(errors_mm)) if errors_mm else None,
             max_error_mm=float(np.max(errors_mm)) if errors_mm else None,
             renders=int(result.renders["total"]),
-            calibration_max_error_rad=float(np.max(np.abs(cal["alpha_e_error_rad"])))
-            if "alpha_e_error_rad" in cal
+            calibration_max_error_rad=float(
+                np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
+            )
+            if result.calibration is not None and result.calibration.layout is not None
             else None,
         )
     except Exception as err:  # a job's error must not take the sweep down
@@ -162,45 +162,6 @@ def _append(path: Path, record: dict[str, Any]) -> None:
         os.fsync(handle.fileno())
 
 
-class _Progress:
-    def __init__(self, total: int, enabled: bool) -> None:
-        self.total, self.enabled = total, enabled
-        self.done = 0
-        self.start = time.perf_counter()
-
-    def step(self, failed: bool) -> None:
-        self.done += 1
-        if not self.enabled:
-            return
-        elapsed = time.perf_counter() - self.start
-        rate = self.done / elapsed if elapsed > 0 else 0.0
-        eta = (self.total - self.done) / rate if rate > 0 else math.inf
-        if not sys.stderr.isatty():  # a log: one plain line per job, no carriage returns
-            left = f"about {eta:.0f} s left" if math.isfinite(eta) else "time left unknown"
-            print(
-                f"headsim sweep: {self.done}/{self.total} jobs done"
-                + (" (this one failed)" if failed else "")
-                + f", {60 * rate:.1f}/min, {left}",
-                file=sys.stderr,
-                flush=True,
-            )
-            return
-        width = 30
-        filled = round(width * self.done / max(self.total, 1))
-        bar = "#" * filled + "-" * (width - filled)
-        print(
-            f"\r[{bar}] {self.done}/{self.total} jobs, {60 * rate:.1f}/min, ETA {eta:4.0f} s"
-            + (" (a job failed)" if failed else ""),
-            end="",
-            file=sys.stderr,
-            flush=True,
-        )
-
-    def close(self) -> None:
-        if self.enabled and self.total and sys.stderr.isatty():
-            print(file=sys.stderr)
-
-
 def run_sweep(
     spec: SweepSpec,
     out_dir: str | Path,
@@ -223,14 +184,26 @@ def run_sweep(
     log = out / "jobs.jsonl"
     done = read_log(log)
     remaining = [job for job in spec.jobs if job.id not in done]
-    bar = _Progress(len(remaining), progress)
+    bar = (
+        Counter(
+            len(remaining),
+            unit="jobs",
+            name="headsim sweep",
+            interval_s=0.0,
+            per_minute=True,
+            notes_in_lines=True,
+        )
+        if progress and remaining
+        else None
+    )
     start = time.perf_counter()
     job_function = functools.partial(run_job, recording=recording) if recording else run_job
 
     def on_record(record: dict[str, Any]) -> None:
         _append(log, record)
         done[record["id"]] = record
-        bar.step(record.get("status") != "ok")
+        if bar is not None:
+            bar.update(note="" if record.get("status") == "ok" else "(this one failed)")
 
     if scheduler is not None:
         client = dask_client(scheduler)
@@ -253,7 +226,8 @@ def run_sweep(
             markers,
             job_function,
         )
-    bar.close()
+    if bar is not None:
+        bar.close()
     wall = time.perf_counter() - start
     outcome = SweepOutcome(
         records={job.id: done[job.id] for job in spec.jobs if job.id in done},

@@ -9,9 +9,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from headsim.active.eye_servo import EyeServo
+from headsim.active.model2 import measure_model2
 from headsim.active.principal import PROBE_ZOOM, principal_points_by_zoom
-from headsim.active.procedures import measure_model2
-from headsim.active.servo import EyeServo
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.triangulation import measure_point_stereo
@@ -89,7 +89,7 @@ def measure_methods(
                         estimate, status = np.full(3, np.nan), str(error)
                 else:
                     m2 = measure_model2(sim, servo, TARGET, calibrations.knowledge(method, refound))
-                    estimate, status = m2.estimate_head_m, m2.status
+                    estimate, status = m2.estimate_head_m, m2.status_text
                 out.append(
                     TargetError(method, index, truth, estimate, status, sim.render_count - start)
                 )

@@ -68,8 +68,9 @@ def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
     assert result.ok
     assert result.renders["calibration"] == 0 and result.renders["total"] > 0
     assert result.calibration is not None
-    assert result.calibration["from"]["path"] == str(head_file)
-    assert result.calibration["alpha_e_rad"] == block["alpha_e_rad"]
+    assert result.calibration.source is not None
+    assert result.calibration.source.path == str(head_file)
+    assert result.calibration.alpha_e_rad == block["alpha_e_rad"]
     assert result.records[0].knowledge == "calibrated"
     # The measurement used the stored directions: millimetres at 0.5 m.
     assert result.records[0].measurement.error_pct_of_depth < 0.2

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import io
 import json
 import math
 import re
@@ -11,8 +10,7 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
-from headsim.run.report import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
-from headsim.run.runner import Progress
+from headsim.run.serialise import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
 from headsim.scenario.loading import load_scenario, scenario_files
 
 README = Path(__file__).resolve().parents[2] / "README.md"
@@ -172,16 +170,3 @@ def test_help_is_available_for_every_command(capsys: pytest.CaptureFixture[str])
         assert stop.value.code == 0
     out = capsys.readouterr().out
     assert "--rrd FILE" in out and "--fast" in out and "--seed N" in out
-
-
-def test_progress_shows_count_rate_and_time_left() -> None:
-    now = [0.0]
-    stream = io.StringIO()
-    progress = Progress(10, stream, width=10, interval_s=0.0, clock=lambda: now[0])
-    now[0] = 2.0
-    progress.step(4, "corner_3_0")
-    assert progress.line() == "[####------] 4/10 fixations  2.0/s  0:03 left  corner_3_0"
-    now[0] = 5.0
-    progress.finished(None)  # type: ignore[arg-type]
-    last = stream.getvalue().split("\r")[-1]
-    assert last.rstrip() == "[##########] 10/10 fixations  2.0/s  5.0 s" and last.endswith("\n")

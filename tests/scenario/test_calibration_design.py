@@ -70,14 +70,15 @@ def test_a_rendered_near_far_calibration_fixates_every_ball() -> None:
     scenario = load_scenario("realistic_field", fast=True, overrides=near_far)
     spec = scenario.experiment.calibration
     assert spec is not None and spec.layout == "near_far"
-    block = calibrate_scenario(scenario)
-    assert block["status"] == "ok" and block["fixated"] == spec.targets == 12
+    report = calibrate_scenario(scenario)
+    assert report.ok and report.fixated == spec.targets == 12
+    assert report.layout is not None and report.lines_of_sight is not None
     settings = scenario.settings
-    world = np.array(block["layout"]["positions_world_m"])
+    world = np.array(report.layout.positions_world_m)
     head = world_to_head(world, 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m)
     np.testing.assert_allclose(np.sort(head[:, 2]), near_far_depths(12, spec.depth_m), atol=1e-9)
-    assert block["layout"]["kind"] == "near_far"
-    assert block["lines_of_sight"]["separable"]
+    assert report.layout.kind == "near_far"
+    assert report.lines_of_sight.separable
 
 
 @pytest.mark.parametrize(

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.active.procedures import Measurement
+from headsim.active.measurement import Measurement
+from headsim.estimators.result import Method, Status
 from headsim.studies.experiments import error_figures
 
 
@@ -13,8 +14,9 @@ def _measurement(error_m, depth_m: float, status: str = "ok") -> Measurement:
     truth = np.array([0.0, 0.0, depth_m])
     return Measurement(
         name="t",
-        method="model2",
-        status=status,
+        method=Method.MODEL2,
+        status=Status.OK if status == "ok" else Status.FAILED,
+        detail="" if status == "ok" else status,
         estimate_head_m=truth + np.asarray(error_m, float),
         truth_head_m=truth,
         estimate_world_m=truth,

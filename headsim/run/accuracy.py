@@ -1,0 +1,111 @@
+"""Statistics of a run's measurements, by what the head knew: counts, errors, depth bands.
+
+The honest headline: the RMS of the 3-D error in % of depth over the whole
+field and all targets, and by depth band (every target counts in exactly one).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from headsim.active.failure import Failure
+from headsim.run.outcomes import MeasurementRecord
+
+#: Depth bands of the honest headline, m: every target counts in exactly one.
+DEPTH_BANDS_M = ((0.0, 0.6), (0.6, 1.0), (1.0, math.inf))
+
+
+@dataclass(frozen=True)
+class DepthBand:
+    """One depth band: its name (e.g. "0.6-1 m"), the targets in it, and their RMS error, %."""
+
+    band: str
+    count: int
+    error_pct_of_depth_rms: float
+
+
+@dataclass(frozen=True)
+class MeasurementSummary:
+    """The measurements made with one knowledge: counts, errors (m, % of depth), renders.
+
+    NaN where undefined (no measurement succeeded).  ``failure_causes``: how
+    many failures had each cause (FailureCause values), most common first.
+    """
+
+    count: int
+    ok: int
+    failed: int
+    error_m_mean: float
+    error_m_max: float
+    error_pct_of_depth_mean: float
+    error_pct_of_depth_max: float
+    renders_per_point: float
+    servo_residual_px_max: float
+    searched: int
+    search_renders: int
+    failure_causes: dict[str, int]
+    error_pct_of_depth_rms: float
+    by_depth: tuple[DepthBand, ...]
+
+
+def _band_name(lo: float, hi: float) -> str:
+    return f"{lo:g}-{hi:g} m" if math.isfinite(hi) else f">= {lo:g} m"
+
+
+def _rms_pct(pct: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(pct * pct))) if pct.size else float("nan")
+
+
+def summarise(records: Sequence[MeasurementRecord]) -> MeasurementSummary:
+    """The statistics of ``records``."""
+    ok = [r.measurement for r in records if r.measurement.ok]
+    errors = np.array([np.linalg.norm(m.error_head_m) for m in ok])
+    pct = np.array([m.error_pct_of_depth for m in ok])
+    residuals = [
+        abs(x) for r in records for x in r.measurement.servo_residual_px if math.isfinite(x)
+    ]
+    nan = float("nan")
+    return MeasurementSummary(
+        count=len(records),
+        ok=len(ok),
+        failed=len(records) - len(ok),
+        error_m_mean=float(errors.mean()) if ok else nan,
+        error_m_max=float(errors.max()) if ok else nan,
+        error_pct_of_depth_mean=float(pct.mean()) if ok else nan,
+        error_pct_of_depth_max=float(pct.max()) if ok else nan,
+        renders_per_point=float(np.mean([r.measurement.renders for r in records]))
+        if records
+        else nan,
+        servo_residual_px_max=max(residuals) if residuals else nan,
+        searched=sum(r.measurement.search_renders > 0 for r in records),
+        search_renders=sum(r.measurement.search_renders for r in records),
+        failure_causes=_cause_counts([r.measurement.failure for r in records]),
+        error_pct_of_depth_rms=_rms_pct(pct),
+        by_depth=tuple(
+            DepthBand(_band_name(lo, hi), int(np.sum(sel)), _rms_pct(pct[sel]))
+            for lo, hi in DEPTH_BANDS_M
+            for sel in [np.array([lo <= m.depth_m < hi for m in ok], dtype=bool)]
+        ),
+    )
+
+
+def _cause_counts(failures: Sequence[Failure | None]) -> dict[str, int]:
+    """How many failures had each cause (FailureCause values), most common first."""
+    counts: dict[str, int] = {}
+    for f in failures:
+        if f is not None:
+            counts[f.cause.value] = counts.get(f.cause.value, 0) + 1
+    return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
+
+
+def summaries(records: Sequence[MeasurementRecord]) -> dict[str, MeasurementSummary]:
+    """Statistics of the measurements, by what the head knew ("none", "calibrated")."""
+    labels = dict.fromkeys(r.knowledge for r in records)
+    return {label: summarise([r for r in records if r.knowledge == label]) for label in labels}
+
+
+__all__ = ["DEPTH_BANDS_M", "DepthBand", "MeasurementSummary", "summaries", "summarise"]

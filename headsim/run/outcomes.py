@@ -1,0 +1,349 @@
+"""What a run found, as types: the calibration report, each procedure's result, the run.
+
+Frozen dataclasses, read by the summary, the recording and the studies;
+:mod:`headsim.run.serialise` is the one place that turns them into
+results.json (README "Scenarios and results" documents every key).  Units are
+in the names: m, rad, px; positions in W unless named otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from headsim.active.failure import Failure
+from headsim.active.measurement import Measurement
+from headsim.estimators.result import Status
+from headsim.scenario.spec import Scenario
+
+# -- the calibration (Sec. V) -------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CalibrationLayout:
+    """Where the calibration ball was placed: the layout's kind and settings, and each position."""
+
+    kind: str
+    near_fraction: float | None
+    depth_m: list[float]
+    lateral: float
+    vertical: float
+    #: (N, 3) as drawn, or as read back from JSON
+    positions_world_m: np.ndarray | list[list[float]]
+
+
+@dataclass(frozen=True)
+class VerticalReference:
+    """The extended calibration's v0, px, and kx/ky of each camera, beside the truth."""
+
+    v0_px: list[float]
+    v0_std_px: list[float]
+    v0_truth_px: list[float]
+    kx_over_ky: list[float]
+    kx_over_ky_std: list[float]
+    kx_over_ky_truth: list[float]
+
+
+@dataclass(frozen=True)
+class LinesOfSightFit:
+    """The extended line-of-sight fit beside the truth.
+
+    ``std_errors_*``: 1-sigma of alpha_e, rad, and of the offsets s1, s2, m;
+    ``covariance``: of (alpha_e1, alpha_e2, s1, s2).
+    """
+
+    alpha_e_rad: list[float]
+    offset_m: list[float]
+    std_errors_alpha_e_rad: list[float]
+    std_errors_offset_m: list[float]
+    offset_truth_m: list[float]
+    covariance: list[list[float]]
+    effective_baseline_m: float
+    effective_baseline_std_m: float
+    effective_baseline_truth_m: float
+    separable: bool
+    message: str
+
+
+@dataclass(frozen=True)
+class KnowledgeReport:
+    """What the calibration taught the head (its :class:`HeadKnowledge`, as numbers)."""
+
+    alpha_e_rad: list[float]
+    v0_px: list[float | None]
+    kx_over_ky: list[float]
+    u0_px: list[float | None]
+    los_offset_m: list[float] | None
+
+
+@dataclass(frozen=True)
+class PositionOutcome:
+    """One calibration position: fixated (``failure`` None) or why not."""
+
+    failure: Failure | None
+
+    @property
+    def status_text(self) -> str:
+        """ "ok", or the failure's message (results.json's "status")."""
+        return "ok" if self.failure is None else self.failure.message
+
+
+@dataclass(frozen=True)
+class CalibrationSource:
+    """Where a calibration read from a file came from (``[experiment.calibration] from``)."""
+
+    path: str
+    scenario: Any
+    seed: Any
+    head_hash: Any
+    renders: Any
+
+
+@dataclass(frozen=True)
+class CalibrationReport:
+    """The Sec. V calibration: results.json's ``calibration`` block.
+
+    ``status``: OK, or FAILED with ``detail`` "failed: why".  ``layout`` is None
+    when the ball positions could not be laid out (nothing below it was tried);
+    the fit's fields are None when the fit did not run.  ``rendered_frames``
+    (pixels rendered, in full frames) is set by ``headsim calibrate`` only;
+    ``source`` only for a calibration read from a file.
+    """
+
+    status: Status
+    detail: str
+    targets: int
+    fixated: int
+    renders: int
+    positions: tuple[PositionOutcome, ...]
+    layout: CalibrationLayout | None = None
+    depth_noise_m: float = 0.0
+    position_noise_m: float = 0.0
+    lines_of_sight_fit: bool = False
+    extended: bool = False
+    alpha_e_rad: list[float] | None = None
+    alpha_e_std_rad: list[float] | None = None
+    alpha_e_covariance_rad2: list[list[float]] | None = None
+    alpha_e_truth_rad: list[float] | None = None
+    alpha_e_error_rad: list[float] | None = None
+    alpha_e_paper_rad: list[float] | None = None
+    converged: bool = False
+    depth_residual_rms_m: float | None = None
+    vertical_reference: VerticalReference | None = None
+    lines_of_sight: LinesOfSightFit | None = None
+    knowledge: KnowledgeReport | None = None
+    rendered_frames: float | None = None
+    source: CalibrationSource | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.status is Status.OK
+
+    @property
+    def status_text(self) -> str:
+        """ "ok", or "failed: why" (results.json's "status")."""
+        return "ok" if self.ok else self.detail
+
+
+# -- each procedure's experiment ------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CheckTarget:
+    """A check target of the calibration procedure: 3-D error before and after, m (NaN: failed)."""
+
+    name: str
+    error_m_uncalibrated: float
+    error_m_calibrated: float
+
+
+@dataclass(frozen=True)
+class PointsResult:
+    """Model 1 or 2 on each target; ``check_targets`` for the calibration procedure only."""
+
+    check_targets: tuple[CheckTarget, ...] | None = None
+
+
+@dataclass(frozen=True)
+class ChessboardPaper:
+    """Table III/IV's square side, mean and std, m."""
+
+    side_mean_m: float
+    side_std_m: float
+
+
+@dataclass(frozen=True)
+class ChessboardResult:
+    """The chessboard's inner corners with Model 2 and the squares they give (Sec. VI-A), m."""
+
+    pattern: list[int]
+    square_m: float
+    corners: int
+    corners_measured: int
+    widths_m: np.ndarray
+    heights_m: np.ndarray
+    true_widths_m: np.ndarray
+    true_heights_m: np.ndarray
+    width_mean_m: float
+    width_std_m: float
+    height_mean_m: float
+    height_std_m: float
+    side_mean_m: float
+    side_std_m: float
+    paper: ChessboardPaper
+
+
+@dataclass(frozen=True)
+class RelativeObject:
+    """One object of relative positioning: its area S1..S12 (0: none), measured and true."""
+
+    name: str
+    colour: str
+    area: int
+    true_area: int
+    agree: bool
+    margin_px: float
+    gain_area: int
+    gain_agree: bool
+    columns_px: list[float]
+    position_head_m: np.ndarray
+
+
+@dataclass(frozen=True)
+class RelativePaper:
+    """Sec. VI-C's fixation angles, rad, and number of objects."""
+
+    alpha1_rad: float
+    alpha2_rad: float
+    objects: int
+
+
+@dataclass(frozen=True)
+class RelativeResult:
+    """Relative positioning (Sec. III, VI-C): the two fixations' angles, rad, and each object."""
+
+    alpha1_rad: float
+    alpha2_rad: float
+    objects: tuple[RelativeObject, ...]
+    missing: list[str]
+    agree: int
+    disagree_outside_margin: int | None
+    gain_agree: int
+    gain_disagree_outside_margin: int | None
+    margin_threshold_px: float | None
+    renders: int
+    paper: RelativePaper
+
+
+@dataclass(frozen=True)
+class TrackingResult:
+    """Tracking a moving target with Model 1: times, s; waypoints and errors in W, m."""
+
+    times_s: Any
+    waypoints_world_m: list[Any]
+    errors_world_m: Any
+    renders_first: int
+    renders_after_mean: float
+
+
+@dataclass(frozen=True)
+class PursuitFigures:
+    """The figures that score a live pursuit, over the frames on which the target was present.
+
+    Times in s, offsets in px, position errors in W, m; NaN where undefined.
+    ``ended``: why the loop ended.
+    """
+
+    frames: int
+    frames_present: int
+    frames_lost: int
+    losses: int
+    reacquisitions: int
+    saccades: int
+    time_to_fixation_s: float
+    lag_s: float
+    offset_rms_px: float
+    position_rms_m: float
+    position_rms_pct_of_depth: float
+    position_max_m: float
+    ended: str
+
+
+@dataclass(frozen=True)
+class PursuitResult:
+    """The live pursuit (:mod:`headsim.live.procedure`): the spec as run, its figures and
+    each frame (None when it never started), and why it failed, one line each."""
+
+    pursuit: dict[str, Any]
+    figures: PursuitFigures | None = None
+    per_frame: dict[str, Any] | None = None
+    failures: tuple[str, ...] = ()
+
+
+Experiment = PointsResult | ChessboardResult | RelativeResult | TrackingResult | PursuitResult
+
+
+# -- the run ----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class MeasurementRecord:
+    """A measurement with what the head knew (``"none"``, ``"calibrated"``), its step and time."""
+
+    measurement: Measurement
+    knowledge: str
+    step: int
+    time_s: float | None = None
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """Everything a run found.  ``failures``: why the run failed, one line each (empty: ok).
+
+    ``experiment``: the procedure's own result (None: the procedure did not run,
+    the calibration failed).  ``renders``: images taken by phase.  ``timing_s``:
+    wall time by phase (not in results.json).
+    """
+
+    scenario: Scenario
+    calibration: CalibrationReport | None
+    records: tuple[MeasurementRecord, ...]
+    experiment: Experiment | None
+    renders: dict[str, int]
+    failures: tuple[str, ...]
+    timing_s: dict[str, float] = field(default_factory=dict, compare=False)
+    #: Pixels rendered by phase, in full frames (a window counts its share), and
+    #: the servo's windows: rendered, missed (a full frame followed), and the binned
+    #: previews that placed a window where no detection did.
+    rendered_frames: dict[str, float] = field(default_factory=dict)
+    windows: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return not self.failures
+
+
+__all__ = [
+    "CalibrationLayout",
+    "CalibrationReport",
+    "CalibrationSource",
+    "CheckTarget",
+    "ChessboardPaper",
+    "ChessboardResult",
+    "Experiment",
+    "KnowledgeReport",
+    "LinesOfSightFit",
+    "MeasurementRecord",
+    "PointsResult",
+    "PositionOutcome",
+    "PursuitFigures",
+    "PursuitResult",
+    "RelativeObject",
+    "RelativePaper",
+    "RelativeResult",
+    "RunResult",
+    "TrackingResult",
+    "VerticalReference",
+]

@@ -1,0 +1,66 @@
+"""Where a run's events go, and the one event the simulator itself reports: an image taken.
+
+An :class:`EventSink` receives events as they happen (``emit``); the simulator,
+the servos and the procedures report to the sink they are given, and a run's
+subscribers (progress, recording, the runner's counts) read them.  Events are
+frozen dataclasses; the procedures' and servos' own are in
+:mod:`headsim.active.events`.  Reporting never changes what is measured: a sink
+only reads.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from headsim.sim.render import Window
+
+
+class EventSink(Protocol):
+    """Anything that takes a run's events, one call each, in the order they happen."""
+
+    def emit(self, event: object) -> None: ...
+
+
+class NoEvents:
+    """The sink that drops every event (the default: nothing subscribes)."""
+
+    def emit(self, event: object) -> None:
+        """Drop ``event``."""
+
+
+#: The shared do-nothing sink.
+NO_EVENTS = NoEvents()
+
+
+class ImageKind(enum.Enum):
+    """How an image was taken (each one is counted as a render by the simulator)."""
+
+    FULL = "full"  # the camera's whole image
+    RETAKE = "retake"  # the whole image of the instant a window was just taken of (it missed)
+    WINDOW = "window"  # only a window of the image (``ImageTaken.window``)
+    PREVIEW = "preview"  # the whole view binned ``binning`` x ``binning``, to place a window
+
+
+@dataclass(frozen=True)
+class ImageTaken:
+    """Camera 1 or 2 took ``image`` (H, W, 3) uint8 as rendered: the whole image, the
+    window's crop, or the binned preview.
+
+    ``window``: where a WINDOW image lies in the full frame, px (None otherwise);
+    ``binning``: a PREVIEW's binning (1 otherwise); ``rendered_frames``: the pixels
+    this image cost, in full frames (the simulator's ``rendered_frames`` increment).
+    """
+
+    camera: int
+    image: np.ndarray
+    kind: ImageKind
+    rendered_frames: float
+    window: Window | None = None
+    binning: int = 1
+
+
+__all__ = ["NO_EVENTS", "EventSink", "ImageKind", "ImageTaken", "NoEvents"]

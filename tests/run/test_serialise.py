@@ -1,0 +1,168 @@
+"""results.json from the typed results: enums write today's strings, blocks keep their key order."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from headsim.active.failure import Failure, FailureCause
+from headsim.active.measurement import Measurement
+from headsim.estimators.result import Method, Status
+from headsim.run.outcomes import (
+    CalibrationLayout,
+    CalibrationReport,
+    CalibrationSource,
+    KnowledgeReport,
+    LinesOfSightFit,
+    MeasurementRecord,
+    PointsResult,
+    PositionOutcome,
+    PursuitResult,
+    TrackingResult,
+    VerticalReference,
+)
+from headsim.run.results import to_jsonable
+from headsim.run.serialise import (
+    MEASUREMENT_KEYS,
+    calibration_block,
+    calibration_from_block,
+    experiment_block,
+    measurement_entry,
+)
+
+LOST = Failure(FailureCause.LOST, "step 1", 2, "and at 12 eye angles searched")
+
+
+def _measurement(error_m: float, depth_m: float, failure: Failure | None = None) -> Measurement:
+    truth = np.array([0.0, 0.0, depth_m])
+    estimate = truth + np.array([error_m, 0.0, 0.0]) if failure is None else np.full(3, np.nan)
+    return Measurement(
+        name="t",
+        method=Method.MODEL2,
+        status=Status.OK if failure is None else Status.FAILED,
+        estimate_head_m=estimate,
+        truth_head_m=truth,
+        estimate_world_m=estimate,
+        truth_world_m=truth,
+        covariance_head_m2=np.eye(3),
+        renders=7,
+        servo_residual_px=(0.25, -0.5),
+        failure=failure,
+        detail="" if failure is None else failure.message,
+    )
+
+
+def _full_report() -> CalibrationReport:
+    return CalibrationReport(
+        status=Status.OK,
+        detail="",
+        targets=3,
+        fixated=2,
+        renders=40,
+        positions=(PositionOutcome(None), PositionOutcome(LOST), PositionOutcome(None)),
+        layout=CalibrationLayout(
+            "near_far", 0.5, [0.4, 1.2], 0.16, 0.08, [[0.0, 0.5, 0.4], [0.1, 0.6, 0.9]]
+        ),
+        depth_noise_m=0.001,
+        alpha_e_rad=[0.0578, -0.0254],
+        alpha_e_std_rad=[1e-4, 2e-4],
+        alpha_e_covariance_rad2=[[1e-8, 0.0], [0.0, 4e-8]],
+        alpha_e_truth_rad=[0.0577, -0.0255],
+        alpha_e_error_rad=[1e-4, 1e-4],
+        alpha_e_paper_rad=[0.0578, -0.0254],
+        converged=True,
+        depth_residual_rms_m=0.002,
+        vertical_reference=VerticalReference(
+            [240.0, 241.0], [0.3, 0.3], [239.5, 240.5], [1.0, 1.01], [0.01, 0.01], [1.0, 1.0]
+        ),
+        lines_of_sight=LinesOfSightFit(
+            [0.0578, -0.0254],
+            [0.001, 0.002],
+            [1e-3, 1e-3],
+            [1e-3, 1e-3],
+            [0.0005, 0.0002],
+            np.eye(4).tolist(),
+            0.15,
+            0.0004,
+            0.1498,
+            True,
+            "",
+        ),
+        knowledge=KnowledgeReport(
+            [0.0578, -0.0254], [240.0, 241.0], [1.0, 1.01], [303.8, 345.1], None
+        ),
+        rendered_frames=12.5,
+    )
+
+
+def test_the_enums_write_the_strings_results_json_always_had() -> None:
+    assert [m.value for m in Method] == ["model1", "model2"]
+    assert [s.value for s in Status] == ["ok", "failed"]
+    assert to_jsonable([Method.MODEL1, Status.FAILED]) == ["model1", "failed"]
+
+
+def test_a_measurement_writes_its_method_status_and_failure_as_documented() -> None:
+    ok = measurement_entry(MeasurementRecord(_measurement(0.003, 0.5), "none", 0))
+    assert list(ok) == list(MEASUREMENT_KEYS)
+    assert ok["method"] == "model2" and ok["status"] == "ok" and ok["failure"] is None
+    assert ok["error_m"] == pytest.approx(0.003)
+    lost = measurement_entry(MeasurementRecord(_measurement(0.0, 0.5, LOST), "none", 1))
+    assert lost["status"] == "Ca2 at step 1: target lost (and at 12 eye angles searched)"
+    assert lost["failure"] == {
+        "cause": "lost",
+        "stage": "step 1",
+        "camera": 2,
+        "detail": "and at 12 eye angles searched",
+    }
+
+
+def test_a_calibration_that_could_not_lay_out_its_positions_writes_five_keys() -> None:
+    report = CalibrationReport(Status.FAILED, "failed: no room", 8, 0, 0, ())
+    block = calibration_block(report)
+    assert block == {
+        "status": "failed: no room",
+        "targets": 8,
+        "fixated": 0,
+        "renders": 0,
+        "positions": [],
+    }
+
+
+def test_a_calibration_block_reads_back_to_the_same_report_and_bytes() -> None:
+    report = _full_report()
+    text = json.dumps(to_jsonable(calibration_block(report)), indent=2)
+    block = json.loads(text)
+    assert list(block)[:5] == ["status", "targets", "fixated", "renders", "layout"]
+    assert list(block)[-2:] == ["positions", "rendered_frames"]
+    assert block["positions"][1] == {"status": LOST.message, "failure": LOST.as_dict()}
+    assert calibration_from_block(block) == report
+    source = CalibrationSource("/tmp/head.json", "quickstart", 0, "abc", 40)
+    stored = calibration_from_block(block, renders=0, source=source)
+    assert stored.renders == 0 and stored.ok
+    again = calibration_block(stored)
+    assert list(again)[-1] == "from" and again["from"]["renders"] == 40
+    # What results.json held before the typed report: the block, renders 0, then "from".
+    assert json.dumps(to_jsonable(again)) == json.dumps(
+        to_jsonable({**block, "renders": 0, "from": again["from"]})
+    )
+
+
+def test_each_experiment_writes_the_procedure_first() -> None:
+    assert experiment_block("model2", PointsResult()) == {"procedure": "model2"}
+    assert experiment_block("chessboard", None) == {"procedure": "chessboard"}
+    tracking = TrackingResult([0.0, 1.0], [[0.0, 0.5, 0.6]], [0.001, 0.002], 12, 4.0)
+    assert list(experiment_block("tracking", tracking)) == [
+        "procedure",
+        "times_s",
+        "waypoints_world_m",
+        "errors_world_m",
+        "renders_first",
+        "renders_after_mean",
+    ]
+    never = PursuitResult({"mode": "smooth"}, failures=("ball: never present in the run",))
+    assert experiment_block("pursuit", never) == {
+        "procedure": "pursuit",
+        "pursuit": {"mode": "smooth"},
+    }
