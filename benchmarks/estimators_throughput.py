@@ -16,7 +16,7 @@ import platform
 import numpy as np
 
 from headsim.estimators.throughput import run
-from headsim.run.results import write_json_atomic
+from headsim.files import write_json_atomic
 
 
 def main(argv: list[str] | None = None) -> int:

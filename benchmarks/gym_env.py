@@ -23,7 +23,7 @@ from gymnasium.utils.env_checker import check_env
 
 import headsim.envs
 from headsim.envs.policies import RandomPolicy, ServoPolicy
-from headsim.run.results import write_json_atomic
+from headsim.files import write_json_atomic
 
 ID = headsim.envs.FIXATE_ID
 

@@ -27,9 +27,9 @@ from functools import partial
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
+from headsim.files import write_json_atomic
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Sinusoid, Waypoints
 from headsim.live.gaze import GazeConfig, SaccadeProfile, acquire, pursue
-from headsim.run.results import write_json_atomic
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import find_marker

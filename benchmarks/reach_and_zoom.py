@@ -38,7 +38,7 @@ from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import calibration_layout
 from headsim.active.principal import principal_points_by_zoom
-from headsim.run.results import write_json_atomic
+from headsim.files import write_json_atomic
 from headsim.run.targets import marker_target
 from headsim.scenario.reach import reach_refusal
 from headsim.sim import names

@@ -23,11 +23,11 @@ import numpy as np
 
 from headsim.estimators import model2
 from headsim.estimators.calibration import calibrate_initial_directions, calibrate_lines_of_sight
+from headsim.files import write_csv_atomic
 from headsim.geometry.camera_model import PinholeCamera
 from headsim.geometry.synthetic import StereoHead, observe, quantise
 from headsim.paper import INITIAL_DIRECTIONS_RAD as PAPER_INITIAL_DIRECTIONS
 from headsim.paper import INTRINSICS as PAPER_INTRINSICS
-from headsim.run.results import write_csv_atomic
 from headsim.scenario.calibration_design import near_far_depths, offset_std_limit
 from headsim.sim.tolerances import REALISTIC_BUDGET
 from headsim.studies.plots import plot_budget

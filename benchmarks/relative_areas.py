@@ -27,7 +27,7 @@ import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
 from headsim.active.relative import relative_positioning
-from headsim.run.results import write_json_atomic
+from headsim.files import write_json_atomic
 from headsim.run.runner import PARKED_WORLD_M
 from headsim.scenario.area_layouts import area_layout
 from headsim.sim import names

@@ -18,8 +18,8 @@ import time
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
+from headsim.files import write_json_atomic
 from headsim.geometry.transforms import frame_deviation
-from headsim.run.results import write_json_atomic
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim

@@ -19,7 +19,7 @@ from collections.abc import Callable
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.run.results import write_json_atomic
+from headsim.files import write_json_atomic
 from headsim.sim import names
 from headsim.sim.settings import ideal_head
 from headsim.sim.simulator import HeadSim

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from headsim.active.measurement import HeadKnowledge
-from headsim.run.results import to_jsonable, write_json_atomic
+from headsim.files import to_jsonable, write_json_atomic
 from headsim.sim.settings import HeadSettings
 
 FORMAT = "headsim-calibration/1"

@@ -22,8 +22,8 @@ def file_size(path: Path) -> str:
 
 def write_all(files: dict[Path, object]) -> None:
     """Write the result files atomically; on a full disk remove the ones this call wrote."""
+    from headsim.files import write_json_atomic, write_text_atomic
     from headsim.run.outputs import disk_full
-    from headsim.run.results import write_json_atomic, write_text_atomic
 
     written: list[Path] = []
     for path, content in files.items():
@@ -46,7 +46,7 @@ def write_all(files: dict[Path, object]) -> None:
 def json_size(payload: object) -> int:
     import json
 
-    from headsim.run.results import to_jsonable
+    from headsim.files import to_jsonable
 
     return len(json.dumps(to_jsonable(payload), indent=2).encode()) + 1
 

@@ -273,7 +273,7 @@ class PursuitFigures:
 
 @dataclass(frozen=True)
 class PursuitResult:
-    """The live pursuit (:mod:`headsim.live.procedure`): the spec as run, its figures and
+    """The live pursuit (:mod:`headsim.run.pursuit`): the spec as run, its figures and
     each frame (None when it never started), and why it failed, one line each."""
 
     pursuit: dict[str, Any]

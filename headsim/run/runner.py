@@ -493,8 +493,8 @@ def _run_tracking(
 def _run_pursuit(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
 ) -> tuple[list[MeasurementRecord], PursuitResult]:
-    """The live head pursues a moving target (headsim.live.procedure)."""
-    from headsim.live.procedure import run_pursuit
+    """The live head pursues a moving target (headsim.run.pursuit)."""
+    from headsim.run.pursuit import run_pursuit
 
     records, block = run_pursuit(scenario, hub, knowledge, label)
     known = {"pursuit", "per_frame", "failures", *(f.name for f in fields(PursuitFigures))}

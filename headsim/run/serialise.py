@@ -3,7 +3,7 @@
 ``results.json`` (README "Scenarios and results" documents every key) holds
 no wall time and no timestamp: the same scenario, seed and software give the
 same bytes.  SI units (m, rad, px); NaN becomes null when
-:func:`headsim.run.results.write_json_atomic` writes it.  A calibration read
+:func:`headsim.files.write_json_atomic` writes it.  A calibration read
 back from a file (``[experiment.calibration] from``) is parsed by
 :func:`calibration_from_block`, the inverse of :func:`calibration_block`.
 """
@@ -321,7 +321,7 @@ def experiment_block(procedure: str, experiment: Experiment | None) -> dict[str,
 
 
 def results_payload(result: RunResult) -> dict[str, Any]:
-    """The results.json document (plain data; :func:`headsim.run.results.write_json_atomic` writes it)."""
+    """The results.json document (plain data; :func:`headsim.files.write_json_atomic` writes it)."""
     s = result.scenario
     return {
         "schema": RESULTS_SCHEMA,

@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 
 import headsim
-from headsim.run.results import write_json_atomic, write_png_atomic
+from headsim.files import write_json_atomic, write_png_atomic
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim

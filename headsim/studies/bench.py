@@ -27,8 +27,8 @@ from headsim.active.model2 import measure_model2
 from headsim.active.placement import calibration_layout
 from headsim.active.servo_types import ServoConfig
 from headsim.estimators.throughput import run as estimator_throughput
+from headsim.files import write_json_atomic
 from headsim.run.progress import Status
-from headsim.run.results import write_json_atomic
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, paper_head, preset
 from headsim.sim.simulator import HeadSim

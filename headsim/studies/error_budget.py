@@ -43,13 +43,13 @@ from typing import Any
 
 import numpy as np
 
-from headsim.geometry.kinematics import world_to_head
-from headsim.run.accuracy import DEPTH_BANDS_M
-from headsim.run.results import (
+from headsim.files import (
     write_csv_atomic,
     write_json_atomic,
     write_text_atomic,
 )
+from headsim.geometry.kinematics import world_to_head
+from headsim.run.accuracy import DEPTH_BANDS_M
 from headsim.sim.settings import HeadSettings
 
 #: The scenario the budget runs: the realistic head over the whole shared field.

@@ -29,7 +29,7 @@ matplotlib.use("Agg")  # no display; must precede pyplot
 import matplotlib.pyplot as plt
 import numpy as np
 
-from headsim.run.results import write_bytes_atomic
+from headsim.files import write_bytes_atomic
 from headsim.studies.methods import METHOD_LABELS
 
 if TYPE_CHECKING:

@@ -40,8 +40,8 @@ from pathlib import Path
 from typing import Any
 
 from headsim.errors import OutputNotWritable
+from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.run.progress import Status, quiet
-from headsim.run.results import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.studies.jobs import render_pool
 from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
 from headsim.studies.reproduce_experiments import (

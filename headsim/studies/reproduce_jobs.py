@@ -12,7 +12,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from headsim.run.results import to_jsonable, write_json_atomic, write_text_atomic
+from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.studies.reproduce_experiments import FIXED_POINT_TARGETS, SCENARIO_JOBS, TABLES_HEAD
 
 

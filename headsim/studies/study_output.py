@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from headsim.run.results import to_jsonable, write_csv_atomic, write_json_atomic
+from headsim.files import to_jsonable, write_csv_atomic, write_json_atomic
 from headsim.sim.settings import HeadSettings
 from headsim.studies.methods import METHOD_LABELS
 from headsim.studies.study_experiments import ExperimentResult, compare_figures

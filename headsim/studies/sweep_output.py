@@ -7,7 +7,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from headsim.run.results import write_csv_atomic, write_json_atomic
+from headsim.files import write_csv_atomic, write_json_atomic
 from headsim.studies.sweep_spec import SweepSpec
 
 #: Columns of aggregate.csv after the swept fields.

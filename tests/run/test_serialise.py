@@ -10,6 +10,7 @@ import pytest
 from headsim.active.failure import Failure, FailureCause
 from headsim.active.measurement import Measurement
 from headsim.estimators.result import Method, Status
+from headsim.files import to_jsonable
 from headsim.run.outcomes import (
     CalibrationLayout,
     CalibrationReport,
@@ -23,7 +24,6 @@ from headsim.run.outcomes import (
     TrackingResult,
     VerticalReference,
 )
-from headsim.run.results import to_jsonable
 from headsim.run.serialise import (
     MEASUREMENT_KEYS,
     calibration_block,

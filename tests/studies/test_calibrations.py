@@ -6,7 +6,7 @@ import json
 
 import numpy as np
 
-from headsim.run.results import to_jsonable
+from headsim.files import to_jsonable
 
 
 def test_calibrations_are_close_to_the_truth(calibrations) -> None:

@@ -1,4 +1,4 @@
-"""Writing results: JSON that scripts read, written atomically."""
+"""Result files: JSON that scripts read, CSV, text and PNG, each written atomically."""
 
 from __future__ import annotations
 

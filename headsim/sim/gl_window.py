@@ -1,0 +1,202 @@
+"""Windows of a camera's image, drawn as the whole frame clipped to the window.
+
+A :class:`Window` is a sub-rectangle of a camera's output image.  It is drawn
+with the frame's own projection and viewport and four OpenGL user clip planes a
+few pixels outside it (:func:`clipped_to`), into an off-screen buffer that
+reaches only from the frame's origin to the window's far corner
+(:class:`WindowBuffer`): every vertex lands where it does in the full frame, to
+the bit, so the window's pixels are the frame's crop (README, windows).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import OrderedDict
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from headsim.sim.backend import RenderBackendError
+
+
+@dataclass(frozen=True)
+class Window:
+    """A sub-rectangle of a camera's output image: top-left (x0, y0) and size, px."""
+
+    x0: int
+    y0: int
+    width: int
+    height: int
+
+    @property
+    def x1(self) -> int:
+        return self.x0 + self.width
+
+    @property
+    def y1(self) -> int:
+        return self.y0 + self.height
+
+    @classmethod
+    def around(
+        cls, centre_uv: tuple[float, float], half_px: float, image_size: tuple[int, int]
+    ) -> Window:
+        """The square of half-side ``half_px`` around ``centre_uv``, moved inside the image."""
+        width, height = image_size
+        side_u = min(width, 2 * math.ceil(half_px) + 1)
+        side_v = min(height, 2 * math.ceil(half_px) + 1)
+        x0 = min(max(round(centre_uv[0] - side_u / 2), 0), width - side_u)
+        y0 = min(max(round(centre_uv[1] - side_v / 2), 0), height - side_v)
+        return cls(int(x0), int(y0), int(side_u), int(side_v))
+
+
+#: Raster pixels kept around a window by the clip planes of :func:`clipped_to`: the
+#: edges that clipping makes lie this far outside the window's pixels.
+CLIP_MARGIN_PX = 4
+#: The OpenGL user clip planes the windows use (MuJoCo uses plane 0 for reflections).
+CLIP_PLANES = (1, 2, 3, 4)
+
+
+@contextmanager
+def clipped_to(
+    scene: mujoco.MjvScene, rect: Window, k: int, full_size: tuple[int, int]
+) -> Iterator[None]:
+    """Clip the scene's geometry to ``rect`` (canvas pixels, supersampled ``k`` times, in a
+    frame of ``full_size`` raster pixels) plus :data:`CLIP_MARGIN_PX`, for the next
+    ``mjr_render`` of the whole frame.
+
+    Four planes through the camera's centre, in eye coordinates, from the frustum
+    that ``mjr_render`` will use: geometry outside them is not rasterised, and
+    every vertex inside keeps its place in the frame.
+    """
+    from OpenGL import GL  # mujoco's own dependency (its EGL and GLFW contexts)
+
+    full_w, full_h = full_size
+    camera = scene.camera[0]
+    near = float(camera.frustum_near)
+    half_w = float(camera.frustum_width) or 0.5 * full_w / full_h * float(
+        camera.frustum_top - camera.frustum_bottom
+    )
+    left = float(camera.frustum_center) - half_w
+    right = float(camera.frustum_center) + half_w
+    bottom, top = float(camera.frustum_bottom), float(camera.frustum_top)
+    # x_ndc = (sx x + ox z) / (-z), likewise y (glFrustum), eye coordinates.
+    sx, ox = 2 * near / (right - left), (right + left) / (right - left)
+    sy, oy = 2 * near / (top - bottom), (top + bottom) / (top - bottom)
+    m = CLIP_MARGIN_PX
+    x_lo = 2 * (k * rect.x0 - m) / full_w - 1
+    x_hi = 2 * (k * rect.x1 + m) / full_w - 1
+    y_lo = 2 * (full_h - k * rect.y1 - m) / full_h - 1  # OpenGL's y runs up
+    y_hi = 2 * (full_h - k * rect.y0 + m) / full_h - 1
+    planes = (  # a point is kept where plane . (x, y, z, 1) >= 0
+        (sx, 0.0, ox + x_lo, 0.0),
+        (-sx, 0.0, -(ox + x_hi), 0.0),
+        (0.0, sy, oy + y_lo, 0.0),
+        (0.0, -sy, -(oy + y_hi), 0.0),
+    )
+    GL.glMatrixMode(GL.GL_MODELVIEW)
+    GL.glLoadIdentity()  # the planes are given in eye coordinates
+    for n, plane in zip(CLIP_PLANES, planes, strict=True):
+        GL.glClipPlane(GL.GL_CLIP_PLANE0 + n, np.array(plane, dtype=np.float64))
+        GL.glEnable(GL.GL_CLIP_PLANE0 + n)
+    try:
+        yield
+    finally:
+        for n in CLIP_PLANES:
+            GL.glDisable(GL.GL_CLIP_PLANE0 + n)
+
+
+#: Off-screen buffers for windows kept per OpenGL context (the least recently used goes).
+WINDOW_BUFFERS = 6
+#: Their sizes are rounded up to this many raster pixels (llvmpipe's tile), to reuse them.
+BUFFER_STEP = 64
+
+
+class WindowBuffer:
+    """A multisampled off-screen buffer like the context's own (same formats and
+    samples), of another size, and its single-sample resolve buffer."""
+
+    def __init__(self, context: mujoco.MjrContext, size: tuple[int, int]) -> None:
+        from OpenGL import GL
+
+        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, context.offColor)
+        colour = GL.glGetRenderbufferParameteriv(
+            GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_INTERNAL_FORMAT
+        )
+        samples = GL.glGetRenderbufferParameteriv(GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_SAMPLES)
+        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, context.offDepthStencil)
+        depth = GL.glGetRenderbufferParameteriv(
+            GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_INTERNAL_FORMAT
+        )
+        width, height = size
+        self.renderbuffers = [int(r) for r in GL.glGenRenderbuffers(3)]
+        self.framebuffers = [int(f) for f in GL.glGenFramebuffers(2)]
+        storage = (
+            (samples, colour, GL.GL_COLOR_ATTACHMENT0, 0),
+            (samples, depth, GL.GL_DEPTH_STENCIL_ATTACHMENT, 0),
+            (0, colour, GL.GL_COLOR_ATTACHMENT0, 1),
+        )
+        for renderbuffer, (n, fmt, attachment, framebuffer) in zip(
+            self.renderbuffers, storage, strict=True
+        ):
+            GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, renderbuffer)
+            GL.glRenderbufferStorageMultisample(GL.GL_RENDERBUFFER, n, fmt, width, height)
+            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, self.framebuffers[framebuffer])
+            GL.glFramebufferRenderbuffer(
+                GL.GL_FRAMEBUFFER, attachment, GL.GL_RENDERBUFFER, renderbuffer
+            )
+        for framebuffer in self.framebuffers:
+            GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, framebuffer)
+            status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
+            if status != GL.GL_FRAMEBUFFER_COMPLETE:
+                raise RenderBackendError(f"window buffer {size} incomplete (status {status})")
+
+
+def draw_window(
+    renderer: mujoco.Renderer, rect: Window, k: int, full_size: tuple[int, int]
+) -> np.ndarray:
+    """Raster pixels (k h, k w, 3) of ``rect`` (canvas pixels, supersampled ``k``
+    times) of the scene, drawn as the whole frame of ``full_size`` raster pixels
+    clipped to the window (:func:`clipped_to`).
+
+    The frame is drawn into a buffer only as large as the window's far corner
+    from the frame's origin needs (rounded up to a tile), not the context's:
+    ``mjr_render`` clears all of its viewport, and a whole frame's
+    multisampled buffer costs more to clear than the window to draw.
+    """
+    from OpenGL import GL
+
+    full_w, full_h = full_size
+    context = renderer._mjr_context
+    step, margin = BUFFER_STEP, CLIP_MARGIN_PX
+    size = (
+        min(full_w, step * math.ceil((k * rect.x1 + margin) / step)),
+        min(full_h, step * math.ceil((full_h - k * rect.y0 + margin) / step)),
+    )
+    buffers = renderer.__dict__.setdefault("_headsim_window_buffers", OrderedDict())
+    buffer = buffers.pop(size, None) or WindowBuffer(context, size)
+    buffers[size] = buffer
+    while len(buffers) > WINDOW_BUFFERS:
+        _, oldest = buffers.popitem(last=False)
+        GL.glDeleteFramebuffers(len(oldest.framebuffers), oldest.framebuffers)
+        GL.glDeleteRenderbuffers(len(oldest.renderbuffers), oldest.renderbuffers)
+    x, y = k * rect.x0, full_h - k * rect.y1  # OpenGL's rows run bottom-up
+    width, height = k * rect.width, k * rect.height
+    try:
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, buffer.framebuffers[0])
+        with clipped_to(renderer.scene, rect, k, full_size):
+            mujoco.mjr_render(mujoco.MjrRect(0, 0, full_w, full_h), renderer.scene, context)
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, buffer.framebuffers[0])
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, buffer.framebuffers[1])
+        GL.glBlitFramebuffer(
+            x, y, x + width, y + height, x, y, x + width, y + height,
+            GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST,
+        )  # fmt: skip
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, buffer.framebuffers[1])
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        raw = GL.glReadPixels(x, y, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
+    finally:
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, context)
+    return np.frombuffer(raw, dtype=np.uint8).reshape(height, width, 3).copy()
