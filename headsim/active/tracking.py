@@ -42,7 +42,7 @@ def track_moving_target(
     target: Target,
     body: str,
     trajectory: Callable[[float], np.ndarray],
-    times_s: Sequence[float],
+    times_s: Sequence[float] | np.ndarray,
     knowledge: HeadKnowledge | None = None,
     sink: EventSink | None = None,
 ) -> TrackingRun:

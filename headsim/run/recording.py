@@ -215,7 +215,7 @@ class Recorder:
             sinks.append(rr.FileSink(self.path))
         if sinks:
             self.rec.set_sinks(*sinks, default_blueprint=layout)  # each sink gets the layout
-        else:
+        elif self.path is not None:
             self.rec.save(self.path, default_blueprint=layout)
         if target.serve:
             # The page only; the data comes from the gRPC server above.

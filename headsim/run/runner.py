@@ -13,7 +13,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, fields, replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -34,7 +34,7 @@ from headsim.active.model2 import Model2Config, measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import calibration_layout
 from headsim.active.relative import relative_positioning
-from headsim.active.servo_types import ServoConfig
+from headsim.active.servo_types import Detector, ServoConfig
 from headsim.active.tracking import track_moving_target
 from headsim.estimators.result import Status
 from headsim.run.events import CalibrationDone, Hub, MeasurementRecorded, RunFinished, Subscriber
@@ -399,7 +399,10 @@ def _run_relative(
             sim.set_body_pose(body, np.array(PARKED_WORLD_M))
         truth = {p.name: np.array(p.position_world_m) for p in (scene.blocks, *scene.objects)}
         hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
-        reference = Target(names.BLOCKS, find_cross_point, lambda s: s.position(names.BLOCKS))
+        # A cross point's detection has the status and uv the servo reads; it is never
+        # windowed (only blob detectors are), so it stands in for a Detection.
+        cross = cast(Detector, find_cross_point)
+        reference = Target(names.BLOCKS, cross, lambda s: s.position(names.BLOCKS))
         run = relative_positioning(
             sim, EyeServo(sim, _servo_config(scenario)), reference, colours, knowledge
         )  # the reference's fixation is the phase's one step

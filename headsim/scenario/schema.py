@@ -146,15 +146,15 @@ def read_head(doc: Table, ctx: Context) -> tuple[HeadSettings, str, str]:
     resolution = head.number(
         "encoder_resolution_rad", base.encoder_resolution_rad, 0.0, 0.01, lo_open=True, unit="rad"
     )
-    mount_range = dict(lo=-0.5, hi=0.5, lo_open=True, hi_open=True, unit="rad")
-    initial = head.numbers("initial_direction_rad", 2, None, **mount_range)  # type: ignore[arg-type]
-    yaw = head.numbers("mount_yaw_rad", 2, None, **mount_range)  # type: ignore[arg-type]
+    mount_range: dict[str, Any] = dict(lo=-0.5, hi=0.5, lo_open=True, hi_open=True, unit="rad")
+    initial = head.numbers("initial_direction_rad", 2, None, **mount_range)
+    yaw = head.numbers("mount_yaw_rad", 2, None, **mount_range)
     if initial is not None and yaw is not None:
         raise head.fail(
             "mount_yaw_rad", "given together with initial_direction_rad", "one of the two"
         )
-    pitch = head.numbers("mount_pitch_rad", 2, (0.0, 0.0), **mount_range)  # type: ignore[arg-type]
-    roll = head.numbers("mount_roll_rad", 2, (0.0, 0.0), **mount_range)  # type: ignore[arg-type]
+    pitch = head.numbers("mount_pitch_rad", 2, (0.0, 0.0), **mount_range)
+    roll = head.numbers("mount_roll_rad", 2, (0.0, 0.0), **mount_range)
     settle = head.choice("settle", ("kinematic", "physics"), "kinematic")
     backlash = head.number("backlash_rad", base.backlash_rad, 0.0, 0.01, unit="rad")
     count_error = head.boolean("count_error", base.count_error)

@@ -18,6 +18,7 @@ taken is reported to the simulator's event sink (:mod:`headsim.sim.events`).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import mujoco
@@ -294,7 +295,10 @@ class HeadSim:
         return points @ transform[:3, :3].T + transform[:3, 3]
 
     def set_body_pose(
-        self, name: str, position_world_m: np.ndarray, quat_world: np.ndarray | None = None
+        self,
+        name: str,
+        position_world_m: np.ndarray | Sequence[float],
+        quat_world: np.ndarray | None = None,
     ) -> None:
         """Place a mocap body (a target) in the world; takes effect at once."""
         body_id = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)

@@ -13,7 +13,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from functools import partial
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -25,6 +25,7 @@ from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import calibration_layout
 from headsim.active.relative import relative_positioning
+from headsim.active.servo_types import Detector
 from headsim.active.tracking import track_moving_target
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
@@ -268,7 +269,8 @@ def relative_areas(
     renders = []
     with HeadSim("blocks", settings) as sim:
         servo = EyeServo(sim)
-        reference = body_target(names.BLOCKS, find_cross_point)
+        # Status and uv are all the servo reads of a cross point (never windowed).
+        reference = body_target(names.BLOCKS, cast(Detector, find_cross_point))
         for layout in range(layouts):
             for name in names.RELATIVE_OBJECTS:
                 z = rng.uniform(0.8, 1.9)

@@ -14,7 +14,8 @@ from headsim.sim.settings import HeadSettings
 
 def centred(settings: HeadSettings) -> HeadSettings:
     """The same head with both principal points at the image centre."""
-    return replace(settings, cameras=tuple(replace(c, cx=None, cy=None) for c in settings.cameras))
+    cam1, cam2 = (replace(c, cx=None, cy=None) for c in settings.cameras)
+    return replace(settings, cameras=(cam1, cam2))
 
 
 def principal_shifted(settings: HeadSettings, shift_px: float) -> HeadSettings:
@@ -33,14 +34,14 @@ def principal_shifted(settings: HeadSettings, shift_px: float) -> HeadSettings:
 
 def k1_changed(settings: HeadSettings, change: float) -> HeadSettings:
     """Both cameras' k1 changed by ``change`` (positive: less barrel distortion)."""
-    return replace(settings, cameras=tuple(replace(c, k1=c.k1 + change) for c in settings.cameras))
+    cam1, cam2 = (replace(c, k1=c.k1 + change) for c in settings.cameras)
+    return replace(settings, cameras=(cam1, cam2))
 
 
 def with_noise(settings: HeadSettings, noise_std: float) -> HeadSettings:
     """Both cameras with Gaussian image noise of ``noise_std`` grey levels."""
-    return replace(
-        settings, cameras=tuple(replace(c, noise_std=noise_std) for c in settings.cameras)
-    )
+    cam1, cam2 = (replace(c, noise_std=noise_std) for c in settings.cameras)
+    return replace(settings, cameras=(cam1, cam2))
 
 
 def with_encoder(settings: HeadSettings, steps_per_turn: float) -> HeadSettings:
