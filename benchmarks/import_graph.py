@@ -1,0 +1,137 @@
+"""Import graph of headsim: circles, upward imports between layers, the largest modules.
+
+    python benchmarks/import_graph.py [REPO_ROOT]
+
+The layers, low to high, are LAYERS (a module's layer is its package under
+headsim/, or its own name for a top-level module). An import from a module to a
+higher layer is upward. Imports inside functions count; a TYPE_CHECKING block
+does not. Exit status 1 when there is a circle, an upward import or a module
+over MAX_LINES lines.
+"""
+
+from __future__ import annotations
+
+import ast
+import sys
+from pathlib import Path
+
+LAYERS = (
+    "errors",
+    "files",
+    "paper",
+    "geometry",
+    "estimators",
+    "sim",
+    "vision",
+    "stereo",
+    "active",
+    "live",
+    "scenario",
+    "run",
+    "studies",
+    "envs",
+    "cli",
+)
+MAX_LINES = 400
+
+
+def module_name(root: Path, path: Path) -> str:
+    parts = list(path.relative_to(root).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imports(tree: ast.AST) -> list[str]:
+    """Every headsim module or name imported outside TYPE_CHECKING blocks."""
+    found: list[str] = []
+
+    def visit(node: ast.AST) -> None:
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test):
+                continue
+            if isinstance(child, ast.ImportFrom) and child.level == 0 and child.module:
+                found.extend(f"{child.module}.{alias.name}" for alias in child.names)
+            elif isinstance(child, ast.Import):
+                found.extend(alias.name for alias in child.names)
+            visit(child)
+
+    visit(tree)
+    return [name for name in found if name.startswith("headsim")]
+
+
+def graph(root: Path) -> tuple[dict[str, set[str]], dict[str, int]]:
+    paths = {module_name(root, p): p for p in (root / "headsim").rglob("*.py")}
+    edges: dict[str, set[str]] = {}
+    for name, path in paths.items():
+        targets = set()
+        for imported in imports(ast.parse(path.read_text())):
+            while imported not in paths and "." in imported:
+                imported = imported.rsplit(".", 1)[0]
+            if imported in paths and imported != name:
+                targets.add(imported)
+        edges[name] = targets
+    lines = {name: len(path.read_text().splitlines()) for name, path in paths.items()}
+    return edges, lines
+
+
+def circles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """Strongly connected components of more than one module (Tarjan)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+
+    def strong(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in edges[v]:
+            if w not in index:
+                strong(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                found.append(sorted(component))
+
+    sys.setrecursionlimit(10_000)
+    for v in edges:
+        if v not in index:
+            strong(v)
+    return found
+
+
+def layer(name: str) -> int:
+    parts = name.split(".")
+    return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else -1
+
+
+def main() -> int:
+    root = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[1]
+    edges, lines = graph(root)
+    found = circles(edges)
+    upward = sorted(
+        (m, t) for m, ts in edges.items() for t in ts if 0 <= layer(m) < layer(t) and layer(t) >= 0
+    )
+    largest = sorted(lines.items(), key=lambda item: -item[1])
+    print(f"modules: {len(edges)}; imports between them: {sum(map(len, edges.values()))}")
+    print(f"circles: {len(found)}", *(" <-> ".join(c) for c in found), sep="\n  ")
+    print(f"upward imports ({' < '.join(LAYERS)}): {len(upward)}")
+    for m, t in upward:
+        print(f"  {m} -> {t}")
+    print("largest modules:", ", ".join(f"{m} ({n})" for m, n in largest[:5]))
+    over = [m for m, n in largest if n > MAX_LINES]
+    print(f"over {MAX_LINES} lines: {len(over)}", *over, sep="\n  ")
+    return 1 if found or upward or over else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
