@@ -26,8 +26,8 @@ import numpy as np
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.active.procedures import body_target, relative_positioning
 from headsim.active.servo import EyeServo
+from headsim.run.phases.setup import PARKED_WORLD_M
 from headsim.run.results import write_json_atomic
-from headsim.run.runner import PARKED_WORLD_M
 from headsim.scenario.area_layouts import area_layout
 from headsim.sim import names
 from headsim.sim.settings import preset

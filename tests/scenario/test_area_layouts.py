@@ -6,7 +6,7 @@ import numpy as np
 
 from headsim.active.procedures import body_target, relative_positioning
 from headsim.active.servo import EyeServo
-from headsim.run.runner import PARKED_WORLD_M
+from headsim.run.phases.setup import PARKED_WORLD_M
 from headsim.scenario.area_layouts import area_layout, reference_angles
 from headsim.sim import names
 from headsim.sim.settings import paper_head

@@ -1,0 +1,74 @@
+"""What every phase of a run builds from its scenario: the simulator reporting to the
+run's hub, the servo and Model 2 settings, what the head is told before a calibration,
+where unused bodies park, the paper's figures, and each measurement's record."""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from typing import Any
+
+from headsim.active.procedures import (
+    HeadKnowledge,
+    Measurement,
+    Model2Config,
+)
+from headsim.active.servo import ServoConfig
+from headsim.run.events import Hub, MeasurementRecorded
+from headsim.run.outcomes import MeasurementRecord
+from headsim.scenario.schema import Scenario
+from headsim.sim.settings import PAPER_INITIAL_DIRECTIONS
+from headsim.sim.simulator import HeadSim
+
+#: Where unused bodies are parked: under the table, out of every camera's view (W, m).
+PARKED_WORLD_M = (0.0, 0.5, -1.0)
+
+
+#: What the paper reports for each experiment (Sec. VI).
+PAPER: dict[str, Any] = {
+    "alpha_e_rad": PAPER_INITIAL_DIRECTIONS,
+    "chessboard_side_mean_m": 0.0303,
+    "chessboard_side_std_m": 0.000677,
+    "relative_alpha1_rad": 0.08,
+    "relative_alpha2_rad": 0.0349,
+    "relative_objects": 6,
+}
+
+
+def servo_config(scenario: Scenario) -> ServoConfig:
+    return ServoConfig(**asdict(scenario.experiment.servo))
+
+
+def model2_config(scenario: Scenario) -> Model2Config:
+    e = scenario.experiment
+    return Model2Config(interpolate=e.interpolate, midline_px=e.midline_px, remedy_px=e.remedy_px)
+
+
+def simulator(hub: Hub, scene: str, scenario: Scenario) -> HeadSim:
+    """The scenario's simulator in ``scene``, reporting to ``hub`` (so do its servos and
+    the procedures working with it)."""
+    return HeadSim(scene, scenario.settings, settle_mode=scenario.settle_mode, sink=hub)
+
+
+def told(scenario: Scenario) -> HeadKnowledge:
+    """What the scenario tells the head before any calibration: its goal columns, if given."""
+    goals = scenario.experiment.goal_columns_px
+    return HeadKnowledge() if goals is None else HeadKnowledge(u0=goals)
+
+
+def record_measurement(
+    hub: Hub, m: Measurement, knowledge: str, step: int, time_s: float | None = None
+) -> MeasurementRecord:
+    record = MeasurementRecord(m, knowledge, step, time_s)
+    hub.emit(MeasurementRecorded(record))
+    return record
+
+
+__all__ = [
+    "PAPER",
+    "PARKED_WORLD_M",
+    "model2_config",
+    "record_measurement",
+    "servo_config",
+    "simulator",
+    "told",
+]
