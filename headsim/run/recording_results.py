@@ -21,7 +21,7 @@ from headsim.run.recording_layout import (
     WHITE,
 )
 from headsim.run.recording_scene import SceneLogging
-from headsim.run.report import summary_text
+from headsim.run.summary import summary_text
 from headsim.sim import names
 
 

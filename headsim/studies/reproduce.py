@@ -159,9 +159,9 @@ def _calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
 
 @_plain_errors
 def _scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
-    from headsim.run.report import summary_text
     from headsim.run.runner import run_scenario
     from headsim.run.serialise import results_payload
+    from headsim.run.summary import summary_text
     from headsim.scenario.schema import load_scenario
 
     scenario_name, _ = SCENARIO_JOBS[name]
