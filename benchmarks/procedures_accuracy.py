@@ -14,25 +14,24 @@ tracking with the neck.  Figures, not a test.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from typing import Any
 
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
+from headsim.run.progress import Status
 from headsim.run.results import write_json_atomic
 from headsim.sim.settings import HeadSettings, paper_head
 from headsim.studies import experiments
 
-
-def progress(message: str) -> None:
-    print(f"\r  {message:70s}", end="", file=sys.stderr, flush=True)
+#: Each experiment's steps on stderr: one redrawn line on a terminal, plain lines in a log.
+progress = Status("procedures_accuracy", transient=True)
 
 
 def done() -> None:
-    print("\r" + " " * 74 + "\r", end="", file=sys.stderr, flush=True)
+    progress.close()
 
 
 def fmt(value: Any, digits: int = 3) -> str:

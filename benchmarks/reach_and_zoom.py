@@ -30,17 +30,14 @@ from typing import Any
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
+from headsim.active.calibration import CalibrationError, calibrate_head
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge, Measurement
+from headsim.active.model1 import measure_model1
+from headsim.active.model2 import measure_model2
+from headsim.active.neck_servo import NeckServo
+from headsim.active.placement import calibration_layout
 from headsim.active.principal import principal_points_by_zoom
-from headsim.active.procedures import (
-    CalibrationError,
-    HeadKnowledge,
-    Measurement,
-    calibrate_head,
-    calibration_layout,
-    measure_model1,
-    measure_model2,
-)
-from headsim.active.servo import EyeServo, NeckServo
 from headsim.run.results import write_json_atomic
 from headsim.run.targets import marker_target
 from headsim.scenario.schema import reach_refusal

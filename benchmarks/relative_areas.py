@@ -24,8 +24,9 @@ from typing import Any
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.active.procedures import body_target, relative_positioning
-from headsim.active.servo import EyeServo
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import body_target
+from headsim.active.relative import relative_positioning
 from headsim.run.phases.setup import PARKED_WORLD_M
 from headsim.run.results import write_json_atomic
 from headsim.scenario.area_layouts import area_layout

@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from headsim.active.procedures import chessboard_corner_target
+from headsim.active.chessboard import chessboard_corner_target
 from headsim.sim.settings import HeadSettings, RenderFidelity
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detect import find_chessboard, find_marker

@@ -22,7 +22,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.run.results import to_jsonable, write_json_atomic
 from headsim.sim.settings import HeadSettings
 

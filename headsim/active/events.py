@@ -22,15 +22,12 @@ from __future__ import annotations
 import enum
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from headsim.active.measurement import HeadKnowledge, Measurement
+from headsim.sim.simulator import HeadSim
 from headsim.vision.detect import DetectionStatus
-
-if TYPE_CHECKING:
-    from headsim.active.procedures import HeadKnowledge, Measurement
-    from headsim.sim.simulator import HeadSim
 
 
 @dataclass(frozen=True)

@@ -135,7 +135,8 @@ def view_scale(settings: HeadSettings, reference_focal_px: float = 850.0) -> flo
 
 def zoomed(settings: HeadSettings, factor: float) -> HeadSettings:
     """The same head with both cameras' focal lengths scaled by ``factor``."""
-    return replace(settings, cameras=tuple(c.with_zoom(factor) for c in settings.cameras))
+    first, second = (c.with_zoom(factor) for c in settings.cameras)
+    return replace(settings, cameras=(first, second))
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""Why a measurement failed, and finding a lost target again from images alone.
+"""Finding a lost target again from images alone.
 
 A search uses only what a real head knows: the eye steps at which a camera
 last saw the target (the servo's memory), the start pose, and the gains the
@@ -9,97 +9,15 @@ render, counted by the caller through ``HeadSim.render_count``.
 
 from __future__ import annotations
 
-import enum
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from headsim.active.servo import (
-    Detector,
-    EyeServo,
-    NeckServo,
-    NeckServoResult,
-    ServoOutcome,
-    ServoResult,
-)
-from headsim.vision.detect import Detection, DetectionStatus
-
-
-class FailureCause(enum.Enum):
-    """Why a measurement (or one calibration position) failed."""
-
-    LOST = "lost"  # nothing of the target in the camera's image
-    CUT = "cut"  # the target runs off the image border
-    OCCLUDED = "occluded"  # partly hidden
-    JOINT_LIMIT = "joint limit"  # the fixation needs a joint beyond its range
-    ITERATION_LIMIT = "iteration limit"  # the servo's bound on moves
-    ESTIMATOR = "estimator"  # the estimator flagged the point invalid
-
-
-_FROM_DETECTION = {
-    DetectionStatus.LOST: FailureCause.LOST,
-    DetectionStatus.CUT: FailureCause.CUT,
-    DetectionStatus.OCCLUDED: FailureCause.OCCLUDED,
-}
-_FROM_OUTCOME = {
-    ServoOutcome.JOINT_LIMIT: FailureCause.JOINT_LIMIT,
-    ServoOutcome.ITERATION_LIMIT: FailureCause.ITERATION_LIMIT,
-}
-
-
-@dataclass(frozen=True)
-class Failure:
-    """A failure's cause, where it happened (``stage``: "step 1", "step 2",
-    "search", "fixation", "estimate"), in which camera (1, 2; None: not one
-    camera's), and any detail."""
-
-    cause: FailureCause
-    stage: str
-    camera: int | None = None
-    detail: str = ""
-
-    @property
-    def message(self) -> str:
-        where = f"Ca{self.camera} at {self.stage}" if self.camera else self.stage
-        what = (
-            f"target {self.cause.value}"
-            if self.cause in _FROM_DETECTION.values()
-            else (self.cause.value)
-        )
-        return f"{where}: {what}" + (f" ({self.detail})" if self.detail else "")
-
-    def as_dict(self) -> dict[str, object]:
-        return {
-            "cause": self.cause.value,
-            "stage": self.stage,
-            "camera": self.camera,
-            "detail": self.detail,
-        }
-
-
-def detection_failure(detection: Detection, stage: str, camera: int, detail: str = "") -> Failure:
-    """The failure of a detection that did not find the target."""
-    cause = _FROM_DETECTION.get(detection.status, FailureCause.LOST)
-    return Failure(cause, stage, camera, detail)
-
-
-def servo_failure(result: ServoResult, stage: str, camera: int) -> Failure:
-    """The failure of an eye servo run that did not converge."""
-    if result.outcome is ServoOutcome.TARGET_LOST:
-        cause = _FROM_DETECTION.get(result.lost_status or DetectionStatus.LOST, FailureCause.LOST)
-    else:
-        cause = _FROM_OUTCOME[result.outcome]
-    detail = f"after {result.iterations} moves" if result.iterations else "in its first image"
-    return Failure(cause, stage, camera, detail)
-
-
-def neck_failure(result: NeckServoResult, stage: str = "fixation") -> Failure:
-    """The failure of a neck servo run (Model 1) that did not converge."""
-    if result.outcome is ServoOutcome.TARGET_LOST:
-        cause = _FROM_DETECTION.get(result.lost_status or DetectionStatus.LOST, FailureCause.LOST)
-        return Failure(cause, stage, result.lost_camera, f"after {result.iterations} moves")
-    return Failure(_FROM_OUTCOME[result.outcome], stage, None, f"after {result.iterations} moves")
+from headsim.active.eye_servo import EyeServo
+from headsim.active.neck_servo import NeckServo
+from headsim.active.servo_types import Detector
+from headsim.vision.detect import Detection
 
 
 @dataclass(frozen=True)
@@ -245,15 +163,10 @@ def nearest_seen(
 
 
 __all__ = [
-    "Failure",
-    "FailureCause",
     "Found",
-    "detection_failure",
     "find_neck_view",
     "find_view",
     "nearest_seen",
-    "neck_failure",
     "neck_search_poses",
     "search_poses",
-    "servo_failure",
 ]

@@ -30,8 +30,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from headsim.active.procedures import HeadKnowledge
-from headsim.active.servo import Detector
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.neck_servo import NeckServo
+from headsim.active.servo_types import Detector, ServoConfig
 from headsim.geometry.kinematics import head_to_world
 from headsim.live.head import Frame, LiveHead
 from headsim.live.motors import MotorDriver, bang_bang_duration, min_jerk_duration
@@ -365,20 +366,22 @@ def pursue(
 
 
 def acquire(
-    live: LiveHead, detector: Detector, knowledge: HeadKnowledge | None = None
+    live: LiveHead,
+    detector: Detector,
+    knowledge: HeadKnowledge | None = None,
+    config: ServoConfig | None = None,
 ) -> GazeEstimator | None:
     """Fixate the target at rest with the paper's Model 1 servo and keep its image Jacobian.
 
     The head is at rest (the target held where it is at the present time);
     the servo's probes and moves settle kinematically, as the at-rest
-    procedures do.  None when the servo did not converge.
+    procedures do.  ``config``: the servo's (None: the defaults).  None when
+    the servo did not converge.
     """
-    from headsim.active.servo import NeckServo
-
     sim = live.sim
     knowledge = knowledge or HeadKnowledge()
     goals = (knowledge.reference(sim, 1), knowledge.reference(sim, 2))
-    servo = NeckServo(sim)
+    servo = NeckServo(sim, config)
     result = servo.run(detector, goals=(goals[0][0], goals[1][0], (goals[0][1] + goals[1][1]) / 2))
     if not result.converged or servo.jacobian is None:
         return None

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.live.gaze import FrameRecord, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
 from headsim.live.spec import PursuitSpec, describe
@@ -70,6 +70,7 @@ def run_pursuit(
 ) -> tuple[list[Any], dict[str, Any]]:
     """The runner's entry for ``procedure = "pursuit"``: (no point records, the experiment block)."""
     from headsim.active.events import PhaseStarted
+    from headsim.active.servo_types import ServoConfig
     from headsim.live.gaze import PursuitFrame
     from headsim.run.targets import marker_target
     from headsim.sim.simulator import HeadSim
@@ -92,9 +93,9 @@ def run_pursuit(
         if first is None:
             return [], {**experiment, "failures": [f"{spec.name}: never present in the run"]}
         live.advance_to(first)
-        # A plain callable, not the marker detector itself: acquiring looks at whole
-        # frames (no windows), as it always has; the servo reports its detections.
-        estimator = acquire(live, lambda image: target.detector(image), knowledge)
+        # Acquiring looks at whole frames (no windows or previews), as it always has.
+        whole_frames = ServoConfig(windows=False)
+        estimator = acquire(live, target.detector, knowledge, whole_frames)
         if estimator is None:
             return [], {**experiment, "failures": [f"{spec.name}: not acquired at rest"]}
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from headsim.active.search import Failure
+from headsim.active.failure import Failure
 from headsim.run.outcomes import MeasurementRecord
 
 #: Depth bands of the honest headline, m: every target counts in exactly one.

@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from headsim.active.procedures import Measurement
-from headsim.active.search import Failure
+from headsim.active.failure import Failure
+from headsim.active.measurement import Measurement
 from headsim.estimators.result import Status
 from headsim.scenario.schema import Scenario
 

@@ -179,7 +179,8 @@ class Status:
 
     ``headsim bench: [   12.3 s] chessboard``, one line each; with ``transient``
     on a terminal one tqdm line redrawn with each message and the time so far,
-    cleared by :meth:`close`.  Call it with each message.
+    cleared by :meth:`close` (the next message draws a new one).  Call it with
+    each message.  ``terminal``: redraw (default: whether ``stream`` is a terminal).
     """
 
     def __init__(
@@ -188,21 +189,28 @@ class Status:
         *,
         stream: TextIO | None = None,
         transient: bool = False,
+        terminal: bool | None = None,
         clock: Callable[[], float] = time.perf_counter,
     ) -> None:
         self.name = name
         self.stream = sys.stderr if stream is None else stream
         self.clock = clock
         self.start = clock()
+        self.redraw = transient and (is_terminal(self.stream) if terminal is None else terminal)
         self._bar: tqdm[Any] | None = None
-        if transient and is_terminal(self.stream):
-            self._bar = _bar(
-                self.stream, total=None, leave=False, bar_format=f"{name}: [{{elapsed}}] {{desc}}"
-            )
 
     def __call__(self, message: str) -> None:
-        if self._bar is not None:
-            self._bar.set_description_str(message)
+        if self.redraw:
+            if self._bar is None:
+                self._bar = _bar(
+                    self.stream,
+                    total=None,
+                    leave=False,
+                    desc=message,
+                    bar_format=f"{self.name}: [{{elapsed}}] {{desc}}",
+                )
+            else:
+                self._bar.set_description_str(message)
             return
         elapsed = self.clock() - self.start
         print(f"{self.name}: [{elapsed:7.1f} s] {message}", file=self.stream, flush=True)

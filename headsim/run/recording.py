@@ -53,7 +53,7 @@ import numpy as np
 import rerun as rr
 
 from headsim.active.events import Detected, FixationStarted, PhaseStarted
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
 from headsim.run.recording_layout import (

@@ -1,6 +1,6 @@
 """Running a scenario: calibrate if asked, run the procedure, collect the results.
 
-The procedures of :mod:`headsim.active.procedures` run unchanged.  What a run
+The procedures of :mod:`headsim.active` run unchanged.  What a run
 shows while it goes (progress, the Rerun recording) follows its events: the
 runner gives the simulator (and through it the servos and the procedures) a
 :class:`headsim.run.events.Hub` as event sink, and the hub passes every event
@@ -15,7 +15,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.run.events import CalibrationDone, Hub, RunFinished, Subscriber
 from headsim.run.outcomes import (
     CalibrationReport,

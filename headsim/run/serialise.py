@@ -21,7 +21,7 @@ import numpy as np
 import scipy
 
 import headsim
-from headsim.active.search import Failure, FailureCause
+from headsim.active.failure import Failure, FailureCause
 from headsim.estimators.result import Status
 from headsim.run.accuracy import MeasurementSummary, summaries
 from headsim.run.outcomes import (

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from functools import partial
 
-from headsim.active.procedures import Target
+from headsim.active.measurement import Target
 from headsim.scenario.schema import MARKER_BODIES
 from headsim.vision.detect import find_marker
 

@@ -15,8 +15,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from headsim.active.procedures import seen_by_both
+from headsim.active.placement import seen_by_both
 from headsim.estimators.areas import areas_from_geometry
+from headsim.geometry.sampling import sample_points_head
 from headsim.sim.simulator import HeadSim
 
 
@@ -116,10 +117,7 @@ def area_layout(
     chosen: list[np.ndarray | None] = [None] * len(wanted)
     for _ in range(batches):
         n = 4000
-        z = rng.uniform(*depth_m, size=n)
-        points = np.column_stack(
-            [rng.uniform(-lateral, lateral, n) * z, rng.uniform(*vertical, size=n) * z, z]
-        )
+        points = sample_points_head(rng, n, (-lateral, lateral), vertical, depth_range_m=depth_m)
         areas = areas_from_geometry(points, alpha1, alpha2, sim.settings.baseline_m, effective)
         areas[_hides_or_hidden(points, reference_head, sim.settings.baseline_m, clear_m)] = 0
         world = sim.transform_points(points, "head", "world")

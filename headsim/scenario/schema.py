@@ -35,6 +35,7 @@ import numpy as np
 
 from headsim.errors import BadInput
 from headsim.geometry.kinematics import head_to_world, world_to_head
+from headsim.geometry.sampling import sample_points_head
 from headsim.scenario.calibration_design import LAYOUTS
 from headsim.sim import names
 from headsim.sim.model import eye_from_camera_rotation, load_spec
@@ -775,9 +776,8 @@ def _random_points_head(table: _Table, count: int, rng: np.random.Generator) -> 
     near, far = _depth_range(table, (0.5, 1.2))
     lateral = table.number("lateral", 0.12, 0.0, 1.0, unit="(|x_h / z_h|)")
     vertical = table.number("vertical", 0.06, 0.0, 1.0, unit="(|y_h / z_h|)")
-    z = rng.uniform(near, far, size=count)
-    return np.column_stack(
-        [rng.uniform(-lateral, lateral, count) * z, rng.uniform(-vertical, vertical, count) * z, z]
+    return sample_points_head(
+        rng, count, (-lateral, lateral), (-vertical, vertical), depth_range_m=(near, far)
     )
 
 

@@ -23,14 +23,12 @@ from typing import Any
 import numpy as np
 
 import headsim
-from headsim.active.procedures import (
-    HeadKnowledge,
-    calibrate_head,
-    calibration_layout,
-    line_of_sight_truth,
-    measure_model2,
-)
-from headsim.active.servo import EyeServo, ServoConfig
+from headsim.active.calibration import calibrate_head, line_of_sight_truth
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.model2 import measure_model2
+from headsim.active.placement import calibration_layout
+from headsim.active.servo_types import ServoConfig
 from headsim.estimators.throughput import run as estimator_throughput
 from headsim.run.progress import Status
 from headsim.run.results import write_json_atomic

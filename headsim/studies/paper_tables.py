@@ -35,15 +35,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from headsim.active.calibration import CalibrationRun, calibrate_head
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge, Measurement
+from headsim.active.model2 import measure_model2
 from headsim.active.principal import PrincipalPointRun, zoomed
-from headsim.active.procedures import (
-    CalibrationRun,
-    HeadKnowledge,
-    Measurement,
-    calibrate_head,
-    measure_model2,
-)
-from headsim.active.servo import EyeServo
 from headsim.estimators import model2
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings

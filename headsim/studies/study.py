@@ -62,6 +62,11 @@ from typing import Any
 
 import numpy as np
 
+from headsim.active.calibration import CalibrationRun, calibrate_head
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge, body_target
+from headsim.active.model2 import measure_model2
+from headsim.active.placement import calibration_layout
 from headsim.active.principal import (
     PROBE_ZOOM,
     PrincipalPointRun,
@@ -69,15 +74,6 @@ from headsim.active.principal import (
     view_scale,
     zoomed,
 )
-from headsim.active.procedures import (
-    CalibrationRun,
-    HeadKnowledge,
-    body_target,
-    calibrate_head,
-    calibration_layout,
-    measure_model2,
-)
-from headsim.active.servo import EyeServo
 from headsim.errors import BadInput, JobFailed
 from headsim.run.progress import Status
 from headsim.run.results import to_jsonable, write_csv_atomic, write_json_atomic

@@ -16,8 +16,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from headsim.active.procedures import HeadKnowledge, measure_model2
-from headsim.active.servo import EyeServo
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.model2 import measure_model2
 from headsim.geometry.kinematics import head_to_world
 from headsim.run.targets import marker_target
 from headsim.sim.settings import HeadSettings, preset

@@ -1,4 +1,4 @@
-"""Search and re-acquisition of lost targets, and each named failure cause, on rendered images."""
+"""Search and re-acquisition of lost targets, on rendered images."""
 
 from __future__ import annotations
 
@@ -8,27 +8,24 @@ from functools import partial
 import numpy as np
 import pytest
 
-from headsim.active.procedures import (
-    CalibrationError,
-    HeadKnowledge,
-    Model2Config,
-    body_target,
-    calibrate_head,
-    calibration_layout,
-    measure_model1,
-    measure_model2,
-    seen_by_both,
-)
-from headsim.active.search import FailureCause, neck_search_poses
-from headsim.active.servo import EyeServo, NeckServo, ServoConfig
+from headsim.active.calibration import calibrate_head
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge, body_target
+from headsim.active.model1 import measure_model1
+from headsim.active.model2 import measure_model2
+from headsim.active.neck_servo import NeckServo
+from headsim.active.placement import calibration_layout, seen_by_both
+from headsim.active.search import neck_search_poses
 from headsim.geometry.kinematics import head_to_world
 from headsim.scenario.schema import _Head, model2_refusal, reach_refusal
 from headsim.sim import names
-from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
+from headsim.sim.settings import HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detect import find_marker
 
 RED = body_target("marker_red", partial(find_marker, colour="red"))
+
+
 BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))
 
 
@@ -112,72 +109,6 @@ def test_the_eye_servo_retreats_to_the_last_pose_that_saw_the_target() -> None:
         assert result.converged
         assert result.retreats >= 1
         assert abs(result.steps - reference.steps) <= 1
-
-
-def test_each_failure_names_its_cause() -> None:
-    with HeadSim("default") as sim:
-        # Lost: behind the head.
-        sim.set_body_pose("marker_red", [0.0, -1.0, 0.2])
-        lost = measure_model2(sim, EyeServo(sim), RED)
-        assert lost.failure is not None and lost.failure.cause is FailureCause.LOST
-        # Cut: half over Ca1's left border at the start pose (a fresh servo knows no
-        # gain, so it has nowhere else to look).
-        cam = sim.camera_settings(1)
-        x_over_z = (
-            3.0 - cam.image_centre[0]
-        ) / cam.kx  # centre 3 px in: the 7.7 px ball crosses the border
-        left = sim.transform_points(
-            np.array([x_over_z * 0.3, 0.0, 0.3]), names.CAMERAS[0], "world"
-        )[0]
-        sim.set_body_pose("marker_red", left)
-        cut = measure_model2(sim, EyeServo(sim), RED)
-        assert cut.failure is not None and cut.failure.cause is FailureCause.CUT, cut.status
-        assert (cut.failure.camera, cut.failure.stage) == (1, "step 1")
-        # Estimator: on the midline without the near-midline remedy, y is 0/0.
-        _place_in_head(sim, "marker_red", [0.0, 0.03, 0.6])
-        flat = measure_model2(sim, EyeServo(sim), RED, config=Model2Config(midline_px=0.0))
-        assert flat.failure is not None and flat.failure.cause is FailureCause.ESTIMATOR
-        assert "NO_Y" in flat.detail
-        # Iteration limit: one move allowed.
-        _place_in_head(sim, "marker_red", [0.1, 0.0, 0.5])
-        short = measure_model2(sim, EyeServo(sim, ServoConfig(max_iterations=1)), RED)
-        assert short.failure is not None
-        assert short.failure.cause is FailureCause.ITERATION_LIMIT
-        assert short.detail == "Ca1 at step 1: iteration limit (after 1 moves)"
-    # Joint limit: a wide-angle head sees a near target that Ca1 would need 0.9 rad to fixate.
-    wide = CameraSettings(kx=200.0, ky=200.0)
-    with HeadSim("default", HeadSettings(cameras=(wide, wide))) as sim:
-        _place_in_head(sim, "marker_red", [0.175, 0.0, 0.2])
-        far = measure_model2(sim, EyeServo(sim), RED)
-        assert far.failure is not None and far.failure.cause is FailureCause.JOINT_LIMIT, far.status
-        assert far.failure.camera == 1
-
-
-def test_calibration_failures_name_their_cause() -> None:
-    with HeadSim("default") as sim:
-        servo = EyeServo(sim)
-        ahead = sim.transform_points(np.array([0.02, 0.0, 0.4]), "head", "world")[0]
-        beside = sim.transform_points(np.array([0.05, 0.0, 0.4]), "head", "world")[0]
-        behind = np.array([0.0, -1.0, 0.2])
-        with pytest.raises(
-            CalibrationError,
-            match=r"too few positions seen: 1 of 3 .* because 2 Ca1 at step 1: target lost$",
-        ) as err:
-            calibrate_head(
-                sim, servo, BALL, names.CALIBRATION_BALL, np.array([ahead, behind, behind])
-            )
-        assert [o is None for o in err.value.outcomes] == [True, False, False]
-        # Two positions at one depth, one lateral spread: alpha_e1 and alpha_e2 not separable.
-        with pytest.raises(CalibrationError, match="degenerate layout because the 2 fixated"):
-            calibrate_head(
-                sim, servo, BALL, names.CALIBRATION_BALL, np.array([ahead, ahead]), extended=False
-            )
-        # Three positions at y = 0: nothing for the extended fit's v0 and kx/ky.
-        near = sim.transform_points(np.array([-0.03, 0.0, 0.3]), "head", "world")[0]
-        with pytest.raises(CalibrationError, match="needs a vertical spread"):
-            calibrate_head(
-                sim, servo, BALL, names.CALIBRATION_BALL, np.array([ahead, beside, near])
-            )
 
 
 def test_neck_search_looks_first_where_the_last_two_fixations_predict_the_target() -> None:

@@ -227,3 +227,27 @@ def test_losses_reacquisitions_and_a_target_that_disappears_and_reappears_elsewh
     assert sum(1 for r in jumped.records if r.truth_world_m is None) == 6  # 0.2 s at 30 Hz
     assert any(r.saccade for r in jumped.records if r.time_s >= 0.5)
     assert 0.0 < jumped.time_to_fixation_s(1.0, since_s=0.5) < 0.4
+
+
+def test_acquiring_with_the_servos_windows_off_looks_at_whole_frames_only() -> None:
+    from headsim.active.servo_types import ServoConfig
+    from headsim.sim.events import ImageKind, ImageTaken
+
+    class Sink:
+        def __init__(self) -> None:
+            self.kinds: list[ImageKind] = []
+
+        def emit(self, event: object) -> None:
+            if isinstance(event, ImageTaken):
+                self.kinds.append(event.kind)
+
+    kinds: dict[bool, list[ImageKind]] = {}
+    for windows in (True, False):
+        sink = Sink()
+        with HeadSim(settings=small_head(), sink=sink) as sim:
+            live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.28)))
+            estimator = acquire(live, RED, config=ServoConfig(windows=windows))
+            assert estimator is not None
+        kinds[windows] = sink.kinds
+    assert set(kinds[False]) == {ImageKind.FULL}
+    assert {ImageKind.PREVIEW, ImageKind.WINDOW} <= set(kinds[True])

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.active.procedures import Measurement
-from headsim.active.search import Failure, FailureCause
+from headsim.active.failure import Failure, FailureCause
+from headsim.active.measurement import Measurement
 from headsim.estimators.result import Method, Status
 from headsim.run.accuracy import DEPTH_BANDS_M, summaries, summarise
 from headsim.run.outcomes import MeasurementRecord

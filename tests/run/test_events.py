@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 
 from headsim.active.events import Detected, FixationStarted, PhaseStarted
-from headsim.active.servo import EyeServo, NeckServo
+from headsim.active.eye_servo import EyeServo
+from headsim.active.neck_servo import NeckServo
 from headsim.run.events import (
     CalibrationDone,
     MeasurementRecorded,

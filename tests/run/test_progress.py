@@ -111,6 +111,23 @@ def test_status_lines_carry_the_seconds_since_the_start() -> None:
     ]
 
 
+def test_a_transient_status_on_a_terminal_is_one_line_redrawn_and_cleared() -> None:
+    stream = io.StringIO()
+    status = Status("headsim bench", stream=stream, transient=True, terminal=True)
+    status("chessboard")
+    status("relative positioning")
+    status.close()
+    status("realistic head")  # a new line after the one cleared
+    status.close()
+    shown = [part for part in stream.getvalue().split("\r") if part.strip()]
+    assert shown[:2] == [
+        "headsim bench: [00:00] chessboard",
+        "headsim bench: [00:00] relative positioning",
+    ]
+    assert shown[-1] == "headsim bench: [00:00] realistic head"
+    assert "\n" not in stream.getvalue()  # nothing left on screen
+
+
 def test_run_and_sweep_print_plain_lines_in_a_log_and_nothing_when_quiet(tmp_path: Path) -> None:
     run = _cli("run", "quickstart", "--fast", "--out", str(tmp_path / "run"))
     assert run.returncode == 0, run.stderr

@@ -7,8 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from headsim.active.procedures import Measurement
-from headsim.active.search import Failure, FailureCause
+from headsim.active.failure import Failure, FailureCause
+from headsim.active.measurement import Measurement
 from headsim.estimators.result import Method, Status
 from headsim.run.outcomes import (
     CalibrationLayout,

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from headsim.active.procedures import body_target, relative_positioning
-from headsim.active.servo import EyeServo
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import body_target
+from headsim.active.relative import relative_positioning
 from headsim.run.phases.setup import PARKED_WORLD_M
 from headsim.scenario.area_layouts import area_layout, reference_angles
 from headsim.sim import names

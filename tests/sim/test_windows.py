@@ -5,9 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.active import servo as servo_module
-from headsim.active.procedures import HeadKnowledge, measure_model1, measure_model2
-from headsim.active.servo import EyeServo, NeckServo, ServoConfig
+from headsim.active import eye_servo
+from headsim.active import windows as window_module
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.model1 import measure_model1
+from headsim.active.model2 import measure_model2
+from headsim.active.neck_servo import NeckServo
+from headsim.active.servo_types import ServoConfig
 from headsim.sim import render
 from headsim.sim.render import Window
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
@@ -209,7 +214,8 @@ def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
     runs = {}
     for windows in (False, True):
         if windows:
-            monkeypatch.setattr(servo_module, "expected_window", far_away)
+            for module in (eye_servo, window_module):  # the servo's and the preview's
+                monkeypatch.setattr(module, "expected_window", far_away)
         with HeadSim("default", settings) as sim:
             servo = LoggingServo(sim, ServoConfig(windows=windows))
             measured = []
@@ -228,7 +234,7 @@ def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
 def test_windows_change_no_chessboard_corner() -> None:
     # The corners of one board share windows that hold the whole board (its extent):
     # every detection and estimate as with full frames, on the distorted paper head.
-    from headsim.active.procedures import measure_chessboard
+    from headsim.active.chessboard import measure_chessboard
     from headsim.sim import names
 
     corners = [0, 1, 8, 27, 46, 47]

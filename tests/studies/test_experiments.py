@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.active.procedures import Measurement
+from headsim.active.measurement import Measurement
 from headsim.estimators.result import Method, Status
 from headsim.sim.settings import HeadSettings, paper_head
 from headsim.studies.experiments import error_figures, random_targets_head, visible_vertical_range

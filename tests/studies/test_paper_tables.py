@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.active.procedures import HeadKnowledge, measure_model2
-from headsim.active.servo import EyeServo
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.model2 import measure_model2
 from headsim.sim.settings import preset
 from headsim.sim.simulator import HeadSim
 from headsim.studies import paper_tables, study

@@ -8,20 +8,17 @@ from functools import partial
 import numpy as np
 import pytest
 
+from headsim.active.calibration import calibrate_head
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge, body_target
+from headsim.active.model2 import measure_model2
+from headsim.active.placement import calibration_layout
 from headsim.active.principal import (
     PrincipalPointError,
     fixed_point_of_zoom,
     principal_points_by_zoom,
     zoomed,
 )
-from headsim.active.procedures import (
-    HeadKnowledge,
-    body_target,
-    calibrate_head,
-    calibration_layout,
-    measure_model2,
-)
-from headsim.active.servo import EyeServo
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim

@@ -8,17 +8,17 @@ from dataclasses import replace
 
 import numpy as np
 
-from headsim.active.events import PhaseStarted
-from headsim.active.procedures import (
+from headsim.active.calibration import (
     CalibrationError,
     CalibrationRun,
-    HeadKnowledge,
     calibrate_head,
-    calibration_layout,
     line_of_sight_truth,
 )
-from headsim.active.search import Failure
-from headsim.active.servo import EyeServo
+from headsim.active.events import PhaseStarted
+from headsim.active.eye_servo import EyeServo
+from headsim.active.failure import Failure
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.placement import calibration_layout
 from headsim.estimators.result import Status
 from headsim.run.events import CalibrationDone, Hub
 from headsim.run.outcomes import (

@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from headsim.active.chessboard import measure_chessboard
 from headsim.active.events import PhaseStarted
-from headsim.active.procedures import (
-    HeadKnowledge,
-    measure_chessboard,
-)
-from headsim.active.servo import EyeServo
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge
 from headsim.run.events import Hub
 from headsim.run.outcomes import (
     ChessboardPaper,

@@ -6,13 +6,11 @@ from __future__ import annotations
 import numpy as np
 
 from headsim.active.events import PhaseStarted
-from headsim.active.procedures import (
-    HeadKnowledge,
-    Measurement,
-    measure_model1,
-    measure_model2,
-)
-from headsim.active.servo import EyeServo, NeckServo
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge, Measurement
+from headsim.active.model1 import measure_model1
+from headsim.active.model2 import measure_model2
+from headsim.active.neck_servo import NeckServo
 from headsim.run.events import Hub
 from headsim.run.outcomes import (
     CheckTarget,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import fields
 
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.run.events import Hub
 from headsim.run.outcomes import (
     MeasurementRecord,

@@ -6,12 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from headsim.active.events import PhaseStarted
-from headsim.active.procedures import (
-    HeadKnowledge,
-    Target,
-    relative_positioning,
-)
-from headsim.active.servo import EyeServo
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge, Target
+from headsim.active.relative import relative_positioning
 from headsim.run.events import Hub
 from headsim.run.outcomes import (
     MeasurementRecord,

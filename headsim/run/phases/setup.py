@@ -7,12 +7,9 @@ from __future__ import annotations
 from dataclasses import asdict
 from typing import Any
 
-from headsim.active.procedures import (
-    HeadKnowledge,
-    Measurement,
-    Model2Config,
-)
-from headsim.active.servo import ServoConfig
+from headsim.active.measurement import HeadKnowledge, Measurement
+from headsim.active.model2 import Model2Config
+from headsim.active.servo_types import ServoConfig
 from headsim.run.events import Hub, MeasurementRecorded
 from headsim.run.outcomes import MeasurementRecord
 from headsim.scenario.schema import Scenario

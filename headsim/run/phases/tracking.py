@@ -5,11 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from headsim.active.events import PhaseStarted
-from headsim.active.procedures import (
-    HeadKnowledge,
-    track_moving_target,
-)
-from headsim.active.servo import NeckServo
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.neck_servo import NeckServo
+from headsim.active.tracking import track_moving_target
 from headsim.run.events import Hub
 from headsim.run.outcomes import (
     MeasurementRecord,

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from headsim.active.search import Failure, FailureCause
+from headsim.active.failure import Failure, FailureCause
 from headsim.estimators.result import Status
 from headsim.run.phases.calibrate import position_outcomes
 from headsim.run.runner import calibrate_scenario

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import asdict
 
-from headsim.active.procedures import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge
 from headsim.run.phases.setup import PAPER, PARKED_WORLD_M, model2_config, servo_config, told
 from headsim.scenario.schema import load_scenario
 from headsim.sim.settings import PAPER_INITIAL_DIRECTIONS

@@ -1,0 +1,153 @@
+"""The chessboard of Sec. VI-A: every chosen inner corner measured with Model 2,
+and the squares' sides they give.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from headsim.active.events import FixationStarted, MeasurementDone
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import (
+    HeadKnowledge,
+    Measurement,
+    Target,
+)
+from headsim.active.model2 import Model2Config, measure_model2
+from headsim.sim import names
+from headsim.sim.events import EventSink
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import (
+    ChessboardDetection,
+    Detection,
+    DetectionStatus,
+    find_chessboard,
+)
+
+
+def board_extent(board: ChessboardDetection, index: int) -> tuple[float, float, float, float]:
+    """(left, top, right, bottom) px from corner ``index`` of what finding ``board`` needs:
+    its inner corners, the outer squares, and half a square of the border around them."""
+    corners = board.corners
+    assert corners is not None
+    columns, rows = board.pattern
+    grid = corners.reshape(rows, columns, 2)
+    spacing = float(
+        max(
+            np.linalg.norm(np.diff(grid, axis=1), axis=-1).max(),
+            np.linalg.norm(np.diff(grid, axis=0), axis=-1).max(),
+        )
+    )
+    low, high = corners.min(axis=0) - corners[index], corners.max(axis=0) - corners[index]
+    pad = 1.5 * spacing
+    return (
+        float(low[0] - pad),
+        float(low[1] - pad),
+        float(high[0] + pad),
+        float(high[1] + pad),
+    )
+
+
+def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: float) -> Target:
+    """Inner corner ``index`` (row-major from the top-left) of the scene's chessboard.
+
+    Found by detecting the whole board (``find_chessboard``): a board cut by
+    the image border loses its corners, it does not guess them.
+    """
+    columns, _ = pattern
+    i, j = index % columns, index // columns
+
+    def detect(image: np.ndarray) -> Detection:
+        board = find_chessboard(image, pattern)
+        if not board.found:
+            return Detection(board.status, None, 0.0)
+        assert board.corners is not None  # found: the corners are there
+        u, v = board.corners[index]
+        return Detection(
+            DetectionStatus.FOUND, (float(u), float(v)), 1.0, board_extent(board, index)
+        )
+
+    # Every corner of one board looks for the whole board: they share windows.
+    detect.window_key = ("chessboard", pattern, square_m)  # type: ignore[attr-defined]
+
+    def truth(sim: HeadSim) -> np.ndarray:
+        body = sim.data.body(names.CHESSBOARD)
+        return body.xpos + body.xmat.reshape(3, 3) @ np.array([i * square_m, j * square_m, 0.0])
+
+    return Target(f"corner_{i}_{j}", detect, truth)
+
+
+@dataclass(frozen=True)
+class ChessboardRun:
+    """Every cross point measured with Model 2, and the squares' sides they give, m.
+
+    ``widths_m``/``heights_m``: distances between horizontally/vertically
+    adjacent measured corners (estimate), with the truth beside them.
+    """
+
+    measurements: tuple[Measurement, ...]
+    square_m: float
+    widths_m: np.ndarray
+    heights_m: np.ndarray
+    true_widths_m: np.ndarray
+    true_heights_m: np.ndarray
+
+    @property
+    def measured(self) -> int:
+        return sum(m.ok for m in self.measurements)
+
+
+def measure_chessboard(
+    sim: HeadSim,
+    servo: EyeServo,
+    knowledge: HeadKnowledge | None = None,
+    config: Model2Config | None = None,
+    pattern: tuple[int, int] = (8, 6),
+    square_m: float = 0.030,
+    corners: Sequence[int] | None = None,
+    sink: EventSink | None = None,
+) -> ChessboardRun:
+    """Measure the chessboard's cross points (all, or ``corners``) and its squares' sides.
+
+    ``sink``: where each corner's fixation ("corner_i_j") and measurement is
+    reported (None: the simulator's sink).
+    """
+    sink = sim.sink if sink is None else sink
+    columns, rows = pattern
+    indices = list(range(columns * rows)) if corners is None else list(corners)
+    measured: dict[int, Measurement] = {}
+    for k in indices:
+        corner = chessboard_corner_target(k, pattern, square_m)
+        sink.emit(FixationStarted(corner.name))
+        measured[k] = measure_model2(sim, servo, corner, knowledge, config)
+        sink.emit(MeasurementDone(measured[k]))
+    widths: list[float] = []
+    heights: list[float] = []
+    true_widths: list[float] = []
+    true_heights: list[float] = []
+    for k, m in measured.items():
+        for neighbour, out, out_true in (
+            (k + 1, widths, true_widths),
+            (k + columns, heights, true_heights),
+        ):
+            if neighbour == k + 1 and (k + 1) % columns == 0:
+                continue
+            other = measured.get(neighbour)
+            if other is None or not (m.ok and other.ok):
+                continue
+            out.append(float(np.linalg.norm(other.estimate_head_m - m.estimate_head_m)))
+            out_true.append(float(np.linalg.norm(other.truth_head_m - m.truth_head_m)))
+    return ChessboardRun(
+        measurements=tuple(measured.values()),
+        square_m=square_m,
+        widths_m=np.array(widths),
+        heights_m=np.array(heights),
+        true_widths_m=np.array(true_widths),
+        true_heights_m=np.array(true_heights),
+    )
+
+
+__all__ = ["ChessboardRun", "board_extent", "chessboard_corner_target", "measure_chessboard"]

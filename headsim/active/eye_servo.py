@@ -1,0 +1,289 @@
+"""Uncalibrated visual servoing of the eye motor from images alone: no focal
+length, no principal point.
+
+The eye servo drives the eye motor, in whole encoder steps, until the chosen
+camera sees the target at a goal column (the image centre).  Its gain (px per
+encoder step) is measured from the images: a probe move when nothing is known,
+then secant (1-D Broyden) updates after every large enough move.  A gain
+learnt on one target seeds the next.  Every loop is bounded and returns a
+:class:`headsim.active.servo_types.ServoResult` that says why it ended.
+"""
+
+from __future__ import annotations
+
+import math
+
+from headsim.active.events import ServoKind, ServoStep
+from headsim.active.servo_types import (
+    Detector,
+    ServoConfig,
+    ServoOutcome,
+    ServoResult,
+)
+from headsim.active.windows import (
+    expected_window,
+    look_in_window,
+    pattern_window,
+    pattern_windowed,
+    preview_window,
+    reporting,
+    windowed,
+)
+from headsim.sim import names
+from headsim.sim.events import EventSink
+from headsim.sim.render import Window
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import Detection, DetectionStatus
+
+
+class EyeServo:
+    """Servo the eye motor so that one camera's target column reaches a goal u."""
+
+    def __init__(
+        self, sim: HeadSim, config: ServoConfig | None = None, sink: EventSink | None = None
+    ) -> None:
+        self.sim = sim
+        self.config = config or ServoConfig()
+        #: Where detections and moves are reported (None: the simulator's sink).
+        self.sink = sim.sink if sink is None else sink
+        low, high = sim.joint_range(names.EYE_MOTOR_JOINT)
+        resolution = sim.settings.encoder_resolution_rad
+        self._step_range = (math.ceil(low / resolution), math.floor(high / resolution))
+        #: Gain per camera, px per encoder step, carried from one target to the next.
+        self.gains: dict[int, float] = {}
+        #: Per camera, the last detection the window is predicted from:
+        #: (detector, eye steps, neck encoders, placements, uv px, area px^2).
+        self._seen: dict[
+            int, tuple[object, int, tuple[float, float], int, tuple[float, float], float]
+        ] = {}
+        #: Per camera, the extent of the pattern last seen (None: a blob).
+        self._extent: dict[int, tuple[float, float, float, float] | None] = {}
+        #: Binned previews rendered to place a window (see ``ServoConfig.preview_binning``).
+        self.previews = 0
+        #: Windows rendered, and windows that missed the target (a full frame followed).
+        self.window_renders = 0
+        self.window_misses = 0
+
+    @property
+    def step_range(self) -> tuple[int, int]:
+        """Eye-motor range, whole encoder steps."""
+        return self._step_range
+
+    def observe(self, camera: int, detector: Detector, key: object = None) -> Detection:
+        """Render ``camera`` and detect the target in it (one render, two on a window miss).
+
+        With windows on, and when this camera last saw the same target
+        (``key``, default the detector) with the neck and the scene unchanged
+        since and a gain known, only a window is rendered: around where the
+        head expects the target from that detection and the eye steps moved
+        since (u + gain * steps), of half-side 3 blob radii plus the margin
+        and a quarter of the predicted motion (blob detectors only, see
+        :data:`WINDOWED_DETECTORS`).  The detection there counts
+        only if it is FOUND at least 3 blob radii + 2 px inside the window
+        (so the blob and every piece the detector looks for beside it lie in
+        the window); otherwise the window is a miss (counted) and a full
+        frame is rendered.  Never from the truth: detections, gain, encoders.
+        """
+        key = detector if key is None else key
+        sim = self.sim
+        steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
+        pattern = pattern_windowed(key)
+        if pattern:  # a pattern's features share their windows
+            key = getattr(key, "window_key", key)
+        window = self._window(camera, key, steps, neck) if pattern or windowed(key) else None
+        if window is None and not pattern and windowed(key) and self._unseen(camera, key, neck):
+            window = self._preview(camera, key)
+        detection = None
+        if window is not None:
+            self.window_renders += 1
+            detection = look_in_window(
+                sim, camera, reporting(detector, self.sink, camera, window), window
+            )
+            if detection is None:
+                self.window_misses += 1
+                # the same instant, whole
+                detection = reporting(detector, self.sink, camera)(sim.retake(camera))
+        if detection is None:
+            detection = reporting(detector, self.sink, camera)(sim.render(camera))
+        # Only blob detections (a centroid and an area) predict a window.
+        if isinstance(detection, Detection) and detection.found and detection.uv is not None:
+            self._seen[camera] = (key, steps, neck, sim.placements, detection.uv, detection.area_px)
+            self._extent[camera] = detection.extent_px
+        else:
+            self._seen.pop(camera, None)
+        return detection
+
+    def _unseen(self, camera: int, key: object, neck: tuple[float, float]) -> bool:
+        """Whether no detection of ``key``'s target predicts where it is (a new target,
+        one moved, or the neck moved since): a preview may find it."""
+        seen = self._seen.get(camera)
+        return seen is None or seen[0] != key or seen[2] != neck or seen[3] != self.sim.placements
+
+    def _preview(self, camera: int, detector: object) -> Window | None:
+        """A preview's window for ``detector``'s blob (see :func:`preview_window`)."""
+        if not self.config.windows or self.config.preview_binning <= 1:
+            return None
+        self.previews += 1
+        return preview_window(self.sim, camera, detector, self.config)
+
+    def _window(
+        self, camera: int, key: object, steps: int, neck: tuple[float, float]
+    ) -> Window | None:
+        """Where to look for ``key``'s target in ``camera``, or None for the full frame."""
+        cfg, sim = self.config, self.sim
+        seen, gain = self._seen.get(camera), self.gains.get(camera)
+        if not cfg.windows or seen is None or gain is None:
+            return None
+        seen_key, seen_steps, seen_neck, placements, uv, area = seen
+        if seen_key != key or seen_neck != neck or placements != sim.placements:
+            return None
+        motion = gain * (steps - seen_steps)
+        extent = self._extent.get(camera)
+        if extent is not None:
+            return pattern_window(
+                sim, camera, (uv[0] + motion, uv[1]), extent, motion, cfg.window_margin_px
+            )
+        return expected_window(
+            sim, camera, (uv[0] + motion, uv[1]), area, motion, cfg.window_margin_px
+        )
+
+    def run(
+        self,
+        camera: int,
+        detector: Detector,
+        goal_u: float | None = None,
+        first: Detection | None = None,
+    ) -> ServoResult:
+        """Drive the eye motor until ``camera`` sees the target at ``goal_u`` (image centre).
+
+        ``first``: a detection already made at the current eye position (saves
+        a render).  A move after which the target is gone is undone (back to
+        the last step that saw it, no render needed) and retried at half the
+        length, at most ``max_retreats`` times.
+        """
+        sim, cfg = self.sim, self.config
+        goal = sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
+        self._renders = 0
+        steps = sim.eye_encoder_steps()
+        if first is None:
+            first = self.observe(camera, detector)
+            self._renders += 1
+        self._path: list[tuple[int, float, float]] = []
+        self._retreats = 0
+        if not first.found or first.uv is None:
+            return self._result(
+                ServoOutcome.TARGET_LOST, steps, None, goal, 0, camera, lost=first.status
+            )
+        visited: dict[int, tuple[float, float]] = {steps: first.uv}
+        self._path.append((steps, *first.uv))
+        uv = first.uv
+        gain = self.gains.get(camera)
+        probe = cfg.probe_steps
+        damping = 1.0
+        for iteration in range(1, cfg.max_iterations + 1):
+            error = uv[0] - goal
+            if gain is not None and abs(error) <= max(cfg.tolerance_px, 0.5 * abs(gain)):
+                return self._result(
+                    ServoOutcome.CONVERGED, steps, uv, goal, iteration - 1, camera, gain
+                )
+            if gain is None:
+                move = probe if steps + probe <= self._step_range[1] else -probe
+                move = round(move * damping) or (1 if move > 0 else -1)
+            else:
+                move = round(-damping * error / gain) or (-1 if error / gain > 0 else 1)
+            target = steps + move
+            if not self._step_range[0] <= target <= self._step_range[1]:
+                return self._result(
+                    ServoOutcome.JOINT_LIMIT, steps, uv, goal, iteration - 1, camera, gain
+                )
+            if target in visited:
+                # Revisiting a step (pixel locking between neighbours): the best
+                # visited step is as close as whole steps get.
+                best = min(visited, key=lambda s: abs(visited[s][0] - goal))
+                if best != steps:
+                    sim.command_eye_steps(best)
+                    sim.settle()
+                return self._result(
+                    ServoOutcome.CONVERGED, best, visited[best], goal, iteration, camera, gain
+                )
+            sim.command_eye_steps(target)
+            sim.settle()
+            detection = self.observe(camera, detector)
+            self._renders += 1
+            self.sink.emit(
+                ServoStep(
+                    ServoKind.EYE,
+                    iteration,
+                    (target,),
+                    None
+                    if not detection.found or detection.uv is None
+                    else (detection.uv[0] - goal,),
+                )
+            )
+            if not detection.found or detection.uv is None:
+                if self._retreats >= cfg.max_retreats or abs(move) <= 1:
+                    return self._result(
+                        ServoOutcome.TARGET_LOST,
+                        target,
+                        None,
+                        goal,
+                        iteration,
+                        camera,
+                        gain,
+                        lost=detection.status,
+                    )
+                # Re-acquire: back to the last step that saw it, then a shorter move.
+                self._retreats += 1
+                damping *= 0.5
+                sim.command_eye_steps(steps)
+                sim.settle()
+                continue
+            change = detection.uv[0] - uv[0]
+            if gain is None:
+                if abs(change) >= cfg.min_probe_px:
+                    gain = change / move
+                else:
+                    probe *= 4
+            elif abs(move) >= cfg.min_secant_steps and change != 0.0:
+                gain = change / move
+            if gain is not None:
+                self.gains[camera] = gain  # what the next window is predicted with
+            steps, uv = target, detection.uv
+            visited[steps] = uv
+            self._path.append((steps, *uv))
+        # The last move may have landed within tolerance: that is converged.
+        done = gain is not None and abs(uv[0] - goal) <= max(cfg.tolerance_px, 0.5 * abs(gain))
+        outcome = ServoOutcome.CONVERGED if done else ServoOutcome.ITERATION_LIMIT
+        return self._result(outcome, steps, uv, goal, cfg.max_iterations, camera, gain)
+
+    def _result(
+        self,
+        outcome: ServoOutcome,
+        steps: int,
+        uv: tuple[float, float] | None,
+        goal: float,
+        iterations: int,
+        camera: int,
+        gain: float | None = None,
+        lost: DetectionStatus | None = None,
+    ) -> ServoResult:
+        if gain is not None:
+            self.gains[camera] = gain
+        residual = math.nan if uv is None else uv[0] - goal
+        subpixel = float(steps) if gain is None or uv is None else steps - residual / gain
+        return ServoResult(
+            outcome,
+            steps,
+            uv,
+            residual,
+            gain,
+            subpixel,
+            self._renders,
+            iterations,
+            lost,
+            tuple(self._path),
+            self._retreats,
+        )
+
+
+__all__ = ["EyeServo"]

@@ -1,0 +1,95 @@
+"""Model 1, fixation with the neck (Sec. II-B): neck and eyes put the target on
+both goal columns, then eqs. (2)-(3) give its position in H and W.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from headsim.active.failure import neck_failure
+from headsim.active.measurement import (
+    HeadKnowledge,
+    Measurement,
+    Target,
+    estimated_measurement,
+    failed_measurement,
+)
+from headsim.active.neck_servo import NeckServo
+from headsim.active.search import find_neck_view
+from headsim.active.servo_types import ServoOutcome
+from headsim.estimators import Uncertainty, model1
+from headsim.sim.simulator import HeadSim
+
+
+def measure_model1(
+    sim: HeadSim,
+    servo: NeckServo,
+    target: Target,
+    knowledge: HeadKnowledge | None = None,
+    interpolate: bool = True,
+    last_seen: Sequence[tuple[int, int, int]] = (),
+) -> Measurement:
+    """Model 1: fixate with neck and eyes, then eqs. (2)-(3) (Sec. II-B).
+
+    ``last_seen``: (yaw, pitch, eye) steps of the last fixations of this same
+    target, oldest first (tracking).  If both cameras do not see it where the
+    neck was left, the head looks around the last of them (and where the last
+    two predict it), then from the start pose; every look is counted in
+    ``search_renders``.
+    """
+    knowledge = knowledge or HeadKnowledge()
+    start = sim.render_count
+    (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+    goals = (u10, u20, (v10 + v20) / 2)
+    result = servo.run(target.detector, goals=goals)
+    search = 0
+    if result.outcome is ServoOutcome.TARGET_LOST and result.iterations == 0:
+        search = result.renders  # the look that did not find it
+        found = None
+        if last_seen:
+            # A tracked target left the view: look around its last fixation.
+            before = sim.render_count
+            found = find_neck_view(servo, target.detector, last_seen)
+            search += sim.render_count - before
+            if found is not None:
+                result = servo.run(target.detector, goals=goals)
+        if found is None and any(servo.steps()):
+            # Not in both views where the neck was left (the last target's pose),
+            # nor around it: back to the start pose and fixate from there.
+            sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
+            sim.settle()
+            result = servo.run(target.detector, goals=goals)
+        elif found is None:
+            search = 0  # nothing else was tried: the first look's failure stands
+    residual = (result.residual_px,)
+    if not result.converged:
+        return failed_measurement(
+            sim,
+            target,
+            "model1",
+            neck_failure(result),
+            sim.render_count - start,
+            residual,
+            search,
+        )
+    resolution = sim.settings.encoder_resolution_rad
+    yaw, pitch, eye = (
+        s * resolution for s in (result.subpixel_steps if interpolate else result.steps)
+    )
+    angle_sigma = resolution * (0.3 if interpolate else 1 / math.sqrt(12.0))
+    belief = knowledge.head_belief(sim)
+    estimate = model1(
+        [eye],
+        belief.baseline_m,
+        alpha_e=knowledge.alpha_e,
+        uncertainty=Uncertainty(encoder=angle_sigma),
+        los_offset_m=knowledge.line_of_sight_offsets(sim),
+    )
+    details = {"alpha_rad": eye, "neck_yaw_rad": yaw, "neck_pitch_rad": pitch}
+    return estimated_measurement(
+        sim, target, "model1", estimate, start, residual, details, (yaw, pitch), belief, search
+    )
+
+
+__all__ = ["measure_model1"]

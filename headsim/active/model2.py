@@ -1,0 +1,248 @@
+"""Model 2, the two-step measurement of Sec. II-C, with the neck still.
+
+The eye servo (``headsim.active.eye_servo``) fixates the target in camera 1, then
+in camera 2; the encoder angles and the other camera's image at each step go
+to the pure estimator ``headsim.estimators.model2``.  A target out of view is
+searched for (``headsim.active.search``); near the midline the y images are
+taken again at an intermediate eye angle (the paper's remedy, generalised).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from headsim.active.eye_servo import EyeServo
+from headsim.active.failure import detection_failure, servo_failure
+from headsim.active.measurement import (
+    NOMINAL_PIXEL_SIGMA,
+    HeadKnowledge,
+    Measurement,
+    Target,
+    estimated_measurement,
+    failed_measurement,
+)
+from headsim.active.search import find_view, nearest_seen
+from headsim.active.servo_types import ServoOutcome, ServoResult
+from headsim.estimators import Uncertainty, model2
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import (
+    Detection,
+)
+
+
+def _observe(servo: EyeServo, camera: int, target: Target) -> Detection:
+    return servo.observe(camera, target.detector)
+
+
+def _fixation_angle(sim: HeadSim, result: ServoResult, interpolate: bool) -> float:
+    """Eye angle at fixation, rad: the whole step, or the sub-step interpolated from the image."""
+    steps = result.subpixel_steps if interpolate else float(result.steps)
+    return steps * sim.settings.encoder_resolution_rad
+
+
+@dataclass(frozen=True)
+class Model2Config:
+    """Options of the two-step measurement.
+
+    ``interpolate``: use the servo's sub-step fixation (image residual / gain)
+    instead of the whole encoder step.  ``midline_px``: when P's offset from
+    the goal column in a y image is below this, take that image again at an
+    eye angle ``remedy_px`` of image motion away (the paper's near-midline
+    remedy, generalised from gamma = 0 to any gamma).
+    """
+
+    interpolate: bool = True
+    midline_px: float = 25.0
+    remedy_px: float = 120.0
+
+
+def measure_model2(
+    sim: HeadSim,
+    servo: EyeServo,
+    target: Target,
+    knowledge: HeadKnowledge | None = None,
+    config: Model2Config | None = None,
+) -> Measurement:
+    """Model 2, the two-step measurement of Sec. II-C, with the neck still."""
+    knowledge = knowledge or HeadKnowledge()
+    config = config or Model2Config()
+    resolution = sim.settings.encoder_resolution_rad
+    start = sim.render_count
+    (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+    # Step 1: Ca1's u to its goal column; then P's image in Ca2 there.
+    step1 = servo.run(1, target.detector, goal_u=u10)
+    search = 0  # renders spent finding the target again
+    if step1.outcome is ServoOutcome.TARGET_LOST and step1.iterations == 0:
+        # Not in Ca1's view where the last measurement left the eyes: search.
+        before = sim.render_count
+        found = find_view(servo, 1, target.detector)
+        search += sim.render_count - before
+        if found is not None:
+            step1 = servo.run(1, target.detector, goal_u=u10, first=found.detection)
+    if not step1.converged:
+        failure = servo_failure(step1, "step 1", 1)
+        if search:
+            failure = replace(failure, detail=f"{failure.detail}; searched {search} poses")
+        return failed_measurement(
+            sim,
+            target,
+            "model2",
+            failure,
+            sim.render_count - start,
+            [step1.residual_px],
+            search,
+        )
+    seen2 = _observe(servo, 2, target)
+    gamma2_steps = step1.steps
+    if not seen2.found or seen2.uv is None:
+        # Ca2 does not see P where Ca1 fixates it (a lateral target, a long focal
+        # length): its y image is taken at an intermediate eye angle where it does,
+        # and step 2 starts there.
+        before = sim.render_count
+        found = find_view(servo, 2, target.detector)
+        search += sim.render_count - before
+        if found is None:
+            failure = detection_failure(seen2, "step 1", 2, f"and at {search} eye angles searched")
+            return failed_measurement(
+                sim,
+                target,
+                "model2",
+                failure,
+                sim.render_count - start,
+                [step1.residual_px],
+                search,
+            )
+        seen2, gamma2_steps = found.detection, found.steps
+    # Step 2: Ca2's u to its goal column, starting from that image; then Ca1's image.
+    step2 = servo.run(2, target.detector, goal_u=u20, first=seen2)
+    residuals = (step1.residual_px, step2.residual_px)
+    if not step2.converged:
+        return failed_measurement(
+            sim,
+            target,
+            "model2",
+            servo_failure(step2, "step 2", 2),
+            sim.render_count - start,
+            residuals,
+            search,
+        )
+    seen1 = _observe(servo, 1, target)
+    gamma1_steps = step2.steps
+    uv1_seen = seen1.uv if seen1.found else None
+    if uv1_seen is None:
+        # Ca1 does not see P where Ca2 fixates it: its y image is one step 1 took.
+        memory = nearest_seen(step1.seen, step2.steps, u10, config.midline_px)
+        if memory is None:
+            return failed_measurement(
+                sim,
+                target,
+                "model2",
+                detection_failure(seen1, "step 2", 1),
+                sim.render_count - start,
+                residuals,
+                search,
+            )
+        gamma1_steps, uv1_seen = memory[0], (memory[1], memory[2])
+    assert seen2.uv is not None
+
+    uv1, uv2 = np.array(uv1_seen), np.array(seen2.uv)
+    gamma1, gamma2 = gamma1_steps * resolution, gamma2_steps * resolution
+    if min(abs(uv1[0] - u10), abs(uv2[0] - u20)) < config.midline_px:
+        remedy = _near_midline_images(sim, servo, target, step1, step2, config)
+        if remedy is not None:
+            gamma, r1, r2 = remedy
+            if r1 is not None and abs(r1[0] - u10) > abs(uv1[0] - u10):
+                uv1, gamma1 = r1, gamma
+            if r2 is not None and abs(r2[0] - u20) > abs(uv2[0] - u20):
+                uv2, gamma2 = r2, gamma
+
+    alpha1 = _fixation_angle(sim, step1, config.interpolate)
+    alpha2 = _fixation_angle(sim, step2, config.interpolate)
+    gains = [abs(r.gain_px_per_step or 1.0) for r in (step1, step2)]
+    angle_sigma = (
+        resolution * NOMINAL_PIXEL_SIGMA / min(gains)
+        if config.interpolate
+        else resolution / math.sqrt(12.0)
+    )
+    estimate = model2(
+        [alpha1],
+        [alpha2],
+        uv1[None],
+        uv2[None],
+        knowledge.head_belief(sim).baseline_m,
+        uv10=(u10, v10),
+        uv20=(u20, v20),
+        alpha_e=knowledge.alpha_e,
+        gamma1=[gamma1],
+        gamma2=[gamma2],
+        kx_over_ky=knowledge.kx_over_ky,
+        uncertainty=Uncertainty(encoder=angle_sigma, pixel=NOMINAL_PIXEL_SIGMA),
+        los_offset_m=knowledge.line_of_sight_offsets(sim),
+    )
+    details = {
+        "alpha1_rad": alpha1,
+        "alpha2_rad": alpha2,
+        "step1_encoder_rad": step1.steps * resolution,
+        "step2_encoder_rad": step2.steps * resolution,
+        "gamma1_rad": gamma1,
+        "gamma2_rad": gamma2,
+        "u11_px": float(uv1[0]),
+        "v11_px": float(uv1[1]),
+        "u21_px": float(uv2[0]),
+        "v21_px": float(uv2[1]),
+    }
+    return estimated_measurement(
+        sim,
+        target,
+        "model2",
+        estimate,
+        start,
+        residuals,
+        details,
+        belief=knowledge.head_belief(sim),
+        search=search,
+    )
+
+
+def _near_midline_images(
+    sim: HeadSim,
+    servo: EyeServo,
+    target: Target,
+    step1: ServoResult,
+    step2: ServoResult,
+    config: Model2Config,
+) -> tuple[float, np.ndarray | None, np.ndarray | None] | None:
+    """Both cameras' images at an eye angle ``remedy_px`` of image motion off the fixations."""
+    gain = max(abs(step1.gain_px_per_step or 0.0), abs(step2.gain_px_per_step or 0.0))
+    if gain == 0.0:
+        return None
+    offset = round(config.remedy_px / gain)
+    low, high = servo.step_range
+    middle = (step1.steps + step2.steps) / 2
+    # Turn outward (towards 0) when converged far in, else inward: stay within range.
+    gamma_steps = round(middle - offset) if middle - offset >= low else round(middle + offset)
+    if not low <= gamma_steps <= high:
+        return None
+    sim.command_eye_steps(gamma_steps)
+    sim.settle()
+    seen = [_observe(servo, camera, target) for camera in (1, 2)]
+    uv = [np.array(s.uv) if s.found and s.uv is not None else None for s in seen]
+    return gamma_steps * sim.settings.encoder_resolution_rad, uv[0], uv[1]
+
+
+def measure_points_model2(
+    sim: HeadSim,
+    servo: EyeServo,
+    targets: Sequence[Target],
+    knowledge: HeadKnowledge | None = None,
+    config: Model2Config | None = None,
+) -> list[Measurement]:
+    """Model 2 on several targets in turn (the servo's gains carry over)."""
+    return [measure_model2(sim, servo, t, knowledge, config) for t in targets]
+
+
+__all__ = ["Model2Config", "measure_model2", "measure_points_model2"]

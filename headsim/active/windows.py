@@ -1,0 +1,166 @@
+"""Where a servo looks: a window around where the target is expected, a binned
+preview to place one, the check that a detection in a window stands for the
+full frame's, and each detection reported to the event sink.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable
+
+import numpy as np
+
+from headsim.active.events import Detected
+from headsim.active.servo_types import (
+    Detector,
+    ServoConfig,
+)
+from headsim.sim.events import EventSink
+from headsim.sim.render import Window
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detect import Detection, DetectionStatus, find_marker
+
+#: Detectors (or the functions that partials of them wrap) that find their target
+#: in a window: a blob's centroid, decided by the blob and what lies within one blob
+#: size of it.  Others (a whole chessboard, a cross point) always see full frames.
+WINDOWED_DETECTORS: set[Callable[..., object]] = {find_marker}
+
+
+def windowed(detector: object) -> bool:
+    """Whether ``detector`` (possibly a ``functools.partial``) may look at windows."""
+    while isinstance(detector, functools.partial):
+        detector = detector.func
+    return detector in WINDOWED_DETECTORS
+
+
+def pattern_windowed(detector: object) -> bool:
+    """Whether ``detector`` finds a feature as part of a pattern it reports the extent of
+    (``Detection.extent_px``) and names by a ``window_key`` shared by the pattern's features."""
+    while isinstance(detector, functools.partial):
+        detector = detector.func
+    return getattr(detector, "window_key", None) is not None
+
+
+def reporting(
+    detector: Detector, sink: EventSink, camera: int, window: Window | None = None
+) -> Detector:
+    """``detector``, reporting to ``sink`` each detection it makes in camera ``camera``'s
+    image (:class:`headsim.active.events.Detected`; in a ``window``, its offset added)."""
+
+    def detect(image: np.ndarray) -> Detection:
+        detection = detector(image)
+        uv = detection.uv if detection.found else None
+        if uv is not None and window is not None:  # in the full frame's pixels
+            uv = (uv[0] + window.x0, uv[1] + window.y0)
+        sink.emit(Detected(camera, detection.status, uv))
+        return detection
+
+    return detect
+
+
+def pattern_window(
+    sim: HeadSim,
+    camera: int,
+    expected_uv: tuple[float, float],
+    extent_px: tuple[float, float, float, float],
+    motion_px: float,
+    margin_px: float,
+) -> Window | None:
+    """The window to look for a pattern of ``extent_px`` around ``expected_uv`` after an
+    image motion of ``motion_px``: the extent plus the margin and a quarter of the motion
+    on every side.  None where it would be barely cheaper than the frame."""
+    settings = sim.camera_settings(camera)
+    grow = margin_px + 0.25 * abs(motion_px)
+    u, v = expected_uv
+    left, top, right, bottom = extent_px
+    x0 = max(math.floor(u + left - grow), 0)
+    y0 = max(math.floor(v + top - grow), 0)
+    x1 = min(math.ceil(u + right + grow) + 1, settings.width)
+    y1 = min(math.ceil(v + bottom + grow) + 1, settings.height)
+    if x1 <= x0 or y1 <= y0 or (x1 - x0) * (y1 - y0) >= 0.5 * settings.width * settings.height:
+        return None
+    return Window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
+
+
+def expected_window(
+    sim: HeadSim,
+    camera: int,
+    expected_uv: tuple[float, float],
+    area_px: float,
+    motion_px: float,
+    margin_px: float,
+) -> Window | None:
+    """The window to look for a blob of ``area_px`` expected at ``expected_uv`` after an
+    image motion of ``motion_px``: half-side 3 blob radii + margin + a quarter of the
+    motion.  None where it would be barely cheaper than the frame."""
+    half = 3.0 * math.sqrt(area_px / math.pi) + margin_px + 0.25 * abs(motion_px)
+    settings = sim.camera_settings(camera)
+    window = Window.around(expected_uv, half, (settings.width, settings.height))
+    if window.width * window.height >= 0.5 * settings.width * settings.height:
+        return None
+    return window
+
+
+def preview_window(
+    sim: HeadSim, camera: int, detector: object, config: ServoConfig
+) -> Window | None:
+    """Render a preview of ``camera``'s whole view binned ``config.preview_binning`` x
+    ``config.preview_binning`` and return the window where it shows the blob, or None
+    (not found, or a window barely cheaper than the frame: a full frame follows)."""
+    b = config.preview_binning
+    assert callable(detector)
+    seen = detector(sim.render_preview(camera, b))
+    if not isinstance(seen, Detection) or not seen.found or seen.uv is None:
+        return None
+    # Binned pixel i covers pixels b i .. b i + b - 1; its position is good to about b px.
+    offset = (b - 1) / 2.0
+    uv = (b * seen.uv[0] + offset, b * seen.uv[1] + offset)
+    return expected_window(sim, camera, uv, b * b * seen.area_px, 4.0 * b, config.window_margin_px)
+
+
+def look_in_window(
+    sim: HeadSim, camera: int, detector: Detector, window: Window
+) -> Detection | None:
+    """Render ``window`` and detect there: the detection in full-frame pixels, or None (a miss).
+
+    It counts only if FOUND at least 3 blob radii + 2 px inside the window, so
+    that the blob and every piece the detector looks for beside it (within one
+    blob size) lie in the window: then the full frame gives the same answer.
+    """
+    seen = detector(sim.render_window(camera, window))
+    if not seen.found or seen.uv is None:
+        return None
+    u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0
+    if seen.extent_px is not None:
+        # A pattern counts only if all of it lies 2 px inside the window, or runs
+        # off a side where the window's edge is the image's (the full frame ends there too).
+        left, top, right, bottom = seen.extent_px
+        settings = sim.camera_settings(camera)
+        if (
+            (window.x0 == 0 or window.x0 + 2 <= u + left)
+            and (window.x1 == settings.width or u + right <= window.x1 - 3)
+            and (window.y0 == 0 or window.y0 + 2 <= v + top)
+            and (window.y1 == settings.height or v + bottom <= window.y1 - 3)
+        ):
+            return Detection(DetectionStatus.FOUND, (u, v), seen.area_px, seen.extent_px)
+        return None
+    inset = 3.0 * math.sqrt(seen.area_px / math.pi) + 2.0
+    if (
+        window.x0 + inset <= u <= window.x1 - 1 - inset
+        and window.y0 + inset <= v <= window.y1 - 1 - inset
+    ):
+        return Detection(DetectionStatus.FOUND, (u, v), seen.area_px)
+    return None
+
+
+__all__ = [
+    "WINDOWED_DETECTORS",
+    "expected_window",
+    "look_in_window",
+    "pattern_window",
+    "pattern_windowed",
+    "preview_window",
+    "reporting",
+    "windowed",
+]
