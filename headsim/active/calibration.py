@@ -139,7 +139,7 @@ def calibrate_head(
             measured[2] += rng.normal(0.0, depth_noise_m)
         depths.append(measured[2])
         rows.append((measured, m.details))
-    sim.park_body(body, parked)
+    sim.set_body_pose(body, parked)
     baseline = base.head_belief(sim).baseline_m
     total = len(outcomes)
     if len(alpha1) < 2:

@@ -206,17 +206,22 @@ class LiveHead:
         middle, end = start + cfg.exposure_s / 2, start + cfg.exposure_s
         if cfg.motion_blur:
             n = cfg.blur_subframes
-            sums = [None, None]
+            sums: list[np.ndarray | None] = [None, None]
             encoders = joints = truth = None
             for i in range(n):
                 self.advance_to(start + (i + 0.5) * cfg.exposure_s / n)
                 for cam in range(2):
                     image = self.sim.render(cam + 1).astype(np.float32)
-                    sums[cam] = image if sums[cam] is None else sums[cam] + image
+                    total = sums[cam]
+                    sums[cam] = image if total is None else total + image
                 if self._steps_at(middle) <= self.step_count and encoders is None:
                     encoders, joints = self.encoders(), self.true_joints()
-            assert sums[0] is not None and sums[1] is not None and encoders is not None
-            images = tuple(np.clip(np.rint(s / n), 0, 255).astype(np.uint8) for s in sums)
+            first, second = sums
+            assert first is not None and second is not None and encoders is not None
+            assert joints is not None
+            images = tuple(
+                np.clip(np.rint(s / n), 0, 255).astype(np.uint8) for s in (first, second)
+            )
             truth = self.target_truth(middle)
             self.advance_to(end)
         else:

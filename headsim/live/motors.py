@@ -133,10 +133,10 @@ class MotorDriver:
             model.actuator_forcelimited[act] = 0
             self._ff_vel.append(kv / kp)
             self._ff_acc.append(1.0 / omega**2)
-        self.motors = [
-            _Motor(lim, *map(float, model.joint(j).range))
-            for lim, j in zip(limits, MOTOR_JOINTS, strict=True)
-        ]
+        self.motors: list[_Motor] = []
+        for lim, j in zip(limits, MOTOR_JOINTS, strict=True):
+            low, high = model.joint(j).range
+            self.motors.append(_Motor(lim, float(low), float(high)))
         self.sync()
 
     def _effective_inertia(self) -> list[float]:

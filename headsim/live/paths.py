@@ -160,7 +160,8 @@ class RandomWalk:
         x = min(max(t, 0.0), self.duration_s) / self.step_s
         i = int(x)
         s = x - i
-        return (1 - s) * self._samples[i] + s * self._samples[i + 1]
+        samples: np.ndarray = self.__dict__["_samples"]  # set in __post_init__, not a field
+        return (1 - s) * samples[i] + s * samples[i + 1]
 
 
 @dataclass(frozen=True)

@@ -18,10 +18,15 @@ from typing import Any
 
 import numpy as np
 
+from headsim.active.events import FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
-from headsim.live.gaze import FrameRecord, PursuitRun, acquire, pursue
+from headsim.active.servo_types import ServoConfig
+from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
 from headsim.live.spec import PursuitSpec, describe
+from headsim.run.targets import marker_target
+from headsim.sim.events import EventSink
+from headsim.sim.simulator import HeadSim
 
 
 def figures(run: PursuitRun, spec: PursuitSpec) -> dict[str, Any]:
@@ -66,18 +71,15 @@ def _per_frame(records: tuple[FrameRecord, ...]) -> dict[str, Any]:
 
 
 def run_pursuit(
-    scenario: Any, hub: Any, knowledge: HeadKnowledge, label: str
+    scenario: Any, sink: EventSink, knowledge: HeadKnowledge, label: str
 ) -> tuple[list[Any], dict[str, Any]]:
-    """The runner's entry for ``procedure = "pursuit"``: (no point records, the experiment block)."""
-    from headsim.active.events import PhaseStarted
-    from headsim.active.servo_types import ServoConfig
-    from headsim.live.gaze import PursuitFrame
-    from headsim.run.targets import marker_target
-    from headsim.sim.simulator import HeadSim
+    """The runner's entry for ``procedure = "pursuit"``: (no point records, the experiment block).
 
+    ``sink``: where the run's events go; ``label``: unused (the runners' common signature).
+    """
     spec: PursuitSpec = scenario.scene.pursuit
     target = marker_target(spec.name, spec.body)
-    with HeadSim("default", scenario.settings, settle_mode=scenario.settle_mode, sink=hub) as sim:
+    with HeadSim("default", scenario.settings, settle_mode=scenario.settle_mode, sink=sink) as sim:
         live = LiveHead(sim, spec.live, spec.body, spec.path, spec.visibility)
         first = next(
             (
@@ -88,20 +90,19 @@ def run_pursuit(
             None,
         )
         truth = {} if first is None else {spec.name: spec.path.position(first)}
-        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
+        sink.emit(PhaseStarted("measurement", sim, knowledge, truth))
         experiment: dict[str, Any] = {"pursuit": describe(spec)}
         if first is None:
             return [], {**experiment, "failures": [f"{spec.name}: never present in the run"]}
         live.advance_to(first)
-        # Acquiring looks at whole frames (no windows or previews), as it always has.
-        whole_frames = ServoConfig(windows=False)
-        estimator = acquire(live, target.detector, knowledge, whole_frames)
+        # Whole frames, no windows or previews: the acquisition as it has always run.
+        estimator = acquire(live, target.detector, knowledge, ServoConfig(windows=False))
         if estimator is None:
             return [], {**experiment, "failures": [f"{spec.name}: not acquired at rest"]}
 
         def on_frame(record: FrameRecord) -> None:
-            hub.begin(f"{spec.name} t={record.time_s:.3f}s")  # a step per frame
-            hub.emit(PursuitFrame(record))
+            sink.emit(FixationStarted(f"{spec.name} t={record.time_s:.3f}s"))  # a step per frame
+            sink.emit(PursuitFrame(record))
 
         run = pursue(live, target.detector, estimator, spec.duration_s, spec.gaze, on_frame)
     experiment.update(figures(run, spec))

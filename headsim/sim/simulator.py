@@ -358,15 +358,6 @@ class HeadSim:
         self, name: str, position_world_m: np.ndarray, quat_world: np.ndarray | None = None
     ) -> None:
         """Place a mocap body (a target) in the world; takes effect at once."""
-        self._move_mocap(name, position_world_m, quat_world)
-
-    def park_body(self, name: str, position_world_m: np.ndarray) -> None:
-        """Put a prop back out of the way after a procedure used it (not a new target placement)."""
-        self._move_mocap(name, position_world_m, None)
-
-    def _move_mocap(
-        self, name: str, position_world_m: np.ndarray, quat_world: np.ndarray | None
-    ) -> None:
         body_id = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, name)
         mocap_id = int(self.model.body_mocapid[body_id]) if body_id >= 0 else -1
         if mocap_id < 0:
