@@ -11,17 +11,13 @@ measure a head at rest, so this is exact, deterministic and costs nothing.
 joints are still (bounded; the outcome says why it stopped), for studies of
 settling error and moving heads.
 
-Joint errors (``HeadSettings.backlash_rad``, ``count_error``): each motor's
-encoder reads its commanded count, while the joint settles (in either mode)
-at the command plus a seeded offset within that count and minus half the
-backlash on the side it came from.  The true angles are ground truth only.
+Joint errors (backlash, count error): :mod:`headsim.sim.joints`.  Every image
+taken is reported to the simulator's event sink (:mod:`headsim.sim.events`).
 """
 
 from __future__ import annotations
 
-import enum
 import math
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
@@ -29,6 +25,13 @@ import numpy as np
 
 from headsim.sim import names
 from headsim.sim.events import NO_EVENTS, EventSink, ImageKind, ImageTaken
+from headsim.sim.joints import (
+    Commands,
+    JointLimitError,
+    SettleOutcome,
+    SettleResult,
+    true_targets,
+)
 from headsim.sim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
 from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
 from headsim.sim.render import EyeRenderer, Window, context_key
@@ -36,41 +39,6 @@ from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, Setti
 
 #: A camera: 1 or 2 (the paper's Ca1, Ca2) or its MJCF name "cam1"/"cam2".
 CameraId = int | str
-
-
-class SettleOutcome(enum.Enum):
-    SETTLED = "settled"
-    TIMEOUT = "timeout"
-    KINEMATIC = "kinematic"
-
-
-@dataclass(frozen=True)
-class SettleResult:
-    """How a settle ended: outcome, physics steps taken, worst joint error (rad)."""
-
-    outcome: SettleOutcome
-    steps: int
-    max_error_rad: float
-
-
-class JointLimitError(ValueError):
-    """A command outside a joint's range."""
-
-
-@dataclass
-class _Commands:
-    neck_yaw: float = 0.0
-    neck_pitch: float = 0.0
-    eye: float = 0.0
-    pending: set[str] = field(default_factory=set)
-    #: Direction each joint last moved in (+1, -1; 0 before any move): backlash side.
-    approach: dict[str, float] = field(
-        default_factory=lambda: {"neck_yaw": 0.0, "neck_pitch": 0.0, "eye": 0.0}
-    )
-
-
-#: Index of each motor in the seeded count-error draw.
-_MOTOR_INDEX = {"neck_yaw": 0, "neck_pitch": 1, "eye": 2}
 
 
 def _homogeneous(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
@@ -125,7 +93,7 @@ class HeadSim:
                 ("eye", names.EYE_MOTOR),
             )
         }
-        self._commands = _Commands()
+        self._commands = Commands()
         #: Bodies placed so far (targets moved: earlier images are out of date).
         self.placements = 0
         self._renderer = EyeRenderer(
@@ -142,7 +110,7 @@ class HeadSim:
     def reset(self) -> None:
         """Back to the ``home`` keyframe (all joints 0)."""
         mujoco.mj_resetDataKeyframe(self.model, self.data, self.model.key(names.HOME).id)
-        self._commands = _Commands()
+        self._commands = Commands()
         mujoco.mj_forward(self.model, self.data)
 
     def close(self) -> None:
@@ -207,26 +175,9 @@ class HeadSim:
         self.command(**targets)
         return self.settle()
 
-    def _joint_offset(self, motor: str, command: float) -> float:
-        """True minus commanded angle of a motor's joint, rad (0 on an ideal head)."""
-        settings = self.settings
-        offset = -0.5 * settings.backlash_rad * self._commands.approach[motor]
-        if settings.count_error:
-            resolution = settings.encoder_resolution_rad
-            count = round(command / resolution)
-            rng = np.random.default_rng(
-                [settings.seed, _MOTOR_INDEX[motor], count & 0xFFFFFFFF, count < 0]
-            )
-            offset += float(rng.uniform(-0.5, 0.5)) * resolution
-        return offset
-
     def _true_targets(self) -> dict[str, float]:
         """Where each motor's joint truly settles, rad, by motor name."""
-        c = self._commands
-        commands = {"neck_yaw": c.neck_yaw, "neck_pitch": c.neck_pitch, "eye": c.eye}
-        if not self.settings.joint_errors:
-            return commands
-        return {m: a + self._joint_offset(m, a) for m, a in commands.items()}
+        return true_targets(self.settings, self._commands)
 
     def _targets(self) -> dict[str, float]:
         true = self._true_targets()
@@ -402,45 +353,37 @@ class HeadSim:
         return yaw if index == 0 else -yaw
 
     # -- images ------------------------------------------------------------
-    def _taken(
-        self,
-        index: int,
-        image: np.ndarray,
-        kind: ImageKind,
-        before: float,
-        window: Window | None = None,
-        binning: int = 1,
-    ) -> np.ndarray:
-        """Report ``image`` (camera ``index`` + 1, rendered since ``before`` frames) to the sink."""
-        self.sink.emit(
-            ImageTaken(index + 1, image, kind, self.rendered_frames - before, window, binning)
-        )
-        return image
-
     def render(self, camera: CameraId) -> np.ndarray:
         """The camera's current image, (H, W, 3) uint8, with its lens and noise."""
         index, before = self.camera_index(camera), self.rendered_frames
         image = self._renderer.render(self.data, index)
-        return self._taken(index, image, ImageKind.FULL, before)
+        self.sink.emit(ImageTaken(index + 1, image, ImageKind.FULL, self.rendered_frames - before))
+        return image
 
     def retake(self, camera: CameraId) -> np.ndarray:
         """The whole image of the instant just taken as a window (same noise), counted."""
         index, before = self.camera_index(camera), self.rendered_frames
         image = self._renderer.render(self.data, index, retake=True)
-        return self._taken(index, image, ImageKind.RETAKE, before)
+        frames = self.rendered_frames - before
+        self.sink.emit(ImageTaken(index + 1, image, ImageKind.RETAKE, frames))
+        return image
 
     def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
         """Only ``window`` of the camera's image: the full image's crop, (h, w, 3) uint8."""
         index, before = self.camera_index(camera), self.rendered_frames
         image = self._renderer.render_window(self.data, index, window)
-        return self._taken(index, image, ImageKind.WINDOW, before, window)
+        frames = self.rendered_frames - before
+        self.sink.emit(ImageTaken(index + 1, image, ImageKind.WINDOW, frames, window))
+        return image
 
     def render_preview(self, camera: CameraId, binning: int) -> np.ndarray:
         """The camera's whole view binned ``binning`` x ``binning`` (for finding where to
         look), (H/b, W/b, 3) uint8, counted as a render."""
         index, before = self.camera_index(camera), self.rendered_frames
         image = self._renderer.render_preview(self.data, index, binning)
-        return self._taken(index, image, ImageKind.PREVIEW, before, binning=binning)
+        frames = self.rendered_frames - before
+        self.sink.emit(ImageTaken(index + 1, image, ImageKind.PREVIEW, frames, binning=binning))
+        return image
 
     @property
     def render_count(self) -> int:

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from headsim.sim import names
+from headsim.sim.joints import JointLimitError, SettleOutcome
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
-from headsim.sim.simulator import HeadSim, JointLimitError, SettleOutcome
+from headsim.sim.simulator import HeadSim
 
 
 @pytest.fixture
