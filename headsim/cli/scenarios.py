@@ -33,10 +33,10 @@ RUN_FILES = ("results.json", "summary.txt", "timing.json")
 
 def run_command(args: argparse.Namespace) -> int:
     from headsim.run.events import Subscriber
-    from headsim.run.report import summary_text
     from headsim.run.rerun_cli import recording_target
     from headsim.run.runner import run_scenario
     from headsim.run.serialise import results_payload
+    from headsim.run.summary import summary_text
     from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)

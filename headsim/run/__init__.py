@@ -1,1 +1,1 @@
-"""One scenario run: the runner, its progress, results files, the report and the Rerun recording."""
+"""One scenario run: the runner and its phases, events, progress, typed results, results.json, the summary and the Rerun recording."""

@@ -95,10 +95,11 @@ class CalibrationSource:
     """Where a calibration read from a file came from (``[experiment.calibration] from``)."""
 
     path: str
-    scenario: Any
-    seed: Any
-    head_hash: Any
-    renders: Any
+    scenario: str
+    seed: int
+    head_hash: str
+    #: the renders the calibration took when it ran (None if the file does not say)
+    renders: int | None
 
 
 @dataclass(frozen=True)
@@ -241,9 +242,9 @@ class RelativeResult:
 class TrackingResult:
     """Tracking a moving target with Model 1: times, s; waypoints and errors in W, m."""
 
-    times_s: Any
-    waypoints_world_m: list[Any]
-    errors_world_m: Any
+    times_s: np.ndarray
+    waypoints_world_m: list[tuple[float, float, float]]
+    errors_world_m: np.ndarray
     renders_first: int
     renders_after_mean: float
 
@@ -273,7 +274,7 @@ class PursuitFigures:
 
 @dataclass(frozen=True)
 class PursuitResult:
-    """The live pursuit (:mod:`headsim.run.pursuit`): the spec as run, its figures and
+    """The live pursuit (:mod:`headsim.run.live_pursuit`): the spec as run, its figures and
     each frame (None when it never started), and why it failed, one line each."""
 
     pursuit: dict[str, Any]

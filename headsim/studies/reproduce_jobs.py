@@ -69,9 +69,9 @@ def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
 
 @_plain_errors
 def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
-    from headsim.run.report import summary_text
     from headsim.run.runner import run_scenario
     from headsim.run.serialise import results_payload
+    from headsim.run.summary import summary_text
     from headsim.scenario.loading import load_scenario
 
     scenario_name, _ = SCENARIO_JOBS[name]

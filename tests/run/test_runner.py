@@ -93,26 +93,18 @@ def test_every_scenario_runs_in_its_fast_variant(
     if scenario.paper_cameras:
         # The paper's figures beside ours in the summary.
         assert re.search(r"alpha_e1 \(rad\)\s+\S+\s+\S+\s+\S+\s+\S+\s+0\.0578", out)
-    experiment = results["experiment"]
+    # Each procedure's own figures are checked in tests/run/phases; here what the summary shows.
+    assert results["experiment"]["procedure"] == scenario.experiment.procedure
     if path.stem == "chessboard":
         assert re.search(r"all sides\s+\d+\s+(29|30)\.\d+\s+0\.\d+\s+30\.000\s+30\.3\s+0\.677", out)
-        assert abs(experiment["side_mean_m"] - 0.030) < 5e-4
     if path.stem == "relative_positioning":
         assert re.search(r"alpha1 \(rad\)\s+0\.0800\s+0\.0800", out)
         assert re.search(r"alpha2 \(rad\)\s+0\.0349\s+0\.0349", out)
-        assert experiment["agree"] == 6 and experiment["missing"] == []
-        assert len({o["area"] for o in experiment["objects"]}) == 6
     if path.stem == "calibration":
-        check = experiment["check_targets"][0]
-        assert check["error_m_calibrated"] < 0.01 * check["error_m_uncalibrated"]
+        assert "Check targets: error before and after the calibration" in out
     if path.stem == "tracking":
-        assert len(experiment["errors_world_m"]) == scenario.scene.moving.steps  # type: ignore[union-attr]
-        assert max(experiment["errors_world_m"]) < 0.003
+        assert "Tracking with the neck (Model 1)" in out
     if path.stem == "pursuit":
-        frames = experiment["per_frame"]
-        assert experiment["frames"] == len(frames["time_s"]) >= 15  # 0.5 s at 30 Hz
-        assert experiment["losses"] == 0 and all(frames["found"])
-        assert experiment["position_rms_pct_of_depth"] < 1.0
         assert "position error RMS along the path" in out
 
 

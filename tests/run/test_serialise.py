@@ -152,7 +152,9 @@ def test_a_calibration_block_reads_back_to_the_same_report_and_bytes() -> None:
 def test_each_experiment_writes_the_procedure_first() -> None:
     assert experiment_block("model2", PointsResult()) == {"procedure": "model2"}
     assert experiment_block("chessboard", None) == {"procedure": "chessboard"}
-    tracking = TrackingResult([0.0, 1.0], [[0.0, 0.5, 0.6]], [0.001, 0.002], 12, 4.0)
+    tracking = TrackingResult(
+        np.array([0.0, 1.0]), [(0.0, 0.5, 0.6)], np.array([1e-3, 2e-3]), 12, 4.0
+    )
     assert list(experiment_block("tracking", tracking)) == [
         "procedure",
         "times_s",

@@ -335,7 +335,7 @@ def summary_text(result: RunResult) -> str:
     elif isinstance(e, PointsResult) and e.check_targets is not None:
         lines += [*_check_lines(e), ""]
     elif isinstance(e, PursuitResult) and e.figures is not None:
-        from headsim.run.pursuit import summary_lines
+        from headsim.run.live_pursuit import summary_lines
 
         lines += [*summary_lines(experiment_block(procedure, e)), ""]
     if result.ok and procedure == "pursuit":
