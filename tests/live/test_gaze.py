@@ -45,44 +45,6 @@ def test_pursuit_predictor_cuts_the_lag_without_losing_the_target() -> None:
     assert with_predictor.rms_offset_px() < without.rms_offset_px()
 
 
-def test_pursuit_scenario_writes_results_and_a_recording_of_path_estimates_and_errors(
-    tmp_path, capsys
-) -> None:
-    import json
-
-    from rerun.chunk import RrdReader
-
-    from headsim.cli import main
-
-    rrd = tmp_path / "pursuit.rrd"
-    code = main(
-        ["run", "pursuit", "--fast", "--out", str(tmp_path), "--rrd", str(rrd), "--no-progress"]
-    )
-    out = capsys.readouterr().out
-    assert code == 0, out
-    experiment = json.loads((tmp_path / "results.json").read_text())["experiment"]
-    frames = experiment["frames"]
-    assert experiment["losses"] == 0 and frames == len(experiment["per_frame"]["error_m"])
-
-    def frames_of(entity: str, component: str) -> list[object]:
-        found = []
-        for chunk in RrdReader(rrd).stream().filter(content=entity, components=component):
-            batch = chunk.to_record_batch()
-            names = batch.schema.names
-            found += (
-                batch.column("frame").to_pylist() if "frame" in names else [None] * batch.num_rows
-            )
-        return found
-
-    assert frames_of("/world/pursuit/path", "LineStrips3D:strips") == [None]  # static
-    errors = frames_of("/measurements/error_mm", "Scalars:scalars")
-    assert len(errors) == frames and errors == sorted(
-        errors
-    )  # one per frame, on the frame timeline
-    assert len(frames_of("/world/pursuit/estimates", "Points3D:positions")) == frames
-    assert max(experiment["per_frame"]["error_m"]) < 0.02  # m, at about 1 m, 320 x 240
-
-
 def test_losses_reacquisitions_and_a_target_that_disappears_and_reappears_elsewhere() -> None:
     centre, aside = (0.0, 0.8, 0.21), (0.08, 0.8, 0.24)
     out_of_view = (0.0, 0.8, 1.5)  # present, far above the view
