@@ -1,4 +1,4 @@
-"""Loading scenario files: every shipped file validates in both variants; the fast table, missing or broken files and the CLI's list say what is wrong."""
+"""Loading scenario files: every shipped file validates in both variants; the fast table and missing or broken files say what is wrong."""
 
 from __future__ import annotations
 
@@ -8,7 +8,6 @@ from pathlib import Path
 
 import pytest
 
-from headsim.cli import main
 from headsim.scenario.loading import load_scenario, scenario_files
 from headsim.scenario.tables import ScenarioError
 
@@ -82,34 +81,3 @@ def test_a_file_that_is_not_toml_or_not_there_says_so(tmp_path: Path) -> None:
         ScenarioError, match=r"no such scenario file .allowed: a .toml path or one of: .*quickstart"
     ):
         load_scenario("kitchen")
-
-
-def test_run_with_a_bad_file_exits_2_and_writes_nothing(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    path = _write(tmp_path, MINIMAL.replace("0.6]", "-0.6]"))
-    out, rrd = tmp_path / "out", tmp_path / "rec" / "run.rrd"
-    assert main(["run", str(path), "--out", str(out), "--rrd", str(rrd)]) == 2
-    err = capsys.readouterr().err
-    assert err.startswith(f"headsim: error: {path}: scene.targets[0]: target at")
-    assert not out.exists() and not rrd.parent.exists()
-    assert main(["run", "quickstart", "--seed", "-3", "--out", str(out)]) == 2
-    assert "seed: -3 is out of range" in capsys.readouterr().err
-    assert not out.exists()
-
-
-def test_list_shows_every_scenario_with_its_description(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["list"]) == 0
-    out = capsys.readouterr().out
-    for path in FILES:
-        description = load_scenario(path).description
-        assert re.search(rf"^  {path.stem}\s+{re.escape(description)}$", out, re.M)
-
-
-def test_list_flags_an_invalid_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    _write(tmp_path, MINIMAL, "good.toml")
-    _write(tmp_path, MINIMAL + "[head]\nbaseline_m = 0\n", "broken.toml")
-    assert main(["list", "--dir", str(tmp_path)]) == 2
-    out = capsys.readouterr().out
-    assert "good" in out and "a test" in out
-    assert "broken  INVALID:" in out and "head.baseline_m: 0 is out of range" in out

@@ -181,38 +181,3 @@ def test_effective_initial_direction_agrees_with_the_forward_model() -> None:
                 camera, cam.mount_yaw_rad, pinhole, cam.image_centre[0]
             )
             assert sim.effective_initial_direction(camera) == pytest.approx(expected, abs=1e-12)
-
-
-def test_every_image_taken_is_reported_to_the_sink_with_its_kind_and_cost() -> None:
-    from headsim.sim.events import ImageKind, ImageTaken
-    from headsim.sim.render import Window
-
-    events: list[object] = []
-
-    class Sink:
-        def emit(self, event: object) -> None:
-            events.append(event)
-
-    with HeadSim("default", sink=Sink()) as sim:
-        window = Window(100, 80, 64, 48)
-        full = sim.render(1)
-        crop = sim.render_window("cam2", window)
-        again = sim.retake(2)
-        preview = sim.render_preview(1, 4)
-        assert [(e.camera, e.kind) for e in events] == [  # type: ignore[attr-defined]
-            (1, ImageKind.FULL),
-            (2, ImageKind.WINDOW),
-            (2, ImageKind.RETAKE),
-            (1, ImageKind.PREVIEW),
-        ]
-        assert all(isinstance(e, ImageTaken) for e in events)
-        taken = [e for e in events if isinstance(e, ImageTaken)]
-        for event, image in zip(taken, (full, crop, again, preview), strict=True):
-            assert event.image is image
-        assert taken[1].window == window and crop.shape == (48, 64, 3)
-        assert taken[3].binning == 4 and taken[0].window is None
-        # What each image cost, in full frames, adds up to the simulator's own count.
-        assert taken[0].rendered_frames == 1.0
-        assert 0.0 < taken[1].rendered_frames < 0.05
-        assert sum(e.rendered_frames for e in taken) == pytest.approx(sim.rendered_frames)
-        assert len(taken) == sim.render_count

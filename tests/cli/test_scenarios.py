@@ -1,0 +1,72 @@
+"""The scenario commands (cli/scenarios.py): run and list refuse bad files with exit 2,
+list describes every scenario, and the progress shown follows the flags."""
+
+from __future__ import annotations
+
+import argparse
+import re
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from headsim.cli import main
+from headsim.cli.scenarios import progress_observer
+from headsim.scenario.loading import load_scenario, scenario_files
+
+FILES = scenario_files()
+
+
+MINIMAL = """
+description = "a test"
+
+[experiment]
+procedure = "model2"
+
+[[scene.targets]]
+position_head_m = [0.02, 0.01, 0.6]
+"""
+
+
+def _write(tmp_path: Path, text: str, name: str = "bad.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(text))
+    return path
+
+
+def test_run_with_a_bad_file_exits_2_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _write(tmp_path, MINIMAL.replace("0.6]", "-0.6]"))
+    out, rrd = tmp_path / "out", tmp_path / "rec" / "run.rrd"
+    assert main(["run", str(path), "--out", str(out), "--rrd", str(rrd)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"headsim: error: {path}: scene.targets[0]: target at")
+    assert not out.exists() and not rrd.parent.exists()
+    assert main(["run", "quickstart", "--seed", "-3", "--out", str(out)]) == 2
+    assert "seed: -3 is out of range" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_list_shows_every_scenario_with_its_description(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for path in FILES:
+        description = load_scenario(path).description
+        assert re.search(rf"^  {path.stem}\s+{re.escape(description)}$", out, re.M)
+
+
+def test_list_flags_an_invalid_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    _write(tmp_path, MINIMAL, "good.toml")
+    _write(tmp_path, MINIMAL + "[head]\nbaseline_m = 0\n", "broken.toml")
+    assert main(["list", "--dir", str(tmp_path)]) == 2
+    out = capsys.readouterr().out
+    assert "good" in out and "a test" in out
+    assert "broken  INVALID:" in out and "head.baseline_m: 0 is out of range" in out
+
+
+def test_progress_is_shown_unless_quiet_or_turned_off() -> None:
+    assert progress_observer(argparse.Namespace(no_progress=True), 5, "fixations") is None
+    assert progress_observer(argparse.Namespace(quiet=True), 5, "fixations") is None
+    shown = progress_observer(argparse.Namespace(), 5, "fixations")
+    assert shown is not None and shown.counter.total == 5

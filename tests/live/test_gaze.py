@@ -1,0 +1,92 @@
+"""Gaze (live/gaze.py): determinism, acquisition, pursuit, losses and re-acquisitions."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Static, Visibility, Waypoints
+from headsim.live.gaze import GazeConfig, acquire, pursue
+from headsim.sim.simulator import HeadSim
+
+from .helpers import RED, small_head
+
+
+def pursuit_run(seed: int, predictor: bool = True, duration_s: float = 0.6):
+    with HeadSim(settings=small_head()) as sim:
+        path = RandomWalk((0.0, 0.8, 0.3), max_speed_m_s=0.3, duration_s=2.0, seed=seed)
+        live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path)
+        estimator = acquire(live, RED)
+        assert estimator is not None
+        run = pursue(live, RED, estimator, duration_s, GazeConfig(predictor=predictor))
+        return run, live.capture().images
+
+
+def test_live_runs_are_identical_from_the_same_seed_and_differ_from_another() -> None:
+    first, images_first = pursuit_run(seed=3)
+    second, images_second = pursuit_run(seed=3)
+    other, _ = pursuit_run(seed=4)
+    assert len(first.records) == len(second.records) > 10
+    for a, b in zip(first.records, second.records, strict=True):
+        assert a.found and b.found
+        np.testing.assert_array_equal(a.estimate_world_m, b.estimate_world_m)
+        np.testing.assert_array_equal(a.encoders_rad, b.encoders_rad)
+    for a, b in zip(images_first, images_second, strict=True):
+        np.testing.assert_array_equal(a, b)
+    truths = [r.truth_world_m for r in other.records]
+    assert not np.allclose(truths[-1], first.records[-1].truth_world_m)
+
+
+def test_pursuit_predictor_cuts_the_lag_without_losing_the_target() -> None:
+    with_predictor, _ = pursuit_run(seed=5, predictor=True, duration_s=1.0)
+    without, _ = pursuit_run(seed=5, predictor=False, duration_s=1.0)
+    assert with_predictor.losses == without.losses == 0
+    assert with_predictor.frames_lost == 0
+    assert with_predictor.lag_s() < without.lag_s()
+    assert with_predictor.rms_offset_px() < without.rms_offset_px()
+
+
+def test_losses_reacquisitions_and_a_target_that_disappears_and_reappears_elsewhere() -> None:
+    centre, aside = (0.0, 0.8, 0.21), (0.08, 0.8, 0.24)
+    out_of_view = (0.0, 0.8, 1.5)  # present, far above the view
+    # Seen, then out of view for 0.1 s (a loss), then back (a re-acquisition).
+    lost_path = Waypoints((centre, out_of_view, (0.0, 0.8, 1.501), centre), (1000.0, 0.01, 1000.0))
+    # Seen, absent from 0.3 to 0.5 s, back elsewhere: no loss, a saccade, a new fixation.
+    jump = Jump(centre, aside, 0.4)
+    windows = Visibility(((0.0, 0.3), (0.5, 2.0)))
+    runs = {}
+    for name, path, visibility in (("lost", lost_path, None), ("jump", jump, windows)):
+        with HeadSim(settings=small_head()) as sim:
+            live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path, visibility)
+            estimator = acquire(live, RED)
+            assert estimator is not None
+            runs[name] = pursue(live, RED, estimator, 1.0)
+    lost, jumped = runs["lost"], runs["jump"]
+    assert lost.losses == 1 and lost.reacquisitions == 1 and lost.frames_lost >= 3
+    assert jumped.losses == 0 and jumped.frames_lost == 0
+    assert sum(1 for r in jumped.records if r.truth_world_m is None) == 6  # 0.2 s at 30 Hz
+    assert any(r.saccade for r in jumped.records if r.time_s >= 0.5)
+    assert 0.0 < jumped.time_to_fixation_s(1.0, since_s=0.5) < 0.4
+
+
+def test_acquiring_with_the_servos_windows_off_looks_at_whole_frames_only() -> None:
+    from headsim.active.servo_types import ServoConfig
+    from headsim.sim.events import ImageKind, ImageTaken
+
+    class Sink:
+        def __init__(self) -> None:
+            self.kinds: list[ImageKind] = []
+
+        def emit(self, event: object) -> None:
+            if isinstance(event, ImageTaken):
+                self.kinds.append(event.kind)
+
+    kinds: dict[bool, list[ImageKind]] = {}
+    for windows in (True, False):
+        sink = Sink()
+        with HeadSim(settings=small_head(), sink=sink) as sim:
+            live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.28)))
+            estimator = acquire(live, RED, config=ServoConfig(windows=windows))
+            assert estimator is not None
+        kinds[windows] = sink.kinds
+    assert set(kinds[False]) == {ImageKind.FULL}
+    assert {ImageKind.PREVIEW, ImageKind.WINDOW} <= set(kinds[True])

@@ -1,0 +1,79 @@
+"""The job pool (studies/jobs.py): one retry per job, records in order, a bound on jobs, and
+the renderers' share of the CPUs."""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import concurrent.futures.process  # noqa: F401  execute() reads cf.process, loaded by its real pools
+import os
+import threading
+from dataclasses import dataclass
+from typing import Any
+
+from headsim.studies.jobs import ATTEMPTS, _render_threads, execute
+
+
+@dataclass(frozen=True)
+class Job:
+    id: str
+    index: int
+    params: dict[str, Any]
+
+
+class Flaky:
+    """Job 1 fails its first attempt, job 2 every attempt, job 3 raises; the rest succeed."""
+
+    def __init__(self) -> None:
+        self.calls: dict[str, int] = {}
+        self.lock = threading.Lock()
+
+    def __call__(self, job: Job, marker: str | None) -> dict[str, Any]:
+        with self.lock:
+            self.calls[job.id] = self.calls.get(job.id, 0) + 1
+            call = self.calls[job.id]
+        if job.index == 3:
+            raise RuntimeError("the worker died")
+        failed = job.index == 2 or (job.index == 1 and call == 1)
+        return {"id": job.id, "index": job.index, "status": "error" if failed else "ok"}
+
+
+JOBS = [Job(f"j{i}", i, {"x": i}) for i in range(5)]
+
+
+def test_every_job_is_retried_once_and_recorded_with_its_attempts() -> None:
+    records: list[dict[str, Any]] = []
+    flaky = Flaky()
+    finished = execute(JOBS, lambda: cf.ThreadPoolExecutor(2), records.append, None, None, flaky)
+    assert finished == 5 and ATTEMPTS == 2
+    by_id = {r["id"]: r for r in records}
+    assert {i: (r["status"], r["attempts"]) for i, r in by_id.items()} == {
+        "j0": ("ok", 1),
+        "j1": ("ok", 2),
+        "j2": ("error", 2),
+        "j3": ("crashed", 2),
+        "j4": ("ok", 1),
+    }
+    assert by_id["j3"]["error"] == "RuntimeError: the worker died"
+    assert by_id["j3"]["params"] == {"x": 3}
+    assert flaky.calls == {"j0": 1, "j1": 2, "j2": 2, "j3": 2, "j4": 1}
+
+
+def test_stop_after_ends_the_run_after_that_many_records() -> None:
+    records: list[dict[str, Any]] = []
+    ok = [Job(f"k{i}", i, {}) for i in range(6)]
+    finished = execute(
+        ok,
+        lambda: cf.ThreadPoolExecutor(1),
+        records.append,
+        2,
+        None,
+        lambda job, marker: {"id": job.id, "index": job.index, "status": "ok"},
+    )
+    assert finished == 2 and len(records) == 2
+
+
+def test_the_renderers_share_the_cpus_and_get_at_least_one_thread() -> None:
+    cpus = len(os.sched_getaffinity(0))
+    assert _render_threads(1) == cpus
+    assert _render_threads(2) == max(1, cpus // 2)
+    assert _render_threads(cpus + 1) == 1
