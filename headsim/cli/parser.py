@@ -31,7 +31,7 @@ def positive_int(text: str) -> int:
 def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     """The command line; ``with_study``: with the study's options (imports the study)."""
     from headsim.sim import names
-    from headsim.sim.settings import PRESETS
+    from headsim.sim.presets import PRESET_NAMES
 
     parser = argparse.ArgumentParser(
         prog="headsim",
@@ -137,7 +137,10 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         help=f"scene: {', '.join(sorted(names.SCENES))} or an MJCF path",
     )
     snap.add_argument(
-        "--preset", default="ideal", choices=sorted(PRESETS), help="camera preset (default: ideal)"
+        "--preset",
+        default="ideal",
+        choices=sorted(PRESET_NAMES),
+        help="camera preset (default: ideal)",
     )
     snap.add_argument(
         "--eye", type=float, default=0.0, help="eye-motor angle, rad, positive inward"

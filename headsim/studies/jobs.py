@@ -4,6 +4,7 @@ retried once and a crashed worker survived, and the render workers' pool."""
 from __future__ import annotations
 
 import concurrent.futures as cf
+import concurrent.futures.process  # noqa: F401  execute() reads cf.process; only a process pool loads it
 import multiprocessing
 import os
 import signal
