@@ -39,8 +39,8 @@ from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
 from headsim.sim.render import EyeRenderer, Window, context_key
 from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
 
-#: A camera: 1 or 2 (the paper's Ca1, Ca2) or its MJCF name "cam1"/"cam2".
-CameraId = int | str
+#: A camera: 1 or 2 (the paper's Ca1, Ca2), its MJCF name "cam1"/"cam2", or a names.Camera.
+CameraId = int | str | names.Camera
 
 
 class HeadSim:
@@ -242,12 +242,12 @@ class HeadSim:
         return {joint: float(self.data.qpos[adr]) for joint, adr in self._qadr.items()}
 
     def camera_index(self, camera: CameraId) -> int:
-        """Position in ``settings.cameras`` (0, 1) of camera 1 or 2 (the paper's Ca1, Ca2) or its name."""
-        if isinstance(camera, int) and not isinstance(camera, bool) and camera in (1, 2):
-            return camera - 1
-        if camera in names.CAMERAS:
-            return names.CAMERAS.index(str(camera))
-        raise SettingsError(f"unknown camera {camera!r}; allowed: 1, 2, {', '.join(names.CAMERAS)}")
+        """Position in ``settings.cameras`` (0, 1) of camera 1 or 2 (the paper's Ca1, Ca2),
+        its MJCF name or its :class:`~headsim.sim.names.Camera`."""
+        try:
+            return names.Camera.of(camera).index
+        except ValueError as err:
+            raise SettingsError(str(err)) from None
 
     def camera_settings(self, camera: CameraId) -> CameraSettings:
         return self.settings.cameras[self.camera_index(camera)]

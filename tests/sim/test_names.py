@@ -29,3 +29,17 @@ def test_a_positive_mount_yaw_turns_each_camera_towards_the_midline() -> None:
         eye_x = spec.body(names.EYE_BODIES[camera.index]).pos[0]  # the eye's side of the midline
         assert np.sign(axis_h[0]) == -np.sign(eye_x) == camera.inward
         assert axis_h[0] == pytest.approx(camera.inward * np.sin(0.2), abs=1e-15)
+
+
+def test_the_simulator_takes_a_camera_by_number_name_or_camera() -> None:
+    from headsim.sim.settings import SettingsError, paper_head
+    from headsim.sim.simulator import HeadSim
+
+    with HeadSim("default", paper_head()) as sim:
+        for camera in names.EYE_CAMERAS:
+            assert sim.camera_index(camera) == camera.index
+            assert sim.camera_index(camera.number) == camera.index
+            assert sim.camera_index(camera.name) == camera.index
+            assert sim.camera_settings(camera) is sim.camera_settings(camera.number)
+        with pytest.raises(SettingsError, match="unknown camera 3; allowed: 1, 2"):
+            sim.camera_index(3)
