@@ -5,39 +5,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.active.failure import Failure, FailureCause
-from headsim.active.measurement import Measurement
-from headsim.estimators.result import Method, Status
 from headsim.run.accuracy import DEPTH_BANDS_M, summaries, summarise
 from headsim.run.outcomes import MeasurementRecord
 
-LOST = Failure(FailureCause.LOST, "step 1", 2, "and at 12 eye angles searched")
-
-
-def _measurement(error_m: float, depth_m: float, failure: Failure | None = None) -> Measurement:
-    truth = np.array([0.0, 0.0, depth_m])
-    estimate = truth + np.array([error_m, 0.0, 0.0]) if failure is None else np.full(3, np.nan)
-    return Measurement(
-        name="t",
-        method=Method.MODEL2,
-        status=Status.OK if failure is None else Status.FAILED,
-        estimate_head_m=estimate,
-        truth_head_m=truth,
-        estimate_world_m=estimate,
-        truth_world_m=truth,
-        covariance_head_m2=np.eye(3),
-        renders=7,
-        servo_residual_px=(0.25, -0.5),
-        failure=failure,
-        detail="" if failure is None else failure.message,
-    )
+from .helpers import LOST, measurement
 
 
 def test_summaries_count_by_knowledge_and_depth_band() -> None:
     records = [
-        MeasurementRecord(_measurement(0.001, 0.5), "none", 0),
-        MeasurementRecord(_measurement(0.004, 0.8), "calibrated", 1),
-        MeasurementRecord(_measurement(0.0, 1.2, LOST), "calibrated", 2),
+        MeasurementRecord(measurement(0.001, 0.5), "none", 0),
+        MeasurementRecord(measurement(0.004, 0.8), "calibrated", 1),
+        MeasurementRecord(measurement(0.0, 1.2, LOST), "calibrated", 2),
     ]
     by_knowledge = summaries(records)
     assert list(by_knowledge) == ["none", "calibrated"]
@@ -50,7 +28,7 @@ def test_summaries_count_by_knowledge_and_depth_band() -> None:
 
 def test_every_depth_counts_in_exactly_one_band() -> None:
     depths = [0.3, 0.6, 0.99, 1.0, 2.5]
-    records = [MeasurementRecord(_measurement(0.001, d), "none", k) for k, d in enumerate(depths)]
+    records = [MeasurementRecord(measurement(0.001, d), "none", k) for k, d in enumerate(depths)]
     s = summarise(records)
     assert len(s.by_depth) == len(DEPTH_BANDS_M)
     assert [b.count for b in s.by_depth] == [1, 2, 2]

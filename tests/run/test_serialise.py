@@ -7,8 +7,6 @@ import json
 import numpy as np
 import pytest
 
-from headsim.active.failure import Failure, FailureCause
-from headsim.active.measurement import Measurement
 from headsim.estimators.result import Method, Status
 from headsim.files import to_jsonable
 from headsim.run.outcomes import (
@@ -32,26 +30,7 @@ from headsim.run.serialise import (
     measurement_entry,
 )
 
-LOST = Failure(FailureCause.LOST, "step 1", 2, "and at 12 eye angles searched")
-
-
-def _measurement(error_m: float, depth_m: float, failure: Failure | None = None) -> Measurement:
-    truth = np.array([0.0, 0.0, depth_m])
-    estimate = truth + np.array([error_m, 0.0, 0.0]) if failure is None else np.full(3, np.nan)
-    return Measurement(
-        name="t",
-        method=Method.MODEL2,
-        status=Status.OK if failure is None else Status.FAILED,
-        estimate_head_m=estimate,
-        truth_head_m=truth,
-        estimate_world_m=estimate,
-        truth_world_m=truth,
-        covariance_head_m2=np.eye(3),
-        renders=7,
-        servo_residual_px=(0.25, -0.5),
-        failure=failure,
-        detail="" if failure is None else failure.message,
-    )
+from .helpers import LOST, measurement
 
 
 def _full_report() -> CalibrationReport:
@@ -104,11 +83,11 @@ def test_the_enums_write_the_strings_results_json_always_had() -> None:
 
 
 def test_a_measurement_writes_its_method_status_and_failure_as_documented() -> None:
-    ok = measurement_entry(MeasurementRecord(_measurement(0.003, 0.5), "none", 0))
+    ok = measurement_entry(MeasurementRecord(measurement(0.003, 0.5), "none", 0))
     assert list(ok) == list(MEASUREMENT_KEYS)
     assert ok["method"] == "model2" and ok["status"] == "ok" and ok["failure"] is None
     assert ok["error_m"] == pytest.approx(0.003)
-    lost = measurement_entry(MeasurementRecord(_measurement(0.0, 0.5, LOST), "none", 1))
+    lost = measurement_entry(MeasurementRecord(measurement(0.0, 0.5, LOST), "none", 1))
     assert lost["status"] == "Ca2 at step 1: target lost (and at 12 eye angles searched)"
     assert lost["failure"] == {
         "cause": "lost",

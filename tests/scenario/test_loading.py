@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-import textwrap
 from pathlib import Path
 
 import pytest
@@ -11,27 +10,12 @@ import pytest
 from headsim.scenario.loading import load_scenario, scenario_files
 from headsim.scenario.tables import ScenarioError
 
+from .helpers import MINIMAL, write_scenario
+
 FILES = scenario_files()
 
 
 PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "tracking")
-
-
-MINIMAL = """
-description = "a test"
-
-[experiment]
-procedure = "model2"
-
-[[scene.targets]]
-position_head_m = [0.02, 0.01, 0.6]
-"""
-
-
-def _write(tmp_path: Path, text: str, name: str = "bad.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(textwrap.dedent(text))
-    return path
 
 
 def test_there_is_a_scenario_for_each_experiment_and_a_quick_start() -> None:
@@ -63,20 +47,20 @@ def test_a_scenario_is_found_by_name_and_the_seed_draws_only_the_random_parts() 
 
 
 def test_the_fast_table_is_checked_and_named(tmp_path: Path) -> None:
-    path = _write(tmp_path, MINIMAL + "[fast]\nexperiment.calibration.targets = 1\n")
+    path = write_scenario(tmp_path, MINIMAL + "[fast]\nexperiment.calibration.targets = 1\n")
     with pytest.raises(
         ScenarioError,
         match=re.escape(f"{path}: fast.experiment.calibration.targets: 1 is out of range"),
     ):
         load_scenario(path)  # the full variant is fine, but both are checked
-    path = _write(tmp_path, MINIMAL + "[fast]\ndescription = 'short'\n")
+    path = write_scenario(tmp_path, MINIMAL + "[fast]\ndescription = 'short'\n")
     with pytest.raises(ScenarioError, match=r"fast.description: unknown key"):
         load_scenario(path)
 
 
 def test_a_file_that_is_not_toml_or_not_there_says_so(tmp_path: Path) -> None:
     with pytest.raises(ScenarioError, match=re.escape(f"{tmp_path / 'bad.toml'}: not valid TOML")):
-        load_scenario(_write(tmp_path, "description = \n"))
+        load_scenario(write_scenario(tmp_path, "description = \n"))
     with pytest.raises(
         ScenarioError, match=r"no such scenario file .allowed: a .toml path or one of: .*quickstart"
     ):

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-import textwrap
 from pathlib import Path
 
 import pytest
@@ -11,22 +10,7 @@ import pytest
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.tables import ScenarioError
 
-MINIMAL = """
-description = "a test"
-
-[experiment]
-procedure = "model2"
-
-[[scene.targets]]
-position_head_m = [0.02, 0.01, 0.6]
-"""
-
-
-def _write(tmp_path: Path, text: str, name: str = "bad.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(textwrap.dedent(text))
-    return path
-
+from .helpers import MINIMAL, write_scenario
 
 REACH = [
     (
@@ -60,7 +44,7 @@ def test_a_target_out_of_reach_is_refused_without_rendering(
     tmp_path: Path, position: str, message: str
 ) -> None:
     text = MINIMAL.replace("[0.02, 0.01, 0.6]", position)
-    path = _write(tmp_path, text)
+    path = write_scenario(tmp_path, text)
     with pytest.raises(ScenarioError, match=re.escape(f"{path}: {message}")):
         load_scenario(path)
 
@@ -70,15 +54,17 @@ def test_other_scenes_check_their_own_things(tmp_path: Path) -> None:
     with pytest.raises(
         ScenarioError, match=r"scene.chessboard.corners: \[48\] has an index out of range"
     ):
-        load_scenario(_write(tmp_path, board + "corners = [48]\n"))
+        load_scenario(write_scenario(tmp_path, board + "corners = [48]\n"))
     with pytest.raises(ScenarioError, match=r"scene.chessboard: corner 0 at .* is behind"):
-        load_scenario(_write(tmp_path, board + "position_head_m = [0.0, 0.0, -1.0]\n"))
+        load_scenario(write_scenario(tmp_path, board + "position_head_m = [0.0, 0.0, -1.0]\n"))
     with pytest.raises(
         ScenarioError,
         match=r"scene.chessboard.position_world_m: given together with position_head_m",
     ):
         load_scenario(
-            _write(tmp_path, board + "position_head_m = [0, 0, 1]\nposition_world_m = [0, 1, 0]\n")
+            write_scenario(
+                tmp_path, board + "position_head_m = [0, 0, 1]\nposition_world_m = [0, 1, 0]\n"
+            )
         )
     track = (
         'description = "t"\n[experiment]\nprocedure = "tracking"\n[scene.moving_target]\n'
@@ -89,14 +75,16 @@ def test_other_scenes_check_their_own_things(tmp_path: Path) -> None:
         match=r"scene.moving_target: the target at t = 1 s at .* needs a neck yaw of -2.783 rad",
     ):
         load_scenario(
-            _write(tmp_path, track + "waypoints_world_m = [[0.3, 0.8, 0.2], [0.3, -0.8, 0.2]]\n")
+            write_scenario(
+                tmp_path, track + "waypoints_world_m = [[0.3, 0.8, 0.2], [0.3, -0.8, 0.2]]\n"
+            )
         )
     with pytest.raises(ScenarioError, match=r"scene.moving_target.waypoints_head_m: missing"):
-        load_scenario(_write(tmp_path, track))
+        load_scenario(write_scenario(tmp_path, track))
     blocks = 'description = "r"\n[experiment]\nprocedure = "relative_positioning"\n'
     with pytest.raises(ScenarioError, match=r"scene.objects\[1\].body: 'object_1' is placed twice"):
         load_scenario(
-            _write(
+            write_scenario(
                 tmp_path,
                 blocks + "[[scene.objects]]\nbody = 'object_1'\nposition_head_m = [0, 0, 1]\n" * 2,
             )
@@ -105,4 +93,6 @@ def test_other_scenes_check_their_own_things(tmp_path: Path) -> None:
         ScenarioError,
         match=r"scene.targets: unknown key \(allowed: blocks, objects, random_objects\)",
     ):
-        load_scenario(_write(tmp_path, blocks + "[[scene.targets]]\nposition_head_m = [0, 0, 1]\n"))
+        load_scenario(
+            write_scenario(tmp_path, blocks + "[[scene.targets]]\nposition_head_m = [0, 0, 1]\n")
+        )

@@ -2,28 +2,13 @@
 
 from __future__ import annotations
 
-import textwrap
 from pathlib import Path
 
 import numpy as np
 
 from headsim.scenario.loading import load_scenario
 
-MINIMAL = """
-description = "a test"
-
-[experiment]
-procedure = "model2"
-
-[[scene.targets]]
-position_head_m = [0.02, 0.01, 0.6]
-"""
-
-
-def _write(tmp_path: Path, text: str, name: str = "bad.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(textwrap.dedent(text))
-    return path
+from .helpers import MINIMAL, write_scenario
 
 
 def test_random_targets_are_drawn_inside_their_spec(tmp_path: Path) -> None:
@@ -31,7 +16,7 @@ def test_random_targets_are_drawn_inside_their_spec(tmp_path: Path) -> None:
         MINIMAL
         + "[scene.random_targets]\ncount = 50\ndepth_m = [0.5, 0.8]\nlateral = 0.1\nvertical = 0.05\n"
     )
-    scenario = load_scenario(_write(tmp_path, text))
+    scenario = load_scenario(write_scenario(tmp_path, text))
     from headsim.geometry.kinematics import world_to_head
 
     s = scenario.settings

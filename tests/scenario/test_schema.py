@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-import textwrap
 from pathlib import Path
 
 import pytest
@@ -11,21 +10,7 @@ import pytest
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.tables import ScenarioError
 
-MINIMAL = """
-description = "a test"
-
-[experiment]
-procedure = "model2"
-
-[[scene.targets]]
-position_head_m = [0.02, 0.01, 0.6]
-"""
-
-
-def _write(tmp_path: Path, text: str, name: str = "bad.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(textwrap.dedent(text))
-    return path
+from .helpers import MINIMAL, write_scenario
 
 
 def test_paper_preset_and_overrides_build_the_cameras() -> None:
@@ -39,7 +24,7 @@ def test_paper_preset_and_overrides_build_the_cameras() -> None:
 def test_initial_directions_set_the_mount_yaws(tmp_path: Path) -> None:
     from headsim.sim.simulator import HeadSim
 
-    path = _write(
+    path = write_scenario(
         tmp_path,
         MINIMAL + "[head]\ninitial_direction_rad = [0.03, -0.02]\n[cam1]\ncx = 300.0\n",
         "ok.toml",
@@ -110,7 +95,7 @@ def test_a_bad_field_is_named_with_what_is_allowed(
     tmp_path: Path, extra: str, message: str
 ) -> None:
     # Top-level keys go first; tables after the minimal file (TOML puts keys in the last table).
-    path = _write(tmp_path, MINIMAL + extra if extra.startswith("[") else extra + MINIMAL)
+    path = write_scenario(tmp_path, MINIMAL + extra if extra.startswith("[") else extra + MINIMAL)
     with pytest.raises(ScenarioError, match=re.escape(f"{path}: {message}")):
         load_scenario(path)
 
@@ -118,11 +103,11 @@ def test_a_bad_field_is_named_with_what_is_allowed(
 def test_names_are_unique_and_required_tables_present(tmp_path: Path) -> None:
     twice = MINIMAL + "[[scene.targets]]\nname = 'target_1'\nposition_head_m = [0, 0, 1]\n"
     with pytest.raises(ScenarioError, match=r"scene.targets\[1\].name: 'target_1' is used twice"):
-        load_scenario(_write(tmp_path, twice))
+        load_scenario(write_scenario(tmp_path, twice))
     with pytest.raises(ScenarioError, match=r"experiment: missing .allowed: an .experiment. table"):
-        load_scenario(_write(tmp_path, 'description = "x"\n'))
+        load_scenario(write_scenario(tmp_path, 'description = "x"\n'))
     with pytest.raises(ScenarioError, match="description: missing"):
-        load_scenario(_write(tmp_path, MINIMAL.replace('description = "a test"', "")))
+        load_scenario(write_scenario(tmp_path, MINIMAL.replace('description = "a test"', "")))
     calibration = 'description = "c"\n[experiment]\nprocedure = "calibration"\n'
     with pytest.raises(ScenarioError, match=r"experiment.calibration: missing"):
-        load_scenario(_write(tmp_path, calibration))
+        load_scenario(write_scenario(tmp_path, calibration))
