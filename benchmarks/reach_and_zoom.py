@@ -38,6 +38,7 @@ from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import calibration_layout
 from headsim.active.principal import principal_points_by_zoom
+from headsim.active.servo_types import ServoConfig
 from headsim.files import write_json_atomic
 from headsim.run.targets import marker_target
 from headsim.scenario.reach import reach_refusal
@@ -128,6 +129,7 @@ def run_zoom(
     goal: str,
     oracle: bool = False,
     fine: bool = False,
+    fixation_sigma_steps: float = 0.0,
 ) -> dict[str, Any]:
     """Calibrate (the layout drawn from the same seed at every zoom, where this zoom's
     cameras see it) and measure every point the reach check accepts at ``zoom``."""
@@ -147,7 +149,8 @@ def run_zoom(
         out["goal_column_error_px"] = [float(e) for e in found.errors_px[:, 0]]
     errors = {m: np.full(len(points_head), np.nan) for m in ("model2", "model1")}
     with HeadSim("default", settings) as sim:
-        servo = EyeServo(sim)
+        config = ServoConfig(fixation_sigma_steps=fixation_sigma_steps)
+        servo = EyeServo(sim, config)
         ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
         # Balls where both cameras see them at the start pose or with the eyes
         # turned in (0.1-0.3 rad): at 1.6x-2x the start pose's common view holds
@@ -182,7 +185,7 @@ def run_zoom(
             m2.append(measure_model2(sim, servo, marker_target(f"t{k}", BODY), knowledge))
         sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
         sim.settle()
-        neck = NeckServo(sim)
+        neck = NeckServo(sim, config)
         m1 = []
         for k in index:
             sim.set_body_pose(BODY, world[k])
@@ -264,6 +267,13 @@ def main() -> int:
     parser.add_argument(
         "--fine", action="store_true", help="render at FINE_RENDERING (4, 2) instead of (4, 1)"
     )
+    parser.add_argument(
+        "--fixation-sigma",
+        type=float,
+        default=0.0,
+        help="the servo's fixation_sigma_steps (0, the default: one image per fixation; "
+        "0.05: averaged to the same angle at every zoom)",
+    )
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
     start = time.perf_counter()
@@ -274,7 +284,14 @@ def main() -> int:
         print(f"  zoom {zoom}x ...", file=sys.stderr, flush=True)
         rows.append(
             run_zoom(
-                zoom, points_head, args.calibration, args.seed, args.goal, args.oracle, args.fine
+                zoom,
+                points_head,
+                args.calibration,
+                args.seed,
+                args.goal,
+                args.oracle,
+                args.fine,
+                args.fixation_sigma,
             )
         )
     ratios = {
@@ -283,7 +300,8 @@ def main() -> int:
     }
     print(
         f"Field: depth {FIELD['depth_m']} m, |x/z| <= {FIELD['lateral']}, "
-        f"|y/z| <= {FIELD['vertical']}; paper's cameras, focal x zoom; goal columns: {args.goal}"
+        f"|y/z| <= {FIELD['vertical']}; paper's cameras, focal x zoom; goal columns: {args.goal}; "
+        f"fixation_sigma_steps {args.fixation_sigma}"
     )
     print(
         f"{'zoom':>5} {'model':>6} {'acc':>4} {'ok':>4} {'lost':>4} {'rms mm':>8} {'rms %':>7} "

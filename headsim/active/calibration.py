@@ -153,7 +153,12 @@ def calibrate_head(
     # Without a depth error model the fit is unweighted and its standard errors
     # come from the scatter of its residuals (the angles' noise is not known a priori).
     z_sigma = math.hypot(depth_noise_m, position_noise_m)
+    resolution = sim.settings.encoder_resolution_rad
     try:
+        if np.ptp(alpha1) < resolution and np.ptp(alpha2) < resolution:
+            # One place to the head (within an encoder step); the servo's averaged
+            # sub-step angles differ by their scatter, so the fit alone may not tell.
+            raise ValueError("their fixation angles lie within one encoder step of each other")
         fit = calibrate_initial_directions(
             np.array(alpha1),
             np.array(alpha2),

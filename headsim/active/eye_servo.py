@@ -12,8 +12,17 @@ learnt on one target seeds the next.  Every loop is bounded and returns a
 from __future__ import annotations
 
 import math
+from dataclasses import replace
+
+import numpy as np
 
 from headsim.active.events import ServoKind, ServoStep
+from headsim.active.fixation_average import (
+    ScatterMemory,
+    detector_kind,
+    pixel_period_steps,
+    samples_wanted,
+)
 from headsim.active.servo_types import (
     Detector,
     ServoConfig,
@@ -63,6 +72,12 @@ class EyeServo:
         #: Windows rendered, and windows that missed the target (a full frame followed).
         self.window_renders = 0
         self.window_misses = 0
+        #: Per (camera, kind of detector), the columns' scatter about the crossing line.
+        self.scatter = ScatterMemory(self.config.pixel_sigma_px)
+
+    def pixel_sigma(self, camera: int, detector: object) -> float:
+        """The learnt scatter of ``detector``'s columns about the crossing line, px."""
+        return self.scatter.sigma_px((camera, detector_kind(detector)))
 
     @property
     def step_range(self) -> tuple[int, int]:
@@ -159,10 +174,70 @@ class EyeServo:
         ``first``: a detection already made at the current eye position (saves
         a render).  A move after which the target is gone is undone (back to
         the last step that saw it, no render needed) and retried at half the
-        length, at most ``max_retreats`` times.
+        length, at most ``max_retreats`` times.  Once converged, the sub-step
+        fixation is averaged over images around the crossing until its
+        standard error reaches ``fixation_sigma_steps`` (see :class:`ServoConfig`).
         """
+        goal = self.sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
+        result = self._servo(camera, detector, goal, first)
+        if result.converged:
+            result = self._average_crossing(camera, detector, goal, result)
+        return result
+
+    def _average_crossing(
+        self, camera: int, detector: Detector, goal: float, result: ServoResult
+    ) -> ServoResult:
+        """Average the crossing over images spread across one pixel around it (see
+        ``ServoConfig.fixation_sigma_steps``); the eye ends at ``result.steps``."""
+        cfg, sim = self.config, self.sim
+        gain = result.gain_px_per_step
+        if cfg.fixation_sigma_steps <= 0 or not gain or result.uv is None or not windowed(detector):
+            return result
+        kind = (camera, detector_kind(detector))
+        if samples_wanted(self.scatter.sigma_px(kind), gain, cfg.fixation_sigma_steps) <= 1:
+            return result
+        low, high = self._step_range
+        poses = [
+            s
+            for s in pixel_period_steps(result.subpixel_steps, gain, cfg.max_fixation_samples)
+            if low <= s <= high
+        ]
+        seen = {s: u for s, u, _ in result.seen}
+        path = list(result.seen)
+        samples: list[tuple[int, float]] = []
+        renders = 0
+        for s in poses:  # bounded: at most max_fixation_samples poses
+            if s not in seen:
+                sim.command_eye_steps(s)
+                sim.settle()
+                detection = self.observe(camera, detector)
+                renders += 1
+                if not detection.found or detection.uv is None:
+                    break  # the averaging is bounded by what the images show
+                seen[s] = detection.uv[0]
+                path.append((s, *detection.uv))
+            samples.append((s, seen[s]))
+        if sim.eye_encoder_steps() != result.steps:
+            sim.command_eye_steps(result.steps)
+            sim.settle()
+        if len(samples) < 2:
+            return replace(result, renders=result.renders + renders, seen=tuple(path))
+        crossings = np.array([s - (u - goal) / gain for s, u in samples])
+        subpixel = float(crossings.mean())
+        self.scatter.add(kind, (crossings - subpixel) * gain, len(samples) - 1)
+        return replace(
+            result,
+            subpixel_steps=subpixel,
+            renders=result.renders + renders,
+            seen=tuple(path),
+            fixation_samples=len(samples),
+        )
+
+    def _servo(
+        self, camera: int, detector: Detector, goal: float, first: Detection | None
+    ) -> ServoResult:
+        """The servo proper: whole-step moves until u is within tolerance of ``goal``."""
         sim, cfg = self.sim, self.config
-        goal = sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
         self._renders = 0
         steps = sim.eye_encoder_steps()
         if first is None:

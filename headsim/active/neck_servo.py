@@ -6,10 +6,17 @@ Broyden's rule (kept for the next fixation).
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from headsim.active.events import ServoKind, ServoStep
+from headsim.active.fixation_average import (
+    ScatterMemory,
+    detector_kind,
+    pixel_period_steps,
+    samples_wanted,
+)
 from headsim.active.servo_types import (
     Detector,
     NeckServoResult,
@@ -68,6 +75,9 @@ class NeckServo:
         self._lost: tuple[int, DetectionStatus] | None = None
         self._key: object = None
         self._current: np.ndarray | None = None  # the Jacobian as the run stands
+        self._goals = np.zeros(3)
+        #: Per kind of detector, the columns' scatter about the fixation, px.
+        self.scatter = ScatterMemory(self.config.pixel_sigma_px)
 
     def _steps(self) -> np.ndarray:
         resolution = self.sim.settings.encoder_resolution_rad
@@ -179,7 +189,59 @@ class NeckServo:
         """Fixate the target with neck and eyes; ``goals`` = (u10, u20, v0), default image centres.
 
         ``key``: what identifies the target for windows (default the detector).
+        Once converged, the sub-step fixation is averaged over poses around it
+        (see :meth:`_average_crossing`).
         """
+        result = self._servo(detector, goals, key)
+        if result.converged:
+            result = self._average_crossing(detector, result)
+        return result
+
+    def _average_crossing(self, detector: Detector, result: NeckServoResult) -> NeckServoResult:
+        """Average the sub-step fixation over eye steps whose images spread both cameras'
+        columns evenly over one pixel around the goals (the eye servo's rule, see
+        ``ServoConfig.fixation_sigma_steps``; two renders a pose); back to ``result.steps``."""
+        cfg, sim, jac = self.config, self.sim, result.jacobian
+        if cfg.fixation_sigma_steps <= 0 or jac is None or not windowed(self._key):
+            return result
+        gain = float(np.max(np.abs(jac[:2, 2])))  # px per eye step in the faster camera
+        kind = detector_kind(self._key)
+        if samples_wanted(self.scatter.sigma_px(kind), gain, cfg.fixation_sigma_steps) <= 1:
+            return result
+        start = sim.render_count
+        whole = np.array(result.steps)
+        final_error = np.array(result.error_px)  # image minus goals at `whole`
+        eyes = pixel_period_steps(result.subpixel_steps[2], gain, cfg.max_fixation_samples)
+        subs = []
+        for eye in eyes:  # bounded: at most max_fixation_samples poses
+            pose = np.array([whole[0], whole[1], eye])
+            if not self._in_range(pose):
+                continue
+            if eye == whole[2]:
+                error = final_error
+            else:
+                self._move(pose)
+                error = self._error(detector, self._goals)
+                if error is None:
+                    break  # the averaging is bounded by what the images show
+            subs.append(pose - np.linalg.solve(jac, error))
+        self._move(whole)
+        renders = result.renders + sim.render_count - start
+        if len(subs) < 2:
+            return replace(result, renders=renders)
+        subs_arr = np.array(subs)
+        mean = subs_arr.mean(axis=0)
+        residuals_px = ((subs_arr - mean) @ jac.T)[:, :2].ravel()
+        self.scatter.add(kind, residuals_px, 2 * (len(subs) - 1))
+        yaw, pitch, eye = (float(x) for x in mean)
+        return replace(
+            result, subpixel_steps=(yaw, pitch, eye), renders=renders, fixation_samples=len(subs)
+        )
+
+    def _servo(
+        self, detector: Detector, goals: tuple[float, float, float] | None, key: object
+    ) -> NeckServoResult:
+        """The servo proper: whole-step moves until the errors are within tolerance."""
         cfg, sim = self.config, self.sim
         self._key = detector if key is None else key
         self._current = self.jacobian
@@ -187,6 +249,7 @@ class NeckServo:
             (u10, v10), (u20, v20) = (sim.camera_settings(c).image_centre for c in (1, 2))
             goals = (u10, u20, (v10 + v20) / 2)
         goal = np.asarray(goals, dtype=float)
+        self._goals = goal
         start = sim.render_count
         self._lost = None
         self._retreats = 0

@@ -33,3 +33,23 @@ def test_neck_servo_reports_lost_and_iteration_limit() -> None:
         assert converged.converged
         assert converged.residual_px <= 0.2
         assert converged.jacobian is not None and abs(np.linalg.det(converged.jacobian)) > 0
+
+
+def test_neck_servo_averages_its_fixation_along_the_eye_joint() -> None:
+    from headsim.active.neck_servo import NeckServo
+
+    with HeadSim("default") as sim:
+        sim.set_body_pose(MARKER, [0.05, 0.7, 0.24])
+        single = NeckServo(sim).run(RED)
+        sim.move(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
+        averaged = NeckServo(sim, ServoConfig(fixation_sigma_steps=0.05)).run(RED)
+        assert single.converged and averaged.converged
+        assert single.fixation_samples == 1 and averaged.fixation_samples >= 2
+        # Two renders a pose; the neck and eyes back where the servo converged.
+        assert 0 < averaged.renders - single.renders <= 2 * averaged.fixation_samples
+        assert averaged.steps == single.steps
+        resolution = sim.settings.encoder_resolution_rad
+        yaw, pitch = (round(a / resolution) for a in sim.neck_encoders())
+        assert (yaw, pitch, sim.eye_encoder_steps()) == averaged.steps
+        # Averaging moves the sub-step fixation by less than a step.
+        assert np.all(np.abs(np.subtract(averaged.subpixel_steps, single.subpixel_steps)) < 1.0)

@@ -79,6 +79,11 @@ BAD = [
         "experiment.servo.max_iterations: must be an integer, got boolean True",
     ),
     (
+        "[experiment.servo]\nfixation_sigma_steps = -0.1\n",
+        "experiment.servo.fixation_sigma_steps: -0.1 is out of range "
+        "(allowed: a number >= 0 and <= 10 encoder steps)",
+    ),
+    (
         "[experiment.calibration]\ndepth_m = [0.6, 0.3]\n",
         "experiment.calibration.depth_m: [0.6, 0.3] is empty",
     ),
