@@ -84,7 +84,9 @@ class EyeServo:
         """Eye-motor range, whole encoder steps."""
         return self._step_range
 
-    def observe(self, camera: int, detector: Detector, key: object = None) -> Detection:
+    def observe(
+        self, camera: int, detector: Detector, key: object = None, preview: bool = True
+    ) -> Detection:
         """Render ``camera`` and detect the target in it (one render, two on a window miss).
 
         With windows on, and when this camera last saw the same target
@@ -98,6 +100,8 @@ class EyeServo:
         (so the blob and every piece the detector looks for beside it lie in
         the window); otherwise the window is a miss (counted) and a full
         frame is rendered.  Never from the truth: detections, gain, encoders.
+        A new target is first found in a binned preview; ``preview=False`` renders
+        the full frame instead (one render: a search's look, which may well miss).
         """
         key = detector if key is None else key
         sim = self.sim
@@ -106,7 +110,13 @@ class EyeServo:
         if pattern:  # a pattern's features share their windows
             key = getattr(key, "window_key", key)
         window = self._window(camera, key, steps, neck) if pattern or windowed(key) else None
-        if window is None and not pattern and windowed(key) and self._unseen(camera, key, neck):
+        if (
+            preview
+            and window is None
+            and not pattern
+            and windowed(key)
+            and self._unseen(camera, key, neck)
+        ):
             window = self._preview(camera, key)
         detection = None
         if window is not None:

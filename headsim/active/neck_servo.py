@@ -90,10 +90,18 @@ class NeckServo:
         self.sim.command(neck_yaw=yaw, neck_pitch=pitch, eye=eye)
         self.sim.settle()
 
+    def _looks(self, detector: Detector) -> list[Detection]:
+        """Camera 1's detection, then camera 2's only if camera 1 saw the target
+        (one render saved where the first image already says it is lost)."""
+        seen = [self._look(1, detector)]
+        if seen[0].found and seen[0].uv is not None:
+            seen.append(self._look(2, detector))
+        return seen
+
     def _error(self, detector: Detector, goals: np.ndarray) -> np.ndarray | None:
-        seen = [self._look(camera, detector) for camera in (1, 2)]
+        seen = self._looks(detector)
         steps = tuple(int(s) for s in self._steps())
-        if all(isinstance(s, Detection) and s.found and s.uv is not None for s in seen):
+        if len(seen) == 2 and all(s.found and s.uv is not None for s in seen):
             self._seen = (self._key, steps, self.sim.placements, [(s.uv, s.area_px) for s in seen])  # type: ignore[misc]
         else:
             self._seen = None
@@ -170,15 +178,16 @@ class NeckServo:
         return yaw, pitch, eye
 
     def look_from(self, steps: tuple[int, int, int], detector: Detector) -> bool:
-        """Move to ``steps`` and look with both cameras (two renders): both see it whole.
+        """Move to ``steps`` and look with both cameras (two renders; one where camera 1
+        does not see it): both see it whole.
 
         Whole frames, no window or preview: a search's look is keyed to no earlier
         detection (as the runner's servo has always looked, its detector wrapped).
         """
         self._key = None
         self._move(np.asarray(steps))
-        seen = [self._look(camera, detector) for camera in (1, 2)]
-        return all(d.found and d.uv is not None for d in seen)
+        seen = self._looks(detector)
+        return len(seen) == 2 and all(d.found and d.uv is not None for d in seen)
 
     def run(
         self,

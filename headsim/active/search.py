@@ -66,8 +66,9 @@ def find_view(
 ) -> Found | None:
     """Turn the eyes to each of :func:`search_poses` in turn until ``camera`` sees the target.
 
-    One render per pose; at most ``max_poses``.  None: not found (the caller
-    names the failure).
+    One render per pose (a full frame: a preview and its window would be two
+    where the target is, and a preview and the frame two where it is not); at
+    most ``max_poses``.  None: not found (the caller names the failure).
     """
     sim = servo.sim
     width = sim.camera_settings(camera).width
@@ -75,7 +76,7 @@ def find_view(
     for tried, steps in enumerate(poses, start=1):
         sim.command_eye_steps(steps)
         sim.settle()
-        detection = servo.observe(camera, detector)
+        detection = servo.observe(camera, detector, preview=False)
         if detection.found and detection.uv is not None:
             return Found(steps, detection, tried)
     return None
@@ -137,8 +138,9 @@ def find_neck_view(
 ) -> tuple[tuple[int, int, int], int] | None:
     """Look from each of :func:`neck_search_poses` until both cameras see the target.
 
-    Two renders per pose; at most ``max_poses``.  Returns the pose and the
-    number of poses tried, or None (the caller names the failure).
+    Two renders per pose (one where camera 1 does not see it); at most
+    ``max_poses``.  Returns the pose and the number of poses tried, or None
+    (the caller names the failure).
     """
     cam = servo.sim.camera_settings(1)
     poses = neck_search_poses(servo, last, (cam.width, cam.height))[:max_poses]

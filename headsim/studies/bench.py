@@ -61,10 +61,10 @@ def _servo(sim: HeadSim, windows: bool, faults: Faults, seen: list[Any]) -> EyeS
     servo = EyeServo(sim, ServoConfig(windows=windows))
     look = servo.observe
 
-    def observe(camera: int, detector: Any, key: object = None) -> Any:
+    def observe(camera: int, detector: Any, key: object = None, preview: bool = True) -> Any:
         if faults.double_renders:
             sim.render(camera)
-        detection = look(camera, detector, key)
+        detection = look(camera, detector, key, preview)
         seen.append(detection.uv)
         return detection
 

@@ -23,8 +23,9 @@ def test_neck_servo_reports_lost_and_iteration_limit() -> None:
         sim.set_body_pose(MARKER, [0.0, -1.0, 0.2])
         lost = NeckServo(sim).run(RED)
         assert lost.outcome is ServoOutcome.TARGET_LOST
-        # One look through each camera, after a binned preview that did not find it.
-        assert lost.renders == 4
+        # Camera 1's look, after a binned preview that did not find it; camera 2
+        # is not rendered once camera 1 has lost the target.
+        assert lost.renders == 2 and lost.lost_camera == 1
         sim.set_body_pose(MARKER, [0.2, 0.6, 0.4])
         limited = NeckServo(sim, ServoConfig(max_iterations=1)).run(RED)
         assert limited.outcome is ServoOutcome.ITERATION_LIMIT

@@ -108,8 +108,8 @@ class LoggingServo(EyeServo):
     seen: list[tuple[float, float] | None]
     steps: list[int]
 
-    def observe(self, camera: int, detector, key: object = None):  # type: ignore[no-untyped-def]
-        detection = super().observe(camera, detector, key)
+    def observe(self, camera: int, detector, key: object = None, preview: bool = True):  # type: ignore[no-untyped-def]
+        detection = super().observe(camera, detector, key, preview)
         self.seen = [*getattr(self, "seen", []), detection.uv]
         self.steps = [*getattr(self, "steps", []), self.sim.eye_encoder_steps()]
         return detection
