@@ -129,7 +129,7 @@ def run_zoom(
     goal: str,
     oracle: bool = False,
     fine: bool = False,
-    fixation_sigma_steps: float = 0.0,
+    average_fixation: bool = False,
 ) -> dict[str, Any]:
     """Calibrate (the layout drawn from the same seed at every zoom, where this zoom's
     cameras see it) and measure every point the reach check accepts at ``zoom``."""
@@ -149,7 +149,7 @@ def run_zoom(
         out["goal_column_error_px"] = [float(e) for e in found.errors_px[:, 0]]
     errors = {m: np.full(len(points_head), np.nan) for m in ("model2", "model1")}
     with HeadSim("default", settings) as sim:
-        config = ServoConfig(fixation_sigma_steps=fixation_sigma_steps)
+        config = ServoConfig(average_fixation=average_fixation)
         servo = EyeServo(sim, config)
         ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
         # Balls where both cameras see them at the start pose or with the eyes
@@ -268,11 +268,10 @@ def main() -> int:
         "--fine", action="store_true", help="render at FINE_RENDERING (4, 2) instead of (4, 1)"
     )
     parser.add_argument(
-        "--fixation-sigma",
-        type=float,
-        default=0.0,
-        help="the servo's fixation_sigma_steps (0, the default: one image per fixation; "
-        "0.05: averaged to the same angle at every zoom)",
+        "--average-fixation",
+        action="store_true",
+        help="average each fixation over images spread across one pixel (ServoConfig."
+        "average_fixation; default: one image per fixation)",
     )
     parser.add_argument("--json", help="write the figures here")
     args = parser.parse_args()
@@ -291,7 +290,7 @@ def main() -> int:
                 args.goal,
                 args.oracle,
                 args.fine,
-                args.fixation_sigma,
+                args.average_fixation,
             )
         )
     ratios = {
@@ -301,7 +300,7 @@ def main() -> int:
     print(
         f"Field: depth {FIELD['depth_m']} m, |x/z| <= {FIELD['lateral']}, "
         f"|y/z| <= {FIELD['vertical']}; paper's cameras, focal x zoom; goal columns: {args.goal}; "
-        f"fixation_sigma_steps {args.fixation_sigma}"
+        f"fixations {'averaged over one pixel' if args.average_fixation else 'one image'}"
     )
     print(
         f"{'zoom':>5} {'model':>6} {'acc':>4} {'ok':>4} {'lost':>4} {'rms mm':>8} {'rms %':>7} "

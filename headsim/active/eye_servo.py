@@ -17,12 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from headsim.active.events import ServoKind, ServoStep
-from headsim.active.fixation_average import (
-    ScatterMemory,
-    detector_kind,
-    pixel_period_steps,
-    samples_wanted,
-)
+from headsim.active.fixation_average import pixel_period_steps
 from headsim.active.servo_types import (
     Detector,
     ServoConfig,
@@ -72,12 +67,6 @@ class EyeServo:
         #: Windows rendered, and windows that missed the target (a full frame followed).
         self.window_renders = 0
         self.window_misses = 0
-        #: Per (camera, kind of detector), the columns' scatter about the crossing line.
-        self.scatter = ScatterMemory(self.config.pixel_sigma_px)
-
-    def pixel_sigma(self, camera: int, detector: object) -> float:
-        """The learnt scatter of ``detector``'s columns about the crossing line, px."""
-        return self.scatter.sigma_px((camera, detector_kind(detector)))
 
     @property
     def step_range(self) -> tuple[int, int]:
@@ -185,8 +174,8 @@ class EyeServo:
         a render).  A move after which the target is gone is undone (back to
         the last step that saw it, no render needed) and retried at half the
         length, at most ``max_retreats`` times.  Once converged, the sub-step
-        fixation is averaged over images around the crossing until its
-        standard error reaches ``fixation_sigma_steps`` (see :class:`ServoConfig`).
+        fixation may be averaged over images around the crossing (see
+        ``ServoConfig.average_fixation``).
         """
         goal = self.sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
         result = self._servo(camera, detector, goal, first)
@@ -198,13 +187,10 @@ class EyeServo:
         self, camera: int, detector: Detector, goal: float, result: ServoResult
     ) -> ServoResult:
         """Average the crossing over images spread across one pixel around it (see
-        ``ServoConfig.fixation_sigma_steps``); the eye ends at ``result.steps``."""
+        ``ServoConfig.average_fixation``); the eye ends at ``result.steps``."""
         cfg, sim = self.config, self.sim
         gain = result.gain_px_per_step
-        if cfg.fixation_sigma_steps <= 0 or not gain or result.uv is None or not windowed(detector):
-            return result
-        kind = (camera, detector_kind(detector))
-        if samples_wanted(self.scatter.sigma_px(kind), gain, cfg.fixation_sigma_steps) <= 1:
+        if not cfg.average_fixation or not gain or result.uv is None or not windowed(detector):
             return result
         low, high = self._step_range
         poses = [
@@ -234,7 +220,6 @@ class EyeServo:
             return replace(result, renders=result.renders + renders, seen=tuple(path))
         crossings = np.array([s - (u - goal) / gain for s, u in samples])
         subpixel = float(crossings.mean())
-        self.scatter.add(kind, (crossings - subpixel) * gain, len(samples) - 1)
         return replace(
             result,
             subpixel_steps=subpixel,

@@ -11,12 +11,7 @@ from dataclasses import replace
 import numpy as np
 
 from headsim.active.events import ServoKind, ServoStep
-from headsim.active.fixation_average import (
-    ScatterMemory,
-    detector_kind,
-    pixel_period_steps,
-    samples_wanted,
-)
+from headsim.active.fixation_average import pixel_period_steps
 from headsim.active.servo_types import (
     Detector,
     NeckServoResult,
@@ -76,8 +71,6 @@ class NeckServo:
         self._key: object = None
         self._current: np.ndarray | None = None  # the Jacobian as the run stands
         self._goals = np.zeros(3)
-        #: Per kind of detector, the columns' scatter about the fixation, px.
-        self.scatter = ScatterMemory(self.config.pixel_sigma_px)
 
     def _steps(self) -> np.ndarray:
         resolution = self.sim.settings.encoder_resolution_rad
@@ -209,13 +202,12 @@ class NeckServo:
     def _average_crossing(self, detector: Detector, result: NeckServoResult) -> NeckServoResult:
         """Average the sub-step fixation over eye steps whose images spread both cameras'
         columns evenly over one pixel around the goals (the eye servo's rule, see
-        ``ServoConfig.fixation_sigma_steps``; two renders a pose); back to ``result.steps``."""
+        ``ServoConfig.average_fixation``; two renders a pose); back to ``result.steps``."""
         cfg, sim, jac = self.config, self.sim, result.jacobian
-        if cfg.fixation_sigma_steps <= 0 or jac is None or not windowed(self._key):
+        if not cfg.average_fixation or jac is None or not windowed(self._key):
             return result
         gain = float(np.max(np.abs(jac[:2, 2])))  # px per eye step in the faster camera
-        kind = detector_kind(self._key)
-        if samples_wanted(self.scatter.sigma_px(kind), gain, cfg.fixation_sigma_steps) <= 1:
+        if gain == 0.0:
             return result
         start = sim.render_count
         whole = np.array(result.steps)
@@ -240,8 +232,6 @@ class NeckServo:
             return replace(result, renders=renders)
         subs_arr = np.array(subs)
         mean = subs_arr.mean(axis=0)
-        residuals_px = ((subs_arr - mean) @ jac.T)[:, :2].ravel()
-        self.scatter.add(kind, residuals_px, 2 * (len(subs) - 1))
         yaw, pitch, eye = (float(x) for x in mean)
         return replace(
             result, subpixel_steps=(yaw, pitch, eye), renders=renders, fixation_samples=len(subs)

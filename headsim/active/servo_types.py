@@ -34,7 +34,7 @@ class ServoResult:
     ``subpixel_steps``: the fractional step at which u would equal the goal,
     interpolated with the gain (the image tells more than the encoder), the
     mean over ``fixation_samples`` images around the crossing (see
-    ``ServoConfig.fixation_sigma_steps``); ``renders``: images taken; ``iterations``: moves made.  ``lost_status``:
+    ``ServoConfig.average_fixation``); ``renders``: images taken; ``iterations``: moves made.  ``lost_status``:
     when the target was lost, what the detector said (lost, cut, occluded).
     ``seen``: every (steps, u, v) at which the camera saw the target, in order
     (the memory a search returns to).  ``retreats``: moves undone because the
@@ -77,18 +77,15 @@ class ServoConfig:
     target), find it first in the whole view binned b x b (1/b^2 of the
     pixels), then render its window; 1: a full frame instead.
 
-    ``fixation_sigma_steps``: the standard error, in encoder steps (the same
-    angle at every zoom), that a converged fixation's sub-step estimate is to
-    reach; 0 (the default): one image, the final step's.  One image's estimate
-    is off by the centroid's sub-pixel rendering floor over the gain, which
-    is more angle at a shorter focal length (``headsim.active.fixation_average``).
-    Where the learnt scatter says one image misses the target, the servo
-    takes images at the whole steps that spread over one pixel of image
-    motion around the crossing (at most ``max_fixation_samples``), averages
-    their crossings and returns to its final step; the scatter starts from
-    ``pixel_sigma_px``.  0.05 makes the error the same angle at every zoom,
-    for about twice the renders.  Blob detectors only; a pattern (a
-    chessboard's corners) is fixated from one image.
+    ``average_fixation``: once converged, take images at the whole steps that
+    spread the target over one pixel of image motion around the crossing (at
+    most ``max_fixation_samples``, every k-th step beyond), average their
+    crossings and return to the final step.  One image's sub-step fixation is
+    off by the centroid's sub-pixel rendering floor over the gain, which is
+    more angle at a shorter focal length; the average leaves the same angle
+    at every zoom (``headsim.active.fixation_average``), for about twice the
+    renders.  Off: one image, the final step's.  Blob detectors only; a
+    pattern (a chessboard's corners) is fixated from one image.
     """
 
     tolerance_px: float = 0.1
@@ -100,9 +97,8 @@ class ServoConfig:
     windows: bool = True
     window_margin_px: float = 8.0
     preview_binning: int = 4
-    fixation_sigma_steps: float = 0.0
+    average_fixation: bool = False
     max_fixation_samples: int = 8
-    pixel_sigma_px: float = 0.05
 
 
 @dataclass(frozen=True)

@@ -308,9 +308,7 @@ def read_experiment(doc: Table, ctx: Context, preset_name: str = "ideal") -> Exp
                 "min_probe_px", 2.0, 0.0, 100.0, lo_open=True, unit="px"
             ),
             min_secant_steps=servo_table.integer("min_secant_steps", 8, 1, 1000),
-            fixation_sigma_steps=servo_table.number(
-                "fixation_sigma_steps", 0.0, 0.0, 10.0, unit="encoder steps"
-            ),
+            average_fixation=servo_table.boolean("average_fixation", False),
         )
         servo_table.done()
     table.done()

@@ -115,7 +115,7 @@ class ServoSpec:
     probe_steps: int = 16
     min_probe_px: float = 2.0
     min_secant_steps: int = 8
-    fixation_sigma_steps: float = 0.0
+    average_fixation: bool = False
 
 
 @dataclass(frozen=True)

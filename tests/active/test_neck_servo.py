@@ -43,7 +43,7 @@ def test_neck_servo_averages_its_fixation_along_the_eye_joint() -> None:
         sim.set_body_pose(MARKER, [0.05, 0.7, 0.24])
         single = NeckServo(sim).run(RED)
         sim.move(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
-        averaged = NeckServo(sim, ServoConfig(fixation_sigma_steps=0.05)).run(RED)
+        averaged = NeckServo(sim, ServoConfig(average_fixation=True)).run(RED)
         assert single.converged and averaged.converged
         assert single.fixation_samples == 1 and averaged.fixation_samples >= 2
         # Two renders a pose; the neck and eyes back where the servo converged.

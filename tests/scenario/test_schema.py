@@ -79,9 +79,8 @@ BAD = [
         "experiment.servo.max_iterations: must be an integer, got boolean True",
     ),
     (
-        "[experiment.servo]\nfixation_sigma_steps = -0.1\n",
-        "experiment.servo.fixation_sigma_steps: -0.1 is out of range "
-        "(allowed: a number >= 0 and <= 10 encoder steps)",
+        "[experiment.servo]\naverage_fixation = 1\n",
+        "experiment.servo.average_fixation: must be true or false, got integer 1",
     ),
     (
         "[experiment.calibration]\ndepth_m = [0.6, 0.3]\n",
