@@ -218,23 +218,24 @@ class NeckServo:
             pose = np.array([whole[0], whole[1], eye])
             if not self._in_range(pose):
                 continue
-            if eye == whole[2]:
-                error = final_error
-            else:
+            error = final_error
+            if eye != whole[2]:
                 self._move(pose)
-                error = self._error(detector, self._goals)
-                if error is None:
+                seen = self._error(detector, self._goals)
+                if seen is None:
                     break  # the averaging is bounded by what the images show
+                error = seen
             subs.append(pose - np.linalg.solve(jac, error))
         self._move(whole)
         renders = result.renders + sim.render_count - start
         if len(subs) < 2:
             return replace(result, renders=renders)
-        subs_arr = np.array(subs)
-        mean = subs_arr.mean(axis=0)
-        yaw, pitch, eye = (float(x) for x in mean)
+        mean_yaw, mean_pitch, mean_eye = (float(x) for x in np.mean(subs, axis=0))
         return replace(
-            result, subpixel_steps=(yaw, pitch, eye), renders=renders, fixation_samples=len(subs)
+            result,
+            subpixel_steps=(mean_yaw, mean_pitch, mean_eye),
+            renders=renders,
+            fixation_samples=len(subs),
         )
 
     def _servo(
