@@ -110,15 +110,33 @@ def clipped_to(
 
 #: Off-screen buffers for windows kept per OpenGL context (the least recently used goes).
 WINDOW_BUFFERS = 6
-#: Their sizes are rounded up to this many raster pixels (llvmpipe's tile), to reuse them.
-BUFFER_STEP = 64
+#: Their sizes are rounded up to this many raster pixels (two of llvmpipe's tiles), to
+#: reuse them.
+BUFFER_STEP = 128
+#: A kept buffer that holds the window's is used if its area is at most this many times
+#: the one needed: a new buffer (allocated, first touched) costs more than clearing a
+#: larger one (the chessboard's and calibration's windows, Dec 2026).
+BUFFER_SLACK = 2.0
+
+
+#: Depth formats with a stencil and the same depth without one (GL enums).
+_WITHOUT_STENCIL = {
+    0x8CAD: 0x8CAC,  # GL_DEPTH32F_STENCIL8 -> GL_DEPTH_COMPONENT32F
+    0x88F0: 0x81A6,  # GL_DEPTH24_STENCIL8 -> GL_DEPTH_COMPONENT24
+}
 
 
 class WindowBuffer:
     """A multisampled off-screen buffer like the context's own (same formats and
     samples), of another size, and its single-sample resolve buffer."""
 
-    def __init__(self, context: mujoco.MjrContext, size: tuple[int, int]) -> None:
+    def __init__(
+        self, context: mujoco.MjrContext, size: tuple[int, int], stencil: bool = True
+    ) -> None:
+        """``stencil``: False for a scene that never uses the stencil (MuJoCo's
+        only use is reflections): then a 32-bit float depth buffer without one,
+        the depth the context's own (32F + stencil 8) holds, which llvmpipe
+        clears in under half the time."""
         from OpenGL import GL
 
         GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, context.offColor)
@@ -130,12 +148,15 @@ class WindowBuffer:
         depth = GL.glGetRenderbufferParameteriv(
             GL.GL_RENDERBUFFER, GL.GL_RENDERBUFFER_INTERNAL_FORMAT
         )
+        depth_attachment = GL.GL_DEPTH_STENCIL_ATTACHMENT
+        if not stencil and depth in _WITHOUT_STENCIL:
+            depth, depth_attachment = _WITHOUT_STENCIL[depth], GL.GL_DEPTH_ATTACHMENT
         width, height = size
         self.renderbuffers = [int(r) for r in GL.glGenRenderbuffers(3)]
         self.framebuffers = [int(f) for f in GL.glGenFramebuffers(2)]
         storage = (
             (samples, colour, GL.GL_COLOR_ATTACHMENT0, 0),
-            (samples, depth, GL.GL_DEPTH_STENCIL_ATTACHMENT, 0),
+            (samples, depth, depth_attachment, 0),
             (0, colour, GL.GL_COLOR_ATTACHMENT0, 1),
         )
         for renderbuffer, (n, fmt, attachment, framebuffer) in zip(
@@ -162,7 +183,8 @@ def draw_window(
     clipped to the window (:func:`clipped_to`).
 
     The frame is drawn into a buffer only as large as the window's far corner
-    from the frame's origin needs (rounded up to a tile), not the context's:
+    from the frame's origin needs (rounded up to :data:`BUFFER_STEP`; or a kept
+    one up to :data:`BUFFER_SLACK` times as large), not the context's:
     ``mjr_render`` clears all of its viewport, and a whole frame's
     multisampled buffer costs more to clear than the window to draw.
     """
@@ -175,9 +197,19 @@ def draw_window(
         min(full_w, step * math.ceil((k * rect.x1 + margin) / step)),
         min(full_h, step * math.ceil((full_h - k * rect.y0 + margin) / step)),
     )
-    buffers = renderer.__dict__.setdefault("_headsim_window_buffers", OrderedDict())
-    buffer = buffers.pop(size, None) or WindowBuffer(context, size)
-    buffers[size] = buffer
+    # MuJoCo's only use of the stencil: reflective geoms (a material's reflectance).
+    stencil = bool(np.any(renderer.model.mat_reflectance > 0))
+    buffers: OrderedDict[tuple[int, int, bool], WindowBuffer] = renderer.__dict__.setdefault(
+        "_headsim_window_buffers", OrderedDict()
+    )
+    # The smallest kept buffer that holds the window (every pixel of the window lands
+    # where it does in any buffer that holds it), unless it is much larger.
+    fits = [b for b in buffers if b[0] >= size[0] and b[1] >= size[1] and b[2] == stencil]
+    key = min(fits, key=lambda b: b[0] * b[1], default=(*size, stencil))
+    if key[0] * key[1] > BUFFER_SLACK * size[0] * size[1]:
+        key = (*size, stencil)
+    buffer = buffers.pop(key, None) or WindowBuffer(context, (key[0], key[1]), stencil)
+    buffers[key] = buffer
     while len(buffers) > WINDOW_BUFFERS:
         _, oldest = buffers.popitem(last=False)
         GL.glDeleteFramebuffers(len(oldest.framebuffers), oldest.framebuffers)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import concurrent.futures.process  # noqa: F401  execute() reads cf.process; only a process pool loads it
+import importlib
 import multiprocessing
 import os
 import signal
@@ -150,22 +151,41 @@ def _render_threads(workers: int) -> int:
     return max(1, (cpus or 1) // workers)
 
 
-def _init_worker(threads: int) -> None:
+def _init_worker(threads: int, preload: tuple[str, ...] = (), ready: Any = None) -> None:
     # Ctrl-C is the parent's to handle: it stops the workers and keeps the report.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     # Mesa's llvmpipe renders with one thread per CPU by default: N workers, each
     # with as many threads as the machine has CPUs, would oversubscribe it.  Read
     # when the worker's first OpenGL context is made; a user's own setting is kept.
     os.environ.setdefault("LP_NUM_THREADS", str(threads))
+    for name in preload:
+        importlib.import_module(name)
+    if ready is not None:
+        ready.put(os.getpid())
 
 
-def render_pool(workers: int) -> cf.Executor:
+def render_pool(workers: int, preload: tuple[str, ...] = (), ready: Any = None) -> cf.Executor:
     """``workers`` spawned processes that share the CPUs among their renderers and leave
-    Ctrl-C to the parent (``headsim reproduce``)."""
+    Ctrl-C to the parent (``headsim reproduce``).
+
+    Each imports the modules ``preload`` as it starts, then puts its pid on the
+    queue ``ready`` (made by :func:`spawn_context`); :func:`start_workers` starts them.
+    """
     # Spawned, not forked: a fork after OpenGL was used hangs (platform notes).
     return cf.ProcessPoolExecutor(
         max_workers=workers,
-        mp_context=multiprocessing.get_context("spawn"),
+        mp_context=spawn_context(),
         initializer=_init_worker,
-        initargs=(_render_threads(workers),),
+        initargs=(_render_threads(workers), preload, ready),
     )
+
+
+def spawn_context() -> Any:
+    """The multiprocessing context of the render pool (its queues must be made from it)."""
+    return multiprocessing.get_context("spawn")
+
+
+def start_workers(pool: cf.Executor, workers: int) -> list[cf.Future[int]]:
+    """Start ``workers`` processes of ``pool`` now, rather than at its first jobs: a
+    spawned pool starts one process per job it is given while none is idle."""
+    return [pool.submit(os.getpid) for _ in range(workers)]

@@ -18,8 +18,9 @@ def cpu_s() -> float:
 
 class RenderClock:
     """Times 640x480 renders of the default scene in this process, while no worker of
-    the run exists: the unit before they start, and a few after they ended, which
-    show how the machine's load moved (reported, not used in the ratio)."""
+    the run works: the unit once they started and wait, idle, for their first jobs,
+    and a few after they ended, which show how the machine's load moved (reported,
+    not used in the ratio)."""
 
     def __init__(self) -> None:
         from headsim.sim.settings import HeadSettings
@@ -48,5 +49,5 @@ class RenderClock:
         self._sim.close()
 
 
-#: Renders timed before the workers start (the unit) and after they end (the load's drift).
+#: Renders timed before the workers' first jobs (the unit) and after they end (the load's drift).
 CLOCK_RENDERS = (21, 7)

@@ -31,6 +31,7 @@ import functools
 import importlib
 import multiprocessing
 import os
+import queue
 import statistics
 import sys
 import threading
@@ -39,10 +40,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from headsim.errors import OutputNotWritable
+from headsim.errors import EnvironmentProblem, OutputNotWritable
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.run.progress import Status, quiet
-from headsim.studies.jobs import render_pool
+from headsim.studies.jobs import render_pool, spawn_context, start_workers
 from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
 from headsim.studies.reproduce_experiments import (
     SCENARIO_JOBS,
@@ -51,6 +52,7 @@ from headsim.studies.reproduce_experiments import (
     ReproduceError,
 )
 from headsim.studies.reproduce_jobs import (
+    WORKER_MODULES,
     calibrate_job,
     fixed_point_job,
     scenario_job,
@@ -59,7 +61,7 @@ from headsim.studies.reproduce_jobs import (
     zhang_job,
 )
 from headsim.studies.reproduce_report import main_figure, report_sections, report_text
-from headsim.studies.reproduce_schedule import PlannedJob, schedule
+from headsim.studies.reproduce_schedule import PlannedJob, interrupt_deferred, schedule
 
 
 def reproduce(
@@ -86,7 +88,7 @@ def reproduce(
     except OSError as err:
         raise OutputNotWritable(f"--out: cannot create {out}: {err.strerror}") from err
     start, epoch = time.perf_counter(), time.time()
-    clock = RenderClock()
+    pool, clock = _start(workers)
     render_s = clock.sample(CLOCK_RENDERS[0])
     state: dict[str, Any] = {
         "status": "running",
@@ -171,7 +173,6 @@ def reproduce(
             ),
         )
 
-    pool = render_pool(workers)
     try:
         write_report(figure=False)
         progress("calibrating the head once (and its stereo pair, Zhang, beside it)")
@@ -267,13 +268,7 @@ def reproduce(
     except KeyboardInterrupt:
         state["status"] = "interrupted"
         # Stop the workers now: their experiments are lost, the finished ones are kept.
-        processes = list((getattr(pool, "_processes", None) or {}).values())
-        pool.shutdown(wait=False, cancel_futures=True)
-        # With a worker caught half-started (Ctrl-C while the pool spawned it, which
-        # the pool does not know of yet), the exit would wait for it forever: every
-        # child of this process is one of the pool's workers.
-        for process in {*processes, *multiprocessing.active_children()}:
-            process.terminate()
+        _stop(pool)
         write_report()
         raise
     finally:
@@ -294,6 +289,61 @@ def reproduce(
         timeline["render_time_end"] = {"pid": os.getpid(), "start": 0.0, "end": time.time() - epoch}
     write_report()
     return state
+
+
+#: How long the workers may take to start and load their modules, s.
+WORKERS_START_S = 300.0
+
+
+def _start(workers: int) -> tuple[Any, RenderClock]:
+    """The pool, its workers started, and the render clock (made meanwhile).
+
+    The workers load what their jobs import (about 1 s) while this process makes
+    its clock; this returns once every worker is ready and waits, idle, so that
+    the clock's renders are timed on a quiet machine.
+    """
+    ready = spawn_context().Queue()
+    pool = render_pool(workers, WORKER_MODULES, ready)
+    clock = None
+    try:
+        with interrupt_deferred():
+            starting = start_workers(pool, workers)
+        clock = RenderClock()
+        deadline, started = time.monotonic() + WORKERS_START_S, 0
+        while started < workers:  # bounded by the deadline
+            try:
+                ready.get(timeout=0.05)
+                started += 1
+            except queue.Empty:
+                failed = [f.exception() for f in starting if f.done() and f.exception()]
+                if failed:
+                    raise WorkersNotStarted(f"a worker failed to start: {failed[0]!r}") from None
+                if time.monotonic() > deadline:
+                    raise WorkersNotStarted(
+                        f"{workers - started} of {workers} workers not started "
+                        f"within {WORKERS_START_S:.0f} s"
+                    ) from None
+        return pool, clock
+    except BaseException:
+        _stop(pool)
+        if clock is not None:
+            clock.close()
+        raise
+
+
+class WorkersNotStarted(EnvironmentProblem):
+    """The worker processes did not start (exit 3)."""
+
+
+def _stop(pool: Any) -> None:
+    """Stop the pool's workers now, whatever they run."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    # With a worker caught half-started (Ctrl-C while the pool spawned it, which
+    # the pool does not know of yet), the exit would wait for it forever: every
+    # child of this process is one of the pool's workers.
+    for process in {*processes, *multiprocessing.active_children()}:
+        process.terminate()
 
 
 def main(args: Any) -> int:

@@ -15,6 +15,19 @@ from typing import Any
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.studies.reproduce_experiments import FIXED_POINT_TARGETS, SCENARIO_JOBS, TABLES_HEAD
 
+#: What the jobs import, loaded by each worker as it starts (about 1 s), while the parent
+#: makes its render clock.
+WORKER_MODULES = (
+    "headsim.run.runner",
+    "headsim.run.serialise",
+    "headsim.run.summary",
+    "headsim.scenario.loading",
+    "headsim.active.calibration_file",
+    "headsim.studies.paper_tables",
+    "headsim.studies.study_experiments",
+    "headsim.studies.study_output",
+)
+
 
 class JobError(RuntimeError):
     """An experiment failed in its worker; the message says why (picklable, unlike

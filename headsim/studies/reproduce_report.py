@@ -199,7 +199,7 @@ def report_text(
         ),
         f"- wall time {state['wall_s']:.1f} s = {state['wall_over_render']:.0f} x the median "
         f"640x480 render ({1e3 * state['render_s']:.1f} ms, measured in this run, "
-        f"{CLOCK_RENDERS[0]} renders before the workers start"
+        f"{CLOCK_RENDERS[0]} renders before the workers' first jobs"
         + (
             f"; {1e3 * state['render_after_s']:.1f} ms after they ended)"
             if state.get("render_after_s")

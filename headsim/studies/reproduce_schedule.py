@@ -52,7 +52,7 @@ def _topological(plan: list[PlannedJob]) -> list[PlannedJob]:
 
 
 @contextlib.contextmanager
-def _interrupt_deferred() -> Iterator[None]:
+def interrupt_deferred() -> Iterator[None]:
     """Ctrl-C waits until the block ends (then KeyboardInterrupt): a worker the pool
     is spawning is never left half-started (it would print a traceback and stay
     unknown to the pool).  Only in the main thread; elsewhere it does nothing."""
@@ -98,7 +98,7 @@ def schedule(
                 skipped(job.name, missing)
             elif len(running) < workers and all(n in done for n in job.needs):
                 waiting.remove(job)
-                with _interrupt_deferred():
+                with interrupt_deferred():
                     future = pool.submit(job.run, *job.args(done))
                 running[future] = (job.name, time.perf_counter())
         for report in ended:

@@ -13,7 +13,7 @@ from headsim.active.model1 import measure_model1
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import ServoConfig
-from headsim.sim import render
+from headsim.sim import gl_window, render
 from headsim.sim.render import Window
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
@@ -100,6 +100,38 @@ def test_simulators_of_one_head_share_one_renderer_and_render_alike() -> None:
         finally:
             own.close()
     assert render.created == before + 1  # the one of its own only
+
+
+def _windows_drawn(settings: HeadSettings) -> list[np.ndarray]:
+    """Windows inside one another, the largest first, in both cameras."""
+    render.release_renderers()  # a fresh context: no window buffer kept
+    with HeadSim("default", settings) as sim:
+        _pose(sim)
+        return [
+            sim.render_window(camera, window)
+            for window in (Window(100, 50, 400, 300), Window(110, 60, 380, 280), WINDOWS[5])
+            for camera in (1, 2)
+        ]
+
+
+def test_window_buffers_change_no_pixel(monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    # Kept buffers reused for smaller windows, depth without stencil (the defaults),
+    # against a buffer of the window's own size each time with the context's depth and
+    # stencil (none of these scenes uses it): the same pixels, bit for bit.
+    settings = paper_head()
+    reused = _windows_drawn(settings)
+    (renderer,) = render._POOL.values()
+    assert len(renderer._headsim_window_buffers) == 1  # the first one, reused
+    assert not any(stencil for _, _, stencil in renderer._headsim_window_buffers)
+    monkeypatch.setattr(gl_window, "BUFFER_SLACK", 1.0)
+    monkeypatch.setattr(gl_window, "_WITHOUT_STENCIL", {})
+    own = _windows_drawn(settings)
+    (renderer,) = render._POOL.values()
+    assert len(renderer._headsim_window_buffers) > 1
+    render.release_renderers()
+    assert len(own) == len(reused)
+    for a, b in zip(reused, own, strict=True):
+        np.testing.assert_array_equal(a, b)
 
 
 class LoggingServo(EyeServo):

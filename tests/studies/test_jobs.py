@@ -10,7 +10,14 @@ import threading
 from dataclasses import dataclass
 from typing import Any
 
-from headsim.studies.jobs import ATTEMPTS, _render_threads, execute
+from headsim.studies.jobs import (
+    ATTEMPTS,
+    _render_threads,
+    execute,
+    render_pool,
+    spawn_context,
+    start_workers,
+)
 
 
 @dataclass(frozen=True)
@@ -77,3 +84,23 @@ def test_the_renderers_share_the_cpus_and_get_at_least_one_thread() -> None:
     assert _render_threads(1) == cpus
     assert _render_threads(2) == max(1, cpus // 2)
     assert _render_threads(cpus + 1) == 1
+
+
+def test_started_workers_load_their_modules_and_say_so_before_any_job() -> None:
+    ready = spawn_context().Queue()
+    pool = render_pool(2, ("headsim.sim.settings",), ready)
+    try:
+        started = start_workers(pool, 2)
+        pids = {ready.get(timeout=60), ready.get(timeout=60)}
+        assert len(pids) == 2  # one process each, both started before any job ran
+        assert {f.result(timeout=60) for f in started} <= pids
+        loaded = pool.submit(_loaded, "headsim.sim.settings").result(timeout=60)
+        assert loaded
+    finally:
+        pool.shutdown(cancel_futures=True)
+
+
+def _loaded(name: str) -> bool:
+    import sys
+
+    return name in sys.modules
