@@ -117,6 +117,23 @@ def interrupted() -> bool:
     return _Signals.received
 
 
+def note_interrupt() -> None:
+    """Note an interrupt (a handler of its own calls this before raising)."""
+    _Signals.received = True
+
+
+def raise_if_interrupted() -> None:
+    """Raise KeyboardInterrupt if an interrupt arrived and was swallowed.
+
+    Python ignores an exception raised in a weakref callback or a finaliser (it
+    reports it as "Exception ignored in ..."); an interrupt that lands inside one,
+    say importlib's module-lock callback during a lazy import, would otherwise let
+    the command run on to the end.  Called where a command is about to write or
+    render (the events hub, before --out is created)."""
+    if _Signals.received:
+        raise KeyboardInterrupt
+
+
 def exit_code_for(err: BaseException) -> tuple[ExitCode, str]:
     """The exit code and the one-line message for an exception that ended a command."""
     if isinstance(err, KeyboardInterrupt) or interrupted():
@@ -150,7 +167,9 @@ def guarded(body: Callable[[], int], *, debug: bool = False, stream: TextIO | No
     """
     stream = sys.stderr if stream is None else stream
     try:
-        return int(body())
+        code = int(body())
+        raise_if_interrupted()  # swallowed on the way and never acted on: still 130
+        return code
     except SystemExit:
         raise
     except BaseException as err:

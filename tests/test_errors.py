@@ -21,6 +21,8 @@ from headsim.errors import (
     guarded,
     interrupt_handler,
     interrupted,
+    note_interrupt,
+    raise_if_interrupted,
 )
 
 
@@ -133,3 +135,21 @@ def test_usage_errors_pass_through_as_systemexit() -> None:
 def test_the_help_text_states_every_code() -> None:
     for code in ExitCode:
         assert f"{int(code)} " in EXIT_CODES_HELP
+
+
+def test_an_interrupt_swallowed_on_the_way_still_exits_130() -> None:
+    # The body ran on to the end (Python ignored the KeyboardInterrupt where it landed).
+    stream = io.StringIO()
+
+    def body() -> int:
+        note_interrupt()
+        return 0
+
+    try:
+        assert guarded(body, stream=stream) == 130
+        assert stream.getvalue() == "headsim: interrupted\n"
+        with pytest.raises(KeyboardInterrupt):
+            raise_if_interrupted()
+    finally:
+        clear_interrupted()
+    raise_if_interrupted()  # nothing noted: nothing raised

@@ -18,6 +18,7 @@ from contextlib import contextmanager
 from headsim.errors import (
     clear_interrupted,
     interrupt_handler,
+    note_interrupt,
 )
 
 
@@ -36,6 +37,7 @@ def sigterm_interrupts() -> Iterator[Interrupted]:
 
     def interrupt(signum: int, frame: object) -> None:
         state.signalled = True
+        note_interrupt()
         raise KeyboardInterrupt
 
     try:
@@ -68,7 +70,16 @@ def process_signals() -> Iterator[None]:
     """SIGINT and SIGTERM interrupt (exit 130, noted even where they surface as another
     error); the file-size limit fails a write (EFBIG) instead of killing the process."""
     clear_interrupted()
+    hook = sys.unraisablehook
 
+    def unraisable(info: sys.UnraisableHookArgs) -> None:
+        # An interrupt raised inside a weakref callback or a finaliser is ignored by
+        # Python: it is noted (headsim.errors.raise_if_interrupted acts on it), so
+        # no "Exception ignored" traceback reaches the user.
+        if not isinstance(info.exc_value, KeyboardInterrupt):
+            hook(info)
+
+    sys.unraisablehook = unraisable
     previous: dict[int, object] = {}
     try:
         previous[signal.SIGTERM] = signal.signal(signal.SIGTERM, interrupt_handler)
@@ -82,5 +93,7 @@ def process_signals() -> Iterator[None]:
     try:
         yield
     finally:
+        sys.unraisablehook = hook
+        clear_interrupted()  # acted on by now (headsim.errors.guarded runs inside)
         for sig, handler in previous.items():
             signal.signal(sig, handler)  # type: ignore[arg-type]

@@ -24,6 +24,7 @@ from headsim.cli.writing import (
 from headsim.errors import (
     ExitCode,
     OutputNotWritable,
+    raise_if_interrupted,
 )
 from headsim.run.outputs import Outputs
 
@@ -41,6 +42,7 @@ def run_command(args: argparse.Namespace) -> int:
 
     scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
     target = recording_target(args)  # a bad --url or port is bad input (exit 2)
+    raise_if_interrupted()  # an interrupt swallowed while loading: nothing written yet
     outputs = Outputs()
     try:
         # Every output, as the real file, before anything is rendered.

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
 from headsim.active.events import FixationStarted, PhaseStarted
+from headsim.errors import raise_if_interrupted
 from headsim.sim.events import ImageKind, ImageTaken
 
 if TYPE_CHECKING:
@@ -87,7 +88,9 @@ class Hub:
         return self.frame + 1
 
     def emit(self, event: object) -> None:
-        """Count and number ``event``, then pass it to every subscriber."""
+        """Count and number ``event``, then pass it to every subscriber (first, stop
+        if an interrupt arrived that Python swallowed: see ``raise_if_interrupted``)."""
+        raise_if_interrupted()
         if isinstance(event, PhaseStarted):
             self.steps = []
         elif isinstance(event, FixationStarted):

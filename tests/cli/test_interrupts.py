@@ -33,3 +33,29 @@ def test_the_process_handlers_note_the_interrupt_and_ignore_the_file_size_signal
         assert {s: signal.getsignal(s) for s in before} == before
     finally:
         clear_interrupted()
+
+
+def test_an_interrupt_python_swallows_is_noted_silently_and_acted_on(capfd) -> None:
+    # A SIGINT that lands inside a weakref callback (importlib's module-lock callback,
+    # during a lazy import) raises KeyboardInterrupt there, which Python ignores.
+    import weakref
+
+    from headsim.errors import raise_if_interrupted
+
+    class Thing:
+        pass
+
+    try:
+        with process_signals():
+            thing = Thing()
+            ref = weakref.ref(thing, lambda _: os.kill(os.getpid(), signal.SIGINT))
+            del thing  # the callback runs here; its KeyboardInterrupt is swallowed
+            assert ref() is None
+            assert interrupted()
+            with pytest.raises(KeyboardInterrupt):
+                raise_if_interrupted()
+        assert not interrupted()  # acted on: the next command starts clean
+    finally:
+        clear_interrupted()
+    err = capfd.readouterr().err
+    assert "Exception ignored" not in err and "Traceback" not in err
