@@ -168,7 +168,8 @@ def guarded(body: Callable[[], int], *, debug: bool = False, stream: TextIO | No
     stream = sys.stderr if stream is None else stream
     try:
         code = int(body())
-        raise_if_interrupted()  # swallowed on the way and never acted on: still 130
+        if code != ExitCode.INTERRUPTED:
+            raise_if_interrupted()  # swallowed on the way and never acted on: still 130
         return code
     except SystemExit:
         raise

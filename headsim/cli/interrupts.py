@@ -60,6 +60,7 @@ def serve_until_interrupted(recorder: object, url: str) -> None:
             while True:  # ends on Ctrl-C or SIGTERM only: serving is what the user asked for
                 time.sleep(0.5)
     except KeyboardInterrupt:
+        clear_interrupted()  # how serving ends: not an interrupted command
         print("stopped serving (interrupted)", file=sys.stderr)
     finally:
         recorder.close()  # type: ignore[attr-defined]
