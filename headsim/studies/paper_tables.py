@@ -49,20 +49,11 @@ from headsim.stereo.triangulation import measure_point_stereo
 from headsim.stereo.views import StereoError
 from headsim.studies.calibrations import calibration_positions, zhang_stereo, zoom_fixed_points
 from headsim.studies.conditions import Condition, ConditionResult
-from headsim.studies.methods import BALL, TARGET, StudyConfig
+from headsim.studies.methods import BALL, METHODS, TARGET, StudyConfig
 from headsim.studies.study_experiments import Experiment, ExperimentResult
 from headsim.studies.target_errors import TargetError, summarise
 from headsim.studies.targets import place_in_head, table_targets
 
-#: The methods measured, in table order; the first three active ones share their images.
-METHODS = (
-    "stereo",
-    "active_v_known",
-    "active_centre",
-    "active_extended",
-    "active_fixed_point",
-    "active_refound",
-)
 #: The active methods that servo on the image centre's column.
 CENTRE_METHODS = METHODS[1:4]
 #: The active method whose servo runs (the others reuse its images).

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import argparse
 import re
-import textwrap
 from pathlib import Path
 
 import pytest
+from scenario.helpers import MINIMAL, write_scenario
 
 from headsim.cli import main
 from headsim.cli.scenarios import progress_observer
@@ -17,27 +17,10 @@ from headsim.scenario.loading import load_scenario, scenario_files
 FILES = scenario_files()
 
 
-MINIMAL = """
-description = "a test"
-
-[experiment]
-procedure = "model2"
-
-[[scene.targets]]
-position_head_m = [0.02, 0.01, 0.6]
-"""
-
-
-def _write(tmp_path: Path, text: str, name: str = "bad.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(textwrap.dedent(text))
-    return path
-
-
 def test_run_with_a_bad_file_exits_2_and_writes_nothing(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    path = _write(tmp_path, MINIMAL.replace("0.6]", "-0.6]"))
+    path = write_scenario(tmp_path, MINIMAL.replace("0.6]", "-0.6]"))
     out, rrd = tmp_path / "out", tmp_path / "rec" / "run.rrd"
     assert main(["run", str(path), "--out", str(out), "--rrd", str(rrd)]) == 2
     err = capsys.readouterr().err
@@ -57,8 +40,8 @@ def test_list_shows_every_scenario_with_its_description(capsys: pytest.CaptureFi
 
 
 def test_list_flags_an_invalid_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    _write(tmp_path, MINIMAL, "good.toml")
-    _write(tmp_path, MINIMAL + "[head]\nbaseline_m = 0\n", "broken.toml")
+    write_scenario(tmp_path, MINIMAL, "good.toml")
+    write_scenario(tmp_path, MINIMAL + "[head]\nbaseline_m = 0\n", "broken.toml")
     assert main(["list", "--dir", str(tmp_path)]) == 2
     out = capsys.readouterr().out
     assert "good" in out and "a test" in out
