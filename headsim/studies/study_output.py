@@ -11,8 +11,20 @@ import numpy as np
 
 from headsim.files import to_jsonable, write_csv_atomic, write_json_atomic
 from headsim.sim.settings import HeadSettings
+from headsim.studies.conditions import Condition
 from headsim.studies.methods import METHOD_LABELS
 from headsim.studies.study_experiments import ExperimentResult, compare_figures
+
+
+def _condition_columns(result: ExperimentResult, c: Condition) -> dict[str, Any]:
+    """The columns every row starts with: the experiment and the condition."""
+    return {
+        "experiment": result.experiment.name,
+        "group": c.group,
+        "condition": c.label,
+        "value": float(c.value),
+        "calibration": c.calibration,
+    }
 
 
 def summary_rows(result: ExperimentResult) -> list[dict[str, Any]]:
@@ -23,11 +35,7 @@ def summary_rows(result: ExperimentResult) -> list[dict[str, Any]]:
         for s in r.summaries:
             rows.append(
                 {
-                    "experiment": result.experiment.name,
-                    "group": c.group,
-                    "condition": c.label,
-                    "value": float(c.value),
-                    "calibration": c.calibration,
+                    **_condition_columns(result, c),
                     "method": s.method,
                     "ok": s.ok,
                     "failed": s.failed,
@@ -50,11 +58,7 @@ def target_rows(result: ExperimentResult) -> list[dict[str, Any]]:
             t, est, err = e.truth_head_m, e.estimate_head_m, e.error_m
             rows.append(
                 {
-                    "experiment": result.experiment.name,
-                    "group": c.group,
-                    "condition": c.label,
-                    "value": float(c.value),
-                    "calibration": c.calibration,
+                    **_condition_columns(result, c),
                     "method": e.method,
                     "target": e.index,
                     "status": e.status,
