@@ -300,23 +300,27 @@ class BodyPoses:
         self.paths = {b: body_path(model, b, root) for b in self.bodies}
         self._last: dict[int, np.ndarray] = {}
 
-    def log(self, rec: rr.RecordingStream, data: mujoco.MjData) -> int:
-        """Log the bodies whose pose changed since the last call (all on the first); returns how many."""
-        count = 0
+    def moved(self, data: mujoco.MjData) -> list[tuple[str, np.ndarray, list[float]]]:
+        """(path, translation, quaternion xyzw) of the bodies whose pose changed since the
+        last call (all on the first)."""
+        rows = []
         for body in self.bodies:
             pose = np.concatenate([data.xpos[body], data.xquat[body]])
             last = self._last.get(body)
             if last is not None and np.array_equal(last, pose):
                 continue
             self._last[body] = pose
+            rows.append((self.paths[body], pose[:3], _xyzw(pose[3:])))
+        return rows
+
+    def log(self, rec: rr.RecordingStream, data: mujoco.MjData) -> int:
+        """Log the bodies whose pose changed since the last call (all on the first); returns how many."""
+        rows = self.moved(data)
+        for path, translation, xyzw in rows:
             rec.log(
-                self.paths[body],
-                rr.Transform3D(
-                    translation=pose[:3], quaternion=rr.Quaternion(xyzw=_xyzw(pose[3:]))
-                ),
+                path, rr.Transform3D(translation=translation, quaternion=rr.Quaternion(xyzw=xyzw))
             )
-            count += 1
-        return count
+        return len(rows)
 
 
 __all__ = [

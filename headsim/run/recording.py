@@ -45,6 +45,7 @@ rewrites it).
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from datetime import timedelta
 from pathlib import Path
 
@@ -56,6 +57,7 @@ from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
+from headsim.run.recording_columns import RowColumns
 from headsim.run.recording_layout import (
     GREEN,
     GREY,
@@ -77,6 +79,9 @@ from headsim.vision.markers import find_markers
 APP_ID = "headsim"
 #: JPEG quality of the recorded images (the experiment's own images are exact; these are for people).
 JPEG_QUALITY = 75
+#: Rows kept for :class:`RowColumns` before they are sent without waiting for the next
+#: measurement (a calibration, a long pursuit): about 40 images' poses and servo errors.
+MAX_KEPT_ROWS = 500
 #: Longest time logged data waits in the batcher before it is written or streamed.
 FLUSH_TICK = timedelta(seconds=1)
 
@@ -158,6 +163,11 @@ class Recorder(ResultsLogging):
         self._static_geometry = len(scenes) == 1
         self.geometry: list[mjcf_rerun.ModelGeometry] = []
         self._rows: list[str] = []
+        self._pose_rows = RowColumns()
+        # JPEG encoding and sending the kept rows run on one thread beside the run's
+        # (OpenCV's encoder lets the renders go on meanwhile), in the order given.
+        self._background = ThreadPoolExecutor(1, thread_name_prefix="headsim-recording")
+        self._pending = []
         self._log_static()
 
     # -- the subscriber -----------------------------------------------------------
@@ -206,6 +216,7 @@ class Recorder(ResultsLogging):
     def phase(
         self, name: str, sim: HeadSim, knowledge: HeadKnowledge, truth: dict[str, np.ndarray]
     ) -> None:
+        self._send_poses()
         self.phase_name = name
         self.truth = {k: np.asarray(v, dtype=float) for k, v in truth.items()}
         self.estimates = {}
@@ -269,17 +280,10 @@ class Recorder(ResultsLogging):
         self.current_frame = frame
         self._time()
         self._pose(sim)
+        if len(self._pose_rows) >= MAX_KEPT_ROWS:
+            self._send_poses()
         cam = names.CAMERAS[camera - 1]
-        ok, jpeg = cv2.imencode(
-            ".jpg",
-            cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
-            [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality],
-        )
-        if ok:
-            self.rec.log(
-                f"/world/head/{cam}/image",
-                rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg"),
-            )
+        self._later(self._log_image, cam, image, frame, self.current_step)
         # Cleared here; the detection made in this image (if any) follows at the same frame.
         self.rec.log(f"/world/head/{cam}/features", rr.Clear(recursive=False))
         if self.objects:
@@ -293,6 +297,21 @@ class Recorder(ResultsLogging):
                     colors=[WHITE] * len(seen),
                     labels=[k for k, _ in seen],
                 ),
+            )
+
+    def _log_image(self, cam: str, image: np.ndarray, frame: int, step: int) -> None:
+        """The image as a JPEG (on the recording's thread: its own time)."""
+        ok, jpeg = cv2.imencode(
+            ".jpg",
+            cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
+            [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality],
+        )
+        if ok:
+            self.rec.set_time("frame", sequence=frame)
+            self.rec.set_time("step", sequence=step)
+            self.rec.log(
+                f"/world/head/{cam}/image",
+                rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg"),
             )
 
     def detected(
@@ -309,15 +328,20 @@ class Recorder(ResultsLogging):
             rr.Points2D([uv], radii=5.0, colors=[GREEN], labels=[self.label]),
         )
         u0, v0 = self.knowledge.reference(sim, camera)
-        self.rec.log(f"/servo/{cam}/u_error_px", rr.Scalars([uv[0] - u0]))
-        self.rec.log(f"/servo/{cam}/v_error_px", rr.Scalars([uv[1] - v0]))
+        for axis, error in (("u", uv[0] - u0), ("v", uv[1] - v0)):
+            self._pose_rows.add(
+                f"/servo/{cam}/{axis}_error_px", frame, self.current_step, rr.Scalars, scalars=error
+            )
 
     def close(self) -> None:
         """Flush and write the footer; the file is complete after this."""
         if not self.closed:
             self.closed = True
-            self.rec.flush()
-            self.rec.disconnect()
+            try:
+                self.flush()
+            finally:
+                self._background.shutdown(wait=True, cancel_futures=False)
+                self.rec.disconnect()
 
     def __enter__(self) -> Recorder:
         return self

@@ -83,7 +83,7 @@ class ResultsLogging(SceneLogging):
                 media_type=rr.MediaType.MARKDOWN,
             ),
         )
-        self.rec.flush()
+        self.flush()
 
     def pursued(self, record: Any, frame: int) -> None:
         """A live pursuit frame: truth, estimate and error on the frame timeline."""
@@ -142,7 +142,7 @@ class ResultsLogging(SceneLogging):
             "/results/calibration",
             rr.TextDocument(calibration_markdown(calibration), media_type=rr.MediaType.MARKDOWN),
         )
-        self.rec.flush()
+        self.flush()
 
     def finished(self, result: RunResult) -> None:
         self._time()

@@ -4,10 +4,14 @@ lines, series, the scenario's document), each scene's model geometry, and the po
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
+
 import numpy as np
 import rerun as rr
 
 from headsim.run import mjcf_rerun
+from headsim.run.recording_columns import RowColumns
 from headsim.run.recording_layout import (
     GREY,
     ORANGE,
@@ -34,6 +38,10 @@ class SceneLogging:
     _scene_key: tuple[str, ...] | None
     _body_poses: mjcf_rerun.BodyPoses | None
     _static_geometry: bool
+    _pose_rows: RowColumns
+    #: The recording's thread (JPEG encoding, sending kept rows) and what it was given.
+    _background: ThreadPoolExecutor
+    _pending: list[Future[None]]
 
     def _time(self) -> None:
         self.rec.set_time("frame", sequence=self.current_frame)
@@ -155,42 +163,78 @@ class SceneLogging:
         self._body_poses = mjcf_rerun.BodyPoses(model)
 
     def _pose(self, sim: HeadSim) -> None:
+        """The head's pose at this image: kept as rows, sent by :meth:`_send_poses`."""
+        rows, frame, step = self._pose_rows, self.current_frame, self.current_step
         if self._body_poses is not None:
-            self._body_poses.log(self.rec, sim.data)
+            for path, translation, xyzw in self._body_poses.moved(sim.data):
+                rows.add(
+                    path, frame, step, rr.Transform3D, translation=translation, quaternion=xyzw
+                )
         world_from_head = sim.world_from_head()
-        self.rec.log(
+        rows.add(
             "/world/head",
-            rr.Transform3D(translation=world_from_head[:3, 3], mat3x3=world_from_head[:3, :3]),
+            frame,
+            step,
+            rr.Transform3D,
+            translation=world_from_head[:3, 3],
+            mat3x3=world_from_head[:3, :3],
         )
         origins, vectors = [], []
         target = self.truth.get(self.label)
         for index, cam in enumerate(names.CAMERAS):
             head_from_camera = sim.head_from_camera(index + 1)
-            self.rec.log(
+            rows.add(
                 f"/world/head/{cam}",
-                rr.Transform3D(
-                    translation=head_from_camera[:3, 3], mat3x3=head_from_camera[:3, :3]
-                ),
+                frame,
+                step,
+                rr.Transform3D,
+                translation=head_from_camera[:3, 3],
+                mat3x3=head_from_camera[:3, :3],
             )
             world_from_camera = sim.world_from_camera(index + 1)
             centre = world_from_camera[:3, 3]
             length = 1.0 if target is None else 1.2 * float(np.linalg.norm(target - centre))
             origins.append(centre)
             vectors.append(world_from_camera[:3, 2] * length)
-        self.rec.log(
+        rows.add(
             "/world/optical_axes",
-            rr.Arrows3D(
-                origins=origins,
-                vectors=vectors,
-                colors=[ORANGE, ORANGE],
-                labels=["cam1", "cam2"],
-                show_labels=False,
-            ),
+            frame,
+            step,
+            rr.Arrows3D,
+            instances=2,
+            per_row={"show_labels": False},
+            origins=origins,
+            vectors=vectors,
+            colors=[ORANGE, ORANGE],
+            labels=["cam1", "cam2"],
         )
         eye = sim.eye_encoder()
         yaw, pitch = sim.neck_encoders()
         for key, value in (("eye_rad", eye), ("neck_yaw_rad", yaw), ("neck_pitch_rad", pitch)):
-            self.rec.log(f"/joints/{key}", rr.Scalars([value]))
+            rows.add(f"/joints/{key}", frame, step, rr.Scalars, scalars=value)
+
+    def _later(self, log: Callable[..., None], *args: object) -> None:
+        """Run ``log(*args)`` on the recording's thread, after what was given before."""
+        self._pending = [f for f in self._pending if not f.done() or f.exception() is not None]
+        self._pending.append(self._background.submit(log, *args))
+
+    def _send_poses(self) -> None:
+        """Send the kept rows, on the recording's thread."""
+        if len(self._pose_rows):
+            rows, self._pose_rows = self._pose_rows, RowColumns()
+            self._later(rows.send, self.rec)
+
+    def _wait(self) -> None:
+        """Until the recording's thread did all it was given; its first error is raised."""
+        pending, self._pending = self._pending, []
+        for future in pending:
+            future.result()
+
+    def flush(self) -> None:
+        """Everything logged so far written (or streamed)."""
+        self._send_poses()
+        self._wait()
+        self.rec.flush()
 
 
 __all__ = ["FRUSTUM_DEPTH_M", "SceneLogging"]
