@@ -6,6 +6,8 @@ from __future__ import annotations
 import concurrent.futures as cf
 import concurrent.futures.process  # noqa: F401  execute() reads cf.process, loaded by its real pools
 import os
+import subprocess
+import sys
 import threading
 from dataclasses import dataclass
 from typing import Any
@@ -79,11 +81,38 @@ def test_stop_after_ends_the_run_after_that_many_records() -> None:
     assert finished == 2 and len(records) == 2
 
 
-def test_the_renderers_share_the_cpus_and_get_at_least_one_thread() -> None:
+def test_the_renderers_share_the_cpus_and_one_cpu_each_renders_in_the_calling_thread() -> None:
     cpus = len(os.sched_getaffinity(0))
-    assert _render_threads(1) == cpus
-    assert _render_threads(2) == max(1, cpus // 2)
-    assert _render_threads(cpus + 1) == 1
+    assert _render_threads(1) == (cpus if cpus > 1 else 0)
+    assert _render_threads(2) == (cpus // 2 if cpus // 2 > 1 else 0)
+    assert _render_threads(cpus + 1) == 0
+
+
+_RENDER_DIGEST = """
+import hashlib
+from headsim.sim.settings import HeadSettings
+from headsim.sim.simulator import HeadSim
+sim = HeadSim("chessboard", HeadSettings())
+sim.move(eye=0.05)
+print(hashlib.sha256(sim.render(1).tobytes() + sim.render(2).tobytes()).hexdigest())
+"""
+
+
+def test_llvmpipe_without_threads_renders_the_same_pixels() -> None:
+    """LP_NUM_THREADS=0 (a worker with one CPU) draws what the threaded renderer draws."""
+    digests = []
+    for threads in ("0", "2"):
+        env = {**os.environ, "LP_NUM_THREADS": threads}
+        done = subprocess.run(
+            [sys.executable, "-c", _RENDER_DIGEST],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=True,
+        )
+        digests.append(done.stdout.strip().splitlines()[-1])
+    assert len(digests[0]) == 64 and digests[0] == digests[1]
 
 
 def test_started_workers_load_their_modules_and_say_so_before_any_job() -> None:
