@@ -284,8 +284,9 @@ class Recorder(ResultsLogging):
             self._send_poses()
         cam = names.CAMERAS[camera - 1]
         self._later(self._log_image, cam, image, frame, self.current_step)
-        # Cleared here; the detection made in this image (if any) follows at the same frame.
-        self.rec.log(f"/world/head/{cam}/features", rr.Clear(recursive=False))
+        # No detection at this frame (the last one goes); the one made in this image, if any,
+        # follows at the same frame.
+        self._features(cam, frame, None)
         if self.objects:
             found = find_markers(image, self.objects)
             seen = [(k, d.uv) for k, d in found.items() if d.found and d.uv is not None]
@@ -314,19 +315,30 @@ class Recorder(ResultsLogging):
                 rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg"),
             )
 
+    def _features(self, cam: str, frame: int, uv: tuple[float, float] | None) -> None:
+        """The detection in the camera's image at ``frame`` (None: none, the last one goes)."""
+        found = [] if uv is None else [uv]
+        self._pose_rows.add(
+            f"/world/head/{cam}/features",
+            frame,
+            self.current_step,
+            rr.Points2D,
+            instances=None,
+            positions=found,
+            radii=[5.0] * len(found),
+            colors=[GREEN] * len(found),
+            labels=[self.label] * len(found),
+        )
+
     def detected(
         self, sim: HeadSim, camera: int, uv: tuple[float, float] | None, status: str, frame: int
     ) -> None:
         cam = names.CAMERAS[camera - 1]
         self.current_frame = frame
         self._time()
+        self._features(cam, frame, uv)
         if uv is None:
-            self.rec.log(f"/world/head/{cam}/features", rr.Clear(recursive=False))
             return
-        self.rec.log(
-            f"/world/head/{cam}/features",
-            rr.Points2D([uv], radii=5.0, colors=[GREEN], labels=[self.label]),
-        )
         u0, v0 = self.knowledge.reference(sim, camera)
         for axis, error in (("u", uv[0] - u0), ("v", uv[1] - v0)):
             self._pose_rows.add(

@@ -17,11 +17,13 @@ import rerun as rr
 
 @dataclass
 class _Entity:
-    """One entity's rows: ``instances`` values of each field per row."""
+    """One entity's rows: ``instances`` values of each field per row (None: a list of
+    any length per row)."""
 
     archetype: Any
-    instances: int
+    instances: int | None
     frames: list[int] = field(default_factory=list)
+    lengths: list[int] = field(default_factory=list)
     steps: list[int] = field(default_factory=list)
     fields: dict[str, list[Any]] = field(default_factory=dict)
     #: Fields with one value per row whatever ``instances`` is (e.g. ``show_labels``).
@@ -40,15 +42,21 @@ class RowColumns:
         frame: int,
         step: int,
         archetype: Any,
-        instances: int = 1,
+        instances: int | None = 1,
         per_row: dict[str, Any] | None = None,
         **values: Any,
     ) -> None:
         """A row of ``archetype`` (``rr.Transform3D``, ``rr.Scalars``, ...) at ``path``:
-        ``values`` are the archetype's fields, ``instances`` values each."""
+        ``values`` are the archetype's fields, ``instances`` values each (1: the value
+        itself; None: lists of one length, which may be 0: nothing at this row)."""
         entity = self._entities.setdefault(path, _Entity(archetype, instances))
         if entity.archetype is not archetype or entity.instances != instances:
             raise ValueError(f"{path}: rows of one archetype and instance count only")
+        if instances != 1:
+            lengths = {len(v) for v in values.values()}
+            if len(lengths) > 1 or (instances is not None and lengths != {instances}):
+                raise ValueError(f"{path}: every field needs {instances or 'the same'} values")
+            entity.lengths.append(lengths.pop() if lengths else 0)
         entity.frames.append(frame)
         entity.steps.append(step)
         for name, value in values.items():
@@ -68,8 +76,8 @@ class RowColumns:
             columns = entity.archetype.columns(
                 **{name: _column(v, entity.instances) for name, v in entity.fields.items()}
             )
-            if entity.instances > 1:
-                columns = columns.partition([entity.instances] * rows)
+            if entity.instances != 1:
+                columns = columns.partition(entity.lengths)
             extra = entity.archetype.columns(**entity.per_row) if entity.per_row else []
             rec.send_columns(
                 path,
@@ -82,10 +90,10 @@ class RowColumns:
         self._entities.clear()
 
 
-def _column(rows: list[Any], instances: int) -> Any:
+def _column(rows: list[Any], instances: int | None) -> Any:
     """The rows' values end to end: an array, or a list of strings (labels)."""
-    flat = [v for row in rows for v in row] if instances > 1 else list(rows)
-    return flat if flat and isinstance(flat[0], str) else np.asarray(flat)
+    flat = list(rows) if instances == 1 else [v for row in rows for v in row]
+    return flat if not flat or isinstance(flat[0], str) else np.asarray(flat)
 
 
 __all__ = ["RowColumns"]

@@ -23,8 +23,14 @@ def test_frusta_images_and_features_at_every_frame(recorded: tuple[Path, dict]) 
         np.testing.assert_allclose(k[0], [expected["kx"], 0, expected["cx"]], rtol=1e-6)
         images = rows(rrd, f"/world/head/{cam}/image", "EncodedImage:blob")
         frames += [r["frame"] for r in images]
-        features = rows(rrd, f"/world/head/{cam}/features", "Points2D:positions")
+        rows_of_features = rows(rrd, f"/world/head/{cam}/features", "Points2D:positions")
+        # Each image first empties the features (the last detection does not linger) ...
+        emptied = {r["frame"] for r in rows_of_features if not r["value"]}
+        assert {r["frame"] for r in images} <= emptied
+        # ... then its detection, if any, follows at the same frame.
+        features = [r for r in rows_of_features if r["value"]]
         assert {r["frame"] for r in features} <= {r["frame"] for r in images}
+        assert all(len(r["value"]) == 1 for r in features)
         assert len(features) > 0.8 * len(images)  # nearly every image had its target found
         u_error = rows(rrd, f"/servo/{cam}/u_error_px", "Scalars:scalars")
         assert [r["frame"] for r in u_error] == [r["frame"] for r in features]
