@@ -20,7 +20,12 @@ from headsim.active.model2 import Model2Config, measure_model2
 from headsim.sim import names
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
-from headsim.vision.chessboard import ChessboardDetection, find_chessboard
+from headsim.vision.chessboard import (
+    ChessboardDetection,
+    corner_support_px,
+    find_chessboard,
+    find_corner_alone,
+)
 from headsim.vision.detection import Detection, DetectionStatus
 
 
@@ -49,6 +54,13 @@ def board_extent(board: ChessboardDetection, index: int) -> tuple[float, float, 
     )
 
 
+def alone_extent(spacing_px: float) -> tuple[float, float, float, float]:
+    """(left, top, right, bottom) px from a corner of what finding it alone needs: the
+    pixels its refinement reads (:func:`headsim.vision.chessboard.corner_support_px`)."""
+    reach = float(corner_support_px(spacing_px))
+    return (-reach, -reach, reach, reach)
+
+
 def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: float) -> Target:
     """Inner corner ``index`` (row-major from the top-left) of the scene's chessboard.
 
@@ -65,11 +77,26 @@ def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: flo
         assert board.corners is not None  # found: the corners are there
         u, v = board.corners[index]
         return Detection(
-            DetectionStatus.FOUND, (float(u), float(v)), 1.0, board_extent(board, index)
+            DetectionStatus.FOUND,
+            (float(u), float(v)),
+            1.0,
+            board_extent(board, index),
+            pattern_uv=tuple((float(a), float(b)) for a, b in board.corners),
+            pattern_scale_px=board.spacing_px,
         )
 
-    # Every corner of one board looks for the whole board: they share windows.
+    def detect_alone(image: np.ndarray, spacing_px: float) -> Detection:
+        uv = find_corner_alone(image, spacing_px)
+        if uv is None:
+            return Detection(DetectionStatus.LOST, None, 0.0)
+        return Detection(DetectionStatus.FOUND, uv, 1.0, alone_extent(spacing_px))
+
+    # Every corner of one board looks for the whole board: they share windows.  Once
+    # the board was seen, a corner is looked for alone, where the board places it.
     detect.window_key = ("chessboard", pattern, square_m)  # type: ignore[attr-defined]
+    detect.feature_index = index  # type: ignore[attr-defined]
+    detect.find_alone = detect_alone  # type: ignore[attr-defined]
+    detect.alone_extent_px = alone_extent  # type: ignore[attr-defined]
 
     def truth(sim: HeadSim) -> np.ndarray:
         body = sim.data.body(names.CHESSBOARD)
@@ -148,4 +175,10 @@ def measure_chessboard(
     )
 
 
-__all__ = ["ChessboardRun", "board_extent", "chessboard_corner_target", "measure_chessboard"]
+__all__ = [
+    "ChessboardRun",
+    "alone_extent",
+    "board_extent",
+    "chessboard_corner_target",
+    "measure_chessboard",
+]

@@ -19,7 +19,7 @@ from headsim.active.servo_types import (
 from headsim.sim.events import EventSink
 from headsim.sim.render import Window
 from headsim.sim.simulator import HeadSim
-from headsim.vision.detection import Detection, DetectionStatus
+from headsim.vision.detection import Detection
 from headsim.vision.markers import find_marker
 
 #: Detectors (or the functions that partials of them wrap) that find their target
@@ -33,6 +33,25 @@ def windowed(detector: object) -> bool:
     while isinstance(detector, functools.partial):
         detector = detector.func
     return detector in WINDOWED_DETECTORS
+
+
+def alone_finder(
+    detector: object,
+) -> (
+    tuple[int, Callable[..., Detection], Callable[[float], tuple[float, float, float, float]]]
+    | None
+):
+    """(feature index, ``find_alone(image, spacing_px)``, ``alone_extent_px(spacing_px)``) of a
+    pattern detector that can find its feature alone once the pattern was seen (a
+    chessboard's corner), else None."""
+    while isinstance(detector, functools.partial):
+        detector = detector.func
+    index = getattr(detector, "feature_index", None)
+    find = getattr(detector, "find_alone", None)
+    extent = getattr(detector, "alone_extent_px", None)
+    if index is None or find is None or extent is None:
+        return None
+    return int(index), find, extent
 
 
 def pattern_windowed(detector: object) -> bool:
@@ -144,19 +163,20 @@ def look_in_window(
             and (window.y0 == 0 or window.y0 + 2 <= v + top)
             and (window.y1 == settings.height or v + bottom <= window.y1 - 3)
         ):
-            return Detection(DetectionStatus.FOUND, (u, v), seen.area_px, seen.extent_px)
+            return seen.moved(window.x0, window.y0)
         return None
     inset = 3.0 * math.sqrt(seen.area_px / math.pi) + 2.0
     if (
         window.x0 + inset <= u <= window.x1 - 1 - inset
         and window.y0 + inset <= v <= window.y1 - 1 - inset
     ):
-        return Detection(DetectionStatus.FOUND, (u, v), seen.area_px)
+        return seen.moved(window.x0, window.y0)
     return None
 
 
 __all__ = [
     "WINDOWED_DETECTORS",
+    "alone_finder",
     "expected_window",
     "look_in_window",
     "pattern_window",

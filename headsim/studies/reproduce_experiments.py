@@ -68,7 +68,7 @@ COSTS = {
     "zhang": 148.0,
     "fixed_point": 110.0,
     "initial_directions": 11.0,
-    "chessboard": 298.0,
+    "chessboard": 195.0,
     "relative_positioning": 43.0,
     "tracking": 72.0,
     STUDY_JOB: 115.0,

@@ -24,7 +24,7 @@ halves the floor (README, rendering fidelity).
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -45,13 +45,26 @@ class Detection:
     the blob (FOUND, OCCLUDED) or its pixel count (CUT), 0 when LOST.
     ``extent_px``: for a feature found as part of a larger pattern (a
     chessboard's corner), the (left, top, right, bottom) px from ``uv`` of
-    everything the detector needed to see; None for a blob.
+    everything the detector needed to see; None for a blob.  ``pattern_uv``:
+    where that detection found every feature of the pattern, (u, v) px in the
+    same pixels as ``uv``, and ``pattern_scale_px`` the pattern's spacing (a
+    chessboard's square); None and 0 otherwise (a feature found alone).
     """
 
     status: DetectionStatus
     uv: tuple[float, float] | None
     area_px: float
     extent_px: tuple[float, float, float, float] | None = None
+    pattern_uv: tuple[tuple[float, float], ...] | None = None
+    pattern_scale_px: float = 0.0
+
+    def moved(self, du: float, dv: float) -> Detection:
+        """This detection in pixels offset by (du, dv) (a window's in the full frame's)."""
+        uv = None if self.uv is None else (self.uv[0] + du, self.uv[1] + dv)
+        pattern = (
+            None if self.pattern_uv is None else tuple((u + du, v + dv) for u, v in self.pattern_uv)
+        )
+        return replace(self, uv=uv, pattern_uv=pattern)
 
     @property
     def found(self) -> bool:

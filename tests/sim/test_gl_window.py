@@ -295,6 +295,45 @@ def test_windows_change_no_chessboard_corner() -> None:
     assert frames < 0.7 * plain_frames
 
 
+def test_a_seen_boards_neighbouring_corners_are_looked_for_alone_in_small_windows() -> None:
+    """Once the board was seen, a corner a short eye move away is looked for alone, in a
+    window of its refinement's support (not the board's): same detections and estimates
+    as full frames, a fraction of the pixels."""
+    from headsim.active.chessboard import measure_chessboard
+    from headsim.sim import names
+
+    corners = [9, 10, 11, 12]
+    runs = {}
+    for windows in (False, True):
+        with HeadSim("chessboard", paper_head()) as sim:
+            sim.set_body_pose(
+                names.CHESSBOARD, sim.transform_points([-0.105, -0.075, 0.85], "head", "world")[0]
+            )
+            sizes: list[int] = []
+            render_window = sim.render_window
+
+            def logged(camera, window, render_window=render_window, sizes=sizes):  # type: ignore[no-untyped-def]
+                sizes.append(window.width * window.height)
+                return render_window(camera, window)
+
+            sim.render_window = logged  # type: ignore[method-assign]
+            servo = LoggingServo(sim, ServoConfig(windows=windows))
+            run = measure_chessboard(sim, servo, HeadKnowledge(), corners=corners)
+            runs[windows] = (run, sizes, servo)
+    (plain, _, _), (windowed, sizes, servo) = runs[False], runs[True]
+    for a, b in zip(plain.measurements, windowed.measurements, strict=True):
+        assert a.ok and b.ok
+        np.testing.assert_allclose(b.estimate_head_m, a.estimate_head_m, rtol=0, atol=1e-6)
+    assert servo.window_misses == 0
+    board = max(sizes)
+    small = [s for s in sizes if s < 0.1 * board]
+    # The others follow the long eye moves between the two steps of Model 2 (the whole board).
+    assert len(small) >= len(sizes) / 3, sizes
+    # The support (18 px each side here), the 8 px margin and a quarter of the motion
+    # (at most 2 squares of 28 px).
+    assert max(small) <= 82 * 82
+
+
 @pytest.mark.parametrize("head", sorted(HEADS))
 def test_a_preview_is_the_binned_view_and_leaves_the_cameras_noise_alone(head: str) -> None:
     import cv2
