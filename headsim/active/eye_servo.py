@@ -20,6 +20,7 @@ import numpy as np
 
 from headsim.active.events import ServoKind, ServoStep
 from headsim.active.fixation_average import pixel_period_steps
+from headsim.active.seen_pattern import SeenPattern, remembered
 from headsim.active.servo_types import (
     Detector,
     ServoConfig,
@@ -41,12 +42,6 @@ from headsim.sim.events import EventSink
 from headsim.sim.render import Window
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection, DetectionStatus
-
-#: A pattern's feature is looked for alone only after an image motion of at most this
-#: many pattern spacings since the pattern was last seen: the gain's linear prediction
-#: is then good to well within the 0.3 spacing that tells the feature from its neighbours
-#: (a chessboard corner 1,300 steps of eye motion away was predicted a square off).
-ALONE_MOTION = 2.0
 
 
 class EyeServo:
@@ -71,11 +66,9 @@ class EyeServo:
         ] = {}
         #: Per camera, the extent of the pattern last seen (None: a blob).
         self._extent: dict[int, tuple[float, float, float, float] | None] = {}
-        #: Per camera, where the last detection puts every feature of its pattern, (N, 2)
-        #: px in the full frame, the pattern's spacing, px, and the box (left, top, right,
-        #: bottom) px that finding it whole needs (a board seen whole, then moved with
-        #: each feature found alone); absent after a blob or a miss.
-        self._pattern: dict[int, tuple[np.ndarray, float, np.ndarray]] = {}
+        #: Per camera, where the last detection puts its pattern (a board seen whole,
+        #: then moved with each feature found alone); absent after a blob or a miss.
+        self._pattern: dict[int, SeenPattern] = {}
         #: Binned previews rendered to place a window (see ``ServoConfig.preview_binning``).
         self.previews = 0
         #: Windows rendered, and windows that missed the target (a full frame followed).
@@ -114,10 +107,8 @@ class EyeServo:
         if pattern:  # a pattern's features share their windows
             key = getattr(key, "window_key", key)
         window, spacing = None, 0.0
-        if alone is not None:
-            window, spacing = self._alone_window(camera, key, alone, steps, neck)
-        elif pattern or windowed(key):
-            window = self._window(camera, key, steps, neck)
+        if pattern or windowed(key):
+            window, spacing = self._window(camera, key, steps, neck, alone)
         if (
             preview
             and window is None
@@ -130,9 +121,7 @@ class EyeServo:
         found_alone = False
         if window is not None:
             self.window_renders += 1
-            look = (
-                detector if not spacing or alone is None else partial(alone[1], spacing_px=spacing)
-            )
+            look = partial(alone[1], spacing_px=spacing) if spacing and alone else detector
             detection = look_in_window(
                 sim, camera, reporting(look, self.sink, camera, window), window
             )
@@ -147,79 +136,17 @@ class EyeServo:
         if isinstance(detection, Detection) and detection.found and detection.uv is not None:
             self._seen[camera] = (key, steps, neck, sim.placements, detection.uv, detection.area_px)
             self._extent[camera] = detection.extent_px
-            self._remember_pattern(camera, detection, alone, found_alone)
+            kept = remembered(self._pattern.get(camera), detection, alone, found_alone)
+            if kept is None:
+                self._pattern.pop(camera, None)
+            else:
+                self._pattern[camera] = kept
+                if found_alone:  # the next whole-pattern window is the pattern's box
+                    self._extent[camera] = kept.extent_from(detection.uv)
         else:
             self._seen.pop(camera, None)
             self._pattern.pop(camera, None)
         return detection
-
-    def _remember_pattern(
-        self,
-        camera: int,
-        detection: Detection,
-        alone: tuple[int, object, object] | None,
-        found_alone: bool,
-    ) -> None:
-        """Keep where ``detection`` puts its pattern: every feature, and the box the whole
-        pattern needs, from a whole pattern; both moved so that a feature found alone is
-        where it was found (the next whole-pattern window is that box, not the feature's)."""
-        uv = np.array(detection.uv)
-        if detection.pattern_uv is not None and detection.extent_px is not None:
-            left, top, right, bottom = detection.extent_px
-            box = uv[[0, 1, 0, 1]] + np.array([left, top, right, bottom])
-            self._pattern[camera] = (
-                np.array(detection.pattern_uv),
-                detection.pattern_scale_px,
-                box,
-            )
-        elif found_alone and alone is not None and camera in self._pattern:
-            features, spacing, box = self._pattern[camera]
-            shift = uv - features[alone[0]]
-            box = box + shift[[0, 1, 0, 1]]
-            self._pattern[camera] = (features + shift, spacing, box)
-            self._extent[camera] = (
-                float(box[0] - uv[0]),
-                float(box[1] - uv[1]),
-                float(box[2] - uv[0]),
-                float(box[3] - uv[1]),
-            )
-        else:
-            self._pattern.pop(camera, None)
-
-    def _alone_window(
-        self,
-        camera: int,
-        key: object,
-        alone: tuple[int, object, Callable[[float], tuple[float, float, float, float]]],
-        steps: int,
-        neck: tuple[float, float],
-    ) -> tuple[Window | None, float]:
-        """Where to look for a pattern's feature alone, and the pattern's spacing, px:
-        around where the last sight of the pattern puts it, moved by the eye steps since;
-        (None, 0) while the pattern was not seen (the whole pattern is looked for)."""
-        cfg, sim = self.config, self.sim
-        seen, gain, kept = self._seen.get(camera), self.gains.get(camera), self._pattern.get(camera)
-        if not cfg.windows or seen is None or gain is None or kept is None:
-            return self._window(camera, key, steps, neck), 0.0
-        seen_key, seen_steps, seen_neck, placements, _, _ = seen
-        if seen_key != key or seen_neck != neck or placements != sim.placements:
-            return None, 0.0
-        features, spacing, _ = kept
-        index, _, extent = alone
-        motion = gain * (steps - seen_steps)
-        if not 0 <= index < len(features) or spacing <= 0.0 or abs(motion) > ALONE_MOTION * spacing:
-            # The gain predicts a long move only to a few per cent: the whole pattern.
-            return self._window(camera, key, steps, neck), 0.0
-        u, v = features[index]
-        window = pattern_window(
-            sim,
-            camera,
-            (float(u) + motion, float(v)),
-            extent(spacing),
-            motion,
-            cfg.window_margin_px,
-        )
-        return window, spacing if window is not None else 0.0
 
     def _unseen(self, camera: int, key: object, neck: tuple[float, float]) -> bool:
         """Whether no detection of ``key``'s target predicts where it is (a new target,
@@ -235,25 +162,41 @@ class EyeServo:
         return preview_window(self.sim, camera, detector, self.config)
 
     def _window(
-        self, camera: int, key: object, steps: int, neck: tuple[float, float]
-    ) -> Window | None:
-        """Where to look for ``key``'s target in ``camera``, or None for the full frame."""
+        self,
+        camera: int,
+        key: object,
+        steps: int,
+        neck: tuple[float, float],
+        alone: tuple[int, object, Callable[[float], tuple[float, float, float, float]]]
+        | None = None,
+    ) -> tuple[Window | None, float]:
+        """Where to look for ``key``'s target in ``camera`` (None: the full frame), and
+        the pattern's spacing, px, when it is a feature looked for ``alone`` (else 0):
+        around where the last sight of the pattern puts it (:class:`SeenPattern`)."""
         cfg, sim = self.config, self.sim
         seen, gain = self._seen.get(camera), self.gains.get(camera)
         if not cfg.windows or seen is None or gain is None:
-            return None
+            return None, 0.0
         seen_key, seen_steps, seen_neck, placements, uv, area = seen
         if seen_key != key or seen_neck != neck or placements != sim.placements:
-            return None
+            return None, 0.0
         motion = gain * (steps - seen_steps)
+        kept = self._pattern.get(camera)
+        if alone is not None and kept is not None and kept.expects_alone(alone[0], motion):
+            u, v = kept.features[alone[0]]
+            spacing = kept.spacing_px
+            window = pattern_window(
+                sim, camera, (u + motion, v), alone[2](spacing), motion, cfg.window_margin_px
+            )
+            return window, spacing if window is not None else 0.0
         extent = self._extent.get(camera)
-        if extent is not None:
+        if extent is not None:  # a pattern: the whole of it
             return pattern_window(
                 sim, camera, (uv[0] + motion, uv[1]), extent, motion, cfg.window_margin_px
-            )
+            ), 0.0
         return expected_window(
             sim, camera, (uv[0] + motion, uv[1]), area, motion, cfg.window_margin_px
-        )
+        ), 0.0
 
     def run(
         self,

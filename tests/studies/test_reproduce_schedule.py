@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from headsim.studies.reproduce_experiments import STUDY_JOB
+from headsim.studies.reproduce_experiments import COSTS, STUDY_JOB
 from headsim.studies.reproduce_schedule import PlannedJob, critical_order, schedule
 
 
@@ -24,7 +24,7 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
     def make(name: str, needs: tuple[str, ...] = ()) -> PlannedJob:
         return job(name, _echo, needs, lambda done, n=name: (n, log))
 
-    # calibration (225) -> chessboard (298) is the longest path; zhang (148) and
+    # calibration (225) -> chessboard (195) is the longest path; zhang (148) and
     # fixed_point (110) lead to tables (115); "broken" fails and its dependent is skipped.
     plan = [
         make("zhang"),
@@ -37,8 +37,10 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
         make("relative_positioning", ("broken",)),
     ]
     level = critical_order(plan)
-    assert level["calibration"] == 225.0 + 298.0
-    assert level["zhang"] == 148.0 + 115.0 and level["fixed_point"] == 110.0 + 115.0
+    cost = COSTS
+    assert level["calibration"] == cost["calibration"] + cost["chessboard"]
+    assert level["zhang"] == cost["zhang"] + cost[STUDY_JOB]
+    assert level["fixed_point"] == cost["fixed_point"] + cost[STUDY_JOB]
     finished, skipped, ran = [], [], []
     with futures.ThreadPoolExecutor(max_workers=1) as pool:
         ended = schedule(
@@ -53,12 +55,12 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
     # One worker: each time the ready job with the longest path to the end.
     assert log == [
         "broken",  # SWEEP_COST: a job without a measured cost counts as long
-        "calibration",
-        "chessboard",
-        "zhang",
-        "fixed_point",
-        STUDY_JOB,
-        "tracking",
+        "calibration",  # 420 to the end
+        "zhang",  # 263
+        "fixed_point",  # 225
+        "chessboard",  # 195, ready since the calibration
+        STUDY_JOB,  # 115, ready once zhang and fixed_point are
+        "tracking",  # 72
     ]
     assert ("broken", True, "RuntimeError: no board") in finished
     assert skipped == [("relative_positioning", "broken")]

@@ -1,0 +1,73 @@
+"""Where the eye servo last saw a pattern (a chessboard): every feature and the box the
+whole pattern needs, px in the full frame, kept to look for one feature alone."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from headsim.vision.detection import Detection
+
+#: A pattern's feature is looked for alone only after an image motion of at most this
+#: many pattern spacings since the pattern was last seen: the gain's linear prediction
+#: is then good to well within the 0.3 spacing that tells the feature from its neighbours
+#: (a chessboard corner 1,300 steps of eye motion away was predicted a square off).
+ALONE_MOTION = 2.0
+
+
+@dataclass(frozen=True, eq=False)
+class SeenPattern:
+    """Every feature (N, 2) px, the spacing px, and the box (left, top, right, bottom) px
+    that finding the whole pattern needs, where the last detection put them."""
+
+    features: np.ndarray
+    spacing_px: float
+    box: np.ndarray
+
+    @classmethod
+    def from_whole(cls, detection: Detection) -> SeenPattern | None:
+        """From a detection of the whole pattern (None: not one)."""
+        if detection.uv is None or detection.pattern_uv is None or detection.extent_px is None:
+            return None
+        u, v = detection.uv
+        left, top, right, bottom = detection.extent_px
+        box = np.array([u + left, v + top, u + right, v + bottom])
+        return cls(np.array(detection.pattern_uv), detection.pattern_scale_px, box)
+
+    def found_alone(self, index: int, uv: tuple[float, float]) -> SeenPattern:
+        """Moved so that feature ``index``, found alone, is at ``uv``."""
+        shift = np.asarray(uv) - self.features[index]
+        return SeenPattern(self.features + shift, self.spacing_px, self.box + shift[[0, 1, 0, 1]])
+
+    def extent_from(self, uv: tuple[float, float]) -> tuple[float, float, float, float]:
+        """The whole pattern's box from ``uv``, px: (left, top, right, bottom)."""
+        left, top, right, bottom = (float(x) for x in self.box)
+        return (left - uv[0], top - uv[1], right - uv[0], bottom - uv[1])
+
+    def expects_alone(self, index: int, motion_px: float) -> bool:
+        """Whether feature ``index`` may be looked for alone after ``motion_px`` of motion."""
+        return (
+            0 <= index < len(self.features)
+            and self.spacing_px > 0.0
+            and abs(motion_px) <= ALONE_MOTION * self.spacing_px
+        )
+
+
+def remembered(
+    kept: SeenPattern | None,
+    detection: Detection,
+    alone: tuple[int, object, object] | None,
+    found_alone: bool,
+) -> SeenPattern | None:
+    """What to keep after ``detection`` (FOUND): the pattern it saw whole; the kept one
+    moved to the feature ``alone[0]`` ``found_alone``; else nothing (a blob)."""
+    whole = SeenPattern.from_whole(detection)
+    if whole is not None:
+        return whole
+    if found_alone and alone is not None and kept is not None and detection.uv is not None:
+        return kept.found_alone(alone[0], detection.uv)
+    return None
+
+
+__all__ = ["ALONE_MOTION", "SeenPattern", "remembered"]
