@@ -1,8 +1,9 @@
 """Check a ``headsim reproduce`` report against the stored baseline (CI runs it).
 
 Fails (exit 1) when the run did not finish ok, when an experiment of the
-baseline is missing or failed, or when a row the baseline reproduced is no
-longer reproduced.  ``--update`` stores the report's rows as the new baseline.
+baseline is missing or failed, when a row the baseline reproduced is no
+longer reproduced, or when the wall ratio's unit is not the quieter of the
+two render medians it was timed as.  ``--update`` stores the report's rows as the new baseline.
 
     python benchmarks/check_reproduce.py out/reproduce/report.json [--update]
 """
@@ -22,6 +23,16 @@ def problems(report: dict, baseline: dict) -> list[str]:
     found = []
     if report.get("status") != "ok":
         found.append(f"status {report.get('status')!r}, not 'ok'")
+    medians = [report.get("render_before_s"), report.get("render_after_s")]
+    if all(isinstance(m, float) for m in medians) and "render_s" in report:
+        unit = min(medians)  # type: ignore[type-var]
+        if report["render_s"] != unit:
+            found.append(f"render unit {report['render_s']} s, not the quieter median {unit} s")
+        elif (
+            abs(report["wall_over_render"] - report["wall_s"] / unit)
+            > 1e-6 * report["wall_s"] / unit
+        ):
+            found.append("wall ratio is not the wall time over the render unit")
     rows_now = report.get("rows", {})
     for experiment, rows in baseline.get("rows", {}).items():
         now = rows_now.get(experiment)

@@ -18,9 +18,9 @@ def cpu_s() -> float:
 
 class RenderClock:
     """Times 640x480 renders of the default scene in this process, while no worker of
-    the run works: the unit once they started and wait, idle, for their first jobs,
-    and a few after they ended, which show how the machine's load moved (reported,
-    not used in the ratio)."""
+    the run works: once they started and wait, idle, for their first jobs, and a few
+    after they ended.  The unit is the quieter of the two medians (the machine's
+    other load only adds time); both are reported."""
 
     def __init__(self) -> None:
         from headsim.sim.settings import HeadSettings
@@ -49,5 +49,5 @@ class RenderClock:
         self._sim.close()
 
 
-#: Renders timed before the workers' first jobs (the unit) and after they end (the load's drift).
+#: Renders timed before the workers' first jobs and after they end (the unit: the quieter median).
 CLOCK_RENDERS = (21, 7)

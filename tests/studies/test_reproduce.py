@@ -31,6 +31,25 @@ def test_the_ci_check_catches_a_row_no_longer_reproduced() -> None:
     ]
 
 
+def test_the_ci_check_wants_the_quieter_render_median_as_the_unit() -> None:
+    report = {
+        "status": "ok",
+        "rows": {},
+        "wall_s": 16.0,
+        "render_before_s": 0.044,
+        "render_after_s": 0.033,
+        "render_s": 0.033,
+        "wall_over_render": 16.0 / 0.033,
+    }
+    assert problems(report, {"rows": {}}) == []
+    flattering = {**report, "render_s": 0.044, "wall_over_render": 16.0 / 0.044}
+    assert problems(flattering, {"rows": {}}) == [
+        "render unit 0.044 s, not the quieter median 0.033 s"
+    ]
+    stale = {**report, "wall_over_render": 16.0 / 0.044}
+    assert problems(stale, {"rows": {}}) == ["wall ratio is not the wall time over the render unit"]
+
+
 def test_bad_input_exits_2_and_writes_nothing(tmp_path: Path, capsys) -> None:
     assert main(["reproduce", "--out", str(tmp_path / "r"), "--workers", "0"]) == 2
     assert "--workers" in capsys.readouterr().err
