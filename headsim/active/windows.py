@@ -28,11 +28,16 @@ from headsim.vision.markers import find_marker
 WINDOWED_DETECTORS: set[Callable[..., object]] = {find_marker}
 
 
-def windowed(detector: object) -> bool:
-    """Whether ``detector`` (possibly a ``functools.partial``) may look at windows."""
+def _unwrapped(detector: object) -> object:
+    """``detector`` without the ``functools.partial`` layers around it."""
     while isinstance(detector, functools.partial):
         detector = detector.func
-    return detector in WINDOWED_DETECTORS
+    return detector
+
+
+def windowed(detector: object) -> bool:
+    """Whether ``detector`` (possibly a ``functools.partial``) may look at windows."""
+    return _unwrapped(detector) in WINDOWED_DETECTORS
 
 
 def alone_finder(
@@ -44,8 +49,7 @@ def alone_finder(
     """(feature index, ``find_alone(image, spacing_px)``, ``alone_extent_px(spacing_px)``) of a
     pattern detector that can find its feature alone once the pattern was seen (a
     chessboard's corner), else None."""
-    while isinstance(detector, functools.partial):
-        detector = detector.func
+    detector = _unwrapped(detector)
     index = getattr(detector, "feature_index", None)
     find = getattr(detector, "find_alone", None)
     extent = getattr(detector, "alone_extent_px", None)
@@ -57,9 +61,7 @@ def alone_finder(
 def pattern_windowed(detector: object) -> bool:
     """Whether ``detector`` finds a feature as part of a pattern it reports the extent of
     (``Detection.extent_px``) and names by a ``window_key`` shared by the pattern's features."""
-    while isinstance(detector, functools.partial):
-        detector = detector.func
-    return getattr(detector, "window_key", None) is not None
+    return getattr(_unwrapped(detector), "window_key", None) is not None
 
 
 def reporting(
