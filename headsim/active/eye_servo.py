@@ -118,14 +118,15 @@ class EyeServo:
         ):
             window = self._preview(camera, key)
         detection = None
-        found_alone = False
+        found_alone: int | None = None  # the feature's index when found alone
         if window is not None:
             self.window_renders += 1
             look = partial(alone[1], spacing_px=spacing) if spacing and alone else detector
             detection = look_in_window(
                 sim, camera, reporting(look, self.sink, camera, window), window
             )
-            found_alone = detection is not None and bool(spacing)
+            if detection is not None and spacing and alone:
+                found_alone = alone[0]
             if detection is None:
                 self.window_misses += 1
                 # the same instant, whole
@@ -136,12 +137,12 @@ class EyeServo:
         if isinstance(detection, Detection) and detection.found and detection.uv is not None:
             self._seen[camera] = (key, steps, neck, sim.placements, detection.uv, detection.area_px)
             self._extent[camera] = detection.extent_px
-            kept = remembered(self._pattern.get(camera), detection, alone, found_alone)
+            kept = remembered(self._pattern.get(camera), detection, found_alone)
             if kept is None:
                 self._pattern.pop(camera, None)
             else:
                 self._pattern[camera] = kept
-                if found_alone:  # the next whole-pattern window is the pattern's box
+                if found_alone is not None:  # the next whole-pattern window is its box
                     self._extent[camera] = kept.extent_from(detection.uv)
         else:
             self._seen.pop(camera, None)

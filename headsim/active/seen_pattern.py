@@ -55,18 +55,15 @@ class SeenPattern:
 
 
 def remembered(
-    kept: SeenPattern | None,
-    detection: Detection,
-    alone: tuple[int, object, object] | None,
-    found_alone: bool,
+    kept: SeenPattern | None, detection: Detection, found_alone: int | None
 ) -> SeenPattern | None:
     """What to keep after ``detection`` (FOUND): the pattern it saw whole; the kept one
-    moved to the feature ``alone[0]`` ``found_alone``; else nothing (a blob)."""
+    moved to it when it is feature ``found_alone`` found alone; else nothing (a blob)."""
     whole = SeenPattern.from_whole(detection)
     if whole is not None:
         return whole
-    if found_alone and alone is not None and kept is not None and detection.uv is not None:
-        return kept.found_alone(alone[0], detection.uv)
+    if found_alone is not None and kept is not None and detection.uv is not None:
+        return kept.found_alone(found_alone, detection.uv)
     return None
 
 
