@@ -163,7 +163,7 @@ class Recorder(ResultsLogging):
         self._static_geometry = len(scenes) == 1
         self.geometry: list[mjcf_rerun.ModelGeometry] = []
         self._rows: list[str] = []
-        self._pose_rows = RowColumns()
+        self._kept_rows = RowColumns()
         # JPEG encoding and sending the kept rows run on one thread beside the run's
         # (OpenCV's encoder lets the renders go on meanwhile), in the order given.
         self._background = ThreadPoolExecutor(1, thread_name_prefix="headsim-recording")
@@ -216,7 +216,7 @@ class Recorder(ResultsLogging):
     def phase(
         self, name: str, sim: HeadSim, knowledge: HeadKnowledge, truth: dict[str, np.ndarray]
     ) -> None:
-        self._send_poses()
+        self._send_kept_rows()
         self.phase_name = name
         self.truth = {k: np.asarray(v, dtype=float) for k, v in truth.items()}
         self.estimates = {}
@@ -280,8 +280,8 @@ class Recorder(ResultsLogging):
         self.current_frame = frame
         self._time()
         self._pose(sim)
-        if len(self._pose_rows) >= MAX_KEPT_ROWS:
-            self._send_poses()
+        if len(self._kept_rows) >= MAX_KEPT_ROWS:
+            self._send_kept_rows()
         cam = names.CAMERAS[camera - 1]
         self._later(self._log_image, cam, image, frame, self.current_step)
         # No detection at this frame (the last one goes); the one made in this image, if any,
@@ -318,7 +318,7 @@ class Recorder(ResultsLogging):
     def _features(self, cam: str, frame: int, uv: tuple[float, float] | None) -> None:
         """The detection in the camera's image at ``frame`` (None: none, the last one goes)."""
         found = [] if uv is None else [uv]
-        self._pose_rows.add(
+        self._kept_rows.add(
             f"/world/head/{cam}/features",
             frame,
             self.current_step,
@@ -341,7 +341,7 @@ class Recorder(ResultsLogging):
             return
         u0, v0 = self.knowledge.reference(sim, camera)
         for axis, error in (("u", uv[0] - u0), ("v", uv[1] - v0)):
-            self._pose_rows.add(
+            self._kept_rows.add(
                 f"/servo/{cam}/{axis}_error_px", frame, self.current_step, rr.Scalars, scalars=error
             )
 

@@ -38,7 +38,7 @@ class SceneLogging:
     _scene_key: tuple[str, ...] | None
     _body_poses: mjcf_rerun.BodyPoses | None
     _static_geometry: bool
-    _pose_rows: RowColumns
+    _kept_rows: RowColumns
     #: The recording's thread (JPEG encoding, sending kept rows) and what it was given.
     _background: ThreadPoolExecutor
     _pending: list[Future[None]]
@@ -163,8 +163,8 @@ class SceneLogging:
         self._body_poses = mjcf_rerun.BodyPoses(model)
 
     def _pose(self, sim: HeadSim) -> None:
-        """The head's pose at this image: kept as rows, sent by :meth:`_send_poses`."""
-        rows, frame, step = self._pose_rows, self.current_frame, self.current_step
+        """The head's pose at this image: kept as rows (with the detections and servo errors), sent by :meth:`_send_kept_rows`."""
+        rows, frame, step = self._kept_rows, self.current_frame, self.current_step
         if self._body_poses is not None:
             for path, translation, xyzw in self._body_poses.moved(sim.data):
                 rows.add(
@@ -218,10 +218,10 @@ class SceneLogging:
         self._pending = [f for f in self._pending if not f.done() or f.exception() is not None]
         self._pending.append(self._background.submit(log, *args))
 
-    def _send_poses(self) -> None:
+    def _send_kept_rows(self) -> None:
         """Send the kept rows, on the recording's thread."""
-        if len(self._pose_rows):
-            rows, self._pose_rows = self._pose_rows, RowColumns()
+        if len(self._kept_rows):
+            rows, self._kept_rows = self._kept_rows, RowColumns()
             self._later(rows.send, self.rec)
 
     def _wait(self) -> None:
@@ -232,7 +232,7 @@ class SceneLogging:
 
     def flush(self) -> None:
         """Everything logged so far written (or streamed)."""
-        self._send_poses()
+        self._send_kept_rows()
         self._wait()
         self.rec.flush()
 
