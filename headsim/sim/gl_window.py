@@ -1,11 +1,12 @@
 """Windows of a camera's image, drawn as the whole frame clipped to the window.
 
 A :class:`Window` is a sub-rectangle of a camera's output image.  It is drawn
-with the frame's own projection and viewport and four OpenGL user clip planes a
-few pixels outside it (:func:`clipped_to`), into an off-screen buffer that
-reaches only from the frame's origin to the window's far corner
-(:class:`WindowBuffer`): every vertex lands where it does in the full frame, to
-the bit, so the window's pixels are the frame's crop (README, windows).
+with the frame's own projection and four OpenGL user clip planes a few pixels
+outside it (:func:`clipped_to`), with the frame's viewport moved by whole
+pixels so that the window's corner is the origin of an off-screen buffer only
+as large as the window (:class:`WindowBuffer`): every vertex lands where it
+does in the frame, less the window's offset, so the window's pixels are the
+frame's crop (README, windows).
 """
 
 from __future__ import annotations
@@ -182,28 +183,26 @@ def draw_window(
     times) of the scene, drawn as the whole frame of ``full_size`` raster pixels
     clipped to the window (:func:`clipped_to`).
 
-    The frame is drawn into a buffer only as large as the window's far corner
-    from the frame's origin needs (rounded up to :data:`BUFFER_STEP`; or a kept
-    one up to :data:`BUFFER_SLACK` times as large), not the context's:
-    ``mjr_render`` clears all of its viewport, and a whole frame's
-    multisampled buffer costs more to clear than the window to draw.
+    The frame's viewport is moved by whole pixels so that the window's corner is
+    the origin of a buffer only as large as the window (rounded up to
+    :data:`BUFFER_STEP`; or a kept one up to :data:`BUFFER_SLACK` times as
+    large), not the context's: ``mjr_render`` clears all of its viewport that
+    the buffer holds, and a whole frame's multisampled buffer costs more to
+    clear than a small window to draw.
     """
     from OpenGL import GL
 
     full_w, full_h = full_size
     context = renderer._mjr_context
-    step, margin = BUFFER_STEP, CLIP_MARGIN_PX
-    size = (
-        min(full_w, step * math.ceil((k * rect.x1 + margin) / step)),
-        min(full_h, step * math.ceil((full_h - k * rect.y0 + margin) / step)),
-    )
+    step = BUFFER_STEP
+    width, height = k * rect.width, k * rect.height
+    size = (step * math.ceil(width / step), step * math.ceil(height / step))
     # MuJoCo's only use of the stencil: reflective geoms (a material's reflectance).
     stencil = bool(np.any(renderer.model.mat_reflectance > 0))
     buffers: OrderedDict[tuple[int, int, bool], WindowBuffer] = renderer.__dict__.setdefault(
         "_headsim_window_buffers", OrderedDict()
     )
-    # The smallest kept buffer that holds the window (every pixel of the window lands
-    # where it does in any buffer that holds it), unless it is much larger.
+    # The smallest kept buffer that holds the window, unless it is much larger.
     fits = [b for b in buffers if b[0] >= size[0] and b[1] >= size[1] and b[2] == stencil]
     key = min(fits, key=lambda b: b[0] * b[1], default=(*size, stencil))
     if key[0] * key[1] > BUFFER_SLACK * size[0] * size[1]:
@@ -214,21 +213,20 @@ def draw_window(
         _, oldest = buffers.popitem(last=False)
         GL.glDeleteFramebuffers(len(oldest.framebuffers), oldest.framebuffers)
         GL.glDeleteRenderbuffers(len(oldest.renderbuffers), oldest.renderbuffers)
-    x, y = k * rect.x0, full_h - k * rect.y1  # OpenGL's rows run bottom-up
-    width, height = k * rect.width, k * rect.height
+    # The window's corner in the frame's raster (OpenGL's rows run bottom-up).
+    x, y = k * rect.x0, full_h - k * rect.y1
     try:
         GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, buffer.framebuffers[0])
         with clipped_to(renderer.scene, rect, k, full_size):
-            mujoco.mjr_render(mujoco.MjrRect(0, 0, full_w, full_h), renderer.scene, context)
+            mujoco.mjr_render(mujoco.MjrRect(-x, -y, full_w, full_h), renderer.scene, context)
         GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, buffer.framebuffers[0])
         GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, buffer.framebuffers[1])
         GL.glBlitFramebuffer(
-            x, y, x + width, y + height, x, y, x + width, y + height,
-            GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST,
-        )  # fmt: skip
+            0, 0, width, height, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST
+        )
         GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, buffer.framebuffers[1])
         GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
-        raw = GL.glReadPixels(x, y, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
+        raw = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
     finally:
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, context)
     return np.frombuffer(raw, dtype=np.uint8).reshape(height, width, 3).copy()
