@@ -12,7 +12,6 @@ learnt on one target seeds the next.  Every loop is bounded and returns a
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
 
@@ -28,9 +27,11 @@ from headsim.active.servo_types import (
     ServoResult,
 )
 from headsim.active.windows import (
+    AloneFinder,
     alone_finder,
     expected_window,
     look_in_window,
+    pattern_preview,
     pattern_window,
     pattern_windowed,
     preview_window,
@@ -96,8 +97,9 @@ class EyeServo:
         (so the blob and every piece the detector looks for beside it lie in
         the window); otherwise the window is a miss (counted) and a full
         frame is rendered.  Never from the truth: detections, gain, encoders.
-        A new target is first found in a binned preview; ``preview=False`` renders
-        the full frame instead (one render: a search's look, which may well miss).
+        A new target, or a pattern's feature after a move too long to find it
+        alone (the pattern placing it), is first found in a binned preview;
+        ``preview=False`` renders the full frame instead (a search's look).
         """
         key = detector if key is None else key
         sim = self.sim
@@ -109,14 +111,13 @@ class EyeServo:
         window, spacing = None, 0.0
         if pattern or windowed(key):
             window, spacing = self._window(camera, key, steps, neck, alone)
-        if (
-            preview
-            and window is None
-            and not pattern
-            and windowed(key)
-            and self._unseen(camera, key, neck)
-        ):
-            window = self._preview(camera, key)
+        looked = None
+        if preview and alone is not None and not spacing:
+            looked = self._pattern_preview(camera, key, detector, alone)
+        if looked is not None:
+            window, spacing = looked
+        elif preview and window is None and not pattern and windowed(key):
+            window = self._preview(camera, key, neck)
         detection = None
         found_alone: int | None = None  # the feature's index when found alone
         if window is not None:
@@ -149,18 +150,33 @@ class EyeServo:
             self._pattern.pop(camera, None)
         return detection
 
-    def _unseen(self, camera: int, key: object, neck: tuple[float, float]) -> bool:
-        """Whether no detection of ``key``'s target predicts where it is (a new target,
-        one moved, or the neck moved since): a preview may find it."""
+    def _preview(self, camera: int, detector: object, neck: tuple[float, float]) -> Window | None:
+        """A preview's window for ``detector``'s blob (see :func:`preview_window`) where no
+        detection predicts where it is (a new target, one moved, or the neck moved since)."""
         seen = self._seen.get(camera)
-        return seen is None or seen[0] != key or seen[2] != neck or seen[3] != self.sim.placements
-
-    def _preview(self, camera: int, detector: object) -> Window | None:
-        """A preview's window for ``detector``'s blob (see :func:`preview_window`)."""
         if not self.config.windows or self.config.preview_binning <= 1:
+            return None
+        if seen is not None and seen[0] == detector and seen[2:4] == (neck, self.sim.placements):
             return None
         self.previews += 1
         return preview_window(self.sim, camera, detector, self.config)
+
+    def _pattern_preview(
+        self, camera: int, key: object, detector: Detector, alone: AloneFinder
+    ) -> tuple[Window | None, float] | None:
+        """After a move too long to find the feature ``alone`` looks for alone, where a
+        binned preview puts it and the pattern's spacing there (:func:`pattern_preview`);
+        None: no preview, or one that did not show the pattern (its window, as before)."""
+        seen, kept = self._seen.get(camera), self._pattern.get(camera)
+        if not self.config.windows or kept is None or seen is None or seen[0] != key:
+            return None
+        looked = pattern_preview(self.sim, camera, detector, kept, alone, self.config)
+        if looked is not None:
+            self.previews += 1
+        if looked is None or looked[0] is None or looked[1] is None:
+            return None
+        self._pattern[camera] = looked[0]
+        return looked[1], looked[0].spacing_px
 
     def _window(
         self,
@@ -168,8 +184,7 @@ class EyeServo:
         key: object,
         steps: int,
         neck: tuple[float, float],
-        alone: tuple[int, object, Callable[[float], tuple[float, float, float, float]]]
-        | None = None,
+        alone: AloneFinder | None = None,
     ) -> tuple[Window | None, float]:
         """Where to look for ``key``'s target in ``camera`` (None: the full frame), and
         the pattern's spacing, px, when it is a feature looked for ``alone`` (else 0):
@@ -331,15 +346,9 @@ class EyeServo:
             if not detection.found or detection.uv is None:
                 if self._retreats >= cfg.max_retreats or abs(move) <= 1:
                     return self._result(
-                        ServoOutcome.TARGET_LOST,
-                        target,
-                        None,
-                        goal,
-                        iteration,
-                        camera,
-                        gain,
+                        ServoOutcome.TARGET_LOST, target, None, goal, iteration, camera, gain,
                         lost=detection.status,
-                    )
+                    )  # fmt: skip
                 # Re-acquire: back to the last step that saw it, then a shorter move.
                 self._retreats += 1
                 damping *= 0.5
@@ -379,19 +388,11 @@ class EyeServo:
             self.gains[camera] = gain
         residual = math.nan if uv is None else uv[0] - goal
         subpixel = float(steps) if gain is None or uv is None else steps - residual / gain
+        path = tuple(self._path)
         return ServoResult(
-            outcome,
-            steps,
-            uv,
-            residual,
-            gain,
-            subpixel,
-            self._renders,
-            iterations,
-            lost,
-            tuple(self._path),
+            outcome, steps, uv, residual, gain, subpixel, self._renders, iterations, lost, path,
             self._retreats,
-        )
+        )  # fmt: skip
 
 
 __all__ = ["EyeServo"]

@@ -14,6 +14,10 @@ from headsim.vision.detection import Detection
 #: is then good to well within the 0.3 spacing that tells the feature from its neighbours
 #: (a chessboard corner 1,300 steps of eye motion away was predicted a square off).
 ALONE_MOTION = 2.0
+#: A pattern is looked for in a binned preview only where its spacing stays at least
+#: this many pixels there: OpenCV found every chessboard of 14 px squares (the scene's
+#: board at 0.85 m binned 2 x 2) and none of 7 px (4 x 4).
+PREVIEW_MIN_SPACING_PX = 10.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -35,6 +39,21 @@ class SeenPattern:
         box = np.array([u + left, v + top, u + right, v + bottom])
         return cls(np.array(detection.pattern_uv), detection.pattern_scale_px, box)
 
+    @classmethod
+    def from_preview(cls, detection: Detection, binning: int) -> SeenPattern | None:
+        """From a detection of the whole pattern in a preview binned ``binning`` x
+        ``binning`` (None: not one), in the full frame's pixels: binned pixel i covers
+        pixels b i .. b i + b - 1."""
+        binned = cls.from_whole(detection)
+        if binned is None:
+            return None
+        offset = (binning - 1) / 2.0
+        return cls(
+            binning * binned.features + offset,
+            binning * binned.spacing_px,
+            binning * binned.box + offset,
+        )
+
     def found_alone(self, index: int, uv: tuple[float, float]) -> SeenPattern:
         """Moved so that feature ``index``, found alone, is at ``uv``."""
         shift = np.asarray(uv) - self.features[index]
@@ -54,6 +73,21 @@ class SeenPattern:
         )
 
 
+def preview_binning(spacing_px: float, largest: int, image_size: tuple[int, int]) -> int:
+    """The largest binning up to ``largest`` (a power of two dividing the image) that keeps
+    the pattern's spacing at least :data:`PREVIEW_MIN_SPACING_PX`; 1: none does."""
+    width, height = image_size
+    b = 1
+    while (
+        2 * b <= largest
+        and width % (2 * b) == 0
+        and height % (2 * b) == 0
+        and spacing_px / (2 * b) >= PREVIEW_MIN_SPACING_PX
+    ):
+        b *= 2
+    return b
+
+
 def remembered(
     kept: SeenPattern | None, detection: Detection, found_alone: int | None
 ) -> SeenPattern | None:
@@ -67,4 +101,10 @@ def remembered(
     return None
 
 
-__all__ = ["ALONE_MOTION", "SeenPattern", "remembered"]
+__all__ = [
+    "ALONE_MOTION",
+    "PREVIEW_MIN_SPACING_PX",
+    "SeenPattern",
+    "preview_binning",
+    "remembered",
+]

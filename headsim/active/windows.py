@@ -12,6 +12,7 @@ from collections.abc import Callable
 import numpy as np
 
 from headsim.active.events import Detected
+from headsim.active.seen_pattern import SeenPattern, preview_binning
 from headsim.active.servo_types import (
     Detector,
     ServoConfig,
@@ -40,12 +41,14 @@ def windowed(detector: object) -> bool:
     return _unwrapped(detector) in WINDOWED_DETECTORS
 
 
-def alone_finder(
-    detector: object,
-) -> (
-    tuple[int, Callable[..., Detection], Callable[[float], tuple[float, float, float, float]]]
-    | None
-):
+#: What :func:`alone_finder` gives: (feature index, ``find_alone(image, spacing_px)``,
+#: ``alone_extent_px(spacing_px)`` as (left, top, right, bottom) px from the feature).
+AloneFinder = tuple[
+    int, Callable[..., Detection], Callable[[float], tuple[float, float, float, float]]
+]
+
+
+def alone_finder(detector: object) -> AloneFinder | None:
     """(feature index, ``find_alone(image, spacing_px)``, ``alone_extent_px(spacing_px)``) of a
     pattern detector that can find its feature alone once the pattern was seen (a
     chessboard's corner), else None."""
@@ -141,6 +144,35 @@ def preview_window(
     return expected_window(sim, camera, uv, b * b * seen.area_px, 4.0 * b, config.window_margin_px)
 
 
+def pattern_preview(
+    sim: HeadSim,
+    camera: int,
+    detector: object,
+    kept: SeenPattern,
+    alone: AloneFinder,
+    config: ServoConfig,
+) -> tuple[SeenPattern | None, Window | None] | None:
+    """After a move too long to find a feature alone, the pattern (``detector``'s, last
+    seen as ``kept``) found in a binned preview of ``camera``'s whole view, and the
+    window to look for feature ``alone[0]`` alone there.  None: no binning keeps the
+    pattern findable (nothing rendered); (None, None): the preview did not show it."""
+    settings = sim.camera_settings(camera)
+    b = preview_binning(kept.spacing_px, config.preview_binning, (settings.width, settings.height))
+    if b <= 1:
+        return None
+    assert callable(detector)
+    seen = SeenPattern.from_preview(detector(sim.render_preview(camera, b)), b)
+    if seen is None:
+        return None, None
+    index, _, extent = alone
+    u, v = seen.features[index]
+    # The preview places each feature to within about b px.
+    window = pattern_window(
+        sim, camera, (u, v), extent(seen.spacing_px), 4.0 * b, config.window_margin_px
+    )
+    return seen, window
+
+
 def look_in_window(
     sim: HeadSim, camera: int, detector: Detector, window: Window
 ) -> Detection | None:
@@ -178,9 +210,11 @@ def look_in_window(
 
 __all__ = [
     "WINDOWED_DETECTORS",
+    "AloneFinder",
     "alone_finder",
     "expected_window",
     "look_in_window",
+    "pattern_preview",
     "pattern_window",
     "pattern_windowed",
     "preview_window",
