@@ -17,9 +17,11 @@ from headsim.active.measurement import (
     Target,
 )
 from headsim.active.model2 import Model2Config, measure_model2
+from headsim.active.windows import look_once
 from headsim.sim import names
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
+from headsim.stereo.views import CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M
 from headsim.vision.chessboard import (
     ChessboardDetection,
     corner_support_px,
@@ -105,6 +107,24 @@ def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: flo
     return Target(f"corner_{i}_{j}", detect, truth)
 
 
+#: The binning of the preview that places a board seen for the first time (stereo's
+#: and the zoom's views): the scene's 30 mm squares, 28.6 px at 0.85 m at the paper's
+#: focal length, stay >= 10 px at 2 x 2 to about 1.2 m (see
+#: ``seen_pattern.PREVIEW_MIN_SPACING_PX``); a board the preview misses is found in
+#: the full frame.
+BOARD_PREVIEW_BINNING = 2
+
+
+def look_for_board(sim: HeadSim, camera: int) -> np.ndarray | None:
+    """The scene's board's inner corners (N, 2) px in ``camera``'s next image, in board
+    order (as ``headsim.stereo.views.detect_chessboard`` gives them), or None: found in
+    the window a binned preview places (:func:`look_once`), else in the full frame."""
+    seen = look_once(sim, camera, _BOARD.detector, binning=BOARD_PREVIEW_BINNING)
+    if not seen.found or seen.pattern_uv is None:
+        return None
+    return np.array(seen.pattern_uv, dtype=float)
+
+
 @dataclass(frozen=True)
 class ChessboardRun:
     """Every cross point measured with Model 2, and the squares' sides they give, m.
@@ -175,10 +195,14 @@ def measure_chessboard(
     )
 
 
+_BOARD = chessboard_corner_target(0, CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M)
+
 __all__ = [
+    "BOARD_PREVIEW_BINNING",
     "ChessboardRun",
     "alone_extent",
     "board_extent",
     "chessboard_corner_target",
+    "look_for_board",
     "measure_chessboard",
 ]

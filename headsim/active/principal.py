@@ -32,10 +32,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from headsim.active.chessboard import look_for_board
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
-from headsim.stereo.views import detect_chessboard, place_chessboard, sample_board_pose
+from headsim.stereo.views import place_chessboard, sample_board_pose
 
 #: Zoom used to find the principal point when the study needs one (f' = 1.3 f).
 PROBE_ZOOM = 1.3
@@ -202,7 +203,7 @@ def principal_points_by_zoom(
                 place_chessboard(sim, head_from_board)
             found_any = False
             for camera in (1, 2):
-                corners = [detect_chessboard(sim.render(camera)) for sim in sims]
+                corners = [look_for_board(sim, camera) for sim in sims]
                 renders += 2
                 if corners[0] is not None and corners[1] is not None:
                     matched[camera - 1].append((corners[0], corners[1]))

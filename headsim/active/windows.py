@@ -128,12 +128,13 @@ def expected_window(
 
 
 def preview_window(
-    sim: HeadSim, camera: int, detector: object, config: ServoConfig
+    sim: HeadSim, camera: int, detector: object, config: ServoConfig, binning: int = 0
 ) -> Window | None:
-    """Render a preview of ``camera``'s whole view binned ``config.preview_binning`` x
-    ``config.preview_binning`` and return the window where it shows the blob, or None
-    (not found, or a window barely cheaper than the frame: a full frame follows)."""
-    b = config.preview_binning
+    """Render a preview of ``camera``'s whole view binned b x b (``binning``, default
+    ``config.preview_binning``) and return the window where it shows the target (a
+    blob's, or a whole pattern's box), or None (not found, or a window barely cheaper
+    than the frame: a full frame follows)."""
+    b = binning or config.preview_binning
     assert callable(detector)
     seen = detector(sim.render_preview(camera, b))
     if not isinstance(seen, Detection) or not seen.found or seen.uv is None:
@@ -141,7 +142,33 @@ def preview_window(
     # Binned pixel i covers pixels b i .. b i + b - 1; its position is good to about b px.
     offset = (b - 1) / 2.0
     uv = (b * seen.uv[0] + offset, b * seen.uv[1] + offset)
+    if seen.extent_px is not None:  # a pattern: its box, from the feature
+        left, top, right, bottom = (b * e for e in seen.extent_px)
+        return pattern_window(
+            sim, camera, uv, (left, top, right, bottom), 4.0 * b, config.window_margin_px
+        )
     return expected_window(sim, camera, uv, b * b * seen.area_px, 4.0 * b, config.window_margin_px)
+
+
+def look_once(
+    sim: HeadSim,
+    camera: int,
+    detector: Detector,
+    config: ServoConfig | None = None,
+    binning: int = 0,
+) -> Detection:
+    """``detector``'s answer on ``camera``'s next image, from as few pixels as the full
+    frame's answer needs: the window a binned preview places (:func:`preview_window`),
+    where the detection counts if it stands for the full frame's (:func:`look_in_window`),
+    else the full frame of the same instant.  For a camera that looks once at a target
+    it has no sight of yet (stereo, chessboard views); a servo predicts its windows."""
+    config = config or ServoConfig()
+    if config.windows and (binning or config.preview_binning) > 1:
+        window = preview_window(sim, camera, detector, config, binning)
+        if window is not None:
+            seen = look_in_window(sim, camera, detector, window)
+            return seen if seen is not None else detector(sim.retake(camera))
+    return detector(sim.render(camera))
 
 
 def pattern_preview(
@@ -214,6 +241,7 @@ __all__ = [
     "alone_finder",
     "expected_window",
     "look_in_window",
+    "look_once",
     "pattern_preview",
     "pattern_window",
     "pattern_windowed",

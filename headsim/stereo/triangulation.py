@@ -89,22 +89,35 @@ def marker_detector(target: str) -> Detector:
     return lambda image: find_marker(image, colour)
 
 
+#: How a camera's next image is detected in: ``look(sim, camera, detector)``.
+Look = Callable[[HeadSim, int, Detector], Detection]
+
+
+def full_frame(sim: HeadSim, camera: int, detector: Detector) -> Detection:
+    """``detector`` on ``camera``'s next image, the full frame."""
+    return detector(sim.render(camera))
+
+
 def measure_point_stereo(
     sim: HeadSim,
     calib: StereoCalibration,
     target: str,
     detector: Detector | None = None,
     head_from_cam1: np.ndarray | None = None,
+    look: Look | None = None,
 ) -> StereoMeasurement:
     """Measure the body ``target`` in H: eye angle 0, render both cameras, detect, triangulate.
 
-    ``detector`` defaults to :func:`marker_detector` of ``target``.
+    ``detector`` defaults to :func:`marker_detector` of ``target``.  ``look(sim,
+    camera, detector)`` detects in the camera's next image (default: the full frame;
+    ``headsim.active.windows.look_once`` renders only where a preview shows the target).
     """
     detect = detector or marker_detector(target)
+    look = look or full_frame
     sim.move(eye=0.0)
     uvs = []
     for index in (1, 2):
-        detection = detect(sim.render(index))
+        detection = look(sim, index, detect)
         if not detection.found or detection.uv is None:
             raise StereoError(
                 f"{target!r} not found in {names.CAMERAS[index - 1]}: {detection.status.value}"

@@ -10,6 +10,7 @@ cannot proceed.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -195,18 +196,32 @@ def detect_chessboard(image: np.ndarray) -> np.ndarray | None:
     return detection.corners.astype(float)
 
 
+#: How a camera's next image gives the board's corners: ``look(sim, camera)``, (N, 2)
+#: px in board order, or None.
+BoardLook = Callable[[HeadSim, int], "np.ndarray | None"]
+
+
+def full_frame_board(sim: HeadSim, camera: int) -> np.ndarray | None:
+    """:func:`detect_chessboard` on ``camera``'s next image, the full frame."""
+    return detect_chessboard(sim.render(camera))
+
+
 def chessboard_views(
     sim: HeadSim,
     n_poses: int,
     rng: np.random.Generator,
     distance_range_m: tuple[float, float] = (0.4, 1.0),
     max_tilt_rad: float = 0.6,
+    look: BoardLook | None = None,
 ) -> ChessboardViews:
     """Render the chessboard in ``n_poses`` random poses at eye angle 0 and detect its corners.
 
     ``sim`` must hold the chessboard scene.  The neck and eyes are moved to 0.
-    Views where either camera misses the board are dropped.
+    Views where either camera misses the board are dropped.  ``look(sim, camera)``
+    gives the corners of the camera's next image (default: :func:`detect_chessboard`
+    on the full frame; ``headsim.active.chessboard.look_for_board`` renders less).
     """
+    look = look or full_frame_board
     if n_poses < 1:
         raise StereoError(f"n_poses must be >= 1, got {n_poses}")
     sim.move(eye=0.0, neck_yaw=0.0, neck_pitch=0.0)
@@ -220,7 +235,7 @@ def chessboard_views(
         sim.set_body_pose(
             names.CHESSBOARD, world_from_board[:3, 3], _quat_from_rotation(world_from_board[:3, :3])
         )
-        detected = [detect_chessboard(sim.render(camera)) for camera in (1, 2)]
+        detected = [look(sim, camera) for camera in (1, 2)]
         if detected[0] is None or detected[1] is None:
             continue
         points_world = object_points @ world_from_board[:3, :3].T + world_from_board[:3, 3]

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from headsim.active.calibration import CalibrationRun, calibrate_head
+from headsim.active.chessboard import look_for_board
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
@@ -144,6 +145,7 @@ def zhang_stereo(
             config.board_poses,
             np.random.default_rng(config.seed),
             distance_range_m=(0.4 * scale, 1.0 * scale),
+            look=look_for_board,
         )
         return calibrate_stereo(sim, views), views
 

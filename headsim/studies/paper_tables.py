@@ -40,6 +40,7 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import measure_model2
 from headsim.active.principal import PrincipalPointRun, zoomed
+from headsim.active.windows import look_once
 from headsim.estimators import model2
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
@@ -179,7 +180,7 @@ def measure_paired(
             truth = sim.position(TARGET.name, "head")
             start = sim.render_count
             try:
-                m = measure_point_stereo(sim, zhang, TARGET.name)
+                m = measure_point_stereo(sim, zhang, TARGET.name, look=look_once)
                 estimate, status = m.p_head, "ok"
             except StereoError as error:
                 estimate, status = np.full(3, np.nan), str(error)

@@ -12,6 +12,7 @@ import numpy as np
 from headsim.active.eye_servo import EyeServo
 from headsim.active.model2 import measure_model2
 from headsim.active.principal import PROBE_ZOOM, principal_points_by_zoom
+from headsim.active.windows import look_once
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.triangulation import measure_point_stereo
@@ -83,7 +84,9 @@ def measure_methods(
                 start = sim.render_count
                 if method == "stereo":
                     try:
-                        m = measure_point_stereo(sim, calibrations.stereo, TARGET.name)
+                        m = measure_point_stereo(
+                            sim, calibrations.stereo, TARGET.name, look=look_once
+                        )
                         estimate, status = m.p_head, "ok"
                     except StereoError as error:
                         estimate, status = np.full(3, np.nan), str(error)

@@ -93,3 +93,41 @@ def test_a_binned_preview_places_a_window_around_the_blob(sim) -> None:
     assert window.x0 < full.uv[0] < window.x1 - 1 and window.y0 < full.uv[1] < window.y1 - 1
     assert window.width * window.height < 0.1 * 640 * 480
     assert preview_window(sim, 1, partial(find_marker, colour="yellow"), ServoConfig()) is None
+
+
+def test_a_camera_that_looks_once_sees_what_the_full_frame_shows_in_fewer_pixels() -> None:
+    # Calibrated stereo's marker images and the chessboard views of Zhang's calibration:
+    # a binned preview places a window; its detection is the full frame's.
+    from headsim.active.chessboard import look_for_board
+    from headsim.active.windows import look_once
+    from headsim.sim.settings import paper_head
+    from headsim.stereo.views import full_frame_board, place_chessboard, sample_board_pose
+    from headsim.studies.targets import place_in_head
+
+    rng = np.random.default_rng(2)
+    with HeadSim("chessboard", paper_head()) as full, HeadSim("chessboard", paper_head()) as seen:
+        for sim in (full, seen):
+            sim.move(eye=0.0, neck_yaw=0.0, neck_pitch=0.0)
+        for _ in range(3):
+            pose = sample_board_pose(full, rng, (0.4, 1.0), 0.6)  # tilted up to 0.6 rad
+            for sim in (full, seen):
+                place_chessboard(sim, pose)
+            for camera in (1, 2):
+                corners, looked = full_frame_board(full, camera), look_for_board(seen, camera)
+                assert corners is not None and looked is not None
+                # 48 such views: within 0.0103 px (a window is the frame's crop to 1 grey
+                # level on all but about 3e-5 of its pixel values).
+                np.testing.assert_allclose(looked, corners, rtol=0, atol=0.02)
+        assert seen.rendered_frames < 0.75 * full.rendered_frames
+    with HeadSim("default", paper_head()) as full, HeadSim("default", paper_head()) as seen:
+        for p_head in ([0.05, -0.02, 0.6], [-0.15, 0.04, 1.1]):
+            for sim in (full, seen):
+                place_in_head(sim, "marker_red", np.array(p_head))
+            for camera in (1, 2):
+                a = RED(full.render(camera))
+                b = look_once(seen, camera, RED)
+                assert a.found and b.found and a.uv is not None and b.uv is not None
+                assert np.max(np.abs(np.subtract(a.uv, b.uv))) < 1e-9
+        # A 4x4 preview and a window each, against full frames.
+        assert seen.render_count == 2 * full.render_count
+        assert seen.rendered_frames < 0.2 * full.rendered_frames
