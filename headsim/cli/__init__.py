@@ -17,8 +17,10 @@ group: :mod:`~headsim.cli.scenarios` (run, calibrate, list), :mod:`~headsim.cli.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
+import threading
 from collections.abc import Sequence
 
 from headsim.cli.interrupts import process_signals
@@ -58,12 +60,26 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.environ.setdefault("RUST_LOG", "off")
     with process_signals():
         code = guarded(lambda: _main(rest, debug=debug, quiet=quiet), debug=debug)
-    if code == ExitCode.INTERRUPTED and argv is None:
-        # The process's own entry point, interrupted: its files are closed. Leave now, for
+    if argv is None and (code == ExitCode.INTERRUPTED or _nothing_left_running()):
+        # The process's own entry point, its command done: every file it wrote is closed
+        # (results written atomically, a recording flushed and disconnected).  Leave now:
+        # tearing the interpreter down frees mujoco's, llvmpipe's and Rerun's state for
+        # about 0.3 s (a tenth of the quick start).  Interrupted, leave in any case, for
         # CPython ends a process by SIGINT at exit (status -2, not 130) once a
         # KeyboardInterrupt passed through an extension's PyRun_* call (pybind11's exec
         # while mujoco imports), even when headsim caught it.
-        sys.stdout.flush()
-        sys.stderr.flush()
+        with contextlib.suppress(OSError):
+            sys.stdout.flush()
+            sys.stderr.flush()
         os._exit(int(code))
     return code
+
+
+def _nothing_left_running() -> bool:
+    """Whether no thread but daemons and no child process is left (else the interpreter's
+    own exit waits for them)."""
+    others = [t for t in threading.enumerate() if t is not threading.main_thread()]
+    if any(t.is_alive() and not t.daemon for t in others):
+        return False
+    processes = sys.modules.get("multiprocessing")
+    return processes is None or not processes.active_children()

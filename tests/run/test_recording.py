@@ -29,6 +29,34 @@ def test_the_file_is_complete_with_its_blueprint(recorded: tuple[Path, dict]) ->
         assert len(reader.blueprints()) == 1
 
 
+def _rows_per_entity(rrd: Path) -> dict[str, int]:
+    counts: dict[str, int] = defaultdict(int)
+    for chunk in RrdReader(rrd).stream():
+        counts[chunk.entity_path] += chunk.to_record_batch().num_rows
+    return dict(counts)
+
+
+def test_the_command_line_leaves_only_once_the_recording_is_complete(
+    recorded: tuple[Path, dict], tmp_path: Path
+) -> None:
+    # The process's own entry point ends without tearing the interpreter down
+    # (os._exit): the recording it wrote has its footer and every row of a run in-process.
+    out, rrd = tmp_path / "out", tmp_path / "run.rrd"
+    command = [sys.executable, "-m", "headsim.cli", "run", "quickstart", "--fast"]
+    command += ["--out", str(out), "--rrd", str(rrd), "--no-progress"]
+    done = subprocess.run(
+        command, capture_output=True, text=True, timeout=300, check=False,
+        env={**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")},
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "recording" in done.stdout  # stdout was flushed before leaving
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a file without footer would warn
+        assert len(RrdReader(rrd).blueprints()) == 1
+    assert _rows_per_entity(rrd) == _rows_per_entity(recorded[0])
+    assert (out / "results.json").read_text() == (recorded[0].parent / "results.json").read_text()
+
+
 def test_every_recorded_entity_is_documented(recorded: tuple[Path, dict]) -> None:
     rrd, _ = recorded
     text = README.read_text()
