@@ -60,17 +60,18 @@ class JobOutcome:
     error: str = ""
 
 
-#: What each job costs, in 640x480 render-times at full size (measured one after the
-#: other on this machine, Dec 2026): the scheduler starts the ready job with the
-#: longest path to the end first.  Sweeps are the longest.
+#: What each job costs, in 640x480 render-times at full size (its CPU time over the
+#: run's render, medians of 3 runs of ``headsim reproduce --workers 2`` on this
+#: machine, Dec 2026): the scheduler starts the ready job with the longest path to the
+#: end first.  Sweeps are the longest.
 COSTS = {
-    "calibration": 225.0,
-    "zhang": 148.0,
-    "fixed_point": 110.0,
-    "initial_directions": 11.0,
-    "chessboard": 195.0,
-    "relative_positioning": 43.0,
-    "tracking": 72.0,
-    STUDY_JOB: 115.0,
+    "calibration": 185.0,
+    "zhang": 120.0,
+    "fixed_point": 130.0,
+    "initial_directions": 12.0,
+    "chessboard": 140.0,
+    "relative_positioning": 45.0,
+    "tracking": 50.0,
+    STUDY_JOB: 80.0,
 }
 SWEEP_COST = 1000.0

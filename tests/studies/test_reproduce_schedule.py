@@ -24,8 +24,8 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
     def make(name: str, needs: tuple[str, ...] = ()) -> PlannedJob:
         return job(name, _echo, needs, lambda done, n=name: (n, log))
 
-    # calibration (225) -> chessboard (195) is the longest path; zhang (148) and
-    # fixed_point (110) lead to tables (115); "broken" fails and its dependent is skipped.
+    # calibration (185) -> chessboard (140) is the longest path; fixed_point (130) and
+    # zhang (120) lead to tables (80); "broken" fails and its dependent is skipped.
     plan = [
         make("zhang"),
         make("fixed_point"),
@@ -55,12 +55,12 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
     # One worker: each time the ready job with the longest path to the end.
     assert log == [
         "broken",  # SWEEP_COST: a job without a measured cost counts as long
-        "calibration",  # 420 to the end
-        "zhang",  # 263
-        "fixed_point",  # 225
-        "chessboard",  # 195, ready since the calibration
-        STUDY_JOB,  # 115, ready once zhang and fixed_point are
-        "tracking",  # 72
+        "calibration",  # 325 to the end
+        "fixed_point",  # 210
+        "zhang",  # 200
+        "chessboard",  # 140, ready since the calibration
+        STUDY_JOB,  # 80, ready once zhang and fixed_point are
+        "tracking",  # 50
     ]
     assert ("broken", True, "RuntimeError: no board") in finished
     assert skipped == [("relative_positioning", "broken")]
