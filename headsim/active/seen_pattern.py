@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from headsim.sim.render import unbinned_px
 from headsim.vision.detection import Detection
 
 #: A pattern's feature is looked for alone only after an image motion of at most this
@@ -43,15 +44,14 @@ class SeenPattern:
     def from_preview(cls, detection: Detection, binning: int) -> SeenPattern | None:
         """From a detection of the whole pattern in a preview binned ``binning`` x
         ``binning`` (None: not one), in the full frame's pixels: binned pixel i covers
-        pixels b i .. b i + b - 1."""
+        pixels b i .. b i + b - 1 (:func:`headsim.sim.render.unbinned_px`)."""
         binned = cls.from_whole(detection)
         if binned is None:
             return None
-        offset = (binning - 1) / 2.0
         return cls(
-            binning * binned.features + offset,
+            unbinned_px(binned.features, binning),
             binning * binned.spacing_px,
-            binning * binned.box + offset,
+            unbinned_px(binned.box, binning),
         )
 
     def found_alone(self, index: int, uv: tuple[float, float]) -> SeenPattern:

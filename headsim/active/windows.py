@@ -18,7 +18,7 @@ from headsim.active.servo_types import (
     ServoConfig,
 )
 from headsim.sim.events import EventSink
-from headsim.sim.render import Window
+from headsim.sim.render import Window, unbinned_px
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection
 from headsim.vision.markers import find_marker
@@ -139,9 +139,9 @@ def preview_window(
     seen = detector(sim.render_preview(camera, b))
     if not isinstance(seen, Detection) or not seen.found or seen.uv is None:
         return None
-    # Binned pixel i covers pixels b i .. b i + b - 1; its position is good to about b px.
-    offset = (b - 1) / 2.0
-    uv = (b * seen.uv[0] + offset, b * seen.uv[1] + offset)
+    # Its position is good to about b px.
+    u, v = unbinned_px(seen.uv, b)
+    uv = (float(u), float(v))
     if seen.extent_px is not None:  # a pattern: its box, from the feature
         left, top, right, bottom = (b * e for e in seen.extent_px)
         return pattern_window(

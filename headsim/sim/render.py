@@ -14,8 +14,9 @@ window is rasterised.  Every vertex lands where it does in the frame, less the
 window's offset, so the window's pixels are the full frame's crop (a window
 drawn as a camera of its own, with a shifted principal point, rounds its
 projection otherwise and flips an MSAA sample now and then).  Noise included:
-the noise of image k of a camera is drawn for the whole frame and cropped.  The head's own geoms (group
-``names.HEAD_VISUAL_GROUP``) are hidden from the eye cameras.  Every image is
+the noise of image k of a camera is drawn for the whole frame and cropped.  The
+head's own geoms (group ``names.HEAD_VISUAL_GROUP``) are hidden from the eye
+cameras.  Every image is
 one render and is counted, with its pixels in full-frame equivalents.
 """
 
@@ -309,6 +310,13 @@ class EyeRenderer:
 
 #: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.
 PREVIEW_STREAM = 1_000_003
+
+
+def unbinned_px(binned_px: tuple[float, ...] | np.ndarray, binning: int) -> np.ndarray:
+    """Full-frame pixel coordinates of coordinates in a preview binned ``binning`` x
+    ``binning`` (``EyeRenderer.render_preview``): binned pixel i covers pixels
+    b i .. b i + b - 1, so its centre is b i + (b - 1) / 2."""
+    return binning * np.asarray(binned_px, dtype=np.float64) + (binning - 1) / 2.0
 
 
 #: Binned canvases by (id of the canvas, binning), with the canvas kept alive.
