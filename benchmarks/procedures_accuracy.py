@@ -170,7 +170,8 @@ def main() -> None:
     done()
     r = figures["relative"]
     print(
-        f"\n== relative positioning: {r['objects']} objects, {r['outside_margin']} more than 2 px from a "
+        f"\n== relative positioning: {r['objects']} objects, {fmt(r['correct_pct'], 1)} % of all in "
+        f"their true area; {r['outside_margin']} more than 2 px from a "
         f"boundary, {fmt(r['outside_margin_correct_pct'], 1)} % of them in their true area; "
         f"{r['within_2px_of_a_boundary']} within 2 px ({r['within_2px_disagreeing']} disagreeing); "
         f"{r['not_seen_in_all_four_images']} not in all four images; true areas seen {r['distinct_true_areas']}"

@@ -40,3 +40,29 @@ def test_error_figures_are_rms_in_mm_and_percent_of_depth() -> None:
     np.testing.assert_allclose(f["rms_pct_depth_xyz"], [0.3 / np.sqrt(2), 0, 0.4 / np.sqrt(2)])
     assert f["max_3d_pct_depth"] == pytest.approx(0.5)
     assert error_figures([ms[2]]) == {"count": 0, "failed": 1}
+
+
+def test_area_tally_counts_every_object_placed_and_the_margin_subset_apart() -> None:
+    """An object not seen, one near a boundary and a layout with no fixation all count."""
+    from headsim.estimators.areas import compare_areas
+    from headsim.studies.experiments import area_tally
+
+    # Layout 1: 4 of 6 seen; one of them disagrees 0.5 px from a boundary (inside the
+    # margin), the other three agree far from every boundary.
+    far = [40.0, 60.0, -30.0, 25.0]
+    near = [40.0, 0.5, -30.0, 25.0]  # u12 0.5 px from Ca1's goal column
+    columns = np.array([far, far, far, near]).T
+    first = compare_areas([5, 6, 7, 8], [5, 6, 7, 3], *columns, 0.0, 0.0)
+    assert (first.n_inside, first.n_disagree_inside) == (1, 1)
+    # Layout 2: all six seen and right.  Layout 3: the reference was not fixated.
+    columns2 = np.array([far] * 6).T
+    second = compare_areas([5] * 6, [5] * 6, *columns2, 0.0, 0.0)
+    tally = area_tally(6, [(2, first), (0, second), (1, None)])
+    assert tally["objects"] == 18
+    assert tally["correct"] == 3 + 6
+    assert tally["correct_pct"] == pytest.approx(100 * 9 / 18)
+    assert tally["not_seen_in_all_four_images"] == 3
+    assert tally["reference_not_fixated"] == 5
+    assert tally["outside_margin"] == 9
+    assert tally["outside_margin_correct_pct"] == pytest.approx(100.0)
+    assert (tally["within_2px_of_a_boundary"], tally["within_2px_disagreeing"]) == (1, 1)
