@@ -24,8 +24,8 @@ demo: setup
 	@echo "open the recording with: $(BIN)/rerun out/quickstart/recording.rrd"
 
 test: setup
-	$(BIN)/ruff check headsim tests benchmarks
-	$(BIN)/ruff format --check headsim tests benchmarks
+	$(BIN)/ruff check headsim tests benchmarks tools
+	$(BIN)/ruff format --check headsim tests benchmarks tools
 	$(BIN)/mypy
 	$(BIN)/python -m pytest -q
 
