@@ -11,7 +11,9 @@ From these, every frame gives
 - a *position estimate*: each camera's line of sight to the target as a
   virtual eye angle ``alpha*_i = alpha_enc - e_i / g_i`` (``g_i``: camera i's
   px per rad of eye motor, from J), then Model 2's eqs. (4), (5) for depth
-  and x, the rows for y, and eq. (3) with the neck encoders.
+  and x, the rows for y, and eq. (3) with the neck encoders.  The geometry
+  is what the head believes (:class:`HeadKnowledge`: its baseline and neck
+  D-H lengths), as in the at-rest Models 1 and 2.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ import numpy as np
 
 from headsim.active.measurement import HeadKnowledge
 from headsim.geometry.kinematics import head_to_world
+from headsim.sim.settings import HeadBelief
 
 
 @dataclass(frozen=True)
@@ -37,20 +40,23 @@ class Offsets:
 
 
 class GazeEstimator:
-    """Fixation angles and a 3-D position from one frame (see the module docstring)."""
+    """Fixation angles and a 3-D position from one frame (see the module docstring).
+
+    ``belief``: the head's believed geometry (baseline, neck D-H lengths, m);
+    ``knowledge``: the initial directions and kx/ky ratios.  Nothing here is
+    the true head.
+    """
 
     def __init__(
         self,
         jacobian_px_per_step: np.ndarray,
         encoder_resolution_rad: float,
-        baseline_m: float,
-        neck_d1_m: float,
-        neck_a2_m: float,
         goals_px: tuple[tuple[float, float], tuple[float, float]],
+        belief: HeadBelief,
         knowledge: HeadKnowledge | None = None,
     ) -> None:
         self.jacobian_per_rad = np.asarray(jacobian_px_per_step, float) / encoder_resolution_rad
-        self.baseline_m, self.d1, self.a2 = baseline_m, neck_d1_m, neck_a2_m
+        self.belief = belief
         self.goals = np.asarray(goals_px, float)  # ((u10, v10), (u20, v20))
         self.knowledge = knowledge or HeadKnowledge()
 
@@ -66,14 +72,16 @@ class GazeEstimator:
         a1 = eye - error[0] / gains[0] + self.knowledge.alpha_e[0]
         a2 = eye - error[1] / gains[1] + self.knowledge.alpha_e[1]
         t1, t2 = math.tan(a1), math.tan(a2)
-        z = self.baseline_m / (t1 + t2) if t1 + t2 > 1e-9 else math.inf
-        x = z * t1 - self.baseline_m / 2
+        d = self.belief.baseline_m
+        z = d / (t1 + t2) if t1 + t2 > 1e-9 else math.inf
+        x = z * t1 - d / 2
         rows = np.array([v1 - v10, v2 - v20])
         ratio = np.asarray(self.knowledge.kx_over_ky, float)
         slopes = rows * ratio / np.abs(gains) / np.cos([a1, a2])
         y = z * float(np.mean(slopes))
         head = np.array([x, y, z])
-        world = head_to_world(head, encoders_rad[0], encoders_rad[1], self.d1, self.a2)
+        b = self.belief
+        world = head_to_world(head, encoders_rad[0], encoders_rad[1], b.neck_d1_m, b.neck_a2_m)
         return Offsets(error, rows, fixation, np.asarray(world, float), head)
 
     def eye_fixation(self, offsets: Offsets, encoders_rad: np.ndarray) -> float:

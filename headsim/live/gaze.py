@@ -310,7 +310,10 @@ def acquire(
     The head is at rest (the target held where it is at the present time);
     the servo's probes and moves settle kinematically, as the at-rest
     procedures do.  ``config``: the servo's (None: the defaults).  None when
-    the servo did not converge.
+    the servo did not converge.  The estimator measures with ``knowledge``'s
+    belief of the head's geometry, never the simulator's true one; the encoder
+    resolution is the encoders' specification (counts per turn), known to the
+    head exactly, as in the at-rest procedures.
     """
     sim = live.sim
     knowledge = knowledge or HeadKnowledge()
@@ -320,13 +323,10 @@ def acquire(
     if not result.converged or servo.jacobian is None:
         return None
     live.motors.sync()
-    s = sim.settings
     return GazeEstimator(
         servo.jacobian,
-        s.encoder_resolution_rad,
-        s.baseline_m,
-        s.neck_d1_m,
-        s.neck_a2_m,
+        sim.settings.encoder_resolution_rad,  # a spec, not an imperfection (see above)
         goals,
+        knowledge.head_belief(sim),
         knowledge,
     )

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
-import numpy as np
+from dataclasses import replace
 
+import numpy as np
+import pytest
+
+from headsim.active.measurement import HeadKnowledge
+from headsim.geometry.kinematics import head_to_world
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Static, Visibility, Waypoints
 from headsim.live.gaze import GazeConfig, acquire, pursue
+from headsim.sim.settings import HeadBelief
 from headsim.sim.simulator import HeadSim
 
 from .helpers import RED, small_head
@@ -90,3 +96,34 @@ def test_acquiring_with_the_servos_windows_off_looks_at_whole_frames_only() -> N
         kinds[windows] = sink.kinds
     assert set(kinds[False]) == {ImageKind.FULL}
     assert {ImageKind.PREVIEW, ImageKind.WINDOW} <= set(kinds[True])
+
+
+def test_the_live_estimate_measures_with_the_heads_belief_not_its_true_geometry() -> None:
+    """Same true head, same images: the estimate moves exactly as the believed geometry does."""
+    truth = replace(small_head(), baseline_m=0.153, neck_d1_m=0.125, neck_a2_m=0.088)
+    design = HeadBelief()  # 150 mm, 0.12 m, 0.09 m: the head's own drawings, not its truth
+    wider = HeadBelief(baseline_m=1.1 * design.baseline_m, neck_d1_m=0.13, neck_a2_m=0.1)
+    measured = {}
+    for name, settings, knowledge in (
+        ("design", replace(truth, belief=design), None),  # the simulator's belief
+        ("wider", truth, HeadKnowledge(belief=wider)),  # the knowledge's own belief
+    ):
+        with HeadSim(settings=settings) as sim:
+            live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.24)))
+            estimator = acquire(live, RED, knowledge)
+            assert estimator is not None
+            frame = live.capture()
+            uv = tuple(RED(image).uv for image in frame.images)
+            measured[name] = (estimator.measure(uv, frame.encoders_rad), frame.encoders_rad)
+    (a, enc_a), (b, enc_b) = measured["design"], measured["wider"]
+    np.testing.assert_array_equal(enc_a, enc_b)  # the true head moved the same way
+    np.testing.assert_array_equal(a.error_px, b.error_px)  # and saw the same images
+    # Depth scales with the believed baseline (no line-of-sight offsets believed).
+    assert b.estimate_head_m[2] / a.estimate_head_m[2] == pytest.approx(1.1, rel=1e-12)
+    # To W through eq. (3) with the believed D-H lengths (the true ones put it elsewhere).
+    for offsets, belief in ((a, design), (b, wider)):
+        head, yaw, pitch = offsets.estimate_head_m, enc_a[0], enc_a[1]
+        believed = head_to_world(head, yaw, pitch, belief.neck_d1_m, belief.neck_a2_m)
+        true = head_to_world(head, yaw, pitch, truth.neck_d1_m, truth.neck_a2_m)
+        np.testing.assert_allclose(offsets.estimate_world_m, believed, rtol=0, atol=1e-12)
+        assert np.linalg.norm(believed - true) > 1e-3
