@@ -12,8 +12,8 @@ From these, every frame gives
   virtual eye angle ``alpha*_i = alpha_enc - e_i / g_i`` (``g_i``: camera i's
   px per rad of eye motor, from J), then Model 2's eqs. (4), (5) for depth
   and x, the rows for y, and eq. (3) with the neck encoders.  The geometry
-  is what the head believes (:class:`HeadKnowledge`: its baseline and neck
-  D-H lengths), as in the at-rest Models 1 and 2.
+  is what the head believes (:class:`HeadKnowledge`: its baseline, neck D-H
+  lengths and lines of sight's offsets), as in the at-rest Models 1 and 2.
 """
 
 from __future__ import annotations
@@ -43,8 +43,9 @@ class GazeEstimator:
     """Fixation angles and a 3-D position from one frame (see the module docstring).
 
     ``belief``: the head's believed geometry (baseline, neck D-H lengths, m);
-    ``knowledge``: the initial directions and kx/ky ratios.  Nothing here is
-    the true head.
+    ``los_offset_m``: each goal column's line of sight's offset from its yaw
+    axis, m (:meth:`HeadKnowledge.line_of_sight_offsets`); ``knowledge``: the
+    initial directions and kx/ky ratios.  Nothing here is the true head.
     """
 
     def __init__(
@@ -54,9 +55,11 @@ class GazeEstimator:
         goals_px: tuple[tuple[float, float], tuple[float, float]],
         belief: HeadBelief,
         knowledge: HeadKnowledge | None = None,
+        los_offset_m: tuple[float, float] = (0.0, 0.0),
     ) -> None:
         self.jacobian_per_rad = np.asarray(jacobian_px_per_step, float) / encoder_resolution_rad
         self.belief = belief
+        self.los_offset_m = (float(los_offset_m[0]), float(los_offset_m[1]))
         self.goals = np.asarray(goals_px, float)  # ((u10, v10), (u20, v20))
         self.knowledge = knowledge or HeadKnowledge()
 
@@ -72,13 +75,16 @@ class GazeEstimator:
         a1 = eye - error[0] / gains[0] + self.knowledge.alpha_e[0]
         a2 = eye - error[1] / gains[1] + self.knowledge.alpha_e[1]
         t1, t2 = math.tan(a1), math.tan(a2)
-        d = self.belief.baseline_m
-        z = d / (t1 + t2) if t1 + t2 > 1e-9 else math.inf
-        x = z * t1 - d / 2
+        d, (o1, o2) = self.belief.baseline_m, self.los_offset_m
+        sec1, sec2 = 1 / math.cos(a1), 1 / math.cos(a2)
+        # Model 2's crossing of the (offset) lines of sight, estimators.model2.
+        z = (d - o1 * sec1 + o2 * sec2) / (t1 + t2) if t1 + t2 > 1e-9 else math.inf
+        x = z * t1 + o1 * sec1 - d / 2
         rows = np.array([v1 - v10, v2 - v20])
         ratio = np.asarray(self.knowledge.kx_over_ky, float)
-        slopes = rows * ratio / np.abs(gains) / np.cos([a1, a2])
-        y = z * float(np.mean(slopes))
+        # Each camera's distance along its line of sight (L1, L2 of estimators.model2).
+        reach = np.array([z * sec1 + o1 * t1, z * sec2 - o2 * t2])
+        y = float(np.mean(rows * ratio / np.abs(gains) * reach))
         head = np.array([x, y, z])
         b = self.belief
         world = head_to_world(head, encoders_rad[0], encoders_rad[1], b.neck_d1_m, b.neck_a2_m)

@@ -329,4 +329,5 @@ def acquire(
         goals,
         knowledge.head_belief(sim),
         knowledge,
+        knowledge.line_of_sight_offsets(sim),
     )

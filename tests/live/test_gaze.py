@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 from headsim.active.measurement import HeadKnowledge
+from headsim.estimators import model2
 from headsim.geometry.kinematics import head_to_world
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Static, Visibility, Waypoints
+from headsim.live.estimator import GazeEstimator
 from headsim.live.gaze import GazeConfig, acquire, pursue
 from headsim.sim.settings import HeadBelief
 from headsim.sim.simulator import HeadSim
@@ -127,3 +129,31 @@ def test_the_live_estimate_measures_with_the_heads_belief_not_its_true_geometry(
         true = head_to_world(head, yaw, pitch, truth.neck_d1_m, truth.neck_a2_m)
         np.testing.assert_allclose(offsets.estimate_world_m, believed, rtol=0, atol=1e-12)
         assert np.linalg.norm(believed - true) > 1e-3
+
+
+def test_the_live_lines_of_sight_cross_where_model_2s_do_offsets_included() -> None:
+    """The believed line-of-sight offsets act on depth and x as in the at-rest Model 2."""
+    resolution = 2 * np.pi / 25600
+    jacobian = np.array([[-2.0, 0.3, 2.5], [-2.0, -0.2, -2.4], [0.1, 2.2, 0.05]])  # px/step
+    goals = ((160.0, 120.0), (161.0, 119.0))
+    offsets_m = (0.001, -0.0005)
+    belief = HeadBelief(baseline_m=0.1503)
+    knowledge = HeadKnowledge(alpha_e=(0.01, -0.02), los_offset_m=offsets_m)
+    live = GazeEstimator(jacobian, resolution, goals, belief, knowledge, offsets_m)
+    encoders = np.array([0.05, -0.1, 0.09])
+    uv = ((171.0, 125.0), (150.0, 128.0))
+    gains = jacobian[:2, 2] / resolution
+    alpha = [encoders[2] - (uv[i][0] - goals[i][0]) / gains[i] for i in range(2)]
+    rest = model2(
+        [alpha[0]],
+        [alpha[1]],
+        [uv[0]],
+        [uv[1]],
+        belief.baseline_m,
+        uv10=goals[0],
+        uv20=goals[1],
+        alpha_e=knowledge.alpha_e,
+        los_offset_m=offsets_m,
+    )
+    estimate = live.measure(uv, encoders).estimate_head_m
+    np.testing.assert_allclose(estimate[[0, 2]], rest.positions[0][[0, 2]], rtol=1e-12)
