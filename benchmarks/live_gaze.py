@@ -215,8 +215,14 @@ def main() -> None:
                     results["pursuit"][
                         f"{prefix}{name} {depth} m {'predictor' if predictor else 'no predictor'}"
                     ] = fig  # type: ignore[index]
+                    row = (
+                        f"{head.name:<9} {name:<12} {depth:>5.1f} {'yes' if predictor else 'no':>5}"
+                    )
+                    if not fig["acquired"]:
+                        print(f"{row} not acquired at rest (the servo did not converge)")
+                        continue
                     print(
-                        f"{head.name:<9} {name:<12} {depth:>5.1f} {'yes' if predictor else 'no':>5} {fig.get('losses', -1):>4.0f} "
+                        f"{row} {fig.get('losses', -1):>4.0f} "
                         f"{fig.get('frames_lost', -1):>4.0f} {fig.get('rms_pct_of_depth', math.nan):>6.3f} "
                         f"{fig.get('rms_mm', math.nan):>7.2f} {fig.get('lag_ms', math.nan):>7.1f} {fig.get('offset_rms_px', math.nan):>6.2f}"
                     )
