@@ -8,9 +8,22 @@ while the motor ramps to it within its acceleration limit (physics).
 
 Reward ``"offsets"`` (default): minus the mean of the absolute image offsets
 ``(u1 - u10)/(W/2), (u2 - u20)/(W/2), ((v1 + v2)/2 - v0)/(H/2)``, each 1 when
-the marker is not seen.  Reward ``"position"``: minus the 3-D error of the
-head's own Model 1 estimate (eqs. (2), (3) from the encoders) against the
-truth, as a fraction of the target's distance (1 when no estimate).
+the marker is not seen.  Reward ``"position"``: the head's own Model 1
+estimate, taken as if it fixated the marker -- eq. (2) from the eye encoder
+with the *believed* baseline and line-of-sight offsets, eq. (3) with the neck
+encoders and the *believed* D-H lengths (``belief``; no truth) -- scored
+against the truth: minus its 3-D error over the marker's true distance from
+the true eyes' centre at rest, capped at 1 (-1 when there is no estimate).
+
+``belief``: the geometry the head believes it has (None: as built, the
+simulator's convention: the drawn ``baseline_m`` and the nominal neck).
+
+Observation and ``info`` carry no truth except ``info["truth_world_m"]``:
+``found`` and ``offsets_px`` (the marker's image offsets, px, NaN when not
+seen) are measured from the images; ``estimate_world_m`` is the position
+reward's estimate (W, m; None when the eyes do not converge); ``time_s`` and
+``steps`` are the clock.  ``truth_world_m``: where the marker truly is (W, m;
+None when absent), for scoring and analysis only -- no policy may read it.
 
 Episodes: ``reset(seed=..., options=...)`` places the marker at a seeded
 random depth and bearing (and, with ``target_speed_m_s`` > 0, on a seeded
@@ -40,13 +53,15 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from headsim.geometry.kinematics import head_to_world
+from headsim.active.measurement import HeadKnowledge, to_world
+from headsim.estimators.model1 import model1
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, Frame, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
 from headsim.sim.settings import (
     CAMERA_NUMBER_FIELDS,
     IDEAL_FOCAL_PX,
     CameraSettings,
+    HeadBelief,
     HeadSettings,
     SettingsError,
 )
@@ -94,6 +109,7 @@ class FixateEnv(gymnasium.Env):
         target_radius_m: float = 0.02,
         multisamples: int = 0,
         render_mode: str | None = None,
+        belief: HeadBelief | None = None,
     ) -> None:
         if reward not in REWARDS:
             raise SettingsError(f"reward must be one of {', '.join(REWARDS)}, got {reward!r}")
@@ -107,6 +123,8 @@ class FixateEnv(gymnasium.Env):
             )
         if multisamples not in (0, 2, 4, 8):
             raise SettingsError(f"multisamples must be 0, 2, 4 or 8, got {multisamples!r}")
+        if not (belief is None or isinstance(belief, HeadBelief)):
+            raise SettingsError(f"belief must be a HeadBelief or None, got {belief!r}")
         self.target_radius_m = float(target_radius_m)
         self.multisamples = multisamples
         self.render_mode = render_mode
@@ -116,7 +134,8 @@ class FixateEnv(gymnasium.Env):
         self.live_config = LiveConfig(frame_rate_hz=frame_rate_hz, latency_frames=latency_frames)
         focal = IDEAL_FOCAL_PX * height / 480.0
         camera = CameraSettings(width=width, height=height, kx=focal, ky=focal)
-        self.base_settings = HeadSettings(cameras=(camera, camera))
+        self.base_settings = HeadSettings(cameras=(camera, camera), belief=belief)
+        self.knowledge = HeadKnowledge()  # uncalibrated: the simulator's belief, no alpha_e
         self.defaults = {
             "depth_m": (0.5, 1.5),
             "bearing_rad": (-0.15, 0.15),
@@ -254,7 +273,22 @@ class FixateEnv(gymnasium.Env):
         if found:
             (u1, v1), (u2, v2) = seen[0].uv, seen[1].uv  # type: ignore[misc]
             offsets = np.array([u1, u2, (v1 + v2) / 2]) - self._goals()
-        return {"found": found, "offsets_px": offsets}
+        return {"found": found, "offsets_px": offsets, "estimate_world_m": self._estimate()}
+
+    def _estimate(self) -> np.ndarray | None:
+        """The head's Model 1 estimate from the encoders and its belief (W, m), as if fixated."""
+        assert self._frame is not None and self._sim is not None
+        yaw, pitch, eye = (float(a) for a in self._frame.encoders_rad)
+        belief = self.knowledge.head_belief(self._sim)
+        estimate = model1(
+            [eye],
+            belief.baseline_m,
+            alpha_e=self.knowledge.alpha_e,
+            los_offset_m=self.knowledge.line_of_sight_offsets(self._sim),
+        )
+        if not bool(estimate.valid[0]):  # eyes parallel or diverging
+            return None
+        return to_world(self._sim, estimate.positions[0], (yaw, pitch), belief)
 
     def _reward(self, measured: dict[str, Any]) -> float:
         assert self._frame is not None and self._settings is not None
@@ -264,20 +298,13 @@ class FixateEnv(gymnasium.Env):
             cam = self._settings.cameras[0]
             scale = np.array([cam.width / 2, cam.width / 2, cam.height / 2])
             return -float(np.mean(np.minimum(np.abs(measured["offsets_px"]) / scale, 1.0)))
-        yaw, pitch, eye = self._frame.encoders_rad
-        truth = self._frame.truth_target_world_m
-        if truth is None or eye <= 0:
+        # Scoring only: the truth judges the head's estimate, it never enters it.
+        estimate, truth = measured["estimate_world_m"], self._frame.truth_target_world_m
+        if truth is None or estimate is None:
             return -1.0
         s = self._settings
-        estimate = head_to_world(
-            np.array([0.0, 0.0, s.baseline_m / (2 * math.tan(eye))]),
-            yaw,
-            pitch,
-            s.neck_d1_m,
-            s.neck_a2_m,
-        )
-        depth = float(np.linalg.norm(truth - np.array([0.0, 0.0, s.neck_d1_m + s.neck_a2_m])))
-        return -min(float(np.linalg.norm(estimate - truth)) / depth, 1.0)
+        distance = float(np.linalg.norm(truth - np.array([0.0, 0.0, s.neck_d1_m + s.neck_a2_m])))
+        return -min(float(np.linalg.norm(estimate - truth)) / distance, 1.0)
 
     def _observation(self) -> dict[str, np.ndarray]:
         assert self._frame is not None
@@ -290,11 +317,13 @@ class FixateEnv(gymnasium.Env):
     def _info(self, measured: dict[str, Any]) -> dict[str, Any]:
         assert self._frame is not None
         truth = self._frame.truth_target_world_m
+        estimate = measured["estimate_world_m"]
         return {
             "found": measured["found"],
             "offsets_px": measured["offsets_px"],
+            "estimate_world_m": None if estimate is None else estimate.copy(),
             "time_s": self._frame.time_s,
-            "truth_world_m": None if truth is None else truth.copy(),
+            "truth_world_m": None if truth is None else truth.copy(),  # truth: scoring only
             "steps": self._steps,
         }
 

@@ -1,17 +1,8 @@
 """Gaze behaviours on the live head: saccades, smooth pursuit, a position estimate every frame.
 
-Measurement path (no ground truth): each frame's marker centroids in both
-images, the encoders latched at its mid-exposure, and the image Jacobian that
-the paper's servo measured at rest (px per encoder step, :class:`NeckServo`).
-From these, every frame gives
-
-- the *fixation angles* ``q*``: the joint angles (neck yaw, neck pitch, eye)
-  at which the target would sit on the goal columns and row,
-  ``q* = q_enc - J^-1 e`` (e: image offsets, px);
-- a *position estimate*: each camera's line of sight to the target as a
-  virtual eye angle ``alpha*_i = alpha_enc - e_i / g_i`` (``g_i``: camera i's
-  px per rad of eye motor, from J), then Model 2's eqs. (4), (5) for depth
-  and x, the rows for y, and eq. (3) with the neck encoders.
+Measurement path (no ground truth): :mod:`headsim.live.estimator` turns each
+frame's marker centroids and encoders into the *fixation angles* ``q*`` and
+a position estimate.
 
 Smooth pursuit drives the motors towards ``q*``; with the constant-velocity
 predictor the goal moves on at ``q*``'s estimated velocity, which makes up for
@@ -33,7 +24,7 @@ import numpy as np
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import Detector, ServoConfig
-from headsim.geometry.kinematics import head_to_world
+from headsim.live.estimator import GazeEstimator
 from headsim.live.head import Frame, LiveHead
 from headsim.live.motors import MotorDriver, bang_bang_duration, min_jerk_duration
 
@@ -60,63 +51,6 @@ class GazeConfig:
     velocity_smoothing: float = 0.5  # weight of the newest velocity sample, (0, 1]
     coast_frames: int = 10  # frames the gaze coasts on its prediction when the target is not seen
     max_frames: int = 100_000
-
-
-@dataclass(frozen=True)
-class Offsets:
-    """A frame's measurement: image offsets from the goals, px, and what follows from them."""
-
-    error_px: np.ndarray  # (u1 - u10, u2 - u20, (v1 + v2)/2 - v0)
-    rows_px: np.ndarray  # (v1 - v10, v2 - v20)
-    fixation_rad: np.ndarray  # q*: (neck yaw, neck pitch, eye)
-    estimate_world_m: np.ndarray
-    estimate_head_m: np.ndarray
-
-
-class GazeEstimator:
-    """Fixation angles and a 3-D position from one frame (see the module docstring)."""
-
-    def __init__(
-        self,
-        jacobian_px_per_step: np.ndarray,
-        encoder_resolution_rad: float,
-        baseline_m: float,
-        neck_d1_m: float,
-        neck_a2_m: float,
-        goals_px: tuple[tuple[float, float], tuple[float, float]],
-        knowledge: HeadKnowledge | None = None,
-    ) -> None:
-        self.jacobian_per_rad = np.asarray(jacobian_px_per_step, float) / encoder_resolution_rad
-        self.baseline_m, self.d1, self.a2 = baseline_m, neck_d1_m, neck_a2_m
-        self.goals = np.asarray(goals_px, float)  # ((u10, v10), (u20, v20))
-        self.knowledge = knowledge or HeadKnowledge()
-
-    def measure(
-        self, uv: tuple[tuple[float, float], tuple[float, float]], encoders_rad: np.ndarray
-    ) -> Offsets:
-        (u1, v1), (u2, v2) = uv
-        (u10, v10), (u20, v20) = self.goals
-        error = np.array([u1 - u10, u2 - u20, (v1 + v2) / 2 - (v10 + v20) / 2])
-        fixation = encoders_rad - np.linalg.solve(self.jacobian_per_rad, error)
-        gains = self.jacobian_per_rad[:2, 2]  # du_i / d(eye), px/rad
-        eye = encoders_rad[2]
-        a1 = eye - error[0] / gains[0] + self.knowledge.alpha_e[0]
-        a2 = eye - error[1] / gains[1] + self.knowledge.alpha_e[1]
-        t1, t2 = math.tan(a1), math.tan(a2)
-        z = self.baseline_m / (t1 + t2) if t1 + t2 > 1e-9 else math.inf
-        x = z * t1 - self.baseline_m / 2
-        rows = np.array([v1 - v10, v2 - v20])
-        ratio = np.asarray(self.knowledge.kx_over_ky, float)
-        slopes = rows * ratio / np.abs(gains) / np.cos([a1, a2])
-        y = z * float(np.mean(slopes))
-        head = np.array([x, y, z])
-        world = head_to_world(head, encoders_rad[0], encoders_rad[1], self.d1, self.a2)
-        return Offsets(error, rows, fixation, np.asarray(world, float), head)
-
-    def eye_fixation(self, offsets: Offsets, encoders_rad: np.ndarray) -> float:
-        """Eyes alone: the eye angle halfway between the two cameras' fixation angles."""
-        gains = self.jacobian_per_rad[:2, 2]
-        return float(encoders_rad[2] - np.mean(offsets.error_px[:2] / gains))
 
 
 @dataclass(frozen=True)
@@ -376,7 +310,10 @@ def acquire(
     The head is at rest (the target held where it is at the present time);
     the servo's probes and moves settle kinematically, as the at-rest
     procedures do.  ``config``: the servo's (None: the defaults).  None when
-    the servo did not converge.
+    the servo did not converge.  The estimator measures with ``knowledge``'s
+    belief of the head's geometry, never the simulator's true one; the encoder
+    resolution is the encoders' specification (counts per turn), known to the
+    head exactly, as in the at-rest procedures.
     """
     sim = live.sim
     knowledge = knowledge or HeadKnowledge()
@@ -386,13 +323,11 @@ def acquire(
     if not result.converged or servo.jacobian is None:
         return None
     live.motors.sync()
-    s = sim.settings
     return GazeEstimator(
         servo.jacobian,
-        s.encoder_resolution_rad,
-        s.baseline_m,
-        s.neck_d1_m,
-        s.neck_a2_m,
+        sim.settings.encoder_resolution_rad,  # a spec, not an imperfection (see above)
         goals,
+        knowledge.head_belief(sim),
         knowledge,
+        knowledge.line_of_sight_offsets(sim),
     )

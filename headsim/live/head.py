@@ -10,7 +10,8 @@ output would latch them.  A command sent after frame ``k`` takes effect
 ``latency_frames`` frame periods after that frame's exposure ended.
 
 Joints move only through the motors (:mod:`headsim.live.motors`), so an image
-taken while the eyes move sees them where the physics put them.  The target
+taken while the eyes move sees them where the physics put them, and each
+encoder reads its joint to the count (no backlash on the live head).  The target
 is a mocap body moved along its path at every physics step.
 """
 
@@ -189,9 +190,15 @@ class LiveHead:
 
     # -- sensing -------------------------------------------------------------
     def encoders(self) -> np.ndarray:
-        """(neck yaw, neck pitch, eye) encoder readings now, rad."""
-        yaw, pitch = self.sim.neck_encoders()
-        return np.array([yaw, pitch, self.sim.eye_encoder()])
+        """(neck yaw, neck pitch, eye) encoder readings now, rad: each joint to its count.
+
+        The live joints move through the motors, so an encoder reads its joint, quantised:
+        the true angle lies anywhere within the count read (``count_error``'s model,
+        always).  The at-rest readings (``sim.neck_encoders``) would give the last at-rest
+        command on a head with joint errors.  Backlash is not modelled here.
+        """
+        resolution = self.sim.settings.encoder_resolution_rad
+        return np.round(self.true_joints() / resolution) * resolution
 
     def true_joints(self) -> np.ndarray:
         return np.array([float(self.sim.data.qpos[a]) for a in self._qadr])

@@ -4,6 +4,8 @@ The head first fixates the target at rest with the paper's Model 1 servo (the
 scenario's servo settings), at the first instant the target is present; the
 servo's image Jacobian then serves the live gaze controller
 (:mod:`headsim.live.gaze`), which runs for ``duration_s`` of simulated time.
+Every estimate uses what the head knows (the scenario's calibration, if it
+has one, and its ``[belief]`` of its own geometry); the truth only scores.
 Results (the ``experiment`` block of results.json): the figures of the run
 (time to fixation, pursuit lag, position error RMS along the path, losses and
 re-acquisitions) and, per frame, time, found, image offsets, estimate, truth

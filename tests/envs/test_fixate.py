@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import gymnasium
 import numpy as np
 import pytest
@@ -9,7 +11,9 @@ from gymnasium.utils.env_checker import check_env
 
 import headsim.envs
 from headsim.envs.policies import ServoPolicy
-from headsim.sim.settings import SettingsError
+from headsim.geometry.kinematics import head_to_world
+from headsim.paper import ENCODER_RESOLUTION_RAD
+from headsim.sim.settings import HeadBelief, SettingsError
 
 ID = headsim.envs.FIXATE_ID
 
@@ -83,3 +87,48 @@ def test_vector_env_runs_two_spawned_workers() -> None:
         assert rewards.shape == (2,) and obs["encoders"].shape == (2, 3)
     finally:
         envs.close()
+
+
+def test_position_reward_is_the_heads_estimate_with_its_belief_and_no_truth_is_observed() -> None:
+    """Same true head and target, two beliefs: identical observations, the estimate and the
+    position reward move with the believed baseline (they would not with the true one)."""
+    design = HeadBelief()
+    wider = replace(design, baseline_m=1.2 * design.baseline_m)
+    runs, spaces = {}, []
+    for name, belief in (("design", design), ("wider", wider)):
+        env = gymnasium.make(ID, reward="position", belief=belief)
+        spaces.append(env.observation_space)
+        policy = ServoPolicy(env.action_space, env.unwrapped.period_s)
+        obs, info = env.reset(seed=3)
+        steps = []
+        for _ in range(12):
+            obs, reward, terminated, _, info = env.step(policy(obs))
+            steps.append((obs, reward, info, env.unwrapped._frame.truth_joints_rad))
+            if terminated:
+                break
+        assert terminated
+        runs[name] = steps
+        env.close()
+    assert spaces[0] == spaces[1]
+    assert set(spaces[0].keys()) == set(runs["design"][-1][0]) == {"cam1", "cam2", "encoders"}
+    true_off_counts = []
+    for (obs_a, _, info_a, joints), (obs_b, _, info_b, _) in zip(*runs.values(), strict=True):
+        for key in obs_a:
+            np.testing.assert_array_equal(obs_a[key], obs_b[key])
+        np.testing.assert_array_equal(info_a["truth_world_m"], info_b["truth_world_m"])
+        # The encoders are readings (whole counts), not the true joint angles.
+        counts = obs_a["encoders"].astype(float) / ENCODER_RESOLUTION_RAD
+        np.testing.assert_allclose(counts, np.round(counts), atol=0.01)
+        true_off_counts.append(np.max(np.abs(joints / ENCODER_RESOLUTION_RAD - counts)))
+    assert max(true_off_counts) > 0.05
+    (obs, reward_a, info_a, _), (_, reward_b, info_b, _) = runs["design"][-1], runs["wider"][-1]
+    yaw, pitch, _ = obs["encoders"].astype(float)
+    eyes = head_to_world(np.zeros(3), yaw, pitch, design.neck_d1_m, design.neck_a2_m)
+    reach = [np.linalg.norm(info["estimate_world_m"] - eyes) for info in (info_a, info_b)]
+    assert reach[1] / reach[0] == pytest.approx(1.2, rel=1e-6)  # float32 encoders
+    truth = info_a["truth_world_m"]
+    distance = np.linalg.norm(truth - np.array([0.0, 0.0, 0.21]))
+    for reward, info in ((reward_a, info_a), (reward_b, info_b)):
+        expected = -min(np.linalg.norm(info["estimate_world_m"] - truth) / distance, 1.0)
+        assert reward == pytest.approx(expected, rel=1e-9)
+    assert reward_a > -0.1 and reward_b < reward_a - 0.1  # 20 % too wide: ~20 % too far

@@ -2,10 +2,18 @@
 
 from __future__ import annotations
 
-import numpy as np
+from dataclasses import replace
 
+import numpy as np
+import pytest
+
+from headsim.active.measurement import HeadKnowledge
+from headsim.estimators import model2
+from headsim.geometry.kinematics import head_to_world
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Static, Visibility, Waypoints
+from headsim.live.estimator import GazeEstimator
 from headsim.live.gaze import GazeConfig, acquire, pursue
+from headsim.sim.settings import HeadBelief
 from headsim.sim.simulator import HeadSim
 
 from .helpers import RED, small_head
@@ -90,3 +98,62 @@ def test_acquiring_with_the_servos_windows_off_looks_at_whole_frames_only() -> N
         kinds[windows] = sink.kinds
     assert set(kinds[False]) == {ImageKind.FULL}
     assert {ImageKind.PREVIEW, ImageKind.WINDOW} <= set(kinds[True])
+
+
+def test_the_live_estimate_measures_with_the_heads_belief_not_its_true_geometry() -> None:
+    """Same true head, same images: the estimate moves exactly as the believed geometry does."""
+    truth = replace(small_head(), baseline_m=0.153, neck_d1_m=0.125, neck_a2_m=0.088)
+    design = HeadBelief()  # 150 mm, 0.12 m, 0.09 m: the head's own drawings, not its truth
+    wider = HeadBelief(baseline_m=1.1 * design.baseline_m, neck_d1_m=0.13, neck_a2_m=0.1)
+    measured = {}
+    for name, settings, knowledge in (
+        ("design", replace(truth, belief=design), None),  # the simulator's belief
+        ("wider", truth, HeadKnowledge(belief=wider)),  # the knowledge's own belief
+    ):
+        with HeadSim(settings=settings) as sim:
+            live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.24)))
+            estimator = acquire(live, RED, knowledge)
+            assert estimator is not None
+            frame = live.capture()
+            uv = tuple(RED(image).uv for image in frame.images)
+            measured[name] = (estimator.measure(uv, frame.encoders_rad), frame.encoders_rad)
+    (a, enc_a), (b, enc_b) = measured["design"], measured["wider"]
+    np.testing.assert_array_equal(enc_a, enc_b)  # the true head moved the same way
+    np.testing.assert_array_equal(a.error_px, b.error_px)  # and saw the same images
+    # Depth scales with the believed baseline (no line-of-sight offsets believed).
+    assert b.estimate_head_m[2] / a.estimate_head_m[2] == pytest.approx(1.1, rel=1e-12)
+    # To W through eq. (3) with the believed D-H lengths (the true ones put it elsewhere).
+    for offsets, belief in ((a, design), (b, wider)):
+        head, yaw, pitch = offsets.estimate_head_m, enc_a[0], enc_a[1]
+        believed = head_to_world(head, yaw, pitch, belief.neck_d1_m, belief.neck_a2_m)
+        true = head_to_world(head, yaw, pitch, truth.neck_d1_m, truth.neck_a2_m)
+        np.testing.assert_allclose(offsets.estimate_world_m, believed, rtol=0, atol=1e-12)
+        assert np.linalg.norm(believed - true) > 1e-3
+
+
+def test_the_live_lines_of_sight_cross_where_model_2s_do_offsets_included() -> None:
+    """The believed line-of-sight offsets act on depth and x as in the at-rest Model 2."""
+    resolution = 2 * np.pi / 25600
+    jacobian = np.array([[-2.0, 0.3, 2.5], [-2.0, -0.2, -2.4], [0.1, 2.2, 0.05]])  # px/step
+    goals = ((160.0, 120.0), (161.0, 119.0))
+    offsets_m = (0.001, -0.0005)
+    belief = HeadBelief(baseline_m=0.1503)
+    knowledge = HeadKnowledge(alpha_e=(0.01, -0.02), los_offset_m=offsets_m)
+    live = GazeEstimator(jacobian, resolution, goals, belief, knowledge, offsets_m)
+    encoders = np.array([0.05, -0.1, 0.09])
+    uv = ((171.0, 125.0), (150.0, 128.0))
+    gains = jacobian[:2, 2] / resolution
+    alpha = [encoders[2] - (uv[i][0] - goals[i][0]) / gains[i] for i in range(2)]
+    rest = model2(
+        [alpha[0]],
+        [alpha[1]],
+        [uv[0]],
+        [uv[1]],
+        belief.baseline_m,
+        uv10=goals[0],
+        uv20=goals[1],
+        alpha_e=knowledge.alpha_e,
+        los_offset_m=offsets_m,
+    )
+    estimate = live.measure(uv, encoders).estimate_head_m
+    np.testing.assert_allclose(estimate[[0, 2]], rest.positions[0][[0, 2]], rtol=1e-12)

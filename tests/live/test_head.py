@@ -1,11 +1,13 @@
-"""The live head (live/head.py): motion blur against a forward model, settings checks."""
+"""The live head (live/head.py): motion blur against a forward model, encoders, settings checks."""
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from headsim.live import LiveConfig, LiveHead, MotorLimits, Waypoints
+from headsim.live import LiveConfig, LiveHead, MotorLimits, Static, Waypoints
 from headsim.sim.settings import SettingsError
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import colour_weight
@@ -59,3 +61,22 @@ def test_live_settings_are_checked_with_the_field_named() -> None:
         MotorLimits(1.0, 0.0)
     with pytest.raises(SettingsError, match="speeds_m_s"):
         Waypoints(((0, 0, 0), (1, 0, 0)), (0.0,))
+
+
+def test_encoders_follow_the_moving_joints_to_the_count_on_a_head_with_joint_errors() -> None:
+    """With count errors and backlash (the realistic preset's) the encoders still read the
+    joints the motors move, each within half a count, not the last at-rest command."""
+    settings = replace(small_head(), count_error=True, backlash_rad=2.9e-4)
+    resolution = settings.encoder_resolution_rad
+    with HeadSim(settings=settings) as sim:
+        live = LiveHead(sim, LiveConfig(latency_frames=0), "marker_red", Static((0, 0.8, 0.2)))
+        live.now(lambda motors, now: motors.set_velocity(0, 0.5))  # neck yaw at 0.5 rad/s
+        frames = [live.capture() for _ in range(4)]
+    for frame in frames:
+        counts = frame.encoders_rad / resolution
+        np.testing.assert_allclose(counts, np.round(counts), rtol=0, atol=1e-6)
+        np.testing.assert_array_less(
+            np.abs(frame.encoders_rad - frame.truth_joints_rad), 0.5 * resolution + 1e-12
+        )
+    yaw = [f.encoders_rad[0] for f in frames]
+    assert np.all(np.diff(yaw) > 0.005)  # ~17 ms of 0.5 rad/s between frames at 30 Hz
