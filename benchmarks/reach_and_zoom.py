@@ -83,11 +83,12 @@ def check_targets(
     accepted = np.zeros(len(points_head), dtype=bool)
     refused: Counter[str] = Counter()
     for k, p_head in enumerate(points_head):
-        refusal = reach_refusal(settings, _head_to_world(settings, p_head), "target", 0.004)
+        p_world = _head_to_world(settings, p_head)
+        refusal = reach_refusal(settings, p_world, "target", 0.004, BODY)
         if refusal is None:
             accepted[k] = True
         else:
-            refused[refusal[0].split(" is ")[-1].split(" needs ")[-1][:48]] += 1
+            refused[refusal.code] += 1
     return accepted, refused
 
 

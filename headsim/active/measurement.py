@@ -90,7 +90,9 @@ class Measurement:
     ``status``: :attr:`Status.OK` or :attr:`Status.FAILED`; ``detail``: why it
     failed (``failure.message``), "" when ok; ``status_text``: results.json's "status".
     ``renders``: images this measurement took, ``search_renders`` of them
-    spent finding a lost target again.  ``servo_residual_px``: the final
+    spent finding a lost target again, ``scan_renders`` of those scanning
+    for a target that the pose the head was at did not show (a new target;
+    ``headsim.active.search.scan_eyes``/``scan_neck``).  ``servo_residual_px``: the final
     |u - u_i0| of each servo.  ``details``: angles and pixels used.
     ``failure``: the cause, None when ok.
     """
@@ -109,6 +111,7 @@ class Measurement:
     failure: Failure | None = None
     search_renders: int = 0
     detail: str = ""
+    scan_renders: int = 0
 
     @property
     def ok(self) -> bool:
@@ -147,6 +150,7 @@ def failed_measurement(
     renders: int,
     residuals: Sequence[float],
     search_renders: int = 0,
+    scan_renders: int = 0,
 ) -> Measurement:
     truth_world = target.truth_world(sim)
     return Measurement(
@@ -156,6 +160,7 @@ def failed_measurement(
         detail=failure.message,
         failure=failure,
         search_renders=search_renders,
+        scan_renders=scan_renders,
         estimate_head_m=_nan3(),
         truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
         estimate_world_m=_nan3(),
@@ -177,12 +182,13 @@ def estimated_measurement(
     neck_rad: tuple[float, float] | None = None,
     belief: HeadBelief | None = None,
     search: int = 0,
+    scan: int = 0,
 ) -> Measurement:
     """The measurement of one estimated point (or why it is invalid) beside the truth."""
     renders = sim.render_count - start
     if not bool(estimate.valid[0]):
         failure = Failure(FailureCause.ESTIMATOR, "estimate", None, repr(estimate.reasons(0)))
-        return failed_measurement(sim, target, method, failure, renders, residuals, search)
+        return failed_measurement(sim, target, method, failure, renders, residuals, search, scan)
     truth_world = target.truth_world(sim)
     estimate_head = estimate.positions[0]
     covariance = estimate.covariance
@@ -199,6 +205,7 @@ def estimated_measurement(
         servo_residual_px=residuals,
         details=details,
         search_renders=search,
+        scan_renders=scan,
     )
 
 

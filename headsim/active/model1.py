@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
 
 from headsim.active.failure import neck_failure
 from headsim.active.measurement import (
@@ -16,7 +17,7 @@ from headsim.active.measurement import (
     failed_measurement,
 )
 from headsim.active.neck_servo import NeckServo
-from headsim.active.search import find_neck_view
+from headsim.active.search import find_neck_view, scan_neck
 from headsim.active.servo_types import ServoOutcome
 from headsim.estimators import Uncertainty, model1
 from headsim.sim.simulator import HeadSim
@@ -36,10 +37,13 @@ def measure_model1(
     target, oldest first (tracking).  If both cameras do not see it where the
     neck was left, the head looks around the last of them (and where the last
     two predict it), then from the start pose; every look is counted in
-    ``search_renders``.  A new target (no ``last_seen``) is fixated from the
-    start pose, where the scenario's reach check has it in both views: where
-    the neck was left belongs to another target (looking there first missed
-    a quarter of the targets and cost 1.1 more renders per point).
+    ``search_renders``.  A new target (no ``last_seen``) is looked for first
+    from the start pose: where the neck was left belongs to another target
+    (looking there first missed a quarter of the targets and cost 1.1 more
+    renders per point).  Where the start pose does not show it to both
+    cameras, the neck scans its ranges with the eyes at 0
+    (:func:`headsim.active.search.scan_neck`, counted in ``scan_renders``)
+    and the servo fixates from where both see it.
     """
     knowledge = knowledge or HeadKnowledge()
     start = sim.render_count
@@ -49,7 +53,8 @@ def measure_model1(
         sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
         sim.settle()
     result = servo.run(target.detector, goals=goals)
-    search = 0
+    search = scan = 0
+    scanned = None
     if result.outcome is ServoOutcome.TARGET_LOST and result.iterations == 0:
         search = result.renders  # the look that did not find it
         found = None
@@ -66,18 +71,31 @@ def measure_model1(
             sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
             sim.settle()
             result = servo.run(target.detector, goals=goals)
-        elif found is None:
-            search = 0  # nothing else was tried: the first look's failure stands
+        if found is None and result.outcome is ServoOutcome.TARGET_LOST and not result.iterations:
+            # Not in both views from the start pose either: scan the neck's ranges.
+            before = sim.render_count
+            scanned = scan_neck(servo, target.detector)
+            scan = sim.render_count - before
+            search += scan
+            if scanned.found:
+                result = servo.run(target.detector, goals=goals)
     residual = (result.residual_px,)
     if not result.converged:
+        failure = neck_failure(result)
+        if scanned is not None and not scanned.found:
+            detail = (
+                f"{failure.detail}; not seen by both from the {scanned.tried} neck poses scanned"
+            )
+            failure = replace(failure, detail=detail)
         return failed_measurement(
             sim,
             target,
             "model1",
-            neck_failure(result),
+            failure,
             sim.render_count - start,
             residual,
             search,
+            scan,
         )
     resolution = sim.settings.encoder_resolution_rad
     yaw, pitch, eye = (
@@ -94,7 +112,17 @@ def measure_model1(
     )
     details = {"alpha_rad": eye, "neck_yaw_rad": yaw, "neck_pitch_rad": pitch}
     return estimated_measurement(
-        sim, target, "model1", estimate, start, residual, details, (yaw, pitch), belief, search
+        sim,
+        target,
+        "model1",
+        estimate,
+        start,
+        residual,
+        details,
+        (yaw, pitch),
+        belief,
+        search,
+        scan,
     )
 
 

@@ -2,9 +2,11 @@
 
 The eye servo (``headsim.active.eye_servo``) fixates the target in camera 1, then
 in camera 2; the encoder angles and the other camera's image at each step go
-to the pure estimator ``headsim.estimators.model2``.  A target out of view is
-searched for (``headsim.active.search``); near the midline the y images are
-taken again at an intermediate eye angle (the paper's remedy, generalised).
+to the pure estimator ``headsim.estimators.model2``.  A target camera 1 does not
+see where the eyes are is scanned for over the eye range, and one camera 2
+does not see where camera 1 fixates is searched for (``headsim.active.search``);
+near the midline the y images are taken again at an intermediate eye angle
+(the paper's remedy, generalised).
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from headsim.active.measurement import (
     estimated_measurement,
     failed_measurement,
 )
-from headsim.active.search import find_view, nearest_seen
+from headsim.active.search import find_view, nearest_seen, scan_eyes
 from headsim.active.servo_types import ServoOutcome, ServoResult
 from headsim.estimators import Uncertainty, model2
 from headsim.sim.simulator import HeadSim
@@ -73,18 +75,22 @@ def measure_model2(
     (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
     # Step 1: Ca1's u to its goal column; then P's image in Ca2 there.
     step1 = servo.run(1, target.detector, goal_u=u10)
-    search = 0  # renders spent finding the target again
+    search = 0  # renders spent finding the target again (the scan's included)
+    scan = 0  # renders spent scanning the eye range for it
+    scanned = None
     if step1.outcome is ServoOutcome.TARGET_LOST and step1.iterations == 0:
-        # Not in Ca1's view where the last measurement left the eyes: search.
+        # Not in Ca1's view where the last measurement left the eyes: scan the eye
+        # range (the start pose first), the neck still.
         before = sim.render_count
-        found = find_view(servo, 1, target.detector)
-        search += sim.render_count - before
-        if found is not None:
-            step1 = servo.run(1, target.detector, goal_u=u10, first=found.detection)
+        scanned = scan_eyes(servo, 1, target.detector)
+        scan = search = sim.render_count - before
+        if scanned.found:
+            step1 = servo.run(1, target.detector, goal_u=u10, first=scanned.detection)
     if not step1.converged:
         failure = servo_failure(step1, "step 1", 1)
-        if search:
-            failure = replace(failure, detail=f"{failure.detail}; searched {search} poses")
+        if scanned is not None and not scanned.found:
+            detail = f"{failure.detail}; not seen from the {scanned.tried} eye poses scanned"
+            failure = replace(failure, detail=detail)
         return failed_measurement(
             sim,
             target,
@@ -93,6 +99,7 @@ def measure_model2(
             sim.render_count - start,
             [step1.residual_px],
             search,
+            scan,
         )
     seen2 = _observe(servo, 2, target)
     gamma2_steps = step1.steps
@@ -113,6 +120,7 @@ def measure_model2(
                 sim.render_count - start,
                 [step1.residual_px],
                 search,
+                scan,
             )
         seen2, gamma2_steps = found.detection, found.steps
     # Step 2: Ca2's u to its goal column, starting from that image; then Ca1's image.
@@ -127,6 +135,7 @@ def measure_model2(
             sim.render_count - start,
             residuals,
             search,
+            scan,
         )
     seen1 = _observe(servo, 1, target)
     gamma1_steps = step2.steps
@@ -143,6 +152,7 @@ def measure_model2(
                 sim.render_count - start,
                 residuals,
                 search,
+                scan,
             )
         gamma1_steps, uv1_seen = memory[0], (memory[1], memory[2])
     assert seen2.uv is not None
@@ -203,6 +213,7 @@ def measure_model2(
         details,
         belief=knowledge.head_belief(sim),
         search=search,
+        scan=scan,
     )
 
 

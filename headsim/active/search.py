@@ -1,14 +1,19 @@
-"""Finding a lost target again from images alone.
+"""Finding a lost target again, or a new one out of view, from images alone.
 
 A search uses only what a real head knows: the eye steps at which a camera
-last saw the target (the servo's memory), the start pose, and the gains the
-servo has learnt (px per encoder step: the image width over the gain is the
-field of view in steps, with no focal length).  Every image it takes is a
-render, counted by the caller through ``HeadSim.render_count``.
+last saw the target (the servo's memory), the start pose, the joints' ranges
+in encoder steps, and the gains the servo has learnt (px per encoder step:
+the image width over the gain is the field of view in steps, with no focal
+length).  A *scan* (:func:`scan_eyes`, :func:`scan_neck`) looks for a target
+that no memory places over the whole range of the joints a procedure may
+move, on binned previews; with no gain learnt yet it steps at a fixed share
+of the range (:data:`SCAN_DIVISIONS`), which needs no field of view.  Every
+image it takes is a render, counted by the caller through ``HeadSim.render_count``.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
@@ -16,8 +21,21 @@ import numpy as np
 
 from headsim.active.eye_servo import EyeServo
 from headsim.active.neck_servo import NeckServo
-from headsim.active.servo_types import Detector
+from headsim.active.servo_types import Detector, ServoConfig
+from headsim.active.windows import windowed
+from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection
+
+#: A scan's poses are at most this share of a field of view apart (the image width,
+#: or height, over the learnt gain): each view overlaps the next by 0.3 of itself.
+SCAN_STRIDE = 0.7
+
+#: With no gain learnt, a scan steps at 1/SCAN_DIVISIONS of each joint's range: it then
+#: covers any field of view wider than that (the eyes' 1.4 rad: 0.0875 rad, 5 degrees).
+SCAN_DIVISIONS = 16
+
+#: The most poses a scan looks from (it stops at the first that shows the target).
+MAX_SCAN_POSES = 48
 
 
 @dataclass(frozen=True)
@@ -80,6 +98,134 @@ def find_view(
         if detection.found and detection.uv is not None:
             return Found(steps, detection, tried)
     return None
+
+
+@dataclass(frozen=True)
+class Scan:
+    """What a scan did: the pose where it found the target (eye steps, or neck yaw,
+    neck pitch and eye steps; None: nowhere), the detection there (a full frame's, when
+    the scan looked with full frames; None when a binned preview showed it: the servo's
+    first look takes its own), and the poses it looked from."""
+
+    pose: tuple[int, ...] | None
+    detection: Detection | None
+    tried: int
+
+    @property
+    def found(self) -> bool:
+        return self.pose is not None
+
+
+def _grid(low: int, high: int, stride: float) -> list[int]:
+    """Whole steps from ``low`` to ``high``, both included, evenly at most ``stride`` apart."""
+    if high <= low:
+        return [low]
+    n = max(1, math.ceil((high - low) / max(stride, 1.0)))
+    return sorted({round(low + k * (high - low) / n) for k in range(n + 1)})
+
+
+def scan_eye_poses(servo: EyeServo, camera: int, width_px: int) -> list[int]:
+    """Eye steps a scan looks from, nearest the start pose first: the start pose (eye 0),
+    then the eye range covered evenly at most :data:`SCAN_STRIDE` of a field of view apart
+    (image width over the learnt gain), or 1/:data:`SCAN_DIVISIONS` of the range with no
+    gain yet."""
+    low, high = servo.step_range
+    gain = servo.gains.get(camera) or servo.gains.get(3 - camera)
+    stride = SCAN_STRIDE * width_px / abs(gain) if gain else (high - low) / SCAN_DIVISIONS
+    poses = [0, *sorted(_grid(low, high, stride), key=lambda p: (abs(p), p))]
+    return [p for k, p in enumerate(poses) if low <= p <= high and p not in poses[:k]]
+
+
+def _binning(sim: HeadSim, camera: int, config: ServoConfig, detector: Detector) -> int:
+    """The preview binning a scan looks with (1: full frames): the servo's, for a blob
+    detector, where it divides the image."""
+    b = config.preview_binning if config.windows else 1
+    cam = sim.camera_settings(camera)
+    if b <= 1 or not windowed(detector) or cam.width % b or cam.height % b:
+        return 1
+    return b
+
+
+def _shows(sim: HeadSim, camera: int, detector: Detector, binning: int) -> bool:
+    """Whether ``camera``'s binned preview shows the target (found, not cut or hidden)."""
+    seen = detector(sim.render_preview(camera, binning))
+    return bool(seen.found and seen.uv is not None)
+
+
+def scan_eyes(
+    servo: EyeServo, camera: int, detector: Detector, max_poses: int = MAX_SCAN_POSES
+) -> Scan:
+    """Turn the eyes to each of :func:`scan_eye_poses` in turn (the neck still) until
+    ``camera`` sees the target: a new target that no memory places and that the eyes'
+    pose shows not.
+
+    One binned preview per pose (``ServoConfig.preview_binning``, for a blob
+    detector; else a full frame), at most ``max_poses``, the pose the eyes are at
+    skipped (it was just looked from).  The eyes stay where it was found.
+    """
+    sim = servo.sim
+    binning = _binning(sim, camera, servo.config, detector)
+    current = sim.eye_encoder_steps()
+    width = sim.camera_settings(camera).width
+    poses = [p for p in scan_eye_poses(servo, camera, width) if p != current][:max_poses]
+    for tried, steps in enumerate(poses, start=1):
+        sim.command_eye_steps(steps)
+        sim.settle()
+        if binning > 1:
+            if _shows(sim, camera, detector, binning):
+                return Scan((steps,), None, tried)
+            continue
+        detection = servo.observe(camera, detector, preview=False)
+        if detection.found and detection.uv is not None:
+            return Scan((steps,), detection, tried)
+    return Scan(None, None, len(poses))
+
+
+def scan_neck_poses(servo: NeckServo, size_px: tuple[int, int]) -> list[tuple[int, int, int]]:
+    """(neck yaw, neck pitch, eye) steps a Model 1 scan looks from, nearest the start pose
+    first (in strides): a grid over the neck's ranges with the eyes at 0, at most
+    :data:`SCAN_STRIDE` of a field of view apart (image width and height over the learnt
+    Jacobian's px per step), or 1/:data:`SCAN_DIVISIONS` of each range with none yet."""
+    (ylo, yhi), (plo, phi), _ = servo.step_ranges
+    jac = servo.jacobian
+    width, height = size_px
+    per_yaw = float(max(abs(jac[0, 0]), abs(jac[1, 0]))) if jac is not None else 0.0
+    per_pitch = float(abs(jac[2, 1])) if jac is not None else 0.0
+    if per_yaw > 0 and per_pitch > 0:
+        strides = (SCAN_STRIDE * width / per_yaw, SCAN_STRIDE * height / per_pitch)
+    else:
+        strides = ((yhi - ylo) / SCAN_DIVISIONS, (phi - plo) / SCAN_DIVISIONS)
+    grid = [(y, p, 0) for y in _grid(ylo, yhi, strides[0]) for p in _grid(plo, phi, strides[1])]
+    return sorted(grid, key=lambda q: (math.hypot(q[0] / strides[0], q[1] / strides[1]), q))
+
+
+def scan_neck(servo: NeckServo, detector: Detector, max_poses: int = MAX_SCAN_POSES) -> Scan:
+    """Move the neck (the eyes at 0) to each of :func:`scan_neck_poses` in turn until both
+    cameras see the target (Model 1's servo needs both to start).
+
+    One binned preview of camera 1 per pose, and one of camera 2 where camera 1's
+    shows it (a blob detector; else both full frames, :meth:`NeckServo.look_from`);
+    at most ``max_poses``, the pose the head is at skipped.  The head stays where
+    it was found.
+    """
+    sim = servo.sim
+    binning = min(_binning(sim, c, servo.config, detector) for c in (1, 2))
+    cam = sim.camera_settings(1)
+    here = servo.steps()
+    poses = [q for q in scan_neck_poses(servo, (cam.width, cam.height)) if q != here]
+    poses = poses[:max_poses]
+    resolution = sim.settings.encoder_resolution_rad
+    for tried, pose in enumerate(poses, start=1):
+        if binning <= 1:
+            if servo.look_from(pose, detector):
+                return Scan(pose, None, tried)
+            continue
+        yaw, pitch, eye = (s * resolution for s in pose)
+        sim.command(neck_yaw=yaw, neck_pitch=pitch, eye=eye)
+        sim.settle()
+        if _shows(sim, 1, detector, binning) and _shows(sim, 2, detector, binning):
+            return Scan(pose, None, tried)
+    return Scan(None, None, len(poses))
 
 
 def neck_search_poses(
@@ -165,10 +311,18 @@ def nearest_seen(
 
 
 __all__ = [
+    "MAX_SCAN_POSES",
+    "SCAN_DIVISIONS",
+    "SCAN_STRIDE",
     "Found",
+    "Scan",
     "find_neck_view",
     "find_view",
     "nearest_seen",
     "neck_search_poses",
+    "scan_eye_poses",
+    "scan_eyes",
+    "scan_neck",
+    "scan_neck_poses",
     "search_poses",
 ]

@@ -1,18 +1,21 @@
 """Statistics of a run's measurements, by what the head knew: counts, errors, depth bands.
 
 The honest headline: the RMS of the 3-D error in % of depth over the whole
-field and all targets, and by depth band (every target counts in exactly one).
+field and all targets, and by depth band (every target counts in exactly one);
+beside it, labelled, the edge of the field apart: the targets that the start
+pose does not show whole to both cameras (``TargetAcceptance.outside_start_view``).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from headsim.active.failure import Failure
+from headsim.active.measurement import Measurement
 from headsim.run.outcomes import MeasurementRecord
 
 #: Depth bands of the honest headline, m: every target counts in exactly one.
@@ -29,11 +32,24 @@ class DepthBand:
 
 
 @dataclass(frozen=True)
+class TargetGroup:
+    """Some of the measurements, named apart: how many, how many ok, their RMS error, %."""
+
+    count: int
+    ok: int
+    error_pct_of_depth_rms: float
+
+
+@dataclass(frozen=True)
 class MeasurementSummary:
     """The measurements made with one knowledge: counts, errors (m, % of depth), renders.
 
     NaN where undefined (no measurement succeeded).  ``failure_causes``: how
     many failures had each cause (FailureCause values), most common first.
+    ``scanned``: measurements that scanned for a target the head's pose did not
+    show, ``scan_renders`` their scans' renders (in ``search_renders``).
+    ``outside_start_view``: the measurements of targets that the start pose does
+    not show whole to both cameras (the edge of the field), apart.
     """
 
     count: int
@@ -50,6 +66,9 @@ class MeasurementSummary:
     failure_causes: dict[str, int]
     error_pct_of_depth_rms: float
     by_depth: tuple[DepthBand, ...]
+    scanned: int = 0
+    scan_renders: int = 0
+    outside_start_view: TargetGroup = TargetGroup(0, 0, float("nan"))
 
 
 def _band_name(lo: float, hi: float) -> str:
@@ -60,8 +79,11 @@ def _rms_pct(pct: np.ndarray) -> float:
     return float(np.sqrt(np.mean(pct * pct))) if pct.size else float("nan")
 
 
-def summarise(records: Sequence[MeasurementRecord]) -> MeasurementSummary:
-    """The statistics of ``records``."""
+def summarise(
+    records: Sequence[MeasurementRecord], outside_start_view: Collection[str] = ()
+) -> MeasurementSummary:
+    """The statistics of ``records``; ``outside_start_view``: the names of the targets at
+    the edge of the field (not seen whole by both cameras at the start pose)."""
     ok = [r.measurement for r in records if r.measurement.ok]
     errors = np.array([np.linalg.norm(m.error_head_m) for m in ok])
     pct = np.array([m.error_pct_of_depth for m in ok])
@@ -90,7 +112,17 @@ def summarise(records: Sequence[MeasurementRecord]) -> MeasurementSummary:
             for lo, hi in DEPTH_BANDS_M
             for sel in [np.array([lo <= m.depth_m < hi for m in ok], dtype=bool)]
         ),
+        scanned=sum(r.measurement.scan_renders > 0 for r in records),
+        scan_renders=sum(r.measurement.scan_renders for r in records),
+        outside_start_view=_group(
+            [r.measurement for r in records if r.measurement.name in outside_start_view]
+        ),
     )
+
+
+def _group(ms: Sequence[Measurement]) -> TargetGroup:
+    pct = np.array([m.error_pct_of_depth for m in ms if m.ok])
+    return TargetGroup(len(ms), int(pct.size), _rms_pct(pct))
 
 
 def _cause_counts(failures: Sequence[Failure | None]) -> dict[str, int]:
@@ -102,10 +134,23 @@ def _cause_counts(failures: Sequence[Failure | None]) -> dict[str, int]:
     return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
 
 
-def summaries(records: Sequence[MeasurementRecord]) -> dict[str, MeasurementSummary]:
-    """Statistics of the measurements, by what the head knew ("none", "calibrated")."""
+def summaries(
+    records: Sequence[MeasurementRecord], outside_start_view: Collection[str] = ()
+) -> dict[str, MeasurementSummary]:
+    """Statistics of the measurements, by what the head knew ("none", "calibrated");
+    ``outside_start_view`` as :func:`summarise`'s."""
     labels = dict.fromkeys(r.knowledge for r in records)
-    return {label: summarise([r for r in records if r.knowledge == label]) for label in labels}
+    return {
+        label: summarise([r for r in records if r.knowledge == label], outside_start_view)
+        for label in labels
+    }
 
 
-__all__ = ["DEPTH_BANDS_M", "DepthBand", "MeasurementSummary", "summaries", "summarise"]
+__all__ = [
+    "DEPTH_BANDS_M",
+    "DepthBand",
+    "MeasurementSummary",
+    "TargetGroup",
+    "summaries",
+    "summarise",
+]

@@ -81,6 +81,7 @@ MEASUREMENT_KEYS = (
     "covariance_head_m2",
     "renders",
     "search_renders",
+    "scan_renders",
     "servo_residual_px",
     "details",
 )
@@ -128,6 +129,7 @@ def measurement_entry(record: MeasurementRecord) -> dict[str, Any]:
         "covariance_head_m2": m.covariance_head_m2,
         "renders": m.renders,
         "search_renders": m.search_renders,
+        "scan_renders": m.scan_renders,
         "servo_residual_px": list(m.servo_residual_px),
         "details": dict(m.details),
     }
@@ -153,6 +155,9 @@ def summary_entry(s: MeasurementSummary) -> dict[str, Any]:
             {"band": b.band, "count": b.count, "error_pct_of_depth_rms": b.error_pct_of_depth_rms}
             for b in s.by_depth
         ],
+        "scanned": s.scanned,
+        "scan_renders": s.scan_renders,
+        "outside_start_view": asdict(s.outside_start_view),
     }
 
 
@@ -322,6 +327,7 @@ def experiment_block(procedure: str, experiment: Experiment | None) -> dict[str,
 def results_payload(result: RunResult) -> dict[str, Any]:
     """The results.json document (plain data; :func:`headsim.files.write_json_atomic` writes it)."""
     s = result.scenario
+    edge = () if s.scene.acceptance is None else s.scene.acceptance.outside_start_view
     return {
         "schema": RESULTS_SCHEMA,
         "scenario": {
@@ -348,7 +354,9 @@ def results_payload(result: RunResult) -> dict[str, Any]:
         if result.calibration is None
         else calibration_block(result.calibration),
         "measurements": [measurement_entry(r) for r in result.records],
-        "summary": {label: summary_entry(s) for label, s in summaries(result.records).items()},
+        "summary": {
+            label: summary_entry(m) for label, m in summaries(result.records, edge).items()
+        },
         "experiment": experiment_block(s.experiment.procedure, result.experiment),
     }
 

@@ -23,6 +23,7 @@ from headsim.run.outcomes import (
     TrackingResult,
 )
 from headsim.run.serialise import experiment_block
+from headsim.scenario.spec import TargetAcceptance
 
 # -- the summary table ------------------------------------------------------------
 
@@ -180,17 +181,27 @@ def _measurement_lines(result: RunResult) -> list[str]:
     methods = ", ".join(sorted({r.measurement.method.value for r in records}))
     lines = [f"Measurements ({methods}; error = |estimate - truth| in H)"]
     lines += format_table(headers, rows)
-    for label, s in summaries(records).items():
+    acceptance = result.scenario.scene.acceptance
+    edge = () if acceptance is None else acceptance.outside_start_view
+    for label, s in summaries(records, edge).items():
         lines.append(
             f"  head knew {label}: {s.ok} of {s.count} ok; error mean {_mm(s.error_m_mean)} mm "
             f"({_cell(s.error_pct_of_depth_mean, '.3f')} % of depth), max {_mm(s.error_m_max)} mm; "
             f"{_cell(s.renders_per_point, '.1f')} renders per point; servo residual "
             f"<= {_cell(s.servo_residual_px_max, '.2f')} px"
         )
+        if acceptance is not None and acceptance.drawn and s.count == acceptance.accepted:
+            lines.append(f"  head knew {label}: {_acceptance_text(s.ok, acceptance)}")
         if s.searched:
+            scanned = (
+                f" ({s.scanned} scanned for where the head's pose did not show them: "
+                f"{s.scan_renders} renders, {s.scan_renders / s.scanned:.1f} per target)"
+                if s.scanned
+                else ""
+            )
             lines.append(
                 f"  head knew {label}: {s.searched} targets searched for again, "
-                f"{s.search_renders} renders of search"
+                f"{s.search_renders} renders of search{scanned}"
             )
         if s.failure_causes:
             causes = ", ".join(f"{n} {c}" for c, n in s.failure_causes.items())
@@ -202,7 +213,25 @@ def _measurement_lines(result: RunResult) -> list[str]:
             f"    whole field, all {s.ok} targets: 3-D error RMS "
             f"{_cell(s.error_pct_of_depth_rms, '.3f')} % of depth; by depth: {bands}"
         )
+        g = s.outside_start_view
+        if g.count:
+            lines.append(
+                f"    of them at the edge of the field (not seen whole by both cameras at the "
+                f"start pose): {g.ok} of {g.count} measured, 3-D error RMS "
+                f"{_cell(g.error_pct_of_depth_rms, '.3f')} % of depth"
+            )
     return lines
+
+
+def _acceptance_text(ok: int, a: TargetAcceptance) -> str:
+    """ "measured / accepted" beside "measured / drawn", with what the reach check refused."""
+    offered = "drawn" if not a.listed else "listed or drawn"
+    refused = ", ".join(f"{n} {code}" for code, n in a.refused.items())
+    return f"{ok} of {a.accepted} accepted targets measured, {ok} of {a.offered} {offered}" + (
+        f" ({a.refused_total} draws refused by the reach check and drawn again: {refused})"
+        if a.refused
+        else " (the reach check refused none)"
+    )
 
 
 def _chessboard_lines(e: ChessboardResult, paper: bool) -> list[str]:

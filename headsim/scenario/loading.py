@@ -17,7 +17,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from headsim.scenario.reach import ReachHead, check_reach
+from headsim.scenario.reach import ReachHead
+from headsim.scenario.reach_check import check_reach
 from headsim.scenario.scene import read_scene
 from headsim.scenario.schema import FIRST_TABLES, read_experiment, read_head
 from headsim.scenario.spec import Scenario

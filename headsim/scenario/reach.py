@@ -1,43 +1,41 @@
-"""Reach: can the head see and fixate a point from its start pose?  Geometry only, no rendering.
+"""Reach: can the head fixate a point at all?  Geometry only, no rendering.
 
-Model 2 needs each eye's fixation angle within the eye range and the point
-seen whole by both cameras at the start pose; Model 1 needs the neck's and
-the eye's angles within their ranges (and, for a first position, the same
-start-pose view).  :func:`reach_refusal` is the check scripts use; the
-scenario loader refuses every target, corner, object and path point that
-fails it, naming why.  Points in W or H, m; angles rad.
+A target is refused only where no pose the procedure may take fixates it:
+Model 2 (the neck still, as in the paper) needs it in front (z_h 0.1-10 m),
+each camera's fixation angle within the eye range, each camera seeing it
+whole where it fixates it, and nothing of the scene in either camera's line
+of sight; Model 1 needs the neck's and the eye's fixation angles within
+their ranges, the same depth and lines of sight, and both cameras seeing it
+whole from some neck pose with the eyes at 0 (where its neck servo can
+start).  A target that the start pose does not show is not refused: the
+procedures scan for it (``headsim.active.search.scan_eyes``/``scan_neck``).
+A moving target's first position, a chessboard corner and the blocks' cross
+point are still refused outside the start pose's view (those procedures
+start there).  Every refusal is a :class:`Refusal` with a short reason code
+(:data:`headsim.scenario.spec.REFUSAL_REASONS`).  :func:`reach_refusal` is
+the check scripts use; the scenario loader refuses every listed target,
+corner, object and path point that fails it, naming why, and counts the
+random draws it refuses.  Points in W or H, m; angles rad.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cache, lru_cache
+from functools import lru_cache
 
-import mujoco
 import numpy as np
 
-from headsim.geometry.kinematics import world_to_head
+from headsim.geometry.kinematics import head_to_world, world_to_head
+from headsim.scenario.occlusion import Occluder, hidden_by, scene_model, scene_occluders
 from headsim.scenario.spec import (
-    CHESSBOARD_PATTERN,
-    CHESSBOARD_SQUARE_M,
     MAX_DEPTH_M,
     MIN_DEPTH_M,
-    Placement,
-    Scenario,
-    corner_count,
 )
-from headsim.scenario.tables import Context
 from headsim.sim import names
 from headsim.sim.forward import effective_directions
-from headsim.sim.model import eye_from_camera_rotation, load_spec
+from headsim.sim.model import eye_from_camera_rotation
 from headsim.sim.settings import HeadSettings
-
-
-@cache
-def scene_model(scene: str) -> mujoco.MjModel:
-    """The compiled scene as in the XML (joint ranges, default poses); no rendering."""
-    return load_spec(scene).compile()
 
 
 @dataclass(frozen=True)
@@ -101,23 +99,91 @@ class ReachHead:
         alpha2 = math.atan2(half - p[0], p[2]) - self.effective_direction(1)
         return alpha1, alpha2
 
-    def to_head(self, point_world: np.ndarray) -> np.ndarray:
+    def to_head(self, point_world: np.ndarray, yaw: float = 0.0, pitch: float = 0.0) -> np.ndarray:
+        """A world point in H with the neck at (``yaw``, ``pitch``), rad (default: the start pose)."""
         s = self.settings
-        return world_to_head(point_world, 0.0, 0.0, s.neck_d1_m, s.neck_a2_m)
+        return world_to_head(point_world, yaw, pitch, s.neck_d1_m, s.neck_a2_m)
+
+    def eye_centres(self, yaw: float = 0.0, pitch: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """Each eye's centre (on its yaw axis) in W with the neck at (``yaw``, ``pitch``), m."""
+        s, half = self.settings, self.settings.baseline_m / 2
+        return tuple(  # type: ignore[return-value]
+            head_to_world(np.array([x, 0.0, 0.0]), yaw, pitch, s.neck_d1_m, s.neck_a2_m)
+            for x in (-half, half)
+        )
+
+    def in_start_view(self, point_world: np.ndarray, radius_m: float = 0.0) -> bool:
+        """Whether both cameras see a world point whole at the start pose (neck and eyes at 0)."""
+        p = self.to_head(point_world)
+        return all(self.in_view(p, index, 0.0, radius_m) for index in (0, 1))
 
 
-def _fmt(p: np.ndarray) -> str:
+@dataclass(frozen=True)
+class Refusal:
+    """Why the head cannot fixate a point: a reason code, what is wrong and what is allowed.
+
+    ``code``: one of :data:`headsim.scenario.spec.REFUSAL_REASONS` (results.json
+    counts refused draws by it); ``message`` and ``allowed`` name the point and
+    the rule, as the loader's error does.
+    """
+
+    code: str
+    message: str
+    allowed: str
+
+
+def _occlusion(
+    head: ReachHead,
+    p_world: np.ndarray,
+    what: str,
+    radius_m: float,
+    occluders: tuple[Occluder, ...],
+    yaw: float = 0.0,
+    pitch: float = 0.0,
+) -> Refusal | None:
+    """A refusal if the scene hides the point from either eye at neck pose (``yaw``, ``pitch``)."""
+    for index, eye in enumerate(head.eye_centres(yaw, pitch)):
+        # 2 px of the true lens beside the ball (placement: truth allowed)
+        margin = 2.0 / head.settings.cameras[index].kx
+        name = hidden_by(eye, p_world, radius_m, margin, occluders)
+        if name is not None:
+            return Refusal(
+                "occluded",
+                f"{what} at {fmt_point(head.to_head(p_world))} m in H is hidden from camera "
+                f"{index + 1} by {name}",
+                "targets that both cameras see with nothing of the scene in front of them",
+            )
+    return None
+
+
+def fmt_point(p: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:.3f}" for v in p) + "]"
 
 
-def _check_in_front(ctx: Context, source: str, p_head: np.ndarray, what: str) -> None:
-    if not MIN_DEPTH_M <= p_head[2] <= MAX_DEPTH_M:
-        where = "behind or too close to the head" if p_head[2] < MIN_DEPTH_M else "too far"
-        raise ctx.error(
-            source,
-            f"{what} at {_fmt(p_head)} m in H is {where}",
-            f"z_h from {MIN_DEPTH_M:g} to {MAX_DEPTH_M:g} m in front of the head",
-        )
+def depth_refusal(p_head: np.ndarray, what: str) -> Refusal | None:
+    """A refusal if a point in H (start pose) is behind, too near or too far, else None."""
+    if MIN_DEPTH_M <= p_head[2] <= MAX_DEPTH_M:
+        return None
+    where = "behind or too close to the head" if p_head[2] < MIN_DEPTH_M else "too far"
+    return Refusal(
+        "depth",
+        f"{what} at {fmt_point(p_head)} m in H is {where}",
+        f"z_h from {MIN_DEPTH_M:g} to {MAX_DEPTH_M:g} m in front of the head",
+    )
+
+
+def _start_view_refusal(
+    head: ReachHead, p: np.ndarray, what: str, radius_m: float, allowed: str
+) -> Refusal | None:
+    for index in (0, 1):
+        if not head.in_view(p, index, 0.0, radius_m):
+            return Refusal(
+                "start_view",
+                f"{what} at {fmt_point(p)} m in H is not seen whole by camera {index + 1} at the "
+                "start pose",
+                allowed,
+            )
+    return None
 
 
 def body_radius(body: str | None) -> float:
@@ -133,52 +199,52 @@ def body_radius(body: str | None) -> float:
 
 
 def model2_refusal(
-    head: ReachHead, p_world: np.ndarray, what: str, radius_m: float = 0.0
-) -> tuple[str, str] | None:
-    """Why Model 2 cannot measure a point (message, what is allowed), or None: it can.
-
-    The criterion the procedure meets (``headsim.active.model2.measure_model2``
-    searches the start pose when a camera loses the target): in front of the
-    head, each camera's fixation angle within the eye range, and the target
-    seen whole by both cameras at the start pose (neck and eyes at 0).
-    """
-    p = head.to_head(p_world)
-    if not MIN_DEPTH_M <= p[2] <= MAX_DEPTH_M:
-        where = "behind or too close to the head" if p[2] < MIN_DEPTH_M else "too far"
-        return (
-            f"{what} at {_fmt(p)} m in H is {where}",
-            f"z_h from {MIN_DEPTH_M:g} to {MAX_DEPTH_M:g} m in front of the head",
-        )
-    lo, hi = head.eye_range
-    for camera, alpha in enumerate(head.model2_angles(p), start=1):
-        if not lo <= alpha <= hi:
-            return (
-                f"{what} at {_fmt(p)} m in H needs an eye angle of {alpha:.3f} rad for "
-                f"camera {camera} to fixate it",
-                f"targets that both eyes fixate within the eye range [{lo:g}, {hi:g}] rad",
-            )
-    for index in (0, 1):
-        if not head.in_view(p, index, 0.0, radius_m):
-            return (
-                f"{what} at {_fmt(p)} m in H is not seen whole by camera {index + 1} at the "
-                "start pose",
-                "a target that both cameras see whole with neck and eyes at 0",
-            )
-    return None
-
-
-def _check_model2_reach(
-    ctx: Context,
     head: ReachHead,
-    source: str,
     p_world: np.ndarray,
     what: str,
     radius_m: float = 0.0,
-) -> None:
-    """Refuse a point that :func:`model2_refusal` refuses, naming the reason."""
-    refusal = model2_refusal(head, p_world, what, radius_m)
+    occluders: tuple[Occluder, ...] = (),
+    start_view: bool = False,
+) -> Refusal | None:
+    """Why Model 2 cannot measure a point, or None: it can.
+
+    The criterion the procedure meets with the neck still
+    (``headsim.active.model2.measure_model2`` scans the eye range for a target
+    camera 1 does not see, and searches for one camera 2 does not see): in
+    front of the head, each camera's fixation angle within the eye range, each
+    camera seeing it whole at its fixation angle (where it is nearest the
+    image's middle row: no eye angle shows it whole if that one does not), and
+    no geom of ``occluders`` in either line of sight.  ``start_view``: also
+    seen whole by both cameras at the start pose (a chessboard corner, the
+    blocks' cross point: those procedures start there).
+    """
+    p = head.to_head(p_world)
+    refusal = depth_refusal(p, what)
     if refusal is not None:
-        raise ctx.error(source, *refusal)
+        return refusal
+    lo, hi = head.eye_range
+    angles = head.model2_angles(p)
+    for camera, alpha in enumerate(angles, start=1):
+        if not lo <= alpha <= hi:
+            return Refusal(
+                "eye_range",
+                f"{what} at {fmt_point(p)} m in H needs an eye angle of {alpha:.3f} rad for "
+                f"camera {camera} to fixate it",
+                f"targets that both eyes fixate within the eye range [{lo:g}, {hi:g}] rad",
+            )
+    if start_view:
+        return _start_view_refusal(
+            head, p, what, radius_m, "a target that both cameras see whole with neck and eyes at 0"
+        )
+    for index, alpha in enumerate(angles):
+        if not head.in_view(p, index, alpha, radius_m):
+            return Refusal(
+                "not_in_any_view",
+                f"{what} at {fmt_point(p)} m in H is not seen whole by camera {index + 1} even where "
+                f"it fixates it (eye angle {alpha:.3f} rad): it lies above or below that view",
+                "targets that each camera sees whole at some eye angle with the neck still",
+            )
+    return _occlusion(head, p_world, what, radius_m, occluders)
 
 
 def _model1_angles(head: ReachHead, p_world: np.ndarray) -> tuple[float, float, float]:
@@ -198,54 +264,77 @@ def _model1_angles(head: ReachHead, p_world: np.ndarray) -> tuple[float, float, 
 
 
 def model1_refusal(
-    head: ReachHead, p_world: np.ndarray, what: str, start: bool, radius_m: float = 0.0
-) -> tuple[str, str] | None:
-    """Why Model 1 cannot fixate a point (message, what is allowed), or None: it can.
+    head: ReachHead,
+    p_world: np.ndarray,
+    what: str,
+    start: bool,
+    radius_m: float = 0.0,
+    occluders: tuple[Occluder, ...] = (),
+    start_view: bool = True,
+) -> Refusal | None:
+    """Why Model 1 cannot fixate a point, or None: it can.
 
-    Within the neck's and eye's ranges; if ``start`` (a first position, which the
-    procedure looks for at the start pose), in front and seen whole by both
-    cameras with neck and eyes at 0.
+    Within the neck's and eye's ranges.  If ``start`` (a first position, which the
+    procedure looks for from the start pose): in front; then, with ``start_view``
+    (a moving target, tracked from where the start pose sees it), seen whole by
+    both cameras with neck and eyes at 0; without it (a target, which
+    ``headsim.active.model1.measure_model1`` scans the neck for), seen whole by
+    both cameras from the neck pose that fixates it with the eyes at 0 (where
+    the neck scan can find it and the servo start: the eyes converge only
+    then), and no geom of ``occluders`` in either line of sight there.
     """
     p = head.to_head(p_world)
     yaw, pitch, eye = _model1_angles(head, p_world)
     if math.isnan(pitch):
         s = head.settings
         distance = math.hypot(math.hypot(p_world[0], p_world[1]), p_world[2] - s.neck_d1_m)
-        return (
-            f"{what} at {_fmt(np.asarray(p_world))} m in W is {distance:.3f} m from the neck's "
+        return Refusal(
+            "neck_offset",
+            f"{what} at {fmt_point(np.asarray(p_world))} m in W is {distance:.3f} m from the neck's "
             f"pitch axis, inside the eyes' offset from it (head.neck_a2_m = {s.neck_a2_m:g} m): "
             "no neck pitch turns the eyes towards it",
             "targets farther from the neck's pitch axis than head.neck_a2_m",
         )
     ranges = (
-        ("neck yaw", yaw, head.neck_yaw_range),
-        ("neck pitch", pitch, head.neck_pitch_range),
-        ("eye angle", eye, head.eye_range),
+        ("neck_range", "neck yaw", yaw, head.neck_yaw_range),
+        ("neck_range", "neck pitch", pitch, head.neck_pitch_range),
+        ("eye_range", "eye angle", eye, head.eye_range),
     )
-    for label, angle, (lo, hi) in ranges:
+    for code, label, angle, (lo, hi) in ranges:
         if not lo <= angle <= hi:
-            return (
-                f"{what} at {_fmt(np.asarray(p_world))} m in W needs a {label} of {angle:.3f} rad",
+            return Refusal(
+                code,
+                f"{what} at {fmt_point(np.asarray(p_world))} m in W needs a {label} of {angle:.3f} rad",
                 f"targets the neck and eyes fixate within their ranges: neck yaw "
                 f"[{head.neck_yaw_range[0]:g}, {head.neck_yaw_range[1]:g}], neck pitch "
                 f"[{head.neck_pitch_range[0]:g}, {head.neck_pitch_range[1]:g}], eyes "
                 f"[{head.eye_range[0]:g}, {head.eye_range[1]:g}] rad",
             )
-    if start:
-        if not MIN_DEPTH_M <= p[2] <= MAX_DEPTH_M:
-            where = "behind or too close to the head" if p[2] < MIN_DEPTH_M else "too far"
-            return (
-                f"{what} at {_fmt(p)} m in H is {where}",
-                f"z_h from {MIN_DEPTH_M:g} to {MAX_DEPTH_M:g} m in front of the head",
+    if not start:
+        return None
+    refusal = depth_refusal(p, what)
+    if refusal is not None:
+        return refusal
+    if start_view:
+        return _start_view_refusal(
+            head,
+            p,
+            what,
+            radius_m,
+            "a first position that both cameras see whole with neck and eyes at 0",
+        )
+    facing = head.to_head(p_world, yaw, pitch)
+    for index in (0, 1):
+        if not head.in_view(facing, index, 0.0, radius_m):
+            return Refusal(
+                "not_in_any_view",
+                f"{what} at {fmt_point(np.asarray(p_world))} m in W is not seen whole by camera "
+                f"{index + 1} with the neck turned to face it (yaw {yaw:.3f}, pitch "
+                f"{pitch:.3f} rad) and the eyes at 0: too near for both views",
+                "targets that both cameras see whole from some neck pose with the eyes at 0 "
+                "(Model 1 scans the neck; its servo converges the eyes once both see it)",
             )
-        for index in (0, 1):
-            if not head.in_view(p, index, 0.0, radius_m):
-                return (
-                    f"{what} at {_fmt(p)} m in H is not seen whole by camera {index + 1} at "
-                    "the start pose",
-                    "a first position that both cameras see whole with neck and eyes at 0",
-                )
-    return None
+    return _occlusion(head, p_world, what, radius_m, occluders, yaw, pitch)
 
 
 @lru_cache(maxsize=8)
@@ -253,118 +342,53 @@ def _head_of(settings: HeadSettings) -> ReachHead:
     return ReachHead.of(settings)
 
 
+def target_refusal(
+    head: ReachHead,
+    procedure: str,
+    p_world: np.ndarray,
+    what: str = "target",
+    radius_m: float = 0.0,
+    occluders: tuple[Occluder, ...] = (),
+) -> Refusal | None:
+    """The reach check of one target of ``procedure`` ("model1"; else Model 2 measures it)."""
+    if procedure == "model1":
+        return model1_refusal(head, p_world, what, True, radius_m, occluders, start_view=False)
+    return model2_refusal(head, p_world, what, radius_m, occluders)
+
+
 def reach_refusal(
     settings: HeadSettings,
     p_world: np.ndarray,
     what: str = "target",
     radius_m: float = 0.0,
-) -> tuple[str, str] | None:
-    """The scenario's reach check for one first target, for Model 2 and Model 1 alike.
+    body: str | None = None,
+) -> Refusal | None:
+    """The scenario's reach check for one target, for Model 2 and Model 1 alike.
 
-    (message, what is allowed) from the first model that refuses the world
-    point ``p_world``, m, or None: both procedures can measure it from the
-    start pose.  The same criterion ``within = "reach"`` applies.
+    The :class:`Refusal` of the first model that refuses the world point
+    ``p_world``, m, or None: both procedures can measure it (from the start
+    pose, or after a scan).  ``body``: the marker placed there (its own place in
+    the default scene then hides nothing); the other geoms of the default scene
+    stay where its XML puts them.  The criterion ``within = "reach"`` applies.
     """
     head = _head_of(settings)
-    return model2_refusal(head, p_world, what, radius_m) or model1_refusal(
-        head, p_world, what, True, radius_m
+    occluders = scene_occluders("default", None, body)
+    return model2_refusal(head, p_world, what, radius_m, occluders) or model1_refusal(
+        head, p_world, what, True, radius_m, occluders, start_view=False
     )
 
 
-def _check_model1_reach(
-    ctx: Context,
-    head: ReachHead,
-    source: str,
-    p_world: np.ndarray,
-    what: str,
-    start: bool,
-    radius_m: float = 0.0,
-) -> None:
-    """Refuse a point that :func:`model1_refusal` refuses, naming the reason."""
-    refusal = model1_refusal(head, p_world, what, start, radius_m)
-    if refusal is not None:
-        raise ctx.error(source, *refusal)
-
-
-def _chessboard_corners_world(placement: Placement, corners: tuple[int, ...] | None) -> np.ndarray:
-    """World positions of the chosen inner corners of a board placed at ``placement``."""
-    model = scene_model("chessboard")
-    rotation = np.zeros(9)
-    mujoco.mju_quat2Mat(rotation, model.body(names.CHESSBOARD).quat)
-    columns = CHESSBOARD_PATTERN[0]
-    indices = range(corner_count()) if corners is None else corners
-    local = np.array(
-        [
-            [(k % columns) * CHESSBOARD_SQUARE_M, (k // columns) * CHESSBOARD_SQUARE_M, 0.0]
-            for k in indices
-        ]
-    )
-    return np.asarray(placement.position_world_m) + local @ rotation.reshape(3, 3).T
-
-
-def check_reach(ctx: Context, scenario: Scenario) -> None:
-    head = ReachHead.of(scenario.settings)
-    scene = scenario.scene
-    procedure = scenario.experiment.procedure
-    for target in scene.targets:
-        radius = body_radius(target.body)
-        if procedure == "model1":
-            _check_model1_reach(
-                ctx,
-                head,
-                f"{target.source}",
-                np.array(target.position_world_m),
-                "target",
-                True,
-                radius,
-            )
-        else:
-            _check_model2_reach(
-                ctx, head, target.source, np.array(target.position_world_m), "target", radius
-            )
-    if scene.chessboard is not None:
-        indices = range(corner_count()) if scene.corners is None else scene.corners
-        for k, p in zip(
-            indices, _chessboard_corners_world(scene.chessboard, scene.corners), strict=True
-        ):
-            _check_model2_reach(ctx, head, scene.chessboard.source, p, f"corner {k}")
-    if scene.blocks is not None:
-        _check_model2_reach(
-            ctx, head, scene.blocks.source, np.array(scene.blocks.position_world_m), "cross point"
-        )
-        for placement in scene.objects:
-            p = head.to_head(np.array(placement.position_world_m))
-            _check_in_front(ctx, placement.source, p, placement.name)
-            if not (head.in_view(p, 0) and head.in_view(p, 1)):
-                raise ctx.error(
-                    placement.source,
-                    f"{placement.name} at {_fmt(p)} m in H is outside a camera's view at the start pose",
-                    "objects that both cameras see with neck and eyes at 0",
-                )
-    if scene.pursuit is not None:
-        pursuit = scene.pursuit
-        first = True
-        for t in pursuit.sample_times():
-            if not pursuit.visibility.visible(float(t)):
-                continue
-            _check_model1_reach(
-                ctx,
-                head,
-                "scene.pursuit.path",
-                pursuit.path.position(float(t)),
-                f"the target at t = {t:g} s",
-                first,
-            )
-            first = False
-    if scene.moving is not None:
-        moving = scene.moving
-        for k, t in enumerate(moving.times_s):
-            _check_model1_reach(
-                ctx,
-                head,
-                "scene.moving_target",
-                moving.position(float(t)),
-                f"the target at t = {t:g} s",
-                k == 0,
-                body_radius(moving.body),
-            )
+__all__ = [
+    "Occluder",
+    "ReachHead",
+    "Refusal",
+    "body_radius",
+    "depth_refusal",
+    "fmt_point",
+    "model1_refusal",
+    "model2_refusal",
+    "reach_refusal",
+    "scene_model",
+    "scene_occluders",
+    "target_refusal",
+]

@@ -18,11 +18,12 @@ from headsim.geometry.kinematics import head_to_world
 from headsim.geometry.sampling import sample_points_head
 from headsim.scenario.pursuit import read_pursuit
 from headsim.scenario.reach import (
+    Occluder,
     ReachHead,
     body_radius,
-    model1_refusal,
-    model2_refusal,
     scene_model,
+    scene_occluders,
+    target_refusal,
 )
 from headsim.scenario.schema import depth_range
 from headsim.scenario.spec import (
@@ -35,6 +36,7 @@ from headsim.scenario.spec import (
     MovingTarget,
     Placement,
     SceneSpec,
+    TargetAcceptance,
     corner_count,
 )
 from headsim.scenario.tables import MISSING, Context, Table, describe_value
@@ -76,6 +78,10 @@ def tuple3(p: np.ndarray) -> tuple[float, float, float]:
     return (float(p[0]), float(p[1]), float(p[2]))
 
 
+#: Draws per random target before ``within = "reach"`` gives up on the box.
+MAX_DRAWS = 200
+
+
 def _redraw_out_of_reach(
     table: Table,
     settings: HeadSettings,
@@ -83,35 +89,37 @@ def _redraw_out_of_reach(
     body: str,
     points_world: np.ndarray,
     rng: np.random.Generator,
-) -> np.ndarray:
-    """Points drawn again from the same box until the reach check accepts each (bounded)."""
+    occluders: tuple[Occluder, ...],
+) -> tuple[np.ndarray, dict[str, int]]:
+    """Points drawn again from the same box until the reach check accepts each (bounded),
+    and how many draws it refused, by reason code, most common first."""
     head = ReachHead.of(settings)
     radius = body_radius(body)
-
-    def refused(p: np.ndarray) -> bool:
-        if procedure == "model1":
-            return model1_refusal(head, p, "target", True, radius) is not None
-        return model2_refusal(head, p, "target", radius) is not None
-
+    refused: dict[str, int] = {}
     points_world = np.array(points_world)
     for k in range(len(points_world)):
-        for _ in range(200):
-            if not refused(points_world[k]):
+        for _ in range(MAX_DRAWS):
+            refusal = target_refusal(head, procedure, points_world[k], "target", radius, occluders)
+            if refusal is None:
                 break
+            refused[refusal.code] = refused.get(refusal.code, 0) + 1
             points_world[k] = _head_to_world(settings, _random_points_head(table, 1, rng))[0]
         else:
             raise table.fail(
                 "within",
-                f"no point of the box within the head's reach in 200 draws (target {k + 1})",
-                "a depth_m, lateral and vertical box that overlaps the field both cameras see",
+                f"no point of the box within the head's reach in {MAX_DRAWS} draws "
+                f"(target {k + 1})",
+                "a depth_m, lateral and vertical box that overlaps what the eyes can fixate",
             )
-    return points_world
+    return points_world, dict(sorted(refused.items(), key=lambda kv: (-kv[1], kv[0])))
 
 
 def _read_targets(
     scene: Table, settings: HeadSettings, seed: int, required: bool, procedure: str = "model2"
-) -> tuple[Placement, ...]:
-    """``[[scene.targets]]`` and ``[scene.random_targets]``: markers to measure, in turn."""
+) -> tuple[tuple[Placement, ...], TargetAcceptance]:
+    """``[[scene.targets]]`` and ``[scene.random_targets]``: markers to measure, in turn,
+    and how they were accepted (the loader's reach check refuses a listed one it cannot
+    fixate; ``within = "reach"`` draws a refused random one again, counted)."""
     bodies = tuple(MARKER_BODIES)
     targets = []
     for k, table in enumerate(scene.tables("targets")):
@@ -120,7 +128,11 @@ def _read_targets(
         position = _position(table, settings)
         table.done()
         targets.append(Placement(name, body, tuple3(position), table.path))
+    listed = len(targets)
     random_table = scene.table("random_targets")
+    within: str | None = None
+    drawn = 0
+    refused: dict[str, int] = {}
     if random_table is not None:
         count = random_table.integer("count", MISSING, 1, 1000)
         body = random_table.choice("body", bodies, names.MARKERS[0])
@@ -128,7 +140,13 @@ def _read_targets(
         rng = np.random.default_rng([seed, STREAM_TARGETS])
         points = _head_to_world(settings, _random_points_head(random_table, count, rng))
         if within == "reach":
-            points = _redraw_out_of_reach(random_table, settings, procedure, body, points, rng)
+            # What can hide them: the scene as the listed targets leave it.
+            placed = {t.body: np.array(t.position_world_m) for t in targets}
+            occluders = scene_occluders(PROCEDURES[procedure], placed, body)
+            points, refused = _redraw_out_of_reach(
+                random_table, settings, procedure, body, points, rng, occluders
+            )
+        drawn = count + sum(refused.values())
         random_table.done()
         targets += [
             Placement(f"random_{k + 1}", body, tuple3(p), f"{random_table.path} (target {k + 1})")
@@ -145,7 +163,20 @@ def _read_targets(
                 f"{placement.source}.name", f"{placement.name!r} is used twice", "unique names"
             )
         seen.add(placement.name)
-    return tuple(targets)
+    head = ReachHead.of(settings)
+    acceptance = TargetAcceptance(
+        within=within,
+        listed=listed,
+        drawn=drawn,
+        refused=refused,
+        accepted=len(targets),
+        outside_start_view=tuple(
+            t.name
+            for t in targets
+            if not head.in_start_view(np.array(t.position_world_m), body_radius(t.body))
+        ),
+    )
+    return tuple(targets), acceptance
 
 
 def _default_position(scene: str, body: str) -> np.ndarray:
@@ -161,10 +192,10 @@ def read_scene(
     table = doc.table("scene") or Table({}, "scene", ctx)
     spec = SceneSpec(scene=scene_name)
     if procedure in ("model2", "model1", "calibration"):
-        targets = _read_targets(
+        targets, acceptance = _read_targets(
             table, settings, seed, required=procedure != "calibration", procedure=procedure
         )
-        spec = replace(spec, targets=targets)
+        spec = replace(spec, targets=targets, acceptance=acceptance)
     elif procedure == "chessboard":
         spec = _read_chessboard(table, ctx, settings)
     elif procedure == "relative_positioning":

@@ -155,12 +155,63 @@ class MovingTarget:
         return np.array([np.interp(t, knots, points[:, k]) for k in range(3)])
 
 
+#: Why the reach check refuses a point (:class:`headsim.scenario.reach.Refusal`'s ``code``):
+#: behind, too near or too far; an eye angle, or a neck angle, beyond its range; inside
+#: the eyes' offset from the neck's pitch axis; outside the view of every pose that can
+#: fixate it; hidden from a camera by the scene; not in both views at the start pose
+#: (only where a procedure starts there: a moving target's first position, a
+#: chessboard corner, the blocks' cross point).
+REFUSAL_REASONS = (
+    "depth",
+    "eye_range",
+    "neck_range",
+    "neck_offset",
+    "not_in_any_view",
+    "occluded",
+    "start_view",
+)
+
+
+@dataclass(frozen=True)
+class TargetAcceptance:
+    """How the scene's targets came to be measured: listed, drawn, refused, accepted.
+
+    ``within``: ``[scene.random_targets] within`` ("box" or "reach"; None: no
+    random targets).  ``listed``: the ``[[scene.targets]]`` entries (each passed
+    the reach check, else the file was refused).  ``drawn``: random draws made,
+    the refused ones included; ``refused``: how many of them the reach check
+    refused, by reason (:data:`REFUSAL_REASONS`), most common first: each was
+    drawn again.  ``accepted``: the targets measured, listed and drawn.
+    ``outside_start_view``: the names of the accepted targets that the start
+    pose (neck and eyes at 0) does not show whole to both cameras, the edge of
+    the field: the procedure finds them by a scan (the reach check before
+    refused them).
+    """
+
+    within: str | None
+    listed: int
+    drawn: int
+    refused: dict[str, int]
+    accepted: int
+    outside_start_view: tuple[str, ...]
+
+    @property
+    def refused_total(self) -> int:
+        return sum(self.refused.values())
+
+    @property
+    def offered(self) -> int:
+        """Targets listed or drawn: what "measured / drawn" divides by."""
+        return self.listed + self.drawn
+
+
 @dataclass(frozen=True)
 class SceneSpec:
     """What is where: ``scene`` is the MJCF scene; ``targets`` to measure (or check
     targets after a calibration); ``chessboard``/``blocks`` the board's top-left inner
     corner or the cross point; ``objects`` for relative positioning; ``parked``
-    bodies moved out of sight; ``corners`` the chessboard corners to measure."""
+    bodies moved out of sight; ``corners`` the chessboard corners to measure;
+    ``acceptance`` how the targets were drawn and which the reach check refused."""
 
     scene: str
     targets: tuple[Placement, ...] = ()
@@ -171,6 +222,8 @@ class SceneSpec:
     parked: tuple[str, ...] = ()
     moving: MovingTarget | None = None
     pursuit: PursuitSpec | None = None  # for the pursuit procedure
+    #: how the targets were drawn and accepted (None: a procedure without targets)
+    acceptance: TargetAcceptance | None = None
 
 
 @dataclass(frozen=True)

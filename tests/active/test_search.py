@@ -165,10 +165,17 @@ def test_reach_refusal_is_the_scenario_check_for_both_models() -> None:
     ahead = head_to_world(
         np.array([0.0, 0.0, 0.8]), 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m
     )
-    aside = head_to_world(
+    edge = head_to_world(
         np.array([0.6, 0.0, 0.8]), 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m
     )
+    aside = head_to_world(
+        np.array([0.8, 0.0, 0.8]), 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m
+    )
     assert reach_refusal(settings, ahead) is None
+    # Outside the start pose's view, but both eyes (and the neck) can fixate it: accepted.
+    assert not ReachHead.of(settings).in_start_view(edge)
+    assert reach_refusal(settings, edge) is None
     refusal = reach_refusal(settings, aside, "ball")
-    assert refusal is not None and refusal[0].startswith("ball at ")
+    assert refusal is not None and refusal.message.startswith("ball at ")
+    assert refusal.code == "eye_range"
     assert refusal == model2_refusal(ReachHead.of(settings), aside, "ball")

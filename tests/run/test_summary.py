@@ -31,3 +31,42 @@ def test_a_failed_calibration_is_the_summarys_problem() -> None:
     assert "Calibration of the initial directions (Sec. V): 2 of 8 ball positions fixated" in text
     assert "  failed: too few positions seen" in text
     assert text.endswith("FAILED: 1 problem(s)\n  calibration: failed: too few positions seen")
+
+
+def test_the_headline_gives_measured_of_accepted_and_of_drawn_and_the_edge_apart() -> None:
+    from dataclasses import replace
+
+    from headsim.run.outcomes import MeasurementRecord
+
+    from .helpers import LOST, measurement
+
+    scenario = load_scenario("stress_zoom", fast=True, seed=1)
+    a = scenario.scene.acceptance
+    assert a is not None and a.refused and a.outside_start_view
+    edge = set(a.outside_start_view)
+    records = []
+    for k, t in enumerate(scenario.scene.targets):
+        # the edge ones 1 % off, the others 0.1 %; the first target failed
+        m = measurement((0.01 if t.name in edge else 0.001) * 0.8, 0.8, LOST if k == 0 else None)
+        scan = 3 if t.name in edge else 0  # a scan's renders are a search's
+        m = replace(m, name=t.name, scan_renders=scan, search_renders=scan)
+        records.append(MeasurementRecord(m, "calibrated", k))
+    result = RunResult(scenario, None, tuple(records), None, {"total": 0}, ("failed",))
+    text = summary_text(result)
+    ok = len(records) - 1
+    refused = ", ".join(f"{n} {code}" for code, n in a.refused.items())
+    assert (
+        f"head knew calibrated: {ok} of {a.accepted} accepted targets measured, {ok} of "
+        f"{a.drawn} drawn ({a.refused_total} draws refused by the reach check and drawn again: "
+        f"{refused})"
+    ) in text
+    edge_ok = len(edge - {scenario.scene.targets[0].name})
+    assert (
+        "of them at the edge of the field (not seen whole by both cameras at the start pose): "
+        f"{edge_ok} of {len(edge)} measured, 3-D error RMS 1.000 % of depth"
+    ) in text
+    assert (
+        f"{len(edge)} targets searched for again, {3 * len(edge)} renders of search ({len(edge)} "
+        f"scanned for where the head's pose did not show them: {3 * len(edge)} renders, 3.0 per "
+        "target)"
+    ) in text

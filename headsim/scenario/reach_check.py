@@ -1,0 +1,113 @@
+"""The loader's reach check: every listed target, chessboard corner, object and path
+point of a scenario that the head cannot fixate (:mod:`headsim.scenario.reach`) is
+refused, naming the field and why.  Geometry only, no rendering.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from headsim.scenario.occlusion import scene_model, scene_occluders
+from headsim.scenario.reach import (
+    ReachHead,
+    Refusal,
+    body_radius,
+    depth_refusal,
+    fmt_point,
+    model1_refusal,
+    model2_refusal,
+    target_refusal,
+)
+from headsim.scenario.spec import (
+    CHESSBOARD_PATTERN,
+    CHESSBOARD_SQUARE_M,
+    Placement,
+    Scenario,
+    corner_count,
+)
+from headsim.scenario.tables import Context
+from headsim.sim import names
+
+
+def _raise(ctx: Context, source: str, refusal: Refusal | None) -> None:
+    if refusal is not None:
+        raise ctx.error(source, refusal.message, refusal.allowed)
+
+
+def _check_in_front(ctx: Context, source: str, p_head: np.ndarray, what: str) -> None:
+    _raise(ctx, source, depth_refusal(p_head, what))
+
+
+def _chessboard_corners_world(placement: Placement, corners: tuple[int, ...] | None) -> np.ndarray:
+    """World positions of the chosen inner corners of a board placed at ``placement``."""
+    model = scene_model("chessboard")
+    rotation = np.zeros(9)
+    mujoco.mju_quat2Mat(rotation, model.body(names.CHESSBOARD).quat)
+    columns = CHESSBOARD_PATTERN[0]
+    indices = range(corner_count()) if corners is None else corners
+    local = np.array(
+        [
+            [(k % columns) * CHESSBOARD_SQUARE_M, (k // columns) * CHESSBOARD_SQUARE_M, 0.0]
+            for k in indices
+        ]
+    )
+    return np.asarray(placement.position_world_m) + local @ rotation.reshape(3, 3).T
+
+
+def check_reach(ctx: Context, scenario: Scenario) -> None:
+    head = ReachHead.of(scenario.settings)
+    scene = scenario.scene
+    procedure = scenario.experiment.procedure
+    placed: dict[str, np.ndarray] = {}
+    for target in scene.targets:
+        # What can hide it: the scene as the earlier targets left it.
+        p = np.array(target.position_world_m)
+        occluders = scene_occluders(scene.scene, placed, target.body)
+        refusal = target_refusal(head, procedure, p, "target", body_radius(target.body), occluders)
+        _raise(ctx, target.source, refusal)
+        placed[target.body] = p
+    if scene.chessboard is not None:
+        indices = range(corner_count()) if scene.corners is None else scene.corners
+        for k, p in zip(
+            indices, _chessboard_corners_world(scene.chessboard, scene.corners), strict=True
+        ):
+            refusal = model2_refusal(head, p, f"corner {k}", start_view=True)
+            _raise(ctx, scene.chessboard.source, refusal)
+    if scene.blocks is not None:
+        p = np.array(scene.blocks.position_world_m)
+        _raise(ctx, scene.blocks.source, model2_refusal(head, p, "cross point", start_view=True))
+        for placement in scene.objects:
+            p = head.to_head(np.array(placement.position_world_m))
+            _check_in_front(ctx, placement.source, p, placement.name)
+            if not (head.in_view(p, 0) and head.in_view(p, 1)):
+                raise ctx.error(
+                    placement.source,
+                    f"{placement.name} at {fmt_point(p)} m in H is outside a camera's view at the start pose",
+                    "objects that both cameras see with neck and eyes at 0",
+                )
+    if scene.pursuit is not None:
+        pursuit = scene.pursuit
+        first = True
+        for t in pursuit.sample_times():
+            if not pursuit.visibility.visible(float(t)):
+                continue
+            refusal = model1_refusal(
+                head, pursuit.path.position(float(t)), f"the target at t = {t:g} s", first
+            )
+            _raise(ctx, "scene.pursuit.path", refusal)
+            first = False
+    if scene.moving is not None:
+        moving = scene.moving
+        for k, t in enumerate(moving.times_s):
+            refusal = model1_refusal(
+                head,
+                moving.position(float(t)),
+                f"the target at t = {t:g} s",
+                k == 0,
+                body_radius(moving.body),
+            )
+            _raise(ctx, "scene.moving_target", refusal)
+
+
+__all__ = ["check_reach"]
