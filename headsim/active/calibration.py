@@ -77,6 +77,29 @@ class CalibrationRun:
         return np.asarray(self.fit.alpha_e) - np.asarray(self.truth_alpha_e)
 
 
+def tape_measure(
+    truth_head_m: np.ndarray,
+    rng: np.random.Generator,
+    *,
+    position_noise_m: float = 0.0,
+    depth_noise_m: float = 0.0,
+) -> np.ndarray:
+    """A target's position in H as the user measures it (a tape measure), m.
+
+    The true position (3,) plus Gaussian error of ``position_noise_m`` on each
+    coordinate and, on z_h only, of ``depth_noise_m`` besides (so z_h's error
+    has the standard deviation ``hypot(position_noise_m, depth_noise_m)``).
+    Drawn from ``rng`` in that order, each only when its noise is > 0.  The one
+    place :func:`calibrate_head` draws the tape's errors.
+    """
+    measured = np.array(truth_head_m, dtype=float)
+    if position_noise_m > 0:
+        measured = measured + rng.normal(0.0, position_noise_m, 3)
+    if depth_noise_m > 0:
+        measured[2] += rng.normal(0.0, depth_noise_m)
+    return measured
+
+
 def calibrate_head(
     sim: HeadSim,
     servo: EyeServo,
@@ -132,11 +155,9 @@ def calibrate_head(
             continue
         alpha1.append(m.details["alpha1_rad"])
         alpha2.append(m.details["alpha2_rad"])
-        measured = m.truth_head_m.copy()
-        if position_noise_m > 0:
-            measured = measured + rng.normal(0.0, position_noise_m, 3)
-        if depth_noise_m > 0:
-            measured[2] += rng.normal(0.0, depth_noise_m)
+        measured = tape_measure(
+            m.truth_head_m, rng, position_noise_m=position_noise_m, depth_noise_m=depth_noise_m
+        )
         depths.append(measured[2])
         rows.append((measured, m.details))
     sim.set_body_pose(body, parked)
@@ -296,4 +317,5 @@ __all__ = [
     "LineOfSightTruth",
     "calibrate_head",
     "line_of_sight_truth",
+    "tape_measure",
 ]

@@ -14,8 +14,10 @@ from headsim.active.failure import FailureCause
 from headsim.active.measurement import HeadKnowledge, body_target
 from headsim.active.model2 import Model2Config, measure_model2
 from headsim.active.placement import calibration_layout
+from headsim.estimators.calibration import calibrate_initial_directions
+from headsim.geometry.synthetic import StereoHead, fixation_angles
 from headsim.sim import names
-from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
+from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import find_marker
 
@@ -106,3 +108,22 @@ def test_paper_cameras_after_calibration_measure_within_the_papers_accuracy() ->
             assert abs(m.error_head_m[1]) < 0.003 * m.depth_m  # with the extended calibration
             plain = measure_model2(sim, servo, RED, HeadKnowledge(alpha_e=run.knowledge.alpha_e))
             assert abs(plain.error_head_m[1]) > abs(m.error_head_m[1])
+
+
+def test_the_calibration_fits_the_believed_baseline_not_the_true_one() -> None:
+    # The head is 3 mm wider than it believes: fitted with the believed D, the initial
+    # directions take up what they can of the error, as the exact forward model predicts.
+    true_d, believed_d = 0.153, 0.150
+    settings = HeadSettings(baseline_m=true_d, belief=HeadBelief(baseline_m=believed_d))
+    with HeadSim("default", settings) as sim:
+        layout = calibration_layout(sim, np.random.default_rng(1), 8)
+        points = sim.transform_points(layout, "world", "head")
+        run = calibrate_head(
+            sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, layout, extended=False
+        )
+    assert run.samples == len(layout)
+    exact = fixation_angles(StereoHead(true_d), points)
+    predicted = calibrate_initial_directions(exact.alpha1, exact.alpha2, points[:, 2], believed_d)
+    print(f"alpha_e {run.fit.alpha_e}, predicted {predicted.alpha_e}, truth {run.truth_alpha_e}")
+    np.testing.assert_allclose(run.fit.alpha_e, predicted.alpha_e, atol=4e-4)
+    assert np.abs(predicted.alpha_e - np.array(run.truth_alpha_e)).max() > 5e-3

@@ -1,4 +1,5 @@
-"""The live head (live/head.py): motion blur against a forward model, encoders, settings checks."""
+"""The live head (live/head.py): motion blur against a forward model, encoders, mid-exposure
+images, latency, settings checks."""
 
 from __future__ import annotations
 
@@ -50,6 +51,48 @@ def test_motion_blur_centroid_and_streak_match_the_forward_model() -> None:
         _, still_var = _weighted_u(sim.render(1))
         expected = still_var + projected[:, 0].var()
         assert streak_var == pytest.approx(expected, rel=0.1)
+
+
+def test_an_image_is_taken_at_mid_exposure() -> None:
+    """Without blur a frame is one render at the middle of its exposure: a moving marker is
+    seen where it is then, half an exposure after the frame's start (8 px at 1.5 m/s here)."""
+    exposure = 1 / 60
+    path = Waypoints(((-0.1, 0.6, 0.21), (0.3, 0.6, 0.21)), (1.5,))
+    config = LiveConfig(frame_rate_hz=30.0, exposure_s=exposure, latency_frames=0)
+    with HeadSim(settings=small_head()) as sim:
+        live = LiveHead(sim, config, "marker_red", path)
+        live.capture()
+        frame = live.capture()
+        start = config.period_s
+        middle = round((start + exposure / 2) / live.dt) * live.dt
+        assert frame.time_s == pytest.approx(middle, abs=1e-9)
+        assert frame.end_s == pytest.approx(start + exposure, abs=live.dt)
+        seen = RED(frame.images[0])
+        assert seen.found
+        at_middle = sim.project(path.position(middle), 1)[0]
+        at_start = sim.project(path.position(start), 1)[0]
+        np.testing.assert_allclose(seen.uv, at_middle, atol=0.15)
+        assert at_middle[0] - at_start[0] > 5.0
+
+
+def test_a_command_acts_the_latency_after_its_frame_ended() -> None:
+    config = LiveConfig(frame_rate_hz=30.0, exposure_s=0.01, latency_frames=2)
+    with HeadSim(settings=small_head()) as sim:
+        live = LiveHead(sim, config, "marker_red", Static((0.0, 0.6, 0.21)))
+        frame = live.capture()
+        acted: list[float] = []
+
+        def turn_eyes(motors, now: float) -> None:  # type: ignore[no-untyped-def]
+            acted.append(now)
+            motors.track(2, 0.1, 0.0, now)
+
+        live.send(turn_eyes, frame)
+        due = frame.end_s + 2 / 30.0  # 10 ms of exposure, then two frame periods: 77 ms
+        live.advance_to(due - 2 * live.dt)
+        assert acted == [] and abs(live.true_joints()[2]) < 1e-9  # nothing yet
+        live.advance_to(due + 0.05)
+    assert len(acted) == 1 and acted[0] == pytest.approx(due, abs=live.dt)
+    assert live.true_joints()[2] > 0.01  # and then the eyes turn
 
 
 def test_live_settings_are_checked_with_the_field_named() -> None:

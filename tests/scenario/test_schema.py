@@ -35,6 +35,60 @@ def test_initial_directions_set_the_mount_yaws(tmp_path: Path) -> None:
         assert sim.effective_initial_direction(2) == pytest.approx(-0.02, abs=1e-12)
 
 
+def _camera(index: int, field: str):  # type: ignore[no-untyped-def]
+    return lambda scenario: getattr(scenario.settings.cameras[index], field)
+
+
+#: Every imperfection a scenario can set for the head, its cameras, its belief and the
+#: calibration's tape: the line, where it must land and the value (unlike every preset's).
+IMPERFECTION_KEYS = [
+    ("[head]\nbaseline_m = 0.16", lambda s: s.settings.baseline_m, 0.16),
+    ("[head]\nneck_d1_m = 0.13", lambda s: s.settings.neck_d1_m, 0.13),
+    ("[head]\nneck_a2_m = 0.1", lambda s: s.settings.neck_a2_m, 0.1),
+    ("[head]\nencoder_resolution_rad = 1e-4", lambda s: s.settings.encoder_resolution_rad, 1e-4),
+    ("[head]\nmount_yaw_rad = [0.01, -0.02]", lambda s: [c.mount_yaw_rad for c in s.settings.cameras], [0.01, -0.02]),
+    ("[head]\nmount_pitch_rad = [0.003, -0.004]", lambda s: [c.mount_pitch_rad for c in s.settings.cameras], [0.003, -0.004]),
+    ("[head]\nmount_roll_rad = [0.005, -0.006]", lambda s: [c.mount_roll_rad for c in s.settings.cameras], [0.005, -0.006]),
+    ("[head]\nbacklash_rad = 5e-4", lambda s: s.settings.backlash_rad, 5e-4),
+    ("[head]\ncount_error = true", lambda s: s.settings.count_error, True),
+    ("[head]\nrender_offsamples = 2", lambda s: s.settings.render.offsamples, 2),
+    ("[head]\nrender_supersample = 3", lambda s: s.settings.render.supersample, 3),
+    ("[head]\nsettle = 'physics'", lambda s: s.settle_mode, "physics"),
+    ("[cam2]\nkx = 600.0", _camera(1, "kx"), 600.0),
+    ("[cam2]\nky = 590.0", _camera(1, "ky"), 590.0),
+    ("[cam2]\ncx = 310.0", _camera(1, "cx"), 310.0),
+    ("[cam2]\ncy = 250.0", _camera(1, "cy"), 250.0),
+    ("[cam2]\nk1 = -0.1", _camera(1, "k1"), -0.1),
+    ("[cam2]\nk2 = 0.02", _camera(1, "k2"), 0.02),
+    ("[cam2]\nnoise_std = 1.5", _camera(1, "noise_std"), 1.5),
+    ("[cam2]\nnodal_offset_m = 0.01", _camera(1, "nodal_offset_m"), 0.01),
+    ("[cam2]\nside_offset_m = 0.001", _camera(1, "side_offset_m"), 0.001),
+    ("[cam2]\neye_axis_tilt_rad = 0.003", _camera(1, "eye_axis_tilt_rad"), 0.003),
+    ("[belief]\nbaseline_m = 0.149", lambda s: s.settings.believed.baseline_m, 0.149),
+    ("[belief]\nneck_d1_m = 0.121", lambda s: s.settings.believed.neck_d1_m, 0.121),
+    ("[belief]\nneck_a2_m = 0.089", lambda s: s.settings.believed.neck_a2_m, 0.089),
+    ("[belief]\nnodal_offset_m = [0.01, 0.02]", lambda s: s.settings.believed.nodal_offset_m, (0.01, 0.02)),
+    ("[belief]\nside_offset_m = [0.001, -0.001]", lambda s: s.settings.believed.side_offset_m, (0.001, -0.001)),
+    ("[experiment.calibration]\ndepth_noise_m = 0.002", lambda s: s.experiment.calibration.depth_noise_m, 0.002),
+    ("[experiment.calibration]\nposition_noise_m = 0.001", lambda s: s.experiment.calibration.position_noise_m, 0.001),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("line", "where", "value"),
+    IMPERFECTION_KEYS,
+    ids=[line.replace("\n", " ").split(" =")[0] for line, _, _ in IMPERFECTION_KEYS],
+)
+def test_every_imperfection_key_reaches_the_settings(tmp_path: Path, line, where, value) -> None:  # type: ignore[no-untyped-def]
+    table, key_line = line.split("\n")
+    plain = load_scenario(write_scenario(tmp_path, MINIMAL + table + "\n", "plain.toml"))
+    told = load_scenario(write_scenario(tmp_path, MINIMAL + line + "\n", "told.toml"))
+    assert where(told) == value
+    assert where(plain) != value  # the preset's own value differs: the key moved it
+    if table == "[cam2]":  # the other camera keeps its own
+        assert _camera(0, key_line.split(" =")[0])(told) != value
+
+
 BAD = [
     (
         "[head]\nbaseline = 0.1\n",

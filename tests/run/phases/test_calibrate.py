@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import math
+from pathlib import Path
+
+import pytest
+from scipy.stats import chi2
+
 from headsim.active.failure import Failure, FailureCause
 from headsim.estimators.result import Status
 from headsim.run.phases.calibrate import position_outcomes
@@ -31,3 +37,26 @@ def test_each_position_outcome_keeps_its_failure() -> None:
     outcomes = position_outcomes([None, lost])
     assert [o.failure for o in outcomes] == [None, lost]
     assert [o.status_text for o in outcomes] == ["ok", "Ca2 at step 1: target lost"]
+
+
+@pytest.mark.parametrize(
+    ("position_noise_m", "depth_noise_m"), [(0.002, 0.0), (0.0, 0.002)], ids=["position", "depth"]
+)
+def test_a_scenarios_tape_noise_reaches_the_fit(
+    tmp_path: Path, position_noise_m: float, depth_noise_m: float
+) -> None:
+    # An ideal head (its servo scatters by about 0.1 mm): the depth residuals are the tape's.
+    path = tmp_path / "tape.toml"
+    path.write_text(
+        'description = "a tape"\n[experiment]\nprocedure = "model2"\n'
+        f"[experiment.calibration]\ntargets = 8\nposition_noise_m = {position_noise_m}\n"
+        f"depth_noise_m = {depth_noise_m}\n"
+        "[[scene.targets]]\nposition_head_m = [0.02, 0.01, 0.6]\n"
+    )
+    report = calibrate_scenario(load_scenario(path))
+    assert report.status is Status.OK and report.depth_residual_rms_m is not None
+    n = report.fixated
+    sigma_z = math.hypot(position_noise_m, depth_noise_m)
+    statistic = n * (report.depth_residual_rms_m / sigma_z) ** 2
+    lo, hi = chi2.ppf([0.001, 0.999], n - 2)  # the fit takes 2 of the n degrees
+    assert lo < statistic < hi, (statistic, lo, hi)
