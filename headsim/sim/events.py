@@ -11,7 +11,7 @@ only reads.
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass, replace
 from typing import Protocol
 
 import numpy as np
@@ -46,6 +46,47 @@ class ImageKind(enum.Enum):
 
 
 @dataclass(frozen=True)
+class RenderCounts:
+    """Images the simulator drew, by kind; every one of them is a render (``total``), the
+    way ``HeadSim.render_count`` counts them.
+
+    ``images``: whole frames (FULL); ``windows``: windows (WINDOW); ``retakes``: whole
+    images of an instant a window had just been taken of, after it missed (RETAKE);
+    ``previews``: binned previews (PREVIEW).
+    """
+
+    images: int = 0
+    windows: int = 0
+    retakes: int = 0
+    previews: int = 0
+
+    @property
+    def total(self) -> int:
+        """Every render: images, windows, retakes and previews."""
+        return self.images + self.windows + self.retakes + self.previews
+
+    def counted(self, kind: ImageKind) -> RenderCounts:
+        """These counts and one image of ``kind``."""
+        field = _COUNTED[kind]
+        return replace(self, **{field: getattr(self, field) + 1})
+
+    def __add__(self, other: RenderCounts) -> RenderCounts:
+        return RenderCounts(*(a + b for a, b in zip(astuple(self), astuple(other), strict=True)))
+
+    def __sub__(self, other: RenderCounts) -> RenderCounts:
+        return RenderCounts(*(a - b for a, b in zip(astuple(self), astuple(other), strict=True)))
+
+
+#: The field of :class:`RenderCounts` that counts each kind of image.
+_COUNTED = {
+    ImageKind.FULL: "images",
+    ImageKind.WINDOW: "windows",
+    ImageKind.RETAKE: "retakes",
+    ImageKind.PREVIEW: "previews",
+}
+
+
+@dataclass(frozen=True)
 class ImageTaken:
     """Camera 1 or 2 took ``image`` (H, W, 3) uint8 as rendered: the whole image, the
     window's crop, or the binned preview.
@@ -63,4 +104,4 @@ class ImageTaken:
     binning: int = 1
 
 
-__all__ = ["NO_EVENTS", "EventSink", "ImageKind", "ImageTaken", "NoEvents"]
+__all__ = ["NO_EVENTS", "EventSink", "ImageKind", "ImageTaken", "NoEvents", "RenderCounts"]

@@ -379,7 +379,8 @@ class HeadSim:
 
     @property
     def render_count(self) -> int:
-        """Images rendered so far by this simulator (full frames and windows)."""
+        """Images this simulator drew so far, each one a render: full frames, windows,
+        retakes and previews (:class:`~headsim.sim.events.RenderCounts` by kind)."""
         return self._renderer.render_count
 
     @property
