@@ -40,7 +40,9 @@ class ImageKind(enum.Enum):
     """How an image was taken (each one is counted as a render by the simulator)."""
 
     FULL = "full"  # the camera's whole image
-    RETAKE = "retake"  # the whole image of the instant a window was just taken of (it missed)
+    # the instant a window was just taken of (it missed) taken again: the whole image, or
+    # the window a preview placed (``ImageTaken.window``)
+    RETAKE = "retake"
     WINDOW = "window"  # only a window of the image (``ImageTaken.window``)
     PREVIEW = "preview"  # the whole view binned ``binning`` x ``binning``, to place a window
 
@@ -50,9 +52,9 @@ class RenderCounts:
     """Images the simulator drew, by kind; every one of them is a render (``total``), the
     way ``HeadSim.render_count`` counts them.
 
-    ``images``: whole frames (FULL); ``windows``: windows (WINDOW); ``retakes``: whole
-    images of an instant a window had just been taken of, after it missed (RETAKE);
-    ``previews``: binned previews (PREVIEW).
+    ``images``: whole frames (FULL); ``windows``: windows (WINDOW); ``retakes``: the
+    instant of a window that missed taken again, whole or as the window a preview
+    placed (RETAKE); ``previews``: binned previews (PREVIEW).
     """
 
     images: int = 0
@@ -91,7 +93,8 @@ class ImageTaken:
     """Camera 1 or 2 took ``image`` (H, W, 3) uint8 as rendered: the whole image, the
     window's crop, or the binned preview.
 
-    ``window``: where a WINDOW image lies in the full frame, px (None otherwise);
+    ``window``: where a WINDOW image (or a RETAKE of a window) lies in the full frame,
+    px (None: the whole image);
     ``binning``: a PREVIEW's binning (1 otherwise); ``rendered_frames``: the pixels
     this image cost, in full frames (the simulator's ``rendered_frames`` increment).
     """

@@ -61,6 +61,29 @@ def test_a_window_is_the_full_frames_crop_noise_included(head: str) -> None:
         assert window_sim.render_count == full_sim.render_count == 2 * len(WINDOWS)
 
 
+def test_a_retaken_window_is_of_the_instant_just_taken() -> None:
+    """A window retaken (after a miss, where a preview places it) has the noise of the
+    image just taken, not the next one's; it is a render, counted as a retake."""
+    settings = HeadSettings(cameras=(CameraSettings(noise_std=3.0),) * 2, seed=4)
+    taken: list[object] = []
+    with HeadSim("default", settings) as sim, HeadSim("default", settings) as plain:
+        sim.sink = type("Sink", (), {"emit": lambda self, e: taken.append(e)})()
+        for s in (sim, plain):
+            _pose(s)
+        first, second = Window(300, 200, 77, 61), Window(250, 180, 140, 100)
+        sim.render_window(1, first)
+        again = sim.render_window(1, second, retake=True)
+        nxt = sim.render_window(1, second)
+        for full, part in ((plain.render(1), again), (plain.render(1), nxt)):
+            crop = full[second.y0 : second.y1, second.x0 : second.x1].astype(int)
+            assert np.mean(np.abs(part.astype(int) - crop) <= 1) >= 0.999
+        assert not np.array_equal(again, nxt)  # the next image has noise of its own
+        assert sim.render_count == 3
+        kinds = [e.kind.value for e in taken]  # type: ignore[attr-defined]
+        assert kinds == ["window", "retake", "window"]
+        assert taken[1].window == second  # type: ignore[attr-defined]
+
+
 def test_a_window_outside_the_image_is_refused() -> None:
     with HeadSim("default") as sim, pytest.raises(ValueError, match="not inside"):
         sim.render_window(1, Window(600, 0, 64, 48))
