@@ -61,9 +61,10 @@ class EyeServo:
         #: Gain per camera, px per encoder step, carried from one target to the next.
         self.gains: dict[int, float] = {}
         #: Per camera, the last detection the window is predicted from:
-        #: (detector, eye steps, neck encoders, placements, uv px, area px^2).
+        #: (detector, eye steps, neck encoders, uv px, area px^2).  Only what the head
+        #: saw and moved: whether the scene changed since, its next image tells.
         self._seen: dict[
-            int, tuple[object, int, tuple[float, float], int, tuple[float, float], float]
+            int, tuple[object, int, tuple[float, float], tuple[float, float], float]
         ] = {}
         #: Per camera, the extent of the pattern last seen (None: a blob).
         self._extent: dict[int, tuple[float, float, float, float] | None] = {}
@@ -84,22 +85,27 @@ class EyeServo:
     def observe(
         self, camera: int, detector: Detector, key: object = None, preview: bool = True
     ) -> Detection:
-        """Render ``camera`` and detect the target in it (one render, two on a window miss).
+        """Render ``camera`` and detect the target in it (one render; more on a window miss).
 
         With windows on, and when this camera last saw the same target
-        (``key``, default the detector) with the neck and the scene unchanged
-        since and a gain known, only a window is rendered: around where the
-        head expects the target from that detection and the eye steps moved
-        since (u + gain * steps), of half-side 3 blob radii plus the margin
-        and a quarter of the predicted motion (blob detectors only, see
-        :data:`WINDOWED_DETECTORS`).  The detection there counts
-        only if it is FOUND at least 3 blob radii + 2 px inside the window
-        (so the blob and every piece the detector looks for beside it lie in
-        the window); otherwise the window is a miss (counted) and a full
-        frame is rendered.  Never from the truth: detections, gain, encoders.
-        A new target, or a pattern's feature after a move too long to find it
-        alone (the pattern placing it), is first found in a binned preview;
-        ``preview=False`` renders the full frame instead (a search's look).
+        (``key``, default the detector) with the neck unchanged since and a
+        gain known, only a window is rendered: around where the head expects
+        the target from that detection and the eye steps moved since
+        (u + gain * steps), of half-side 3 blob radii plus the margin and a
+        quarter of the predicted motion (blob detectors only, see
+        :data:`WINDOWED_DETECTORS`).  The detection there counts only if it
+        is FOUND at least 3 blob radii + 2 px inside the window (so the blob
+        and every piece the detector looks for beside it lie in the window)
+        and, for a blob, with an area within ``AREA_CHANGE`` of the one seen
+        then; otherwise the window is a miss (counted): the target moved, or
+        something else is there.  A blob's miss is looked for again in a
+        binned preview and the window it places, of the same instant, and
+        where that misses too (or for a pattern) the same instant's full frame
+        is rendered.  Never from the truth, nor from whether the scene changed:
+        detections, gain, encoders.  A new target, or a pattern's feature
+        after a move too long to find it alone (the pattern placing it), is
+        first found in a binned preview; ``preview=False`` renders the full
+        frame instead (a search's look).
         """
         key = detector if key is None else key
         sim = self.sim
@@ -111,6 +117,8 @@ class EyeServo:
         window, spacing = None, 0.0
         if pattern or windowed(key):
             window, spacing = self._window(camera, key, steps, neck, alone)
+        # A blob's window placed from the last sight of it: a guess the image confirms.
+        guessed = self._seen[camera][4] if window is not None and not pattern else None
         looked = None
         if preview and alone is not None and not spacing:
             looked = self._pattern_preview(camera, key, detector, alone)
@@ -124,19 +132,22 @@ class EyeServo:
             self.window_renders += 1
             look = partial(alone[1], spacing_px=spacing) if spacing and alone else detector
             detection = look_in_window(
-                sim, camera, reporting(look, self.sink, camera, window), window
+                sim, camera, reporting(look, self.sink, camera, window), window, guessed
             )
             if detection is not None and spacing and alone:
                 found_alone = alone[0]
             if detection is None:
                 self.window_misses += 1
+                if guessed is not None and preview:
+                    detection = self._found_again(camera, key, detector)
+            if detection is None:
                 # the same instant, whole
                 detection = reporting(detector, self.sink, camera)(sim.retake(camera))
         if detection is None:
             detection = reporting(detector, self.sink, camera)(sim.render(camera))
         # Only blob detections (a centroid and an area) predict a window.
         if isinstance(detection, Detection) and detection.found and detection.uv is not None:
-            self._seen[camera] = (key, steps, neck, sim.placements, detection.uv, detection.area_px)
+            self._seen[camera] = (key, steps, neck, detection.uv, detection.area_px)
             self._extent[camera] = detection.extent_px
             kept = remembered(self._pattern.get(camera), detection, found_alone)
             if kept is None:
@@ -152,14 +163,31 @@ class EyeServo:
 
     def _preview(self, camera: int, detector: object, neck: tuple[float, float]) -> Window | None:
         """A preview's window for ``detector``'s blob (see :func:`preview_window`) where no
-        detection predicts where it is (a new target, one moved, or the neck moved since)."""
+        detection predicts where it is (a new target, or the neck moved since)."""
         seen = self._seen.get(camera)
         if not self.config.windows or self.config.preview_binning <= 1:
             return None
-        if seen is not None and seen[0] == detector and seen[2:4] == (neck, self.sim.placements):
+        if seen is not None and seen[0] == detector and seen[2] == neck:
             return None
         self.previews += 1
         return preview_window(self.sim, camera, detector, self.config)
+
+    def _found_again(self, camera: int, key: object, detector: Detector) -> Detection | None:
+        """After the window the last sight placed missed: the blob in the window a binned
+        preview of the same instant places (:func:`preview_window`), or None (no preview,
+        not in it, or that window missed too: the full frame follows)."""
+        if self.config.preview_binning <= 1:
+            return None
+        self.previews += 1
+        window = preview_window(self.sim, camera, key, self.config)
+        if window is None:
+            return None
+        self.window_renders += 1
+        look = reporting(detector, self.sink, camera, window)
+        detection = look_in_window(self.sim, camera, look, window, retake=True)
+        if detection is None:
+            self.window_misses += 1
+        return detection
 
     def _pattern_preview(
         self, camera: int, key: object, detector: Detector, alone: AloneFinder
@@ -193,8 +221,8 @@ class EyeServo:
         seen, gain = self._seen.get(camera), self.gains.get(camera)
         if not cfg.windows or seen is None or gain is None:
             return None, 0.0
-        seen_key, seen_steps, seen_neck, placements, uv, area = seen
-        if seen_key != key or seen_neck != neck or placements != sim.placements:
+        seen_key, seen_steps, seen_neck, uv, area = seen
+        if seen_key != key or seen_neck != neck:
             return None, 0.0
         motion = gain * (steps - seen_steps)
         kept = self._pattern.get(camera)

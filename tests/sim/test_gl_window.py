@@ -214,8 +214,11 @@ def test_windows_change_no_measurement(head: str) -> None:
     assert len(changes) >= 0.9 * len(servo.seen)
     assert max(changes) <= 0.01
     # Same images taken, plus a binned preview where no detection placed the window
-    # (a new target); far fewer pixels rendered.
-    assert renders == plain_renders + servo.previews
+    # (a new target), and where the last sight's window missed (the target was moved:
+    # at most once per point and camera) a preview and the image it places, of the same
+    # instant; far fewer pixels rendered.
+    assert renders == plain_renders + servo.previews + servo.window_misses
+    assert 0 < servo.window_misses <= 2 * len(points)
     assert 0 < servo.previews <= servo.window_renders
     assert servo.window_renders > renders / 2
     assert frames < 0.5 * plain_frames
@@ -255,8 +258,10 @@ def test_windows_change_no_fixation_with_the_neck() -> None:
         assert (a_uv is None) == (b_uv is None)
         if a_uv is not None and b_uv is not None:
             assert np.max(np.abs(np.subtract(a_uv, b_uv))) <= 0.01
-    assert renders == plain_renders + servo.previews
-    assert servo.window_renders > 0 and servo.window_misses <= servo.window_renders // 10
+    assert renders == plain_renders + servo.previews + servo.window_misses
+    # A miss where the last fixation's window no longer holds the moved target: at
+    # most once per point and camera.
+    assert servo.window_renders > 0 and servo.window_misses <= 2 * len(points)
     assert frames < 0.7 * plain_frames
 
 
@@ -341,9 +346,9 @@ def test_a_seen_boards_corners_are_looked_for_alone_in_small_windows() -> None:
             sizes: list[int] = []
             render_window = sim.render_window
 
-            def logged(camera, window, render_window=render_window, sizes=sizes):  # type: ignore[no-untyped-def]
+            def logged(camera, window, retake=False, render_window=render_window, sizes=sizes):  # type: ignore[no-untyped-def]
                 sizes.append(window.width * window.height)
-                return render_window(camera, window)
+                return render_window(camera, window, retake)
 
             sim.render_window = logged  # type: ignore[method-assign]
             servo = LoggingServo(sim, ServoConfig(windows=windows))
