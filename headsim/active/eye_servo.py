@@ -71,6 +71,11 @@ class EyeServo:
         #: Per camera, where the last detection puts its pattern (a board seen whole,
         #: then moved with each feature found alone); absent after a blob or a miss.
         self._pattern: dict[int, SeenPattern] = {}
+        #: Cameras that saw the pattern whole in this fixation (since ``run`` began one):
+        #: only they look for a feature alone.  A chessboard's corners all look alike, so
+        #: only the whole board tells which one a window holds, and a board may have moved
+        #: by whole squares since the last fixation, for all the head knows.
+        self._confirmed: set[int] = set()
         #: Binned previews rendered to place a window (see ``ServoConfig.preview_binning``).
         self.previews = 0
         #: Windows rendered, and windows that missed the target (a full frame followed).
@@ -114,13 +119,13 @@ class EyeServo:
         alone = alone_finder(key) if pattern else None
         if pattern:  # a pattern's features share their windows
             key = getattr(key, "window_key", key)
-        window, spacing = None, 0.0
+        window, spacing, whole = None, 0.0, False
         if pattern or windowed(key):
-            window, spacing = self._window(camera, key, steps, neck, alone)
+            window, spacing, whole = self._window(camera, key, steps, neck, alone)
         # A blob's window placed from the last sight of it: a guess the image confirms.
         guessed = self._seen[camera][4] if window is not None and not pattern else None
         looked = None
-        if preview and alone is not None and not spacing:
+        if preview and alone is not None and not spacing and not whole:
             looked = self._pattern_preview(camera, key, detector, alone)
         if looked is not None:
             window, spacing = looked
@@ -147,6 +152,8 @@ class EyeServo:
             detection = reporting(detector, self.sink, camera)(sim.render(camera))
         # Only blob detections (a centroid and an area) predict a window.
         if isinstance(detection, Detection) and detection.found and detection.uv is not None:
+            if looked is not None or detection.pattern_uv is not None:
+                self._confirmed.add(camera)  # the pattern seen whole (or its preview)
             self._seen[camera] = (key, steps, neck, detection.uv, detection.area_px)
             self._extent[camera] = detection.extent_px
             kept = remembered(self._pattern.get(camera), detection, found_alone)
@@ -159,6 +166,7 @@ class EyeServo:
         else:
             self._seen.pop(camera, None)
             self._pattern.pop(camera, None)
+            self._confirmed.discard(camera)
         return detection
 
     def _preview(self, camera: int, detector: object, neck: tuple[float, float]) -> Window | None:
@@ -213,34 +221,51 @@ class EyeServo:
         steps: int,
         neck: tuple[float, float],
         alone: AloneFinder | None = None,
-    ) -> tuple[Window | None, float]:
-        """Where to look for ``key``'s target in ``camera`` (None: the full frame), and
-        the pattern's spacing, px, when it is a feature looked for ``alone`` (else 0):
-        around where the last sight of the pattern puts it (:class:`SeenPattern`)."""
+    ) -> tuple[Window | None, float, bool]:
+        """Where to look for ``key``'s target in ``camera`` (None: the full frame), the
+        pattern's spacing, px, when it is a feature looked for ``alone`` (else 0), and
+        whether it is the whole pattern's window that confirms which feature is which
+        before one is looked for alone (a new fixation after a short move): around
+        where the last sight of the pattern puts it (:class:`SeenPattern`)."""
         cfg, sim = self.config, self.sim
         seen, gain = self._seen.get(camera), self.gains.get(camera)
         if not cfg.windows or seen is None or gain is None:
-            return None, 0.0
+            return None, 0.0, False
         seen_key, seen_steps, seen_neck, uv, area = seen
         if seen_key != key or seen_neck != neck:
-            return None, 0.0
+            return None, 0.0, False
         motion = gain * (steps - seen_steps)
         kept = self._pattern.get(camera)
+        extent = self._extent.get(camera)
         if alone is not None and kept is not None and kept.expects_alone(alone[0], motion):
+            if camera not in self._confirmed:  # the whole pattern first
+                window = None
+                if extent is not None:
+                    window = pattern_window(
+                        sim, camera, (uv[0] + motion, uv[1]), extent, motion, cfg.window_margin_px
+                    )
+                return window, 0.0, window is not None
             u, v = kept.features[alone[0]]
             spacing = kept.spacing_px
             window = pattern_window(
                 sim, camera, (u + motion, v), alone[2](spacing), motion, cfg.window_margin_px
             )
-            return window, spacing if window is not None else 0.0
-        extent = self._extent.get(camera)
+            return window, spacing if window is not None else 0.0, False
         if extent is not None:  # a pattern: the whole of it
-            return pattern_window(
-                sim, camera, (uv[0] + motion, uv[1]), extent, motion, cfg.window_margin_px
-            ), 0.0
-        return expected_window(
-            sim, camera, (uv[0] + motion, uv[1]), area, motion, cfg.window_margin_px
-        ), 0.0
+            return (
+                pattern_window(
+                    sim, camera, (uv[0] + motion, uv[1]), extent, motion, cfg.window_margin_px
+                ),
+                0.0,
+                False,
+            )
+        return (
+            expected_window(
+                sim, camera, (uv[0] + motion, uv[1]), area, motion, cfg.window_margin_px
+            ),
+            0.0,
+            False,
+        )
 
     def run(
         self,
@@ -256,8 +281,11 @@ class EyeServo:
         the last step that saw it, no render needed) and retried at half the
         length, at most ``max_retreats`` times.  Once converged, the sub-step
         fixation may be averaged over images around the crossing (see
-        ``ServoConfig.average_fixation``).
+        ``ServoConfig.average_fixation``).  Without ``first`` a new fixation begins: a
+        pattern is seen whole again before its features are looked for alone.
         """
+        if first is None:
+            self._confirmed.clear()
         goal = self.sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
         result = self._servo(camera, detector, goal, first)
         if result.converged:

@@ -14,11 +14,14 @@ import mujoco
 import numpy as np
 import pytest
 
+from headsim.active.chessboard import chessboard_corner_target
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import Measurement, body_target
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
+from headsim.sim import names
 from headsim.sim.events import ImageKind, ImageTaken
+from headsim.sim.settings import paper_head
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import find_marker
 
@@ -153,6 +156,29 @@ def test_the_neck_servo_finds_a_moved_target_from_its_images() -> None:
     assert ImageKind.PREVIEW not in near and near[0] is ImageKind.WINDOW
     assert far[:3] == [ImageKind.WINDOW, ImageKind.PREVIEW, ImageKind.RETAKE]
     assert misses >= 1
+
+
+def test_a_board_moved_by_whole_squares_is_seen_whole_before_a_corner_alone() -> None:
+    """A chessboard's corners all look alike: after the board moved by exactly two squares,
+    the window where the last fixation put corner 19 holds corner 17.  A new fixation
+    looks at the whole board first, so the corner measured is corner 19, as a fresh
+    head measures it."""
+    shifted = np.array([0.06, 0.0, 0.0])  # two 30 mm squares along the board's rows
+    target = chessboard_corner_target(19, (8, 6), 0.03)
+    estimates: list[np.ndarray] = []
+    for remembered in (True, False):
+        with HeadSim("chessboard", paper_head()) as sim:
+            base = sim.transform_points([-0.105, -0.075, 0.85], "head", "world")[0]
+            sim.set_body_pose(names.CHESSBOARD, base)
+            rows = sim.data.body(names.CHESSBOARD).xmat.reshape(3, 3)
+            servo = EyeServo(sim)
+            if remembered:
+                assert measure_model2(sim, servo, target).ok
+            sim.set_body_pose(names.CHESSBOARD, base + rows @ shifted)
+            m = measure_model2(sim, servo, target)  # the fresh head: its first sight
+            assert m.ok
+            estimates.append(m.estimate_head_m)
+    np.testing.assert_allclose(estimates[0], estimates[1], atol=1e-5)  # 0.01 mm
 
 
 def _reads_placements(path: Path) -> bool:
