@@ -12,13 +12,10 @@ learnt on one target seeds the next.  Every loop is bounded and returns a
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from functools import partial
 
-import numpy as np
-
 from headsim.active.events import ServoKind, ServoStep
-from headsim.active.fixation_average import pixel_period_steps
+from headsim.active.fixation_average import average_eye_crossing
 from headsim.active.seen_pattern import SeenPattern, remembered
 from headsim.active.servo_types import (
     Detector,
@@ -30,6 +27,7 @@ from headsim.active.windows import (
     AloneFinder,
     alone_finder,
     expected_window,
+    look_again,
     look_in_window,
     pattern_preview,
     pattern_window,
@@ -60,9 +58,9 @@ class EyeServo:
         self._step_range = (math.ceil(low / resolution), math.floor(high / resolution))
         #: Gain per camera, px per encoder step, carried from one target to the next.
         self.gains: dict[int, float] = {}
-        #: Per camera, the last detection the window is predicted from:
-        #: (detector, eye steps, neck encoders, uv px, area px^2).  Only what the head
-        #: saw and moved: whether the scene changed since, its next image tells.
+        #: Per camera, the last detection the window is predicted from (what the head
+        #: saw and did, not whether the scene changed): (detector, eye steps, neck
+        #: encoders, uv px, area px^2).
         self._seen: dict[
             int, tuple[object, int, tuple[float, float], tuple[float, float], float]
         ] = {}
@@ -71,10 +69,8 @@ class EyeServo:
         #: Per camera, where the last detection puts its pattern (a board seen whole,
         #: then moved with each feature found alone); absent after a blob or a miss.
         self._pattern: dict[int, SeenPattern] = {}
-        #: Cameras that saw the pattern whole in this fixation (since ``run`` began one):
-        #: only they look for a feature alone.  A chessboard's corners all look alike, so
-        #: only the whole board tells which one a window holds, and a board may have moved
-        #: by whole squares since the last fixation, for all the head knows.
+        #: Cameras that saw the pattern whole in this fixation (``run`` begins one): only
+        #: they look for a feature alone (the board may have moved by whole squares since).
         self._confirmed: set[int] = set()
         #: Binned previews rendered to place a window (see ``ServoConfig.preview_binning``).
         self.previews = 0
@@ -101,19 +97,17 @@ class EyeServo:
         :data:`WINDOWED_DETECTORS`).  The detection there counts only if it
         is FOUND at least 3 blob radii + 2 px inside the window (so the blob
         and every piece the detector looks for beside it lie in the window)
-        and, for a blob, with an area within ``AREA_CHANGE`` of the one seen
-        then; otherwise the window is a miss (counted): the target moved, or
-        something else is there.  A blob's miss is looked for again in a
-        binned preview and the window it places, of the same instant, and
-        where that misses too (or for a pattern) the same instant's full frame
-        is rendered.  Never from the truth, nor from whether the scene changed:
-        detections, gain, encoders.  A new target, or a pattern's feature
-        after a move too long to find it alone (the pattern placing it), is
-        first found in a binned preview; ``preview=False`` renders the full
-        frame instead (a search's look).
+        and, for a blob, with an area within ``AREA_CHANGE`` of the one seen;
+        otherwise it is a miss (counted: the target moved, or something else is
+        there), looked for again in a preview (:func:`look_again`), then in the
+        same instant's full frame.  Never from the truth, nor from whether the
+        scene changed: detections, gain, encoders.  A new target, or a
+        pattern's feature after a move too long to find it alone, is first
+        found in a binned preview; ``preview=False`` renders the full frame
+        instead (a search's look).
         """
         key = detector if key is None else key
-        sim = self.sim
+        sim, cfg = self.sim, self.config
         steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
         pattern = pattern_windowed(key)
         alone = alone_finder(key) if pattern else None
@@ -143,8 +137,12 @@ class EyeServo:
                 found_alone = alone[0]
             if detection is None:
                 self.window_misses += 1
-                if guessed is not None and preview:
-                    detection = self._found_again(camera, key, detector)
+            if detection is None and guessed is not None and preview and cfg.preview_binning > 1:
+                self.previews += 1
+                report = partial(reporting, detector, self.sink, camera)
+                detection, rendered = look_again(sim, camera, key, cfg, report)
+                self.window_renders += rendered
+                self.window_misses += rendered and detection is None
             if detection is None:
                 # the same instant, whole
                 detection = reporting(detector, self.sink, camera)(sim.retake(camera))
@@ -180,23 +178,6 @@ class EyeServo:
         self.previews += 1
         return preview_window(self.sim, camera, detector, self.config)
 
-    def _found_again(self, camera: int, key: object, detector: Detector) -> Detection | None:
-        """After the window the last sight placed missed: the blob in the window a binned
-        preview of the same instant places (:func:`preview_window`), or None (no preview,
-        not in it, or that window missed too: the full frame follows)."""
-        if self.config.preview_binning <= 1:
-            return None
-        self.previews += 1
-        window = preview_window(self.sim, camera, key, self.config)
-        if window is None:
-            return None
-        self.window_renders += 1
-        look = reporting(detector, self.sink, camera, window)
-        detection = look_in_window(self.sim, camera, look, window, retake=True)
-        if detection is None:
-            self.window_misses += 1
-        return detection
-
     def _pattern_preview(
         self, camera: int, key: object, detector: Detector, alone: AloneFinder
     ) -> tuple[Window | None, float] | None:
@@ -224,9 +205,8 @@ class EyeServo:
     ) -> tuple[Window | None, float, bool]:
         """Where to look for ``key``'s target in ``camera`` (None: the full frame), the
         pattern's spacing, px, when it is a feature looked for ``alone`` (else 0), and
-        whether it is the whole pattern's window that confirms which feature is which
-        before one is looked for alone (a new fixation after a short move): around
-        where the last sight of the pattern puts it (:class:`SeenPattern`)."""
+        whether it is the whole pattern's window that tells the features apart first (in
+        a new fixation): around where the last sight of the pattern puts it."""
         cfg, sim = self.config, self.sim
         seen, gain = self._seen.get(camera), self.gains.get(camera)
         if not cfg.windows or seen is None or gain is None:
@@ -235,37 +215,21 @@ class EyeServo:
         if seen_key != key or seen_neck != neck:
             return None, 0.0, False
         motion = gain * (steps - seen_steps)
-        kept = self._pattern.get(camera)
-        extent = self._extent.get(camera)
+        kept, extent = self._pattern.get(camera), self._extent.get(camera)
+        expected, margin, whole = (uv[0] + motion, uv[1]), cfg.window_margin_px, False
         if alone is not None and kept is not None and kept.expects_alone(alone[0], motion):
-            if camera not in self._confirmed:  # the whole pattern first
-                window = None
-                if extent is not None:
-                    window = pattern_window(
-                        sim, camera, (uv[0] + motion, uv[1]), extent, motion, cfg.window_margin_px
-                    )
-                return window, 0.0, window is not None
-            u, v = kept.features[alone[0]]
-            spacing = kept.spacing_px
-            window = pattern_window(
-                sim, camera, (u + motion, v), alone[2](spacing), motion, cfg.window_margin_px
-            )
-            return window, spacing if window is not None else 0.0, False
+            if camera in self._confirmed:
+                u, v = kept.features[alone[0]]
+                spacing = kept.spacing_px
+                window = pattern_window(
+                    sim, camera, (u + motion, v), alone[2](spacing), motion, margin
+                )
+                return window, spacing if window is not None else 0.0, False
+            whole = True  # a new fixation: the whole pattern first
         if extent is not None:  # a pattern: the whole of it
-            return (
-                pattern_window(
-                    sim, camera, (uv[0] + motion, uv[1]), extent, motion, cfg.window_margin_px
-                ),
-                0.0,
-                False,
-            )
-        return (
-            expected_window(
-                sim, camera, (uv[0] + motion, uv[1]), area, motion, cfg.window_margin_px
-            ),
-            0.0,
-            False,
-        )
+            window = pattern_window(sim, camera, expected, extent, motion, margin)
+            return window, 0.0, whole and window is not None
+        return expected_window(sim, camera, expected, area, motion, margin), 0.0, False
 
     def run(
         self,
@@ -289,53 +253,8 @@ class EyeServo:
         goal = self.sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
         result = self._servo(camera, detector, goal, first)
         if result.converged:
-            result = self._average_crossing(camera, detector, goal, result)
+            result = average_eye_crossing(self, camera, detector, goal, result)
         return result
-
-    def _average_crossing(
-        self, camera: int, detector: Detector, goal: float, result: ServoResult
-    ) -> ServoResult:
-        """Average the crossing over images spread across one pixel around it (see
-        ``ServoConfig.average_fixation``); the eye ends at ``result.steps``."""
-        cfg, sim = self.config, self.sim
-        gain = result.gain_px_per_step
-        if not cfg.average_fixation or not gain or result.uv is None or not windowed(detector):
-            return result
-        low, high = self._step_range
-        poses = [
-            s
-            for s in pixel_period_steps(result.subpixel_steps, gain, cfg.max_fixation_samples)
-            if low <= s <= high
-        ]
-        seen = {s: u for s, u, _ in result.seen}
-        path = list(result.seen)
-        samples: list[tuple[int, float]] = []
-        renders = 0
-        for s in poses:  # bounded: at most max_fixation_samples poses
-            if s not in seen:
-                sim.command_eye_steps(s)
-                sim.settle()
-                detection = self.observe(camera, detector)
-                renders += 1
-                if not detection.found or detection.uv is None:
-                    break  # the averaging is bounded by what the images show
-                seen[s] = detection.uv[0]
-                path.append((s, *detection.uv))
-            samples.append((s, seen[s]))
-        if sim.eye_encoder_steps() != result.steps:
-            sim.command_eye_steps(result.steps)
-            sim.settle()
-        if len(samples) < 2:
-            return replace(result, renders=result.renders + renders, seen=tuple(path))
-        crossings = np.array([s - (u - goal) / gain for s, u in samples])
-        subpixel = float(crossings.mean())
-        return replace(
-            result,
-            subpixel_steps=subpixel,
-            renders=result.renders + renders,
-            seen=tuple(path),
-            fixation_samples=len(samples),
-        )
 
     def _servo(
         self, camera: int, detector: Detector, goal: float, first: Detection | None

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
@@ -20,6 +21,7 @@ from headsim.active.servo_types import (
 )
 from headsim.active.windows import (
     expected_window,
+    look_again,
     look_in_window,
     preview_window,
     reporting,
@@ -154,7 +156,7 @@ class NeckServo:
     ) -> Detection:
         """Detect in a rendered window; a miss costs the same instant's whole frame, or,
         for a window ``guessed`` from a blob of that area seen before, first a preview
-        and the window it places, of the same instant."""
+        and the window it places (:func:`look_again`)."""
         self.window_renders += 1
         detection = look_in_window(
             self.sim, camera, reporting(detector, self.sink, camera, window), window, guessed
@@ -164,14 +166,12 @@ class NeckServo:
         self.window_misses += 1
         if guessed is not None and self.config.preview_binning > 1:
             self.previews += 1
-            again = preview_window(self.sim, camera, self._key, self.config)
-            if again is not None:
-                self.window_renders += 1
-                look = reporting(detector, self.sink, camera, again)
-                detection = look_in_window(self.sim, camera, look, again, retake=True)
-                if detection is not None:
-                    return detection
-                self.window_misses += 1
+            report = partial(reporting, detector, self.sink, camera)
+            detection, rendered = look_again(self.sim, camera, self._key, self.config, report)
+            self.window_renders += rendered
+            if detection is not None:
+                return detection
+            self.window_misses += rendered
         return reporting(detector, self.sink, camera)(self.sim.retake(camera))
 
     def _in_range(self, steps: np.ndarray) -> bool:

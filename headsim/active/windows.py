@@ -5,7 +5,7 @@ full frame's, and each detection reported to the event sink.
 A servo knows nothing of the scene but its images: a window where its last sight
 puts the target is a guess, which the image in it confirms (the blob found well
 inside it, about as large as it was) or not; then the target is looked for
-again in a preview (:func:`preview_window`), as a target never seen is.
+again in a preview (:func:`look_again`), as a target never seen is.
 """
 
 from __future__ import annotations
@@ -163,6 +163,24 @@ def preview_window(
     return expected_window(sim, camera, uv, b * b * seen.area_px, 4.0 * b, config.window_margin_px)
 
 
+def look_again(
+    sim: HeadSim,
+    camera: int,
+    detector: object,
+    config: ServoConfig,
+    report: Callable[[Window], Detector],
+) -> tuple[Detection | None, bool]:
+    """After a window placed from an earlier sight missed (the target moved, or the window
+    shows something else): ``detector``'s blob found again in a binned preview, and
+    detected (by ``report(window)``) in the window the preview places, retaken of the
+    same instant.  Returns the detection (None: not in the preview, or that window
+    missed too: the full frame follows) and whether that window was rendered."""
+    window = preview_window(sim, camera, detector, config)
+    if window is None:
+        return None, False
+    return look_in_window(sim, camera, report(window), window, retake=True), True
+
+
 def look_once(
     sim: HeadSim,
     camera: int,
@@ -266,6 +284,7 @@ __all__ = [
     "AloneFinder",
     "alone_finder",
     "expected_window",
+    "look_again",
     "look_in_window",
     "look_once",
     "pattern_preview",
