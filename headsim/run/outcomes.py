@@ -102,7 +102,7 @@ class CalibrationSource:
     #: the renders the calibration took when it ran, by kind (None if the file does not
     #: say: one written before calibration blocks had ``render_counts``, whose
     #: ``renders`` left the previews out)
-    renders: RenderCounts | None
+    render_counts: RenderCounts | None
 
 
 @dataclass(frozen=True)

@@ -89,7 +89,7 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
                 scenario=stored.scenario,
                 seed=stored.seed,
                 head_hash=stored.head_hash,
-                renders=render_counts_from_block(stored.block),
+                render_counts=render_counts_from_block(stored.block),
             ),
         )
         hub.emit(CalibrationDone(calibration))

@@ -157,40 +157,24 @@ def summary_entry(s: MeasurementSummary) -> dict[str, Any]:
     }
 
 
-# -- renders ------------------------------------------------------------------------------
-
-
-def render_counts_entry(counts: RenderCounts) -> dict[str, int]:
-    """Every image drawn, by kind, and their ``total`` (each one a render)."""
-    return {
-        "images": counts.images,
-        "windows": counts.windows,
-        "retakes": counts.retakes,
-        "previews": counts.previews,
-        "total": counts.total,
-    }
-
-
 def render_counts_from_block(block: dict[str, Any]) -> RenderCounts | None:
     """The ``render_counts`` of a ``calibration`` block read back (None: the block has none,
     as one written before renders counted previews, whose ``renders`` counted them apart)."""
     entry = block.get("render_counts")
-    if entry is None:
-        return None
-    return RenderCounts(entry["images"], entry["windows"], entry["retakes"], entry["previews"])
+    return None if entry is None else RenderCounts.from_dict(entry)
 
 
 def run_render_counts(renders: RunRenders) -> dict[str, Any]:
     """results.json's ``render_counts``: each phase's and the run's renders by kind; the
     experiment's split into those its measurements count and the rest."""
     return {
-        "calibration": render_counts_entry(renders.calibration),
+        "calibration": renders.calibration.as_dict(),
         "experiment": {
-            **render_counts_entry(renders.experiment),
+            **renders.experiment.as_dict(),
             "in_measurements": renders.in_measurements,
             "outside_measurements": renders.outside_measurements,
         },
-        "overall": render_counts_entry(renders.overall),
+        "overall": renders.overall.as_dict(),
     }
 
 
@@ -225,7 +209,7 @@ def calibration_block(report: CalibrationReport) -> dict[str, Any]:
         "status": report.status_text,
         "targets": report.targets,
         "fixated": report.fixated,
-        "render_counts": render_counts_entry(report.renders),
+        "render_counts": report.renders.as_dict(),
     }
     layout = report.layout
     if layout is not None:
@@ -262,15 +246,10 @@ def calibration_block(report: CalibrationReport) -> dict[str, Any]:
     if report.rendered_frames is not None:
         block["rendered_frames"] = report.rendered_frames
     if report.source is not None:
-        source = report.source
+        counts = report.source.render_counts
         block["from"] = {
-            "path": source.path,
-            "scenario": source.scenario,
-            "seed": source.seed,
-            "head_hash": source.head_hash,
-            "render_counts": None
-            if source.renders is None
-            else render_counts_entry(source.renders),
+            **asdict(report.source),
+            "render_counts": None if counts is None else counts.as_dict(),
         }
     return block
 
@@ -289,14 +268,11 @@ def calibration_from_block(
 ) -> CalibrationReport:
     """The report of a ``calibration`` block read back from JSON (head.json), as written.
 
-    ``renders`` and ``source`` replace the block's own (a calibration read from a file);
-    a block without ``render_counts`` (written before renders counted previews) needs
-    ``renders``.
+    ``renders`` and ``source`` replace the block's own (a calibration read from a file;
+    a block written before renders counted previews has no ``render_counts``).
     """
     if renders is None:
-        renders = render_counts_from_block(block)
-        if renders is None:
-            raise KeyError("render_counts")
+        renders = RenderCounts.from_dict(block["render_counts"])
     status = block["status"]
     layout = block.get("layout")
     lines = block.get("lines_of_sight")
@@ -416,7 +392,6 @@ __all__ = [
     "calibration_from_block",
     "experiment_block",
     "measurement_entry",
-    "render_counts_entry",
     "render_counts_from_block",
     "results_payload",
     "run_render_counts",

@@ -11,7 +11,7 @@ only reads.
 from __future__ import annotations
 
 import enum
-from dataclasses import astuple, dataclass, replace
+from dataclasses import asdict, astuple, dataclass, fields, replace
 from typing import Protocol
 
 import numpy as np
@@ -66,6 +66,15 @@ class RenderCounts:
     def total(self) -> int:
         """Every render: images, windows, retakes and previews."""
         return self.images + self.windows + self.retakes + self.previews
+
+    def as_dict(self) -> dict[str, int]:
+        """The counts by kind and their ``total``, as results.json holds them."""
+        return {**asdict(self), "total": self.total}
+
+    @classmethod
+    def from_dict(cls, entry: dict[str, int]) -> RenderCounts:
+        """The counts of :meth:`as_dict` read back (its ``total`` follows from them)."""
+        return cls(**{f.name: int(entry[f.name]) for f in fields(cls)})
 
     def counted(self, kind: ImageKind) -> RenderCounts:
         """These counts and one image of ``kind``."""

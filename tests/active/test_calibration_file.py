@@ -68,8 +68,8 @@ def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
     assert result.ok
     assert result.renders.calibration.total == 0 and result.renders.overall.total > 0
     assert result.calibration is not None and result.calibration.source is not None
-    assert result.calibration.source.renders is not None
-    assert result.calibration.source.renders.total == block["render_counts"]["total"]
+    assert result.calibration.source.render_counts is not None
+    assert result.calibration.source.render_counts.total == block["render_counts"]["total"]
     assert result.calibration is not None
     assert result.calibration.source is not None
     assert result.calibration.source.path == str(head_file)
