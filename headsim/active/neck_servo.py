@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
@@ -20,6 +21,7 @@ from headsim.active.servo_types import (
 )
 from headsim.active.windows import (
     expected_window,
+    look_again,
     look_in_window,
     preview_window,
     reporting,
@@ -58,10 +60,11 @@ class NeckServo:
         ]
         self.jacobian: np.ndarray | None = None
         #: The last images' detections the windows are predicted from:
-        #: (detector, steps, placements, ((u, v), area) per camera), and the count
-        #: of windows rendered and missed (see :meth:`EyeServo.observe`).
+        #: (detector, steps, ((u, v), area) per camera), and the count of windows
+        #: rendered and missed (see :meth:`EyeServo.observe`).  Only what the head saw
+        #: and moved: whether the scene changed since, its next images tell.
         self._seen: (
-            tuple[object, tuple[int, ...], int, list[tuple[tuple[float, float], float]]] | None
+            tuple[object, tuple[int, ...], list[tuple[tuple[float, float], float]]] | None
         ) = None
         self.window_renders = 0
         self.window_misses = 0
@@ -95,7 +98,7 @@ class NeckServo:
         seen = self._looks(detector)
         steps = tuple(int(s) for s in self._steps())
         if len(seen) == 2 and all(s.found and s.uv is not None for s in seen):
-            self._seen = (self._key, steps, self.sim.placements, [(s.uv, s.area_px) for s in seen])  # type: ignore[misc]
+            self._seen = (self._key, steps, [(s.uv, s.area_px) for s in seen])  # type: ignore[misc]
         else:
             self._seen = None
         for camera, s in enumerate(seen, start=1):
@@ -107,8 +110,11 @@ class NeckServo:
 
     def _look(self, camera: int, detector: Detector) -> Detection:
         """Detect in ``camera``: in a window around where the last images and the
-        Jacobian put the target (same target, scene unchanged, blob detector), else
-        in the full frame; a miss costs the full frame and is counted."""
+        Jacobian put the target (same target, blob detector), else in the full frame.
+        The window's detection counts if the blob is well inside it and about as large
+        as seen then (see :meth:`EyeServo.observe`); a miss (the target moved, or
+        something else is there) is counted and looked for again in a preview and its
+        window of the same instant, then in the same instant's full frame."""
         sim, seen = self.sim, self._seen
         jac = self._current
         if (
@@ -116,12 +122,11 @@ class NeckServo:
             and seen is not None
             and jac is not None
             and seen[0] is self._key
-            and seen[2] == sim.placements
             and windowed(self._key)
         ):
             move = self._steps() - np.array(seen[1])
             du1, du2, dv = jac @ move
-            (u, v), area = seen[3][camera - 1]
+            (u, v), area = seen[2][camera - 1]
             du = du1 if camera == 1 else du2
             window = expected_window(
                 sim,
@@ -132,29 +137,41 @@ class NeckServo:
                 self.config.window_margin_px,
             )
             if window is not None:
-                return self._look_in(window, camera, detector)
+                return self._look_in(window, camera, detector, area)
         elif (
             self.config.windows
             and self.config.preview_binning > 1
             and windowed(self._key)
-            and (seen is None or seen[0] is not self._key or seen[2] != sim.placements)
+            and (seen is None or seen[0] is not self._key)
         ):
-            # A new or moved target: find it in a preview, then render its window.
+            # A new target: find it in a preview, then render its window.
             self.previews += 1
             window = preview_window(sim, camera, self._key, self.config)
             if window is not None:
                 return self._look_in(window, camera, detector)
         return reporting(detector, self.sink, camera)(sim.render(camera))
 
-    def _look_in(self, window: Window, camera: int, detector: Detector) -> Detection:
-        """Detect in a rendered window; a miss costs the same instant's whole frame."""
+    def _look_in(
+        self, window: Window, camera: int, detector: Detector, guessed: float | None = None
+    ) -> Detection:
+        """Detect in a rendered window; a miss costs the same instant's whole frame, or,
+        for a window ``guessed`` from a blob of that area seen before, first a preview
+        and the window it places (:func:`look_again`)."""
         self.window_renders += 1
         detection = look_in_window(
-            self.sim, camera, reporting(detector, self.sink, camera, window), window
+            self.sim, camera, reporting(detector, self.sink, camera, window), window, guessed
         )
         if detection is not None:
             return detection
         self.window_misses += 1
+        if guessed is not None and self.config.preview_binning > 1:
+            self.previews += 1
+            report = partial(reporting, detector, self.sink, camera)
+            detection, rendered = look_again(self.sim, camera, self._key, self.config, report)
+            self.window_renders += rendered
+            if detection is not None:
+                return detection
+            self.window_misses += rendered
         return reporting(detector, self.sink, camera)(self.sim.retake(camera))
 
     def _in_range(self, steps: np.ndarray) -> bool:

@@ -36,7 +36,7 @@ def run_command(args: argparse.Namespace) -> int:
     from headsim.run.events import Subscriber
     from headsim.run.rerun_cli import recording_target
     from headsim.run.runner import run_scenario
-    from headsim.run.serialise import results_payload
+    from headsim.run.serialise import results_payload, run_render_counts
     from headsim.run.summary import summary_text
     from headsim.scenario.loading import load_scenario
 
@@ -97,9 +97,8 @@ def run_command(args: argparse.Namespace) -> int:
                     "fast": scenario.fast,
                     "wall_s": wall,
                     "phases_s": result.timing_s,
-                    "renders": result.renders,
+                    "render_counts": run_render_counts(result.renders),
                     "rendered_frames": result.rendered_frames,
-                    "windows": result.windows,
                     "rrd_bytes": rrd.stat().st_size if rrd is not None else None,
                 },
             }
@@ -174,7 +173,7 @@ def calibrate_command(args: argparse.Namespace) -> int:
     assert alpha is not None and std is not None and report.rendered_frames is not None
     print(
         f"{scenario.name}{' (fast)' if scenario.fast else ''}: {report.fixated} of "
-        f"{report.targets} ball positions fixated, {report.renders} renders "
+        f"{report.targets} ball positions fixated, {report.renders.total} renders "
         f"({report.rendered_frames:.1f} full frames of pixels) in {wall:.1f} s"
     )
     for index in (0, 1):

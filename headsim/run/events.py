@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Protocol
 
 from headsim.active.events import FixationStarted, PhaseStarted
 from headsim.errors import raise_if_interrupted
-from headsim.sim.events import ImageKind, ImageTaken
+from headsim.sim.events import ImageKind, ImageTaken, RenderCounts
 
 if TYPE_CHECKING:
     from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RunResult
@@ -66,10 +66,10 @@ class Subscriber(Protocol):
 class Hub:
     """The runner's event sink: numbers frames and steps, counts renders, tells the subscribers.
 
-    ``rendered_frames``: pixels rendered, in full frames (a window counts its
-    share); ``windows``: windows rendered; ``window_misses``: windows that
-    missed (each cost the same instant's whole image, a RETAKE); ``previews``:
-    binned previews.  ``steps``: the steps begun in the current phase, in order.
+    ``renders``: every image the simulators drew, by kind (whole frames, windows,
+    retakes, previews: each one a render, as ``HeadSim.render_count`` counts them);
+    ``rendered_frames``: their pixels, in full frames (a window counts its share).
+    ``steps``: the steps begun in the current phase, in order.
     """
 
     def __init__(self, subscribers: Sequence[Subscriber] = ()) -> None:
@@ -78,14 +78,7 @@ class Hub:
         self.step = -1
         self.steps: list[int] = []
         self.rendered_frames = 0.0
-        self.windows = 0
-        self.window_misses = 0
-        self.previews = 0
-
-    @property
-    def images(self) -> int:
-        """Images taken so far (previews apart): the next image's frame number."""
-        return self.frame + 1
+        self.renders = RenderCounts()
 
     def emit(self, event: object) -> None:
         """Count and number ``event``, then pass it to every subscriber (first, stop
@@ -98,12 +91,9 @@ class Hub:
             self.steps.append(self.step)
         elif isinstance(event, ImageTaken):
             self.rendered_frames += event.rendered_frames
-            if event.kind is ImageKind.PREVIEW:
-                self.previews += 1
-            else:
+            self.renders = self.renders.counted(event.kind)
+            if event.kind is not ImageKind.PREVIEW:  # previews are not shown: not numbered
                 self.frame += 1
-                self.windows += int(event.kind is ImageKind.WINDOW)
-                self.window_misses += int(event.kind is ImageKind.RETAKE)
         stamp = Stamp(self.frame, self.step)
         for subscriber in self.subscribers:
             subscriber.notify(event, stamp)

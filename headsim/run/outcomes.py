@@ -17,6 +17,7 @@ from headsim.active.failure import Failure
 from headsim.active.measurement import Measurement
 from headsim.estimators.result import Status
 from headsim.scenario.spec import Scenario
+from headsim.sim.events import RenderCounts
 
 # -- the calibration (Sec. V) -------------------------------------------------------
 
@@ -98,8 +99,10 @@ class CalibrationSource:
     scenario: str
     seed: int
     head_hash: str
-    #: the renders the calibration took when it ran (None if the file does not say)
-    renders: int | None
+    #: the renders the calibration took when it ran, by kind (None if the file does not
+    #: say: one written before calibration blocks had ``render_counts``, whose
+    #: ``renders`` left the previews out)
+    render_counts: RenderCounts | None
 
 
 @dataclass(frozen=True)
@@ -108,7 +111,8 @@ class CalibrationReport:
 
     ``status``: OK, or FAILED with ``detail`` "failed: why".  ``layout`` is None
     when the ball positions could not be laid out (nothing below it was tried);
-    the fit's fields are None when the fit did not run.  ``rendered_frames``
+    the fit's fields are None when the fit did not run.  ``renders``: every image the
+    calibration drew, by kind (previews included; none for one read from a file).  ``rendered_frames``
     (pixels rendered, in full frames) is set by ``headsim calibrate`` only;
     ``source`` only for a calibration read from a file.
     """
@@ -117,7 +121,7 @@ class CalibrationReport:
     detail: str
     targets: int
     fixated: int
-    renders: int
+    renders: RenderCounts
     positions: tuple[PositionOutcome, ...]
     layout: CalibrationLayout | None = None
     depth_noise_m: float = 0.0
@@ -300,26 +304,50 @@ class MeasurementRecord:
 
 
 @dataclass(frozen=True)
+class RunRenders:
+    """Every image a run's simulators drew (whole frames, windows, retakes and previews:
+    each one a render), by phase.
+
+    ``in_measurements``: the experiment's renders that its measurements count (their
+    ``renders`` summed); ``outside_measurements`` the rest: renders of the procedure
+    that belong to no measurement (relative positioning's four images of the objects
+    at the two fixations; every frame of a live pursuit, which records none).
+    """
+
+    calibration: RenderCounts
+    experiment: RenderCounts
+    in_measurements: int
+
+    @property
+    def overall(self) -> RenderCounts:
+        """The calibration's and the experiment's together."""
+        return self.calibration + self.experiment
+
+    @property
+    def outside_measurements(self) -> int:
+        """The experiment's renders that no measurement counts."""
+        return self.experiment.total - self.in_measurements
+
+
+@dataclass(frozen=True)
 class RunResult:
     """Everything a run found.  ``failures``: why the run failed, one line each (empty: ok).
 
     ``experiment``: the procedure's own result (None: the procedure did not run,
-    the calibration failed).  ``renders``: images taken by phase.  ``timing_s``:
-    wall time by phase (not in results.json).
+    the calibration failed).  ``renders``: every image drawn, by phase and kind.
+    ``timing_s``: wall time by phase (not in results.json).
     """
 
     scenario: Scenario
     calibration: CalibrationReport | None
     records: tuple[MeasurementRecord, ...]
     experiment: Experiment | None
-    renders: dict[str, int]
+    renders: RunRenders
     failures: tuple[str, ...]
     timing_s: dict[str, float] = field(default_factory=dict, compare=False)
-    #: Pixels rendered by phase, in full frames (a window counts its share), and
-    #: the servo's windows: rendered, missed (a full frame followed), and the binned
-    #: previews that placed a window where no detection did.
+    #: Pixels rendered by phase, in full frames (a window counts its share, a preview
+    #: its binned pixels).
     rendered_frames: dict[str, float] = field(default_factory=dict)
-    windows: dict[str, int] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
@@ -344,6 +372,7 @@ __all__ = [
     "RelativeObject",
     "RelativePaper",
     "RelativeResult",
+    "RunRenders",
     "RunResult",
     "TrackingResult",
     "VerticalReference",

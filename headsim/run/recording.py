@@ -199,7 +199,7 @@ class Recorder(ResultsLogging):
     def _frame_image(self, event: ImageTaken) -> np.ndarray:
         """The image as shown: a window in a full-size frame, around it the camera's last
         whole image at half brightness (not rendered now), or black before there is one."""
-        if event.kind is not ImageKind.WINDOW or event.window is None:
+        if event.window is None:
             self._last_full[event.camera] = event.image
             return event.image
         assert self.sim is not None

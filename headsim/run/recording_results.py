@@ -203,7 +203,7 @@ def calibration_markdown(report: CalibrationReport) -> str:
     )
     text = (
         "# Calibration of the initial directions (Sec. V)\n\n"
-        f"{report.fixated} of {report.targets} positions fixated, {report.renders} renders\n\n"
+        f"{report.fixated} of {report.targets} positions fixated, {report.renders.total} renders\n\n"
         "| rad | ours | truth | paper |\n|---|---|---|---|\n" + rows + "\n"
     )
     vertical = report.vertical_reference

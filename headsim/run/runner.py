@@ -24,6 +24,7 @@ from headsim.run.outcomes import (
     MeasurementRecord,
     PursuitResult,
     RelativeResult,
+    RunRenders,
     RunResult,
 )
 from headsim.run.phases.calibrate import calibrate
@@ -33,8 +34,9 @@ from headsim.run.phases.pursuit import run_pursuit_phase
 from headsim.run.phases.relative import run_relative
 from headsim.run.phases.setup import told
 from headsim.run.phases.tracking import run_tracking
-from headsim.run.serialise import calibration_from_block
+from headsim.run.serialise import calibration_from_block, render_counts_from_block
 from headsim.scenario.spec import Scenario
+from headsim.sim.events import RenderCounts
 
 RUNNERS: dict[
     str, Callable[[Scenario, Hub, HeadKnowledge, str], tuple[list[MeasurementRecord], Experiment]]
@@ -54,8 +56,8 @@ def calibrate_scenario(
 ) -> CalibrationReport:
     """Only the scenario's Sec. V calibration (``headsim calibrate``): its report.
 
-    ``status`` is OK or why it failed; ``rendered_frames`` the pixels it
-    rendered, in full frames.
+    ``status`` is OK or why it failed; ``renders`` every image it drew, by kind;
+    ``rendered_frames`` their pixels, in full frames.
     """
     spec = scenario.experiment.calibration
     if spec is None or spec.source is not None:
@@ -69,7 +71,7 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
     """Run a checked scenario; the subscribers see every image, detection and result."""
     hub = Hub(subscribers)
     timing: dict[str, float] = {}
-    renders = {"calibration": 0, "experiment": 0, "recording": 0}
+    renders = {"calibration": RenderCounts(), "experiment": RenderCounts()}
     rendered_frames = {"calibration": 0.0, "experiment": 0.0}
     knowledge, label = told(scenario), "none"
     calibration = None
@@ -81,13 +83,13 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
         stored = read_calibration(spec.source, scenario.settings)
         calibration = calibration_from_block(
             stored.block,
-            renders=0,
+            renders=RenderCounts(),
             source=CalibrationSource(
                 path=str(stored.path),
                 scenario=stored.scenario,
                 seed=stored.seed,
                 head_hash=stored.head_hash,
-                renders=stored.block.get("renders"),
+                render_counts=render_counts_from_block(stored.block),
             ),
         )
         hub.emit(CalibrationDone(calibration))
@@ -106,12 +108,12 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
     experiment: Experiment | None = None
     if not failures:
         start = time.perf_counter()
-        frames = hub.images
+        before = hub.renders
         records, experiment = RUNNERS[scenario.experiment.procedure](
             scenario, hub, knowledge, label
         )
         timing["experiment"] = time.perf_counter() - start
-        renders["experiment"] = hub.images - frames
+        renders["experiment"] = hub.renders - before
         rendered_frames["experiment"] = hub.rendered_frames - rendered_frames["calibration"]
     failures += [
         f"{r.measurement.name}: {r.measurement.status_text}"
@@ -122,21 +124,23 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
         failures += [f"{name}: not seen in all four images" for name in experiment.missing]
     if isinstance(experiment, PursuitResult):
         failures += list(experiment.failures)
-    renders["total"] = renders["calibration"] + renders["experiment"]
     timing["total"] = sum(timing.values())
     result = RunResult(
         scenario=scenario,
         calibration=calibration,
         records=tuple(records),
         experiment=experiment,
-        renders=renders,
+        renders=RunRenders(
+            calibration=renders["calibration"],
+            experiment=renders["experiment"],
+            in_measurements=sum(r.measurement.renders for r in records),
+        ),
         failures=tuple(failures),
         timing_s=timing,
         rendered_frames={
             **rendered_frames,
             "total": rendered_frames["calibration"] + rendered_frames["experiment"],
         },
-        windows={"rendered": hub.windows, "missed": hub.window_misses, "previews": hub.previews},
     )
     hub.emit(RunFinished(result))
     return result

@@ -36,13 +36,15 @@ from headsim.run.outcomes import (
     PositionOutcome,
     PursuitResult,
     RelativeResult,
+    RunRenders,
     RunResult,
     TrackingResult,
     VerticalReference,
 )
+from headsim.sim.events import RenderCounts
 
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
-RESULTS_SCHEMA = "headsim.results/1"
+RESULTS_SCHEMA = "headsim.results/2"
 
 #: Keys of results.json and of each measurement in it (README documents each).
 RESULTS_KEYS = (
@@ -54,9 +56,8 @@ RESULTS_KEYS = (
     "software",
     "settings",
     "belief",
-    "renders",
+    "render_counts",
     "rendered_frames",
-    "windows",
     "calibration",
     "measurements",
     "summary",
@@ -161,6 +162,27 @@ def summary_entry(s: MeasurementSummary) -> dict[str, Any]:
     }
 
 
+def render_counts_from_block(block: dict[str, Any]) -> RenderCounts | None:
+    """The ``render_counts`` of a ``calibration`` block read back (None: the block has none,
+    as one written before renders counted previews, whose ``renders`` counted them apart)."""
+    entry = block.get("render_counts")
+    return None if entry is None else RenderCounts.from_dict(entry)
+
+
+def run_render_counts(renders: RunRenders) -> dict[str, Any]:
+    """results.json's ``render_counts``: each phase's and the run's renders by kind; the
+    experiment's split into those its measurements count and the rest."""
+    return {
+        "calibration": renders.calibration.as_dict(),
+        "experiment": {
+            **renders.experiment.as_dict(),
+            "in_measurements": renders.in_measurements,
+            "outside_measurements": renders.outside_measurements,
+        },
+        "overall": renders.overall.as_dict(),
+    }
+
+
 # -- the calibration block -------------------------------------------------------------
 
 
@@ -192,7 +214,7 @@ def calibration_block(report: CalibrationReport) -> dict[str, Any]:
         "status": report.status_text,
         "targets": report.targets,
         "fixated": report.fixated,
-        "renders": report.renders,
+        "render_counts": report.renders.as_dict(),
     }
     layout = report.layout
     if layout is not None:
@@ -229,7 +251,11 @@ def calibration_block(report: CalibrationReport) -> dict[str, Any]:
     if report.rendered_frames is not None:
         block["rendered_frames"] = report.rendered_frames
     if report.source is not None:
-        block["from"] = asdict(report.source)
+        counts = report.source.render_counts
+        block["from"] = {
+            **asdict(report.source),
+            "render_counts": None if counts is None else counts.as_dict(),
+        }
     return block
 
 
@@ -240,12 +266,18 @@ def _failure(entry: dict[str, Any] | None) -> Failure | None:
 
 
 def calibration_from_block(
-    block: dict[str, Any], *, renders: int | None = None, source: CalibrationSource | None = None
+    block: dict[str, Any],
+    *,
+    renders: RenderCounts | None = None,
+    source: CalibrationSource | None = None,
 ) -> CalibrationReport:
     """The report of a ``calibration`` block read back from JSON (head.json), as written.
 
-    ``renders`` and ``source`` replace the block's own (a calibration read from a file).
+    ``renders`` and ``source`` replace the block's own (a calibration read from a file;
+    a block written before renders counted previews has no ``render_counts``).
     """
+    if renders is None:
+        renders = RenderCounts.from_dict(block["render_counts"])
     status = block["status"]
     layout = block.get("layout")
     lines = block.get("lines_of_sight")
@@ -256,7 +288,7 @@ def calibration_from_block(
         detail="" if status == "ok" else status,
         targets=block["targets"],
         fixated=block["fixated"],
-        renders=block["renders"] if renders is None else renders,
+        renders=renders,
         positions=tuple(PositionOutcome(_failure(p["failure"])) for p in block["positions"]),
         layout=None if layout is None else CalibrationLayout(**layout),
         depth_noise_m=block.get("depth_noise_m", 0.0),
@@ -347,9 +379,8 @@ def results_payload(result: RunResult) -> dict[str, Any]:
         "settings": {**asdict(s.settings), "settle_mode": s.settle_mode},
         # The truth above; what the head believes (and its estimators use) here.
         "belief": asdict(s.settings.believed),
-        "renders": result.renders,
+        "render_counts": run_render_counts(result.renders),
         "rendered_frames": result.rendered_frames,
-        "windows": result.windows,
         "calibration": None
         if result.calibration is None
         else calibration_block(result.calibration),
@@ -369,7 +400,9 @@ __all__ = [
     "calibration_from_block",
     "experiment_block",
     "measurement_entry",
+    "render_counts_from_block",
     "results_payload",
+    "run_render_counts",
     "software_versions",
     "summary_entry",
 ]

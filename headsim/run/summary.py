@@ -24,6 +24,7 @@ from headsim.run.outcomes import (
 )
 from headsim.run.serialise import experiment_block
 from headsim.scenario.spec import TargetAcceptance
+from headsim.sim.events import RenderCounts
 
 # -- the summary table ------------------------------------------------------------
 
@@ -57,7 +58,7 @@ def _mm(value_m: float | None, fmt: str = ".2f") -> str:
 def _calibration_lines(report: CalibrationReport, paper: bool) -> list[str]:
     lines = [
         f"Calibration of the initial directions (Sec. V): {report.fixated} of "
-        f"{report.targets} ball positions fixated, {report.renders} renders"
+        f"{report.targets} ball positions fixated, {report.renders.total} renders"
     ]
     missed = [p.status_text for p in report.positions if p.failure is not None]
     if missed:
@@ -332,6 +333,19 @@ def _check_lines(e: PointsResult) -> list[str]:
     ]
 
 
+def _renders_text(counts: RenderCounts) -> str:
+    """ "107 renders (40 full frames, 44 windows, 1 retake, 22 previews)"."""
+
+    def n(count: int, what: str) -> str:
+        return f"{count} {what}{'' if count == 1 else 's'}"
+
+    return (
+        f"{n(counts.total, 'render')} ({n(counts.images, 'full frame')}, "
+        f"{n(counts.windows, 'window')}, {n(counts.retakes, 'retake')}, "
+        f"{n(counts.previews, 'preview')})"
+    )
+
+
 def summary_text(result: RunResult) -> str:
     """The table printed at the end of a run (figures of the paper beside ours for its head)."""
     s = result.scenario
@@ -340,9 +354,9 @@ def summary_text(result: RunResult) -> str:
     lines = [
         f"{s.name}{' (fast variant)' if s.fast else ''}: {s.description}",
         f"head: {s.preset} preset; seed {s.seed}; procedure {s.experiment.procedure}; "
-        f"{result.renders['total']} renders"
+        f"{_renders_text(result.renders.overall)}"
         + (
-            f" ({result.rendered_frames['total']:.1f} full frames of pixels)"
+            f"; {result.rendered_frames['total']:.1f} full frames of pixels"
             if result.rendered_frames
             else ""
         )

@@ -11,7 +11,7 @@ only reads.
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+from dataclasses import asdict, astuple, dataclass, fields, replace
 from typing import Protocol
 
 import numpy as np
@@ -40,9 +40,61 @@ class ImageKind(enum.Enum):
     """How an image was taken (each one is counted as a render by the simulator)."""
 
     FULL = "full"  # the camera's whole image
-    RETAKE = "retake"  # the whole image of the instant a window was just taken of (it missed)
+    # the instant a window was just taken of (it missed) taken again: the whole image, or
+    # the window a preview placed (``ImageTaken.window``)
+    RETAKE = "retake"
     WINDOW = "window"  # only a window of the image (``ImageTaken.window``)
     PREVIEW = "preview"  # the whole view binned ``binning`` x ``binning``, to place a window
+
+
+@dataclass(frozen=True)
+class RenderCounts:
+    """Images the simulator drew, by kind; every one of them is a render (``total``), the
+    way ``HeadSim.render_count`` counts them.
+
+    ``images``: whole frames (FULL); ``windows``: windows (WINDOW); ``retakes``: the
+    instant of a window that missed taken again, whole or as the window a preview
+    placed (RETAKE); ``previews``: binned previews (PREVIEW).
+    """
+
+    images: int = 0
+    windows: int = 0
+    retakes: int = 0
+    previews: int = 0
+
+    @property
+    def total(self) -> int:
+        """Every render: images, windows, retakes and previews."""
+        return self.images + self.windows + self.retakes + self.previews
+
+    def as_dict(self) -> dict[str, int]:
+        """The counts by kind and their ``total``, as results.json holds them."""
+        return {**asdict(self), "total": self.total}
+
+    @classmethod
+    def from_dict(cls, entry: dict[str, int]) -> RenderCounts:
+        """The counts of :meth:`as_dict` read back (its ``total`` follows from them)."""
+        return cls(**{f.name: int(entry[f.name]) for f in fields(cls)})
+
+    def counted(self, kind: ImageKind) -> RenderCounts:
+        """These counts and one image of ``kind``."""
+        field = _COUNTED[kind]
+        return replace(self, **{field: getattr(self, field) + 1})
+
+    def __add__(self, other: RenderCounts) -> RenderCounts:
+        return RenderCounts(*(a + b for a, b in zip(astuple(self), astuple(other), strict=True)))
+
+    def __sub__(self, other: RenderCounts) -> RenderCounts:
+        return RenderCounts(*(a - b for a, b in zip(astuple(self), astuple(other), strict=True)))
+
+
+#: The field of :class:`RenderCounts` that counts each kind of image.
+_COUNTED = {
+    ImageKind.FULL: "images",
+    ImageKind.WINDOW: "windows",
+    ImageKind.RETAKE: "retakes",
+    ImageKind.PREVIEW: "previews",
+}
 
 
 @dataclass(frozen=True)
@@ -50,7 +102,8 @@ class ImageTaken:
     """Camera 1 or 2 took ``image`` (H, W, 3) uint8 as rendered: the whole image, the
     window's crop, or the binned preview.
 
-    ``window``: where a WINDOW image lies in the full frame, px (None otherwise);
+    ``window``: where a WINDOW image (or a RETAKE of a window) lies in the full frame,
+    px (None: the whole image);
     ``binning``: a PREVIEW's binning (1 otherwise); ``rendered_frames``: the pixels
     this image cost, in full frames (the simulator's ``rendered_frames`` increment).
     """
@@ -63,4 +116,4 @@ class ImageTaken:
     binning: int = 1
 
 
-__all__ = ["NO_EVENTS", "EventSink", "ImageKind", "ImageTaken", "NoEvents"]
+__all__ = ["NO_EVENTS", "EventSink", "ImageKind", "ImageTaken", "NoEvents", "RenderCounts"]

@@ -255,8 +255,14 @@ class EyeRenderer:
         image = apply_canvas(self._draw(data, index, None), self._canvases[index])
         return self._add_noise(image, index, None, retake)
 
-    def render_window(self, data: mujoco.MjData, index: int, window: Window) -> np.ndarray:
-        """Render only ``window`` of camera ``index``: the full frame's crop, (h, w, 3) uint8."""
+    def render_window(
+        self, data: mujoco.MjData, index: int, window: Window, retake: bool = False
+    ) -> np.ndarray:
+        """Render only ``window`` of camera ``index``: the full frame's crop, (h, w, 3) uint8.
+
+        ``retake``: a window of the image just taken (the same instant: the same noise);
+        it is still a render and is counted.
+        """
         camera, canvas = self._cameras[index], self._canvases[index]
         if not (
             0 <= window.x0 < window.x1 <= camera.width
@@ -285,7 +291,7 @@ class EyeRenderer:
                     valid_fraction=canvas.valid_fraction,
                 )
                 image = apply_canvas(region, shifted)
-        return self._add_noise(image, index, window)
+        return self._add_noise(image, index, window, retake)
 
     def _add_noise(
         self, image: np.ndarray, index: int, window: Window | None, retake: bool = False

@@ -360,12 +360,17 @@ class HeadSim:
         self.sink.emit(ImageTaken(index + 1, image, ImageKind.RETAKE, frames))
         return image
 
-    def render_window(self, camera: CameraId, window: Window) -> np.ndarray:
-        """Only ``window`` of the camera's image: the full image's crop, (h, w, 3) uint8."""
+    def render_window(self, camera: CameraId, window: Window, retake: bool = False) -> np.ndarray:
+        """Only ``window`` of the camera's image: the full image's crop, (h, w, 3) uint8.
+
+        ``retake``: a window of the instant just taken (same noise: after a window that
+        missed, where a preview places the target), counted as a retake.
+        """
         index, before = self.camera_index(camera), self.rendered_frames
-        image = self._renderer.render_window(self.data, index, window)
+        image = self._renderer.render_window(self.data, index, window, retake=retake)
         frames = self.rendered_frames - before
-        self.sink.emit(ImageTaken(index + 1, image, ImageKind.WINDOW, frames, window))
+        kind = ImageKind.RETAKE if retake else ImageKind.WINDOW
+        self.sink.emit(ImageTaken(index + 1, image, kind, frames, window))
         return image
 
     def render_preview(self, camera: CameraId, binning: int) -> np.ndarray:
@@ -379,7 +384,8 @@ class HeadSim:
 
     @property
     def render_count(self) -> int:
-        """Images rendered so far by this simulator (full frames and windows)."""
+        """Images this simulator drew so far, each one a render: full frames, windows,
+        retakes and previews (:class:`~headsim.sim.events.RenderCounts` by kind)."""
         return self._renderer.render_count
 
     @property

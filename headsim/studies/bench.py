@@ -350,7 +350,7 @@ def scenario_metrics(name: str) -> Metrics:
         if errors
         else math.inf,
         # Per fixation, so that +0.5 renders per point is one tolerance everywhere.
-        f"scenario.{name}.renders_per_point": float(result.renders["total"])
+        f"scenario.{name}.renders_per_point": float(result.renders.overall.total)
         / max(scenario.fixations, 1),
     }
     if result.calibration and result.calibration.layout is not None:

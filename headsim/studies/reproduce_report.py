@@ -192,7 +192,7 @@ def report_text(
         "- one calibration: `head.json` "
         + (
             f"({calibration['block']['fixated']} of {calibration['block']['targets']} ball positions, "
-            f"{calibration['block']['renders']} renders, {calibration.get('wall_s', math.nan):.1f} s), used by "
+            f"{calibration['block']['render_counts']['total']} renders, {calibration.get('wall_s', math.nan):.1f} s), used by "
             "every scenario experiment"
             if calibration
             else "(not made)"

@@ -105,7 +105,7 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
             rms_error_pct_depth=float(np.sqrt(np.mean(np.square(pct)))) if pct else None,
             mean_error_mm=float(np.mean(errors_mm)) if errors_mm else None,
             max_error_mm=float(np.max(errors_mm)) if errors_mm else None,
-            renders=int(result.renders["total"]),
+            renders=result.renders.overall.total,
             calibration_max_error_rad=float(
                 np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
             )

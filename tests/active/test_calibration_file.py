@@ -59,14 +59,17 @@ def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
     assert stored["format"] == "headsim-calibration/1"
     assert stored["head"]["hash"] == head_hash(load_scenario("quickstart").settings)
     block = stored["calibration"]
-    assert block["status"] == "ok" and block["renders"] > 0
+    assert block["status"] == "ok" and block["render_counts"]["previews"] > 0
     assert len(block["alpha_e_std_rad"]) == 2 and block["vertical_reference"] is not None
 
     scenario_file = tmp_path / "measure.toml"
     scenario_file.write_text(SCENARIO.format(head=head_file, extra=""))
     result = run_scenario(load_scenario(scenario_file))
     assert result.ok
-    assert result.renders["calibration"] == 0 and result.renders["total"] > 0
+    assert result.renders.calibration.total == 0 and result.renders.overall.total > 0
+    assert result.calibration is not None and result.calibration.source is not None
+    assert result.calibration.source.render_counts is not None
+    assert result.calibration.source.render_counts.total == block["render_counts"]["total"]
     assert result.calibration is not None
     assert result.calibration.source is not None
     assert result.calibration.source.path == str(head_file)

@@ -38,7 +38,9 @@ def test_model2_measures_ideal_targets_within_a_fraction_of_a_percent() -> None:
             np.testing.assert_allclose(cov, cov.T, atol=1e-15)
             assert np.all(np.linalg.eigvalsh(cov) > 0) and cov[2, 2] == cov.diagonal().max()
             renders.append(m.renders)
-        assert np.mean(renders[1:]) <= 9  # the servo gains carry over after the first point
+        # The servo gains carry over after the first point; each camera first looks for
+        # a moved point where it saw the last one (a miss: one render more than a preview).
+        assert np.mean(renders[1:]) <= 9 + 2
 
 
 def test_near_midline_target_uses_the_remedy_image() -> None:

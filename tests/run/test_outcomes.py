@@ -8,12 +8,15 @@ import pytest
 
 from headsim.active.failure import Failure, FailureCause
 from headsim.estimators.result import Status
-from headsim.run.outcomes import CalibrationReport, PositionOutcome, RunResult
+from headsim.run.outcomes import CalibrationReport, PositionOutcome, RunRenders, RunResult
 from headsim.scenario.loading import load_scenario
+from headsim.sim.events import RenderCounts
 
 
 def test_a_report_is_ok_only_with_status_ok_and_names_why_not() -> None:
-    failed = CalibrationReport(Status.FAILED, "failed: degenerate layout", 4, 1, 12, ())
+    failed = CalibrationReport(
+        Status.FAILED, "failed: degenerate layout", 4, 1, RenderCounts(images=12), ()
+    )
     assert not failed.ok and failed.status_text == "failed: degenerate layout"
     ok = replace(failed, status=Status.OK, detail="")
     assert ok.ok and ok.status_text == "ok"
@@ -29,6 +32,6 @@ def test_a_position_is_ok_without_a_failure() -> None:
 
 def test_a_run_is_ok_without_failures() -> None:
     scenario = load_scenario("quickstart", fast=True)
-    result = RunResult(scenario, None, (), None, {"total": 0}, ())
+    result = RunResult(scenario, None, (), None, RunRenders(RenderCounts(), RenderCounts(), 0), ())
     assert result.ok
     assert not replace(result, failures=("near: Ca2 at step 1: target lost",)).ok

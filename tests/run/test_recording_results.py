@@ -10,6 +10,7 @@ import numpy as np
 from headsim.estimators.result import Status
 from headsim.run.outcomes import CalibrationReport
 from headsim.run.recording_results import calibration_markdown
+from headsim.sim.events import RenderCounts
 
 from .rrd import rows
 
@@ -48,7 +49,9 @@ def test_results_are_in_the_recording_as_text(recorded: tuple[Path, dict]) -> No
 
 
 def test_the_calibration_document_reads_the_report() -> None:
-    failed = CalibrationReport(Status.FAILED, "failed: too few positions seen", 8, 2, 30, ())
+    failed = CalibrationReport(
+        Status.FAILED, "failed: too few positions seen", 8, 2, RenderCounts(images=30), ()
+    )
     assert calibration_markdown(failed) == "# Calibration\n\nfailed: too few positions seen\n"
     ok = replace(
         failed,

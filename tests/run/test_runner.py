@@ -49,9 +49,19 @@ def _check_schema(results: dict, scenario_name: str) -> None:
         results["software"]
     )
     assert len(results["settings"]["cameras"]) == 2
-    renders = results["renders"]
-    assert renders["total"] == renders["calibration"] + renders["experiment"] > 0
-    assert renders["recording"] == 0
+    renders = results["render_counts"]
+    kinds = ("images", "windows", "retakes", "previews", "total")
+    for phase in ("calibration", "experiment", "overall"):
+        counts = renders[phase]
+        assert counts["total"] == sum(counts[k] for k in kinds[:-1])
+    for kind in kinds:
+        assert (
+            renders["overall"][kind] == renders["calibration"][kind] + renders["experiment"][kind]
+        )
+    assert renders["overall"]["total"] > 0
+    experiment = renders["experiment"]
+    assert experiment["in_measurements"] == sum(m["renders"] for m in results["measurements"])
+    assert experiment["in_measurements"] + experiment["outside_measurements"] == experiment["total"]
     steps = []
     for m in results["measurements"]:
         assert list(m) == list(MEASUREMENT_KEYS)

@@ -28,7 +28,9 @@ from headsim.run.serialise import (
     calibration_from_block,
     experiment_block,
     measurement_entry,
+    render_counts_from_block,
 )
+from headsim.sim.events import RenderCounts
 
 from .helpers import LOST, measurement
 
@@ -39,7 +41,7 @@ def _full_report() -> CalibrationReport:
         detail="",
         targets=3,
         fixated=2,
-        renders=40,
+        renders=RenderCounts(images=10, windows=20, retakes=1, previews=9),
         positions=(PositionOutcome(None), PositionOutcome(LOST), PositionOutcome(None)),
         layout=CalibrationLayout(
             "near_far", 0.5, [0.4, 1.2], 0.16, 0.08, [[0.0, 0.5, 0.4], [0.1, 0.6, 0.9]]
@@ -98,13 +100,13 @@ def test_a_measurement_writes_its_method_status_and_failure_as_documented() -> N
 
 
 def test_a_calibration_that_could_not_lay_out_its_positions_writes_five_keys() -> None:
-    report = CalibrationReport(Status.FAILED, "failed: no room", 8, 0, 0, ())
+    report = CalibrationReport(Status.FAILED, "failed: no room", 8, 0, RenderCounts(), ())
     block = calibration_block(report)
     assert block == {
         "status": "failed: no room",
         "targets": 8,
         "fixated": 0,
-        "renders": 0,
+        "render_counts": {"images": 0, "windows": 0, "retakes": 0, "previews": 0, "total": 0},
         "positions": [],
     }
 
@@ -113,19 +115,38 @@ def test_a_calibration_block_reads_back_to_the_same_report_and_bytes() -> None:
     report = _full_report()
     text = json.dumps(to_jsonable(calibration_block(report)), indent=2)
     block = json.loads(text)
-    assert list(block)[:5] == ["status", "targets", "fixated", "renders", "layout"]
+    assert list(block)[:5] == ["status", "targets", "fixated", "render_counts", "layout"]
+    assert block["render_counts"] == {
+        "images": 10,
+        "windows": 20,
+        "retakes": 1,
+        "previews": 9,
+        "total": 40,
+    }
     assert list(block)[-2:] == ["positions", "rendered_frames"]
     assert block["positions"][1] == {"status": LOST.message, "failure": LOST.as_dict()}
     assert calibration_from_block(block) == report
-    source = CalibrationSource("/tmp/head.json", "quickstart", 0, "abc", 40)
-    stored = calibration_from_block(block, renders=0, source=source)
-    assert stored.renders == 0 and stored.ok
+    source = CalibrationSource("/tmp/head.json", "quickstart", 0, "abc", report.renders)
+    stored = calibration_from_block(block, renders=RenderCounts(), source=source)
+    assert stored.renders.total == 0 and stored.ok
     again = calibration_block(stored)
-    assert list(again)[-1] == "from" and again["from"]["renders"] == 40
-    # What results.json held before the typed report: the block, renders 0, then "from".
+    assert list(again)[-1] == "from" and again["from"]["render_counts"]["total"] == 40
+    # What results.json held before the typed report: the block, no renders, then "from".
+    nothing = {"images": 0, "windows": 0, "retakes": 0, "previews": 0, "total": 0}
     assert json.dumps(to_jsonable(again)) == json.dumps(
-        to_jsonable({**block, "renders": 0, "from": again["from"]})
+        to_jsonable({**block, "render_counts": nothing, "from": again["from"]})
     )
+
+
+def test_a_block_from_before_renders_counted_previews_says_nothing_of_them() -> None:
+    # head.json written by a headsim whose "renders" left the previews out: its count is
+    # not today's, so a calibration read from it reports none rather than a wrong one.
+    block = {k: v for k, v in calibration_block(_full_report()).items() if k != "render_counts"}
+    old = {**block, "renders": 31}
+    assert render_counts_from_block(old) is None
+    with pytest.raises(KeyError, match="render_counts"):
+        calibration_from_block(old)
+    assert calibration_from_block(old, renders=RenderCounts()).renders == RenderCounts()
 
 
 def test_each_experiment_writes_the_procedure_first() -> None:

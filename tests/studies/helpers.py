@@ -9,7 +9,7 @@ CALIBRATION = {
         "alpha_e_std_rad": [2e-4, 2e-4],
         "fixated": 11,
         "targets": 12,
-        "renders": 75,
+        "render_counts": {"images": 5, "windows": 50, "retakes": 0, "previews": 20, "total": 75},
     },
 }
 

@@ -39,6 +39,7 @@ from headsim.run.targets import marker_target
 from headsim.scenario.calibration_design import near_far_depths, near_fraction
 from headsim.scenario.spec import STREAM_CALIBRATION, STREAM_DEPTH_NOISE, Scenario
 from headsim.sim import names
+from headsim.sim.events import RenderCounts
 from headsim.sim.simulator import HeadSim
 
 
@@ -47,6 +48,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
     spec = scenario.experiment.calibration
     assert spec is not None
     seed = scenario.seed
+    start = hub.renders  # every image this phase draws is one of its renders
     with simulator(hub, "default", scenario) as sim:
         try:
             positions = calibration_layout(
@@ -66,7 +68,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
                 detail=f"failed: {err}",
                 targets=spec.targets,
                 fixated=0,
-                renders=0,
+                renders=hub.renders - start,
                 positions=(),
             )
             hub.emit(CalibrationDone(report))
@@ -82,7 +84,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
             detail="",
             targets=spec.targets,
             fixated=0,
-            renders=0,
+            renders=RenderCounts(),
             positions=(),
             layout=CalibrationLayout(
                 kind=spec.layout,
@@ -103,8 +105,6 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
             alpha_e_truth_rad=truth_alpha_e,
             alpha_e_paper_rad=list(PAPER["alpha_e_rad"]),
         )
-        start = sim.render_count
-        previews = hub.previews  # counted apart: images taken are what subscribers see
         try:
             run = calibrate_head(
                 sim,
@@ -125,7 +125,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
                 planned,
                 status=Status.FAILED,
                 detail=f"failed: {err}",
-                renders=sim.render_count - start - (hub.previews - previews),
+                renders=hub.renders - start,
                 fixated=sum(o is None for o in outcomes),
                 positions=position_outcomes(outcomes),
             )
@@ -136,7 +136,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
         planned,
         fixated=run.samples,
         positions=position_outcomes(run.outcomes),
-        renders=run.renders - (hub.previews - previews),
+        renders=hub.renders - start,
         alpha_e_rad=list(fit.alpha_e),
         alpha_e_std_rad=list(fit.std_errors),
         alpha_e_covariance_rad2=np.asarray(fit.covariance).tolist(),
