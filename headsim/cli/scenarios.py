@@ -36,7 +36,7 @@ def run_command(args: argparse.Namespace) -> int:
     from headsim.run.events import Subscriber
     from headsim.run.rerun_cli import recording_target
     from headsim.run.runner import run_scenario
-    from headsim.run.serialise import results_payload, run_render_counts
+    from headsim.run.serialise import results_payload
     from headsim.run.summary import summary_text
     from headsim.scenario.loading import load_scenario
 
@@ -97,7 +97,7 @@ def run_command(args: argparse.Namespace) -> int:
                     "fast": scenario.fast,
                     "wall_s": wall,
                     "phases_s": result.timing_s,
-                    "render_counts": run_render_counts(result.renders),
+                    "render_counts": result.renders.as_dict(),
                     "rendered_frames": result.rendered_frames,
                     "rrd_bytes": rrd.stat().st_size if rrd is not None else None,
                 },

@@ -328,6 +328,19 @@ class RunRenders:
         """The experiment's renders that no measurement counts."""
         return self.experiment.total - self.in_measurements
 
+    def as_dict(self) -> dict[str, Any]:
+        """results.json's ``render_counts``: each phase's and the run's renders by kind; the
+        experiment's split into those its measurements count and the rest."""
+        return {
+            "calibration": self.calibration.as_dict(),
+            "experiment": {
+                **self.experiment.as_dict(),
+                "in_measurements": self.in_measurements,
+                "outside_measurements": self.outside_measurements,
+            },
+            "overall": self.overall.as_dict(),
+        }
+
 
 @dataclass(frozen=True)
 class RunResult:

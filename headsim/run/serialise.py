@@ -36,7 +36,6 @@ from headsim.run.outcomes import (
     PositionOutcome,
     PursuitResult,
     RelativeResult,
-    RunRenders,
     RunResult,
     TrackingResult,
     VerticalReference,
@@ -167,20 +166,6 @@ def render_counts_from_block(block: dict[str, Any]) -> RenderCounts | None:
     as one written before renders counted previews, whose ``renders`` counted them apart)."""
     entry = block.get("render_counts")
     return None if entry is None else RenderCounts.from_dict(entry)
-
-
-def run_render_counts(renders: RunRenders) -> dict[str, Any]:
-    """results.json's ``render_counts``: each phase's and the run's renders by kind; the
-    experiment's split into those its measurements count and the rest."""
-    return {
-        "calibration": renders.calibration.as_dict(),
-        "experiment": {
-            **renders.experiment.as_dict(),
-            "in_measurements": renders.in_measurements,
-            "outside_measurements": renders.outside_measurements,
-        },
-        "overall": renders.overall.as_dict(),
-    }
 
 
 # -- the calibration block -------------------------------------------------------------
@@ -379,7 +364,7 @@ def results_payload(result: RunResult) -> dict[str, Any]:
         "settings": {**asdict(s.settings), "settle_mode": s.settle_mode},
         # The truth above; what the head believes (and its estimators use) here.
         "belief": asdict(s.settings.believed),
-        "render_counts": run_render_counts(result.renders),
+        "render_counts": result.renders.as_dict(),
         "rendered_frames": result.rendered_frames,
         "calibration": None
         if result.calibration is None
@@ -402,7 +387,6 @@ __all__ = [
     "measurement_entry",
     "render_counts_from_block",
     "results_payload",
-    "run_render_counts",
     "software_versions",
     "summary_entry",
 ]

@@ -83,7 +83,7 @@ def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
 @_plain_errors
 def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
     from headsim.run.runner import run_scenario
-    from headsim.run.serialise import results_payload, run_render_counts
+    from headsim.run.serialise import results_payload
     from headsim.run.summary import summary_text
     from headsim.scenario.loading import load_scenario
 
@@ -101,7 +101,7 @@ def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -
     return {
         "results": payload,
         "wall_s": wall,
-        "render_counts": run_render_counts(result.renders),
+        "render_counts": result.renders.as_dict(),
         "rendered_frames": result.rendered_frames,
         "points": len(result.records),
     }
