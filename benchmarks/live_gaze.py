@@ -29,7 +29,7 @@ import numpy as np
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.files import write_json_atomic
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Sinusoid, Waypoints
-from headsim.live.gaze import GazeConfig, SaccadeProfile, acquire, pursue
+from headsim.live.gaze import GazeConfig, GazeMode, SaccadeProfile, acquire, pursue
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import find_marker
@@ -61,13 +61,16 @@ def paths(depth: float, speed: float, duration: float, seed: int) -> dict[str, o
     }
 
 
-def pursuit_case(path: object, predictor: bool, duration: float) -> dict[str, float]:
+def pursuit_case(
+    path: object, predictor: bool, duration: float, mode: GazeMode = GazeMode.NECK
+) -> dict[str, float]:
+    """One pursuit run of ``duration`` s on ``path``: losses, error along the path, lag, offsets."""
     with HeadSim(settings=HeadSettings()) as sim:
         live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path)  # type: ignore[arg-type]
         estimator = acquire(live, RED)
         if estimator is None:
             return {"acquired": 0.0}
-        run = pursue(live, RED, estimator, duration, GazeConfig(predictor=predictor))
+        run = pursue(live, RED, estimator, duration, GazeConfig(mode=mode, predictor=predictor))
         depth = float(np.mean(run.depths_m))
         return {
             "acquired": 1.0,
