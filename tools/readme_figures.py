@@ -37,6 +37,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import figures_live as live
+import figures_realistic as realistic
+import figures_servo as servo
 from figures_common import ROOT, bands, calibration_errors, effort, payload, pct, summary
 
 README = ROOT / "README.md"
@@ -111,7 +114,26 @@ class Generator:
 
 GENERATORS: dict[str, Generator] = {
     "quickstart": Generator(quickstart, cheap=True, seconds=3),
+    "reproduce": Generator(live.reproduce, cheap=False, seconds=45),
+    "chessboard_windows": Generator(servo.chessboard_windows, cheap=False, seconds=7),
+    "windows": Generator(servo.windows, cheap=False, group="bench points", seconds=5),
+    "averaged_fixation": Generator(
+        servo.averaged_fixation, cheap=False, group="bench points", seconds=4
+    ),
+    "reach_zoom": Generator(servo.reach_zoom, cheap=False, group="zoom", seconds=170),
+    "reach_zoom_angles": Generator(servo.reach_zoom_angles, cheap=False, group="zoom", seconds=15),
+    "relative_areas": Generator(servo.relative_areas, cheap=False, seconds=80),
+    "live_gaze": Generator(live.live_gaze, cheap=False, seconds=70),
+    "gym": Generator(live.gym_policies, cheap=False, seconds=5),
+    "forward_field": Generator(realistic.forward_field, cheap=True, group="forward", seconds=4),
+    "forward_budget": Generator(realistic.forward_budget, cheap=True, group="forward", seconds=1),
     "realistic_field": Generator(realistic_field, cheap=False, seconds=8),
+    "layouts": Generator(realistic.layouts, cheap=False, group="forward", seconds=35),
+    "budget": Generator(realistic.budget, cheap=False, seconds=75),
+    "render_fidelity": Generator(servo.render_fidelity, cheap=False, group="fidelity", seconds=30),
+    "render_fidelity_presets": Generator(
+        servo.render_fidelity_presets, cheap=False, group="fidelity", seconds=20
+    ),
 }
 
 
