@@ -45,7 +45,7 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
 from headsim.files import write_json_atomic
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Sinusoid, Waypoints
-from headsim.live.gaze import GazeConfig, SaccadeProfile, acquire, pursue
+from headsim.live.gaze import GazeConfig, GazeMode, SaccadeProfile, acquire, pursue
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
@@ -108,13 +108,16 @@ def paths(depth: float, speed: float, duration: float, seed: int) -> dict[str, o
     }
 
 
-def pursuit_case(path: object, predictor: bool, duration: float, head: Head) -> dict[str, float]:
+def pursuit_case(
+    path: object, predictor: bool, duration: float, head: Head, mode: GazeMode = GazeMode.NECK
+) -> dict[str, float]:
+    """One pursuit run of ``duration`` s on ``path``: losses, error along the path, lag, offsets."""
     with HeadSim(settings=head.settings) as sim:
         live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path)  # type: ignore[arg-type]
         estimator = acquire(live, RED, head.knowledge)
         if estimator is None:
             return {"acquired": 0.0}
-        run = pursue(live, RED, estimator, duration, GazeConfig(predictor=predictor))
+        run = pursue(live, RED, estimator, duration, GazeConfig(mode=mode, predictor=predictor))
         depth = float(np.mean(run.depths_m))
         return {
             "acquired": 1.0,

@@ -18,6 +18,7 @@ import argparse
 import math
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -172,9 +173,9 @@ def _condition(
     }
 
 
-def budget(p: np.ndarray, seeds: int, out: Path | None) -> None:
+def budget_conditions(p: np.ndarray, seeds: int) -> list[dict[str, float | str]]:
     """The error budget: the realistic head, each imperfection off in turn, each extension on/off."""
-    conditions = [
+    return [
         _condition("realistic, all on", p, seeds),
         _condition("  optical-centre offsets off", p, seeds, offsets=False),
         _condition("  baseline error off", p, seeds, baseline_error=False),
@@ -183,6 +184,11 @@ def budget(p: np.ndarray, seeds: int, out: Path | None) -> None:
         _condition("  offsets not corrected", p, seeds, correct=False),
         _condition("  Sec. V only (no extension)", p, seeds, extended=False),
     ]
+
+
+def budget(p: np.ndarray, seeds: int, out: Path | None) -> None:
+    """Print the error budget (and write its CSV and chart into ``out``)."""
+    conditions = budget_conditions(p, seeds)
     print(
         f"\n4. Error budget, whole field (median over {seeds} calibrations); predicted: eqs. 15-18 to first order"
     )
@@ -208,8 +214,12 @@ def budget(p: np.ndarray, seeds: int, out: Path | None) -> None:
     print(f"   wrote {out / 'error_budget.csv'} and {out / 'error_budget.png'}")
 
 
-def recovery(head: StereoHead, seeds: int, layout: str) -> None:
-    """Section 3: the extended fit against the truth over ``seeds`` tape draws."""
+def recovery_figures(head: StereoHead, seeds: int, layout: str) -> dict[str, Any]:
+    """Section 3: the extended fit against the truth over ``seeds`` tape draws.
+
+    Lengths in m; ``offsets`` holds s1's and s2's figures, ``directions`` alpha_e1's and
+    alpha_e2's; ``limit_m`` is eq. (1)'s least standard error of an offset for the layout.
+    """
     s_true = head.line_of_sight_offsets()
     half = (head.baseline - BELIEVED_D) / 2
     exact_e = head.effective_initial_directions()
@@ -220,11 +230,6 @@ def recovery(head: StereoHead, seeds: int, layout: str) -> None:
         if layout == "near_far"
         else np.random.default_rng(0).uniform(*CALIBRATION_DEPTH_M, 100_000)
     )
-    limit = offset_std_limit(ranges, 1e-3) * math.sqrt(len(ranges) / 60)
-    print(
-        f"\n3. Calibration recovery over {seeds} seeds (60 balls at 0.25-1.5 m, layout "
-        f"{layout}, 1 mm tape), realistic head; offset limit of eq. (1): {1e3 * limit:.3f} mm"
-    )
     est, std, be, bs = [], [], [], []
     for seed in range(seeds):
         fit = calibrate(head, 1000 + seed, layout=layout)
@@ -232,36 +237,61 @@ def recovery(head: StereoHead, seeds: int, layout: str) -> None:
         std.append(fit.std_errors)
         be.append(fit.effective_baseline_m - truth_b)
         bs.append(fit.effective_baseline_std_m)
-    est, std, be, bs = np.array(est), np.array(std), np.array(be), np.array(bs)
-    err = est - truth
-    print(f"   effective baseline error: RMS {1e3 * np.sqrt(np.mean(be**2)):.3f} mm, max {1e3 * np.max(np.abs(be)):.3f} mm; "
-          f"stated std {1e3 * np.mean(bs):.3f} mm, z-score spread {np.std(be / bs):.2f}")  # fmt: skip
-    for k, name in ((2, "s1"), (3, "s2")):
-        z = err[:, k] / std[:, k]
-        print(f"   {name} error: RMS {1e3 * np.sqrt(np.mean(err[:, k] ** 2)):.3f} mm, max {1e3 * np.max(np.abs(err[:, k])):.3f} mm; "
-              f"stated std {1e3 * np.mean(std[:, k]):.3f} mm, z-score spread {np.std(z):.2f}, "
-              f"within 1 stated std {100 * np.mean(np.abs(z) < 1):.0f} % (68 % expected)")  # fmt: skip
-    for k, name in ((0, "alpha_e1"), (1, "alpha_e2")):
-        print(
-            f"   {name} error RMS {np.sqrt(np.mean(err[:, k] ** 2)):.2e} rad; z-score spread {np.std(err[:, k] / std[:, k]):.2f}"
-        )
+    est_a, std_a, be_a, bs_a = np.array(est), np.array(std), np.array(be), np.array(bs)
+    err = est_a - truth
+    z = err / std_a
+    return {
+        "layout": layout,
+        "seeds": seeds,
+        "near_balls": int(np.sum(ranges == CALIBRATION_DEPTH_M[0])) if layout == "near_far" else 0,
+        "limit_m": offset_std_limit(ranges, 1e-3) * math.sqrt(len(ranges) / 60),
+        "baseline": {
+            "rms_m": float(np.sqrt(np.mean(be_a**2))),
+            "max_m": float(np.max(np.abs(be_a))),
+            "std_m": float(np.mean(bs_a)),
+            "z_spread": float(np.std(be_a / bs_a)),
+        },
+        "offsets": [
+            {
+                "rms_m": float(np.sqrt(np.mean(err[:, k] ** 2))),
+                "max_m": float(np.max(np.abs(err[:, k]))),
+                "std_m": float(np.mean(std_a[:, k])),
+                "z_spread": float(np.std(z[:, k])),
+                "within_1_std_pct": float(100 * np.mean(np.abs(z[:, k]) < 1)),
+            }
+            for k in (2, 3)
+        ],
+        "directions": [
+            {"rms_rad": float(np.sqrt(np.mean(err[:, k] ** 2))), "z_spread": float(np.std(z[:, k]))}
+            for k in (0, 1)
+        ],
+    }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seeds", type=int, default=50)
-    parser.add_argument("--budget-seeds", type=int, default=10)
-    parser.add_argument("--out", type=Path, default=None, help="write error_budget.csv/.png here")
-    args = parser.parse_args()
-    rng = np.random.default_rng(2026)
-    p = field(rng, 2000)
-
+def recovery(head: StereoHead, seeds: int, layout: str) -> None:
+    """Print section 3 (see :func:`recovery_figures`)."""
+    f = recovery_figures(head, seeds, layout)
     print(
-        "1. Realistic head, whole field (2000 targets), after the extended calibration (60 targets, 1 mm tape)"
+        f"\n3. Calibration recovery over {seeds} seeds (60 balls at 0.25-1.5 m, layout "
+        f"{layout}, 1 mm tape), realistic head; offset limit of eq. (1): {1e3 * f['limit_m']:.3f} mm"
     )
+    b = f["baseline"]
+    print(f"   effective baseline error: RMS {1e3 * b['rms_m']:.3f} mm, max {1e3 * b['max_m']:.3f} mm; "
+          f"stated std {1e3 * b['std_m']:.3f} mm, z-score spread {b['z_spread']:.2f}")  # fmt: skip
+    for name, o in zip(("s1", "s2"), f["offsets"], strict=True):
+        print(f"   {name} error: RMS {1e3 * o['rms_m']:.3f} mm, max {1e3 * o['max_m']:.3f} mm; "
+              f"stated std {1e3 * o['std_m']:.3f} mm, z-score spread {o['z_spread']:.2f}, "
+              f"within 1 stated std {o['within_1_std_pct']:.0f} % (68 % expected)")  # fmt: skip
+    for name, d in zip(("alpha_e1", "alpha_e2"), f["directions"], strict=True):
+        print(f"   {name} error RMS {d['rms_rad']:.2e} rad; z-score spread {d['z_spread']:.2f}")
+
+
+def whole_field(p: np.ndarray, seeds: int) -> np.ndarray:
+    """Section 1: (seeds, 4) 3-D error RMS, % of depth, over ``p`` and per band in BANDS,
+    after each of ``seeds`` extended calibrations of the realistic head."""
     head = realistic()
     rows = []
-    for seed in range(args.seeds):
+    for seed in range(seeds):
         fit = calibrate(head, seed)
         err = measure(head, p, tuple(fit.alpha_e), tuple(fit.offset_m), BELIEVED_D) - p
         rows.append(
@@ -271,14 +301,13 @@ def main() -> None:
                 for lo, hi in BANDS
             ]
         )
-    rows = np.array(rows)
-    print(f"   3-D error RMS, % of depth, median over {args.seeds} calibrations (95th percentile):")
-    for k, name in enumerate(["all", *(f"{lo}-{hi} m" for lo, hi in BANDS)]):
-        print(f"     {name:10s} {np.median(rows[:, k]):.3f} ({np.percentile(rows[:, k], 95):.3f})")
+    return np.array(rows)
 
-    print(
-        "\n2. Offsets left uncorrected (initial directions exact; line-of-sight offsets taken as 0)"
-    )
+
+def uncorrected(p: np.ndarray) -> dict[str, dict[str, float]]:
+    """Section 2: depth error RMS with the offsets left uncorrected (initial directions exact),
+    beside eq. 15's first-order |dD_eff| / D, % (and ``s``, the offsets, m), per head."""
+    out = {}
     for label, h in (
         (
             "n = 20 mm both, delta of the paper's cameras",
@@ -300,10 +329,20 @@ def main() -> None:
     ):
         s1, s2 = h.line_of_sight_offsets()
         err = measure(h, p, h.effective_initial_directions(), (0.0, 0.0), BELIEVED_D) - p
-        dz = float(100 * np.sqrt(np.mean((err[:, 2] / p[:, 2]) ** 2)))
-        predicted = 100 * abs(h.baseline - s1 + s2 - BELIEVED_D) / BELIEVED_D  # dz/z = dD/D, eq. 15
-        print(f"   {label}: s = ({s1 * 1e3:.3f}, {s2 * 1e3:.3f}) mm; depth error RMS {dz:.3f} %, "
-              f"first-order |dD_eff|/D {predicted:.3f} %, ratio {dz / predicted:.3f}")  # fmt: skip
+        out[label] = {
+            "s1_m": s1,
+            "s2_m": s2,
+            "depth_pct": float(100 * np.sqrt(np.mean((err[:, 2] / p[:, 2]) ** 2))),
+            "x_pct": float(100 * np.sqrt(np.mean((err[:, 0] / p[:, 2]) ** 2))),
+            # dz/z = dD/D, eq. 15
+            "predicted_pct": 100 * abs(h.baseline - s1 + s2 - BELIEVED_D) / BELIEVED_D,
+        }
+    return out
+
+
+def principal_columns_change(p: np.ndarray) -> tuple[float, float]:
+    """Largest change of any x, z estimate and of any y, m, that n = 20 mm alone makes with
+    the goal columns at the principal points (initial directions exact, offsets uncorrected)."""
     c = paper_cameras(False)
     h0 = StereoHead(
         BELIEVED_D,
@@ -319,12 +358,45 @@ def main() -> None:
         measure(h0, p, h0.effective_initial_directions(), (0.0, 0.0), BELIEVED_D)
         - measure(hp, p, hp.effective_initial_directions(), (0.0, 0.0), BELIEVED_D)
     )
+    return float(np.nanmax(diff[:, [0, 2]])), float(np.nanmax(diff[:, 1]))
+
+
+def targets() -> np.ndarray:
+    """The whole shared field's 2000 targets (seeded), in H, m."""
+    return field(np.random.default_rng(2026), 2000)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=50)
+    parser.add_argument("--budget-seeds", type=int, default=10)
+    parser.add_argument("--out", type=Path, default=None, help="write error_budget.csv/.png here")
+    args = parser.parse_args()
+    p = targets()
+
+    print(
+        "1. Realistic head, whole field (2000 targets), after the extended calibration (60 targets, 1 mm tape)"
+    )
+    rows = whole_field(p, args.seeds)
+    print(f"   3-D error RMS, % of depth, median over {args.seeds} calibrations (95th percentile):")
+    for k, name in enumerate(["all", *(f"{lo}-{hi} m" for lo, hi in BANDS)]):
+        print(f"     {name:10s} {np.median(rows[:, k]):.3f} ({np.percentile(rows[:, k], 95):.3f})")
+
+    print(
+        "\n2. Offsets left uncorrected (initial directions exact; line-of-sight offsets taken as 0)"
+    )
+    for label, u in uncorrected(p).items():
+        print(f"   {label}: s = ({u['s1_m'] * 1e3:.3f}, {u['s2_m'] * 1e3:.3f}) mm; depth error RMS "
+              f"{u['depth_pct']:.3f} %, x {u['x_pct']:.3f} %, first-order |dD_eff|/D "
+              f"{u['predicted_pct']:.3f} %")  # fmt: skip
+    xz, y = principal_columns_change(p)
     print(
         "   goal columns at the principal points, n = 20 mm alone: largest change of any x, z "
-        f"estimate {np.nanmax(diff[:, [0, 2]]):.2e} m; of y {np.nanmax(diff[:, 1]):.2e} m "
+        f"estimate {xz:.2e} m; of y {y:.2e} m "
         "(y: near-midline targets switch between one camera's y and the mean)"
     )
 
+    head = realistic()
     for layout in ("uniform", "near_far"):
         recovery(head, args.seeds, layout)
 

@@ -39,24 +39,23 @@ MAGNITUDE_AREAS = (1, 2, 3, 4, 7, 8)
 OBJECT_RADIUS_M = 0.006
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--per-area", type=int, default=20)
-    parser.add_argument("--preset", default="paper", choices=("paper", "ideal", "realistic"))
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument(
-        "--near-axis", type=int, default=10, help="extra layouts near Z_h (magnitude areas)"
-    )
-    parser.add_argument("--json")
-    args = parser.parse_args()
-    start = time.perf_counter()
-    rng = np.random.default_rng(args.seed)
+def area_study(
+    per_area: int = 20,
+    preset_name: str = "paper",
+    seed: int = 0,
+    near_axis: int = 10,
+    progress: bool = True,
+) -> dict[str, Any]:
+    """Layouts until every area holds ``per_area`` objects seen in all four images, then
+    ``near_axis`` near Z_h; every object's row (``rows``), and the layouts' counts.
+    ``progress``: each layout's number on stderr."""
+    rng = np.random.default_rng(seed)
     objects = names.RELATIVE_OBJECTS
-    n_layouts = int(np.ceil(12 * args.per_area / len(objects)))
+    n_layouts = int(np.ceil(12 * per_area / len(objects)))
     rows: list[dict[str, Any]] = []
     reference = body_target(names.BLOCKS, find_cross_point)
     layout_failures = 0
-    with HeadSim("blocks", preset(args.preset, seed=args.seed)) as sim:
+    with HeadSim("blocks", preset(preset_name, seed=seed)) as sim:
         servo = EyeServo(sim)
         seen_per_area = dict.fromkeys(range(1, 13), 0)
         spread_layouts = 0
@@ -65,8 +64,8 @@ def main() -> int:
         # images (at most three times the planned count), then the near-axis ones.
         while True:
             layout += 1
-            near = min(seen_per_area.values()) >= args.per_area or layout >= 3 * n_layouts
-            if near and layout - spread_layouts >= args.near_axis:
+            near = min(seen_per_area.values()) >= per_area or layout >= 3 * n_layouts
+            if near and layout - spread_layouts >= near_axis:
                 break
             if near:  # magnitude-test areas only, within |x/z| <= 0.02 of the Z_h axis
                 wanted = [MAGNITUDE_AREAS[(layout + j) % 6] for j in range(len(objects))]
@@ -103,7 +102,8 @@ def main() -> int:
                     last_error = str(err)
             if placed is None:
                 layout_failures += 1
-                print(f"  layout {layout + 1}: {last_error}", file=sys.stderr)
+                if progress:
+                    print(f"  layout {layout + 1}: {last_error}", file=sys.stderr)
                 continue
             world = sim.transform_points(np.nan_to_num(placed), "head", "world")
             colours = {}
@@ -113,7 +113,8 @@ def main() -> int:
                 if not unplaced:
                     colours[body] = names.RELATIVE_OBJECT_COLOURS[body]
             run = relative_positioning(sim, servo, reference, colours)
-            print(f"  layout {layout + 1}", end="\r", file=sys.stderr, flush=True)
+            if progress:
+                print(f"  layout {layout + 1}", end="\r", file=sys.stderr, flush=True)
             seen = [o for o in colours if o not in run.missing]
             margin = dict(zip(seen, run.comparison.margin, strict=True)) if run.comparison else {}
             gain_margin = (
@@ -141,48 +142,42 @@ def main() -> int:
                         "x_h_m": float(p[0]),
                     }
                 )
-    print(file=sys.stderr)
-    header = (
-        f"{'area':>4} {'n':>4} {'seen':>4} | {'paper agree':>11} {'>2px':>9} | "
-        f"{'gain agree':>10} {'>2px':>9}"
-    )
-    print(
-        f"Relative positioning, {args.preset} cameras: {len(rows)} objects in "
-        f"{spread_layouts} spread layouts and {layout - spread_layouts} near Z_h"
-    )
-    print(header)
+    if progress:
+        print(file=sys.stderr)
+    return {
+        "rows": rows,
+        "spread_layouts": spread_layouts,
+        "near_layouts": layout - spread_layouts,
+        "layout_failures": layout_failures,
+    }
+
+
+def tally(rows: list[dict[str, Any]]) -> tuple[dict[int, dict[str, int]], dict[str, Any]]:
+    """Per true area, the paper's and the gain-normalised test against the geometry (all, and
+    outside the 2 px margin); and the magnitude-test areas' misclassifications."""
     per_area = {}
     spread = [r for r in rows if not r["near_axis"]]
     for area in range(1, 13):
         rs = [r for r in spread if r["seen"] and r["true"] == area]
-        n_all = sum(r["wanted"] == area for r in spread)
-        paper_ok = sum(r["paper"] == area for r in rs)
-        gain_ok = sum(r["gain"] == area for r in rs)
         out_p = [r for r in rs if r["margin_px"] > 2.0]
         out_g = [r for r in rs if r["gain_margin_px"] > 2.0]
-        p_out_ok = sum(r["paper"] == area for r in out_p)
-        g_out_ok = sum(r["gain"] == area for r in out_g)
         per_area[area] = {
             "objects": len(rs),
-            "placed": n_all,
-            "paper_agree": paper_ok,
+            "placed": sum(r["wanted"] == area for r in spread),
+            "paper_agree": sum(r["paper"] == area for r in rs),
             "paper_outside_margin": len(out_p),
-            "paper_agree_outside_margin": p_out_ok,
-            "gain_agree": gain_ok,
+            "paper_agree_outside_margin": sum(r["paper"] == area for r in out_p),
+            "gain_agree": sum(r["gain"] == area for r in rs),
             "gain_outside_margin": len(out_g),
-            "gain_agree_outside_margin": g_out_ok,
+            "gain_agree_outside_margin": sum(r["gain"] == area for r in out_g),
         }
-        print(
-            f"{'S' + str(area):>4} {n_all:>4} {len(rs):>4} | {paper_ok:>5}/{len(rs):<5} "
-            f"{p_out_ok:>4}/{len(out_p):<4} | {gain_ok:>4}/{len(rs):<5} {g_out_ok:>4}/{len(out_g):<4}"
-        )
     near_axis: dict[str, Any] = {}
     for label, subset in (
         ("all layouts", [r for r in rows if r["seen"]]),
         ("near Z_h (|x/z| <= 0.02)", [r for r in rows if r["seen"] and r["near_axis"]]),
     ):
         mag = [r for r in subset if r["true"] in MAGNITUDE_AREAS]
-        figures = {"objects": len(mag)}
+        figures: dict[str, Any] = {"objects": len(mag)}
         for test, key in (("paper", "margin_px"), ("gain", "gain_margin_px")):
             wrong = [r for r in mag if r[test] != r["true"]]
             outside = [r for r in wrong if r[key] > 2.0]
@@ -192,8 +187,43 @@ def main() -> int:
                 "max_abs_x_h_mm": 1e3 * max((abs(r["x_h_m"]) for r in wrong), default=0.0),
             }
         near_axis[label] = figures
+    return per_area, near_axis
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--per-area", type=int, default=20)
+    parser.add_argument("--preset", default="paper", choices=("paper", "ideal", "realistic"))
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--near-axis", type=int, default=10, help="extra layouts near Z_h (magnitude areas)"
+    )
+    parser.add_argument("--json")
+    args = parser.parse_args()
+    start = time.perf_counter()
+    study = area_study(args.per_area, args.preset, args.seed, args.near_axis)
+    rows = study["rows"]
+    per_area, near_axis = tally(rows)
+    header = (
+        f"{'area':>4} {'n':>4} {'seen':>4} | {'paper agree':>11} {'>2px':>9} | "
+        f"{'gain agree':>10} {'>2px':>9}"
+    )
+    print(
+        f"Relative positioning, {args.preset} cameras: {len(rows)} objects in "
+        f"{study['spread_layouts']} spread layouts and {study['near_layouts']} near Z_h"
+    )
+    print(header)
+    for area, a in per_area.items():
         print(
-            f"Magnitude-test areas (S1-S4, S7, S8), {label}: {len(mag)} objects; "
+            f"{'S' + str(area):>4} {a['placed']:>4} {a['objects']:>4} | "
+            f"{a['paper_agree']:>5}/{a['objects']:<5} "
+            f"{a['paper_agree_outside_margin']:>4}/{a['paper_outside_margin']:<4} | "
+            f"{a['gain_agree']:>4}/{a['objects']:<5} "
+            f"{a['gain_agree_outside_margin']:>4}/{a['gain_outside_margin']:<4}"
+        )
+    for label, figures in near_axis.items():
+        print(
+            f"Magnitude-test areas (S1-S4, S7, S8), {label}: {figures['objects']} objects; "
             f"paper's test misclassifies {figures['paper']['misclassified']} "
             f"({figures['paper']['misclassified_outside_2px']} outside 2 px, |x_h| <= "
             f"{figures['paper']['max_abs_x_h_mm']:.1f} mm); gain-normalised "
@@ -201,7 +231,7 @@ def main() -> int:
             "outside 2 px)"
         )
     print(
-        f"layouts not placed: {layout_failures}; objects not seen in all four images: "
+        f"layouts not placed: {study['layout_failures']}; objects not seen in all four images: "
         f"{sum(not r['seen'] for r in rows)}; wall {time.perf_counter() - start:.0f} s"
     )
     if args.json:

@@ -1,0 +1,143 @@
+"""What the README's figure generators share: runs of today's code and how to read them.
+
+Every key of results.json that a generator reads goes through :func:`summary`,
+:func:`effort` or :func:`bands`, so that a renamed key is changed in one place.
+Runs that more than one block quotes are cached for the process
+(:func:`payload`), so the whole check runs each one once.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.util
+import json
+import math
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from types import ModuleType
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run_payload(
+    scenario: str, *, fast: bool = False, seed: int | None = None, **overrides: Any
+) -> dict[str, Any]:
+    """results.json's document of one scenario run (no files written)."""
+    from headsim.run.runner import run_scenario
+    from headsim.run.serialise import results_payload
+    from headsim.scenario.loading import load_scenario
+
+    loaded = load_scenario(scenario, fast=fast, seed=seed, overrides=overrides or None)
+    return results_payload(run_scenario(loaded))
+
+
+@functools.cache
+def _cached(scenario: str, fast: bool, seed: int | None, overrides: str) -> dict[str, Any]:
+    return run_payload(scenario, fast=fast, seed=seed, **json.loads(overrides))
+
+
+def payload(
+    scenario: str, *, fast: bool = False, seed: int | None = None, **overrides: Any
+) -> dict[str, Any]:
+    """:func:`run_payload`, run once per process for the same arguments."""
+    return _cached(scenario, fast, seed, json.dumps(overrides, sort_keys=True))
+
+
+@functools.cache
+def benchmark(name: str) -> ModuleType:
+    """The script ``benchmarks/NAME.py`` as a module (its functions, not its ``main``)."""
+    path = ROOT / "benchmarks" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"benchmarks_{name}", path)
+    assert spec is not None and spec.loader is not None, path
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+# --- results.json's keys: read here only ---------------------------------------------
+
+
+def summary(payload: dict[str, Any]) -> dict[str, Any]:
+    """The run's one summary entry (the knowledge the head measured with)."""
+    (entry,) = payload["summary"].values()
+    return entry
+
+
+def effort(payload: dict[str, Any]) -> dict[str, float]:
+    """What a run drew: images (``renders``, ``calibration_renders``,
+    ``experiment_renders``), the servos' ``windows``, ``previews`` and ``missed``
+    windows, and ``frames``, its pixels in full frames."""
+    r, w = payload["renders"], payload["windows"]
+    return {
+        "renders": r["total"],
+        "calibration_renders": r["calibration"],
+        "experiment_renders": r["experiment"],
+        "windows": w["rendered"],
+        "previews": w["previews"],
+        "missed": w["missed"],
+        "frames": payload["rendered_frames"]["total"],
+    }
+
+
+def calibration_errors(payload: dict[str, Any]) -> dict[str, Any]:
+    """The extended calibration against the truth: ``baseline_mm`` (effective baseline),
+    ``offsets_mm`` (line-of-sight offsets), ``directions_mrad`` (initial directions), each
+    found minus true; ``*_std`` their stated standard errors; balls ``fixated`` of
+    ``targets``.  Only the two counts when the fit had no lines of sight."""
+    c = payload["calibration"]
+    out: dict[str, Any] = {"fixated": c["fixated"], "targets": c["targets"]}
+    los = c.get("lines_of_sight")
+    if not los:
+        return out
+    std = los["std_errors"]
+    out["baseline_mm"] = 1e3 * (los["effective_baseline_m"] - los["effective_baseline_truth_m"])
+    out["baseline_std_mm"] = 1e3 * los["effective_baseline_std_m"]
+    out["offsets_mm"] = [
+        1e3 * (a - b) for a, b in zip(los["offset_m"], los["offset_truth_m"], strict=True)
+    ]
+    out["offsets_std_mm"] = [1e3 * v for v in std["offset_m"]]
+    out["directions_mrad"] = [
+        1e3 * (a - b) for a, b in zip(los["alpha_e_rad"], c["alpha_e_truth_rad"], strict=True)
+    ]
+    out["directions_std_mrad"] = [1e3 * v for v in std["alpha_e_rad"]]
+    return out
+
+
+def band_rms(entry: dict[str, Any]) -> list[float]:
+    """A summary entry's 3-D error RMS per depth band, % of depth, nearest band first."""
+    return [b["error_pct_of_depth_rms"] for b in entry["by_depth"]]
+
+
+def bands(entry: dict[str, Any]) -> str:
+    """A summary entry's RMS by depth band: 'BAND: X % (COUNT); ...'."""
+    return "; ".join(
+        f"{b['band']}: {pct(b['error_pct_of_depth_rms'])} ({b['count']})" for b in entry["by_depth"]
+    )
+
+
+# --- formatting ---------------------------------------------------------------------
+
+
+def pct(value: float | None, digits: int = 3) -> str:
+    """``value`` in % with ``digits`` decimals; '-' for none."""
+    return "-" if value is None or math.isnan(value) else f"{value:.{digits}f} %"
+
+
+def num(value: float | None, digits: int = 3) -> str:
+    """``value`` with ``digits`` decimals; '-' for none or NaN."""
+    return "-" if value is None or math.isnan(value) else f"{value:.{digits}f}"
+
+
+def span(values: Iterable[float], digits: int = 2, sep: str = "-") -> str:
+    """'LOW-HIGH' of ``values`` (one number when they agree to the digits)."""
+    vs = sorted(values)
+    lo, hi = f"{vs[0]:.{digits}f}", f"{vs[-1]:.{digits}f}"
+    return lo if lo == hi else f"{lo}{sep}{hi}"
+
+
+def table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
+    """A markdown table."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(row) + " |" for row in rows]
+    return "\n".join(lines) + "\n"
