@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 export MUJOCO_GL ?= egl
 
-.PHONY: setup demo test regress bench clean
+.PHONY: setup demo test regress bench figures clean
 
 $(BIN)/headsim: pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -32,6 +32,11 @@ test: setup
 # The regression suite CI runs after the tests: exits 1 on a regression.
 regress: setup
 	$(BIN)/headsim bench
+
+# Every figure block of the README regenerated and checked (about 10 minutes; CI checks
+# all but the longest): after an intended change, `python tools/readme_figures.py --write`.
+figures: setup
+	$(BIN)/python tools/readme_figures.py
 
 # Every benchmark script's figures (minutes; not run by CI).
 bench: setup

@@ -64,20 +64,30 @@ def summary(payload: dict[str, Any]) -> dict[str, Any]:
     return entry
 
 
-def effort(payload: dict[str, Any]) -> dict[str, float]:
-    """What a run drew: images (``renders``, ``calibration_renders``,
-    ``experiment_renders``), the servos' ``windows``, ``previews`` and ``missed``
-    windows, and ``frames``, its pixels in full frames."""
-    r, w = payload["renders"], payload["windows"]
+def effort(payload: dict[str, Any]) -> dict[str, Any]:
+    """What a run drew, every image a render: ``renders`` in all, ``calibration_renders``,
+    ``experiment_renders``, ``measurement_renders`` (the experiment's that its
+    measurements count), by kind ``images`` (full frames), ``windows``, ``retakes`` and
+    ``previews``, and ``frames``, its pixels in full frames."""
+    counts = payload["render_counts"]
+    overall = counts["overall"]
     return {
-        "renders": r["total"],
-        "calibration_renders": r["calibration"],
-        "experiment_renders": r["experiment"],
-        "windows": w["rendered"],
-        "previews": w["previews"],
-        "missed": w["missed"],
+        "renders": overall["total"],
+        "calibration_renders": counts["calibration"]["total"],
+        "experiment_renders": counts["experiment"]["total"],
+        "measurement_renders": counts["experiment"]["in_measurements"],
+        "images": overall["images"],
+        "windows": overall["windows"],
+        "retakes": overall["retakes"],
+        "previews": overall["previews"],
         "frames": payload["rendered_frames"]["total"],
     }
+
+
+def acceptance(payload: dict[str, Any]) -> dict[str, Any]:
+    """The scene's targets: ``listed``, random ``drawn`` (refused draws included),
+    ``refused`` by reason, ``accepted``, and those ``outside_start_view``."""
+    return payload["scenario"]["scene"]["acceptance"]
 
 
 def calibration_errors(payload: dict[str, Any]) -> dict[str, Any]:

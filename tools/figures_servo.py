@@ -214,8 +214,8 @@ def chessboard_windows() -> str:
     e = effort(payload("chessboard"))
     return (
         f"  `headsim run chessboard` (seed 0, its calibration included): {e['windows']} windows "
-        f"and {e['previews']} previews among {e['renders']} images, {e['missed']} windows "
-        f"missed; {e['frames']:.1f} full frames of pixels.\n"
+        f"and {e['previews']} previews among {e['renders']} renders ({e['images']} full frames, "
+        f"{e['retakes']} windows retaken whole); {e['frames']:.1f} full frames of pixels.\n"
     )
 
 

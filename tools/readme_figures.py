@@ -14,6 +14,7 @@ every run on one machine.  Usage::
 
     python tools/readme_figures.py              # check every block; exit 1 naming each stale one
     python tools/readme_figures.py --cheap      # only the blocks that take seconds (a test runs these)
+    python tools/readme_figures.py --ci         # all but the few of several minutes (CI runs these)
     python tools/readme_figures.py --write      # rewrite the blocks in place
     python tools/readme_figures.py --only NAME  # one block (repeatable)
     python tools/readme_figures.py --jobs 1     # in this process only (default: 2 processes)
@@ -40,7 +41,17 @@ from typing import Any
 import figures_live as live
 import figures_realistic as realistic
 import figures_servo as servo
-from figures_common import ROOT, bands, calibration_errors, effort, payload, pct, summary
+from figures_common import (
+    ROOT,
+    acceptance,
+    bands,
+    calibration_errors,
+    effort,
+    payload,
+    pct,
+    summary,
+    table,
+)
 
 README = ROOT / "README.md"
 _BLOCK = re.compile(
@@ -56,23 +67,37 @@ def quickstart() -> str:
         f"`headsim run quickstart` (seed 0): all {s['ok']} of {s['count']} markers measured, "
         f"3-D error RMS **{pct(s['error_pct_of_depth_rms'])} of depth** "
         f"(by depth band: {bands(s)}); {s['renders_per_point']:.1f} renders per marker. "
-        f"The run drew {e['renders']} images ({e['calibration_renders']} in the calibration, "
-        f"{e['experiment_renders']} in the measurements; {e['windows']} windows and "
-        f"{e['previews']} previews among them), {e['frames']:.1f} full frames of pixels.\n"
+        f"{_renders_line(e)}\n"
+    )
+
+
+def _renders_line(e: dict[str, Any]) -> str:
+    """Every image the run drew, by phase and by kind (each one a render)."""
+    return (
+        f"The run drew {e['renders']} renders: {e['calibration_renders']} in the calibration "
+        f"and {e['experiment_renders']} in the experiment ({e['measurement_renders']} of them "
+        f"counted by its measurements); by kind {e['images']} full frames, {e['windows']} "
+        f"windows, {e['retakes']} windows retaken whole and {e['previews']} previews, "
+        f"{e['frames']:.1f} full frames of pixels."
     )
 
 
 def realistic_field() -> str:
     """``headsim run realistic_field`` at seed 0: the whole field, effort, the calibration."""
     p = payload("realistic_field")
-    s, e = summary(p), effort(p)
+    s, e, a = summary(p), effort(p), acceptance(p)
+    edge = s["outside_start_view"]
+    refused = ", ".join(f"{n} {code}" for code, n in sorted(a["refused"].items())) or "none"
     return (
-        f"`headsim run realistic_field` (seed 0): {s['ok']} of {s['count']} targets measured "
-        f"({s['searched']} needed a search, {s['search_renders']} renders of search); "
-        f"3-D error RMS over all {s['count']}: **{pct(s['error_pct_of_depth_rms'])} of depth**; "
-        f"by depth band: {bands(s)}; {s['renders_per_point']:.1f} renders per point "
-        f"({e['frames']:.0f} full frames of pixels for {e['renders']} "
-        f"renders). {_calibration_line(p)}\n"
+        f"`headsim run realistic_field` (seed 0): {s['ok']} of {a['accepted']} accepted "
+        f"targets measured, {s['ok']} of {a['drawn']} drawn (the reach check refused "
+        f"{a['drawn'] - a['accepted']} draws: {refused}); {s['searched']} needed a search, "
+        f"{s['search_renders']} renders of search ({s['scan_renders']} of them scanning for "
+        f"{s['scanned']} targets the start pose did not show). 3-D error RMS over all "
+        f"{s['count']}: **{pct(s['error_pct_of_depth_rms'])} of depth**; by depth band: "
+        f"{bands(s)}; over the {edge['count']} targets outside the start pose's view alone: "
+        f"{pct(edge['error_pct_of_depth_rms'])}. {s['renders_per_point']:.1f} renders per "
+        f"point. {_renders_line(e)} {_calibration_line(p)}\n"
     )
 
 
@@ -96,11 +121,69 @@ def _calibration_line(p: dict[str, Any]) -> str:
     )
 
 
+#: The stress scenarios whose random targets reach the field's edge, and their seeds.
+STRESS_SCENARIOS, STRESS_SEEDS = ("stress_zoom", "stress_shared_field"), range(5)
+
+
+def _pooled_rms(parts: list[tuple[int, float | None]]) -> float | None:
+    """The RMS over the union of groups given as (count, RMS)."""
+    n = sum(k for k, r in parts if r is not None)
+    if not n:
+        return None
+    return float((sum(k * r * r for k, r in parts if r is not None) / n) ** 0.5)
+
+
+def stress() -> str:
+    """Every drawn target of the stress scenarios attempted, at seeds 0-4, full size."""
+    rows = []
+    for name in STRESS_SCENARIOS:
+        runs = [payload(name, seed=seed) for seed in STRESS_SEEDS]
+        sums = [summary(p) for p in runs]
+        accept = [acceptance(p) for p in runs]
+        refused: dict[str, int] = {}
+        causes: dict[str, int] = {}
+        for a, s in zip(accept, sums, strict=True):
+            for code, n in a["refused"].items():
+                refused[code] = refused.get(code, 0) + n
+            for cause, n in s["failure_causes"].items():
+                causes[cause] = causes.get(cause, 0) + n
+        edge = [s["outside_start_view"] for s in sums]
+        scanned = sum(s["scanned"] for s in sums)
+        rows.append(
+            [
+                f"`{name}`",
+                f"{sum(s['ok'] for s in sums)} / {sum(a['accepted'] for a in accept)} / "
+                f"{sum(a['drawn'] + a['listed'] for a in accept)}",
+                ", ".join(f"{n} {c}" for c, n in sorted(refused.items())) or "none",
+                ", ".join(f"{n} {c}" for c, n in sorted(causes.items())) or "none",
+                pct(_pooled_rms([(s["ok"], s["error_pct_of_depth_rms"]) for s in sums])),
+                f"{pct(_pooled_rms([(e['ok'], e['error_pct_of_depth_rms']) for e in edge]))} "
+                f"({sum(e['count'] for e in edge)})",
+                f"{scanned}, {sum(s['scan_renders'] for s in sums) / scanned:.2f}"
+                if scanned
+                else "0, -",
+            ]
+        )
+    return table(
+        [
+            "scenario, seeds 0-4",
+            "measured / accepted / drawn",
+            "draws refused",
+            "failures",
+            "3-D RMS, all measured",
+            "3-D RMS, outside the start view (targets)",
+            "scanned targets, renders of scan each",
+        ],
+        rows,
+    )
+
+
 @dataclass(frozen=True)
 class Generator:
     """A block's generator: its text from fresh runs.
 
-    ``cheap``: seconds, not minutes (the test suite checks it).  ``group``: blocks that
+    ``cheap``: seconds, not minutes (the test suite checks it).  ``ci``: CI checks it
+    (every block but those of several minutes; ``make figures`` checks them all).  ``group``: blocks that
     share runs (cached per process) are made in one process.  ``seconds``: roughly how
     long the block takes with a core of its own, its own runs only (the longest groups
     start first; the check prints what each group took).
@@ -108,6 +191,7 @@ class Generator:
 
     make: Callable[[], str]
     cheap: bool
+    ci: bool = True
     group: str = ""
     seconds: float = 1.0
 
@@ -120,16 +204,19 @@ GENERATORS: dict[str, Generator] = {
     "averaged_fixation": Generator(
         servo.averaged_fixation, cheap=False, group="bench points", seconds=4
     ),
-    "reach_zoom": Generator(servo.reach_zoom, cheap=False, group="zoom", seconds=170),
-    "reach_zoom_angles": Generator(servo.reach_zoom_angles, cheap=False, group="zoom", seconds=15),
+    "reach_zoom": Generator(servo.reach_zoom, cheap=False, ci=False, group="zoom", seconds=170),
+    "reach_zoom_angles": Generator(
+        servo.reach_zoom_angles, cheap=False, ci=False, group="zoom", seconds=15
+    ),
     "relative_areas": Generator(servo.relative_areas, cheap=False, seconds=80),
-    "live_gaze": Generator(live.live_gaze, cheap=False, seconds=70),
+    "live_gaze": Generator(live.live_gaze, cheap=False, ci=False, seconds=70),
     "gym": Generator(live.gym_policies, cheap=False, seconds=5),
     "forward_field": Generator(realistic.forward_field, cheap=True, group="forward", seconds=4),
     "forward_budget": Generator(realistic.forward_budget, cheap=True, group="forward", seconds=1),
     "realistic_field": Generator(realistic_field, cheap=False, seconds=8),
+    "stress": Generator(stress, cheap=False, seconds=100),
     "layouts": Generator(realistic.layouts, cheap=False, group="forward", seconds=35),
-    "budget": Generator(realistic.budget, cheap=False, seconds=75),
+    "budget": Generator(realistic.budget, cheap=False, ci=False, seconds=75),
     "render_fidelity": Generator(servo.render_fidelity, cheap=False, group="fidelity", seconds=30),
     "render_fidelity_presets": Generator(
         servo.render_fidelity_presets, cheap=False, group="fidelity", seconds=20
@@ -202,6 +289,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--write", action="store_true", help="rewrite the blocks in place")
     parser.add_argument("--cheap", action="store_true", help="only the blocks that take seconds")
+    parser.add_argument("--ci", action="store_true", help="only the blocks CI checks")
     parser.add_argument(
         "--only", action="append", default=[], metavar="NAME", help="one block (repeatable)"
     )
@@ -232,7 +320,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return 2
-    names = args.only or [n for n, g in GENERATORS.items() if g.cheap or not args.cheap]
+    names = args.only or [
+        n
+        for n, g in GENERATORS.items()
+        if (g.cheap or not args.cheap) and (g.ci or g.cheap or not args.ci)
+    ]
     fresh, stale = check(names, text, args.jobs)
     if args.write:
         args.readme.write_text(rewrite(text, fresh))
