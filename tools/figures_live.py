@@ -132,6 +132,35 @@ def live_gaze() -> str:
 SERVO_EPISODES, RANDOM_EPISODES = 100, 20
 
 
+#: The realistic budget's geometry errors: the true head, and what it believes of itself.
+TRUE_GEOMETRY_M = {"baseline_m": 0.1503, "neck_d1_m": 0.1205, "neck_a2_m": 0.0895}
+BELIEVED_GEOMETRY_M = {"baseline_m": 0.150, "neck_d1_m": 0.120, "neck_a2_m": 0.090}
+
+
+def pursuit_belief() -> str:
+    """``headsim run pursuit`` (1.5 s) on a head built off its design: measured with its
+    belief, and with a belief that happens to be the truth (what a leak of truth gave)."""
+    from headsim.run.runner import run_scenario
+    from headsim.scenario.loading import load_scenario
+
+    def rms(belief: dict[str, float]) -> Any:
+        overrides: dict[str, Any] = {"scene.pursuit.duration_s": 1.5}
+        overrides |= {f"head.{k}": v for k, v in TRUE_GEOMETRY_M.items()}
+        overrides |= {f"belief.{k}": v for k, v in belief.items()}
+        experiment = run_scenario(load_scenario("pursuit", overrides=overrides)).experiment
+        return experiment.figures  # type: ignore[union-attr]
+
+    built, known = rms(BELIEVED_GEOMETRY_M), rms(TRUE_GEOMETRY_M)
+    return (
+        "`headsim run pursuit` for 1.5 s on a head built off its design (true D 150.3 mm, "
+        "d1 120.5 mm, a2 89.5 mm) that believes the design (150 / 120 / 90 mm): position "
+        f"RMS **{built.position_rms_pct_of_depth:.3f} % of distance** "
+        f"({1e3 * built.position_rms_m:.2f} mm, {built.frames} frames, {built.frames_lost} "
+        f"lost); a head whose belief were its true geometry would get "
+        f"{known.position_rms_pct_of_depth:.3f} % ({1e3 * known.position_rms_m:.2f} mm).\n"
+    )
+
+
 def gym_policies() -> str:
     """The reference policies on seeded episodes of headsim/Fixate-v0."""
     import gymnasium

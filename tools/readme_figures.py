@@ -211,6 +211,7 @@ GENERATORS: dict[str, Generator] = {
     "relative_areas": Generator(servo.relative_areas, cheap=False, seconds=80),
     "live_gaze": Generator(live.live_gaze, cheap=False, ci=False, seconds=70),
     "gym": Generator(live.gym_policies, cheap=False, seconds=5),
+    "pursuit_belief": Generator(live.pursuit_belief, cheap=False, seconds=12),
     "forward_field": Generator(realistic.forward_field, cheap=True, group="forward", seconds=4),
     "forward_budget": Generator(realistic.forward_budget, cheap=True, group="forward", seconds=1),
     "realistic_field": Generator(realistic_field, cheap=False, seconds=8),
