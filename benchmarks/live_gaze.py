@@ -39,17 +39,13 @@ from functools import partial
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.active.calibration import calibrate_head
-from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
-from headsim.active.placement import calibration_layout
 from headsim.files import write_json_atomic
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Sinusoid, Waypoints
 from headsim.live.gaze import GazeConfig, GazeMode, SaccadeProfile, acquire, pursue
-from headsim.sim import names
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
-from headsim.studies import experiments
+from headsim.studies.calibrations import calibrate_realistic
 from headsim.vision.markers import find_marker
 
 RED = partial(find_marker, colour="red")
@@ -72,16 +68,7 @@ def make_head(name: str, seed: int = 0) -> Head:
         return Head(name, HeadSettings(), HeadKnowledge())
     settings = preset("realistic")
     with HeadSim("default", settings) as sim:
-        run = calibrate_head(
-            sim,
-            EyeServo(sim),
-            experiments.BALL,
-            names.CALIBRATION_BALL,
-            calibration_layout(sim, np.random.default_rng(seed + 2), 30, depth_range_m=(0.25, 1.5)),
-            position_noise_m=0.001,
-            rng=np.random.default_rng([seed, 7]),
-            lines_of_sight=True,
-        )
+        run = calibrate_realistic(sim, np.random.default_rng(seed + 2), seed)
     return Head(name, settings, run.knowledge)
 
 

@@ -34,6 +34,7 @@ from headsim.sim.settings import HeadSettings, paper_head, preset
 from headsim.sim.simulator import HeadSim
 from headsim.studies import experiments
 from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
+from headsim.studies.calibrations import calibrate_realistic
 from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
 
 Progress = Callable[[str], None]
@@ -289,16 +290,7 @@ def _realistic_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     progress("realistic head: extended calibration (30 balls, 1 mm tape)")
     settings = preset("realistic")
     with HeadSim("default", settings) as sim:
-        run = calibrate_head(
-            sim,
-            EyeServo(sim),
-            experiments.BALL,
-            names.CALIBRATION_BALL,
-            calibration_layout(sim, rng, 30, depth_range_m=(0.25, 1.5)),
-            position_noise_m=0.001,
-            rng=np.random.default_rng([seed, 7]),
-            lines_of_sight=True,
-        )
+        run = calibrate_realistic(sim, rng, seed)
         truth = line_of_sight_truth(sim, run.knowledge)
     knowledge = run.knowledge
     if faults.mount_sign:

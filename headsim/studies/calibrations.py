@@ -242,3 +242,18 @@ class CalibrationCache:
     @property
     def calibrations(self) -> list[Calibrations]:
         return list(self._cache.values())
+
+
+def calibrate_realistic(sim: HeadSim, rng: np.random.Generator, seed: int) -> CalibrationRun:
+    """The bench's extended calibration of a realistic head: 30 balls at 0.25-1.5 m drawn
+    from ``rng``, a 1 mm tape seeded by ``seed``."""
+    return calibrate_head(
+        sim,
+        EyeServo(sim),
+        BALL,
+        names.CALIBRATION_BALL,
+        calibration_layout(sim, rng, 30, depth_range_m=(0.25, 1.5)),
+        position_noise_m=0.001,
+        rng=np.random.default_rng([seed, 7]),
+        lines_of_sight=True,
+    )

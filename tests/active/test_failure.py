@@ -9,13 +9,14 @@ import pytest
 
 from headsim.active.calibration import CalibrationError, calibrate_head
 from headsim.active.eye_servo import EyeServo
-from headsim.active.failure import FailureCause
+from headsim.active.failure import FailureCause, detection_failure
 from headsim.active.measurement import body_target
 from headsim.active.model2 import Model2Config, measure_model2
 from headsim.active.servo_types import ServoConfig
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings
 from headsim.sim.simulator import HeadSim
+from headsim.vision.detection import DetectionStatus
 from headsim.vision.markers import find_marker
 
 RED = body_target("marker_red", partial(find_marker, colour="red"))
@@ -36,8 +37,8 @@ def test_each_failure_names_its_cause() -> None:
         sim.set_body_pose("marker_red", [0.0, -1.0, 0.2])
         lost = measure_model2(sim, EyeServo(sim), RED)
         assert lost.failure is not None and lost.failure.cause is FailureCause.LOST
-        # Cut: half over Ca1's left border at the start pose (a fresh servo knows no
-        # gain, so it has nowhere else to look).
+        # Cut: half over Ca1's left border at the start pose.  The detection says so,
+        # and its failure is a cut of camera 1 at step 1 ...
         cam = sim.camera_settings(1)
         x_over_z = (
             3.0 - cam.image_centre[0]
@@ -46,9 +47,14 @@ def test_each_failure_names_its_cause() -> None:
             np.array([x_over_z * 0.3, 0.0, 0.3]), names.CAMERAS[0], "world"
         )[0]
         sim.set_body_pose("marker_red", left)
+        seen = RED.detector(sim.render(1))
+        assert seen.status is DetectionStatus.CUT
+        failure = detection_failure(seen, "step 1", 1)
+        assert (failure.cause, failure.camera, failure.stage) == (FailureCause.CUT, 1, "step 1")
+        # ... but the eyes can fixate it, so Model 2 scans the eye range and measures it.
         cut = measure_model2(sim, EyeServo(sim), RED)
-        assert cut.failure is not None and cut.failure.cause is FailureCause.CUT, cut.status
-        assert (cut.failure.camera, cut.failure.stage) == (1, "step 1")
+        assert cut.ok and cut.scan_renders > 0, cut.status
+        assert np.linalg.norm(cut.estimate_head_m - cut.truth_head_m) < 0.01 * 0.3
         # Estimator: on the midline without the near-midline remedy, y is 0/0.
         _place_in_head(sim, "marker_red", [0.0, 0.03, 0.6])
         flat = measure_model2(sim, EyeServo(sim), RED, config=Model2Config(midline_px=0.0))
