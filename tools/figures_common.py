@@ -12,6 +12,7 @@ import functools
 import importlib.util
 import json
 import math
+import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from types import ModuleType
@@ -51,6 +52,7 @@ def benchmark(name: str) -> ModuleType:
     spec = importlib.util.spec_from_file_location(f"benchmarks_{name}", path)
     assert spec is not None and spec.loader is not None, path
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # registered first, as an import does (dataclasses need it)
     spec.loader.exec_module(module)
     return module
 

@@ -263,9 +263,13 @@ def generate(names: Sequence[str], jobs: int = 1) -> dict[str, str]:
     spawn = multiprocessing.get_context("spawn")  # EGL does not survive a fork
     made: dict[str, str] = {}
     with ProcessPoolExecutor(max_workers=jobs, mp_context=spawn) as pool:
-        for part in [pool.submit(_make, group) for group in order]:
-            made.update(part.result())
-    return {name: made[name] for name in names}
+        parts = {pool.submit(_make, group): group for group in order}
+        for part, group in parts.items():
+            try:
+                made.update(part.result())
+            except Exception as err:  # one broken generator must not lose the others' work
+                print(f"readme_figures: {', '.join(group)} failed: {err!r}", file=sys.stderr)
+    return {name: made[name] for name in names if name in made}
 
 
 def check(names: Sequence[str], text: str, jobs: int = 1) -> tuple[dict[str, str], list[str]]:
@@ -274,7 +278,9 @@ def check(names: Sequence[str], text: str, jobs: int = 1) -> tuple[dict[str, str
     fresh = generate(names, jobs)
     stale: list[str] = []
     for name in names:
-        if fresh[name] != current[name]:
+        if name not in fresh:
+            stale.append(f"README {name}: its generator failed (above)")
+        elif fresh[name] != current[name]:
             diff = difflib.unified_diff(
                 current[name].splitlines(),
                 fresh[name].splitlines(),
@@ -330,7 +336,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.write:
         args.readme.write_text(rewrite(text, fresh))
         print(f"readme_figures: wrote {len(fresh)} blocks ({', '.join(fresh)})")
-        return 0
+        return 0 if len(fresh) == len(names) else 1
     for diff in stale:
         print(diff)
     print(f"readme_figures: {len(names) - len(stale)} of {len(names)} blocks match today's code")

@@ -54,7 +54,14 @@ def test_the_headline_gives_measured_of_accepted_and_of_drawn_and_the_edge_apart
         scan = 3 if t.name in edge else 0  # a scan's renders are a search's
         m = replace(m, name=t.name, scan_renders=scan, search_renders=scan)
         records.append(MeasurementRecord(m, "calibrated", k))
-    result = RunResult(scenario, None, tuple(records), None, {"total": 0}, ("failed",))
+    result = RunResult(
+        scenario,
+        None,
+        tuple(records),
+        None,
+        RunRenders(RenderCounts(), RenderCounts(), 0),
+        ("failed",),
+    )
     text = summary_text(result)
     ok = len(records) - 1
     refused = ", ".join(f"{n} {code}" for code, n in a.refused.items())
