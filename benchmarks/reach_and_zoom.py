@@ -109,6 +109,7 @@ def stats(ms: list[Measurement]) -> dict[str, Any]:
         "measured": len(ok),
         "failures": dict(Counter(m.failure.message for m in ms if m.failure is not None)),
         "lost": sum(m.failure is not None and m.failure.cause.value == "lost" for m in ms),
+        "failure_causes": dict(Counter(m.failure.cause.value for m in ms if m.failure is not None)),
         "error_rms_mm": float(np.sqrt(np.mean(errors**2)) * 1e3) if ok else None,
         "error_rms_pct": float(np.sqrt(np.mean(pct**2))) if ok else None,
         "renders_per_point": float(np.mean([m.renders for m in ms])) if ms else None,

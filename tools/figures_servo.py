@@ -261,6 +261,12 @@ def reach_zoom() -> str:
     stats = [r[m] for r in runs for m, _ in MODELS]
     fixated = [r["calibration"]["fixated"] for r in runs]
     searched = [r["model2"] for r in runs if r["model2"]["searched"]]
+    searched1 = [r["model1"] for r in runs if r["model1"]["searched"]]
+    causes: dict[str, int] = {}
+    for s in stats:
+        for cause, n in s["failure_causes"].items():
+            causes[cause] = causes.get(cause, 0) + n
+    failed = ", ".join(f"{n} {c}" for c, n in sorted(causes.items())) or "none failed"
     one_image = [r for goal, avg, _ in CONFIGS if not avg for r in _config_rows(goal, avg)]
     fixed_avg = _config_rows("fixed-point", True)
 
@@ -291,12 +297,14 @@ def reach_zoom() -> str:
         f"{sum(accepted)} in all; each measured with Model 2 and with Model 1), in four "
         "configurations (goal columns at the zoom's fixed point, `--goal fixed-point`, or the "
         "image centre; one image per fixation, the default, or `--average-fixation`): "
-        f"{sum(s['measured'] for s in stats)} of {sum(s['targets'] for s in stats)} measured, "
-        f"{sum(s['lost'] for s in stats)} lost; the calibration ({ZOOM_CALIBRATION} positions, "
+        f"{sum(s['measured'] for s in stats)} of {sum(s['targets'] for s in stats)} measured "
+        f"(failures by cause: {failed}); the calibration ({ZOOM_CALIBRATION} positions, "
         f"eyes allowed to turn in) fixated {span(fixated, 0)} of {ZOOM_CALIBRATION} at every "
         f"zoom. Model 2 searched for {span((s['searched'] for s in searched), 0)} targets per "
         f"zoom at {span((s['search_renders_mean'] for s in searched), 1)} extra renders each "
-        "(one full frame per pose); Model 1 needs no search (a new target from the start pose). "
+        "(one full frame per pose, or a binned preview per pose of a scan); Model 1 for "
+        f"{span((s['searched'] for s in searched1), 0) if searched1 else '0'} (a scan of the "
+        "neck's ranges for a new target the start pose does not show). "
         f"Renders per point, one image: {per_point(one_image, 'model2')} (Model 2, "
         f"{per_point(one_image, 'model2', 'renders_per_point_without_searched')} without the "
         f"searched targets) and {per_point(one_image, 'model1')} (Model 1); averaged, fixed "
