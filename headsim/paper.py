@@ -1,7 +1,7 @@
 """Every number taken from the paper, each with its section.
 
 De Xu, You Fu Li, Min Tan, Yang Shen, "A new active visual system for humanoid
-robots" (/work/shared/paper; equations.md's "Figures from the paper's
+robots", IEEE Trans. SMC-B (docs/equations.md's "Figures from the paper's
 experiments" lists the same).  Units: metres, radians, pixels (OpenCV's:
 pixel centres at integer coordinates).  Nothing here is a setting of headsim's
 own: the presets, studies and reports read the paper's figures from here.
@@ -32,7 +32,7 @@ IMAGE_SIZE_PX = (640, 480)
 #: Calibrated initial directions alpha_e1, alpha_e2, rad (Sec. VI, by the method of Sec. V).
 INITIAL_DIRECTIONS_RAD = (0.0578, -0.0254)
 #: Zhang intrinsics of Ca1 and Ca2 (Sec. VI-B): focal lengths kx, ky, px (rounded to 0.01
-#: as in equations.md), principal point (cx, cy), px, radial distortion k1 (the paper's kc).
+#: as in docs/equations.md), principal point (cx, cy), px, radial distortion k1 (the paper's kc).
 INTRINSICS: tuple[Intrinsics, Intrinsics] = (
     {"kx": 834.83, "ky": 815.42, "cx": 303.8, "cy": 306.3, "k1": -0.38741},
     {"kx": 850.46, "ky": 833.29, "cx": 345.1, "cy": 197.3, "k1": -0.30938},

@@ -1,6 +1,6 @@
 """The paper's equations as pure, vectorised numpy functions (no simulator inside).
 
-Frames, signs and units as in ``shared/design/equations.md``: positions in the
+Frames, signs and units as in ``docs/equations.md``: positions in the
 head frame H, m; angles in rad; pixels in the OpenCV convention.
 """
 

@@ -11,7 +11,7 @@ a_i = alpha_i + alpha_ei:
     y_ci = (v_id / u_id) (kx_i / ky_i) x_ci                (7), (9), (10)
     y_h = (y_c1 + y_c2) / 2                                (11)
 
-Beyond the paper (equations.md, last section): when each line of sight
+Beyond the paper (docs/equations.md, last section): when each line of sight
 misses its yaw axis by s_i (along the effective camera's x), P is the exact
 crossing of the two offset lines, and x_c takes the offset too:
 

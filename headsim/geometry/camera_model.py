@@ -188,12 +188,12 @@ def ideal() -> PinholeCamera:
 
 
 def paper_cam1() -> PinholeCamera:
-    """Ca1 of the paper (Zhang calibration, Sec. VI-B; equations.md's last table), k2 = 0."""
+    """Ca1 of the paper (Zhang calibration, Sec. VI-B; docs/equations.md's last table), k2 = 0."""
     return PinholeCamera(*IMAGE_SIZE_PX, **INTRINSICS[0])
 
 
 def paper_cam2() -> PinholeCamera:
-    """Ca2 of the paper (Zhang calibration, Sec. VI-B; equations.md's last table), k2 = 0."""
+    """Ca2 of the paper (Zhang calibration, Sec. VI-B; docs/equations.md's last table), k2 = 0."""
     return PinholeCamera(*IMAGE_SIZE_PX, **INTRINSICS[1])
 
 

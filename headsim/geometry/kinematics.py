@@ -1,6 +1,6 @@
 """Rigid transforms of the head: the neck's D-H transform, eq. (1), and the eye poses.
 
-Frames (equations.md): W world (z up, y forward, x right), H head (x right from
+Frames (docs/equations.md): W world (z up, y forward, x right), H head (x right from
 C1 to C2, y down, z forward, origin mid-baseline), Ci camera i (OpenCV: x right,
 y down, z along the optical axis).  Transforms are named ``dst_from_src`` and
 act on homogeneous column vectors: ``p_W = world_from_head(...) @ p_H``.

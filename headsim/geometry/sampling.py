@@ -1,6 +1,6 @@
 """Random target positions in H: the one sampler every layout draws from.
 
-Frames as in equations.md: H has x right (C1 to C2), y down, z forward,
+Frames as in docs/equations.md: H has x right (C1 to C2), y down, z forward,
 origin mid-baseline; positions in metres.  A point is drawn as its depth z_h,
 then its horizontal slope x_h / z_h, then its vertical slope y_h / z_h, each
 uniform, in that order of generator calls, so a seeded layout is the same

@@ -1,6 +1,6 @@
 """Exact forward model of the head: what it observes of a known point, no simulator.
 
-Frames and signs as in equations.md: points in H (x right from C1 to C2, y down,
+Frames and signs as in docs/equations.md: points in H (x right from C1 to C2, y down,
 z forward, origin mid-baseline), m; eye angles are encoder readings, rad,
 positive inwards; the true yaw of camera i is ``eye_angle + alpha_ei``.
 
@@ -42,7 +42,7 @@ class StereoHead:
     ``u10``/``u20`` default to each image's centre column.  ``nodal1``/``nodal2``
     and ``side1``/``side2``, m: each optical centre's offset from its eye's yaw
     axis, forward along the optical axis and along the camera's x
-    (equations.md, last section); 0 is the paper's eye.
+    (docs/equations.md, last section); 0 is the paper's eye.
     """
 
     baseline: float

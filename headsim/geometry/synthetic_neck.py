@@ -1,7 +1,7 @@
 """Exact forward model of Model 1 (Sec. II-B): the neck and eye angles that fixate a point.
 
 The neck puts P in the plane of the optical axes and the eyes verge until both
-images lie at their target columns.  Frames and signs as in equations.md and
+images lie at their target columns.  Frames and signs as in docs/equations.md and
 :mod:`headsim.geometry.synthetic`: points in W or H, m; angles rad, eye angles
 positive inwards.
 """

@@ -2,7 +2,7 @@
 
 A pose ``a_from_b`` is a 4 x 4 homogeneous transform that maps points in frame
 b to frame a (metres); rotations are 3 x 3, angles in radians, right-handed
-(frames and signs: equations.md).
+(frames and signs: docs/equations.md).
 """
 
 from __future__ import annotations

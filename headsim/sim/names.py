@@ -25,7 +25,7 @@ CAMERAS = ("cam1", "cam2")
 @dataclass(frozen=True)
 class Camera:
     """One eye camera: ``index`` into ``settings.cameras`` (0, 1), its MJCF ``name``, and
-    ``inward``: the sign of a yaw that turns it inward, about H's +y (equations.md:
+    ``inward``: the sign of a yaw that turns it inward, about H's +y (docs/equations.md:
     +1 for Ca1, whose inward direction is its +x; -1 for Ca2)."""
 
     index: int

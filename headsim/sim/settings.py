@@ -334,7 +334,7 @@ def paper_head(**overrides: object) -> HeadSettings:
     cams = []
     for index, (intr, effective) in enumerate(zip(INTRINSICS, INITIAL_DIRECTIONS_RAD, strict=True)):
         cam = CameraSettings(**intr)
-        # Ca1's inward direction is its +x, Ca2's its -x (equations.md).
+        # Ca1's inward direction is its +x, Ca2's its -x (docs/equations.md).
         cams.append(
             replace(cam, mount_yaw_rad=mount_yaw_for_direction(index + 1, effective, cam.pinhole()))
         )

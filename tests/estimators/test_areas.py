@@ -90,7 +90,7 @@ def test_pixels_agree_with_geometry_beyond_2_px_on_random_layouts(record_propert
 
 
 def test_paper_cameras_only_swap_across_the_magnitude_boundary(record_property):
-    # Unequal focal lengths shift the magnitude tests (equations.md); the sign
+    # Unequal focal lengths shift the magnitude tests (docs/equations.md); the sign
     # tests survive any intrinsics and the radial distortion.
     head = StereoHead(D, paper_cam1(), paper_cam2(), alpha_e1=0.0578, alpha_e2=-0.0254)
     for kx in (None, (head.cam1.kx, head.cam2.kx)):

@@ -1,4 +1,4 @@
-"""Eq. (1) and the eye poses: frames and signs as equations.md fixes them."""
+"""Eq. (1) and the eye poses: frames and signs as docs/equations.md fixes them."""
 
 from __future__ import annotations
 
