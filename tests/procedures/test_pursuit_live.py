@@ -1,4 +1,4 @@
-"""The pursuit procedure (run/live_pursuit.py): its results and recording, a target never
+"""The pursuit procedure (procedures/pursuit.py): its results and recording, a target never
 present, and the summary's lines."""
 
 from __future__ import annotations
