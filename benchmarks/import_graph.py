@@ -28,6 +28,7 @@ LAYERS = (
     "live",
     "scenario",
     "run",
+    "procedures",
     "studies",
     "envs",
     "cli",

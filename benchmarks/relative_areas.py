@@ -28,7 +28,7 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
 from headsim.active.relative import relative_positioning
 from headsim.files import write_json_atomic
-from headsim.run.phases.setup import PARKED_WORLD_M
+from headsim.run.context import PARKED_WORLD_M
 from headsim.scenario.area_layouts import area_layout
 from headsim.sim import names
 from headsim.sim.settings import preset

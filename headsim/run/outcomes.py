@@ -278,7 +278,7 @@ class PursuitFigures:
 
 @dataclass(frozen=True)
 class PursuitResult:
-    """The live pursuit (:mod:`headsim.run.live_pursuit`): the spec as run, its figures and
+    """The live pursuit (:mod:`headsim.procedures.pursuit`): the spec as run, its figures and
     each frame (None when it never started), and why it failed, one line each."""
 
     pursuit: dict[str, Any]
@@ -354,7 +354,7 @@ class RunResult:
     scenario: Scenario
     calibration: CalibrationReport | None
     records: tuple[MeasurementRecord, ...]
-    experiment: Experiment | None
+    experiment: Any
     renders: RunRenders
     failures: tuple[str, ...]
     timing_s: dict[str, float] = field(default_factory=dict, compare=False)

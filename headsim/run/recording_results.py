@@ -1,6 +1,6 @@
 """What a recording logs of the results: each measurement (estimate, error, the
 measurements' table), each live pursuit frame, the calibration's and the summary's
-documents, and relative positioning's lines and areas; read from the typed results."""
+documents, and what the procedure adds (:attr:`headsim.scenario.registry.Procedure.rows`)."""
 
 from __future__ import annotations
 
@@ -10,18 +10,17 @@ from typing import Any
 import numpy as np
 import rerun as rr
 
-from headsim.geometry.kinematics import head_to_world
-from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RelativeResult, RunResult
+from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RunResult
 from headsim.run.recording_layout import (
     GREEN,
     GREY,
-    ORANGE,
     RED,
     UI_RADIUS,
     WHITE,
 )
 from headsim.run.recording_scene import SceneLogging
 from headsim.run.summary import summary_text
+from headsim.scenario.registry import get
 from headsim.sim import names
 
 
@@ -146,45 +145,12 @@ class ResultsLogging(SceneLogging):
 
     def finished(self, result: RunResult) -> None:
         self._time()
-        if isinstance(result.experiment, RelativeResult):
-            self._log_areas(result.experiment)
+        if result.experiment is not None:
+            get(self.scenario.experiment.procedure).rows(result.experiment, self)
         text = summary_text(result)
         self.rec.log(
             "/results/summary",
             rr.TextDocument(f"```\n{text}\n```", media_type=rr.MediaType.MARKDOWN),
-        )
-
-    def _log_areas(self, e: RelativeResult) -> None:
-        """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
-        baseline = self.scenario.settings.baseline_m
-        s = self.scenario.settings
-        strips, labels = [], []
-        far = 2.0
-        for step_index, alpha in enumerate((e.alpha1_rad, e.alpha2_rad)):
-            if not math.isfinite(alpha):
-                return
-            for camera in (1, 2):
-                sign = 1.0 if camera == 1 else -1.0
-                yaw = alpha + self.effective_alpha_e[camera - 1]
-                start = np.array([-sign * baseline / 2, 0.0, 0.0])
-                end = start + far * np.array([sign * math.sin(yaw), 0.0, math.cos(yaw)])
-                strips.append(
-                    head_to_world(np.array([start, end]), 0.0, 0.0, s.neck_d1_m, s.neck_a2_m)
-                )
-                labels.append(f"L{camera}{step_index + 1}")
-        self.rec.log(
-            "/world/areas/lines", rr.LineStrips3D(strips, colors=[ORANGE] * 4, labels=labels)
-        )
-        objects = e.objects
-        positions = [self.truth[o.name] for o in objects if o.name in self.truth]
-        self.rec.log(
-            "/world/areas/objects",
-            rr.Points3D(
-                positions,
-                radii=0.008,
-                colors=[GREEN if o.agree else RED for o in objects],
-                labels=[f"{o.name}: S{o.area} (true S{o.true_area})" for o in objects],
-            ),
         )
 
 

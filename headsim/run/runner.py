@@ -6,49 +6,30 @@ runner gives the simulator (and through it the servos and the procedures) a
 :class:`headsim.run.events.Hub` as event sink, and the hub passes every event
 on to the run's subscribers.  The runner adds its own events: each recorded
 measurement, the calibration's report and the finished run.  Each phase (the
-calibration, each procedure's measurement) is a module of :mod:`headsim.run.phases`.
+calibration is :mod:`headsim.run.calibrate`; each procedure is found by its name in
+:mod:`headsim.scenario.registry` (the built-in ones are :mod:`headsim.procedures`).
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import replace
 
-from headsim.active.measurement import HeadKnowledge
+from headsim.run.calibrate import calibrate
+from headsim.run.context import told
 from headsim.run.events import CalibrationDone, Hub, RunFinished, Subscriber
 from headsim.run.outcomes import (
     CalibrationReport,
     CalibrationSource,
-    Experiment,
     MeasurementRecord,
-    PursuitResult,
-    RelativeResult,
     RunRenders,
     RunResult,
 )
-from headsim.run.phases.calibrate import calibrate
-from headsim.run.phases.chessboard import run_chessboard
-from headsim.run.phases.points import run_points
-from headsim.run.phases.pursuit import run_pursuit_phase
-from headsim.run.phases.relative import run_relative
-from headsim.run.phases.setup import told
-from headsim.run.phases.tracking import run_tracking
 from headsim.run.serialise import calibration_from_block, render_counts_from_block
+from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
 from headsim.sim.events import RenderCounts
-
-RUNNERS: dict[
-    str, Callable[[Scenario, Hub, HeadKnowledge, str], tuple[list[MeasurementRecord], Experiment]]
-] = {
-    "model2": run_points,
-    "model1": run_points,
-    "calibration": run_points,
-    "chessboard": run_chessboard,
-    "relative_positioning": run_relative,
-    "tracking": run_tracking,
-    "pursuit": run_pursuit_phase,
-}
 
 
 def calibrate_scenario(
@@ -105,13 +86,13 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
         else:
             knowledge, label = run.knowledge, "calibrated"
     records: list[MeasurementRecord] = []
-    experiment: Experiment | None = None
+    experiment: object | None = None
+    procedure = get(scenario.experiment.procedure)
     if not failures:
         start = time.perf_counter()
         before = hub.renders
-        records, experiment = RUNNERS[scenario.experiment.procedure](
-            scenario, hub, knowledge, label
-        )
+        ran, experiment = procedure.run(scenario, hub, knowledge, label)
+        records = list(ran)
         timing["experiment"] = time.perf_counter() - start
         renders["experiment"] = hub.renders - before
         rendered_frames["experiment"] = hub.rendered_frames - rendered_frames["calibration"]
@@ -120,10 +101,8 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
         for r in records
         if not r.measurement.ok
     ]
-    if isinstance(experiment, RelativeResult):
-        failures += [f"{name}: not seen in all four images" for name in experiment.missing]
-    if isinstance(experiment, PursuitResult):
-        failures += list(experiment.failures)
+    if experiment is not None:
+        failures += procedure.failures(experiment)
     timing["total"] = sum(timing.values())
     result = RunResult(
         scenario=scenario,
@@ -146,4 +125,4 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
     return result
 
 
-__all__ = ["RUNNERS", "calibrate_scenario", "run_scenario"]
+__all__ = ["calibrate_scenario", "run_scenario"]

@@ -27,19 +27,14 @@ from headsim.run.outcomes import (
     CalibrationLayout,
     CalibrationReport,
     CalibrationSource,
-    ChessboardResult,
-    Experiment,
     KnowledgeReport,
     LinesOfSightFit,
     MeasurementRecord,
-    PointsResult,
     PositionOutcome,
-    PursuitResult,
-    RelativeResult,
     RunResult,
-    TrackingResult,
     VerticalReference,
 )
+from headsim.scenario.registry import get
 from headsim.sim.events import RenderCounts
 
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
@@ -313,31 +308,11 @@ def calibration_from_block(
 # -- each procedure's experiment ---------------------------------------------------------
 
 
-def _experiment_fields(experiment: Experiment) -> dict[str, Any]:
-    if isinstance(experiment, PointsResult):
-        if experiment.check_targets is None:
-            return {}
-        return {"check_targets": [asdict(c) for c in experiment.check_targets]}
-    if isinstance(experiment, ChessboardResult):
-        return asdict(experiment)
-    if isinstance(experiment, RelativeResult):
-        return asdict(experiment)
-    if isinstance(experiment, TrackingResult):
-        return asdict(experiment)
-    assert isinstance(experiment, PursuitResult)
-    block: dict[str, Any] = {"pursuit": experiment.pursuit}
-    if experiment.figures is not None:
-        block.update(asdict(experiment.figures))
-    if experiment.per_frame is not None:
-        block["per_frame"] = experiment.per_frame
-    return block
-
-
-def experiment_block(procedure: str, experiment: Experiment | None) -> dict[str, Any]:
+def experiment_block(procedure: str, experiment: object | None) -> dict[str, Any]:
     """results.json's ``experiment``: the procedure, then its result's fields (none if it did not run)."""
     return {
         "procedure": procedure,
-        **({} if experiment is None else _experiment_fields(experiment)),
+        **({} if experiment is None else get(procedure).fields(experiment)),
     }
 
 

@@ -7,52 +7,18 @@ beside ours for its head; lengths in mm, errors in % of depth.
 
 from __future__ import annotations
 
-import math
-from typing import Any
-
 import numpy as np
 
 from headsim.run.accuracy import summaries
-from headsim.run.outcomes import (
-    CalibrationReport,
-    ChessboardResult,
-    PointsResult,
-    PursuitResult,
-    RelativeResult,
-    RunResult,
-    TrackingResult,
-)
-from headsim.run.serialise import experiment_block
+from headsim.run.outcomes import CalibrationReport, RunResult
+from headsim.run.table import cell as _cell
+from headsim.run.table import format_table
+from headsim.run.table import mm as _mm
+from headsim.scenario.registry import get
 from headsim.scenario.spec import TargetAcceptance
 from headsim.sim.events import RenderCounts
 
 # -- the summary table ------------------------------------------------------------
-
-
-def _cell(value: Any, fmt: str = "") -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float):
-        return "-" if not math.isfinite(value) else format(value, fmt)
-    return str(value)
-
-
-def format_table(headers: list[str], rows: list[list[str]], indent: str = "  ") -> list[str]:
-    """Columns padded to their widest cell; the first column left, the others right."""
-    widths = [max(len(str(c)) for c in column) for column in zip(headers, *rows, strict=True)]
-
-    def line(cells: list[str]) -> str:
-        parts = [
-            str(c).ljust(w) if k == 0 else str(c).rjust(w)
-            for k, (c, w) in enumerate(zip(cells, widths, strict=True))
-        ]
-        return (indent + "  ".join(parts)).rstrip()
-
-    return [line(headers), *(line(r) for r in rows)]
-
-
-def _mm(value_m: float | None, fmt: str = ".2f") -> str:
-    return _cell(None if value_m is None else value_m * 1000.0, fmt)
 
 
 def _calibration_lines(report: CalibrationReport, paper: bool) -> list[str]:
@@ -235,104 +201,6 @@ def _acceptance_text(ok: int, a: TargetAcceptance) -> str:
     )
 
 
-def _chessboard_lines(e: ChessboardResult, paper: bool) -> list[str]:
-    headers = ["", "n", "mean mm", "std mm", "truth mm"] + (
-        ["paper mean", "paper std"] if paper else []
-    )
-    sides = (
-        ("widths", e.widths_m, e.true_widths_m, e.width_mean_m, e.width_std_m),
-        ("heights", e.heights_m, e.true_heights_m, e.height_mean_m, e.height_std_m),
-        (
-            "all sides",
-            np.concatenate([e.widths_m, e.heights_m]),
-            np.concatenate([e.true_widths_m, e.true_heights_m]),
-            e.side_mean_m,
-            e.side_std_m,
-        ),
-    )
-    rows = []
-    for label, values, true_values, mean_m, std_m in sides:
-        truth = np.asarray(true_values)
-        paper_cells = ["-", "-"]
-        if label == "all sides":
-            paper_cells = [_mm(e.paper.side_mean_m, ".1f"), _mm(e.paper.side_std_m, ".3f")]
-        rows.append(
-            [
-                label,
-                str(len(values)),
-                _mm(mean_m, ".3f"),
-                _mm(std_m, ".3f"),
-                _mm(float(np.mean(truth)) if len(truth) else None, ".3f"),
-                *(paper_cells if paper else []),
-            ]
-        )
-    title = (
-        f"Chessboard squares (Tables III, IV): {e.corners_measured} of {e.corners} cross "
-        f"points measured, squares {e.square_m * 1000:g} mm"
-    )
-    return [title, *format_table(headers, rows)]
-
-
-def _relative_lines(e: RelativeResult, paper: bool) -> list[str]:
-    headers = ["", "ours"] + (["paper"] if paper else [])
-    rows = [
-        [
-            "alpha1 (rad)",
-            _cell(e.alpha1_rad, ".4f"),
-            *([_cell(e.paper.alpha1_rad, ".4f")] if paper else []),
-        ],
-        [
-            "alpha2 (rad)",
-            _cell(e.alpha2_rad, ".4f"),
-            *([_cell(e.paper.alpha2_rad, ".4f")] if paper else []),
-        ],
-        ["objects", str(len(e.objects)), *([str(e.paper.objects)] if paper else [])],
-    ]
-    lines = [
-        "Relative positioning (Sec. III, Table VII): fixations on the cross point",
-        *format_table(headers, rows),
-    ]
-    obj_rows = [
-        [
-            o.name,
-            o.colour,
-            f"S{o.area}" if o.area else "-",
-            f"S{o.true_area}" if o.true_area else "-",
-            "yes" if o.agree else "NO",
-            _cell(o.margin_px, ".1f"),
-        ]
-        for o in e.objects
-    ]
-    lines += format_table(["object", "colour", "area", "true area", "agree", "margin px"], obj_rows)
-    lines.append(
-        f"  {e.agree} of {len(e.objects)} objects in their true areas"
-        + (f"; not seen: {', '.join(e.missing)}" if e.missing else "")
-    )
-    return lines
-
-
-def _tracking_lines(e: TrackingResult) -> list[str]:
-    errors = np.asarray(e.errors_world_m, dtype=float)
-    finite = errors[np.isfinite(errors)]
-    return [
-        f"Tracking with the neck (Model 1): {len(finite)} of {len(errors)} fixations; error in W "
-        f"mean {_mm(float(finite.mean()) if finite.size else None)} mm, max "
-        f"{_mm(float(finite.max()) if finite.size else None)} mm; renders {e.renders_first} for the "
-        f"first fixation, {_cell(e.renders_after_mean, '.1f')} per fixation after"
-    ]
-
-
-def _check_lines(e: PointsResult) -> list[str]:
-    rows = [
-        [c.name, _mm(c.error_m_uncalibrated), _mm(c.error_m_calibrated)]
-        for c in e.check_targets or ()
-    ]
-    return [
-        "Check targets: error before and after the calibration",
-        *format_table(["target", "uncalibrated mm", "calibrated mm"], rows),
-    ]
-
-
 def _renders_text(counts: RenderCounts) -> str:
     """ "107 renders (40 full frames, 44 windows, 1 retake, 22 previews)"."""
 
@@ -368,25 +236,13 @@ def summary_text(result: RunResult) -> str:
     measurement = _measurement_lines(result)
     if measurement:
         lines += [*measurement, ""]
-    procedure = s.experiment.procedure
-    if isinstance(e, ChessboardResult):
-        lines += [*_chessboard_lines(e, paper), ""]
-    elif isinstance(e, RelativeResult):
-        lines += [*_relative_lines(e, paper), ""]
-    elif isinstance(e, TrackingResult):
-        lines += [*_tracking_lines(e), ""]
-    elif isinstance(e, PointsResult) and e.check_targets is not None:
-        lines += [*_check_lines(e), ""]
-    elif isinstance(e, PursuitResult) and e.figures is not None:
-        from headsim.run.live_pursuit import summary_lines
-
-        lines += [*summary_lines(experiment_block(procedure, e)), ""]
-    if result.ok and procedure == "pursuit":
-        figures = e.figures if isinstance(e, PursuitResult) else None
-        lines.append(f"OK: {figures.frames if figures else 0} frames, the target never lost")
-    elif result.ok:
-        count = len(result.records)
-        lines.append(f"OK: {count} measurement{'' if count == 1 else 's'}, none failed")
+    procedure = get(s.experiment.procedure)
+    if e is not None:
+        own = procedure.summary(e, paper)
+        if own:
+            lines += [*own, ""]
+    if result.ok:
+        lines.append(procedure.ok_line(e, len(result.records)))
     else:
         lines.append(f"FAILED: {len(result.failures)} problem(s)")
         lines += [f"  {f}" for f in result.failures]

@@ -25,11 +25,11 @@ from headsim.scenario.reach import (
     scene_occluders,
     target_refusal,
 )
+from headsim.scenario.registry import get
 from headsim.scenario.schema import depth_range
 from headsim.scenario.spec import (
     MARKER_BODIES,
     MAX_DEPTH_M,
-    PROCEDURES,
     STREAM_MOVING,
     STREAM_OBJECTS,
     STREAM_TARGETS,
@@ -142,7 +142,7 @@ def _read_targets(
         if within == "reach":
             # What can hide them: the scene as the listed targets leave it.
             placed = {t.body: np.array(t.position_world_m) for t in targets}
-            occluders = scene_occluders(PROCEDURES[procedure], placed, body)
+            occluders = scene_occluders(get(procedure).scene, placed, body)
             points, refused = _redraw_out_of_reach(
                 random_table, settings, procedure, body, points, rng, occluders
             )
@@ -188,7 +188,7 @@ def read_scene(
     doc: Table, ctx: Context, procedure: str, settings: HeadSettings, seed: int
 ) -> SceneSpec:
     """``[scene]``: what the procedure measures, and where it is."""
-    scene_name = PROCEDURES[procedure]
+    scene_name = get(procedure).scene
     table = doc.table("scene") or Table({}, "scene", ctx)
     spec = SceneSpec(scene=scene_name)
     if procedure in ("model2", "model1", "calibration"):

@@ -15,12 +15,12 @@ from typing import Any
 
 from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import INITIAL_DIRECTIONS_RAD
+from headsim.scenario import registry
 from headsim.scenario.calibration_design import LAYOUTS
 from headsim.scenario.spec import (
     MAX_DEPTH_M,
     MIN_BASELINE_M,
     MIN_DEPTH_M,
-    PROCEDURES,
     CalibrationSpec,
     ExperimentSpec,
     ServoSpec,
@@ -278,7 +278,7 @@ def read_experiment(doc: Table, ctx: Context, preset_name: str = "ideal") -> Exp
     table = doc.table("experiment")
     if table is None:
         raise ctx.error("experiment", "missing", "an [experiment] table with a procedure")
-    procedure = table.choice("procedure", tuple(PROCEDURES))
+    procedure = table.choice("procedure", registry.names())
     calibration = _read_calibration(table.table("calibration"), preset_name == "realistic")
     if procedure == "calibration" and calibration is None:
         raise table.fail(

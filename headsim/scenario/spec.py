@@ -27,18 +27,6 @@ if TYPE_CHECKING:
 MIN_BASELINE_M = 0.01
 
 
-#: Procedure -> the scene (``names.SCENES``) it runs in.
-PROCEDURES = {
-    "model2": "default",
-    "model1": "default",
-    "calibration": "default",
-    "tracking": "default",
-    "chessboard": "chessboard",
-    "relative_positioning": "blocks",
-    "pursuit": "default",  # the live head (headsim.scenario.pursuit)
-}
-
-
 #: Bodies of the default scene that can be measured, and the colour each is found by.
 MARKER_BODIES = {**names.MARKER_COLOURS, names.CALIBRATION_BALL: "yellow"}
 

@@ -103,7 +103,7 @@ def test_every_scenario_runs_in_its_fast_variant(
     if scenario.paper_cameras:
         # The paper's figures beside ours in the summary.
         assert re.search(r"alpha_e1 \(rad\)\s+\S+\s+\S+\s+\S+\s+\S+\s+0\.0578", out)
-    # Each procedure's own figures are checked in tests/run/phases; here what the summary shows.
+    # Each procedure's own figures are checked in tests/procedures; here what the summary shows.
     assert results["experiment"]["procedure"] == scenario.experiment.procedure
     if path.stem == "chessboard":
         assert re.search(r"all sides\s+\d+\s+(29|30)\.\d+\s+0\.\d+\s+30\.000\s+30\.3\s+0\.677", out)

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from headsim.scenario.registry import get, names
 from headsim.scenario.spec import (
     MARKER_BODIES,
-    PROCEDURES,
     CalibrationSpec,
     ExperimentSpec,
     MovingTarget,
@@ -19,7 +19,7 @@ from headsim.scenario.spec import (
     SceneSpec,
     corner_count,
 )
-from headsim.sim import names
+from headsim.sim import names as scenes
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 
@@ -64,8 +64,8 @@ def test_only_the_papers_cameras_show_the_papers_figures(preset: str) -> None:
 
 
 def test_every_procedure_has_a_scene_and_every_marker_body_is_in_the_default_scene() -> None:
-    assert set(PROCEDURES.values()) <= set(names.SCENES)
+    assert {get(name).scene for name in names()} <= set(scenes.SCENES)
     with HeadSim("default") as sim:
         for body in MARKER_BODIES:
             assert np.isfinite(sim.position(body)).all()
-    assert MARKER_BODIES[names.CALIBRATION_BALL] == "yellow"
+    assert MARKER_BODIES[scenes.CALIBRATION_BALL] == "yellow"

@@ -16,6 +16,7 @@ its record a ``PursuitFrame`` event.
 from __future__ import annotations
 
 import math
+from dataclasses import asdict, fields
 from typing import Any
 
 import numpy as np
@@ -25,8 +26,12 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.active.servo_types import ServoConfig
 from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
+from headsim.run.events import Hub
+from headsim.run.outcomes import MeasurementRecord, PursuitFigures, PursuitResult
 from headsim.run.targets import marker_target
 from headsim.scenario.pursuit import PursuitSpec, describe
+from headsim.scenario.registry import Procedure, register
+from headsim.scenario.spec import Scenario
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
 
@@ -114,21 +119,79 @@ def run_pursuit(
     return [], experiment
 
 
-def summary_lines(e: dict[str, Any]) -> list[str]:
-    """The summary's lines for a pursuit run."""
-    p = e.get("pursuit", {})
+def run_pursuit_phase(
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], PursuitResult]:
+    """:func:`run_pursuit`'s block, typed."""
+    records, block = run_pursuit(scenario, hub, knowledge, label)
+    known = {"pursuit", "per_frame", "failures", *(f.name for f in fields(PursuitFigures))}
+    if set(block) - known:  # a new figure must get its field, or it would not be written
+        raise KeyError(f"pursuit figures without a PursuitFigures field: {set(block) - known}")
+    figures = None
+    if "frames" in block:
+        figures = PursuitFigures(**{f.name: block[f.name] for f in fields(PursuitFigures)})
+    return records, PursuitResult(
+        pursuit=block["pursuit"],
+        figures=figures,
+        per_frame=block.get("per_frame"),
+        failures=tuple(block.get("failures", ())),
+    )
+
+
+def summary_lines(e: PursuitResult) -> list[str]:
+    """The summary's lines for a pursuit run (none when it never started)."""
+    p, figures = e.pursuit, e.figures
+    if figures is None:
+        return []
 
     def f(key: str, scale: float = 1.0, fmt: str = ".2f") -> str:
-        value = e.get(key)
+        value = getattr(figures, key)
         return "n/a" if value is None or not math.isfinite(value) else format(value * scale, fmt)
 
     return [
         f"pursuit: {p.get('path_kind')} path for {p.get('duration_s')} s; {p.get('frame_rate_hz')} Hz, "
         f"latency {p.get('latency_frames')} frame(s), exposure {p.get('exposure_s')} s x {p.get('blur_subframes')} "
         f"sub-frames; gaze {p.get('mode')}, predictor {'on' if p.get('predictor') else 'off'}, saccade {p.get('saccade')}",
-        f"frames {e.get('frames')} (target present {e.get('frames_present')}), lost {e.get('frames_lost')}, "
-        f"losses {e.get('losses')}, re-acquisitions {e.get('reacquisitions')}, saccades {e.get('saccades')}",
+        f"frames {figures.frames} (target present {figures.frames_present}), lost {figures.frames_lost}, "
+        f"losses {figures.losses}, re-acquisitions {figures.reacquisitions}, saccades {figures.saccades}",
         f"position error RMS along the path {f('position_rms_m', 1000)} mm = {f('position_rms_pct_of_depth')} % of "
         f"distance (max {f('position_max_m', 1000)} mm); pursuit lag {f('lag_s', 1000, '.1f')} ms; "
         f"image offset RMS {f('offset_rms_px')} px; time to fixation {f('time_to_fixation_s', 1000, '.0f')} ms",
     ]
+
+
+def _fields(e: PursuitResult) -> dict[str, Any]:
+    block: dict[str, Any] = {"pursuit": e.pursuit}
+    if e.figures is not None:
+        block.update(asdict(e.figures))
+    if e.per_frame is not None:
+        block["per_frame"] = e.per_frame
+    return block
+
+
+def _summary(e: PursuitResult, paper: bool) -> list[str]:
+    return summary_lines(e)
+
+
+def _ok_line(e: PursuitResult, measured: int) -> str:
+    return f"OK: {e.figures.frames if e.figures else 0} frames, the target never lost"
+
+
+def _failures(e: PursuitResult) -> tuple[str, ...]:
+    return e.failures
+
+
+PURSUIT = register(
+    Procedure(
+        "pursuit",
+        "default",
+        run_pursuit_phase,
+        fields=_fields,
+        summary=_summary,
+        ok_line=_ok_line,
+        failures=_failures,
+    )
+)
+
+
+__all__ = ["PURSUIT", "figures", "run_pursuit", "run_pursuit_phase", "summary_lines"]

@@ -1,4 +1,4 @@
-"""The pursuit procedure (run/live_pursuit.py): its results and recording, a target never
+"""The pursuit procedure (procedures/pursuit.py): its results and recording, a target never
 present, and the summary's lines."""
 
 from __future__ import annotations
@@ -8,7 +8,8 @@ from dataclasses import replace
 
 from headsim.active.measurement import HeadKnowledge
 from headsim.live import Visibility
-from headsim.run.live_pursuit import run_pursuit, summary_lines
+from headsim.procedures.pursuit import run_pursuit, summary_lines
+from headsim.run.outcomes import PursuitFigures, PursuitResult
 from headsim.scenario.loading import load_scenario
 
 
@@ -73,15 +74,27 @@ def test_a_target_never_present_is_a_failure_named_before_any_image() -> None:
 
 
 def test_the_summary_gives_millimetres_and_milliseconds_and_n_a_for_no_figure() -> None:
-    experiment = {
-        "pursuit": {"path_kind": "sinusoid", "duration_s": 2.0, "predictor": True},
-        "frames": 60,
-        "position_rms_m": 0.0012,
-        "position_max_m": math.nan,
-        "lag_s": 0.0333,
-    }
-    first, second, third = summary_lines(experiment)
+    figures = PursuitFigures(
+        frames=60,
+        frames_present=58,
+        frames_lost=2,
+        losses=1,
+        reacquisitions=1,
+        saccades=0,
+        time_to_fixation_s=math.nan,
+        lag_s=0.0333,
+        offset_rms_px=0.5,
+        position_rms_m=0.0012,
+        position_rms_pct_of_depth=0.2,
+        position_max_m=math.nan,
+        ended="duration",
+    )
+    result = PursuitResult(
+        pursuit={"path_kind": "sinusoid", "duration_s": 2.0, "predictor": True}, figures=figures
+    )
+    first, second, third = summary_lines(result)
     assert first.startswith("pursuit: sinusoid path for 2.0 s;") and "predictor on" in first
-    assert second.startswith("frames 60 (target present None)")
+    assert second.startswith("frames 60 (target present 58), lost 2")
     assert "RMS along the path 1.20 mm" in third and "(max n/a mm)" in third
     assert "pursuit lag 33.3 ms" in third and "time to fixation n/a ms" in third
+    assert summary_lines(PursuitResult(pursuit={})) == []

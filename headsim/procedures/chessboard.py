@@ -2,25 +2,29 @@
 
 from __future__ import annotations
 
+from dataclasses import asdict
+
 import numpy as np
 
 from headsim.active.chessboard import measure_chessboard
 from headsim.active.events import PhaseStarted
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
-from headsim.run.events import Hub
-from headsim.run.outcomes import (
-    ChessboardPaper,
-    ChessboardResult,
-    MeasurementRecord,
-)
-from headsim.run.phases.setup import (
+from headsim.run.context import (
     PAPER,
     model2_config,
     record_measurement,
     servo_config,
     simulator,
 )
+from headsim.run.events import Hub
+from headsim.run.outcomes import (
+    ChessboardPaper,
+    ChessboardResult,
+    MeasurementRecord,
+)
+from headsim.run.table import format_table, mm
+from headsim.scenario.registry import Procedure, register
 from headsim.scenario.spec import CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M, Scenario
 from headsim.sim import names
 
@@ -96,4 +100,47 @@ def run_chessboard(
     return records, experiment
 
 
-__all__ = ["run_chessboard"]
+def _chessboard_lines(e: ChessboardResult, paper: bool) -> list[str]:
+    headers = ["", "n", "mean mm", "std mm", "truth mm"] + (
+        ["paper mean", "paper std"] if paper else []
+    )
+    sides = (
+        ("widths", e.widths_m, e.true_widths_m, e.width_mean_m, e.width_std_m),
+        ("heights", e.heights_m, e.true_heights_m, e.height_mean_m, e.height_std_m),
+        (
+            "all sides",
+            np.concatenate([e.widths_m, e.heights_m]),
+            np.concatenate([e.true_widths_m, e.true_heights_m]),
+            e.side_mean_m,
+            e.side_std_m,
+        ),
+    )
+    rows = []
+    for label, values, true_values, mean_m, std_m in sides:
+        truth = np.asarray(true_values)
+        paper_cells = ["-", "-"]
+        if label == "all sides":
+            paper_cells = [mm(e.paper.side_mean_m, ".1f"), mm(e.paper.side_std_m, ".3f")]
+        rows.append(
+            [
+                label,
+                str(len(values)),
+                mm(mean_m, ".3f"),
+                mm(std_m, ".3f"),
+                mm(float(np.mean(truth)) if len(truth) else None, ".3f"),
+                *(paper_cells if paper else []),
+            ]
+        )
+    title = (
+        f"Chessboard squares (Tables III, IV): {e.corners_measured} of {e.corners} cross "
+        f"points measured, squares {e.square_m * 1000:g} mm"
+    )
+    return [title, *format_table(headers, rows)]
+
+
+CHESSBOARD = register(
+    Procedure("chessboard", "chessboard", run_chessboard, fields=asdict, summary=_chessboard_lines)
+)
+
+
+__all__ = ["CHESSBOARD", "run_chessboard"]

@@ -3,6 +3,9 @@ each check target before and after the calibration."""
 
 from __future__ import annotations
 
+from dataclasses import asdict
+from typing import Any
+
 import numpy as np
 
 from headsim.active.events import PhaseStarted
@@ -11,20 +14,22 @@ from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model1 import measure_model1
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
-from headsim.run.events import Hub
-from headsim.run.outcomes import (
-    CheckTarget,
-    MeasurementRecord,
-    PointsResult,
-)
-from headsim.run.phases.setup import (
+from headsim.run.context import (
     model2_config,
     record_measurement,
     servo_config,
     simulator,
     told,
 )
+from headsim.run.events import Hub
+from headsim.run.outcomes import (
+    CheckTarget,
+    MeasurementRecord,
+    PointsResult,
+)
+from headsim.run.table import format_table, mm
 from headsim.run.targets import marker_target
+from headsim.scenario.registry import Procedure, register
 from headsim.scenario.spec import Scenario
 
 
@@ -75,4 +80,31 @@ def _error(m: Measurement) -> float:
     return float(np.linalg.norm(m.error_head_m)) if m.ok else float("nan")
 
 
-__all__ = ["run_points"]
+def _check_lines(e: PointsResult) -> list[str]:
+    rows = [
+        [c.name, mm(c.error_m_uncalibrated), mm(c.error_m_calibrated)]
+        for c in e.check_targets or ()
+    ]
+    return [
+        "Check targets: error before and after the calibration",
+        *format_table(["target", "uncalibrated mm", "calibrated mm"], rows),
+    ]
+
+
+def _fields(e: PointsResult) -> dict[str, Any]:
+    if e.check_targets is None:
+        return {}
+    return {"check_targets": [asdict(c) for c in e.check_targets]}
+
+
+def _summary(e: PointsResult, paper: bool) -> list[str]:
+    return [] if e.check_targets is None else _check_lines(e)
+
+
+MODEL2, MODEL1, CALIBRATION = (
+    register(Procedure(name, "default", run_points, fields=_fields, summary=_summary))
+    for name in ("model2", "model1", "calibration")
+)
+
+
+__all__ = ["CALIBRATION", "MODEL1", "MODEL2", "run_points"]

@@ -10,7 +10,7 @@ from scipy.stats import chi2
 
 from headsim.active.failure import Failure, FailureCause
 from headsim.estimators.result import Status
-from headsim.run.phases.calibrate import position_outcomes
+from headsim.run.calibrate import position_outcomes
 from headsim.run.runner import calibrate_scenario
 from headsim.scenario.loading import load_scenario
 

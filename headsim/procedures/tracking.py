@@ -2,23 +2,27 @@
 
 from __future__ import annotations
 
+from dataclasses import asdict
+
 import numpy as np
 
 from headsim.active.events import PhaseStarted
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.active.tracking import track_moving_target
+from headsim.run.context import (
+    record_measurement,
+    servo_config,
+    simulator,
+)
 from headsim.run.events import Hub
 from headsim.run.outcomes import (
     MeasurementRecord,
     TrackingResult,
 )
-from headsim.run.phases.setup import (
-    record_measurement,
-    servo_config,
-    simulator,
-)
+from headsim.run.table import cell, mm
 from headsim.run.targets import marker_target
+from headsim.scenario.registry import Procedure, register
 from headsim.scenario.spec import Scenario
 
 
@@ -59,4 +63,22 @@ def run_tracking(
     return records, experiment
 
 
-__all__ = ["run_tracking"]
+def _tracking_lines(e: TrackingResult) -> list[str]:
+    errors = np.asarray(e.errors_world_m, dtype=float)
+    finite = errors[np.isfinite(errors)]
+    return [
+        f"Tracking with the neck (Model 1): {len(finite)} of {len(errors)} fixations; error in W "
+        f"mean {mm(float(finite.mean()) if finite.size else None)} mm, max "
+        f"{mm(float(finite.max()) if finite.size else None)} mm; renders {e.renders_first} for the "
+        f"first fixation, {cell(e.renders_after_mean, '.1f')} per fixation after"
+    ]
+
+
+def _summary(e: TrackingResult, paper: bool) -> list[str]:
+    return _tracking_lines(e)
+
+
+TRACKING = register(Procedure("tracking", "default", run_tracking, fields=asdict, summary=_summary))
+
+
+__all__ = ["TRACKING", "run_tracking"]

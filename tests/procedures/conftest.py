@@ -1,4 +1,4 @@
-"""One run per scenario (its fast variant) for the phase tests of a module, typed as the runner returns it."""
+"""One run per scenario (its fast variant) for the procedure tests of a module, typed as the runner returns it."""
 
 from __future__ import annotations
 

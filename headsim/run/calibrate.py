@@ -20,6 +20,12 @@ from headsim.active.failure import Failure
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
 from headsim.estimators.result import Status
+from headsim.run.context import (
+    PAPER,
+    servo_config,
+    simulator,
+    told,
+)
 from headsim.run.events import CalibrationDone, Hub
 from headsim.run.outcomes import (
     CalibrationLayout,
@@ -28,12 +34,6 @@ from headsim.run.outcomes import (
     LinesOfSightFit,
     PositionOutcome,
     VerticalReference,
-)
-from headsim.run.phases.setup import (
-    PAPER,
-    servo_config,
-    simulator,
-    told,
 )
 from headsim.run.targets import marker_target
 from headsim.scenario.calibration_design import near_far_depths, near_fraction

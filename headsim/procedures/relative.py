@@ -3,15 +3,26 @@
 
 from __future__ import annotations
 
-from typing import cast
+import math
+from dataclasses import asdict
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
+import rerun as rr
 
 from headsim.active.events import PhaseStarted
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Target
 from headsim.active.relative import relative_positioning
 from headsim.active.servo_types import Detector
+from headsim.geometry.kinematics import head_to_world
+from headsim.run.context import (
+    PAPER,
+    PARKED_WORLD_M,
+    record_measurement,
+    servo_config,
+    simulator,
+)
 from headsim.run.events import Hub
 from headsim.run.outcomes import (
     MeasurementRecord,
@@ -19,16 +30,15 @@ from headsim.run.outcomes import (
     RelativePaper,
     RelativeResult,
 )
-from headsim.run.phases.setup import (
-    PAPER,
-    PARKED_WORLD_M,
-    record_measurement,
-    servo_config,
-    simulator,
-)
+from headsim.run.recording_layout import GREEN, ORANGE, RED
+from headsim.run.table import cell, format_table
+from headsim.scenario.registry import Procedure, register
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.vision.crosses import find_cross_point
+
+if TYPE_CHECKING:
+    from headsim.run.recording_results import ResultsLogging
 
 
 def run_relative(
@@ -102,4 +112,89 @@ def run_relative(
     return records, experiment
 
 
-__all__ = ["run_relative"]
+def _relative_lines(e: RelativeResult, paper: bool) -> list[str]:
+    headers = ["", "ours"] + (["paper"] if paper else [])
+    rows = [
+        [
+            "alpha1 (rad)",
+            cell(e.alpha1_rad, ".4f"),
+            *([cell(e.paper.alpha1_rad, ".4f")] if paper else []),
+        ],
+        [
+            "alpha2 (rad)",
+            cell(e.alpha2_rad, ".4f"),
+            *([cell(e.paper.alpha2_rad, ".4f")] if paper else []),
+        ],
+        ["objects", str(len(e.objects)), *([str(e.paper.objects)] if paper else [])],
+    ]
+    lines = [
+        "Relative positioning (Sec. III, Table VII): fixations on the cross point",
+        *format_table(headers, rows),
+    ]
+    obj_rows = [
+        [
+            o.name,
+            o.colour,
+            f"S{o.area}" if o.area else "-",
+            f"S{o.true_area}" if o.true_area else "-",
+            "yes" if o.agree else "NO",
+            cell(o.margin_px, ".1f"),
+        ]
+        for o in e.objects
+    ]
+    lines += format_table(["object", "colour", "area", "true area", "agree", "margin px"], obj_rows)
+    lines.append(
+        f"  {e.agree} of {len(e.objects)} objects in their true areas"
+        + (f"; not seen: {', '.join(e.missing)}" if e.missing else "")
+    )
+    return lines
+
+
+def _rows(e: RelativeResult, log: ResultsLogging) -> None:
+    """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
+    baseline = log.scenario.settings.baseline_m
+    s = log.scenario.settings
+    strips, labels = [], []
+    far = 2.0
+    for step_index, alpha in enumerate((e.alpha1_rad, e.alpha2_rad)):
+        if not math.isfinite(alpha):
+            return
+        for camera in (1, 2):
+            sign = 1.0 if camera == 1 else -1.0
+            yaw = alpha + log.effective_alpha_e[camera - 1]
+            start = np.array([-sign * baseline / 2, 0.0, 0.0])
+            end = start + far * np.array([sign * math.sin(yaw), 0.0, math.cos(yaw)])
+            strips.append(head_to_world(np.array([start, end]), 0.0, 0.0, s.neck_d1_m, s.neck_a2_m))
+            labels.append(f"L{camera}{step_index + 1}")
+    log.rec.log("/world/areas/lines", rr.LineStrips3D(strips, colors=[ORANGE] * 4, labels=labels))
+    objects = e.objects
+    positions = [log.truth[o.name] for o in objects if o.name in log.truth]
+    log.rec.log(
+        "/world/areas/objects",
+        rr.Points3D(
+            positions,
+            radii=0.008,
+            colors=[GREEN if o.agree else RED for o in objects],
+            labels=[f"{o.name}: S{o.area} (true S{o.true_area})" for o in objects],
+        ),
+    )
+
+
+def _missing(e: RelativeResult) -> tuple[str, ...]:
+    return tuple(f"{name}: not seen in all four images" for name in e.missing)
+
+
+RELATIVE_POSITIONING = register(
+    Procedure(
+        "relative_positioning",
+        "blocks",
+        run_relative,
+        fields=asdict,
+        summary=_relative_lines,
+        failures=_missing,
+        rows=_rows,
+    )
+)
+
+
+__all__ = ["RELATIVE_POSITIONING", "run_relative"]

@@ -1,0 +1,28 @@
+"""The procedures a scenario can name, one module each; importing this package registers them.
+
+Each module holds a procedure's run (on the run's simulator, event hub and what
+the head knows: :mod:`headsim.run.context`) and what its typed result writes:
+its results.json ``experiment`` fields, its summary lines and its recording
+rows, gathered in a :class:`Procedure` given to :func:`register`.  The runner,
+results.json, the summary and the recording find a procedure by name
+(:func:`get`) and never name its result type.  CONTRIBUTING.md walks through
+adding one.
+"""
+
+from __future__ import annotations
+
+from headsim.procedures import chessboard, points, pursuit, relative, tracking
+from headsim.scenario.registry import REGISTRY, Procedure, get, names, register
+
+__all__ = [
+    "REGISTRY",
+    "Procedure",
+    "chessboard",
+    "get",
+    "names",
+    "points",
+    "pursuit",
+    "register",
+    "relative",
+    "tracking",
+]

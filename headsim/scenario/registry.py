@@ -1,0 +1,98 @@
+"""The registry of procedures: each scenario's ``[experiment] procedure`` names one.
+
+A :class:`Procedure` is what the generic code (the scenario reader, the runner,
+results.json, the summary, the recording) needs of a procedure, and nothing of
+its result's type: the result is handed back to the procedure's own functions.
+The built-in procedures register themselves in :mod:`headsim.procedures`, which
+:func:`get` loads by name the first time a procedure is looked up (a plugin
+load: this layer never imports the procedures, which sit above the runner).
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from headsim.active.measurement import HeadKnowledge
+    from headsim.run.events import Hub
+    from headsim.run.outcomes import MeasurementRecord
+    from headsim.run.recording_results import ResultsLogging
+    from headsim.scenario.spec import Scenario
+
+#: The module whose import registers the built-in procedures.
+BUILT_IN = "headsim.procedures"
+
+
+def _no_lines(result: Any, paper: bool) -> list[str]:
+    return []
+
+
+def _no_failures(result: Any) -> tuple[str, ...]:
+    return ()
+
+
+def _no_rows(result: Any, log: ResultsLogging) -> None:
+    return None
+
+
+def _measured_line(result: Any, measured: int) -> str:
+    return f"OK: {measured} measurement{'' if measured == 1 else 's'}, none failed"
+
+
+@dataclass(frozen=True)
+class Procedure:
+    """One procedure, as the runner and the writers see it.
+
+    ``run(scenario, hub, knowledge, label)``: the records of its measurements and
+    its result (``knowledge`` is what the head knows, ``label`` says whether it was
+    calibrated).  The other functions take that result: ``fields`` its
+    results.json ``experiment`` fields; ``summary(result, paper)`` its lines in the
+    summary table; ``ok_line(result, measured)`` the table's last line when the run
+    succeeded; ``failures`` what failed beyond its measurements; ``rows(result, log)``
+    what it adds to a recording, through ``log.rec``.  ``scene`` is the MJCF scene
+    (``headsim.sim.names.SCENES``) it runs in.
+    """
+
+    name: str
+    scene: str
+    run: Callable[[Scenario, Hub, HeadKnowledge, str], tuple[Sequence[MeasurementRecord], Any]]
+    fields: Callable[[Any], dict[str, Any]]
+    summary: Callable[[Any, bool], list[str]] = _no_lines
+    ok_line: Callable[[Any, int], str] = _measured_line
+    failures: Callable[[Any], tuple[str, ...]] = _no_failures
+    rows: Callable[[Any, ResultsLogging], None] = _no_rows
+
+
+#: Every registered procedure, by name.
+REGISTRY: dict[str, Procedure] = {}
+
+
+def register(procedure: Procedure) -> Procedure:
+    """Add ``procedure`` under its name (a second one by the same name is an error)."""
+    known = REGISTRY.get(procedure.name)
+    if known is not None and known is not procedure:
+        raise ValueError(f"a procedure named {procedure.name!r} is already registered")
+    REGISTRY[procedure.name] = procedure
+    return procedure
+
+
+def names() -> tuple[str, ...]:
+    """The names of every procedure, the built-in ones first."""
+    importlib.import_module(BUILT_IN)
+    return tuple(REGISTRY)
+
+
+def get(name: str) -> Procedure:
+    """The procedure named ``name``."""
+    if name not in REGISTRY:
+        importlib.import_module(BUILT_IN)
+    try:
+        return REGISTRY[name]
+    except KeyError:
+        raise KeyError(f"no procedure named {name!r}; known: {', '.join(REGISTRY)}") from None
+
+
+__all__ = ["BUILT_IN", "REGISTRY", "Procedure", "get", "names", "register"]

@@ -1,0 +1,95 @@
+"""A procedure defined here, registered through the public registry and run by ``headsim run``:
+its results.json block, its summary lines and its recording rows, with no other module edited."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import rerun as rr
+from rerun.chunk import RrdReader
+
+from headsim import procedures
+from headsim.active.measurement import HeadKnowledge
+from headsim.cli import main
+from headsim.run.context import simulator
+from headsim.run.events import Hub
+from headsim.run.outcomes import MeasurementRecord
+from headsim.run.recording_results import ResultsLogging
+from headsim.scenario.spec import Scenario
+from headsim.sim import names
+
+BODY = sorted(names.MARKER_COLOURS)[0]
+
+
+@dataclass(frozen=True)
+class HeightResult:
+    """How high a marker stands in W, m (the truth: this procedure only reads the scene)."""
+
+    body: str
+    height_m: float
+
+
+def run_height(
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], HeightResult]:
+    with simulator(hub, "default", scenario) as sim:
+        return [], HeightResult(BODY, float(sim.position(BODY)[2]))
+
+
+def rows(result: HeightResult, log: ResultsLogging) -> None:
+    log.rec.log("/results/height", rr.Scalars(result.height_m))
+
+
+HEIGHT = procedures.Procedure(
+    "marker_height",
+    "default",
+    run_height,
+    fields=lambda r: {"body": r.body, "height_m": r.height_m},
+    summary=lambda r, paper: [f"Marker height: {r.body} at {r.height_m * 1000:.1f} mm"],
+    rows=rows,
+)
+
+
+@pytest.fixture
+def registered() -> Iterator[procedures.Procedure]:
+    procedures.register(HEIGHT)
+    yield HEIGHT
+    del procedures.REGISTRY[HEIGHT.name]
+
+
+def test_a_new_procedure_runs_through_headsim_run(
+    registered: procedures.Procedure, tmp_path: Path
+) -> None:
+    scenario = tmp_path / "height.toml"
+    scenario.write_text(
+        'description = "How high a marker stands"\nseed = 0\n\n'
+        '[experiment]\nprocedure = "marker_height"\n'
+    )
+    out, rrd = tmp_path / "out", tmp_path / "height.rrd"
+    argv = ["run", str(scenario), "--out", str(out), "--rrd", str(rrd), "--no-progress"]
+    assert main(argv) == 0
+    block: dict[str, Any] = json.loads((out / "results.json").read_text())["experiment"]
+    assert block["procedure"] == "marker_height" and block["body"] == BODY
+    assert 0.0 < block["height_m"] < 2.0
+    summary = (out / "summary.txt").read_text()
+    assert f"Marker height: {BODY} at {block['height_m'] * 1000:.1f} mm" in summary
+    assert "OK: 0 measurements, none failed" in summary
+    values = [
+        value
+        for chunk in RrdReader(rrd).stream().filter(content="/results/height")
+        for value in chunk.to_record_batch().column("Scalars:scalars").to_pylist()
+    ]
+    assert len(values) == 1 and np.allclose(np.ravel(values), block["height_m"])
+
+
+def test_a_name_taken_twice_is_refused(registered: procedures.Procedure) -> None:
+    with pytest.raises(ValueError, match="already registered"):
+        procedures.register(procedures.Procedure("marker_height", "default", run_height, dict))
+    assert procedures.get("marker_height") is HEIGHT
+    assert {"model2", "pursuit", "marker_height"} <= set(procedures.names())
