@@ -1,8 +1,7 @@
 """Every number taken from the paper, each with its section.
 
 De Xu, You Fu Li, Min Tan, Yang Shen, "A new active visual system for humanoid
-robots" (/work/shared/paper; equations.md's "Figures from the paper's
-experiments" lists the same).  Units: metres, radians, pixels (OpenCV's:
+robots" (the paper headsim reproduces).  Units: metres, radians, pixels (OpenCV's:
 pixel centres at integer coordinates).  Nothing here is a setting of headsim's
 own: the presets, studies and reports read the paper's figures from here.
 """
