@@ -62,7 +62,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         from headsim.errors import guarded
 
         with process_signals():
-            return guarded(lambda: _main(rest, debug=debug, quiet=quiet), debug=debug)
+            code = guarded(lambda: _main(rest, debug=debug, quiet=quiet), debug=debug)
     except KeyboardInterrupt:  # before the command's own guard, or as it is taken down
         print("headsim: interrupted", file=sys.stderr)
-        return int(ExitCode.INTERRUPTED)
+        code = int(ExitCode.INTERRUPTED)
+    if argv is None and code == ExitCode.INTERRUPTED:
+        # CPython ends a process by SIGINT at exit (status -2, not 130) once a
+        # KeyboardInterrupt passed through an extension's PyRun_* call (pybind11's exec
+        # while mujoco imports), even when it was caught; the next PyRun_* call that
+        # succeeds clears that flag, so the process exits with the status returned.
+        import ctypes
+
+        ctypes.pythonapi.PyRun_SimpleString(b"pass")
+    return code
