@@ -2,7 +2,8 @@
 
 Imports only the standard library, :mod:`headsim.errors` and the command
 modules at the top (they load their work inside), so that ``--help`` stays
-fast; :func:`build_parser` reads the scene names and presets when called.
+fast; :func:`build_parser` reads the scene names when called, and a given preset is
+checked against the settings' list only then.
 """
 
 from __future__ import annotations
@@ -28,10 +29,20 @@ def positive_int(text: str) -> int:
     return value
 
 
+def preset_name(text: str) -> str:
+    """An argparse type: a head preset's name (the settings load only for a given one)."""
+    from headsim.sim.settings import PRESETS
+
+    if text not in PRESETS:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a preset (allowed: {', '.join(sorted(PRESETS))})"
+        )
+    return text
+
+
 def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     """The command line; ``with_study``: with the study's options (imports the study)."""
     from headsim.sim import names
-    from headsim.sim.presets import PRESET_NAMES
 
     parser = argparse.ArgumentParser(
         prog="headsim",
@@ -139,8 +150,8 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     snap.add_argument(
         "--preset",
         default="ideal",
-        choices=sorted(PRESET_NAMES),
-        help="camera preset (default: ideal)",
+        type=preset_name,
+        help="camera preset (default: ideal; a wrong name is answered with the list)",
     )
     snap.add_argument(
         "--eye", type=float, default=0.0, help="eye-motor angle, rad, positive inward"

@@ -262,8 +262,7 @@ def reproduce(
         progress(f"scheduler: {ended}")
         # Every job ended and its files are written: the idle workers are stopped
         # rather than left to tear down their interpreters and GL contexts (~0.5 s).
-        for process in list((getattr(pool, "_processes", None) or {}).values()):
-            process.terminate()
+        _terminate_children()
         state["status"] = (
             "ok" if calibration and all(o.status == "ok" for o in outcomes.values()) else "failed"
         )
@@ -347,12 +346,15 @@ class WorkersNotStarted(EnvironmentProblem):
 
 def _stop(pool: Any) -> None:
     """Stop the pool's workers now, whatever they run."""
-    processes = list((getattr(pool, "_processes", None) or {}).values())
     pool.shutdown(wait=False, cancel_futures=True)
-    # With a worker caught half-started (Ctrl-C while the pool spawned it, which
-    # the pool does not know of yet), the exit would wait for it forever: every
-    # child of this process is one of the pool's workers.
-    for process in {*processes, *multiprocessing.active_children()}:
+    _terminate_children()
+
+
+def _terminate_children() -> None:
+    """Terminate every child process: each is one of the pool's workers, including
+    one caught half-started (Ctrl-C while the pool spawned it, which the pool does
+    not know of yet, and for which the exit would otherwise wait forever)."""
+    for process in multiprocessing.active_children():
         process.terminate()
 
 

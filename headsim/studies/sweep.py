@@ -28,6 +28,7 @@ from __future__ import annotations
 import functools
 import json
 import os
+import signal
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -58,7 +59,7 @@ def run_job(job: Job, marker_dir: str | None = None, recording: Any = None) -> d
         marker.touch()
     crash = {int(i) for i in os.environ.get(CRASH_ENV, "").split(",") if i.strip()}
     if job.index in crash:
-        os._exit(86)  # a hard crash, as a segfault in a renderer would be
+        os.kill(os.getpid(), signal.SIGKILL)  # a hard crash, as a segfault in a renderer
     try:
         return _run_job(job, recording)
     finally:

@@ -18,6 +18,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import pytest
+
 CLI = [sys.executable, "-m", "headsim.cli"]
 
 
@@ -213,9 +215,14 @@ def _interrupt(args: list[str], *, after_s: float | None = None, after_line: str
     return process.returncode, stdout, stderr
 
 
-def test_interrupt_during_start_up_is_130_without_a_traceback(tmp_path: Path) -> None:
+@pytest.mark.parametrize("after_s", [0.15, 0.3, 0.6])
+def test_interrupt_during_start_up_is_130_without_a_traceback(
+    tmp_path: Path, after_s: float
+) -> None:
+    """Early (the commands still importing, inside main's guard) and later (numpy,
+    mujoco and the scenario loading): one line, exit 130, no folder."""
     out = tmp_path / "out"
-    code, _, stderr = _interrupt(["run", "quickstart", "--out", str(out)], after_s=0.3)
+    code, _, stderr = _interrupt(["run", "quickstart", "--out", str(out)], after_s=after_s)
     assert code == 130, stderr
     assert "Traceback" not in stderr
     assert "interrupted" in stderr

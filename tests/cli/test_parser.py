@@ -8,11 +8,12 @@ import sys
 
 import pytest
 
-from headsim.cli.parser import build_parser, positive_int
+from headsim.cli.parser import build_parser, positive_int, preset_name
 from headsim.cli.scenarios import calibrate_command, list_command, run_command
 from headsim.cli.snapshot import snapshot_command
 from headsim.cli.studies import bench_command, reproduce_command, study_command, sweep_command
 from headsim.errors import EXIT_CODES_HELP
+from headsim.sim.settings import PRESETS
 
 
 def _commands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
@@ -52,7 +53,11 @@ def test_bad_arguments_are_usage_errors(capsys: pytest.CaptureFixture[str]) -> N
     with pytest.raises(SystemExit) as stop:
         parser.parse_args(["snapshot", "--out", "x", "--preset", "toy"])
     assert stop.value.code == 2
-    assert "argument --preset: invalid choice: 'toy'" in capsys.readouterr().err
+    assert (
+        "argument --preset: 'toy' is not a preset (allowed: ideal, paper, realistic)"
+        in capsys.readouterr().err
+    )
+    assert [preset_name(name) for name in PRESETS] == list(PRESETS)
     assert positive_int("3") == 3
     with pytest.raises(
         argparse.ArgumentTypeError, match=r"0 is not allowed \(allowed: an integer >= 1\)"

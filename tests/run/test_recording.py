@@ -39,8 +39,8 @@ def _rows_per_entity(rrd: Path) -> dict[str, int]:
 def test_the_command_line_leaves_only_once_the_recording_is_complete(
     recorded: tuple[Path, dict], tmp_path: Path
 ) -> None:
-    # The process's own entry point ends without tearing the interpreter down
-    # (os._exit): the recording it wrote has its footer and every row of a run in-process.
+    # The process's own entry point: the recording it wrote has its footer and every
+    # row of a run in-process.
     out, rrd = tmp_path / "out", tmp_path / "run.rrd"
     command = [sys.executable, "-m", "headsim.cli", "run", "quickstart", "--fast"]
     command += ["--out", str(out), "--rrd", str(rrd), "--no-progress"]

@@ -19,7 +19,7 @@ from headsim.run.rerun_cli import (
     add_recording_arguments,
     recording_target,
 )
-from headsim.run.viewer_browser import free_port, rerun_executable, wait_for_port
+from tests.run.viewer.browser import free_port, rerun_executable, wait_for_port
 
 
 def _target(*argv: str):

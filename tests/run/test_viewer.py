@@ -2,7 +2,7 @@
 
 Needs Debian's ``chromium`` (CI installs it: .ci/run).  The viewer draws into
 a canvas, so the checks are pixel statistics of each view's region
-(headsim.run.viewer_judge.judge); the layout's text views are checked in the
+(tests.run.viewer.judge.judge); the layout's text views are checked in the
 layout itself in tests/run/test_recording.py.
 """
 
@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from headsim.cli import main
-from headsim.run.viewer_browser import (
+from tests.run.viewer.browser import (
     chromium_path,
     free_port,
     screenshot,
@@ -28,7 +28,7 @@ from headsim.run.viewer_browser import (
     viewer_url,
     wait_for_port,
 )
-from headsim.run.viewer_judge import judge
+from tests.run.viewer.judge import judge
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = Path(__file__).resolve().parents[1] / "data"

@@ -9,7 +9,7 @@ import urllib.parse
 
 import pytest
 
-from headsim.run.viewer_browser import ViewerCheckError, free_port, viewer_url, wait_for_port
+from tests.run.viewer.browser import ViewerCheckError, free_port, viewer_url, wait_for_port
 
 
 def test_the_live_viewer_url_opens_the_grpc_proxy_with_webgl() -> None:

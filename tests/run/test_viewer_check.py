@@ -1,4 +1,4 @@
-"""The viewer check's command line (run/viewer_check.py): usage errors and exit 3 when the
+"""The viewer check's command line (tests/run/viewer/check.py): usage errors and exit 3 when the
 viewer cannot be run, with no screenshot written."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from headsim.run.viewer_check import main
+from tests.run.viewer.check import main
 
 
 def test_a_recording_or_a_url_is_required(capsys) -> None:

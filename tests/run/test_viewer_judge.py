@@ -13,7 +13,7 @@ import cv2
 import numpy as np
 import pytest
 
-from headsim.run.viewer_judge import WINDOW, judge, view_regions
+from tests.run.viewer.judge import WINDOW, judge, view_regions
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 

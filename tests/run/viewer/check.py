@@ -1,9 +1,9 @@
 """Open a recording in Rerun's web viewer in headless Chromium and take a screenshot.
 
-The command line over :mod:`headsim.run.viewer_browser` (serving, Chromium,
-the screenshot) and :mod:`headsim.run.viewer_judge` (what each view shows):
+The command line over :mod:`tests.run.viewer.browser` (serving, Chromium,
+the screenshot) and :mod:`tests.run.viewer.judge` (what each view shows):
 
-    python -m headsim.run.viewer_check out/quickstart/recording.rrd --png docs/recording.png
+    python -m tests.run.viewer.check out/quickstart/recording.rrd --png docs/recording.png
 
 Exit status: 0 every view drew, 1 a view did not, 3 the viewer or Chromium
 could not be run.
@@ -17,8 +17,8 @@ from pathlib import Path
 
 import cv2
 
-from headsim.run.viewer_browser import ViewerCheckError, screenshot, serve_file
-from headsim.run.viewer_judge import judge
+from tests.run.viewer.browser import ViewerCheckError, screenshot, serve_file
+from tests.run.viewer.judge import judge
 
 
 def main(argv: list[str] | None = None) -> int:

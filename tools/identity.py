@@ -3,8 +3,8 @@
 A change that should alter no behaviour (a restructuring) must leave every
 scenario's results.json byte-identical, and the bench's accuracy metrics equal.
 
-    python benchmarks/identity.py collect OUT_DIR [--jobs N] [--only NAME ...]
-    python benchmarks/identity.py compare BEFORE_DIR AFTER_DIR
+    python tools/identity.py collect OUT_DIR [--jobs N] [--only NAME ...]
+    python tools/identity.py compare BEFORE_DIR AFTER_DIR
 
 `collect` runs `headsim run NAME --out ...` for every scenario shipped in
 headsim's scenarios folder, with and without --fast, plus `headsim bench --json`

@@ -5,7 +5,7 @@ baseline is missing or failed, when a row the baseline reproduced is no
 longer reproduced, or when the wall ratio's unit is not the quieter of the
 two render medians it was timed as.  ``--update`` stores the report's rows as the new baseline.
 
-    python benchmarks/check_reproduce.py out/reproduce/report.json [--update]
+    python tools/check_reproduce.py out/reproduce/report.json [--update]
 """
 
 from __future__ import annotations

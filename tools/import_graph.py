@@ -1,6 +1,6 @@
 """Import graph of headsim: circles, upward imports between layers, the largest modules.
 
-    python benchmarks/import_graph.py [REPO_ROOT]
+    python tools/import_graph.py [REPO_ROOT]
 
 The layers, low to high, are LAYERS (a module's layer is its package under
 headsim/, or its own name for a top-level module). An import from a module to a
@@ -33,7 +33,8 @@ LAYERS = (
     "envs",
     "cli",
 )
-MAX_LINES = 400
+#: Modules are sized by concern; none is over about this many lines.
+MAX_LINES = 800
 
 
 def module_name(root: Path, path: Path) -> str:

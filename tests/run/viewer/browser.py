@@ -30,7 +30,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from headsim.run.viewer_judge import WINDOW, drawn
+from tests.run.viewer.judge import WINDOW, drawn
 
 #: Chromium's flags: headless, no network beyond 127.0.0.1, WebGL through SwiftShader.
 CHROMIUM_FLAGS = (
