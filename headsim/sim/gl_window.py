@@ -21,6 +21,8 @@ import mujoco
 import numpy as np
 
 from headsim.sim.backend import RenderBackendError
+from headsim.sim.mujoco_renderer import attachment as renderer_attachment
+from headsim.sim.mujoco_renderer import mjr_context
 
 
 @dataclass(frozen=True)
@@ -193,14 +195,14 @@ def draw_window(
     from OpenGL import GL
 
     full_w, full_h = full_size
-    context = renderer._mjr_context
+    context = mjr_context(renderer)
     step = BUFFER_STEP
     width, height = k * rect.width, k * rect.height
     size = (step * math.ceil(width / step), step * math.ceil(height / step))
     # MuJoCo's only use of the stencil: reflective geoms (a material's reflectance).
     stencil = bool(np.any(renderer.model.mat_reflectance > 0))
-    buffers: OrderedDict[tuple[int, int, bool], WindowBuffer] = renderer.__dict__.setdefault(
-        "_headsim_window_buffers", OrderedDict()
+    buffers: OrderedDict[tuple[int, int, bool], WindowBuffer] = renderer_attachment(
+        renderer, "_headsim_window_buffers", OrderedDict
     )
     # The smallest kept buffer that holds the window, unless it is much larger.
     fits = [b for b in buffers if b[0] >= size[0] and b[1] >= size[1] and b[2] == stencil]

@@ -34,6 +34,7 @@ import numpy as np
 from headsim.sim import names
 from headsim.sim.backend import INSTALL_HINT, RenderBackendError, check_backend
 from headsim.sim.gl_window import Window, draw_window
+from headsim.sim.mujoco_renderer import check_renderer, make_current, mjr_context, use_model
 from headsim.sim.optics import DistortionCanvas, GaussianNoise, apply_canvas
 from headsim.sim.settings import CameraSettings
 
@@ -91,6 +92,7 @@ def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
             ) from err
         finally:
             model.vis.global_.offwidth, model.vis.global_.offheight = saved
+        check_renderer(renderer)
         created += 1
     _POOL[key] = renderer
     while len(_POOL) > POOL_SIZE:
@@ -149,7 +151,7 @@ class EyeRenderer:
 
     def _renderer(self) -> mujoco.Renderer:
         renderer = _acquire(self._key, self._model)
-        renderer._model = self._model  # the same assets; this model's cameras and bodies
+        use_model(renderer, self._model)  # the same assets; this model's cameras and bodies
         return renderer
 
     def _draw(
@@ -192,14 +194,13 @@ class EyeRenderer:
                     model.cam_sensorsize[cam],
                     model.cam_intrinsic[cam],
                 ) = saved
-        gl_context = renderer._gl_context
-        if gl_context is not None:
-            gl_context.make_current()
+        make_current(renderer)
+        context = mjr_context(renderer)
         if binning > 1:
             viewport = mujoco.MjrRect(0, 0, out_w, out_h)
-            mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
+            mujoco.mjr_render(viewport, renderer.scene, context)
             pixels: np.ndarray = np.empty((out_h, out_w, 3), dtype=np.uint8)
-            mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
+            mujoco.mjr_readPixels(pixels, None, viewport, context)
             self.rendered_frames += (out_w * out_h) / (width_c * height_c)
             return np.ascontiguousarray(pixels[::-1])
         # Supersampled k times (headsim.sim.settings.RenderFidelity): the model's
@@ -208,9 +209,9 @@ class EyeRenderer:
         if rect is None or (rect.width, rect.height) == (width_c, height_c):
             rect = Window(0, 0, width_c, height_c)
             viewport = mujoco.MjrRect(0, 0, full_w, full_h)
-            mujoco.mjr_render(viewport, renderer.scene, renderer._mjr_context)
+            mujoco.mjr_render(viewport, renderer.scene, context)
             pixels = np.empty((full_h, full_w, 3), dtype=np.uint8)
-            mujoco.mjr_readPixels(pixels, None, viewport, renderer._mjr_context)
+            mujoco.mjr_readPixels(pixels, None, viewport, context)
         else:
             # A window is drawn as the whole frame (the same projection and
             # viewport: every vertex lands where it does in the frame, so its
