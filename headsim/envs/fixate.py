@@ -65,7 +65,7 @@ from headsim.sim.settings import (
     HeadSettings,
     SettingsError,
 )
-from headsim.sim.simulator import HeadSim
+from headsim.sim.simulator import HeadSim, for_settings
 from headsim.vision.markers import find_marker
 
 TARGET_BODY = "marker_red"
@@ -192,7 +192,7 @@ class FixateEnv(gymnasium.Env):
         if self._sim is None or settings != self._settings:
             if self._sim is not None:
                 self._sim.close()
-            self._sim, self._settings = HeadSim("default", settings), settings
+            self._sim, self._settings = for_settings(settings), settings
             self._prepare_model(self._sim)
         sim = self._sim
         sim.reset()

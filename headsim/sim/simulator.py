@@ -392,3 +392,14 @@ class HeadSim:
     def rendered_frames(self) -> float:
         """Pixels rendered so far by this simulator, in full frames."""
         return self._renderer.rendered_frames
+
+
+def for_settings(
+    settings: HeadSettings,
+    scene: str | Path = "default",
+    settle_mode: str = "kinematic",
+    sink: EventSink | None = None,
+) -> HeadSim:
+    """The simulator for ``settings`` in ``scene``: the one builder that code outside the
+    simulator, the procedures, the runner and the tests goes through."""
+    return HeadSim(scene, settings, settle_mode=settle_mode, sink=sink)

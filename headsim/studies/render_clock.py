@@ -24,9 +24,9 @@ class RenderClock:
 
     def __init__(self) -> None:
         from headsim.sim.settings import HeadSettings
-        from headsim.sim.simulator import HeadSim
+        from headsim.sim.simulator import for_settings
 
-        self._sim = HeadSim("default", HeadSettings())
+        self._sim = for_settings(HeadSettings())
         self._sim.move(eye=0.05)
         for camera in (1, 2):
             self._sim.render(camera)
