@@ -1,10 +1,10 @@
-"""A real, non-editable install works from any folder: models and scenarios are package data.
+"""Wheel and editable installs work from any folder: models/ and scenarios/ are package data.
 
-CI runs this with the rest of the suite.  To stay fast and offline it builds the
-wheel with pip (build isolation, setuptools from pip's cache or index), installs
-it with ``--no-deps`` into a fresh venv, and lends that venv the test
-environment's site-packages for the dependencies (numpy, mujoco, ...) through a
-``.pth`` line; headsim itself comes only from the wheel.
+CI runs this with the rest of the suite.  To stay fast and offline it builds with
+pip (build isolation, setuptools from pip's cache or index), installs with
+``--no-deps`` into a fresh venv, and lends that venv the test environment's
+site-packages for the dependencies (numpy, mujoco, ...) through a ``.pth`` line;
+headsim itself comes only from the copy of the sources under test.
 """
 
 from __future__ import annotations
@@ -30,18 +30,20 @@ def _run(args: list[str], **kwargs) -> subprocess.CompletedProcess[str]:
     return result
 
 
-def test_pip_install_runs_the_quick_start_from_another_folder(tmp_path: Path) -> None:
-    # The sources as a user gets them (no build products of the checkout).
+def _sources(tmp_path: Path) -> Path:
+    """The sources as a user gets them (no build products of the checkout)."""
     source = tmp_path / "source"
-    shutil.copytree(
-        REPO / "headsim", source / "headsim", ignore=shutil.ignore_patterns("__pycache__")
-    )
+    for folder in ("headsim", "models", "scenarios"):
+        shutil.copytree(
+            REPO / folder, source / folder, ignore=shutil.ignore_patterns("__pycache__")
+        )
     for name in ("pyproject.toml", "README.md"):
         shutil.copy2(REPO / name, source / name)
-    wheels = tmp_path / "wheels"
-    _run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(wheels), str(source)])
-    (wheel,) = wheels.glob("headsim-*.whl")
+    return source
 
+
+def _venv(tmp_path: Path) -> tuple[Path, Path]:
+    """A fresh venv that borrows the test environment's dependencies: (python, site-packages)."""
     target = tmp_path / "venv"
     venv.EnvBuilder(with_pip=False).create(target)
     python = target / "bin" / "python"
@@ -51,11 +53,12 @@ def test_pip_install_runs_the_quick_start_from_another_folder(tmp_path: Path) ->
         ).stdout.strip()
     )
     (site / "_headsim_test_deps.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
-    _run(
-        [sys.executable, "-m", "pip", "--python", str(python), "install", "-q", "--no-deps",
-         "--no-index", str(wheel)]
-    )  # fmt: skip
+    return python, site
 
+
+def _run_elsewhere(tmp_path: Path, python: Path) -> list[Path]:
+    """Run the quick start, the listing and a snapshot from a folder outside the sources;
+    the resolved paths of headsim's modules, models and scenarios."""
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
@@ -65,12 +68,42 @@ def test_pip_install_runs_the_quick_start_from_another_folder(tmp_path: Path) ->
          "print(m.__file__); print(m.MODELS_DIR); print(s.SCENARIOS_DIR)"],
         cwd=elsewhere, env=env,
     ).stdout.split()  # fmt: skip
-    assert all(line.startswith(str(site)) for line in where), where  # the wheel, not the checkout
-
-    headsim = str(target / "bin" / "headsim")
+    headsim = str(python.parent / "headsim")
     listing = _run([headsim, "list"], cwd=elsewhere, env=env)
     assert "quickstart" in listing.stdout and "INVALID" not in listing.stdout
     _run([headsim, "run", "quickstart", "--quiet", "--out", "X"], cwd=elsewhere, env=env)
     assert (elsewhere / "X" / "results.json").is_file()
     _run([headsim, "snapshot", "--out", "snap"], cwd=elsewhere, env=env)
     assert (elsewhere / "snap" / "cam1.png").is_file()
+    return [Path(line).resolve() for line in where]
+
+
+def test_pip_install_runs_the_quick_start_from_another_folder(tmp_path: Path) -> None:
+    source = _sources(tmp_path)
+    wheels = tmp_path / "wheels"
+    _run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(wheels), str(source)])
+    (wheel,) = wheels.glob("headsim-*.whl")
+    python, site = _venv(tmp_path)
+    _run(
+        [sys.executable, "-m", "pip", "--python", str(python), "install", "-q", "--no-deps",
+         "--no-index", str(wheel)]
+    )  # fmt: skip
+    module, models, scenarios = _run_elsewhere(tmp_path, python)
+    site = site.resolve()
+    assert module.is_relative_to(site), module  # the wheel, not the checkout
+    assert models == site / "headsim" / "models", models
+    assert scenarios == site / "headsim" / "scenarios", scenarios
+
+
+def test_editable_install_finds_the_top_level_models_and_scenarios(tmp_path: Path) -> None:
+    source = _sources(tmp_path)
+    python, _ = _venv(tmp_path)
+    _run(
+        [sys.executable, "-m", "pip", "--python", str(python), "install", "-q", "--no-deps",
+         "-e", str(source)]
+    )  # fmt: skip
+    module, models, scenarios = _run_elsewhere(tmp_path, python)
+    source = source.resolve()
+    assert module == source / "headsim" / "sim" / "model.py", module
+    assert models == source / "models", models
+    assert scenarios == source / "scenarios", scenarios

@@ -28,7 +28,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-SCENARIOS = ROOT / "headsim" / "scenarios"
+SCENARIOS = ROOT / "scenarios"
 HEADSIM = [sys.executable, "-m", "headsim.cli"]
 # Keys of `reproduce`'s report that carry clock readings, worker ids or CPU ratios
 # (seconds end in _s); render counts and every result stay in the comparison.

@@ -69,7 +69,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     run.add_argument(
         "scenario",
         metavar="SCENARIO",
-        help="a scenario file (.toml) or the name of one in headsim/scenarios/ (see `headsim list`)",
+        help="a scenario file (.toml) or the name of one in scenarios/ (see `headsim list`)",
     )
     run.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
     run.add_argument(
@@ -129,7 +129,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     listing = commands.add_parser(
         "list",
         help="list the scenario files with one-line descriptions",
-        description="List the scenario files (headsim/scenarios/*.toml) with their descriptions; "
+        description="List the scenario files (scenarios/*.toml) with their descriptions; "
         "a file that does not validate says why.",
     )
     listing.add_argument("--dir", metavar="DIR", help="another directory of scenario files")

@@ -25,8 +25,9 @@ from headsim.scenario.spec import Scenario
 from headsim.scenario.tables import Context, ScenarioError, Table, describe_value
 from headsim.scenario.toml_file import deep_line, read_toml, text_or_empty
 
-#: Where ``headsim list`` and ``headsim run NAME`` look for scenario files.
-SCENARIOS_DIR = Path(str(resources.files("headsim") / "scenarios"))
+#: Where ``headsim list`` and ``headsim run NAME`` look for scenario files: the
+#: repository's scenarios/, installed as package data.
+SCENARIOS_DIR = Path(str(resources.files("headsim.scenarios")))
 
 
 def _merge(base: dict[str, Any], override: dict[str, Any]) -> dict[str, Any]:
@@ -67,7 +68,7 @@ def set_field(doc: dict[str, Any], dotted: str, value: Any) -> dict[str, Any]:
 
 
 def resolve_path(name_or_path: str | Path) -> Path:
-    """A scenario file: a path, or the name of a file in ``headsim/scenarios/`` (without .toml)."""
+    """A scenario file: a path, or the name of a file in ``scenarios/`` (without .toml)."""
     path = Path(name_or_path)
     if path.is_file():
         return path
@@ -215,7 +216,7 @@ def _check_servo(ctx: Context, scenario: Scenario) -> None:
 
 
 def scenario_files(directory: Path | None = None) -> list[Path]:
-    """The scenario files in ``directory`` (default ``headsim/scenarios/``), sorted by name."""
+    """The scenario files in ``directory`` (default ``scenarios/``), sorted by name."""
     directory = SCENARIOS_DIR if directory is None else directory
     return sorted(directory.glob("*.toml")) if directory.is_dir() else []
 

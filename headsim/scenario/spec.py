@@ -31,7 +31,7 @@ MIN_BASELINE_M = 0.01
 MARKER_BODIES = {**names.MARKER_COLOURS, names.CALIBRATION_BALL: "yellow"}
 
 
-#: The chessboard of ``headsim/models/scene_chessboard.xml``: inner corners (columns, rows), square, m.
+#: The chessboard of ``models/scene_chessboard.xml``: inner corners (columns, rows), square, m.
 CHESSBOARD_PATTERN = (8, 6)
 
 

@@ -1,6 +1,6 @@
 """Building scenes: load an MJCF scene and apply head settings through MjSpec.
 
-The XML files in ``headsim/models/`` hold the defaults (ideal cameras, D = 150 mm);
+The XML files in ``models/`` (installed as ``headsim.models``) hold the defaults (ideal cameras, D = 150 mm);
 :func:`build_model` edits a fresh spec from them with a :class:`HeadSettings`
 and compiles it.  Props (markers, chessboards) can be added the same way.
 """
@@ -19,8 +19,8 @@ from headsim.sim import names
 from headsim.sim.optics import DistortionCanvas, distortion_canvas
 from headsim.sim.settings import MAX_IMAGE_SIDE, CameraSettings, HeadSettings, SettingsError
 
-#: The head and scene MJCF files, installed as package data (headsim/models).
-MODELS_DIR = Path(str(resources.files("headsim") / "models"))
+#: The head and scene MJCF files: the repository's models/, installed as package data.
+MODELS_DIR = Path(str(resources.files("headsim.models")))
 #: Sensor pixel pitch used to express pixel intrinsics in MuJoCo's length units, m.
 PIXEL_PITCH_M = 1e-5
 

@@ -1,4 +1,4 @@
-"""Every MJCF name the Python code uses, in one place (headsim/models/*.xml), and the
+"""Every MJCF name the Python code uses, in one place (models/*.xml), and the
 :class:`Camera` type that ties each eye camera's number, name and inward sign together."""
 
 from __future__ import annotations
@@ -70,12 +70,12 @@ MARKER_COLOURS = {"marker_red": "red", "marker_green": "green", "marker_blue": "
 CHESSBOARD = "chessboard"
 BLOCKS = "blocks"
 RELATIVE_OBJECTS = tuple(f"object_{i}" for i in range(1, 7))
-#: Colour of each relative-positioning object (headsim/models/scene_blocks.xml).
+#: Colour of each relative-positioning object (models/scene_blocks.xml).
 RELATIVE_OBJECT_COLOURS = dict(
     zip(RELATIVE_OBJECTS, ("red", "green", "blue", "yellow", "magenta", "cyan"), strict=True)
 )
 
-# Scene files in headsim/models/, by short name.
+# Scene files in models/, by short name.
 SCENES = {
     "default": "scene.xml",
     "base": "scene_base.xml",

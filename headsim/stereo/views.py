@@ -27,7 +27,7 @@ class StereoError(ValueError):
     """The stereo baseline cannot proceed (too few views, a target not seen, ...)."""
 
 
-#: Inner corners of the scene's chessboard (columns, rows): headsim/models/scene_chessboard.xml.
+#: Inner corners of the scene's chessboard (columns, rows): models/scene_chessboard.xml.
 CHESSBOARD_PATTERN = (8, 6)
 
 

@@ -3,7 +3,7 @@
 A sweep file (TOML) names a scenario and the fields to vary::
 
     description = "Model 2 error against the focal length"
-    scenario = "quickstart"          # a name in headsim/scenarios/ or a path
+    scenario = "quickstart"          # a name in scenarios/ or a path
     fast = true                      # each job runs the scenario's fast variant
 
     [grid]                           # every combination of these values

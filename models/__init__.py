@@ -1,0 +1,1 @@
+"""The head and scene MJCF files: package data, installed as ``headsim.models``."""

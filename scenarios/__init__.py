@@ -1,0 +1,1 @@
+"""The scenario files: package data, installed as ``headsim.scenarios``."""
