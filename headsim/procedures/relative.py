@@ -38,7 +38,7 @@ from headsim.sim import names
 from headsim.vision.crosses import find_cross_point
 
 if TYPE_CHECKING:
-    from headsim.run.recording_results import ResultsLogging
+    from headsim.run.recording import Recorder
 
 
 def run_relative(
@@ -150,7 +150,7 @@ def _relative_lines(e: RelativeResult, paper: bool) -> list[str]:
     return lines
 
 
-def _rows(e: RelativeResult, log: ResultsLogging) -> None:
+def _rows(e: RelativeResult, log: Recorder) -> None:
     """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
     baseline = log.scenario.settings.baseline_m
     s = log.scenario.settings

@@ -29,9 +29,10 @@ and timelines (README "Scenarios and results" lists them):
 - ``/world/model/<body>`` (Transform3D world_from_body when it moved) and
   its geoms (:mod:`headsim.run.mjcf_rerun`): the head and the scene in 3-D.
 
-The layout and palette are in :mod:`headsim.run.recording_layout`, the head and
-scene's logging in :mod:`headsim.run.recording_scene`, the results' in
-:mod:`headsim.run.recording_results`; the :class:`Recorder` follows the events.
+The :class:`Recorder` follows the events and logs the head, its scene and the
+results; the rows logged with every image are kept and sent as columns
+(:class:`RowColumns`).  The layout, the palette and the text documents are in
+:mod:`headsim.run.recording_layout`.
 
 The stream goes to a file, a running viewer (``--connect``) or a served web
 viewer (``--serve``), or several (:class:`headsim.run.rerun_cli.RecordingTarget`).
@@ -45,9 +46,13 @@ rewrites it).
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+import math
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
 from datetime import timedelta
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -57,22 +62,28 @@ from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
-from headsim.run.recording_columns import RowColumns
+from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RunResult
 from headsim.run.recording_layout import (
     GREEN,
     GREY,
     ORANGE,
+    RED,
+    UI_RADIUS,
     UI_RADIUS_LARGE,
     UI_RADIUS_SMALL,
     WHITE,
     blueprint,
+    calibration_markdown,
     recording_id,
+    scenario_markdown,
 )
-from headsim.run.recording_results import ResultsLogging
 from headsim.run.rerun_cli import RecordingTarget
+from headsim.run.summary import summary_text
+from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.events import ImageKind, ImageTaken
+from headsim.sim.optics import camera_matrix
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import find_markers
 
@@ -84,9 +95,11 @@ JPEG_QUALITY = 75
 MAX_KEPT_ROWS = 500
 #: Longest time logged data waits in the batcher before it is written or streamed.
 FLUSH_TICK = timedelta(seconds=1)
+#: Distance from the image plane to the optical centre of a drawn frustum, m.
+FRUSTUM_DEPTH_M = 0.08
 
 
-class Recorder(ResultsLogging):
+class Recorder:
     """Logs a run to ``path`` as it goes; :meth:`close` writes the footer."""
 
     def __init__(
@@ -167,7 +180,7 @@ class Recorder(ResultsLogging):
         # JPEG encoding and sending the kept rows run on one thread beside the run's
         # (OpenCV's encoder lets the renders go on meanwhile), in the order given.
         self._background = ThreadPoolExecutor(1, thread_name_prefix="headsim-recording")
-        self._pending = []
+        self._pending: list[Future[None]] = []
         self._log_static()
 
     # -- the subscriber -----------------------------------------------------------
@@ -345,6 +358,287 @@ class Recorder(ResultsLogging):
                 f"/servo/{cam}/{axis}_error_px", frame, self.current_step, rr.Scalars, scalars=error
             )
 
+    # -- the results ---------------------------------------------------------------
+    def measured(self, record: MeasurementRecord) -> None:
+        m = record.measurement
+        self.current_step = record.step
+        self._time()
+        label = m.name
+        if record.time_s is not None:
+            label += f" t={record.time_s:g}s"
+        if self.scenario.experiment.procedure == "calibration":
+            label += f" ({record.knowledge})"
+        self.estimates[f"{record.step}"] = (m.estimate_world_m, m.truth_world_m, m.ok)
+        self._labels[f"{record.step}"] = label
+        done = [(k, e, t) for k, (e, t, ok) in self.estimates.items() if ok]
+        if done:
+            self.rec.log(
+                "/world/estimate",
+                rr.Points3D(
+                    [e for _, e, _ in done],
+                    radii=UI_RADIUS,
+                    colors=[GREEN] * len(done),
+                    labels=[self._labels[k] for k, _, _ in done],
+                    show_labels=False,
+                ),
+            )
+            self.rec.log(
+                "/world/error",
+                rr.LineStrips3D([[t, e] for _, e, t in done], colors=[RED] * len(done)),
+            )
+        error = float(np.linalg.norm(m.error_head_m))
+        if math.isfinite(error):
+            self.rec.log("/measurements/error_mm", rr.Scalars([error * 1000.0]))
+            self.rec.log("/measurements/error_pct_of_depth", rr.Scalars([m.error_pct_of_depth]))
+        self.rec.log("/measurements/renders", rr.Scalars([float(m.renders)]))
+        residuals = [abs(r) for r in m.servo_residual_px if math.isfinite(r)]
+        if residuals:
+            self.rec.log("/measurements/servo_residual_px", rr.Scalars([max(residuals)]))
+        self._rows.append(
+            f"| {record.step} | {label} | {m.status_text} | {error * 1000.0:.2f} | "
+            f"{m.error_pct_of_depth:.3f} | {m.renders} | "
+            f"{max(residuals) if residuals else float('nan'):.2f} |"
+        )
+        self.rec.log(
+            "/results/measurements",
+            rr.TextDocument(
+                "# Measurements\n\n| step | target | status | error mm | % of depth | renders "
+                "| residual px |\n|---|---|---|---|---|---|---|\n" + "\n".join(self._rows) + "\n",
+                media_type=rr.MediaType.MARKDOWN,
+            ),
+        )
+        self.flush()
+
+    def pursued(self, record: Any, frame: int) -> None:
+        """A live pursuit frame: truth, estimate and error on the frame timeline."""
+        self.current_frame = frame
+        self._time()
+        spec = self.scenario.scene.pursuit
+        if not self._pursuit_trail and spec is not None:
+            times = spec.sample_times(0.02)
+            path = [
+                spec.path.position(float(t)) for t in times if spec.visibility.visible(float(t))
+            ]
+            if len(path) > 1:
+                self.rec.log(
+                    "/world/pursuit/path",
+                    rr.LineStrips3D([np.array(path)], colors=[GREY], labels=["path"]),
+                    static=True,
+                )
+        truth, estimate = record.truth_world_m, record.estimate_world_m
+        if truth is not None:
+            self.rec.log("/world/truth", rr.Points3D([truth], radii=0.003, colors=[WHITE]))
+        else:
+            self.rec.log("/world/truth", rr.Clear(recursive=False))
+        for index, cam in enumerate(names.CAMERAS):
+            uv = record.uv_px[index]
+            if uv is None:
+                self.rec.log(f"/world/head/{cam}/features", rr.Clear(recursive=False))
+                continue
+            self.rec.log(
+                f"/world/head/{cam}/features", rr.Points2D([uv], radii=4.0, colors=[GREEN])
+            )
+        if record.error_px is not None:
+            for index, cam in enumerate(names.CAMERAS):
+                self.rec.log(
+                    f"/servo/{cam}/u_error_px", rr.Scalars([float(record.error_px[index])])
+                )
+        if estimate is None or not np.all(np.isfinite(estimate)):
+            self.rec.log("/world/estimate", rr.Clear(recursive=False))
+            self.rec.log("/world/error", rr.Clear(recursive=False))
+            return
+        self._pursuit_trail.append(np.asarray(estimate, float))
+        self.rec.log("/world/estimate", rr.Points3D([estimate], radii=0.004, colors=[GREEN]))
+        self.rec.log(
+            "/world/pursuit/estimates",
+            rr.Points3D(np.array(self._pursuit_trail), radii=0.0015, colors=[GREEN]),
+        )
+        if truth is not None:
+            error = float(np.linalg.norm(estimate - truth))
+            self.rec.log("/world/error", rr.LineStrips3D([[truth, estimate]], colors=[RED]))
+            self.rec.log("/measurements/error_mm", rr.Scalars([error * 1000.0]))
+            depth = float(np.linalg.norm(truth - self.world_from_head_start[:3, 3]))
+            self.rec.log("/measurements/error_pct_of_depth", rr.Scalars([100.0 * error / depth]))
+
+    def calibrated(self, calibration: CalibrationReport) -> None:
+        self._time()
+        self.rec.log(
+            "/results/calibration",
+            rr.TextDocument(calibration_markdown(calibration), media_type=rr.MediaType.MARKDOWN),
+        )
+        self.flush()
+
+    def finished(self, result: RunResult) -> None:
+        self._time()
+        if result.experiment is not None:
+            get(self.scenario.experiment.procedure).rows(result.experiment, self)
+        text = summary_text(result)
+        self.rec.log(
+            "/results/summary",
+            rr.TextDocument(f"```\n{text}\n```", media_type=rr.MediaType.MARKDOWN),
+        )
+
+    # -- the head and its scene -----------------------------------------------------
+    def _time(self) -> None:
+        self.rec.set_time("frame", sequence=self.current_frame)
+        self.rec.set_time("step", sequence=self.current_step)
+
+    def _log_static(self) -> None:
+        s = self.scenario
+        self.rec.log("/world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+        for index, cam in enumerate(names.CAMERAS):
+            settings = s.settings.cameras[index]
+            # headsim's camera frames are OpenCV's (x right, y down, z forward):
+            # Rerun's RDF, so no conversion here (MuJoCo's RUB is converted in headsim.sim.simulator).
+            self.rec.log(
+                f"/world/head/{cam}",
+                rr.Pinhole(
+                    image_from_camera=camera_matrix(settings),
+                    resolution=[settings.width, settings.height],
+                    camera_xyz=rr.ViewCoordinates.RDF,
+                    image_plane_distance=FRUSTUM_DEPTH_M,
+                ),
+                static=True,
+            )
+            u0, v0 = settings.image_centre
+            self.rec.log(
+                f"/world/head/{cam}/goal",
+                rr.LineStrips2D(
+                    [
+                        [[u0, 0.0], [u0, settings.height - 1.0]],
+                        [[0.0, v0], [settings.width - 1.0, v0]],
+                    ],
+                    colors=[ORANGE, GREY],
+                    labels=["goal column u0", "centre row"],
+                    show_labels=False,
+                ),
+                static=True,
+            )
+        for key, unit in (
+            ("error_mm", "mm"),
+            ("error_pct_of_depth", "%"),
+            ("servo_residual_px", "px"),
+        ):
+            self.rec.log(
+                f"/measurements/{key}", rr.SeriesPoints(names=[f"{key} ({unit})"]), static=True
+            )
+        for cam in names.CAMERAS:
+            for axis in ("u", "v"):
+                self.rec.log(
+                    f"/servo/{cam}/{axis}_error_px",
+                    rr.SeriesLines(names=[f"{cam} {axis} - {axis}0"]),
+                    static=True,
+                )
+        self.rec.log(
+            "/results/scenario",
+            rr.TextDocument(scenario_markdown(self.scenario), media_type=rr.MediaType.MARKDOWN),
+            static=True,
+        )
+        # Until they exist, the other documents say what will be there (frame 0).
+        self._time()
+        calibration = self.scenario.experiment.calibration
+        for path, text in (
+            (
+                "/results/calibration",
+                "# Calibration\n\n"
+                + ("running ..." if calibration else "none: this scenario does not calibrate"),
+            ),
+            ("/results/summary", "# Summary\n\nwritten when the run ends"),
+            ("/results/measurements", "# Measurements\n\nnone yet"),
+        ):
+            self.rec.log(path, rr.TextDocument(text, media_type=rr.MediaType.MARKDOWN))
+
+    def _scene(self, sim: HeadSim) -> None:
+        """Log the model's geometry when this sim's model is new to the recording."""
+        model = sim.model
+        key = tuple(mjcf_rerun.body_name(model, b) for b in range(model.nbody)) + tuple(
+            mjcf_rerun.geom_name(model, g) for g in range(model.ngeom)
+        )
+        if key == self._scene_key:
+            return
+        if self._scene_key is not None and not self._static_geometry:
+            self.rec.log(mjcf_rerun.ROOT, rr.Clear(recursive=True))
+        self._scene_key = key
+        self.geometry.append(
+            mjcf_rerun.log_model_geometry(self.rec, model, static=self._static_geometry)
+        )
+        self._body_poses = mjcf_rerun.BodyPoses(model)
+
+    def _pose(self, sim: HeadSim) -> None:
+        """The head's pose at this image: kept as rows (with the detections and servo errors), sent by :meth:`_send_kept_rows`."""
+        rows, frame, step = self._kept_rows, self.current_frame, self.current_step
+        if self._body_poses is not None:
+            for path, translation, xyzw in self._body_poses.moved(sim.data):
+                rows.add(
+                    path, frame, step, rr.Transform3D, translation=translation, quaternion=xyzw
+                )
+        world_from_head = sim.world_from_head()
+        rows.add(
+            "/world/head",
+            frame,
+            step,
+            rr.Transform3D,
+            translation=world_from_head[:3, 3],
+            mat3x3=world_from_head[:3, :3],
+        )
+        origins, vectors = [], []
+        target = self.truth.get(self.label)
+        for index, cam in enumerate(names.CAMERAS):
+            head_from_camera = sim.head_from_camera(index + 1)
+            rows.add(
+                f"/world/head/{cam}",
+                frame,
+                step,
+                rr.Transform3D,
+                translation=head_from_camera[:3, 3],
+                mat3x3=head_from_camera[:3, :3],
+            )
+            world_from_camera = sim.world_from_camera(index + 1)
+            centre = world_from_camera[:3, 3]
+            length = 1.0 if target is None else 1.2 * float(np.linalg.norm(target - centre))
+            origins.append(centre)
+            vectors.append(world_from_camera[:3, 2] * length)
+        rows.add(
+            "/world/optical_axes",
+            frame,
+            step,
+            rr.Arrows3D,
+            instances=2,
+            per_row={"show_labels": False},
+            origins=origins,
+            vectors=vectors,
+            colors=[ORANGE, ORANGE],
+            labels=["cam1", "cam2"],
+        )
+        eye = sim.eye_encoder()
+        yaw, pitch = sim.neck_encoders()
+        for key, value in (("eye_rad", eye), ("neck_yaw_rad", yaw), ("neck_pitch_rad", pitch)):
+            rows.add(f"/joints/{key}", frame, step, rr.Scalars, scalars=value)
+
+    # -- the recording's thread ------------------------------------------------------
+    def _later(self, log: Callable[..., None], *args: object) -> None:
+        """Run ``log(*args)`` on the recording's thread, after what was given before."""
+        self._pending = [f for f in self._pending if not f.done() or f.exception() is not None]
+        self._pending.append(self._background.submit(log, *args))
+
+    def _send_kept_rows(self) -> None:
+        """Send the kept rows, on the recording's thread."""
+        if len(self._kept_rows):
+            rows, self._kept_rows = self._kept_rows, RowColumns()
+            self._later(rows.send, self.rec)
+
+    def _wait(self) -> None:
+        """Until the recording's thread did all it was given; its first error is raised."""
+        pending, self._pending = self._pending, []
+        for future in pending:
+            future.result()
+
+    def flush(self) -> None:
+        """Everything logged so far written (or streamed)."""
+        self._send_kept_rows()
+        self._wait()
+        self.rec.flush()
+
     def close(self) -> None:
         """Flush and write the footer; the file is complete after this."""
         if not self.closed:
@@ -362,4 +656,93 @@ class Recorder(ResultsLogging):
         self.close()
 
 
-__all__ = ["APP_ID", "JPEG_QUALITY", "Recorder"]
+# -- rows sent as columns ---------------------------------------------------------
+# The rows logged with every image (poses, joint angles, detections, servo errors) are
+# gathered per entity and sent with one ``send_columns`` call per entity instead of one
+# ``log`` per row: ``rr.log`` costs about 0.1 ms per Transform3D here, and every image
+# logs a dozen of them (half a second of the quick start).  The rows are the same
+# (frame and step, the values), so a viewer shows the same recording.
+
+
+@dataclass
+class _Entity:
+    """One entity's rows: ``instances`` values of each field per row (None: a list of
+    any length per row)."""
+
+    archetype: Any
+    instances: int | None
+    frames: list[int] = field(default_factory=list)
+    lengths: list[int] = field(default_factory=list)
+    steps: list[int] = field(default_factory=list)
+    fields: dict[str, list[Any]] = field(default_factory=dict)
+    #: Fields with one value per row whatever ``instances`` is (e.g. ``show_labels``).
+    per_row: dict[str, list[Any]] = field(default_factory=dict)
+
+
+class RowColumns:
+    """Rows kept per entity path until :meth:`send`."""
+
+    def __init__(self) -> None:
+        self._entities: dict[str, _Entity] = {}
+
+    def add(
+        self,
+        path: str,
+        frame: int,
+        step: int,
+        archetype: Any,
+        instances: int | None = 1,
+        per_row: dict[str, Any] | None = None,
+        **values: Any,
+    ) -> None:
+        """A row of ``archetype`` (``rr.Transform3D``, ``rr.Scalars``, ...) at ``path``:
+        ``values`` are the archetype's fields, ``instances`` values each (1: the value
+        itself; None: lists of one length, which may be 0: nothing at this row)."""
+        entity = self._entities.setdefault(path, _Entity(archetype, instances))
+        if entity.archetype is not archetype or entity.instances != instances:
+            raise ValueError(f"{path}: rows of one archetype and instance count only")
+        if instances != 1:
+            lengths = {len(v) for v in values.values()}
+            if len(lengths) > 1 or (instances is not None and lengths != {instances}):
+                raise ValueError(f"{path}: every field needs {instances or 'the same'} values")
+            entity.lengths.append(lengths.pop() if lengths else 0)
+        entity.frames.append(frame)
+        entity.steps.append(step)
+        for name, value in values.items():
+            entity.fields.setdefault(name, []).append(value)
+        for name, value in (per_row or {}).items():
+            entity.per_row.setdefault(name, []).append(value)
+
+    def __len__(self) -> int:
+        return sum(len(e.frames) for e in self._entities.values())
+
+    def send(self, rec: rr.RecordingStream) -> None:
+        """Send every kept row, an entity per call, and forget them."""
+        for path, entity in self._entities.items():
+            rows = len(entity.frames)
+            if rows == 0:
+                continue
+            columns = entity.archetype.columns(
+                **{name: _column(v, entity.instances) for name, v in entity.fields.items()}
+            )
+            if entity.instances != 1:
+                columns = columns.partition(entity.lengths)
+            extra = entity.archetype.columns(**entity.per_row) if entity.per_row else []
+            rec.send_columns(
+                path,
+                indexes=[
+                    rr.TimeColumn("frame", sequence=entity.frames),
+                    rr.TimeColumn("step", sequence=entity.steps),
+                ],
+                columns=[*columns, *extra],
+            )
+        self._entities.clear()
+
+
+def _column(rows: list[Any], instances: int | None) -> Any:
+    """The rows' values end to end: an array, or a list of strings (labels)."""
+    flat = list(rows) if instances == 1 else [v for row in rows for v in row]
+    return flat if not flat or isinstance(flat[0], str) else np.asarray(flat)
+
+
+__all__ = ["APP_ID", "FRUSTUM_DEPTH_M", "JPEG_QUALITY", "Recorder", "RowColumns"]

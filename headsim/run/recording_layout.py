@@ -1,6 +1,7 @@
-"""The recording's layout and palette: the default Rerun blueprint (the 3-D view, both
-cameras, the traces, one tab per text document), its starting eye, the recording's id,
-and the colours and marker sizes every logged entity uses."""
+"""The recording's layout, palette and documents: the default Rerun blueprint (the 3-D
+view, both cameras, the traces, one tab per text document), its starting eye, the
+recording's id, the colours and marker sizes every logged entity uses, and the markdown
+of the scenario's and the calibration's documents."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from headsim.run import mjcf_rerun
+from headsim.run.outcomes import CalibrationReport
 from headsim.scenario.spec import Scenario
 
 GREEN = (40, 220, 90)
@@ -115,6 +117,72 @@ def recording_id(scenario: Scenario) -> str:
     return f"{scenario.name}{'-fast' if scenario.fast else ''}-seed{scenario.seed}"
 
 
+def scenario_markdown(scenario: Scenario) -> str:
+    """The scenario's document: its description, the cameras and the real head."""
+    s = scenario
+    rows = "\n".join(
+        f"| cam{k + 1} | {c.width}x{c.height} | {c.kx:.2f} | {c.ky:.2f} | "
+        f"{c.principal[0]:.1f}, {c.principal[1]:.1f} | {c.k1:.4f} | {c.mount_yaw_rad:.4f} | {c.noise_std:g} |"
+        for k, c in enumerate(s.settings.cameras)
+    )
+    return (
+        f"# {s.name}{' (fast)' if s.fast else ''}\n\n{s.description}\n\n"
+        f"procedure `{s.experiment.procedure}`, preset `{s.preset}`, seed {s.seed}, "
+        f"baseline {s.settings.baseline_m * 1000:g} mm\n\n"
+        "| camera | size | kx | ky | principal | k1 | mount yaw | noise |\n"
+        "|---|---|---|---|---|---|---|---|\n" + rows + "\n" + _real_head_markdown(scenario)
+    )
+
+
+def _real_head_markdown(scenario: Scenario) -> str:
+    """The imperfections beyond the paper and what the head believes."""
+    s = scenario.settings
+    b = s.believed
+    cams = "\n".join(
+        f"| cam{k + 1} | {1e3 * c.nodal_offset_m:g} | {1e3 * c.side_offset_m:g} | "
+        f"{1e3 * c.eye_axis_tilt_rad:g} | {1e3 * b.nodal_offset_m[k]:g} | {1e3 * b.side_offset_m[k]:g} |"
+        for k, c in enumerate(s.cameras)
+    )
+    return (
+        f"\ntruth / belief: baseline {s.baseline_m * 1000:g} / {b.baseline_m * 1000:g} mm, "
+        f"neck d1 {s.neck_d1_m * 1000:g} / {b.neck_d1_m * 1000:g} mm, "
+        f"a2 {s.neck_a2_m * 1000:g} / {b.neck_a2_m * 1000:g} mm; backlash "
+        f"{s.backlash_rad:g} rad; count error {'on' if s.count_error else 'off'}; rendering "
+        f"offsamples {s.render.offsamples}, supersample {s.render.supersample}\n\n"
+        "| camera | nodal mm | side mm | axis tilt mrad | believed nodal mm | believed side mm |\n"
+        "|---|---|---|---|---|---|\n" + cams + "\n"
+    )
+
+
+def calibration_markdown(report: CalibrationReport) -> str:
+    """The calibration's document: the initial directions and the extended calibration."""
+    if not report.ok:
+        return f"# Calibration\n\n{report.status_text}\n"
+    alpha_e, truth_e, paper_e = (
+        report.alpha_e_rad,
+        report.alpha_e_truth_rad,
+        report.alpha_e_paper_rad,
+    )
+    assert alpha_e is not None and truth_e is not None and paper_e is not None
+    rows = "\n".join(
+        f"| alpha_e{k + 1} | {alpha_e[k]:.5f} | {truth_e[k]:.5f} | {paper_e[k]:.4f} |"
+        for k in range(2)
+    )
+    text = (
+        "# Calibration of the initial directions (Sec. V)\n\n"
+        f"{report.fixated} of {report.targets} positions fixated, {report.renders.total} renders\n\n"
+        "| rad | ours | truth | paper |\n|---|---|---|---|\n" + rows + "\n"
+    )
+    vertical = report.vertical_reference
+    if vertical:
+        text += "\n| extended | ours | truth |\n|---|---|---|\n" + "\n".join(
+            f"| v{k + 1}0 px | {vertical.v0_px[k]:.2f} | {vertical.v0_truth_px[k]:.2f} |\n"
+            f"| kx{k + 1}/ky{k + 1} | {vertical.kx_over_ky[k]:.4f} | {vertical.kx_over_ky_truth[k]:.4f} |"
+            for k in range(2)
+        )
+    return text
+
+
 __all__ = [
     "GREEN",
     "GREY",
@@ -126,7 +194,9 @@ __all__ = [
     "UI_RADIUS_SMALL",
     "WHITE",
     "blueprint",
+    "calibration_markdown",
     "eye_controls",
     "recording_id",
+    "scenario_markdown",
     "text_views",
 ]

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from headsim.active.measurement import HeadKnowledge
     from headsim.run.events import Hub
     from headsim.run.outcomes import MeasurementRecord
-    from headsim.run.recording_results import ResultsLogging
+    from headsim.run.recording import Recorder
     from headsim.scenario.spec import Scenario
 
 #: The module whose import registers the built-in procedures.
@@ -34,7 +34,7 @@ def _no_failures(result: Any) -> tuple[str, ...]:
     return ()
 
 
-def _no_rows(result: Any, log: ResultsLogging) -> None:
+def _no_rows(result: Any, log: Recorder) -> None:
     return None
 
 
@@ -63,7 +63,7 @@ class Procedure:
     summary: Callable[[Any, bool], list[str]] = _no_lines
     ok_line: Callable[[Any, int], str] = _measured_line
     failures: Callable[[Any], tuple[str, ...]] = _no_failures
-    rows: Callable[[Any, ResultsLogging], None] = _no_rows
+    rows: Callable[[Any, Recorder], None] = _no_rows
 
 
 #: Every registered procedure, by name.

@@ -20,7 +20,7 @@ from headsim.cli import main
 from headsim.run.context import simulator
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
-from headsim.run.recording_results import ResultsLogging
+from headsim.run.recording import Recorder
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
 
@@ -42,7 +42,7 @@ def run_height(
         return [], HeightResult(BODY, float(sim.position(BODY)[2]))
 
 
-def rows(result: HeightResult, log: ResultsLogging) -> None:
+def rows(result: HeightResult, log: Recorder) -> None:
     log.rec.log("/results/height", rr.Scalars(result.height_m))
 
 

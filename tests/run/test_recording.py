@@ -1,4 +1,6 @@
-"""The Rerun recording, read back with ``rerun.chunk.RrdReader``: the documented entities at their steps."""
+"""The Rerun recording (run/recording.py), read back with ``rerun.chunk.RrdReader``: the
+documented entities at their steps, the head and its scene, the results, and the rows
+sent as columns."""
 
 from __future__ import annotations
 
@@ -12,7 +14,12 @@ import warnings
 from collections import defaultdict
 from pathlib import Path
 
+import numpy as np
+import pytest
+import rerun as rr
 from rerun.chunk import RrdReader
+
+from headsim.run.recording import RowColumns
 
 from .rrd import rows
 
@@ -121,3 +128,164 @@ def test_an_interrupted_run_leaves_a_readable_recording_and_no_results(tmp_path:
     for chunk in RrdReader(rrd).stream():
         counts[chunk.entity_path] += 1
     assert counts["/world/head"] > 0
+
+
+# -- the head and its scene
+
+
+def test_frusta_images_and_features_at_every_frame(recorded: tuple[Path, dict]) -> None:
+    rrd, results = recorded
+    counts = results["render_counts"]["overall"]
+    total = counts["total"] - counts["previews"]  # the recording shows no preview
+    frames = []
+    for cam in ("cam1", "cam2"):
+        pinhole = rows(rrd, f"/world/head/{cam}", "Pinhole:image_from_camera")
+        assert len(pinhole) == 1 and pinhole[0]["frame"] is None  # static: the true K
+        k = np.array(pinhole[0]["value"]).reshape(3, 3).T  # column-major
+        expected = results["settings"]["cameras"][0 if cam == "cam1" else 1]
+        np.testing.assert_allclose(k[0], [expected["kx"], 0, expected["cx"]], rtol=1e-6)
+        images = rows(rrd, f"/world/head/{cam}/image", "EncodedImage:blob")
+        frames += [r["frame"] for r in images]
+        rows_of_features = rows(rrd, f"/world/head/{cam}/features", "Points2D:positions")
+        # Each image first empties the features (the last detection does not linger) ...
+        emptied = {r["frame"] for r in rows_of_features if not r["value"]}
+        assert {r["frame"] for r in images} <= emptied
+        # ... then its detection, if any, follows at the same frame.
+        features = [r for r in rows_of_features if r["value"]]
+        assert {r["frame"] for r in features} <= {r["frame"] for r in images}
+        assert all(len(r["value"]) == 1 for r in features)
+        assert len(features) > 0.8 * len(images)  # nearly every image had its target found
+        u_error = rows(rrd, f"/servo/{cam}/u_error_px", "Scalars:scalars")
+        assert [r["frame"] for r in u_error] == [r["frame"] for r in features]
+    # Every image the run took is in the recording once, in order, and no other.
+    assert sorted(frames) == list(range(total))
+    transforms = rows(rrd, "/world/head/cam1", "Transform3D:translation")
+    assert set(frames) <= {r["frame"] for r in transforms}
+    for joint in ("eye_rad", "neck_yaw_rad", "neck_pitch_rad"):
+        assert set(frames) <= {r["frame"] for r in rows(rrd, f"/joints/{joint}", "Scalars:scalars")}
+
+
+def test_the_head_and_scene_are_in_3d_and_the_eyes_move(recorded: tuple[Path, dict]) -> None:
+    rrd, _ = recorded
+    static = {
+        chunk.entity_path
+        for chunk in RrdReader(rrd).stream()
+        if chunk.entity_path.startswith("/world/model/") and chunk.is_static
+    }
+    # The default scene (calibration and measurements): head, table, markers, ball.
+    for entity in (
+        "/world/model/head/boxes",
+        "/world/model/eye1/cylinders",
+        "/world/model/eye2/cylinders",
+        "/world/model/neck_yaw_link/cylinders",
+        "/world/model/world/boxes",
+        "/world/model/marker_red/ellipsoids",
+        "/world/model/calibration_ball/ellipsoids",
+    ):
+        assert entity in static, entity
+    for eye in ("eye1", "eye2"):
+        rotations = rows(rrd, f"/world/model/{eye}", "Transform3D:quaternion")
+        assert len({tuple(r["value"][0]) for r in rotations}) > 5  # the eyes turned
+    eye_rad = rows(rrd, "/joints/eye_rad", "Scalars:scalars")[-1]["value"][0]
+    eye1 = np.array(rows(rrd, "/world/model/eye1", "Transform3D:quaternion")[-1]["value"][0])
+    head = np.array(rows(rrd, "/world/model/head", "Transform3D:quaternion")[-1]["value"][0])
+    # eye1 is turned from the head's frame by the eye angle (to an encoder step).
+    angle = 2 * np.arccos(min(1.0, abs(float(np.dot(eye1, head)))))
+    assert angle == pytest.approx(abs(eye_rad), abs=1e-3)
+
+
+# -- the results
+
+
+def test_true_and_estimated_points_at_each_measurement_step(recorded: tuple[Path, dict]) -> None:
+    rrd, results = recorded
+    measurements = results["measurements"]
+    estimates = rows(rrd, "/world/estimate", "Points3D:positions")
+    assert [r["step"] for r in estimates] == [m["step"] for m in measurements]
+    # The last row holds every estimate, where results.json has them.
+    np.testing.assert_allclose(
+        np.array(estimates[-1]["value"]), [m["estimate_world_m"] for m in measurements], atol=1e-6
+    )
+    truth = rows(rrd, "/world/truth", "Points3D:positions")
+    np.testing.assert_allclose(
+        np.array(truth[-1]["value"]), [m["truth_world_m"] for m in measurements], atol=1e-6
+    )
+    errors = rows(rrd, "/measurements/error_mm", "Scalars:scalars")
+    assert [r["step"] for r in errors] == [m["step"] for m in measurements]
+    np.testing.assert_allclose(
+        [r["value"][0] for r in errors], [1000 * m["error_m"] for m in measurements], rtol=1e-6
+    )
+    calibration = rows(rrd, "/world/calibration/positions", "Points3D:positions")
+    assert len(calibration[0]["value"]) == results["calibration"]["targets"]
+    steps = {r["step"] for r in rows(rrd, "/world/current_target", "Points3D:positions")}
+    assert steps == set(range(results["calibration"]["targets"] + len(measurements)))
+
+
+def test_results_are_in_the_recording_as_text(recorded: tuple[Path, dict]) -> None:
+    rrd, results = recorded
+    summary = rows(rrd, "/results/summary", "TextDocument:text")
+    assert "OK: 3 measurements, none failed" in summary[-1]["value"][0]
+    calibration = rows(rrd, "/results/calibration", "TextDocument:text")
+    text = calibration[-1]["value"][0]
+    assert f"{results['calibration']['alpha_e_rad'][0]:.5f}" in text and "0.0578" in text
+
+
+# -- rows sent as columns
+
+
+def test_rows_come_back_with_their_frames_steps_and_values(tmp_path: Path) -> None:
+    path = tmp_path / "columns.rrd"
+    rec = rr.RecordingStream("headsim_test")
+    rec.save(path)
+    kept = RowColumns()
+    for frame in range(3):
+        turn = np.array(
+            [
+                [1.0, 0.0, 0.0],
+                [0.0, np.cos(frame), -np.sin(frame)],
+                [0, np.sin(frame), np.cos(frame)],
+            ]
+        )
+        kept.add(
+            "/a", frame, frame // 2, rr.Transform3D, translation=[frame, 0.0, 1.0], mat3x3=turn
+        )
+        kept.add("/s", frame, frame // 2, rr.Scalars, scalars=0.5 * frame)
+        kept.add(
+            "/arrows",
+            frame,
+            frame // 2,
+            rr.Arrows3D,
+            instances=2,
+            per_row={"show_labels": False},
+            origins=[[0.0, 0.0, frame], [1.0, 0.0, 0.0]],
+            vectors=[[1.0, 0.0, 0.0], [0.0, 1.0, frame]],
+            labels=["cam1", "cam2"],
+        )
+    assert len(kept) == 9
+    kept.send(rec)
+    assert len(kept) == 0
+    kept.send(rec)  # nothing kept: nothing sent
+    rec.flush()
+    rec.disconnect()
+
+    translations = rows(path, "/a", "Transform3D:translation")
+    assert [(r["frame"], r["step"]) for r in translations] == [(0, 0), (1, 0), (2, 1)]
+    assert [r["value"] for r in translations] == [[[f, 0.0, 1.0]] for f in (0.0, 1.0, 2.0)]
+    mats = rows(path, "/a", "Transform3D:mat3x3")
+    # Rerun stores 3x3 matrices column-major.
+    np.testing.assert_allclose(
+        np.reshape(mats[1]["value"][0], (3, 3)).T[1, 1:], [np.cos(1), -np.sin(1)]
+    )
+    assert [r["value"] for r in rows(path, "/s", "Scalars:scalars")] == [[0.0], [0.5], [1.0]]
+    vectors = rows(path, "/arrows", "Arrows3D:vectors")
+    assert [len(r["value"]) for r in vectors] == [2, 2, 2]
+    assert vectors[2]["value"][1] == [0.0, 1.0, 2.0]
+    assert [r["value"] for r in rows(path, "/arrows", "Arrows3D:labels")] == [["cam1", "cam2"]] * 3
+    assert [r["value"] for r in rows(path, "/arrows", "Arrows3D:show_labels")] == [[False]] * 3
+
+
+def test_one_entity_keeps_one_archetype_and_instance_count() -> None:
+    kept = RowColumns()
+    kept.add("/s", 0, 0, rr.Scalars, scalars=1.0)
+    with pytest.raises(ValueError, match="/s"):
+        kept.add("/s", 1, 0, rr.Transform3D, translation=[0.0, 0.0, 0.0])

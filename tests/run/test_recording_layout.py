@@ -1,12 +1,19 @@
-"""The recording's layout, read back from the file: one document per text view, the 3-D view's eye."""
+"""The recording's layout, read back from the file: one document per text view, the 3-D
+view's eye; the calibration's document."""
 
 from __future__ import annotations
 
 from collections import defaultdict
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 from rerun.chunk import RrdReader
+
+from headsim.estimators.result import Status
+from headsim.run.outcomes import CalibrationReport
+from headsim.run.recording_layout import calibration_markdown
+from headsim.sim.events import RenderCounts
 
 
 def _blueprint_views(path: Path) -> dict[str, dict[str, object]]:
@@ -91,3 +98,22 @@ def test_the_3d_view_starts_behind_and_above_the_head(recorded: tuple[Path, dict
     # Looking forward, between the head and the targets.
     farthest = max(m["truth_world_m"][1] for m in results["measurements"])
     assert head[1] < target[1] < farthest
+
+
+def test_the_calibration_document_reads_the_report() -> None:
+    failed = CalibrationReport(
+        Status.FAILED, "failed: too few positions seen", 8, 2, RenderCounts(images=30), ()
+    )
+    assert calibration_markdown(failed) == "# Calibration\n\nfailed: too few positions seen\n"
+    ok = replace(
+        failed,
+        status=Status.OK,
+        detail="",
+        fixated=8,
+        alpha_e_rad=[0.05812, -0.02531],
+        alpha_e_truth_rad=[0.0578, -0.0254],
+        alpha_e_paper_rad=[0.0578, -0.0254],
+    )
+    text = calibration_markdown(ok)
+    assert "8 of 8 positions fixated, 30 renders" in text
+    assert "| alpha_e1 | 0.05812 | 0.05780 | 0.0578 |" in text and "extended" not in text
