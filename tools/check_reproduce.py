@@ -15,7 +15,7 @@ import json
 import sys
 from pathlib import Path
 
-BASELINE = Path(__file__).resolve().parent / "reproduce_baseline.json"
+BASELINE = Path(__file__).resolve().parents[1] / "benchmarks" / "reproduce_baseline.json"
 
 
 def problems(report: dict, baseline: dict) -> list[str]:

@@ -95,3 +95,11 @@ def test_the_command_line_ends_a_run_of_workers_cleanly(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert "Warning" not in done.stderr and "leaked" not in done.stderr, done.stderr
     assert json.loads((out / "report.json").read_text())["status"] == "ok"
+
+
+def test_check_reproduce_finds_its_stored_baseline() -> None:
+    """CI calls the check without --baseline: its default is the stored file in benchmarks/."""
+    from check_reproduce import BASELINE
+
+    assert BASELINE.is_file(), BASELINE
+    assert json.loads(BASELINE.read_text())["rows"]
