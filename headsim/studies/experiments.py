@@ -22,12 +22,13 @@ from headsim.active.chessboard import measure_chessboard
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement, body_target
 from headsim.active.model2 import measure_model2
-from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import calibration_layout
 from headsim.active.relative import relative_positioning
 from headsim.active.servo_types import Detector
-from headsim.active.tracking import track_moving_target
 from headsim.estimators.areas import AreaComparison
+from headsim.run.runner import run_scenario
+from headsim.scenario.loading import scenario_from_document
+from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
@@ -370,21 +371,41 @@ def servo_robustness(
     return out
 
 
+def _circle_world_m(t: float) -> np.ndarray:
+    """The tracking benchmark's path at ``t``: a loop 0.8 m ahead (W, m)."""
+    return np.array([0.15 * np.cos(t), 0.8 + 0.15 * np.sin(t), 0.25 + 0.08 * np.sin(2 * t)])
+
+
+def tracking_scenario(fixations: int = 12) -> Scenario:
+    """The red marker on :func:`_circle_world_m` over one turn, fixated ``fixations`` times
+    with Model 1 (neck and eyes) by the ideal head, told nothing: the path is sampled at
+    the fixation times, so the scenario's piecewise-linear target is on the circle there."""
+    times = np.linspace(0, 2 * np.pi, fixations)
+    doc = {
+        "description": "Model 1 follows a marker on a circle 0.8 m ahead (ideal head)",
+        "experiment": {"procedure": "tracking"},
+        "scene": {
+            "moving_target": {
+                "body": "marker_red",
+                "waypoints_world_m": [[float(v) for v in _circle_world_m(t)] for t in times],
+                "duration_s": float(times[-1]),
+                "steps": fixations,
+            }
+        },
+    }
+    return scenario_from_document(doc, "tracking_circle")
+
+
 def tracking_accuracy(fixations: int = 12) -> dict[str, Any]:
     """A target on a circle 0.8 m ahead, followed with Model 1 (neck and eyes)."""
-    with HeadSim("default") as sim:
-
-        def circle(t: float) -> np.ndarray:
-            return np.array([0.15 * np.cos(t), 0.8 + 0.15 * np.sin(t), 0.25 + 0.08 * np.sin(2 * t)])
-
-        run = track_moving_target(
-            sim, NeckServo(sim), RED, "marker_red", circle, np.linspace(0, 2 * np.pi, fixations)
-        )
-    errors = run.errors_world_m
-    renders = [m.renders for m in run.measurements]
+    result = run_scenario(tracking_scenario(fixations))
+    measurements = [r.measurement for r in result.records]
+    experiment: Any = result.experiment  # the tracking procedure's result
+    errors = experiment.errors_world_m
+    renders = [m.renders for m in measurements]
     return {
         "fixations": fixations,
-        "ok": sum(m.ok for m in run.measurements),
+        "ok": sum(m.ok for m in measurements),
         "error_world_mm_rms": float(1000 * np.sqrt(np.nanmean(errors**2))),
         "error_world_mm_max": float(1000 * np.nanmax(errors)),
         "renders_first": renders[0],

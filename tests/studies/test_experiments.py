@@ -66,3 +66,14 @@ def test_area_tally_counts_every_object_placed_and_the_margin_subset_apart() -> 
     assert tally["outside_margin"] == 9
     assert tally["outside_margin_correct_pct"] == pytest.approx(100.0)
     assert (tally["within_2px_of_a_boundary"], tally["within_2px_disagreeing"]) == (1, 1)
+
+
+def test_the_tracking_scenario_puts_the_target_on_the_circle_at_every_fixation() -> None:
+    from headsim.studies.experiments import _circle_world_m, tracking_scenario
+
+    scenario = tracking_scenario(7)
+    moving = scenario.scene.moving
+    assert scenario.experiment.procedure == "tracking" and moving is not None
+    assert scenario.fixations == 7 and scenario.experiment.calibration is None
+    for t in moving.times_s:
+        assert np.array_equal(moving.position(float(t)), _circle_world_m(float(t)))
