@@ -77,3 +77,12 @@ def test_the_tracking_scenario_puts_the_target_on_the_circle_at_every_fixation()
     assert scenario.fixations == 7 and scenario.experiment.calibration is None
     for t in moving.times_s:
         assert np.array_equal(moving.position(float(t)), _circle_world_m(float(t)))
+
+
+def test_tracking_through_the_runner_fixates_every_time_within_a_millimetre() -> None:
+    from headsim.studies.experiments import tracking_accuracy
+
+    figures = tracking_accuracy(fixations=3)
+    assert figures["fixations"] == 3 and figures["ok"] == 3
+    assert 0.0 < figures["error_world_mm_rms"] <= figures["error_world_mm_max"] < 1.0
+    assert figures["renders_first"] > figures["renders_per_fixation_after_first"] > 0
