@@ -108,7 +108,8 @@ def listing() -> list[str]:
 
 
 def run_script(bench_case: BenchCase, arguments: list[str]) -> int:
-    """Run a figures case's script with ``arguments`` in this interpreter; its exit status."""
+    """Run a figures case's script with ``arguments`` in this interpreter; its exit status
+    (1 where a signal ended it, so that a crash never reads as success)."""
     path = bench_case.path
     assert path is not None, f"{bench_case.name} is a regression case, not a script"
     if not path.is_file():
@@ -119,7 +120,8 @@ def run_script(bench_case: BenchCase, arguments: list[str]) -> int:
         )
         return 2
     print(f"== {bench_case.name}: {bench_case.description()}", flush=True)
-    return subprocess.run([sys.executable, str(path), *arguments], check=False).returncode
+    code = subprocess.run([sys.executable, str(path), *arguments], check=False).returncode
+    return code if code >= 0 else 1
 
 
 __all__ = ["CASES", "KINDS", "BenchCase", "case", "listing", "of_kind", "run_script"]

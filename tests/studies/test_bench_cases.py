@@ -52,3 +52,15 @@ def test_a_figures_case_runs_its_script_with_the_arguments_after_the_dashes(capf
 def test_bench_refuses_what_it_cannot_run(argv: list[str], why: str, capsys) -> None:
     assert main(["bench", *argv]) == 2
     assert why in capsys.readouterr().err
+
+
+def test_a_script_ended_by_a_signal_is_a_failure_not_a_success(tmp_path, capfd) -> None:
+    from headsim.studies.bench_cases import BenchCase, run_script
+
+    script = tmp_path / "crash.py"
+    script.write_text(
+        '"""Dies of SIGKILL."""\nimport os, signal\nos.kill(os.getpid(), signal.SIGKILL)\n'
+    )
+    # An absolute script path stands for itself, outside benchmarks/.
+    assert run_script(BenchCase("crash", "figures", str(script)), []) == 1
+    assert "== crash: Dies of SIGKILL." in capfd.readouterr().out
