@@ -38,15 +38,11 @@ regress: setup
 figures: setup
 	$(BIN)/python tools/readme_figures.py
 
-# Every benchmark script's figures (minutes; not run by CI).
+# Every benchmark is a case of `headsim bench` (`headsim bench --list`): the regression
+# cases, then every figures case of minutes (not run by CI). A long one runs by name:
+# `headsim bench --case reach_and_zoom -- --targets 50`.
 bench: setup
-	$(BIN)/python benchmarks/render_speed.py
-	$(BIN)/python benchmarks/estimators_throughput.py
-	$(BIN)/python benchmarks/vision_speed.py
-	$(BIN)/python benchmarks/stereo_calibration.py
-	$(BIN)/python benchmarks/procedures_accuracy.py
-	$(BIN)/python benchmarks/live_gaze.py
-	$(BIN)/python benchmarks/gym_env.py
+	$(BIN)/headsim bench --all
 
 clean:
 	rm -rf $(VENV) out

@@ -201,11 +201,24 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
 
     bench = commands.add_parser(
         "bench",
-        help="run the regression suite and compare it with the stored baseline",
-        description="Run a fixed suite (Model 2 on ideal and paper cameras, calibration, "
-        "chessboard, areas, the paper scenarios' fast variants, estimator speed) and compare "
-        "each metric with benchmarks/baseline.json within benchmarks/tolerances.json. Exit "
-        "status 1 on a regression beyond tolerance.",
+        help="run the regression suite (or any benchmark case) and compare it with the baseline",
+        description="Without options: run the regression cases (Model 2 on ideal and paper "
+        "cameras, calibration, chessboard, areas, the paper scenarios' fast variants, estimator "
+        "speed) and compare each metric with benchmarks/baseline.json within "
+        "benchmarks/tolerances.json; exit status 1 on a regression beyond tolerance. Every "
+        "benchmark is a case: --list shows them, --case NAME runs one (a figures case's script "
+        "takes its own arguments after --), --all runs the regression cases and every figures "
+        "case of minutes.",
+    )
+    bench.add_argument("--list", action="store_true", help="list every case and exit")
+    bench.add_argument(
+        "--case", action="append", metavar="NAME", help="run this case (repeatable; see --list)"
+    )
+    bench.add_argument(
+        "--all", action="store_true", help="the regression cases, then every figures case"
+    )
+    bench.add_argument(
+        "script_args", nargs="*", metavar="-- ARGS", help="a figures case's own arguments"
     )
     bench.add_argument("--seed", type=int, default=0, help="seed of the suite (default 0)")
     bench.add_argument("--json", metavar="FILE", help="also write the metrics to FILE")

@@ -106,6 +106,26 @@ def load_scenario(
         ) from err
 
 
+def scenario_from_document(
+    doc: dict[str, Any],
+    name: str,
+    *,
+    fast: bool = False,
+    seed: int | None = None,
+    overrides: dict[str, Any] | None = None,
+    directory: Path | None = None,
+) -> Scenario:
+    """A scenario given as a parsed document (the tables of a scenario file), named ``name``.
+
+    Checked like a file by :func:`load_scenario`; how a study or a benchmark
+    describes its experiment without writing a file.  ``directory`` stands for
+    the file's folder: relative paths in ``doc`` are relative to it (default:
+    the working directory).
+    """
+    path = (Path.cwd() if directory is None else Path(directory)) / f"{name}.toml"
+    return _load(doc, path, fast=fast, seed=seed, overrides=overrides)
+
+
 def _load(
     doc: dict[str, Any],
     path: Path,

@@ -33,6 +33,7 @@ from headsim.sim import names
 from headsim.sim.settings import HeadSettings, paper_head, preset
 from headsim.sim.simulator import HeadSim
 from headsim.studies import experiments
+from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
 from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
 from headsim.studies.calibrations import calibrate_realistic
 from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
@@ -114,8 +115,9 @@ def _measure_points(
     return out, render_s, frames, seen, min(walls)
 
 
-#: The suite's parts, in order; ``suite(parts=...)`` runs a subset (tests do).
-PARTS = ("ideal", "paper", "realistic", "scenarios", "speed")
+#: The suite's parts, in order (the regression cases of :mod:`headsim.studies.bench_cases`);
+#: ``suite(parts=...)`` runs a subset (tests and ``headsim bench --case`` do).
+PARTS = tuple(c.name for c in of_kind("regress"))
 
 
 def suite(
@@ -352,13 +354,51 @@ def scenario_metrics(name: str) -> Metrics:
     return metrics
 
 
-def main(args: Any) -> int:
-    """``headsim bench``: run the suite, compare, print, maybe update the baseline."""
+def selected_cases(args: Any) -> tuple[BenchCase, ...]:
+    """The cases ``headsim bench`` runs: ``--case`` names, ``--all``'s, or the regression suite."""
+    names = getattr(args, "case", None) or []
+    if names:
+        return tuple(case(name) for name in names)
+    if getattr(args, "all", False):
+        return of_kind("regress", "figures")
+    return of_kind("regress")
 
+
+def main(args: Any) -> int:
+    """``headsim bench``: list the cases, or run the chosen ones: the regression cases
+    compared with the baseline (maybe updating it), then each figures case's script."""
+    if getattr(args, "list", False):
+        print("\n".join(listing()))
+        return 0
+    try:
+        chosen = selected_cases(args)
+    except KeyError as err:
+        print(f"headsim bench: {err.args[0]}", file=sys.stderr)
+        return 2
+    parts = tuple(c.name for c in chosen if c.kind == "regress")
+    scripts = [c for c in chosen if c.kind != "regress"]
+    script_args = list(getattr(args, "script_args", None) or [])
+    if script_args and len(scripts) != 1:
+        print(
+            "headsim bench: arguments after -- go to one figures case (--case NAME -- ARGS)",
+            file=sys.stderr,
+        )
+        return 2
+    if args.update_baseline and parts != PARTS:
+        print("headsim bench: --update-baseline needs the whole regression suite", file=sys.stderr)
+        return 2
+    status = _regress(args, parts) if parts else 0
+    for script in scripts:
+        status = max(status, run_script(script, script_args))
+    return status
+
+
+def _regress(args: Any, parts: tuple[str, ...]) -> int:
+    """The regression cases ``parts``: run, compare, print, maybe update the baseline."""
     quiet = getattr(args, "quiet", False)
     start = time.perf_counter()
     status = None if quiet else Status("headsim bench", transient=True)
-    metrics = suite(seed=args.seed, progress=_quiet if status is None else status)
+    metrics = suite(seed=args.seed, progress=_quiet if status is None else status, parts=parts)
     wall = time.perf_counter() - start
     if status is not None:
         status.close()

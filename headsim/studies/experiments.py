@@ -9,28 +9,31 @@ the true z_h.
 from __future__ import annotations
 
 import statistics
+import tempfile
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from functools import partial
+from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
 
 from headsim.active.calibration import calibrate_head
-from headsim.active.chessboard import measure_chessboard
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement, body_target
 from headsim.active.model2 import measure_model2
-from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import calibration_layout
 from headsim.active.relative import relative_positioning
 from headsim.active.servo_types import Detector
-from headsim.active.tracking import track_moving_target
 from headsim.estimators.areas import AreaComparison
+from headsim.run.runner import run_scenario
+from headsim.scenario.loading import scenario_from_document
+from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
+from headsim.studies.scenario_runs import knowledge_file, preset_of
 from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
 from headsim.vision.crosses import find_cross_point
 from headsim.vision.markers import find_marker
@@ -231,25 +234,45 @@ def chessboard_accuracy(
     distance_m: float = 0.85,
     corners: Sequence[int] | None = None,
 ) -> dict[str, Any]:
-    """Square sides from the chessboard's measured cross points, mm, with and without v0/kx/ky."""
+    """Square sides from the chessboard's measured cross points, mm, with and without v0/kx/ky.
+
+    The chessboard scenario on the preset head ``settings``, its top-left inner
+    corner ``distance_m`` ahead, told ``knowledge`` (then its initial directions only).
+    """
     out: dict[str, Any] = {}
-    for label, know in (
-        ("extended calibration", knowledge),
-        ("offsets only", HeadKnowledge(alpha_e=knowledge.alpha_e)),
-    ):
-        with HeadSim("chessboard", settings) as sim:
-            sim.set_body_pose(names.CHESSBOARD, [-0.105, distance_m, 0.21 + 0.075])
-            run = measure_chessboard(sim, EyeServo(sim), know, corners=corners)
-        widths, heights = 1000 * run.widths_m, 1000 * run.heights_m
-        out[label] = {
-            "corners_measured": run.measured,
-            "corners": len(run.measurements),
-            "width_mean_mm": float(widths.mean()) if widths.size else None,
-            "width_std_mm": float(widths.std()) if widths.size else None,
-            "height_mean_mm": float(heights.mean()) if heights.size else None,
-            "height_std_mm": float(heights.std()) if heights.size else None,
-            "points": error_figures(run.measurements),
-        }
+    head = preset_of(settings)
+    with tempfile.TemporaryDirectory() as folder:
+        for k, (label, know) in enumerate(
+            (
+                ("extended calibration", knowledge),
+                ("offsets only", HeadKnowledge(alpha_e=knowledge.alpha_e)),
+            )
+        ):
+            told = knowledge_file(Path(folder) / f"told_{k}.json", settings, know)
+            doc = {
+                "description": "The chessboard's squares from its measured cross points",
+                "head": {"preset": head},
+                "experiment": {"procedure": "chessboard", "calibration": {"from": str(told)}},
+                "scene": {
+                    "chessboard": {
+                        "position_world_m": [-0.105, distance_m, 0.21 + 0.075],
+                        "corners": "all" if corners is None else list(corners),
+                    }
+                },
+            }
+            result = run_scenario(scenario_from_document(doc, "chessboard_accuracy"))
+            board: Any = result.experiment  # the chessboard procedure's result
+            measurements = [r.measurement for r in result.records]
+            widths, heights = 1000 * board.widths_m, 1000 * board.heights_m
+            out[label] = {
+                "corners_measured": board.corners_measured,
+                "corners": len(measurements),
+                "width_mean_mm": float(widths.mean()) if widths.size else None,
+                "width_std_mm": float(widths.std()) if widths.size else None,
+                "height_mean_mm": float(heights.mean()) if heights.size else None,
+                "height_std_mm": float(heights.std()) if heights.size else None,
+                "points": error_figures(measurements),
+            }
     return out
 
 
@@ -370,21 +393,41 @@ def servo_robustness(
     return out
 
 
+def _circle_world_m(t: float) -> np.ndarray:
+    """The tracking benchmark's path at ``t``: a loop 0.8 m ahead (W, m)."""
+    return np.array([0.15 * np.cos(t), 0.8 + 0.15 * np.sin(t), 0.25 + 0.08 * np.sin(2 * t)])
+
+
+def tracking_scenario(fixations: int = 12) -> Scenario:
+    """The red marker on :func:`_circle_world_m` over one turn, fixated ``fixations`` times
+    with Model 1 (neck and eyes) by the ideal head, told nothing: the path is sampled at
+    the fixation times, so the scenario's piecewise-linear target is on the circle there."""
+    times = np.linspace(0, 2 * np.pi, fixations)
+    doc = {
+        "description": "Model 1 follows a marker on a circle 0.8 m ahead (ideal head)",
+        "experiment": {"procedure": "tracking"},
+        "scene": {
+            "moving_target": {
+                "body": "marker_red",
+                "waypoints_world_m": [[float(v) for v in _circle_world_m(t)] for t in times],
+                "duration_s": float(times[-1]),
+                "steps": fixations,
+            }
+        },
+    }
+    return scenario_from_document(doc, "tracking_circle")
+
+
 def tracking_accuracy(fixations: int = 12) -> dict[str, Any]:
     """A target on a circle 0.8 m ahead, followed with Model 1 (neck and eyes)."""
-    with HeadSim("default") as sim:
-
-        def circle(t: float) -> np.ndarray:
-            return np.array([0.15 * np.cos(t), 0.8 + 0.15 * np.sin(t), 0.25 + 0.08 * np.sin(2 * t)])
-
-        run = track_moving_target(
-            sim, NeckServo(sim), RED, "marker_red", circle, np.linspace(0, 2 * np.pi, fixations)
-        )
-    errors = run.errors_world_m
-    renders = [m.renders for m in run.measurements]
+    result = run_scenario(tracking_scenario(fixations))
+    measurements = [r.measurement for r in result.records]
+    experiment: Any = result.experiment  # the tracking procedure's result
+    errors = experiment.errors_world_m
+    renders = [m.renders for m in measurements]
     return {
         "fixations": fixations,
-        "ok": sum(m.ok for m in run.measurements),
+        "ok": sum(m.ok for m in measurements),
         "error_world_mm_rms": float(1000 * np.sqrt(np.nanmean(errors**2))),
         "error_world_mm_max": float(1000 * np.nanmax(errors)),
         "renders_first": renders[0],

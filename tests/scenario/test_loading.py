@@ -65,3 +65,19 @@ def test_a_file_that_is_not_toml_or_not_there_says_so(tmp_path: Path) -> None:
         ScenarioError, match=r"no such scenario file .allowed: a .toml path or one of: .*quickstart"
     ):
         load_scenario("kitchen")
+
+
+def test_a_document_is_the_scenario_its_file_would_be(tmp_path: Path) -> None:
+    import tomllib
+
+    from headsim.scenario.loading import scenario_from_document
+
+    path = write_scenario(tmp_path, MINIMAL, "minimal.toml")
+    doc = tomllib.loads(path.read_text())
+    from_file = load_scenario(path)
+    from_doc = scenario_from_document(doc, "minimal", directory=tmp_path)
+    assert from_doc == from_file and from_doc.path == path
+    # Checked like a file: a target behind the head is refused, the document named.
+    behind = {**doc, "scene": {"targets": [{"position_head_m": [0.0, 0.0, -0.5]}]}}
+    with pytest.raises(ScenarioError, match=r"behind\.toml: scene\.targets\[0\]"):
+        scenario_from_document(behind, "behind", directory=tmp_path)

@@ -66,3 +66,23 @@ def test_area_tally_counts_every_object_placed_and_the_margin_subset_apart() -> 
     assert tally["outside_margin"] == 9
     assert tally["outside_margin_correct_pct"] == pytest.approx(100.0)
     assert (tally["within_2px_of_a_boundary"], tally["within_2px_disagreeing"]) == (1, 1)
+
+
+def test_the_tracking_scenario_puts_the_target_on_the_circle_at_every_fixation() -> None:
+    from headsim.studies.experiments import _circle_world_m, tracking_scenario
+
+    scenario = tracking_scenario(7)
+    moving = scenario.scene.moving
+    assert scenario.experiment.procedure == "tracking" and moving is not None
+    assert scenario.fixations == 7 and scenario.experiment.calibration is None
+    for t in moving.times_s:
+        assert np.array_equal(moving.position(float(t)), _circle_world_m(float(t)))
+
+
+def test_tracking_through_the_runner_fixates_every_time_within_a_millimetre() -> None:
+    from headsim.studies.experiments import tracking_accuracy
+
+    figures = tracking_accuracy(fixations=3)
+    assert figures["fixations"] == 3 and figures["ok"] == 3
+    assert 0.0 < figures["error_world_mm_rms"] <= figures["error_world_mm_max"] < 1.0
+    assert figures["renders_first"] > figures["renders_per_fixation_after_first"] > 0
