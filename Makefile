@@ -14,10 +14,7 @@ $(BIN)/headsim: pyproject.toml
 	$(BIN)/pip install -q -e '.[test]'
 	@touch $@
 
-# Bytecode written once (an editable install has none, and PYTHONDONTWRITEBYTECODE
-# stops Python writing it): each run then reads it instead of compiling ~150 modules.
 setup: $(BIN)/headsim
-	@$(BIN)/python -m compileall -q headsim
 
 demo: setup
 	$(BIN)/headsim run quickstart --out out/quickstart --rrd out/quickstart/recording.rrd
