@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from headsim.active.eye_servo import EyeServo
+from headsim.active.look import Glance, Looker, finds_blob
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import Detector, ServoConfig
-from headsim.active.windows import windowed
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection
 
@@ -141,14 +141,14 @@ def _binning(sim: HeadSim, camera: int, config: ServoConfig, detector: Detector)
     detector, where it divides the image."""
     b = config.preview_binning if config.windows else 1
     cam = sim.camera_settings(camera)
-    if b <= 1 or not windowed(detector) or cam.width % b or cam.height % b:
+    if b <= 1 or not finds_blob(detector) or cam.width % b or cam.height % b:
         return 1
     return b
 
 
-def _shows(sim: HeadSim, camera: int, detector: Detector, binning: int) -> bool:
+def _shows(looker: Looker, camera: int, detector: Detector, binning: int) -> bool:
     """Whether ``camera``'s binned preview shows the target (found, not cut or hidden)."""
-    seen = detector(sim.render_preview(camera, binning))
+    seen = looker.look(camera, detector, Glance(binning))
     return bool(seen.found and seen.uv is not None)
 
 
@@ -172,7 +172,7 @@ def scan_eyes(
         sim.command_eye_steps(steps)
         sim.settle()
         if binning > 1:
-            if _shows(sim, camera, detector, binning):
+            if _shows(servo.looker, camera, detector, binning):
                 return Scan((steps,), None, tried)
             continue
         detection = servo.observe(camera, detector, preview=False)
@@ -223,7 +223,9 @@ def scan_neck(servo: NeckServo, detector: Detector, max_poses: int = MAX_SCAN_PO
         yaw, pitch, eye = (s * resolution for s in pose)
         sim.command(neck_yaw=yaw, neck_pitch=pitch, eye=eye)
         sim.settle()
-        if _shows(sim, 1, detector, binning) and _shows(sim, 2, detector, binning):
+        if _shows(servo.looker, 1, detector, binning) and _shows(
+            servo.looker, 2, detector, binning
+        ):
             return Scan(pose, None, tried)
     return Scan(None, None, len(poses))
 

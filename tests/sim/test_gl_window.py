@@ -5,8 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.active import eye_servo
-from headsim.active import windows as window_module
+from headsim.active import look
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.model1 import measure_model1
@@ -272,14 +271,13 @@ def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
     rng = np.random.default_rng(9)
     points = random_targets_head(rng, 3, (0.5, 1.0), vertical=(-0.1, 0.1))
 
-    def far_away(sim, camera, expected_uv, area_px, motion_px, margin_px):  # type: ignore[no-untyped-def]
+    def far_away(image_size, expected_uv, area_px, motion_px, margin_px):  # type: ignore[no-untyped-def]
         return Window(0, 0, 24, 24) if expected_uv[0] > 100 else Window(600, 440, 24, 24)
 
     runs = {}
     for windows in (False, True):
         if windows:
-            for module in (eye_servo, window_module):  # the servo's and the preview's
-                monkeypatch.setattr(module, "expected_window", far_away)
+            monkeypatch.setattr(look, "expected_window", far_away)
         with HeadSim("default", settings) as sim:
             servo = LoggingServo(sim, ServoConfig(windows=windows))
             measured = []
