@@ -113,9 +113,6 @@ def clipped_to(
 
 #: Off-screen buffers for windows kept per OpenGL context (the least recently used goes).
 WINDOW_BUFFERS = 6
-#: Their sizes are rounded up to this many raster pixels (two of llvmpipe's tiles), to
-#: reuse them.
-BUFFER_STEP = 128
 #: A kept buffer that holds the window's is used if its area is at most this many times
 #: the one needed: a new buffer (allocated, first touched) costs more than clearing a
 #: larger one (the chessboard's and calibration's windows, Dec 2026).
@@ -137,9 +134,8 @@ class WindowBuffer:
         self, context: mujoco.MjrContext, size: tuple[int, int], stencil: bool = True
     ) -> None:
         """``stencil``: False for a scene that never uses the stencil (MuJoCo's
-        only use is reflections): then a 32-bit float depth buffer without one,
-        the depth the context's own (32F + stencil 8) holds, which llvmpipe
-        clears in under half the time."""
+        only use is reflections): then a depth buffer without one, of the depth the
+        context's own holds (32F + stencil 8 -> 32F), and less memory to clear."""
         from OpenGL import GL
 
         GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, context.offColor)
@@ -178,6 +174,11 @@ class WindowBuffer:
                 raise RenderBackendError(f"window buffer {size} incomplete (status {status})")
 
 
+def _power_of_two(n: int) -> int:
+    """The least power of two >= ``n`` (n >= 1)."""
+    return 1 << (n - 1).bit_length()
+
+
 def draw_window(
     renderer: mujoco.Renderer, rect: Window, k: int, full_size: tuple[int, int]
 ) -> np.ndarray:
@@ -186,9 +187,9 @@ def draw_window(
     clipped to the window (:func:`clipped_to`).
 
     The frame's viewport is moved by whole pixels so that the window's corner is
-    the origin of a buffer only as large as the window (rounded up to
-    :data:`BUFFER_STEP`; or a kept one up to :data:`BUFFER_SLACK` times as
-    large), not the context's: ``mjr_render`` clears all of its viewport that
+    the origin of a buffer only as large as the window (each side rounded up to a
+    power of two, so that windows of about one size share it; or a kept one up to
+    :data:`BUFFER_SLACK` times as large), not the context's: ``mjr_render`` clears all of its viewport that
     the buffer holds, and a whole frame's multisampled buffer costs more to
     clear than a small window to draw.
     """
@@ -196,9 +197,8 @@ def draw_window(
 
     full_w, full_h = full_size
     context = mjr_context(renderer)
-    step = BUFFER_STEP
     width, height = k * rect.width, k * rect.height
-    size = (step * math.ceil(width / step), step * math.ceil(height / step))
+    size = (_power_of_two(width), _power_of_two(height))
     # MuJoCo's only use of the stencil: reflective geoms (a material's reflectance).
     stencil = bool(np.any(renderer.model.mat_reflectance > 0))
     buffers: OrderedDict[tuple[int, int, bool], WindowBuffer] = renderer_attachment(
