@@ -402,8 +402,8 @@ class Looker:
         self._report = report
         self.counts = LookCounts()
         self._memory = _Memory()
-        #: Each camera's image size, px (camera 1, 2).
-        self._sizes = {
+        #: Each camera's image size (width, height) px, by camera (1, 2).
+        self.sizes = {
             n: (camera.width, camera.height) for n, camera in enumerate(sim.settings.cameras, 1)
         }
 
@@ -422,7 +422,7 @@ class Looker:
         cfg = self.config
         if isinstance(hint, Around) and cfg.windows and finds_blob(hint.key):
             window = expected_window(
-                self._sizes[camera], hint.uv_px, hint.area_px, hint.motion_px,
+                self.sizes[camera], hint.uv_px, hint.area_px, hint.motion_px,
                 cfg.window_margin_px,
             )  # fmt: skip
             if window is not None:
@@ -496,7 +496,7 @@ class Looker:
         """Render ``window`` and detect there: the detection in full-frame pixels, or None
         (a miss, :func:`stands_for_frame`).  ``retake``: of the instant just taken."""
         seen = detector(self._take(camera, window, retake=retake))
-        return stands_for_frame(seen, window, self._sizes[camera], expected_area_px)
+        return stands_for_frame(seen, window, self.sizes[camera], expected_area_px)
 
     def _preview_window(self, camera: int, detector: object, binning: int = 0) -> Window | None:
         """Render a preview of ``camera``'s whole view binned b x b (``binning``, default
@@ -512,7 +512,7 @@ class Looker:
         # Its position is good to about b px.
         u, v = unbinned_px(seen.uv, b)
         uv = (float(u), float(v))
-        size = self._sizes[camera]
+        size = self.sizes[camera]
         if seen.extent_px is not None:  # a pattern: its box, from the feature
             left, top, right, bottom = (b * e for e in seen.extent_px)
             return pattern_window(
@@ -650,7 +650,7 @@ class Looker:
         seen, kept = self._memory.sight.get(camera), self._memory.pattern.get(camera)
         if not self.config.windows or kept is None or seen is None or seen.key != key:
             return None
-        size = self._sizes[camera]
+        size = self.sizes[camera]
         b = preview_binning(kept.spacing_px, self.config.preview_binning, size)
         if b <= 1:
             return None
@@ -688,7 +688,7 @@ class Looker:
             return None, 0.0, False
         if seen.key != key or seen.neck != neck:
             return None, 0.0, False
-        size = self._sizes[camera]
+        size = self.sizes[camera]
         motion = gain * (steps - seen.steps)
         kept, extent = memory.pattern.get(camera), memory.extent.get(camera)
         expected, margin, whole = (seen.uv[0] + motion, seen.uv[1]), cfg.window_margin_px, False
