@@ -34,7 +34,6 @@ import argparse
 import math
 import time
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 
@@ -46,9 +45,9 @@ from headsim.live.gaze import GazeConfig, GazeMode, SaccadeProfile, acquire, pur
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
 from headsim.studies.calibrations import calibrate_realistic
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = partial(find_marker, colour="red")
+RED = MarkerDetector("red")
 EYE_HEIGHT = 0.21  # m, d1 + a2 of the default head (the realistic head's true d1 + a2 too)
 HEADS = ("ideal", "realistic")
 

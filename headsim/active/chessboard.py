@@ -11,13 +11,13 @@ import numpy as np
 
 from headsim.active.events import FixationStarted, MeasurementDone
 from headsim.active.eye_servo import EyeServo
+from headsim.active.look import look_once
 from headsim.active.measurement import (
     HeadKnowledge,
     Measurement,
     Target,
 )
 from headsim.active.model2 import Model2Config, measure_model2
-from headsim.active.windows import look_once
 from headsim.sim import names
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
@@ -63,54 +63,70 @@ def alone_extent(spacing_px: float) -> tuple[float, float, float, float]:
     return (-reach, -reach, reach, reach)
 
 
-def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: float) -> Target:
-    """Inner corner ``index`` (row-major from the top-left) of the scene's chessboard.
+@dataclass(frozen=True, eq=False)
+class ChessboardCorner:
+    """The detector of inner corner ``index`` of a board of ``pattern`` inner corners: the
+    whole board found (a :class:`~headsim.active.look.PatternFeature`).  Every corner of one
+    board shares its windows (``window_key``); once the board was seen, a corner is looked
+    for alone, where the board places it."""
 
-    Found by detecting the whole board (``find_chessboard``): a board cut by
-    the image border loses its corners, it does not guess them.
-    """
-    columns, _ = pattern
-    i, j = index % columns, index // columns
+    index: int
+    pattern: tuple[int, int]
+    square_m: float
 
-    def detect(image: np.ndarray) -> Detection:
-        board = find_chessboard(image, pattern)
+    @property
+    def window_key(self) -> tuple[str, tuple[int, int], float]:
+        return ("chessboard", self.pattern, self.square_m)
+
+    @property
+    def feature_index(self) -> int:
+        return self.index
+
+    def __call__(self, image: np.ndarray) -> Detection:
+        board = find_chessboard(image, self.pattern)
         if not board.found:
             return Detection(board.status, None, 0.0)
         assert board.corners is not None  # found: the corners are there
-        u, v = board.corners[index]
+        u, v = board.corners[self.index]
         return Detection(
             DetectionStatus.FOUND,
             (float(u), float(v)),
             1.0,
-            board_extent(board, index),
+            board_extent(board, self.index),
             pattern_uv=tuple((float(a), float(b)) for a, b in board.corners),
             pattern_scale_px=board.spacing_px,
         )
 
-    def detect_alone(image: np.ndarray, spacing_px: float) -> Detection:
+    def find_alone(self, image: np.ndarray, spacing_px: float) -> Detection:
         uv = find_corner_alone(image, spacing_px)
         if uv is None:
             return Detection(DetectionStatus.LOST, None, 0.0)
         return Detection(DetectionStatus.FOUND, uv, 1.0, alone_extent(spacing_px))
 
-    # Every corner of one board looks for the whole board: they share windows.  Once
-    # the board was seen, a corner is looked for alone, where the board places it.
-    detect.window_key = ("chessboard", pattern, square_m)  # type: ignore[attr-defined]
-    detect.feature_index = index  # type: ignore[attr-defined]
-    detect.find_alone = detect_alone  # type: ignore[attr-defined]
-    detect.alone_extent_px = alone_extent  # type: ignore[attr-defined]
+    def alone_extent_px(self, spacing_px: float) -> tuple[float, float, float, float]:
+        return alone_extent(spacing_px)
+
+
+def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: float) -> Target:
+    """Inner corner ``index`` (row-major from the top-left) of the scene's chessboard.
+
+    Found by detecting the whole board (:class:`ChessboardCorner`): a board cut by
+    the image border loses its corners, it does not guess them.
+    """
+    columns, _ = pattern
+    i, j = index % columns, index // columns
 
     def truth(sim: HeadSim) -> np.ndarray:
         body = sim.data.body(names.CHESSBOARD)
         return body.xpos + body.xmat.reshape(3, 3) @ np.array([i * square_m, j * square_m, 0.0])
 
-    return Target(f"corner_{i}_{j}", detect, truth)
+    return Target(f"corner_{i}_{j}", ChessboardCorner(index, pattern, square_m), truth)
 
 
 #: The binning of the preview that places a board seen for the first time (stereo's
 #: and the zoom's views): the scene's 30 mm squares, 28.6 px at 0.85 m at the paper's
 #: focal length, stay >= 10 px at 2 x 2 to about 1.2 m (see
-#: ``seen_pattern.PREVIEW_MIN_SPACING_PX``); a board the preview misses is found in
+#: ``look.PREVIEW_MIN_SPACING_PX``); a board the preview misses is found in
 #: the full frame.
 BOARD_PREVIEW_BINNING = 2
 
@@ -199,6 +215,7 @@ _BOARD = chessboard_corner_target(0, CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M)
 
 __all__ = [
     "BOARD_PREVIEW_BINNING",
+    "ChessboardCorner",
     "ChessboardRun",
     "alone_extent",
     "board_extent",

@@ -7,38 +7,34 @@ encoder step) is measured from the images: a probe move when nothing is known,
 then secant (1-D Broyden) updates after every large enough move.  A gain
 learnt on one target seeds the next.  Every loop is bounded and returns a
 :class:`headsim.active.servo_types.ServoResult` that says why it ended.
+
+Averaging a converged fixation (``ServoConfig.average_fixation``): a blob's detected
+column carries a sub-pixel rendering floor that depends on the pixel's phase and not
+on the frame: repeated images at one pose repeat it.  One image's crossing (the
+fractional encoder step where the column would meet its goal, from the learnt gain)
+is therefore off by that floor over the gain, in encoder steps, which is more angle at
+a shorter focal length.  Images at the whole steps that spread the target over one
+pixel of image motion (the floor's period, :func:`pixel_period_steps`) sample every
+phase; the mean of their crossings averages the floor out, at every zoom alike.
 """
 
 from __future__ import annotations
 
 import math
-from functools import partial
+from dataclasses import replace
+
+import numpy as np
 
 from headsim.active.events import ServoKind, ServoStep
-from headsim.active.fixation_average import average_eye_crossing
-from headsim.active.seen_pattern import SeenPattern, remembered
+from headsim.active.look import Looker, Since, finds_blob
 from headsim.active.servo_types import (
     Detector,
     ServoConfig,
     ServoOutcome,
     ServoResult,
 )
-from headsim.active.windows import (
-    AloneFinder,
-    alone_finder,
-    expected_window,
-    look_again,
-    look_in_window,
-    pattern_preview,
-    pattern_window,
-    pattern_windowed,
-    preview_window,
-    reporting,
-    windowed,
-)
 from headsim.sim import names
 from headsim.sim.events import EventSink
-from headsim.sim.render import Window
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection, DetectionStatus
 
@@ -58,25 +54,23 @@ class EyeServo:
         self._step_range = (math.ceil(low / resolution), math.floor(high / resolution))
         #: Gain per camera, px per encoder step, carried from one target to the next.
         self.gains: dict[int, float] = {}
-        #: Per camera, the last detection the window is predicted from (what the head
-        #: saw and did, not whether the scene changed): (detector, eye steps, neck
-        #: encoders, uv px, area px^2).
-        self._seen: dict[
-            int, tuple[object, int, tuple[float, float], tuple[float, float], float]
-        ] = {}
-        #: Per camera, the extent of the pattern last seen (None: a blob).
-        self._extent: dict[int, tuple[float, float, float, float] | None] = {}
-        #: Per camera, where the last detection puts its pattern (a board seen whole,
-        #: then moved with each feature found alone); absent after a blob or a miss.
-        self._pattern: dict[int, SeenPattern] = {}
-        #: Cameras that saw the pattern whole in this fixation (``run`` begins one): only
-        #: they look for a feature alone (the board may have moved by whole squares since).
-        self._confirmed: set[int] = set()
-        #: Binned previews rendered to place a window (see ``ServoConfig.preview_binning``).
-        self.previews = 0
-        #: Windows rendered, and windows that missed the target (a full frame followed).
-        self.window_renders = 0
-        self.window_misses = 0
+        #: Where the servo looks (windows, previews and what is kept between looks).
+        self.looker = Looker(sim, self.config, self.sink)
+
+    @property
+    def previews(self) -> int:
+        """Binned previews rendered to place a window."""
+        return self.looker.counts.previews
+
+    @property
+    def window_renders(self) -> int:
+        """Windows rendered."""
+        return self.looker.counts.window_renders
+
+    @property
+    def window_misses(self) -> int:
+        """Windows that missed the target (a preview's window, or a full frame, followed)."""
+        return self.looker.counts.window_misses
 
     @property
     def step_range(self) -> tuple[int, int]:
@@ -86,150 +80,11 @@ class EyeServo:
     def observe(
         self, camera: int, detector: Detector, key: object = None, preview: bool = True
     ) -> Detection:
-        """Render ``camera`` and detect the target in it (one render; more on a window miss).
-
-        With windows on, and when this camera last saw the same target
-        (``key``, default the detector) with the neck unchanged since and a
-        gain known, only a window is rendered: around where the head expects
-        the target from that detection and the eye steps moved since
-        (u + gain * steps), of half-side 3 blob radii plus the margin and a
-        quarter of the predicted motion (blob detectors only, see
-        :data:`WINDOWED_DETECTORS`).  The detection there counts only if it
-        is FOUND at least 3 blob radii + 2 px inside the window (so the blob
-        and every piece the detector looks for beside it lie in the window)
-        and, for a blob, with an area within ``AREA_CHANGE`` of the one seen;
-        otherwise it is a miss (counted: the target moved, or something else is
-        there), looked for again in a preview (:func:`look_again`), then in the
-        same instant's full frame.  Never from the truth, nor from whether the
-        scene changed: detections, gain, encoders.  A new target, or a
-        pattern's feature after a move too long to find it alone, is first
-        found in a binned preview; ``preview=False`` renders the full frame
-        instead (a search's look).
-        """
-        key = detector if key is None else key
-        sim, cfg = self.sim, self.config
-        steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
-        pattern = pattern_windowed(key)
-        alone = alone_finder(key) if pattern else None
-        if pattern:  # a pattern's features share their windows
-            key = getattr(key, "window_key", key)
-        window, spacing, whole = None, 0.0, False
-        if pattern or windowed(key):
-            window, spacing, whole = self._window(camera, key, steps, neck, alone)
-        # A blob's window placed from the last sight of it: a guess the image confirms.
-        guessed = self._seen[camera][4] if window is not None and not pattern else None
-        looked = None
-        if preview and alone is not None and not spacing and not whole:
-            looked = self._pattern_preview(camera, key, detector, alone)
-        if looked is not None:
-            window, spacing = looked
-        elif preview and window is None and not pattern and windowed(key):
-            window = self._preview(camera, key, neck)
-        detection = None
-        found_alone: int | None = None  # the feature's index when found alone
-        if window is not None:
-            self.window_renders += 1
-            look = partial(alone[1], spacing_px=spacing) if spacing and alone else detector
-            detection = look_in_window(
-                sim, camera, reporting(look, self.sink, camera, window), window, guessed
-            )
-            if detection is not None and spacing and alone:
-                found_alone = alone[0]
-            if detection is None:
-                self.window_misses += 1
-            if detection is None and guessed is not None and preview and cfg.preview_binning > 1:
-                self.previews += 1
-                report = partial(reporting, detector, self.sink, camera)
-                detection, rendered = look_again(sim, camera, key, cfg, report)
-                self.window_renders += rendered
-                self.window_misses += rendered and detection is None
-            if detection is None:
-                # the same instant, whole
-                detection = reporting(detector, self.sink, camera)(sim.retake(camera))
-        if detection is None:
-            detection = reporting(detector, self.sink, camera)(sim.render(camera))
-        # Only blob detections (a centroid and an area) predict a window.
-        if isinstance(detection, Detection) and detection.found and detection.uv is not None:
-            if looked is not None or detection.pattern_uv is not None:
-                self._confirmed.add(camera)  # the pattern seen whole (or its preview)
-            self._seen[camera] = (key, steps, neck, detection.uv, detection.area_px)
-            self._extent[camera] = detection.extent_px
-            kept = remembered(self._pattern.get(camera), detection, found_alone)
-            if kept is None:
-                self._pattern.pop(camera, None)
-            else:
-                self._pattern[camera] = kept
-                if found_alone is not None:  # the next whole-pattern window is its box
-                    self._extent[camera] = kept.extent_from(detection.uv)
-        else:
-            self._seen.pop(camera, None)
-            self._pattern.pop(camera, None)
-            self._confirmed.discard(camera)
-        return detection
-
-    def _preview(self, camera: int, detector: object, neck: tuple[float, float]) -> Window | None:
-        """A preview's window for ``detector``'s blob (see :func:`preview_window`) where no
-        detection predicts where it is (a new target, or the neck moved since)."""
-        seen = self._seen.get(camera)
-        if not self.config.windows or self.config.preview_binning <= 1:
-            return None
-        if seen is not None and seen[0] == detector and seen[2] == neck:
-            return None
-        self.previews += 1
-        return preview_window(self.sim, camera, detector, self.config)
-
-    def _pattern_preview(
-        self, camera: int, key: object, detector: Detector, alone: AloneFinder
-    ) -> tuple[Window | None, float] | None:
-        """After a move too long to find the feature ``alone`` looks for alone, where a
-        binned preview puts it and the pattern's spacing there (:func:`pattern_preview`);
-        None: no preview, or one that did not show the pattern (its window, as before)."""
-        seen, kept = self._seen.get(camera), self._pattern.get(camera)
-        if not self.config.windows or kept is None or seen is None or seen[0] != key:
-            return None
-        looked = pattern_preview(self.sim, camera, detector, kept, alone, self.config)
-        if looked is not None:
-            self.previews += 1
-        if looked is None or looked[0] is None or looked[1] is None:
-            return None
-        self._pattern[camera] = looked[0]
-        return looked[1], looked[0].spacing_px
-
-    def _window(
-        self,
-        camera: int,
-        key: object,
-        steps: int,
-        neck: tuple[float, float],
-        alone: AloneFinder | None = None,
-    ) -> tuple[Window | None, float, bool]:
-        """Where to look for ``key``'s target in ``camera`` (None: the full frame), the
-        pattern's spacing, px, when it is a feature looked for ``alone`` (else 0), and
-        whether it is the whole pattern's window that tells the features apart first (in
-        a new fixation): around where the last sight of the pattern puts it."""
-        cfg, sim = self.config, self.sim
-        seen, gain = self._seen.get(camera), self.gains.get(camera)
-        if not cfg.windows or seen is None or gain is None:
-            return None, 0.0, False
-        seen_key, seen_steps, seen_neck, uv, area = seen
-        if seen_key != key or seen_neck != neck:
-            return None, 0.0, False
-        motion = gain * (steps - seen_steps)
-        kept, extent = self._pattern.get(camera), self._extent.get(camera)
-        expected, margin, whole = (uv[0] + motion, uv[1]), cfg.window_margin_px, False
-        if alone is not None and kept is not None and kept.expects_alone(alone[0], motion):
-            if camera in self._confirmed:
-                u, v = kept.features[alone[0]]
-                spacing = kept.spacing_px
-                window = pattern_window(
-                    sim, camera, (u + motion, v), alone[2](spacing), motion, margin
-                )
-                return window, spacing if window is not None else 0.0, False
-            whole = True  # a new fixation: the whole pattern first
-        if extent is not None:  # a pattern: the whole of it
-            window = pattern_window(sim, camera, expected, extent, motion, margin)
-            return window, 0.0, whole and window is not None
-        return expected_window(sim, camera, expected, area, motion, margin), 0.0, False
+        """``camera``'s detection of ``detector``'s target now, through the servo's
+        :class:`~headsim.active.look.Looker`: a window where the last sight and the gain
+        put it, else a preview's window, else the full frame (``preview=False``: no
+        preview, a search's look).  ``key``: what names the target (default the detector)."""
+        return self.looker.look(camera, detector, Since(self.gains.get(camera), preview, key))
 
     def run(
         self,
@@ -249,12 +104,58 @@ class EyeServo:
         pattern is seen whole again before its features are looked for alone.
         """
         if first is None:
-            self._confirmed.clear()
+            self.looker.new_fixation()
         goal = self.sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
         result = self._servo(camera, detector, goal, first)
         if result.converged:
-            result = average_eye_crossing(self, camera, detector, goal, result)
+            result = self._averaged(camera, detector, goal, result)
         return result
+
+    def _averaged(
+        self, camera: int, detector: Detector, goal: float, result: ServoResult
+    ) -> ServoResult:
+        """The converged ``result`` with its crossing averaged over images spread
+        across one pixel around it (see ``ServoConfig.average_fixation``); the eye ends at
+        ``result.steps``."""
+        cfg, sim = self.config, self.sim
+        gain = result.gain_px_per_step
+        if not cfg.average_fixation or not gain or result.uv is None or not finds_blob(detector):
+            return result
+        low, high = self.step_range
+        poses = [
+            s
+            for s in pixel_period_steps(result.subpixel_steps, gain, cfg.max_fixation_samples)
+            if low <= s <= high
+        ]
+        seen = {s: u for s, u, _ in result.seen}
+        path = list(result.seen)
+        samples: list[tuple[int, float]] = []
+        renders = 0
+        for s in poses:  # bounded: at most max_fixation_samples poses
+            if s not in seen:
+                sim.command_eye_steps(s)
+                sim.settle()
+                detection = self.observe(camera, detector)
+                renders += 1
+                if not detection.found or detection.uv is None:
+                    break  # the averaging is bounded by what the images show
+                seen[s] = detection.uv[0]
+                path.append((s, *detection.uv))
+            samples.append((s, seen[s]))
+        if sim.eye_encoder_steps() != result.steps:
+            sim.command_eye_steps(result.steps)
+            sim.settle()
+        if len(samples) < 2:
+            return replace(result, renders=result.renders + renders, seen=tuple(path))
+        crossings = np.array([s - (u - goal) / gain for s, u in samples])
+        subpixel = float(crossings.mean())
+        return replace(
+            result,
+            subpixel_steps=subpixel,
+            renders=result.renders + renders,
+            seen=tuple(path),
+            fixation_samples=len(samples),
+        )
 
     def _servo(
         self, camera: int, detector: Detector, goal: float, first: Detection | None
@@ -370,4 +271,15 @@ class EyeServo:
         )  # fmt: skip
 
 
-__all__ = ["EyeServo"]
+def pixel_period_steps(centre_steps: float, gain_px_per_step: float, most: int) -> list[int]:
+    """Whole steps whose images spread evenly over one pixel of image motion around
+    ``centre_steps``: consecutive steps, round(1 / |gain|) of them (one pixel's worth),
+    every k-th step where that is more than ``most`` (at most ``most`` of them)."""
+    per_pixel = max(1, round(1.0 / abs(gain_px_per_step)))
+    stride = math.ceil(per_pixel / most)
+    count = max(2, round(1.0 / (stride * abs(gain_px_per_step))))
+    first = round(centre_steps - stride * (count - 1) / 2)
+    return [first + stride * k for k in range(count)]
+
+
+__all__ = ["EyeServo", "pixel_period_steps"]

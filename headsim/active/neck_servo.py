@@ -7,29 +7,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from functools import partial
 
 import numpy as np
 
 from headsim.active.events import ServoKind, ServoStep
-from headsim.active.fixation_average import pixel_period_steps
+from headsim.active.eye_servo import pixel_period_steps
+from headsim.active.look import Anew, Around, Hint, Looker, Whole, finds_blob
 from headsim.active.servo_types import (
     Detector,
     NeckServoResult,
     ServoConfig,
     ServoOutcome,
 )
-from headsim.active.windows import (
-    expected_window,
-    look_again,
-    look_in_window,
-    preview_window,
-    reporting,
-    windowed,
-)
 from headsim.sim import names
 from headsim.sim.events import EventSink
-from headsim.sim.render import Window
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection, DetectionStatus
 
@@ -60,15 +51,13 @@ class NeckServo:
         ]
         self.jacobian: np.ndarray | None = None
         #: The last images' detections the windows are predicted from:
-        #: (detector, steps, ((u, v), area) per camera), and the count of windows
-        #: rendered and missed (see :meth:`EyeServo.observe`).  Only what the head saw
+        #: (detector, steps, ((u, v), area) per camera).  Only what the head saw
         #: and moved: whether the scene changed since, its next images tell.
         self._seen: (
             tuple[object, tuple[int, ...], list[tuple[tuple[float, float], float]]] | None
         ) = None
-        self.window_renders = 0
-        self.window_misses = 0
-        self.previews = 0
+        #: Where the servo looks (windows, previews; see :class:`~headsim.active.look.Looker`).
+        self.looker = Looker(sim, self.config, self.sink)
         #: Where the target was lost in the current run: (camera, what the detector said).
         self._lost: tuple[int, DetectionStatus] | None = None
         self._key: object = None
@@ -110,69 +99,37 @@ class NeckServo:
 
     def _look(self, camera: int, detector: Detector) -> Detection:
         """Detect in ``camera``: in a window around where the last images and the
-        Jacobian put the target (same target, blob detector), else in the full frame.
-        The window's detection counts if the blob is well inside it and about as large
-        as seen then (see :meth:`EyeServo.observe`); a miss (the target moved, or
-        something else is there) is counted and looked for again in a preview and its
-        window of the same instant, then in the same instant's full frame."""
-        sim, seen = self.sim, self._seen
-        jac = self._current
-        if (
-            self.config.windows
-            and seen is not None
-            and jac is not None
-            and seen[0] is self._key
-            and windowed(self._key)
-        ):
+        Jacobian put the target (same target, blob detector), a new target in a
+        preview's window, else in the full frame (see :class:`~headsim.active.look.Looker`)."""
+        return self.looker.look(camera, detector, self._hint(camera))
+
+    def _hint(self, camera: int) -> Hint:
+        """Where the last images and the Jacobian put the target in ``camera``, if they do."""
+        seen, jac = self._seen, self._current
+        if self.config.windows and seen is not None and jac is not None and seen[0] is self._key:
             move = self._steps() - np.array(seen[1])
             du1, du2, dv = jac @ move
             (u, v), area = seen[2][camera - 1]
             du = du1 if camera == 1 else du2
-            window = expected_window(
-                sim,
-                camera,
-                (u + du, v + dv),
-                area,
-                max(abs(du), abs(dv)),
-                self.config.window_margin_px,
-            )
-            if window is not None:
-                return self._look_in(window, camera, detector, area)
-        elif (
-            self.config.windows
-            and self.config.preview_binning > 1
-            and windowed(self._key)
-            and (seen is None or seen[0] is not self._key)
-        ):
-            # A new target: find it in a preview, then render its window.
-            self.previews += 1
-            window = preview_window(sim, camera, self._key, self.config)
-            if window is not None:
-                return self._look_in(window, camera, detector)
-        return reporting(detector, self.sink, camera)(sim.render(camera))
+            return Around(self._key, (u + du, v + dv), area, max(abs(du), abs(dv)))
+        if seen is None or seen[0] is not self._key:
+            return Anew(self._key)
+        return Whole()
 
-    def _look_in(
-        self, window: Window, camera: int, detector: Detector, guessed: float | None = None
-    ) -> Detection:
-        """Detect in a rendered window; a miss costs the same instant's whole frame, or,
-        for a window ``guessed`` from a blob of that area seen before, first a preview
-        and the window it places (:func:`look_again`)."""
-        self.window_renders += 1
-        detection = look_in_window(
-            self.sim, camera, reporting(detector, self.sink, camera, window), window, guessed
-        )
-        if detection is not None:
-            return detection
-        self.window_misses += 1
-        if guessed is not None and self.config.preview_binning > 1:
-            self.previews += 1
-            report = partial(reporting, detector, self.sink, camera)
-            detection, rendered = look_again(self.sim, camera, self._key, self.config, report)
-            self.window_renders += rendered
-            if detection is not None:
-                return detection
-            self.window_misses += rendered
-        return reporting(detector, self.sink, camera)(self.sim.retake(camera))
+    @property
+    def previews(self) -> int:
+        """Binned previews rendered to place a window."""
+        return self.looker.counts.previews
+
+    @property
+    def window_renders(self) -> int:
+        """Windows rendered."""
+        return self.looker.counts.window_renders
+
+    @property
+    def window_misses(self) -> int:
+        """Windows that missed the target (a preview's window, or a full frame, followed)."""
+        return self.looker.counts.window_misses
 
     def _in_range(self, steps: np.ndarray) -> bool:
         return all(lo <= s <= hi for s, (lo, hi) in zip(steps, self._ranges, strict=True))
@@ -221,7 +178,7 @@ class NeckServo:
         columns evenly over one pixel around the goals (the eye servo's rule, see
         ``ServoConfig.average_fixation``; two renders a pose); back to ``result.steps``."""
         cfg, sim, jac = self.config, self.sim, result.jacobian
-        if not cfg.average_fixation or jac is None or not windowed(self._key):
+        if not cfg.average_fixation or jac is None or not finds_blob(self._key):
             return result
         gain = float(np.max(np.abs(jac[:2, 2])))  # px per eye step in the faster camera
         if gain == 0.0:

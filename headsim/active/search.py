@@ -20,10 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from headsim.active.eye_servo import EyeServo
+from headsim.active.look import Glance, Looker, finds_blob
 from headsim.active.neck_servo import NeckServo
-from headsim.active.servo_types import Detector, ServoConfig
-from headsim.active.windows import windowed
-from headsim.sim.simulator import HeadSim
+from headsim.active.servo_types import Detector
 from headsim.vision.detection import Detection
 
 #: A scan's poses are at most this share of a field of view apart (the image width,
@@ -89,7 +88,7 @@ def find_view(
     most ``max_poses``.  None: not found (the caller names the failure).
     """
     sim = servo.sim
-    width = sim.camera_settings(camera).width
+    width = servo.looker.sizes[camera][0]
     poses = search_poses(servo, camera, remembered, width)[:max_poses]
     for tried, steps in enumerate(poses, start=1):
         sim.command_eye_steps(steps)
@@ -136,19 +135,19 @@ def scan_eye_poses(servo: EyeServo, camera: int, width_px: int) -> list[int]:
     return [p for k, p in enumerate(poses) if low <= p <= high and p not in poses[:k]]
 
 
-def _binning(sim: HeadSim, camera: int, config: ServoConfig, detector: Detector) -> int:
+def _binning(looker: Looker, camera: int, detector: Detector) -> int:
     """The preview binning a scan looks with (1: full frames): the servo's, for a blob
     detector, where it divides the image."""
-    b = config.preview_binning if config.windows else 1
-    cam = sim.camera_settings(camera)
-    if b <= 1 or not windowed(detector) or cam.width % b or cam.height % b:
+    b = looker.config.preview_binning if looker.config.windows else 1
+    width, height = looker.sizes[camera]
+    if b <= 1 or not finds_blob(detector) or width % b or height % b:
         return 1
     return b
 
 
-def _shows(sim: HeadSim, camera: int, detector: Detector, binning: int) -> bool:
+def _shows(looker: Looker, camera: int, detector: Detector, binning: int) -> bool:
     """Whether ``camera``'s binned preview shows the target (found, not cut or hidden)."""
-    seen = detector(sim.render_preview(camera, binning))
+    seen = looker.look(camera, detector, Glance(binning))
     return bool(seen.found and seen.uv is not None)
 
 
@@ -164,15 +163,15 @@ def scan_eyes(
     skipped (it was just looked from).  The eyes stay where it was found.
     """
     sim = servo.sim
-    binning = _binning(sim, camera, servo.config, detector)
+    binning = _binning(servo.looker, camera, detector)
+    poses = scan_eye_poses(servo, camera, servo.looker.sizes[camera][0])
     current = sim.eye_encoder_steps()
-    width = sim.camera_settings(camera).width
-    poses = [p for p in scan_eye_poses(servo, camera, width) if p != current][:max_poses]
+    poses = [p for p in poses if p != current][:max_poses]
     for tried, steps in enumerate(poses, start=1):
         sim.command_eye_steps(steps)
         sim.settle()
         if binning > 1:
-            if _shows(sim, camera, detector, binning):
+            if _shows(servo.looker, camera, detector, binning):
                 return Scan((steps,), None, tried)
             continue
         detection = servo.observe(camera, detector, preview=False)
@@ -209,10 +208,9 @@ def scan_neck(servo: NeckServo, detector: Detector, max_poses: int = MAX_SCAN_PO
     it was found.
     """
     sim = servo.sim
-    binning = min(_binning(sim, c, servo.config, detector) for c in (1, 2))
-    cam = sim.camera_settings(1)
+    binning = min(_binning(servo.looker, c, detector) for c in (1, 2))
     here = servo.steps()
-    poses = [q for q in scan_neck_poses(servo, (cam.width, cam.height)) if q != here]
+    poses = [q for q in scan_neck_poses(servo, servo.looker.sizes[1]) if q != here]
     poses = poses[:max_poses]
     resolution = sim.settings.encoder_resolution_rad
     for tried, pose in enumerate(poses, start=1):
@@ -223,7 +221,9 @@ def scan_neck(servo: NeckServo, detector: Detector, max_poses: int = MAX_SCAN_PO
         yaw, pitch, eye = (s * resolution for s in pose)
         sim.command(neck_yaw=yaw, neck_pitch=pitch, eye=eye)
         sim.settle()
-        if _shows(sim, 1, detector, binning) and _shows(sim, 2, detector, binning):
+        if _shows(servo.looker, 1, detector, binning) and _shows(
+            servo.looker, 2, detector, binning
+        ):
             return Scan(pose, None, tried)
     return Scan(None, None, len(poses))
 
@@ -288,8 +288,7 @@ def find_neck_view(
     ``max_poses``.  Returns the pose and the number of poses tried, or None
     (the caller names the failure).
     """
-    cam = servo.sim.camera_settings(1)
-    poses = neck_search_poses(servo, last, (cam.width, cam.height))[:max_poses]
+    poses = neck_search_poses(servo, last, servo.looker.sizes[1])[:max_poses]
     for tried, pose in enumerate(poses, start=1):
         if servo.look_from(pose, detector):
             return pose, tried

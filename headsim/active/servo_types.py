@@ -83,7 +83,7 @@ class ServoConfig:
     crossings and return to the final step.  One image's sub-step fixation is
     off by the centroid's sub-pixel rendering floor over the gain, which is
     more angle at a shorter focal length; the average leaves the same angle
-    at every zoom (``headsim.active.fixation_average``), for about twice the
+    at every zoom (``headsim.active.eye_servo``), for about twice the
     renders.  Off: one image, the final step's.  Blob detectors only; a
     pattern (a chessboard's corners) is fixated from one image.
     """

@@ -2,18 +2,14 @@
 
 from __future__ import annotations
 
-from functools import partial
-
 from headsim.active.measurement import Target
 from headsim.scenario.spec import MARKER_BODIES
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
 
 def marker_target(name: str, body: str) -> Target:
     """A marker body of the default scene, found by its colour, named ``name``."""
-    return Target(
-        name, partial(find_marker, colour=MARKER_BODIES[body]), lambda sim: sim.position(body)
-    )
+    return Target(name, MarkerDetector(MARKER_BODIES[body]), lambda sim: sim.position(body))
 
 
 __all__ = ["marker_target"]

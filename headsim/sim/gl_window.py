@@ -12,7 +12,6 @@ frame's crop (README, windows).
 from __future__ import annotations
 
 import math
-from collections import OrderedDict
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -21,7 +20,6 @@ import mujoco
 import numpy as np
 
 from headsim.sim.backend import RenderBackendError
-from headsim.sim.mujoco_renderer import attachment as renderer_attachment
 from headsim.sim.mujoco_renderer import mjr_context
 
 
@@ -111,17 +109,6 @@ def clipped_to(
             GL.glDisable(GL.GL_CLIP_PLANE0 + n)
 
 
-#: Off-screen buffers for windows kept per OpenGL context (the least recently used goes).
-WINDOW_BUFFERS = 6
-#: Their sizes are rounded up to this many raster pixels (two of llvmpipe's tiles), to
-#: reuse them.
-BUFFER_STEP = 128
-#: A kept buffer that holds the window's is used if its area is at most this many times
-#: the one needed: a new buffer (allocated, first touched) costs more than clearing a
-#: larger one (the chessboard's and calibration's windows, Dec 2026).
-BUFFER_SLACK = 2.0
-
-
 #: Depth formats with a stencil and the same depth without one (GL enums).
 _WITHOUT_STENCIL = {
     0x8CAD: 0x8CAC,  # GL_DEPTH32F_STENCIL8 -> GL_DEPTH_COMPONENT32F
@@ -137,9 +124,8 @@ class WindowBuffer:
         self, context: mujoco.MjrContext, size: tuple[int, int], stencil: bool = True
     ) -> None:
         """``stencil``: False for a scene that never uses the stencil (MuJoCo's
-        only use is reflections): then a 32-bit float depth buffer without one,
-        the depth the context's own (32F + stencil 8) holds, which llvmpipe
-        clears in under half the time."""
+        only use is reflections): then a depth buffer without one, of the depth the
+        context's own holds (32F + stencil 8 -> 32F), and less memory to clear."""
         from OpenGL import GL
 
         GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, context.offColor)
@@ -186,35 +172,19 @@ def draw_window(
     clipped to the window (:func:`clipped_to`).
 
     The frame's viewport is moved by whole pixels so that the window's corner is
-    the origin of a buffer only as large as the window (rounded up to
-    :data:`BUFFER_STEP`; or a kept one up to :data:`BUFFER_SLACK` times as
-    large), not the context's: ``mjr_render`` clears all of its viewport that
-    the buffer holds, and a whole frame's multisampled buffer costs more to
-    clear than a small window to draw.
+    the origin of a buffer of the window's own size, made for it and deleted after
+    the read, not the context's: ``mjr_render`` clears all of its viewport that the
+    buffer holds, and a whole frame's multisampled buffer costs more to clear than a
+    small window to draw.
     """
     from OpenGL import GL
 
     full_w, full_h = full_size
     context = mjr_context(renderer)
-    step = BUFFER_STEP
     width, height = k * rect.width, k * rect.height
-    size = (step * math.ceil(width / step), step * math.ceil(height / step))
     # MuJoCo's only use of the stencil: reflective geoms (a material's reflectance).
     stencil = bool(np.any(renderer.model.mat_reflectance > 0))
-    buffers: OrderedDict[tuple[int, int, bool], WindowBuffer] = renderer_attachment(
-        renderer, "_headsim_window_buffers", OrderedDict
-    )
-    # The smallest kept buffer that holds the window, unless it is much larger.
-    fits = [b for b in buffers if b[0] >= size[0] and b[1] >= size[1] and b[2] == stencil]
-    key = min(fits, key=lambda b: b[0] * b[1], default=(*size, stencil))
-    if key[0] * key[1] > BUFFER_SLACK * size[0] * size[1]:
-        key = (*size, stencil)
-    buffer = buffers.pop(key, None) or WindowBuffer(context, (key[0], key[1]), stencil)
-    buffers[key] = buffer
-    while len(buffers) > WINDOW_BUFFERS:
-        _, oldest = buffers.popitem(last=False)
-        GL.glDeleteFramebuffers(len(oldest.framebuffers), oldest.framebuffers)
-        GL.glDeleteRenderbuffers(len(oldest.renderbuffers), oldest.renderbuffers)
+    buffer = WindowBuffer(context, (width, height), stencil)
     # The window's corner in the frame's raster (OpenGL's rows run bottom-up).
     x, y = k * rect.x0, full_h - k * rect.y1
     try:
@@ -231,4 +201,6 @@ def draw_window(
         raw = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
     finally:
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, context)
+        GL.glDeleteFramebuffers(len(buffer.framebuffers), buffer.framebuffers)
+        GL.glDeleteRenderbuffers(len(buffer.renderbuffers), buffer.renderbuffers)
     return np.frombuffer(raw, dtype=np.uint8).reshape(height, width, 3).copy()

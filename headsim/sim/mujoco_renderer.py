@@ -9,15 +9,10 @@ fails here, by name (:func:`check_renderer`), and nowhere else.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Any, TypeVar
-
 import mujoco
 
 #: The private attributes of ``mujoco.Renderer`` headsim reads or sets.
 PRIVATE_ATTRIBUTES = ("_model", "_mjr_context", "_gl_context")
-
-_T = TypeVar("_T")
 
 
 class RendererInternalsError(RuntimeError):
@@ -53,20 +48,9 @@ def make_current(renderer: mujoco.Renderer) -> None:
         gl_context.make_current()
 
 
-def attachment(renderer: mujoco.Renderer, name: str, factory: Callable[[], _T]) -> _T:
-    """What headsim keeps with one renderer under ``name``, made by ``factory`` on
-    first use (it lives and dies with the renderer's OpenGL context)."""
-    store: dict[str, Any] = renderer.__dict__
-    if name not in store:
-        store[name] = factory()
-    value: _T = store[name]
-    return value
-
-
 __all__ = [
     "PRIVATE_ATTRIBUTES",
     "RendererInternalsError",
-    "attachment",
     "check_renderer",
     "make_current",
     "mjr_context",

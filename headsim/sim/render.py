@@ -128,7 +128,7 @@ class EyeRenderer:
         """``supersample``: the model's cameras render at this many times each
         canvas's size (``headsim.sim.settings.RenderFidelity``); images are area-averaged
         back to the canvas."""
-        self._model = model
+        self._mj_model = model
         self._supersample = supersample
         self._cameras = cameras
         self._canvases = canvases
@@ -150,8 +150,8 @@ class EyeRenderer:
         self.rendered_frames = 0.0
 
     def _renderer(self) -> mujoco.Renderer:
-        renderer = _acquire(self._key, self._model)
-        use_model(renderer, self._model)  # the same assets; this model's cameras and bodies
+        renderer = _acquire(self._key, self._mj_model)
+        use_model(renderer, self._mj_model)  # the same assets; this model's cameras and bodies
         return renderer
 
     def _draw(
@@ -165,7 +165,7 @@ class EyeRenderer:
         width_c, height_c = canvas.size
         full_w, full_h = k * width_c, k * height_c
         cam = self._cam_ids[index]
-        model = self._model
+        model = self._mj_model
         saved = None
         if binning > 1:
             # A preview: the same camera at 1/b of the resolution (the sensor binned
@@ -317,13 +317,6 @@ class EyeRenderer:
 
 #: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.
 PREVIEW_STREAM = 1_000_003
-
-
-def unbinned_px(binned_px: tuple[float, ...] | np.ndarray, binning: int) -> np.ndarray:
-    """Full-frame pixel coordinates of coordinates in a preview binned ``binning`` x
-    ``binning`` (``EyeRenderer.render_preview``): binned pixel i covers pixels
-    b i .. b i + b - 1, so its centre is b i + (b - 1) / 2."""
-    return binning * np.asarray(binned_px, dtype=np.float64) + (binning - 1) / 2.0
 
 
 #: Binned canvases by (id of the canvas, binning), with the canvas kept alive.

@@ -110,7 +110,7 @@ def measure_point_stereo(
 
     ``detector`` defaults to :func:`marker_detector` of ``target``.  ``look(sim,
     camera, detector)`` detects in the camera's next image (default: the full frame;
-    ``headsim.active.windows.look_once`` renders only where a preview shows the target).
+    ``headsim.active.look.look_once`` renders only where a preview shows the target).
     """
     detect = detector or marker_detector(target)
     look = look or full_frame

@@ -13,7 +13,6 @@ import tempfile
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from functools import partial
 from pathlib import Path
 from typing import Any, cast
 
@@ -36,10 +35,10 @@ from headsim.sim.simulator import HeadSim
 from headsim.studies.scenario_runs import knowledge_file, preset_of
 from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
 from headsim.vision.crosses import find_cross_point
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
-BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))
+RED = body_target("marker_red", MarkerDetector("red"))
+BALL = body_target(names.CALIBRATION_BALL, MarkerDetector("yellow"))
 DEPTH_BANDS_M = ((0.3, 0.6), (0.6, 1.0), (1.0, 1.5))
 #: Rows within this many px of the image centre row count as "near the centre row".
 CENTRE_ROW_BAND_PX = 100.0

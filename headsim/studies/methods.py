@@ -5,12 +5,11 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import partial
 from typing import Any
 
 from headsim.active.measurement import body_target
 from headsim.sim import names
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
 METHODS = (
     "stereo",
@@ -32,8 +31,8 @@ METHOD_LABELS = {
     "active_fixed_point": "active, zoom fixed point",
     "active_refound": "active, zoom fixed point found again",
 }
-TARGET = body_target(names.MARKERS[0], partial(find_marker, colour="red"))
-BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))
+TARGET = body_target(names.MARKERS[0], MarkerDetector("red"))
+BALL = body_target(names.CALIBRATION_BALL, MarkerDetector("yellow"))
 
 
 Progress = Callable[[str], None]

@@ -37,10 +37,10 @@ import numpy as np
 
 from headsim.active.calibration import CalibrationRun, calibrate_head
 from headsim.active.eye_servo import EyeServo
+from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import measure_model2
 from headsim.active.principal import PrincipalPointRun, zoomed
-from headsim.active.windows import look_once
 from headsim.estimators import model2
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings

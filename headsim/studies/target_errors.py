@@ -10,9 +10,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from headsim.active.eye_servo import EyeServo
+from headsim.active.look import look_once
 from headsim.active.model2 import measure_model2
 from headsim.active.principal import PROBE_ZOOM, principal_points_by_zoom
-from headsim.active.windows import look_once
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.triangulation import measure_point_stereo

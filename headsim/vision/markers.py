@@ -20,6 +20,7 @@ background and is not flagged.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -138,6 +139,22 @@ def find_marker(
     check_rgb(image)
     weight = _weight_u8(tuple(cv2.split(image)), colour)
     return _blob_detection(weight, threshold, expected_area_px, min_area_fraction)
+
+
+@dataclass(frozen=True, eq=False)
+class MarkerDetector:
+    """The detector of the largest blob of ``colour`` (:func:`find_marker`).  A blob: its
+    answer is decided by the blob and what lies within one blob size of it, so it may
+    look at windows and previews (``finds_blob``).  Compared by identity: one target."""
+
+    colour: str
+
+    @property
+    def finds_blob(self) -> bool:
+        return True
+
+    def __call__(self, image: np.ndarray) -> Detection:
+        return find_marker(image, self.colour)
 
 
 def find_markers(

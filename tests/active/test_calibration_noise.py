@@ -14,7 +14,6 @@ the only error there.
 from __future__ import annotations
 
 import math
-from functools import partial
 
 import numpy as np
 from scipy.stats import chi2
@@ -30,9 +29,9 @@ from headsim.paper import BASELINE_M, INITIAL_DIRECTIONS_RAD
 from headsim.sim import names
 from headsim.sim.settings import ideal_head
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))
+BALL = body_target(names.CALIBRATION_BALL, MarkerDetector("yellow"))
 HEAD = StereoHead(
     BASELINE_M, alpha_e1=INITIAL_DIRECTIONS_RAD[0], alpha_e2=INITIAL_DIRECTIONS_RAD[1]
 )

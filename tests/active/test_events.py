@@ -3,7 +3,6 @@ image, detection, move and result, and nothing that changes a measurement."""
 
 from __future__ import annotations
 
-from functools import partial
 from itertools import pairwise
 
 import numpy as np
@@ -27,10 +26,10 @@ from headsim.sim import names
 from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import DetectionStatus
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
-BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))
+RED = body_target("marker_red", MarkerDetector("red"))
+BALL = body_target(names.CALIBRATION_BALL, MarkerDetector("yellow"))
 
 
 class ListSink:

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 import pytest
 
@@ -11,9 +9,9 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.servo_types import ServoConfig, ServoOutcome
 from headsim.sim.settings import CameraSettings, HeadSettings
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = partial(find_marker, colour="red")
+RED = MarkerDetector("red")
 
 
 MARKER = "marker_red"

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 import pytest
 
@@ -17,12 +15,12 @@ from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import DetectionStatus
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
+RED = body_target("marker_red", MarkerDetector("red"))
 
 
-BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))
+BALL = body_target(names.CALIBRATION_BALL, MarkerDetector("yellow"))
 
 
 def _place_in_head(sim: HeadSim, body: str, p_head: list[float]) -> np.ndarray:

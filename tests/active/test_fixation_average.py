@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.active.fixation_average import pixel_period_steps
+from headsim.active.eye_servo import pixel_period_steps
 
 
 @pytest.mark.parametrize("gain", [0.05, 0.1, 0.143, -0.204, 0.265, 0.326, -0.41, 0.6])

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 import pytest
 
@@ -18,7 +16,7 @@ from headsim.active.measurement import (
 from headsim.estimators.result import Flag, Method, PositionEstimate, Status
 from headsim.sim.settings import HeadBelief
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
 
 @pytest.fixture(scope="module")
@@ -52,7 +50,7 @@ def test_to_world_undoes_the_neck_for_a_head_that_is_as_designed(sim) -> None:
 
 
 def test_a_measurement_sets_estimate_beside_truth_and_a_failure_says_why(sim) -> None:
-    target = body_target("marker_red", partial(find_marker, colour="red"))
+    target = body_target("marker_red", MarkerDetector("red"))
     truth_world = target.truth_world(sim)
     np.testing.assert_array_equal(truth_world, sim.position("marker_red"))
     truth_head = sim.transform_points(truth_world, "world", "head")[0]

@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 
 from headsim.active.measurement import body_target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
+RED = body_target("marker_red", MarkerDetector("red"))
 
 
 def test_model1_fixates_with_the_neck_and_places_the_point_in_the_world() -> None:

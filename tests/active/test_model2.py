@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 import pytest
 
@@ -12,9 +10,9 @@ from headsim.active.failure import FailureCause
 from headsim.active.measurement import body_target
 from headsim.active.model2 import Model2Config, measure_model2
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector, find_marker
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
+RED = body_target("marker_red", MarkerDetector("red"))
 
 
 def _place_in_head(sim: HeadSim, body: str, p_head) -> None:

@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 
 from headsim.active.servo_types import ServoConfig, ServoOutcome
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = partial(find_marker, colour="red")
+RED = MarkerDetector("red")
 
 
 MARKER = "marker_red"

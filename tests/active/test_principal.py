@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from dataclasses import replace
-from functools import partial
 
 import numpy as np
 import pytest
@@ -22,10 +21,10 @@ from headsim.active.principal import (
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
-BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))
+RED = body_target("marker_red", MarkerDetector("red"))
+BALL = body_target(names.CALIBRATION_BALL, MarkerDetector("yellow"))
 
 
 def test_fixed_point_of_a_synthetic_zoom_is_recovered(rng) -> None:

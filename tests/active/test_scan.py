@@ -4,7 +4,6 @@ bounded where it is nowhere.  Real renders."""
 
 from __future__ import annotations
 
-from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -22,9 +21,9 @@ from headsim.run.summary import summary_text
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.reach import ReachHead, scene_occluders, target_refusal
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector, find_marker
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
+RED = body_target("marker_red", MarkerDetector("red"))
 
 #: Camera 2 sees it at the start pose, camera 1 (0.64 rad off its axis) does not.
 ASIDE = """

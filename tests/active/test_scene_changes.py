@@ -7,7 +7,6 @@ pixels are the full frame's)."""
 from __future__ import annotations
 
 import ast
-from functools import partial
 from pathlib import Path
 
 import mujoco
@@ -23,9 +22,9 @@ from headsim.sim import names
 from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.settings import paper_head
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
+RED = body_target("marker_red", MarkerDetector("red"))
 SOURCE = Path(__file__).resolve().parents[2] / "headsim"
 
 

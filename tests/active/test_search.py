@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from dataclasses import replace
-from functools import partial
 
 import numpy as np
 import pytest
@@ -21,12 +20,12 @@ from headsim.scenario.reach import ReachHead, model2_refusal, reach_refusal
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
+RED = body_target("marker_red", MarkerDetector("red"))
 
 
-BALL = body_target(names.CALIBRATION_BALL, partial(find_marker, colour="yellow"))
+BALL = body_target(names.CALIBRATION_BALL, MarkerDetector("yellow"))
 
 
 def _zoomed(zoom: float) -> HeadSettings:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.active.seen_pattern import (
+from headsim.active.look import (
     PREVIEW_MIN_SPACING_PX,
     SeenPattern,
     preview_binning,

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from dataclasses import replace
-from functools import partial
 
 import numpy as np
 
@@ -13,9 +12,9 @@ from headsim.active.placement import seen_by_both
 from headsim.active.tracking import track_moving_target
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = body_target("marker_red", partial(find_marker, colour="red"))
+RED = body_target("marker_red", MarkerDetector("red"))
 
 
 def test_tracking_follows_a_moving_target_with_fewer_renders_after_the_first() -> None:

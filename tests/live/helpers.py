@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-from functools import partial
-
 from headsim.sim.settings import IDEAL_FOCAL_PX, CameraSettings, HeadSettings
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector
 
-RED = partial(find_marker, colour="red")
+RED = MarkerDetector("red")
 
 
 def small_head(scale: float = 0.5) -> HeadSettings:

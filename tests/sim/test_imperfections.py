@@ -9,8 +9,6 @@ simulator's own model of the imperfection.
 
 from __future__ import annotations
 
-from functools import partial
-
 import numpy as np
 import pytest
 
@@ -22,10 +20,10 @@ from headsim.geometry.transforms import rotation_z
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, RenderFidelity
 from headsim.sim.simulator import HeadSim
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector, find_marker
 
 MARKER = "marker_red"
-RED = body_target(MARKER, partial(find_marker, colour="red"))
+RED = body_target(MARKER, MarkerDetector("red"))
 
 
 def test_a_mount_roll_turns_the_image_about_the_optical_axis() -> None:

@@ -1,0 +1,740 @@
+"""One way to look: a servo asks for a detection, and this module decides which image
+to render for it (a whole frame, a window, a binned preview) and keeps what it needs
+between looks.
+
+A servo knows nothing of the scene but its images.  A window placed where its last
+sight puts the target is a guess, which the image in it confirms (the blob found well
+inside it, about as large as it was; a pattern wholly inside it) or not; a miss is
+looked for again in a preview, then in the same instant's full frame.  Never from the
+truth, nor from whether the scene changed: detections, gains, encoders.
+
+The servos call :meth:`Looker.look` with a :data:`Hint`; nothing else here renders.
+What a detector can do is declared by the protocols :class:`BlobDetector` and
+:class:`PatternFeature`; a detector that declares neither always sees whole frames.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass, field
+from functools import partial
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+from headsim.active.events import Detected
+from headsim.active.servo_types import Detector, ServoConfig
+from headsim.sim.events import EventSink
+from headsim.sim.render import Window
+from headsim.sim.simulator import HeadSim
+from headsim.vision.detection import Detection
+
+#: A blob found in a window placed from an earlier sight counts only if its area is
+#: within this factor of the area seen then; else the window is a miss.  A target's
+#: image area changes little as the eyes or the neck move it across the image (the
+#: fast scenarios: within 1.2 but for a 42 px blob crossing the realistic head's
+#: distorted image, 1.44), and a lot when it moved in depth, or when the window shows
+#: another, smaller blob of its colour (the full frame's answer is the largest one).
+AREA_CHANGE = 2.0
+#: A pattern's feature is looked for alone only after an image motion of at most this
+#: many pattern spacings since the pattern was last seen: the gain's linear prediction
+#: is then good to well within the 0.3 spacing that tells the feature from its neighbours
+#: (a chessboard corner 1,300 steps of eye motion away was predicted a square off).
+ALONE_MOTION = 2.0
+#: A pattern is looked for in a binned preview only where its spacing stays at least
+#: this many pixels there: OpenCV found every chessboard of 14 px squares (the scene's
+#: board at 0.85 m binned 2 x 2) and none of 7 px (4 x 4).
+PREVIEW_MIN_SPACING_PX = 10.0
+
+Extent = tuple[float, float, float, float]
+
+
+# -- what a detector can do --------------------------------------------------------
+@runtime_checkable
+class BlobDetector(Protocol):
+    """A detector of a blob (a centroid and an area) whose answer is decided by the blob
+    and what lies within one blob size of it: a window around the blob gives the full
+    frame's answer, and a binned preview finds it."""
+
+    @property
+    def finds_blob(self) -> bool: ...
+
+    def __call__(self, image: np.ndarray) -> Detection: ...
+
+
+@runtime_checkable
+class PatternFeature(Protocol):
+    """A detector of one feature of a pattern (a chessboard's corner) that reports the
+    pattern's extent (``Detection.extent_px``) and, once the pattern was seen, can find
+    its feature alone where the pattern places it."""
+
+    @property
+    def window_key(self) -> Hashable:
+        """What the pattern's features share: their windows and the pattern's memory."""
+        ...
+
+    @property
+    def feature_index(self) -> int:
+        """The feature's index in ``Detection.pattern_uv``."""
+        ...
+
+    def __call__(self, image: np.ndarray) -> Detection: ...
+
+    def find_alone(self, image: np.ndarray, spacing_px: float) -> Detection:
+        """The feature alone, in an image of its surroundings (a pattern of ``spacing_px``)."""
+        ...
+
+    def alone_extent_px(self, spacing_px: float) -> Extent:
+        """(left, top, right, bottom) px from the feature of what finding it alone needs."""
+        ...
+
+
+def finds_blob(detector: object) -> bool:
+    """Whether ``detector`` declares itself a :class:`BlobDetector`."""
+    return isinstance(detector, BlobDetector) and detector.finds_blob
+
+
+def pattern_feature(detector: object) -> PatternFeature | None:
+    """``detector`` as a :class:`PatternFeature`, or None where it is not one."""
+    return detector if isinstance(detector, PatternFeature) else None
+
+
+# -- what the caller tells of its target ---------------------------------------------
+@dataclass(frozen=True)
+class Since:
+    """The eye servo's hint: the look's own last sight of the target, moved by
+    ``gain_px_per_step`` times the eye steps since (None: no gain learnt yet).
+    ``preview``: False for a search's look (a whole frame where nothing is predicted)."""
+
+    gain_px_per_step: float | None
+    preview: bool = True
+    key: object = None
+
+
+@dataclass(frozen=True)
+class Around:
+    """The neck servo's hint: its own prediction of the blob ``key`` found: at
+    ``uv_px``, of ``area_px``, after an image motion of ``motion_px``."""
+
+    key: object
+    uv_px: tuple[float, float]
+    area_px: float
+    motion_px: float
+
+
+@dataclass(frozen=True)
+class Anew:
+    """A target the caller has no sight of yet (found first in a binned preview)."""
+
+    key: object
+    binning: int = 0
+
+
+@dataclass(frozen=True)
+class Whole:
+    """The whole frame, nothing else."""
+
+
+@dataclass(frozen=True)
+class Glance:
+    """Only the whole view binned ``binning`` x ``binning`` (a scan's look): the
+    detection is in the preview's pixels and is not reported."""
+
+    binning: int
+
+
+Hint = Since | Around | Anew | Whole | Glance
+
+
+# -- what is kept between looks ------------------------------------------------------
+@dataclass(frozen=True)
+class Sight:
+    """A camera's last detection the next window is predicted from: what the head saw
+    and did (``key``, eye steps, neck encoders rad, uv px, area px^2)."""
+
+    key: object
+    steps: int
+    neck: tuple[float, float]
+    uv: tuple[float, float]
+    area_px: float
+
+
+def unbinned_px(binned_px: tuple[float, ...] | np.ndarray, binning: int) -> np.ndarray:
+    """Full-frame pixel coordinates of coordinates in a preview binned ``binning`` x
+    ``binning`` (``HeadSim.render_preview``): binned pixel i covers pixels
+    b i .. b i + b - 1, so its centre is b i + (b - 1) / 2."""
+    return binning * np.asarray(binned_px, dtype=np.float64) + (binning - 1) / 2.0
+
+
+@dataclass(frozen=True, eq=False)
+class SeenPattern:
+    """Every feature (N, 2) px, the spacing px, and the box (left, top, right, bottom) px
+    that finding the whole pattern needs, where the last detection put them."""
+
+    features: np.ndarray
+    spacing_px: float
+    box: np.ndarray
+
+    @classmethod
+    def from_whole(cls, detection: Detection) -> SeenPattern | None:
+        """From a detection of the whole pattern (None: not one)."""
+        if detection.uv is None or detection.pattern_uv is None or detection.extent_px is None:
+            return None
+        u, v = detection.uv
+        left, top, right, bottom = detection.extent_px
+        box = np.array([u + left, v + top, u + right, v + bottom])
+        return cls(np.array(detection.pattern_uv), detection.pattern_scale_px, box)
+
+    @classmethod
+    def from_preview(cls, detection: Detection, binning: int) -> SeenPattern | None:
+        """From a detection of the whole pattern in a preview binned ``binning`` x
+        ``binning`` (None: not one), in the full frame's pixels: binned pixel i covers
+        pixels b i .. b i + b - 1 (:func:`unbinned_px`)."""
+        binned = cls.from_whole(detection)
+        if binned is None:
+            return None
+        return cls(
+            unbinned_px(binned.features, binning),
+            binning * binned.spacing_px,
+            unbinned_px(binned.box, binning),
+        )
+
+    def found_alone(self, index: int, uv: tuple[float, float]) -> SeenPattern:
+        """Moved so that feature ``index``, found alone, is at ``uv``."""
+        shift = np.asarray(uv) - self.features[index]
+        return SeenPattern(self.features + shift, self.spacing_px, self.box + shift[[0, 1, 0, 1]])
+
+    def extent_from(self, uv: tuple[float, float]) -> Extent:
+        """The whole pattern's box from ``uv``, px: (left, top, right, bottom)."""
+        left, top, right, bottom = (float(x) for x in self.box)
+        return (left - uv[0], top - uv[1], right - uv[0], bottom - uv[1])
+
+    def expects_alone(self, index: int, motion_px: float) -> bool:
+        """Whether feature ``index`` may be looked for alone after ``motion_px`` of motion."""
+        return (
+            0 <= index < len(self.features)
+            and self.spacing_px > 0.0
+            and abs(motion_px) <= ALONE_MOTION * self.spacing_px
+        )
+
+
+def preview_binning(spacing_px: float, largest: int, image_size: tuple[int, int]) -> int:
+    """The largest binning up to ``largest`` (a power of two dividing the image) that keeps
+    the pattern's spacing at least :data:`PREVIEW_MIN_SPACING_PX`; 1: none does."""
+    width, height = image_size
+    b = 1
+    while (
+        2 * b <= largest
+        and width % (2 * b) == 0
+        and height % (2 * b) == 0
+        and spacing_px / (2 * b) >= PREVIEW_MIN_SPACING_PX
+    ):
+        b *= 2
+    return b
+
+
+def remembered(
+    kept: SeenPattern | None, detection: Detection, found_alone: int | None
+) -> SeenPattern | None:
+    """What to keep after ``detection`` (FOUND): the pattern it saw whole; the kept one
+    moved to it when it is feature ``found_alone`` found alone; else nothing (a blob)."""
+    whole = SeenPattern.from_whole(detection)
+    if whole is not None:
+        return whole
+    if found_alone is not None and kept is not None and detection.uv is not None:
+        return kept.found_alone(found_alone, detection.uv)
+    return None
+
+
+# -- where a window goes (pure) ------------------------------------------------------
+def pattern_window(
+    image_size: tuple[int, int],
+    expected_uv: tuple[float, float],
+    extent_px: Extent,
+    motion_px: float,
+    margin_px: float,
+) -> Window | None:
+    """The window to look for a pattern of ``extent_px`` around ``expected_uv`` after an
+    image motion of ``motion_px``: the extent plus the margin and a quarter of the motion
+    on every side.  None where it would be barely cheaper than the frame."""
+    width, height = image_size
+    grow = margin_px + 0.25 * abs(motion_px)
+    u, v = expected_uv
+    left, top, right, bottom = extent_px
+    x0 = max(math.floor(u + left - grow), 0)
+    y0 = max(math.floor(v + top - grow), 0)
+    x1 = min(math.ceil(u + right + grow) + 1, width)
+    y1 = min(math.ceil(v + bottom + grow) + 1, height)
+    if x1 <= x0 or y1 <= y0 or (x1 - x0) * (y1 - y0) >= 0.5 * width * height:
+        return None
+    return Window(int(x0), int(y0), int(x1 - x0), int(y1 - y0))
+
+
+def expected_window(
+    image_size: tuple[int, int],
+    expected_uv: tuple[float, float],
+    area_px: float,
+    motion_px: float,
+    margin_px: float,
+) -> Window | None:
+    """The window to look for a blob of ``area_px`` expected at ``expected_uv`` after an
+    image motion of ``motion_px``: half-side 3 blob radii + margin + a quarter of the
+    motion.  None where it would be barely cheaper than the frame."""
+    half = 3.0 * math.sqrt(area_px / math.pi) + margin_px + 0.25 * abs(motion_px)
+    window = Window.around(expected_uv, half, image_size)
+    if window.width * window.height >= 0.5 * image_size[0] * image_size[1]:
+        return None
+    return window
+
+
+def stands_for_frame(
+    seen: Detection,
+    window: Window,
+    image_size: tuple[int, int],
+    expected_area_px: float | None = None,
+) -> Detection | None:
+    """``seen`` (detected in ``window``) in full-frame pixels if the full frame would give
+    the same answer, else None (a miss).
+
+    A blob counts only if FOUND at least 3 blob radii + 2 px inside the window, so that
+    the blob and every piece the detector looks for beside it (within one blob size) lie
+    in the window; with ``expected_area_px`` (an earlier sight placed the window), only
+    if its area is within :data:`AREA_CHANGE` of it.  A pattern counts only if all of it
+    lies 2 px inside the window, or runs off a side where the window's edge is the
+    image's (the full frame ends there too).
+    """
+    if not seen.found or seen.uv is None:
+        return None
+    if expected_area_px is not None and not (
+        expected_area_px / AREA_CHANGE <= seen.area_px <= AREA_CHANGE * expected_area_px
+    ):
+        return None
+    u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0
+    width, height = image_size
+    if seen.extent_px is not None:
+        left, top, right, bottom = seen.extent_px
+        if (
+            (window.x0 == 0 or window.x0 + 2 <= u + left)
+            and (window.x1 == width or u + right <= window.x1 - 3)
+            and (window.y0 == 0 or window.y0 + 2 <= v + top)
+            and (window.y1 == height or v + bottom <= window.y1 - 3)
+        ):
+            return seen.moved(window.x0, window.y0)
+        return None
+    inset = 3.0 * math.sqrt(seen.area_px / math.pi) + 2.0
+    if (
+        window.x0 + inset <= u <= window.x1 - 1 - inset
+        and window.y0 + inset <= v <= window.y1 - 1 - inset
+    ):
+        return seen.moved(window.x0, window.y0)
+    return None
+
+
+def reporting(
+    detector: Detector, sink: EventSink, camera: int, window: Window | None = None
+) -> Detector:
+    """``detector``, reporting to ``sink`` each detection it makes in camera ``camera``'s
+    image (:class:`headsim.active.events.Detected`; in a ``window``, its offset added)."""
+
+    def detect(image: np.ndarray) -> Detection:
+        detection = detector(image)
+        uv = detection.uv if detection.found else None
+        if uv is not None and window is not None:  # in the full frame's pixels
+            uv = (uv[0] + window.x0, uv[1] + window.y0)
+        sink.emit(Detected(camera, detection.status, uv))
+        return detection
+
+    return detect
+
+
+def look_once(
+    sim: HeadSim,
+    camera: int,
+    detector: Detector,
+    config: ServoConfig | None = None,
+    binning: int = 0,
+) -> Detection:
+    """``detector``'s answer on ``camera``'s next image, for a caller that looks once at a
+    target it has no sight of yet and keeps nothing (stereo, chessboard views):
+    :meth:`Looker.look` with :class:`Anew`, unreported."""
+    return Looker(sim, config, report=False).look(camera, detector, Anew(detector, binning))
+
+
+# -- the look ------------------------------------------------------------------------
+@dataclass
+class LookCounts:
+    """Binned previews rendered to place a window, windows rendered, and windows that
+    missed the target (a full frame, or a preview's window, followed)."""
+
+    previews: int = 0
+    window_renders: int = 0
+    window_misses: int = 0
+
+
+@dataclass
+class _Memory:
+    """Per camera: the last sight, the extent of the pattern last seen (None: a blob),
+    where the last detection puts its pattern (a board seen whole, then moved with each
+    feature found alone), and the cameras that saw the pattern whole in this fixation
+    (only they look for a feature alone: the board may have moved by whole squares)."""
+
+    sight: dict[int, Sight] = field(default_factory=dict)
+    extent: dict[int, Extent | None] = field(default_factory=dict)
+    pattern: dict[int, SeenPattern] = field(default_factory=dict)
+    confirmed: set[int] = field(default_factory=set)
+
+
+class Looker:
+    """A servo's eyes on the simulator: :meth:`look` renders what a :data:`Hint` calls for
+    and detects there, and keeps what the next look is predicted from."""
+
+    def __init__(
+        self,
+        sim: HeadSim,
+        config: ServoConfig | None = None,
+        sink: EventSink | None = None,
+        report: bool = True,
+    ) -> None:
+        self.sim = sim
+        self.config = config or ServoConfig()
+        self.sink = sim.sink if sink is None else sink
+        self._report = report
+        self.counts = LookCounts()
+        self._memory = _Memory()
+        #: Each camera's image size (width, height) px, by camera (1, 2).
+        self.sizes = {
+            n: (camera.width, camera.height) for n, camera in enumerate(sim.settings.cameras, 1)
+        }
+
+    def new_fixation(self) -> None:
+        """A new fixation begins: a pattern is seen whole again before its features are
+        looked for alone."""
+        self._memory.confirmed.clear()
+
+    def look(self, camera: int, detector: Detector, hint: Hint) -> Detection:
+        """``detector``'s answer on ``camera``'s next image, from as few pixels as the full
+        frame's answer needs (see each :data:`Hint`)."""
+        if isinstance(hint, Since):
+            return self._since(camera, detector, hint)
+        if isinstance(hint, Glance):
+            return detector(self._take(camera, binning=hint.binning))
+        cfg = self.config
+        if isinstance(hint, Around) and cfg.windows and finds_blob(hint.key):
+            window = expected_window(
+                self.sizes[camera], hint.uv_px, hint.area_px, hint.motion_px,
+                cfg.window_margin_px,
+            )  # fmt: skip
+            if window is not None:
+                return self._confirm(camera, detector, hint.key, window, hint.area_px)
+        elif isinstance(hint, Anew) and self._previews(hint):
+            self.counts.previews += 1
+            window = self._preview_window(camera, hint.key, hint.binning)
+            if window is not None:
+                return self._confirm(camera, detector, hint.key, window)
+        return self._reported(detector, camera)(self._take(camera))
+
+    def _previews(self, hint: Anew) -> bool:
+        """Whether a new target is looked for in a preview first."""
+        if not self.config.windows or (hint.binning or self.config.preview_binning) <= 1:
+            return False
+        # One-time looks (no key of a servo's) place any detector's window from a preview.
+        return not self._report or finds_blob(hint.key)
+
+    def _reported(self, detector: Detector, camera: int, window: Window | None = None) -> Detector:
+        return reporting(detector, self.sink, camera, window) if self._report else detector
+
+    def _confirm(
+        self,
+        camera: int,
+        detector: Detector,
+        key: object,
+        window: Window,
+        guessed: float | None = None,
+    ) -> Detection:
+        """Detect in a rendered window; a miss costs the same instant's whole frame, or,
+        for a window ``guessed`` from a blob of that area seen before, first a preview
+        and the window it places."""
+        self.counts.window_renders += 1
+        detection = self._in_window(
+            camera, self._reported(detector, camera, window), window, guessed
+        )
+        if detection is not None:
+            return detection
+        self.counts.window_misses += 1
+        if guessed is not None and self.config.preview_binning > 1:
+            self.counts.previews += 1
+            report = partial(reporting, detector, self.sink, camera)
+            detection, rendered = self._look_again(camera, key, report)
+            self.counts.window_renders += rendered
+            if detection is not None:
+                return detection
+            self.counts.window_misses += rendered
+        return self._reported(detector, camera)(self._take(camera, retake=True))
+
+    # -- images ------------------------------------------------------------------------
+    def _take(
+        self, camera: int, window: Window | None = None, binning: int = 1, retake: bool = False
+    ) -> np.ndarray:
+        """The one place a look renders: ``camera``'s whole frame, a ``window`` of it, or
+        its whole view binned ``binning`` x ``binning``; ``retake``: of the instant just
+        taken (the same noise)."""
+        if binning > 1:
+            return self.sim.render_preview(camera, binning)
+        if window is not None:
+            return self.sim.render_window(camera, window, retake=retake)
+        return self.sim.retake(camera) if retake else self.sim.render(camera)
+
+    def _in_window(
+        self,
+        camera: int,
+        detector: Detector,
+        window: Window,
+        expected_area_px: float | None = None,
+        retake: bool = False,
+    ) -> Detection | None:
+        """Render ``window`` and detect there: the detection in full-frame pixels, or None
+        (a miss, :func:`stands_for_frame`).  ``retake``: of the instant just taken."""
+        seen = detector(self._take(camera, window, retake=retake))
+        return stands_for_frame(seen, window, self.sizes[camera], expected_area_px)
+
+    def _preview_window(self, camera: int, detector: object, binning: int = 0) -> Window | None:
+        """Render a preview of ``camera``'s whole view binned b x b (``binning``, default
+        ``config.preview_binning``) and return the window where it shows the target (a
+        blob's, or a whole pattern's box), or None (not found, or a window barely cheaper
+        than the frame: a full frame follows)."""
+        config = self.config
+        b = binning or config.preview_binning
+        assert callable(detector)
+        seen = detector(self._take(camera, binning=b))
+        if not isinstance(seen, Detection) or not seen.found or seen.uv is None:
+            return None
+        # Its position is good to about b px.
+        u, v = unbinned_px(seen.uv, b)
+        uv = (float(u), float(v))
+        size = self.sizes[camera]
+        if seen.extent_px is not None:  # a pattern: its box, from the feature
+            left, top, right, bottom = (b * e for e in seen.extent_px)
+            return pattern_window(
+                size, uv, (left, top, right, bottom), 4.0 * b, config.window_margin_px
+            )
+        return expected_window(size, uv, b * b * seen.area_px, 4.0 * b, config.window_margin_px)
+
+    def _look_again(
+        self, camera: int, detector: object, report: Callable[[Window], Detector]
+    ) -> tuple[Detection | None, bool]:
+        """After a window placed from an earlier sight missed (the target moved, or the
+        window shows something else): ``detector``'s blob found again in a binned preview,
+        and detected (by ``report(window)``) in the window the preview places, retaken of
+        the same instant.  Returns the detection (None: not in the preview, or that window
+        missed too: the full frame follows) and whether that window was rendered."""
+        window = self._preview_window(camera, detector)
+        if window is None:
+            return None, False
+        return self._in_window(camera, report(window), window, retake=True), True
+
+    # -- the eye servo's look: predicted from the last sight -------------------------
+    def _since(self, camera: int, detector: Detector, hint: Since) -> Detection:
+        """With windows on, and when this camera last saw the same target (``key``,
+        default the detector) with the neck unchanged since and a gain known, only a
+        window is rendered: around where the head expects the target from that sight and
+        the eye steps moved since (u + gain * steps), of half-side 3 blob radii plus the
+        margin and a quarter of the predicted motion (blob detectors), or the pattern's
+        box so grown.  A miss is looked for again in a preview, then in the same
+        instant's full frame.  A new target, or a pattern's feature after a move too long
+        to find it alone, is first found in a binned preview; ``preview=False`` renders
+        the full frame instead (a search's look)."""
+        key = detector if hint.key is None else hint.key
+        sim, cfg, memory, counts = self.sim, self.config, self._memory, self.counts
+        steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
+        feature = pattern_feature(key)
+        if feature is not None:  # a pattern's features share their windows
+            key = feature.window_key
+        window, spacing, whole = None, 0.0, False
+        if feature is not None or finds_blob(key):
+            window, spacing, whole = self._window(
+                camera, key, steps, neck, hint.gain_px_per_step, feature
+            )
+        # A blob's window placed from the last sight of it: a guess the image confirms.
+        guessed = memory.sight[camera].area_px if window is not None and feature is None else None
+        looked = None
+        if hint.preview and feature is not None and not spacing and not whole:
+            looked = self._pattern_preview(camera, key, detector, feature)
+        if looked is not None:
+            window, spacing = looked
+        elif hint.preview and window is None and feature is None and finds_blob(key):
+            window = self._blob_preview(camera, key, neck)
+        detection = None
+        found_alone: int | None = None  # the feature's index when found alone
+        if window is not None:
+            counts.window_renders += 1
+            look = (
+                partial(feature.find_alone, spacing_px=spacing)
+                if spacing and feature is not None
+                else detector
+            )
+            detection = self._in_window(
+                camera, reporting(look, self.sink, camera, window), window, guessed
+            )
+            if detection is not None and spacing and feature is not None:
+                found_alone = feature.feature_index
+            if detection is None:
+                counts.window_misses += 1
+            if (
+                detection is None
+                and guessed is not None
+                and hint.preview
+                and cfg.preview_binning > 1
+            ):
+                counts.previews += 1
+                report = partial(reporting, detector, self.sink, camera)
+                detection, rendered = self._look_again(camera, key, report)
+                counts.window_renders += rendered
+                counts.window_misses += rendered and detection is None
+            if detection is None:
+                # the same instant, whole
+                detection = reporting(detector, self.sink, camera)(self._take(camera, retake=True))
+        if detection is None:
+            detection = reporting(detector, self.sink, camera)(self._take(camera))
+        self._remember(camera, detection, (key, steps, neck), looked is not None, found_alone)
+        return detection
+
+    def _remember(
+        self,
+        camera: int,
+        detection: Detection,
+        where: tuple[object, int, tuple[float, float]],
+        previewed: bool,
+        found_alone: int | None,
+    ) -> None:
+        """Keep what ``detection`` tells the next look: ``where`` the head was (key, eye
+        steps, neck encoders), whether a preview showed the pattern, and the feature's
+        index when it was found alone.  Only detections with a centroid and an area
+        predict a window."""
+        memory = self._memory
+        if isinstance(detection, Detection) and detection.found and detection.uv is not None:
+            if previewed or detection.pattern_uv is not None:
+                memory.confirmed.add(camera)  # the pattern seen whole (or its preview)
+            memory.sight[camera] = Sight(*where, detection.uv, detection.area_px)
+            memory.extent[camera] = detection.extent_px
+            kept = remembered(memory.pattern.get(camera), detection, found_alone)
+            if kept is None:
+                memory.pattern.pop(camera, None)
+            else:
+                memory.pattern[camera] = kept
+                if found_alone is not None:  # the next whole-pattern window is its box
+                    memory.extent[camera] = kept.extent_from(detection.uv)
+        else:
+            memory.sight.pop(camera, None)
+            memory.pattern.pop(camera, None)
+            memory.confirmed.discard(camera)
+
+    def _blob_preview(self, camera: int, key: object, neck: tuple[float, float]) -> Window | None:
+        """A preview's window for ``key``'s blob where no sight predicts where it is (a
+        new target, or the neck moved since)."""
+        seen = self._memory.sight.get(camera)
+        if not self.config.windows or self.config.preview_binning <= 1:
+            return None
+        if seen is not None and seen.key == key and seen.neck == neck:
+            return None
+        self.counts.previews += 1
+        return self._preview_window(camera, key)
+
+    def _pattern_preview(
+        self, camera: int, key: object, detector: Detector, feature: PatternFeature
+    ) -> tuple[Window | None, float] | None:
+        """After a move too long to find ``feature`` alone, where a binned preview of the
+        whole view puts it and the pattern's spacing there.  None: no preview (no binning
+        keeps the pattern findable), or one that did not show the pattern (its window, as
+        before)."""
+        seen, kept = self._memory.sight.get(camera), self._memory.pattern.get(camera)
+        if not self.config.windows or kept is None or seen is None or seen.key != key:
+            return None
+        size = self.sizes[camera]
+        b = preview_binning(kept.spacing_px, self.config.preview_binning, size)
+        if b <= 1:
+            return None
+        self.counts.previews += 1
+        found = SeenPattern.from_preview(detector(self._take(camera, binning=b)), b)
+        if found is None:
+            return None
+        u, v = found.features[feature.feature_index]
+        # The preview places each feature to within about b px.
+        window = pattern_window(
+            size, (u, v), feature.alone_extent_px(found.spacing_px), 4.0 * b,
+            self.config.window_margin_px,
+        )  # fmt: skip
+        if window is None:
+            return None
+        self._memory.pattern[camera] = found
+        return window, found.spacing_px
+
+    def _window(
+        self,
+        camera: int,
+        key: object,
+        steps: int,
+        neck: tuple[float, float],
+        gain: float | None,
+        feature: PatternFeature | None,
+    ) -> tuple[Window | None, float, bool]:
+        """Where to look for ``key``'s target in ``camera`` (None: the full frame), the
+        pattern's spacing, px, when it is a ``feature`` looked for alone (else 0), and
+        whether it is the whole pattern's window that tells the features apart first (in
+        a new fixation): around where the last sight of the pattern puts it."""
+        cfg, memory = self.config, self._memory
+        seen = memory.sight.get(camera)
+        if not cfg.windows or seen is None or gain is None:
+            return None, 0.0, False
+        if seen.key != key or seen.neck != neck:
+            return None, 0.0, False
+        size = self.sizes[camera]
+        motion = gain * (steps - seen.steps)
+        kept, extent = memory.pattern.get(camera), memory.extent.get(camera)
+        expected, margin, whole = (seen.uv[0] + motion, seen.uv[1]), cfg.window_margin_px, False
+        if (
+            feature is not None
+            and kept is not None
+            and kept.expects_alone(feature.feature_index, motion)
+        ):
+            if camera in memory.confirmed:
+                u, v = kept.features[feature.feature_index]
+                spacing = kept.spacing_px
+                window = pattern_window(
+                    size, (u + motion, v), feature.alone_extent_px(spacing), motion, margin
+                )
+                return window, spacing if window is not None else 0.0, False
+            whole = True  # a new fixation: the whole pattern first
+        if extent is not None:  # a pattern: the whole of it
+            window = pattern_window(size, expected, extent, motion, margin)
+            return window, 0.0, whole and window is not None
+        return expected_window(size, expected, seen.area_px, motion, margin), 0.0, False
+
+
+__all__ = [
+    "ALONE_MOTION",
+    "AREA_CHANGE",
+    "PREVIEW_MIN_SPACING_PX",
+    "Anew",
+    "Around",
+    "BlobDetector",
+    "Glance",
+    "Hint",
+    "LookCounts",
+    "Looker",
+    "PatternFeature",
+    "SeenPattern",
+    "Sight",
+    "Since",
+    "Whole",
+    "expected_window",
+    "finds_blob",
+    "look_once",
+    "pattern_feature",
+    "pattern_window",
+    "preview_binning",
+    "remembered",
+    "reporting",
+    "stands_for_frame",
+    "unbinned_px",
+]
