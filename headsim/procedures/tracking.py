@@ -2,28 +2,103 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
-from headsim.active.events import PhaseStarted
-from headsim.active.measurement import HeadKnowledge
+from headsim.active.events import FixationStarted, MeasurementDone, PhaseStarted
+from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
-from headsim.active.tracking import track_moving_target
 from headsim.run.context import (
     record_measurement,
     servo_config,
     simulator,
 )
 from headsim.run.events import Hub
-from headsim.run.outcomes import (
-    MeasurementRecord,
-    TrackingResult,
-)
+from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import cell, mm
 from headsim.run.targets import marker_target
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.spec import Scenario
+from headsim.sim.events import EventSink
+from headsim.sim.simulator import HeadSim
+
+
+@dataclass(frozen=True)
+class TrackingResult:
+    """Tracking a moving target with Model 1: times, s; waypoints and errors in W, m."""
+
+    times_s: np.ndarray
+    waypoints_world_m: list[tuple[float, float, float]]
+    errors_world_m: np.ndarray
+    renders_first: int
+    renders_after_mean: float
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: every field, in order."""
+        return asdict(self)
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        """One line: the fixations made, their error in W and their renders."""
+        errors = np.asarray(self.errors_world_m, dtype=float)
+        finite = errors[np.isfinite(errors)]
+        return [
+            f"Tracking with the neck (Model 1): {len(finite)} of {len(errors)} fixations; error in W "
+            f"mean {mm(float(finite.mean()) if finite.size else None)} mm, max "
+            f"{mm(float(finite.max()) if finite.size else None)} mm; renders {self.renders_first} for the "
+            f"first fixation, {cell(self.renders_after_mean, '.1f')} per fixation after"
+        ]
+
+
+@dataclass(frozen=True)
+class TrackingRun:
+    """A moving target followed with the neck model: one measurement per fixation, time in s."""
+
+    times_s: np.ndarray
+    measurements: tuple[Measurement, ...]
+
+    @property
+    def errors_world_m(self) -> np.ndarray:
+        """(N,) 3-D error of each fixation in W, m (NaN where it failed)."""
+        return np.array(
+            [np.linalg.norm(m.estimate_world_m - m.truth_world_m) for m in self.measurements]
+        )
+
+
+def track_moving_target(
+    sim: HeadSim,
+    servo: NeckServo,
+    target: Target,
+    body: str,
+    trajectory: Callable[[float], np.ndarray],
+    times_s: Sequence[float] | np.ndarray,
+    knowledge: HeadKnowledge | None = None,
+    sink: EventSink | None = None,
+) -> TrackingRun:
+    """Move ``body`` along ``trajectory(t)`` (world, m) and fixate it at each time with Model 1.
+
+    The servo's Jacobian carries from one fixation to the next, so after the
+    first fixation each one starts from the last and takes few renders.  A
+    target that left both views since is searched for around the last
+    fixation (:func:`headsim.active.search.find_neck_view`), then from the start pose.
+    ``sink``: where each fixation ("<target> 1", ...) and measurement is reported
+    (None: the simulator's sink).
+    """
+    sink = sim.sink if sink is None else sink
+    measurements = []
+    fixations: list[tuple[int, int, int]] = []  # where the target was seen, in steps
+    for k, t in enumerate(times_s):
+        sink.emit(FixationStarted(f"{target.name} {k + 1}"))
+        sim.set_body_pose(body, trajectory(float(t)))
+        m = measure_model1(sim, servo, target, knowledge, last_seen=fixations[-2:])
+        sink.emit(MeasurementDone(m, float(t)))
+        measurements.append(m)
+        if m.ok:
+            fixations.append(servo.steps())
+    return TrackingRun(np.asarray(times_s, dtype=float), tuple(measurements))
 
 
 def run_tracking(
@@ -63,22 +138,15 @@ def run_tracking(
     return records, experiment
 
 
-def _tracking_lines(e: TrackingResult) -> list[str]:
-    errors = np.asarray(e.errors_world_m, dtype=float)
-    finite = errors[np.isfinite(errors)]
-    return [
-        f"Tracking with the neck (Model 1): {len(finite)} of {len(errors)} fixations; error in W "
-        f"mean {mm(float(finite.mean()) if finite.size else None)} mm, max "
-        f"{mm(float(finite.max()) if finite.size else None)} mm; renders {e.renders_first} for the "
-        f"first fixation, {cell(e.renders_after_mean, '.1f')} per fixation after"
-    ]
+TRACKING = register(
+    Procedure(
+        "tracking",
+        "default",
+        run_tracking,
+        fields=TrackingResult.block,
+        summary=TrackingResult.summary_lines,
+    )
+)
 
 
-def _summary(e: TrackingResult, paper: bool) -> list[str]:
-    return _tracking_lines(e)
-
-
-TRACKING = register(Procedure("tracking", "default", run_tracking, fields=asdict, summary=_summary))
-
-
-__all__ = ["TRACKING", "run_tracking"]
+__all__ = ["TRACKING", "TrackingResult", "TrackingRun", "run_tracking", "track_moving_target"]

@@ -1,8 +1,9 @@
-"""What a run found, as types: the calibration report, each procedure's result, the run.
+"""What a run found, as types: the calibration report, each measurement's record, the run.
 
 Frozen dataclasses, read by the summary, the recording and the studies;
 :mod:`headsim.run.serialise` is the one place that turns them into
-results.json (README "Scenarios and results" documents every key).  Units are
+results.json (README "Scenarios and results" documents every key).  Each
+procedure's own result is its module's (:mod:`headsim.procedures`).  Units are
 in the names: m, rad, px; positions in W unless named otherwise.
 """
 
@@ -152,144 +153,6 @@ class CalibrationReport:
         return "ok" if self.ok else self.detail
 
 
-# -- each procedure's experiment ------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class CheckTarget:
-    """A check target of the calibration procedure: 3-D error before and after, m (NaN: failed)."""
-
-    name: str
-    error_m_uncalibrated: float
-    error_m_calibrated: float
-
-
-@dataclass(frozen=True)
-class PointsResult:
-    """Model 1 or 2 on each target; ``check_targets`` for the calibration procedure only."""
-
-    check_targets: tuple[CheckTarget, ...] | None = None
-
-
-@dataclass(frozen=True)
-class ChessboardPaper:
-    """Table III/IV's square side, mean and std, m."""
-
-    side_mean_m: float
-    side_std_m: float
-
-
-@dataclass(frozen=True)
-class ChessboardResult:
-    """The chessboard's inner corners with Model 2 and the squares they give (Sec. VI-A), m."""
-
-    pattern: list[int]
-    square_m: float
-    corners: int
-    corners_measured: int
-    widths_m: np.ndarray
-    heights_m: np.ndarray
-    true_widths_m: np.ndarray
-    true_heights_m: np.ndarray
-    width_mean_m: float
-    width_std_m: float
-    height_mean_m: float
-    height_std_m: float
-    side_mean_m: float
-    side_std_m: float
-    paper: ChessboardPaper
-
-
-@dataclass(frozen=True)
-class RelativeObject:
-    """One object of relative positioning: its area S1..S12 (0: none), measured and true."""
-
-    name: str
-    colour: str
-    area: int
-    true_area: int
-    agree: bool
-    margin_px: float
-    gain_area: int
-    gain_agree: bool
-    columns_px: list[float]
-    position_head_m: np.ndarray
-
-
-@dataclass(frozen=True)
-class RelativePaper:
-    """Sec. VI-C's fixation angles, rad, and number of objects."""
-
-    alpha1_rad: float
-    alpha2_rad: float
-    objects: int
-
-
-@dataclass(frozen=True)
-class RelativeResult:
-    """Relative positioning (Sec. III, VI-C): the two fixations' angles, rad, and each object."""
-
-    alpha1_rad: float
-    alpha2_rad: float
-    objects: tuple[RelativeObject, ...]
-    missing: list[str]
-    agree: int
-    disagree_outside_margin: int | None
-    gain_agree: int
-    gain_disagree_outside_margin: int | None
-    margin_threshold_px: float | None
-    renders: int
-    paper: RelativePaper
-
-
-@dataclass(frozen=True)
-class TrackingResult:
-    """Tracking a moving target with Model 1: times, s; waypoints and errors in W, m."""
-
-    times_s: np.ndarray
-    waypoints_world_m: list[tuple[float, float, float]]
-    errors_world_m: np.ndarray
-    renders_first: int
-    renders_after_mean: float
-
-
-@dataclass(frozen=True)
-class PursuitFigures:
-    """The figures that score a live pursuit, over the frames on which the target was present.
-
-    Times in s, offsets in px, position errors in W, m; NaN where undefined.
-    ``ended``: why the loop ended.
-    """
-
-    frames: int
-    frames_present: int
-    frames_lost: int
-    losses: int
-    reacquisitions: int
-    saccades: int
-    time_to_fixation_s: float
-    lag_s: float
-    offset_rms_px: float
-    position_rms_m: float
-    position_rms_pct_of_depth: float
-    position_max_m: float
-    ended: str
-
-
-@dataclass(frozen=True)
-class PursuitResult:
-    """The live pursuit (:mod:`headsim.procedures.pursuit`): the spec as run, its figures and
-    each frame (None when it never started), and why it failed, one line each."""
-
-    pursuit: dict[str, Any]
-    figures: PursuitFigures | None = None
-    per_frame: dict[str, Any] | None = None
-    failures: tuple[str, ...] = ()
-
-
-Experiment = PointsResult | ChessboardResult | RelativeResult | TrackingResult | PursuitResult
-
-
 # -- the run ----------------------------------------------------------------------------
 
 
@@ -371,22 +234,11 @@ __all__ = [
     "CalibrationLayout",
     "CalibrationReport",
     "CalibrationSource",
-    "CheckTarget",
-    "ChessboardPaper",
-    "ChessboardResult",
-    "Experiment",
     "KnowledgeReport",
     "LinesOfSightFit",
     "MeasurementRecord",
-    "PointsResult",
     "PositionOutcome",
-    "PursuitFigures",
-    "PursuitResult",
-    "RelativeObject",
-    "RelativePaper",
-    "RelativeResult",
     "RunRenders",
     "RunResult",
-    "TrackingResult",
     "VerticalReference",
 ]

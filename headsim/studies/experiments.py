@@ -18,16 +18,16 @@ from typing import Any, cast
 import numpy as np
 
 from headsim.active.calibration import calibrate_head
-from headsim.active.chessboard import measure_chessboard
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement, body_target
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import calibration_layout
-from headsim.active.relative import relative_positioning
 from headsim.active.servo_types import Detector
-from headsim.active.tracking import track_moving_target
 from headsim.estimators.areas import AreaComparison
+from headsim.procedures.chessboard import measure_chessboard
+from headsim.procedures.relative import relative_positioning
+from headsim.procedures.tracking import track_moving_target
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim

@@ -9,6 +9,9 @@ import pytest
 
 from headsim.estimators.result import Method, Status
 from headsim.files import to_jsonable
+from headsim.procedures.model2 import Model2Result
+from headsim.procedures.pursuit import PursuitResult
+from headsim.procedures.tracking import TrackingResult
 from headsim.run.outcomes import (
     CalibrationLayout,
     CalibrationReport,
@@ -16,10 +19,7 @@ from headsim.run.outcomes import (
     KnowledgeReport,
     LinesOfSightFit,
     MeasurementRecord,
-    PointsResult,
     PositionOutcome,
-    PursuitResult,
-    TrackingResult,
     VerticalReference,
 )
 from headsim.run.serialise import (
@@ -150,7 +150,7 @@ def test_a_block_from_before_renders_counted_previews_says_nothing_of_them() -> 
 
 
 def test_each_experiment_writes_the_procedure_first() -> None:
-    assert experiment_block("model2", PointsResult()) == {"procedure": "model2"}
+    assert experiment_block("model2", Model2Result()) == {"procedure": "model2"}
     assert experiment_block("chessboard", None) == {"procedure": "chessboard"}
     tracking = TrackingResult(
         np.array([0.0, 1.0]), [(0.0, 0.5, 0.6)], np.array([1e-3, 2e-3]), 12, 4.0

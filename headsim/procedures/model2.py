@@ -1,0 +1,47 @@
+"""Model 2 (the eyes alone, the neck still) on each of the scenario's targets (Sec. IV-B)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.model2 import measure_model2
+from headsim.procedures.each_target import measure_each_target
+from headsim.run.context import model2_config, servo_config
+from headsim.run.events import Hub
+from headsim.run.outcomes import MeasurementRecord
+from headsim.scenario.registry import Procedure, register
+from headsim.scenario.spec import Scenario
+
+
+@dataclass(frozen=True)
+class Model2Result:
+    """Model 2 on each target: nothing beyond its measurements."""
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: none."""
+        return {}
+
+
+def run_model2(
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], Model2Result]:
+    """Model 2 on each target in turn, one eye servo for all."""
+    config = model2_config(scenario)
+    records = measure_each_target(
+        scenario,
+        hub,
+        knowledge,
+        [(knowledge, label)],
+        lambda sim: EyeServo(sim, servo_config(scenario)),
+        lambda sim, servo, target, known: measure_model2(sim, servo, target, known, config),
+    )
+    return records, Model2Result()
+
+
+MODEL2 = register(Procedure("model2", "default", run_model2, fields=Model2Result.block))
+
+
+__all__ = ["MODEL2", "Model2Result", "run_model2"]
