@@ -10,7 +10,8 @@ from typing import Any
 import numpy as np
 import rerun as rr
 
-from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RunResult
+from headsim.active.calibration_report import CalibrationReport
+from headsim.run.outcomes import MeasurementRecord, RunResult
 from headsim.run.recording_layout import (
     GREEN,
     GREY,

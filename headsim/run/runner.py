@@ -16,17 +16,12 @@ import time
 from collections.abc import Sequence
 from dataclasses import replace
 
+from headsim.active.calibration_file import StoredCalibration, head_hash, read_calibration
+from headsim.active.calibration_report import CalibrationReport
 from headsim.run.calibrate import calibrate
 from headsim.run.context import told
 from headsim.run.events import CalibrationDone, Hub, RunFinished, Subscriber
-from headsim.run.outcomes import (
-    CalibrationReport,
-    CalibrationSource,
-    MeasurementRecord,
-    RunRenders,
-    RunResult,
-)
-from headsim.run.serialise import calibration_from_block, render_counts_from_block
+from headsim.run.outcomes import MeasurementRecord, RunRenders, RunResult
 from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
 from headsim.sim.events import RenderCounts
@@ -48,6 +43,15 @@ def calibrate_scenario(
     return replace(report, rendered_frames=hub.rendered_frames)
 
 
+def _stored_calibration(scenario: Scenario, source: str) -> StoredCalibration:
+    """The calibration file the reader read, or, for a scenario changed since (another
+    head), the file read again and checked for this head."""
+    stored = scenario.stored_calibration
+    if stored is not None and stored.head_hash == head_hash(scenario.settings):
+        return stored
+    return read_calibration(source, scenario.settings)
+
+
 def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> RunResult:
     """Run a checked scenario; the subscribers see every image, detection and result."""
     hub = Hub(subscribers)
@@ -59,20 +63,8 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
     failures: list[str] = []
     spec = scenario.experiment.calibration
     if spec is not None and spec.source is not None:
-        from headsim.active.calibration_file import read_calibration
-
-        stored = read_calibration(spec.source, scenario.settings)
-        calibration = calibration_from_block(
-            stored.block,
-            renders=RenderCounts(),
-            source=CalibrationSource(
-                path=str(stored.path),
-                scenario=stored.scenario,
-                seed=stored.seed,
-                head_hash=stored.head_hash,
-                render_counts=render_counts_from_block(stored.block),
-            ),
-        )
+        stored = _stored_calibration(scenario, spec.source)
+        calibration = stored.report
         hub.emit(CalibrationDone(calibration))
         knowledge, label = stored.knowledge, "calibrated"
     elif spec is not None:

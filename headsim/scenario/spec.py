@@ -21,6 +21,7 @@ from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 
 if TYPE_CHECKING:
+    from headsim.active.calibration_file import StoredCalibration
     from headsim.scenario.pursuit import PursuitSpec
 
 #: The narrowest baseline a scenario may set, m: below it vergence carries no depth.
@@ -216,7 +217,11 @@ class SceneSpec:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A checked scenario, ready to run (random parts already drawn from ``seed``)."""
+    """A checked scenario, ready to run (random parts already drawn from ``seed``).
+
+    ``stored_calibration``: the calibration file ``[experiment.calibration] from``
+    names, as the reader read and checked it (None: the scenario has none).
+    """
 
     name: str
     path: Path
@@ -228,6 +233,7 @@ class Scenario:
     settle_mode: str
     scene: SceneSpec
     experiment: ExperimentSpec
+    stored_calibration: StoredCalibration | None = field(default=None, compare=False, repr=False)
 
     @property
     def paper_cameras(self) -> bool:

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from headsim.active.calibration_report import CalibrationReport
 from headsim.estimators.result import Status
-from headsim.run.outcomes import CalibrationReport
 from headsim.run.recording_results import calibration_markdown
 from headsim.sim.events import RenderCounts
 

@@ -7,29 +7,25 @@ import json
 import numpy as np
 import pytest
 
-from headsim.estimators.result import Method, Status
-from headsim.files import to_jsonable
-from headsim.procedures.model2 import Model2Result
-from headsim.procedures.pursuit import PursuitResult
-from headsim.procedures.tracking import TrackingResult
-from headsim.run.outcomes import (
+from headsim.active.calibration_report import (
     CalibrationLayout,
     CalibrationReport,
     CalibrationSource,
     KnowledgeReport,
     LinesOfSightFit,
-    MeasurementRecord,
     PositionOutcome,
     VerticalReference,
-)
-from headsim.run.serialise import (
-    MEASUREMENT_KEYS,
     calibration_block,
     calibration_from_block,
-    experiment_block,
-    measurement_entry,
     render_counts_from_block,
 )
+from headsim.estimators.result import Method, Status
+from headsim.files import to_jsonable
+from headsim.procedures.model2 import Model2Result
+from headsim.procedures.pursuit import PursuitResult
+from headsim.procedures.tracking import TrackingResult
+from headsim.run.outcomes import MeasurementRecord
+from headsim.run.serialise import MEASUREMENT_KEYS, experiment_block, measurement_entry
 from headsim.sim.events import RenderCounts
 
 from .helpers import LOST, measurement
