@@ -17,7 +17,10 @@ from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import format_table, mm
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.spec import Scenario
+from headsim.scenario.scene import targets_reader
+from headsim.scenario.schema import interpolate_option, near_midline_options
+from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.tables import Table
 
 
 @dataclass(frozen=True)
@@ -79,6 +82,20 @@ def _error(m: Measurement) -> float:
     return float(np.linalg.norm(m.error_head_m)) if m.ok else float("nan")
 
 
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment]``: the calibration to run (required), ``interpolate`` and the
+    near-midline remedy's ``midline_px``, ``remedy_px``."""
+    if calibration is None:
+        raise table.fail(
+            "calibration", "missing", "an [experiment.calibration] table (the calibration to run)"
+        )
+    return {**interpolate_option(table), **near_midline_options(table)}
+
+
+def _fixations(scenario: Scenario) -> int:
+    return 2 * len(scenario.scene.targets)  # each check target before and after
+
+
 CALIBRATION = register(
     Procedure(
         "calibration",
@@ -86,6 +103,9 @@ CALIBRATION = register(
         run_calibration_check,
         fields=CalibrationCheck.block,
         summary=CalibrationCheck.summary_lines,
+        options=read_options,
+        read_scene=targets_reader("calibration", required=False),
+        fixations=_fixations,
     )
 )
 

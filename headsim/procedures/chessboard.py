@@ -24,7 +24,16 @@ from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import format_table, mm
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.spec import CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M, Scenario
+from headsim.scenario.scene import read_chessboard
+from headsim.scenario.schema import interpolate_option, near_midline_options
+from headsim.scenario.spec import (
+    CHESSBOARD_PATTERN,
+    CHESSBOARD_SQUARE_M,
+    CalibrationSpec,
+    Scenario,
+    corner_count,
+)
+from headsim.scenario.tables import Table
 from headsim.sim import names
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
@@ -242,6 +251,15 @@ def run_chessboard(
     return records, experiment
 
 
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment]``: ``interpolate``, and the near-midline remedy's ``midline_px``, ``remedy_px``."""
+    return {**interpolate_option(table), **near_midline_options(table)}
+
+
+def _fixations(scenario: Scenario) -> int:
+    return len(scenario.scene.corners or range(corner_count()))
+
+
 CHESSBOARD = register(
     Procedure(
         "chessboard",
@@ -249,6 +267,9 @@ CHESSBOARD = register(
         run_chessboard,
         fields=ChessboardResult.block,
         summary=ChessboardResult.summary_lines,
+        options=read_options,
+        read_scene=read_chessboard,
+        fixations=_fixations,
     )
 )
 

@@ -13,7 +13,10 @@ from headsim.run.context import servo_config
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.spec import Scenario
+from headsim.scenario.scene import targets_reader
+from headsim.scenario.schema import interpolate_option
+from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.tables import Table
 
 
 @dataclass(frozen=True)
@@ -41,7 +44,21 @@ def run_model1(
     return records, Model1Result()
 
 
-MODEL1 = register(Procedure("model1", "default", run_model1, fields=Model1Result.block))
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment]``: ``interpolate``."""
+    return interpolate_option(table)
+
+
+MODEL1 = register(
+    Procedure(
+        "model1",
+        "default",
+        run_model1,
+        fields=Model1Result.block,
+        options=read_options,
+        read_scene=targets_reader("model1", required=True),
+    )
+)
 
 
 __all__ = ["MODEL1", "Model1Result", "run_model1"]

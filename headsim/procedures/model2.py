@@ -13,7 +13,10 @@ from headsim.run.context import model2_config, servo_config
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.spec import Scenario
+from headsim.scenario.scene import targets_reader
+from headsim.scenario.schema import interpolate_option, near_midline_options
+from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.tables import Table
 
 
 @dataclass(frozen=True)
@@ -41,7 +44,21 @@ def run_model2(
     return records, Model2Result()
 
 
-MODEL2 = register(Procedure("model2", "default", run_model2, fields=Model2Result.block))
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment]``: ``interpolate``, and the near-midline remedy's ``midline_px``, ``remedy_px``."""
+    return {**interpolate_option(table), **near_midline_options(table)}
+
+
+MODEL2 = register(
+    Procedure(
+        "model2",
+        "default",
+        run_model2,
+        fields=Model2Result.block,
+        options=read_options,
+        read_scene=targets_reader("model2", required=True),
+    )
+)
 
 
 __all__ = ["MODEL2", "Model2Result", "run_model2"]

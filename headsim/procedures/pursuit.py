@@ -30,6 +30,7 @@ from headsim.run.outcomes import MeasurementRecord
 from headsim.run.targets import marker_target
 from headsim.scenario.pursuit import PursuitSpec, describe
 from headsim.scenario.registry import Procedure, register
+from headsim.scenario.scene import read_pursuit_scene
 from headsim.scenario.spec import Scenario
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
@@ -196,6 +197,12 @@ def run_pursuit(
     )
 
 
+def _fixations(scenario: Scenario) -> int:
+    pursuit = scenario.scene.pursuit
+    assert pursuit is not None  # the reader sets it for this procedure
+    return math.ceil(pursuit.duration_s * pursuit.live.frame_rate_hz)  # one per camera frame
+
+
 PURSUIT = register(
     Procedure(
         "pursuit",
@@ -205,6 +212,8 @@ PURSUIT = register(
         summary=PursuitResult.summary_lines,
         ok_line=PursuitResult.ok_line,
         failures=PursuitResult.failure_lines,
+        read_scene=read_pursuit_scene,
+        fixations=_fixations,
     )
 )
 

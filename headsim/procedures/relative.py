@@ -34,6 +34,7 @@ from headsim.run.outcomes import MeasurementRecord
 from headsim.run.recording_layout import GREEN, ORANGE, RED
 from headsim.run.table import cell, format_table
 from headsim.scenario.registry import Procedure, register
+from headsim.scenario.scene import read_blocks
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.events import EventSink
@@ -379,6 +380,8 @@ RELATIVE_POSITIONING = register(
         summary=RelativeResult.summary_lines,
         failures=RelativeResult.failures,
         rows=RelativeResult.log_rows,
+        read_scene=read_blocks,
+        fixations=lambda scenario: 1,  # the cross point's
     )
 )
 

@@ -22,7 +22,10 @@ from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import cell, mm
 from headsim.run.targets import marker_target
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.spec import Scenario
+from headsim.scenario.scene import read_moving_scene
+from headsim.scenario.schema import interpolate_option
+from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.tables import Table
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
 
@@ -138,6 +141,15 @@ def run_tracking(
     return records, experiment
 
 
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment]``: ``interpolate``."""
+    return interpolate_option(table)
+
+
+def _fixations(scenario: Scenario) -> int:
+    return scenario.scene.moving.steps if scenario.scene.moving else 0
+
+
 TRACKING = register(
     Procedure(
         "tracking",
@@ -145,6 +157,9 @@ TRACKING = register(
         run_tracking,
         fields=TrackingResult.block,
         summary=TrackingResult.summary_lines,
+        options=read_options,
+        read_scene=read_moving_scene,
+        fixations=_fixations,
     )
 )
 

@@ -9,8 +9,7 @@ scenario's seed, one stream per use (``STREAM_*``).
 
 from __future__ import annotations
 
-from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,6 +25,9 @@ from headsim.scenario.reach import (
     target_refusal,
 )
 from headsim.scenario.registry import get
+
+if TYPE_CHECKING:
+    from headsim.scenario.registry import SceneReader
 from headsim.scenario.schema import depth_range
 from headsim.scenario.spec import (
     MARKER_BODIES,
@@ -188,27 +190,38 @@ def read_scene(
     doc: Table, ctx: Context, procedure: str, settings: HeadSettings, seed: int
 ) -> SceneSpec:
     """``[scene]``: what the procedure measures, and where it is."""
-    scene_name = get(procedure).scene
+    found = get(procedure)
     table = doc.table("scene") or Table({}, "scene", ctx)
-    spec = SceneSpec(scene=scene_name)
-    if procedure in ("model2", "model1", "calibration"):
-        targets, acceptance = _read_targets(
-            table, settings, seed, required=procedure != "calibration", procedure=procedure
-        )
-        spec = replace(spec, targets=targets, acceptance=acceptance)
-    elif procedure == "chessboard":
-        spec = _read_chessboard(table, ctx, settings)
-    elif procedure == "relative_positioning":
-        spec = _read_blocks(table, ctx, settings, seed)
-    elif procedure == "tracking":
-        spec = replace(spec, moving=_read_moving(table, ctx, settings, seed))
-    elif procedure == "pursuit":
-        spec = replace(spec, pursuit=read_pursuit(table, seed, tuple(MARKER_BODIES)))
+    read = found.read_scene
+    spec = SceneSpec(scene=found.scene) if read is None else read(table, ctx, settings, seed)
     table.done()
     return spec
 
 
-def _read_chessboard(table: Table, ctx: Context, settings: HeadSettings) -> SceneSpec:
+def targets_reader(procedure: str, *, required: bool) -> SceneReader:
+    """The reader of ``[[scene.targets]]`` and ``[scene.random_targets]`` in the default
+    scene, checked for ``procedure``'s reach (``required``: at least one target)."""
+
+    def read(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+        targets, acceptance = _read_targets(
+            table, settings, seed, required=required, procedure=procedure
+        )
+        return SceneSpec(scene="default", targets=targets, acceptance=acceptance)
+
+    return read
+
+
+def read_moving_scene(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+    """``[scene.moving_target]`` in the default scene."""
+    return SceneSpec(scene="default", moving=_read_moving(table, ctx, settings, seed))
+
+
+def read_pursuit_scene(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+    """``[scene.pursuit]`` in the default scene."""
+    return SceneSpec(scene="default", pursuit=read_pursuit(table, seed, tuple(MARKER_BODIES)))
+
+
+def read_chessboard(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
     """``[scene.chessboard]``: where the board's top-left inner corner is; which corners."""
     board = table.table("chessboard") or Table({}, "scene.chessboard", ctx)
     position = _position(board, settings, _default_position("chessboard", names.CHESSBOARD))
@@ -239,7 +252,7 @@ def _read_chessboard(table: Table, ctx: Context, settings: HeadSettings) -> Scen
     return SceneSpec(scene="chessboard", chessboard=placement, corners=corners)
 
 
-def _read_blocks(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+def read_blocks(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
     """``[scene.blocks]`` (the cross point) and ``[[scene.objects]]``/``[scene.random_objects]``."""
     blocks = table.table("blocks") or Table({}, "scene.blocks", ctx)
     reference = _position(blocks, settings, _default_position("blocks", names.BLOCKS))

@@ -9,7 +9,6 @@ OpenCV's.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -17,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from headsim import paper
+from headsim.scenario import registry
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 
@@ -245,19 +245,7 @@ class Scenario:
         """How many fixations the run makes (for the progress bar)."""
         calibration = self.experiment.calibration
         count = calibration.targets if calibration else 0
-        procedure = self.experiment.procedure
-        if procedure == "chessboard":
-            return count + len(self.scene.corners or range(corner_count()))
-        if procedure == "relative_positioning":
-            return count + 1
-        if procedure == "tracking":
-            return count + (self.scene.moving.steps if self.scene.moving else 0)
-        if procedure == "pursuit":  # one step per camera frame
-            pursuit = self.scene.pursuit
-            assert pursuit is not None  # the reader sets it for this procedure
-            return count + math.ceil(pursuit.duration_s * pursuit.live.frame_rate_hz)
-        per_target = 2 if procedure == "calibration" else 1
-        return count + per_target * len(self.scene.targets)
+        return count + registry.get(self.experiment.procedure).fixations(self)
 
 
 def corner_count() -> int:
