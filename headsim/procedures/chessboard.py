@@ -24,18 +24,21 @@ from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import format_table, mm
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.scene import read_chessboard
+from headsim.scenario.scene import default_position, read_position, tuple3
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import (
     CHESSBOARD_PATTERN,
     CHESSBOARD_SQUARE_M,
     CalibrationSpec,
+    Placement,
     Scenario,
+    SceneSpec,
     corner_count,
 )
-from headsim.scenario.tables import Table
+from headsim.scenario.tables import Context, Table, describe_value
 from headsim.sim import names
 from headsim.sim.events import EventSink
+from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 
 
@@ -249,6 +252,37 @@ def run_chessboard(
         ),
     )
     return records, experiment
+
+
+def read_chessboard(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+    """``[scene.chessboard]``: where the board's top-left inner corner is; which corners."""
+    board = table.table("chessboard") or Table({}, "scene.chessboard", ctx)
+    position = read_position(board, settings, default_position("chessboard", names.CHESSBOARD))
+    count = corner_count()
+    corners_value = board.data.get("corners", "all")
+    board.has("corners")
+    allowed = f'"all" or an array of corner indices 0..{count - 1} (row-major from the top-left)'
+    if corners_value == "all":
+        corners = None
+    elif (
+        isinstance(corners_value, list)
+        and corners_value
+        and all(isinstance(c, int) and not isinstance(c, bool) for c in corners_value)
+    ):
+        if not all(0 <= c < count for c in corners_value) or len(set(corners_value)) != len(
+            corners_value
+        ):
+            raise board.fail(
+                "corners", f"{corners_value} has an index out of range or twice", allowed
+            )
+        corners = tuple(corners_value)
+    else:
+        raise board.fail(
+            "corners", f'must be "all" or indices, got {describe_value(corners_value)}', allowed
+        )
+    board.done()
+    placement = Placement(names.CHESSBOARD, names.CHESSBOARD, tuple3(position), board.path)
+    return SceneSpec(scene="chessboard", chessboard=placement, corners=corners)
 
 
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:

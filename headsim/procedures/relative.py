@@ -34,10 +34,18 @@ from headsim.run.outcomes import MeasurementRecord
 from headsim.run.recording_layout import GREEN, ORANGE, RED
 from headsim.run.table import cell, format_table
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.scene import read_blocks
-from headsim.scenario.spec import Scenario
+from headsim.scenario.scene import (
+    default_position,
+    random_points_head,
+    read_position,
+    start_head_to_world,
+    tuple3,
+)
+from headsim.scenario.spec import STREAM_OBJECTS, Placement, Scenario, SceneSpec
+from headsim.scenario.tables import MISSING, Context, Table
 from headsim.sim import names
 from headsim.sim.events import EventSink
+from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.vision.crosses import find_cross_point
 from headsim.vision.detection import Detection
@@ -369,6 +377,48 @@ def run_relative(
         ),
     )
     return records, experiment
+
+
+def read_blocks(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+    """``[scene.blocks]`` (the cross point) and ``[[scene.objects]]``/``[scene.random_objects]``."""
+    blocks = table.table("blocks") or Table({}, "scene.blocks", ctx)
+    reference = read_position(blocks, settings, default_position("blocks", names.BLOCKS))
+    blocks.done()
+    objects: list[Placement] = []
+    for entry in table.tables("objects", len(names.RELATIVE_OBJECTS)):
+        body = entry.choice("body", names.RELATIVE_OBJECTS)
+        position = read_position(entry, settings)
+        entry.done()
+        if any(o.body == body for o in objects):
+            raise entry.fail("body", f"{body!r} is placed twice", "each object once")
+        objects.append(Placement(body, body, tuple3(position), entry.path))
+    random_table = table.table("random_objects")
+    if random_table is not None:
+        if objects:
+            raise random_table.fail(
+                "count", "given together with [[scene.objects]]", "one of the two"
+            )
+        count = random_table.integer("count", MISSING, 1, len(names.RELATIVE_OBJECTS))
+        rng = np.random.default_rng([seed, STREAM_OBJECTS])
+        points = start_head_to_world(settings, random_points_head(random_table, count, rng))
+        random_table.done()
+        objects = [
+            Placement(body, body, tuple3(p), f"{random_table.path} (object {k + 1})")
+            for k, (body, p) in enumerate(zip(names.RELATIVE_OBJECTS, points, strict=False))
+        ]
+    if not objects:
+        objects = [
+            Placement(body, body, tuple3(default_position("blocks", body)), "scene (model default)")
+            for body in names.RELATIVE_OBJECTS
+        ]
+    used = {o.body for o in objects}
+    parked = tuple(body for body in names.RELATIVE_OBJECTS if body not in used)
+    return SceneSpec(
+        scene="blocks",
+        blocks=Placement(names.BLOCKS, names.BLOCKS, tuple3(reference), blocks.path),
+        objects=tuple(objects),
+        parked=parked,
+    )
 
 
 RELATIVE_POSITIONING = register(

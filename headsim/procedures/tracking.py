@@ -22,11 +22,25 @@ from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import cell, mm
 from headsim.run.targets import marker_target
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.scene import read_moving_scene
+from headsim.scenario.scene import (
+    finite_number,
+    random_points_head,
+    start_head_to_world,
+    tuple3,
+)
 from headsim.scenario.schema import interpolate_option
-from headsim.scenario.spec import CalibrationSpec, Scenario
-from headsim.scenario.tables import Table
+from headsim.scenario.spec import (
+    MARKER_BODIES,
+    STREAM_MOVING,
+    CalibrationSpec,
+    MovingTarget,
+    Scenario,
+    SceneSpec,
+)
+from headsim.scenario.tables import MISSING, Context, Table, describe_value
+from headsim.sim import names
 from headsim.sim.events import EventSink
+from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 
 
@@ -139,6 +153,52 @@ def run_tracking(
         renders_after_mean=float(np.mean(renders[1:])) if len(renders) > 1 else float("nan"),
     )
     return records, experiment
+
+
+def read_moving_scene(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+    """``[scene.moving_target]`` in the default scene."""
+    return SceneSpec(scene="default", moving=_read_moving(table, ctx, settings, seed))
+
+
+def _read_moving(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> MovingTarget:
+    """``[scene.moving_target]``: a marker moved along waypoints, explicit or random."""
+    moving = table.table("moving_target")
+    if moving is None:
+        raise table.fail("moving_target", "missing", "a [scene.moving_target] table")
+    name = moving.string("name", "moving_target", 60)
+    body = moving.choice("body", tuple(MARKER_BODIES), names.MARKERS[0])
+    duration = moving.number("duration_s", 10.0, 0.0, 3600.0, lo_open=True, unit="s")
+    steps = moving.integer("steps", MISSING, 1, 10000)
+    allowed = "waypoints_head_m or waypoints_world_m (arrays of [x, y, z], at least 2) or [scene.moving_target.random]"
+    given = []
+    for key, frame in (("waypoints_head_m", "head"), ("waypoints_world_m", "world")):
+        value = moving.data.get(key, MISSING)
+        moving.has(key)
+        if value is MISSING:
+            continue
+        if (
+            not isinstance(value, list)
+            or len(value) < 2
+            or not all(isinstance(p, list) and len(p) == 3 for p in value)
+        ):
+            raise moving.fail(
+                key, f"must be an array of [x, y, z], got {describe_value(value)}", allowed
+            )
+        points = np.array(
+            [[finite_number(moving, f"{key}[{i}]", c) for c in p] for i, p in enumerate(value)]
+        )
+        given.append(start_head_to_world(settings, points) if frame == "head" else points)
+    random_table = moving.table("random")
+    if random_table is not None:
+        count = random_table.integer("waypoints", MISSING, 2, 1000)
+        rng = np.random.default_rng([seed, STREAM_MOVING])
+        given.append(start_head_to_world(settings, random_points_head(random_table, count, rng)))
+        random_table.done()
+    moving.done()
+    if len(given) != 1:
+        raise moving.fail("waypoints_head_m", "missing" if not given else "given twice", allowed)
+    waypoints = tuple(tuple3(p) for p in given[0])
+    return MovingTarget(name, body, waypoints, duration, steps)
 
 
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
