@@ -1,13 +1,13 @@
 """Running a scenario: calibrate if asked, run the procedure, collect the results.
 
-The procedures of :mod:`headsim.active` run unchanged.  What a run
-shows while it goes (progress, the Rerun recording) follows its events: the
-runner gives the simulator (and through it the servos and the procedures) a
-:class:`headsim.run.events.Hub` as event sink, and the hub passes every event
-on to the run's subscribers.  The runner adds its own events: each recorded
-measurement, the calibration's report and the finished run.  Each phase (the
-calibration is :mod:`headsim.run.calibrate`; each procedure is found by its name in
+The calibration is :mod:`headsim.run.calibrate`'s (or a calibration file's, as
+the scenario reader read it); the procedure is found by its name in
 :mod:`headsim.scenario.registry` (the built-in ones are :mod:`headsim.procedures`).
+What a run shows while it goes (progress, the Rerun recording) follows its
+events: the runner gives the simulator (and through it the servos and the
+procedure) a :class:`headsim.run.events.Hub` as event sink, and the hub passes
+every event on to the run's subscribers.  The runner adds its own events: the
+calibration's report and the finished run.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import replace
 
-from headsim.active.calibration_file import StoredCalibration, head_hash, read_calibration
+from headsim.active.calibration_file import head_hash, read_calibration
 from headsim.active.calibration_report import CalibrationReport
 from headsim.run.calibrate import calibrate
 from headsim.run.context import told
@@ -43,15 +43,6 @@ def calibrate_scenario(
     return replace(report, rendered_frames=hub.rendered_frames)
 
 
-def _stored_calibration(scenario: Scenario, source: str) -> StoredCalibration:
-    """The calibration file the reader read, or, for a scenario changed since (another
-    head), the file read again and checked for this head."""
-    stored = scenario.stored_calibration
-    if stored is not None and stored.head_hash == head_hash(scenario.settings):
-        return stored
-    return read_calibration(source, scenario.settings)
-
-
 def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> RunResult:
     """Run a checked scenario; the subscribers see every image, detection and result."""
     hub = Hub(subscribers)
@@ -63,7 +54,9 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
     failures: list[str] = []
     spec = scenario.experiment.calibration
     if spec is not None and spec.source is not None:
-        stored = _stored_calibration(scenario, spec.source)
+        stored = scenario.stored_calibration  # as the reader read it, unless the head changed
+        if stored is None or stored.head_hash != head_hash(scenario.settings):
+            stored = read_calibration(spec.source, scenario.settings)
         calibration = stored.report
         hub.emit(CalibrationDone(calibration))
         knowledge, label = stored.knowledge, "calibrated"
