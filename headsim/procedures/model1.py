@@ -1,4 +1,4 @@
-"""Model 1 (the neck and the eyes) on each of the scenario's targets (Sec. IV-A)."""
+"""Model 1 (fixation with the neck, Sec. II-B) on each of the scenario's targets."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Model 2 (the eyes alone, the neck still) on each of the scenario's targets (Sec. IV-B)."""
+"""Model 2 (the two-step measurement of Sec. II-C, the neck still) on each of the scenario's targets."""
 
 from __future__ import annotations
 
