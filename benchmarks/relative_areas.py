@@ -26,8 +26,8 @@ import numpy as np
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
-from headsim.active.relative import relative_positioning
 from headsim.files import write_json_atomic
+from headsim.procedures.relative import relative_positioning
 from headsim.run.context import PARKED_WORLD_M
 from headsim.scenario.area_layouts import area_layout
 from headsim.sim import names

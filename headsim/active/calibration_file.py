@@ -22,8 +22,15 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from headsim.active.calibration_report import (
+    CalibrationReport,
+    CalibrationSource,
+    calibration_from_block,
+    render_counts_from_block,
+)
 from headsim.active.measurement import HeadKnowledge
 from headsim.files import to_jsonable, write_json_atomic
+from headsim.sim.events import RenderCounts
 from headsim.sim.settings import HeadSettings
 
 FORMAT = "headsim-calibration/1"
@@ -63,11 +70,12 @@ def head_hash(settings: HeadSettings) -> str:
 
 @dataclass(frozen=True)
 class StoredCalibration:
-    """A calibration read from a file: what the head knows, and the run that found it."""
+    """A calibration read from a file: what the head knows, and the report of the run
+    that found it (no renders of its own; ``source`` says where it came from)."""
 
     path: Path
     knowledge: HeadKnowledge
-    block: dict[str, Any]
+    report: CalibrationReport
     scenario: str
     seed: int
     head_hash: str
@@ -121,6 +129,11 @@ def _differences(stored: dict[str, Any], current: dict[str, Any]) -> list[str]:
 def read_calibration(path: str | Path, settings: HeadSettings) -> StoredCalibration:
     """Read ``path`` and check it holds for the head ``settings`` (else CalibrationFileError)."""
     path = Path(path)
+    return calibration_for_head(read_calibration_document(path), path, settings)
+
+
+def read_calibration_document(path: Path) -> dict[str, Any]:
+    """The calibration file ``path`` as JSON, its format checked (else CalibrationFileError)."""
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError) as err:
@@ -132,6 +145,14 @@ def read_calibration(path: str | Path, settings: HeadSettings) -> StoredCalibrat
             f"{path} is not a calibration file (format {FORMAT!r}; write one with "
             "`headsim calibrate SCENARIO --out FILE`)"
         )
+    return doc
+
+
+def calibration_for_head(
+    doc: dict[str, Any], path: Path, settings: HeadSettings
+) -> StoredCalibration:
+    """The calibration file ``doc`` (read from ``path``), checked to hold for the head
+    ``settings`` and decoded (else CalibrationFileError)."""
     try:
         head, block = doc["head"], doc["calibration"]
         knowledge = knowledge_from_block(block)
@@ -145,11 +166,22 @@ def read_calibration(path: str | Path, settings: HeadSettings) -> StoredCalibrat
             f"{path} was made for a different head: {detail}. Calibrate this head with "
             "`headsim calibrate SCENARIO --out FILE`"
         )
+    try:
+        source = CalibrationSource(
+            path=str(path),
+            scenario=str(doc.get("scenario", "")),
+            seed=int(doc.get("seed", 0)),
+            head_hash=stored_hash,
+            render_counts=render_counts_from_block(block),
+        )
+        report = calibration_from_block(block, renders=RenderCounts(), source=source)
+    except (KeyError, TypeError, ValueError) as err:
+        raise CalibrationFileError(f"{path} is malformed: {err!r} missing or wrong") from err
     return StoredCalibration(
         path=path,
         knowledge=knowledge,
-        block=block,
-        scenario=str(doc.get("scenario", "")),
-        seed=int(doc.get("seed", 0)),
+        report=report,
+        scenario=source.scenario,
+        seed=source.seed,
         head_hash=stored_hash,
     )

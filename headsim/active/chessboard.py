@@ -1,25 +1,16 @@
-"""The chessboard of Sec. VI-A: every chosen inner corner measured with Model 2,
-and the squares' sides they give.
+"""The chessboard of Sec. VI-A as a target: each inner corner found on the whole board,
+or alone where the board places it, and the board found in a camera's next image.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from headsim.active.events import FixationStarted, MeasurementDone
-from headsim.active.eye_servo import EyeServo
 from headsim.active.look import look_once
-from headsim.active.measurement import (
-    HeadKnowledge,
-    Measurement,
-    Target,
-)
-from headsim.active.model2 import Model2Config, measure_model2
+from headsim.active.measurement import Target
 from headsim.sim import names
-from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.views import CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M
 from headsim.vision.chessboard import (
@@ -141,85 +132,13 @@ def look_for_board(sim: HeadSim, camera: int) -> np.ndarray | None:
     return np.array(seen.pattern_uv, dtype=float)
 
 
-@dataclass(frozen=True)
-class ChessboardRun:
-    """Every cross point measured with Model 2, and the squares' sides they give, m.
-
-    ``widths_m``/``heights_m``: distances between horizontally/vertically
-    adjacent measured corners (estimate), with the truth beside them.
-    """
-
-    measurements: tuple[Measurement, ...]
-    square_m: float
-    widths_m: np.ndarray
-    heights_m: np.ndarray
-    true_widths_m: np.ndarray
-    true_heights_m: np.ndarray
-
-    @property
-    def measured(self) -> int:
-        return sum(m.ok for m in self.measurements)
-
-
-def measure_chessboard(
-    sim: HeadSim,
-    servo: EyeServo,
-    knowledge: HeadKnowledge | None = None,
-    config: Model2Config | None = None,
-    pattern: tuple[int, int] = (8, 6),
-    square_m: float = 0.030,
-    corners: Sequence[int] | None = None,
-    sink: EventSink | None = None,
-) -> ChessboardRun:
-    """Measure the chessboard's cross points (all, or ``corners``) and its squares' sides.
-
-    ``sink``: where each corner's fixation ("corner_i_j") and measurement is
-    reported (None: the simulator's sink).
-    """
-    sink = sim.sink if sink is None else sink
-    columns, rows = pattern
-    indices = list(range(columns * rows)) if corners is None else list(corners)
-    measured: dict[int, Measurement] = {}
-    for k in indices:
-        corner = chessboard_corner_target(k, pattern, square_m)
-        sink.emit(FixationStarted(corner.name))
-        measured[k] = measure_model2(sim, servo, corner, knowledge, config)
-        sink.emit(MeasurementDone(measured[k]))
-    widths: list[float] = []
-    heights: list[float] = []
-    true_widths: list[float] = []
-    true_heights: list[float] = []
-    for k, m in measured.items():
-        for neighbour, out, out_true in (
-            (k + 1, widths, true_widths),
-            (k + columns, heights, true_heights),
-        ):
-            if neighbour == k + 1 and (k + 1) % columns == 0:
-                continue
-            other = measured.get(neighbour)
-            if other is None or not (m.ok and other.ok):
-                continue
-            out.append(float(np.linalg.norm(other.estimate_head_m - m.estimate_head_m)))
-            out_true.append(float(np.linalg.norm(other.truth_head_m - m.truth_head_m)))
-    return ChessboardRun(
-        measurements=tuple(measured.values()),
-        square_m=square_m,
-        widths_m=np.array(widths),
-        heights_m=np.array(heights),
-        true_widths_m=np.array(true_widths),
-        true_heights_m=np.array(true_heights),
-    )
-
-
 _BOARD = chessboard_corner_target(0, CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M)
 
 __all__ = [
     "BOARD_PREVIEW_BINNING",
     "ChessboardCorner",
-    "ChessboardRun",
     "alone_extent",
     "board_extent",
     "chessboard_corner_target",
     "look_for_board",
-    "measure_chessboard",
 ]

@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
-from headsim.active.chessboard import measure_chessboard
-from headsim.active.events import PhaseStarted
+from headsim.active.chessboard import chessboard_corner_target
+from headsim.active.events import FixationStarted, MeasurementDone, PhaseStarted
 from headsim.active.eye_servo import EyeServo
-from headsim.active.measurement import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge, Measurement
+from headsim.active.model2 import Model2Config, measure_model2
 from headsim.run.context import (
     PAPER,
     model2_config,
@@ -18,15 +21,166 @@ from headsim.run.context import (
     simulator,
 )
 from headsim.run.events import Hub
-from headsim.run.outcomes import (
-    ChessboardPaper,
-    ChessboardResult,
-    MeasurementRecord,
-)
+from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import format_table, mm
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.spec import CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M, Scenario
+from headsim.scenario.scene import default_position, read_position, tuple3
+from headsim.scenario.schema import interpolate_option, near_midline_options
+from headsim.scenario.spec import (
+    CHESSBOARD_PATTERN,
+    CHESSBOARD_SQUARE_M,
+    CalibrationSpec,
+    Placement,
+    Scenario,
+    SceneSpec,
+    corner_count,
+)
+from headsim.scenario.tables import Context, Table, describe_value
 from headsim.sim import names
+from headsim.sim.events import EventSink
+from headsim.sim.settings import HeadSettings
+from headsim.sim.simulator import HeadSim
+
+
+@dataclass(frozen=True)
+class ChessboardPaper:
+    """Table III/IV's square side, mean and std, m."""
+
+    side_mean_m: float
+    side_std_m: float
+
+
+@dataclass(frozen=True)
+class ChessboardResult:
+    """The chessboard's inner corners with Model 2 and the squares they give (Sec. VI-A), m."""
+
+    pattern: list[int]
+    square_m: float
+    corners: int
+    corners_measured: int
+    widths_m: np.ndarray
+    heights_m: np.ndarray
+    true_widths_m: np.ndarray
+    true_heights_m: np.ndarray
+    width_mean_m: float
+    width_std_m: float
+    height_mean_m: float
+    height_std_m: float
+    side_mean_m: float
+    side_std_m: float
+    paper: ChessboardPaper
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: every field, in order."""
+        return asdict(self)
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        """The squares' widths, heights and all sides beside the truth (and the paper's)."""
+        headers = ["", "n", "mean mm", "std mm", "truth mm"] + (
+            ["paper mean", "paper std"] if paper else []
+        )
+        sides = (
+            ("widths", self.widths_m, self.true_widths_m, self.width_mean_m, self.width_std_m),
+            ("heights", self.heights_m, self.true_heights_m, self.height_mean_m, self.height_std_m),
+            (
+                "all sides",
+                np.concatenate([self.widths_m, self.heights_m]),
+                np.concatenate([self.true_widths_m, self.true_heights_m]),
+                self.side_mean_m,
+                self.side_std_m,
+            ),
+        )
+        rows = []
+        for label, values, true_values, mean_m, std_m in sides:
+            truth = np.asarray(true_values)
+            paper_cells = ["-", "-"]
+            if label == "all sides":
+                paper_cells = [mm(self.paper.side_mean_m, ".1f"), mm(self.paper.side_std_m, ".3f")]
+            rows.append(
+                [
+                    label,
+                    str(len(values)),
+                    mm(mean_m, ".3f"),
+                    mm(std_m, ".3f"),
+                    mm(float(np.mean(truth)) if len(truth) else None, ".3f"),
+                    *(paper_cells if paper else []),
+                ]
+            )
+        title = (
+            f"Chessboard squares (Tables III, IV): {self.corners_measured} of {self.corners} cross "
+            f"points measured, squares {self.square_m * 1000:g} mm"
+        )
+        return [title, *format_table(headers, rows)]
+
+
+@dataclass(frozen=True)
+class ChessboardRun:
+    """Every cross point measured with Model 2, and the squares' sides they give, m.
+
+    ``widths_m``/``heights_m``: distances between horizontally/vertically
+    adjacent measured corners (estimate), with the truth beside them.
+    """
+
+    measurements: tuple[Measurement, ...]
+    square_m: float
+    widths_m: np.ndarray
+    heights_m: np.ndarray
+    true_widths_m: np.ndarray
+    true_heights_m: np.ndarray
+
+    @property
+    def measured(self) -> int:
+        return sum(m.ok for m in self.measurements)
+
+
+def measure_chessboard(
+    sim: HeadSim,
+    servo: EyeServo,
+    knowledge: HeadKnowledge | None = None,
+    config: Model2Config | None = None,
+    pattern: tuple[int, int] = (8, 6),
+    square_m: float = 0.030,
+    corners: Sequence[int] | None = None,
+    sink: EventSink | None = None,
+) -> ChessboardRun:
+    """Measure the chessboard's cross points (all, or ``corners``) and its squares' sides.
+
+    ``sink``: where each corner's fixation ("corner_i_j") and measurement is
+    reported (None: the simulator's sink).
+    """
+    sink = sim.sink if sink is None else sink
+    columns, rows = pattern
+    indices = list(range(columns * rows)) if corners is None else list(corners)
+    measured: dict[int, Measurement] = {}
+    for k in indices:
+        corner = chessboard_corner_target(k, pattern, square_m)
+        sink.emit(FixationStarted(corner.name))
+        measured[k] = measure_model2(sim, servo, corner, knowledge, config)
+        sink.emit(MeasurementDone(measured[k]))
+    widths: list[float] = []
+    heights: list[float] = []
+    true_widths: list[float] = []
+    true_heights: list[float] = []
+    for k, m in measured.items():
+        for neighbour, out, out_true in (
+            (k + 1, widths, true_widths),
+            (k + columns, heights, true_heights),
+        ):
+            if neighbour == k + 1 and (k + 1) % columns == 0:
+                continue
+            other = measured.get(neighbour)
+            if other is None or not (m.ok and other.ok):
+                continue
+            out.append(float(np.linalg.norm(other.estimate_head_m - m.estimate_head_m)))
+            out_true.append(float(np.linalg.norm(other.truth_head_m - m.truth_head_m)))
+    return ChessboardRun(
+        measurements=tuple(measured.values()),
+        square_m=square_m,
+        widths_m=np.array(widths),
+        heights_m=np.array(heights),
+        true_widths_m=np.array(true_widths),
+        true_heights_m=np.array(true_heights),
+    )
 
 
 def _stats(values: np.ndarray) -> tuple[float, float]:
@@ -100,47 +254,65 @@ def run_chessboard(
     return records, experiment
 
 
-def _chessboard_lines(e: ChessboardResult, paper: bool) -> list[str]:
-    headers = ["", "n", "mean mm", "std mm", "truth mm"] + (
-        ["paper mean", "paper std"] if paper else []
-    )
-    sides = (
-        ("widths", e.widths_m, e.true_widths_m, e.width_mean_m, e.width_std_m),
-        ("heights", e.heights_m, e.true_heights_m, e.height_mean_m, e.height_std_m),
-        (
-            "all sides",
-            np.concatenate([e.widths_m, e.heights_m]),
-            np.concatenate([e.true_widths_m, e.true_heights_m]),
-            e.side_mean_m,
-            e.side_std_m,
-        ),
-    )
-    rows = []
-    for label, values, true_values, mean_m, std_m in sides:
-        truth = np.asarray(true_values)
-        paper_cells = ["-", "-"]
-        if label == "all sides":
-            paper_cells = [mm(e.paper.side_mean_m, ".1f"), mm(e.paper.side_std_m, ".3f")]
-        rows.append(
-            [
-                label,
-                str(len(values)),
-                mm(mean_m, ".3f"),
-                mm(std_m, ".3f"),
-                mm(float(np.mean(truth)) if len(truth) else None, ".3f"),
-                *(paper_cells if paper else []),
-            ]
+def read_chessboard(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+    """``[scene.chessboard]``: where the board's top-left inner corner is; which corners."""
+    board = table.table("chessboard") or Table({}, "scene.chessboard", ctx)
+    position = read_position(board, settings, default_position("chessboard", names.CHESSBOARD))
+    count = corner_count()
+    corners_value = board.data.get("corners", "all")
+    board.has("corners")
+    allowed = f'"all" or an array of corner indices 0..{count - 1} (row-major from the top-left)'
+    if corners_value == "all":
+        corners = None
+    elif (
+        isinstance(corners_value, list)
+        and corners_value
+        and all(isinstance(c, int) and not isinstance(c, bool) for c in corners_value)
+    ):
+        if not all(0 <= c < count for c in corners_value) or len(set(corners_value)) != len(
+            corners_value
+        ):
+            raise board.fail(
+                "corners", f"{corners_value} has an index out of range or twice", allowed
+            )
+        corners = tuple(corners_value)
+    else:
+        raise board.fail(
+            "corners", f'must be "all" or indices, got {describe_value(corners_value)}', allowed
         )
-    title = (
-        f"Chessboard squares (Tables III, IV): {e.corners_measured} of {e.corners} cross "
-        f"points measured, squares {e.square_m * 1000:g} mm"
-    )
-    return [title, *format_table(headers, rows)]
+    board.done()
+    placement = Placement(names.CHESSBOARD, names.CHESSBOARD, tuple3(position), board.path)
+    return SceneSpec(scene="chessboard", chessboard=placement, corners=corners)
+
+
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment]``: ``interpolate``, and the near-midline remedy's ``midline_px``, ``remedy_px``."""
+    return {**interpolate_option(table), **near_midline_options(table)}
+
+
+def _fixations(scenario: Scenario) -> int:
+    return len(scenario.scene.corners or range(corner_count()))
 
 
 CHESSBOARD = register(
-    Procedure("chessboard", "chessboard", run_chessboard, fields=asdict, summary=_chessboard_lines)
+    Procedure(
+        "chessboard",
+        "chessboard",
+        run_chessboard,
+        fields=ChessboardResult.block,
+        summary=ChessboardResult.summary_lines,
+        options=read_options,
+        read_scene=read_chessboard,
+        fixations=_fixations,
+    )
 )
 
 
-__all__ = ["CHESSBOARD", "run_chessboard"]
+__all__ = [
+    "CHESSBOARD",
+    "ChessboardPaper",
+    "ChessboardResult",
+    "ChessboardRun",
+    "measure_chessboard",
+    "run_chessboard",
+]

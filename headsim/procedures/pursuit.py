@@ -16,7 +16,7 @@ its record a ``PursuitFrame`` event.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, fields
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -26,35 +26,109 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.active.servo_types import ServoConfig
 from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
-from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord, PursuitFigures, PursuitResult
+from headsim.run.outcomes import MeasurementRecord
 from headsim.run.targets import marker_target
 from headsim.scenario.pursuit import PursuitSpec, describe
 from headsim.scenario.registry import Procedure, register
+from headsim.scenario.scene import read_pursuit_scene
 from headsim.scenario.spec import Scenario
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
 
 
-def figures(run: PursuitRun, spec: PursuitSpec) -> dict[str, Any]:
+@dataclass(frozen=True)
+class PursuitFigures:
+    """The figures that score a live pursuit, over the frames on which the target was present.
+
+    Times in s, offsets in px, position errors in W, m; NaN where undefined.
+    ``ended``: why the loop ended.
+    """
+
+    frames: int
+    frames_present: int
+    frames_lost: int
+    losses: int
+    reacquisitions: int
+    saccades: int
+    time_to_fixation_s: float
+    lag_s: float
+    offset_rms_px: float
+    position_rms_m: float
+    position_rms_pct_of_depth: float
+    position_max_m: float
+    ended: str
+
+
+@dataclass(frozen=True)
+class PursuitResult:
+    """The live pursuit: the spec as run, its figures and each frame (None when it never
+    started), and why it failed, one line each."""
+
+    pursuit: dict[str, Any]
+    figures: PursuitFigures | None = None
+    per_frame: dict[str, Any] | None = None
+    failures: tuple[str, ...] = ()
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: the spec, then the figures and each frame."""
+        block: dict[str, Any] = {"pursuit": self.pursuit}
+        if self.figures is not None:
+            block.update(asdict(self.figures))
+        if self.per_frame is not None:
+            block["per_frame"] = self.per_frame
+        return block
+
+    def summary_lines(self, paper: bool = False) -> list[str]:
+        """The summary's lines for a pursuit run (none when it never started)."""
+        p, figures = self.pursuit, self.figures
+        if figures is None:
+            return []
+
+        def f(key: str, scale: float = 1.0, fmt: str = ".2f") -> str:
+            value = getattr(figures, key)
+            return (
+                "n/a" if value is None or not math.isfinite(value) else format(value * scale, fmt)
+            )
+
+        return [
+            f"pursuit: {p.get('path_kind')} path for {p.get('duration_s')} s; {p.get('frame_rate_hz')} Hz, "
+            f"latency {p.get('latency_frames')} frame(s), exposure {p.get('exposure_s')} s x {p.get('blur_subframes')} "
+            f"sub-frames; gaze {p.get('mode')}, predictor {'on' if p.get('predictor') else 'off'}, saccade {p.get('saccade')}",
+            f"frames {figures.frames} (target present {figures.frames_present}), lost {figures.frames_lost}, "
+            f"losses {figures.losses}, re-acquisitions {figures.reacquisitions}, saccades {figures.saccades}",
+            f"position error RMS along the path {f('position_rms_m', 1000)} mm = {f('position_rms_pct_of_depth')} % of "
+            f"distance (max {f('position_max_m', 1000)} mm); pursuit lag {f('lag_s', 1000, '.1f')} ms; "
+            f"image offset RMS {f('offset_rms_px')} px; time to fixation {f('time_to_fixation_s', 1000, '.0f')} ms",
+        ]
+
+    def ok_line(self, measured: int) -> str:
+        """The table's last line when no frame lost the target."""
+        return f"OK: {self.figures.frames if self.figures else 0} frames, the target never lost"
+
+    def failure_lines(self) -> tuple[str, ...]:
+        """Why the pursuit failed, one line each."""
+        return self.failures
+
+
+def figures(run: PursuitRun, spec: PursuitSpec) -> PursuitFigures:
     """The figures that score a pursuit run (all frames on which the target was present)."""
     errors = run.errors_m
     start = spec.visibility.windows[0][0] if spec.visibility.windows else 0.0
-    return {
-        "frames": len(run.records),
-        "frames_present": sum(1 for r in run.records if r.truth_world_m is not None),
-        "frames_lost": run.frames_lost,
-        "losses": run.losses,
-        "reacquisitions": run.reacquisitions,
-        "saccades": sum(1 for r in run.records if r.saccade),
-        "time_to_fixation_s": run.time_to_fixation_s(spec.gaze.fixation_tolerance_px, start),
-        "lag_s": run.lag_s(),
-        "offset_rms_px": run.rms_offset_px(),
-        "position_rms_m": float(np.sqrt(np.mean(errors**2))) if errors.size else math.nan,
-        "position_rms_pct_of_depth": run.rms_error_pct_of_depth(),
-        "position_max_m": float(errors.max()) if errors.size else math.nan,
-        "ended": run.ended,
-    }
+    return PursuitFigures(
+        frames=len(run.records),
+        frames_present=sum(1 for r in run.records if r.truth_world_m is not None),
+        frames_lost=run.frames_lost,
+        losses=run.losses,
+        reacquisitions=run.reacquisitions,
+        saccades=sum(1 for r in run.records if r.saccade),
+        time_to_fixation_s=run.time_to_fixation_s(spec.gaze.fixation_tolerance_px, start),
+        lag_s=run.lag_s(),
+        offset_rms_px=run.rms_offset_px(),
+        position_rms_m=float(np.sqrt(np.mean(errors**2))) if errors.size else math.nan,
+        position_rms_pct_of_depth=run.rms_error_pct_of_depth(),
+        position_max_m=float(errors.max()) if errors.size else math.nan,
+        ended=run.ended,
+    )
 
 
 def _per_frame(records: tuple[FrameRecord, ...]) -> dict[str, Any]:
@@ -78,13 +152,14 @@ def _per_frame(records: tuple[FrameRecord, ...]) -> dict[str, Any]:
 
 
 def run_pursuit(
-    scenario: Any, sink: EventSink, knowledge: HeadKnowledge, label: str
-) -> tuple[list[Any], dict[str, Any]]:
-    """The runner's entry for ``procedure = "pursuit"``: (no point records, the experiment block).
+    scenario: Scenario, sink: EventSink, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], PursuitResult]:
+    """Acquire at rest, then pursue: no point records, and the pursuit's result.
 
-    ``sink``: where the run's events go; ``label``: unused (the runners' common signature).
+    ``sink``: where the run's events go; ``label``: unused (the procedures' common signature).
     """
-    spec: PursuitSpec = scenario.scene.pursuit
+    spec = scenario.scene.pursuit
+    assert spec is not None  # the reader sets it for this procedure
     target = marker_target(spec.name, spec.body)
     with HeadSim("default", scenario.settings, settle_mode=scenario.settle_mode, sink=sink) as sim:
         live = LiveHead(sim, spec.live, spec.body, spec.path, spec.visibility)
@@ -98,100 +173,49 @@ def run_pursuit(
         )
         truth = {} if first is None else {spec.name: spec.path.position(first)}
         sink.emit(PhaseStarted("measurement", sim, knowledge, truth))
-        experiment: dict[str, Any] = {"pursuit": describe(spec)}
+        described = describe(spec)
         if first is None:
-            return [], {**experiment, "failures": [f"{spec.name}: never present in the run"]}
+            return [], PursuitResult(
+                described, failures=(f"{spec.name}: never present in the run",)
+            )
         live.advance_to(first)
         # Whole frames, no windows or previews: the acquisition as it has always run.
         estimator = acquire(live, target.detector, knowledge, ServoConfig(windows=False))
         if estimator is None:
-            return [], {**experiment, "failures": [f"{spec.name}: not acquired at rest"]}
+            return [], PursuitResult(described, failures=(f"{spec.name}: not acquired at rest",))
 
         def on_frame(record: FrameRecord) -> None:
             sink.emit(FixationStarted(f"{spec.name} t={record.time_s:.3f}s"))  # a step per frame
             sink.emit(PursuitFrame(record))
 
         run = pursue(live, target.detector, estimator, spec.duration_s, spec.gaze, on_frame)
-    experiment.update(figures(run, spec))
-    experiment["per_frame"] = _per_frame(run.records)
-    if run.losses:
-        experiment["failures"] = [f"{spec.name}: lost {run.losses} times"]
-    return [], experiment
-
-
-def run_pursuit_phase(
-    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
-) -> tuple[list[MeasurementRecord], PursuitResult]:
-    """:func:`run_pursuit`'s block, typed."""
-    records, block = run_pursuit(scenario, hub, knowledge, label)
-    known = {"pursuit", "per_frame", "failures", *(f.name for f in fields(PursuitFigures))}
-    if set(block) - known:  # a new figure must get its field, or it would not be written
-        raise KeyError(f"pursuit figures without a PursuitFigures field: {set(block) - known}")
-    figures = None
-    if "frames" in block:
-        figures = PursuitFigures(**{f.name: block[f.name] for f in fields(PursuitFigures)})
-    return records, PursuitResult(
-        pursuit=block["pursuit"],
-        figures=figures,
-        per_frame=block.get("per_frame"),
-        failures=tuple(block.get("failures", ())),
+    return [], PursuitResult(
+        described,
+        figures=figures(run, spec),
+        per_frame=_per_frame(run.records),
+        failures=(f"{spec.name}: lost {run.losses} times",) if run.losses else (),
     )
 
 
-def summary_lines(e: PursuitResult) -> list[str]:
-    """The summary's lines for a pursuit run (none when it never started)."""
-    p, figures = e.pursuit, e.figures
-    if figures is None:
-        return []
-
-    def f(key: str, scale: float = 1.0, fmt: str = ".2f") -> str:
-        value = getattr(figures, key)
-        return "n/a" if value is None or not math.isfinite(value) else format(value * scale, fmt)
-
-    return [
-        f"pursuit: {p.get('path_kind')} path for {p.get('duration_s')} s; {p.get('frame_rate_hz')} Hz, "
-        f"latency {p.get('latency_frames')} frame(s), exposure {p.get('exposure_s')} s x {p.get('blur_subframes')} "
-        f"sub-frames; gaze {p.get('mode')}, predictor {'on' if p.get('predictor') else 'off'}, saccade {p.get('saccade')}",
-        f"frames {figures.frames} (target present {figures.frames_present}), lost {figures.frames_lost}, "
-        f"losses {figures.losses}, re-acquisitions {figures.reacquisitions}, saccades {figures.saccades}",
-        f"position error RMS along the path {f('position_rms_m', 1000)} mm = {f('position_rms_pct_of_depth')} % of "
-        f"distance (max {f('position_max_m', 1000)} mm); pursuit lag {f('lag_s', 1000, '.1f')} ms; "
-        f"image offset RMS {f('offset_rms_px')} px; time to fixation {f('time_to_fixation_s', 1000, '.0f')} ms",
-    ]
-
-
-def _fields(e: PursuitResult) -> dict[str, Any]:
-    block: dict[str, Any] = {"pursuit": e.pursuit}
-    if e.figures is not None:
-        block.update(asdict(e.figures))
-    if e.per_frame is not None:
-        block["per_frame"] = e.per_frame
-    return block
-
-
-def _summary(e: PursuitResult, paper: bool) -> list[str]:
-    return summary_lines(e)
-
-
-def _ok_line(e: PursuitResult, measured: int) -> str:
-    return f"OK: {e.figures.frames if e.figures else 0} frames, the target never lost"
-
-
-def _failures(e: PursuitResult) -> tuple[str, ...]:
-    return e.failures
+def _fixations(scenario: Scenario) -> int:
+    pursuit = scenario.scene.pursuit
+    assert pursuit is not None  # the reader sets it for this procedure
+    return math.ceil(pursuit.duration_s * pursuit.live.frame_rate_hz)  # one per camera frame
 
 
 PURSUIT = register(
     Procedure(
         "pursuit",
         "default",
-        run_pursuit_phase,
-        fields=_fields,
-        summary=_summary,
-        ok_line=_ok_line,
-        failures=_failures,
+        run_pursuit,
+        fields=PursuitResult.block,
+        summary=PursuitResult.summary_lines,
+        ok_line=PursuitResult.ok_line,
+        failures=PursuitResult.failure_lines,
+        read_scene=read_pursuit_scene,
+        fixations=_fixations,
     )
 )
 
 
-__all__ = ["PURSUIT", "figures", "run_pursuit", "run_pursuit_phase", "summary_lines"]
+__all__ = ["PURSUIT", "PursuitFigures", "PursuitResult", "figures", "run_pursuit"]

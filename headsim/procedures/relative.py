@@ -4,17 +4,23 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict
-from typing import TYPE_CHECKING, cast
+from dataclasses import asdict, dataclass, field
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 import rerun as rr
 
-from headsim.active.events import PhaseStarted
+from headsim.active.events import FixationStarted, MeasurementDone, PhaseStarted
 from headsim.active.eye_servo import EyeServo
-from headsim.active.measurement import HeadKnowledge, Target
-from headsim.active.relative import relative_positioning
+from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.active.model2 import Model2Config, measure_model2
 from headsim.active.servo_types import Detector
+from headsim.estimators.areas import (
+    AreaComparison,
+    areas_from_geometry,
+    areas_from_pixels,
+    compare_areas,
+)
 from headsim.geometry.kinematics import head_to_world
 from headsim.run.context import (
     PAPER,
@@ -24,21 +30,282 @@ from headsim.run.context import (
     simulator,
 )
 from headsim.run.events import Hub
-from headsim.run.outcomes import (
-    MeasurementRecord,
-    RelativeObject,
-    RelativePaper,
-    RelativeResult,
-)
+from headsim.run.outcomes import MeasurementRecord
 from headsim.run.recording_layout import GREEN, ORANGE, RED
 from headsim.run.table import cell, format_table
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.spec import Scenario
+from headsim.scenario.scene import (
+    default_position,
+    random_points_head,
+    read_position,
+    start_head_to_world,
+    tuple3,
+)
+from headsim.scenario.spec import STREAM_OBJECTS, Placement, Scenario, SceneSpec
+from headsim.scenario.tables import MISSING, Context, Table
 from headsim.sim import names
+from headsim.sim.events import EventSink
+from headsim.sim.settings import HeadSettings
+from headsim.sim.simulator import HeadSim
 from headsim.vision.crosses import find_cross_point
+from headsim.vision.detection import Detection
+from headsim.vision.markers import find_markers
 
 if TYPE_CHECKING:
     from headsim.run.recording import Recorder
+
+
+@dataclass(frozen=True)
+class RelativeObject:
+    """One object of relative positioning: its area S1..S12 (0: none), measured and true."""
+
+    name: str
+    colour: str
+    area: int
+    true_area: int
+    agree: bool
+    margin_px: float
+    gain_area: int
+    gain_agree: bool
+    columns_px: list[float]
+    position_head_m: np.ndarray
+
+
+@dataclass(frozen=True)
+class RelativePaper:
+    """Sec. VI-C's fixation angles, rad, and number of objects."""
+
+    alpha1_rad: float
+    alpha2_rad: float
+    objects: int
+
+
+@dataclass(frozen=True)
+class RelativeResult:
+    """Relative positioning (Sec. III, VI-C): the two fixations' angles, rad, and each object."""
+
+    alpha1_rad: float
+    alpha2_rad: float
+    objects: tuple[RelativeObject, ...]
+    missing: list[str]
+    agree: int
+    disagree_outside_margin: int | None
+    gain_agree: int
+    gain_disagree_outside_margin: int | None
+    margin_threshold_px: float | None
+    renders: int
+    paper: RelativePaper
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: every field, in order."""
+        return asdict(self)
+
+    def failures(self) -> tuple[str, ...]:
+        """Each object not seen in all four images."""
+        return tuple(f"{name}: not seen in all four images" for name in self.missing)
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        """The two fixations' angles (and the paper's) and each object's area."""
+        headers = ["", "ours"] + (["paper"] if paper else [])
+        rows = [
+            [
+                "alpha1 (rad)",
+                cell(self.alpha1_rad, ".4f"),
+                *([cell(self.paper.alpha1_rad, ".4f")] if paper else []),
+            ],
+            [
+                "alpha2 (rad)",
+                cell(self.alpha2_rad, ".4f"),
+                *([cell(self.paper.alpha2_rad, ".4f")] if paper else []),
+            ],
+            ["objects", str(len(self.objects)), *([str(self.paper.objects)] if paper else [])],
+        ]
+        lines = [
+            "Relative positioning (Sec. III, Table VII): fixations on the cross point",
+            *format_table(headers, rows),
+        ]
+        obj_rows = [
+            [
+                o.name,
+                o.colour,
+                f"S{o.area}" if o.area else "-",
+                f"S{o.true_area}" if o.true_area else "-",
+                "yes" if o.agree else "NO",
+                cell(o.margin_px, ".1f"),
+            ]
+            for o in self.objects
+        ]
+        lines += format_table(
+            ["object", "colour", "area", "true area", "agree", "margin px"], obj_rows
+        )
+        lines.append(
+            f"  {self.agree} of {len(self.objects)} objects in their true areas"
+            + (f"; not seen: {', '.join(self.missing)}" if self.missing else "")
+        )
+        return lines
+
+    def log_rows(self, log: Recorder) -> None:
+        """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
+        baseline = log.scenario.settings.baseline_m
+        s = log.scenario.settings
+        strips, labels = [], []
+        far = 2.0
+        for step_index, alpha in enumerate((self.alpha1_rad, self.alpha2_rad)):
+            if not math.isfinite(alpha):
+                return
+            for camera in (1, 2):
+                sign = 1.0 if camera == 1 else -1.0
+                yaw = alpha + log.effective_alpha_e[camera - 1]
+                start = np.array([-sign * baseline / 2, 0.0, 0.0])
+                end = start + far * np.array([sign * math.sin(yaw), 0.0, math.cos(yaw)])
+                strips.append(
+                    head_to_world(np.array([start, end]), 0.0, 0.0, s.neck_d1_m, s.neck_a2_m)
+                )
+                labels.append(f"L{camera}{step_index + 1}")
+        log.rec.log(
+            "/world/areas/lines", rr.LineStrips3D(strips, colors=[ORANGE] * 4, labels=labels)
+        )
+        objects = self.objects
+        positions = [log.truth[o.name] for o in objects if o.name in log.truth]
+        log.rec.log(
+            "/world/areas/objects",
+            rr.Points3D(
+                positions,
+                radii=0.008,
+                colors=[GREEN if o.agree else RED for o in objects],
+                labels=[f"{o.name}: S{o.area} (true S{o.true_area})" for o in objects],
+            ),
+        )
+
+
+@dataclass(frozen=True)
+class RelativeRun:
+    """Areas S1..S12 of objects around a reference, by eq. (12) on pixels and by geometry.
+
+    ``areas``/``true_areas``: label -> area number (0: unclassified or not
+    seen in all four images); ``columns``: label -> (u11, u12, u21, u22), px;
+    ``comparison``: the estimator's count of disagreements by margin.
+    ``gain_areas``/``gain_comparison``: the same with each camera's offsets
+    divided by its gain (px per encoder step, learnt by the servo from the
+    images: no intrinsics), so the magnitude tests compare angles, not pixels
+    of two different focal lengths; margins in px at the mean gain.
+    """
+
+    reference: Measurement
+    areas: dict[str, int]
+    true_areas: dict[str, int]
+    columns: dict[str, tuple[float, float, float, float]]
+    missing: tuple[str, ...]
+    comparison: AreaComparison | None
+    renders: int
+    gain_areas: dict[str, int] = field(default_factory=dict)
+    gain_comparison: AreaComparison | None = None
+
+
+def _touching_blobs(found: dict[str, Detection], gap_px: float = 1.5) -> set[str]:
+    """Labels of blobs that touch another label's blob in the same image.
+
+    Where one ball partly hides another, both blobs meet and the hidden one's
+    centroid moves by up to its radius, which no single image can tell from a
+    shift.  Radii come from the blobs' areas (px): image-only.
+    """
+    blobs = [
+        (name, np.array(d.uv), math.sqrt(d.area_px / math.pi))
+        for name, d in found.items()
+        if d.found and d.uv is not None
+    ]
+    out = set()
+    for i, (name_a, uv_a, r_a) in enumerate(blobs):
+        for name_b, uv_b, r_b in blobs[:i]:
+            if float(np.linalg.norm(uv_a - uv_b)) < r_a + r_b + gap_px:
+                out |= {name_a, name_b}
+    return out
+
+
+def relative_positioning(
+    sim: HeadSim,
+    servo: EyeServo,
+    reference: Target,
+    objects: dict[str, str],
+    knowledge: HeadKnowledge | None = None,
+    sink: EventSink | None = None,
+) -> RelativeRun:
+    """Measure ``reference`` with Model 2, then place ``objects`` (body -> colour) in areas.
+
+    The four images (each camera at each step) are taken again at the two
+    fixations' whole encoder steps, where the lines L11..L22 are.  An object
+    whose blob touches another's in any image (one partly hides the other)
+    counts as not seen: its centroid would be biased.
+    ``sink``: where the reference's fixation and measurement are reported (None:
+    the simulator's sink).
+    """
+    sink = sim.sink if sink is None else sink
+    knowledge = knowledge or HeadKnowledge()
+    start = sim.render_count
+    sink.emit(FixationStarted(reference.name))
+    ref = measure_model2(sim, servo, reference, knowledge, Model2Config(midline_px=0.0))
+    sink.emit(MeasurementDone(ref))
+    if not ref.ok:
+        return RelativeRun(ref, {}, {}, {}, tuple(objects), None, sim.render_count - start)
+    resolution = sim.settings.encoder_resolution_rad
+    # The lines L11..L22 are the cameras' lines of sight at the two fixations
+    # (not where a search took a y image).
+    steps = (
+        round(ref.details["step1_encoder_rad"] / resolution),
+        round(ref.details["step2_encoder_rad"] / resolution),
+    )
+    columns: dict[str, list[float]] = {name: [math.nan] * 4 for name in objects}
+    # Order of the four columns: u11 (Ca1, step 1), u12 (Ca1, step 2), u21, u22.
+    for step_index, step in enumerate(steps):
+        sim.command_eye_steps(step)
+        sim.settle()
+        for camera in (1, 2):
+            found = find_markers(sim.render(camera), objects)
+            touching = _touching_blobs(found)
+            for name, detection in found.items():
+                if detection.found and detection.uv is not None and name not in touching:
+                    columns[name][2 * (camera - 1) + step_index] = detection.uv[0]
+    seen = [name for name in objects if np.all(np.isfinite(columns[name]))]
+    missing = tuple(name for name in objects if name not in seen)
+    (u10, _), (u20, _) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+    alpha1, alpha2 = steps[0] * resolution, steps[1] * resolution
+    areas: dict[str, int] = dict.fromkeys(objects, 0)
+    true_areas: dict[str, int] = dict.fromkeys(objects, 0)
+    comparison = gain_comparison = None
+    gain_areas: dict[str, int] = {}
+    if seen:
+        cols = np.array([columns[name] for name in seen])
+        u11, u12, u21, u22 = cols.T
+        pixel_areas = areas_from_pixels(u11, u12, u21, u22, u10, u20, alpha1=alpha1, alpha2=alpha2)
+        truth_h = np.array([sim.position(name, "head") for name in seen])
+        effective = (sim.effective_initial_direction(1), sim.effective_initial_direction(2))
+        truth = areas_from_geometry(truth_h, alpha1, alpha2, sim.settings.baseline_m, effective)
+        comparison = compare_areas(pixel_areas, truth, u11, u12, u21, u22, u10, u20)
+        areas.update(zip(seen, (int(a) for a in pixel_areas), strict=True))
+        true_areas.update(zip(seen, (int(a) for a in truth), strict=True))
+        g1, g2 = (abs(servo.gains.get(camera) or 0.0) for camera in (1, 2))
+        if g1 > 0 and g2 > 0:
+            gain = areas_from_pixels(
+                u11, u12, u21, u22, u10, u20, alpha1=alpha1, alpha2=alpha2, kx=(g1, g2)
+            )
+            mean = (g1 + g2) / 2
+            scaled = cols.copy()
+            scaled[:, :2] = u10 + (cols[:, :2] - u10) * mean / g1
+            scaled[:, 2:] = u20 + (cols[:, 2:] - u20) * mean / g2
+            s11, s12, s21, s22 = scaled.T
+            gain_comparison = compare_areas(gain, truth, s11, s12, s21, s22, u10, u20)
+            gain_areas = dict(zip(seen, (int(a) for a in gain), strict=True))
+    return RelativeRun(
+        reference=ref,
+        areas=areas,
+        true_areas=true_areas,
+        columns={name: (c[0], c[1], c[2], c[3]) for name, c in columns.items()},
+        missing=missing,
+        comparison=comparison,
+        renders=sim.render_count - start,
+        gain_areas=gain_areas,
+        gain_comparison=gain_comparison,
+    )
 
 
 def run_relative(
@@ -112,76 +379,46 @@ def run_relative(
     return records, experiment
 
 
-def _relative_lines(e: RelativeResult, paper: bool) -> list[str]:
-    headers = ["", "ours"] + (["paper"] if paper else [])
-    rows = [
-        [
-            "alpha1 (rad)",
-            cell(e.alpha1_rad, ".4f"),
-            *([cell(e.paper.alpha1_rad, ".4f")] if paper else []),
-        ],
-        [
-            "alpha2 (rad)",
-            cell(e.alpha2_rad, ".4f"),
-            *([cell(e.paper.alpha2_rad, ".4f")] if paper else []),
-        ],
-        ["objects", str(len(e.objects)), *([str(e.paper.objects)] if paper else [])],
-    ]
-    lines = [
-        "Relative positioning (Sec. III, Table VII): fixations on the cross point",
-        *format_table(headers, rows),
-    ]
-    obj_rows = [
-        [
-            o.name,
-            o.colour,
-            f"S{o.area}" if o.area else "-",
-            f"S{o.true_area}" if o.true_area else "-",
-            "yes" if o.agree else "NO",
-            cell(o.margin_px, ".1f"),
+def read_blocks(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+    """``[scene.blocks]`` (the cross point) and ``[[scene.objects]]``/``[scene.random_objects]``."""
+    blocks = table.table("blocks") or Table({}, "scene.blocks", ctx)
+    reference = read_position(blocks, settings, default_position("blocks", names.BLOCKS))
+    blocks.done()
+    objects: list[Placement] = []
+    for entry in table.tables("objects", len(names.RELATIVE_OBJECTS)):
+        body = entry.choice("body", names.RELATIVE_OBJECTS)
+        position = read_position(entry, settings)
+        entry.done()
+        if any(o.body == body for o in objects):
+            raise entry.fail("body", f"{body!r} is placed twice", "each object once")
+        objects.append(Placement(body, body, tuple3(position), entry.path))
+    random_table = table.table("random_objects")
+    if random_table is not None:
+        if objects:
+            raise random_table.fail(
+                "count", "given together with [[scene.objects]]", "one of the two"
+            )
+        count = random_table.integer("count", MISSING, 1, len(names.RELATIVE_OBJECTS))
+        rng = np.random.default_rng([seed, STREAM_OBJECTS])
+        points = start_head_to_world(settings, random_points_head(random_table, count, rng))
+        random_table.done()
+        objects = [
+            Placement(body, body, tuple3(p), f"{random_table.path} (object {k + 1})")
+            for k, (body, p) in enumerate(zip(names.RELATIVE_OBJECTS, points, strict=False))
         ]
-        for o in e.objects
-    ]
-    lines += format_table(["object", "colour", "area", "true area", "agree", "margin px"], obj_rows)
-    lines.append(
-        f"  {e.agree} of {len(e.objects)} objects in their true areas"
-        + (f"; not seen: {', '.join(e.missing)}" if e.missing else "")
+    if not objects:
+        objects = [
+            Placement(body, body, tuple3(default_position("blocks", body)), "scene (model default)")
+            for body in names.RELATIVE_OBJECTS
+        ]
+    used = {o.body for o in objects}
+    parked = tuple(body for body in names.RELATIVE_OBJECTS if body not in used)
+    return SceneSpec(
+        scene="blocks",
+        blocks=Placement(names.BLOCKS, names.BLOCKS, tuple3(reference), blocks.path),
+        objects=tuple(objects),
+        parked=parked,
     )
-    return lines
-
-
-def _rows(e: RelativeResult, log: Recorder) -> None:
-    """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
-    baseline = log.scenario.settings.baseline_m
-    s = log.scenario.settings
-    strips, labels = [], []
-    far = 2.0
-    for step_index, alpha in enumerate((e.alpha1_rad, e.alpha2_rad)):
-        if not math.isfinite(alpha):
-            return
-        for camera in (1, 2):
-            sign = 1.0 if camera == 1 else -1.0
-            yaw = alpha + log.effective_alpha_e[camera - 1]
-            start = np.array([-sign * baseline / 2, 0.0, 0.0])
-            end = start + far * np.array([sign * math.sin(yaw), 0.0, math.cos(yaw)])
-            strips.append(head_to_world(np.array([start, end]), 0.0, 0.0, s.neck_d1_m, s.neck_a2_m))
-            labels.append(f"L{camera}{step_index + 1}")
-    log.rec.log("/world/areas/lines", rr.LineStrips3D(strips, colors=[ORANGE] * 4, labels=labels))
-    objects = e.objects
-    positions = [log.truth[o.name] for o in objects if o.name in log.truth]
-    log.rec.log(
-        "/world/areas/objects",
-        rr.Points3D(
-            positions,
-            radii=0.008,
-            colors=[GREEN if o.agree else RED for o in objects],
-            labels=[f"{o.name}: S{o.area} (true S{o.true_area})" for o in objects],
-        ),
-    )
-
-
-def _missing(e: RelativeResult) -> tuple[str, ...]:
-    return tuple(f"{name}: not seen in all four images" for name in e.missing)
 
 
 RELATIVE_POSITIONING = register(
@@ -189,12 +426,22 @@ RELATIVE_POSITIONING = register(
         "relative_positioning",
         "blocks",
         run_relative,
-        fields=asdict,
-        summary=_relative_lines,
-        failures=_missing,
-        rows=_rows,
+        fields=RelativeResult.block,
+        summary=RelativeResult.summary_lines,
+        failures=RelativeResult.failures,
+        rows=RelativeResult.log_rows,
+        read_scene=read_blocks,
+        fixations=lambda scenario: 1,  # the cross point's
     )
 )
 
 
-__all__ = ["RELATIVE_POSITIONING", "run_relative"]
+__all__ = [
+    "RELATIVE_POSITIONING",
+    "RelativeObject",
+    "RelativePaper",
+    "RelativeResult",
+    "RelativeRun",
+    "relative_positioning",
+    "run_relative",
+]

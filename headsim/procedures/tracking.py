@@ -2,28 +2,120 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
 
-from headsim.active.events import PhaseStarted
-from headsim.active.measurement import HeadKnowledge
+from headsim.active.events import FixationStarted, MeasurementDone, PhaseStarted
+from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
-from headsim.active.tracking import track_moving_target
 from headsim.run.context import (
     record_measurement,
     servo_config,
     simulator,
 )
 from headsim.run.events import Hub
-from headsim.run.outcomes import (
-    MeasurementRecord,
-    TrackingResult,
-)
+from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import cell, mm
 from headsim.run.targets import marker_target
 from headsim.scenario.registry import Procedure, register
-from headsim.scenario.spec import Scenario
+from headsim.scenario.scene import (
+    finite_number,
+    random_points_head,
+    start_head_to_world,
+    tuple3,
+)
+from headsim.scenario.schema import interpolate_option
+from headsim.scenario.spec import (
+    MARKER_BODIES,
+    STREAM_MOVING,
+    CalibrationSpec,
+    MovingTarget,
+    Scenario,
+    SceneSpec,
+)
+from headsim.scenario.tables import MISSING, Context, Table, describe_value
+from headsim.sim import names
+from headsim.sim.events import EventSink
+from headsim.sim.settings import HeadSettings
+from headsim.sim.simulator import HeadSim
+
+
+@dataclass(frozen=True)
+class TrackingResult:
+    """Tracking a moving target with Model 1: times, s; waypoints and errors in W, m."""
+
+    times_s: np.ndarray
+    waypoints_world_m: list[tuple[float, float, float]]
+    errors_world_m: np.ndarray
+    renders_first: int
+    renders_after_mean: float
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: every field, in order."""
+        return asdict(self)
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        """One line: the fixations made, their error in W and their renders."""
+        errors = np.asarray(self.errors_world_m, dtype=float)
+        finite = errors[np.isfinite(errors)]
+        return [
+            f"Tracking with the neck (Model 1): {len(finite)} of {len(errors)} fixations; error in W "
+            f"mean {mm(float(finite.mean()) if finite.size else None)} mm, max "
+            f"{mm(float(finite.max()) if finite.size else None)} mm; renders {self.renders_first} for the "
+            f"first fixation, {cell(self.renders_after_mean, '.1f')} per fixation after"
+        ]
+
+
+@dataclass(frozen=True)
+class TrackingRun:
+    """A moving target followed with the neck model: one measurement per fixation, time in s."""
+
+    times_s: np.ndarray
+    measurements: tuple[Measurement, ...]
+
+    @property
+    def errors_world_m(self) -> np.ndarray:
+        """(N,) 3-D error of each fixation in W, m (NaN where it failed)."""
+        return np.array(
+            [np.linalg.norm(m.estimate_world_m - m.truth_world_m) for m in self.measurements]
+        )
+
+
+def track_moving_target(
+    sim: HeadSim,
+    servo: NeckServo,
+    target: Target,
+    body: str,
+    trajectory: Callable[[float], np.ndarray],
+    times_s: Sequence[float] | np.ndarray,
+    knowledge: HeadKnowledge | None = None,
+    sink: EventSink | None = None,
+) -> TrackingRun:
+    """Move ``body`` along ``trajectory(t)`` (world, m) and fixate it at each time with Model 1.
+
+    The servo's Jacobian carries from one fixation to the next, so after the
+    first fixation each one starts from the last and takes few renders.  A
+    target that left both views since is searched for around the last
+    fixation (:func:`headsim.active.search.find_neck_view`), then from the start pose.
+    ``sink``: where each fixation ("<target> 1", ...) and measurement is reported
+    (None: the simulator's sink).
+    """
+    sink = sim.sink if sink is None else sink
+    measurements = []
+    fixations: list[tuple[int, int, int]] = []  # where the target was seen, in steps
+    for k, t in enumerate(times_s):
+        sink.emit(FixationStarted(f"{target.name} {k + 1}"))
+        sim.set_body_pose(body, trajectory(float(t)))
+        m = measure_model1(sim, servo, target, knowledge, last_seen=fixations[-2:])
+        sink.emit(MeasurementDone(m, float(t)))
+        measurements.append(m)
+        if m.ok:
+            fixations.append(servo.steps())
+    return TrackingRun(np.asarray(times_s, dtype=float), tuple(measurements))
 
 
 def run_tracking(
@@ -63,22 +155,73 @@ def run_tracking(
     return records, experiment
 
 
-def _tracking_lines(e: TrackingResult) -> list[str]:
-    errors = np.asarray(e.errors_world_m, dtype=float)
-    finite = errors[np.isfinite(errors)]
-    return [
-        f"Tracking with the neck (Model 1): {len(finite)} of {len(errors)} fixations; error in W "
-        f"mean {mm(float(finite.mean()) if finite.size else None)} mm, max "
-        f"{mm(float(finite.max()) if finite.size else None)} mm; renders {e.renders_first} for the "
-        f"first fixation, {cell(e.renders_after_mean, '.1f')} per fixation after"
-    ]
+def read_moving_scene(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+    """``[scene.moving_target]`` in the default scene."""
+    return SceneSpec(scene="default", moving=_read_moving(table, ctx, settings, seed))
 
 
-def _summary(e: TrackingResult, paper: bool) -> list[str]:
-    return _tracking_lines(e)
+def _read_moving(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> MovingTarget:
+    """``[scene.moving_target]``: a marker moved along waypoints, explicit or random."""
+    moving = table.table("moving_target")
+    if moving is None:
+        raise table.fail("moving_target", "missing", "a [scene.moving_target] table")
+    name = moving.string("name", "moving_target", 60)
+    body = moving.choice("body", tuple(MARKER_BODIES), names.MARKERS[0])
+    duration = moving.number("duration_s", 10.0, 0.0, 3600.0, lo_open=True, unit="s")
+    steps = moving.integer("steps", MISSING, 1, 10000)
+    allowed = "waypoints_head_m or waypoints_world_m (arrays of [x, y, z], at least 2) or [scene.moving_target.random]"
+    given = []
+    for key, frame in (("waypoints_head_m", "head"), ("waypoints_world_m", "world")):
+        value = moving.data.get(key, MISSING)
+        moving.has(key)
+        if value is MISSING:
+            continue
+        if (
+            not isinstance(value, list)
+            or len(value) < 2
+            or not all(isinstance(p, list) and len(p) == 3 for p in value)
+        ):
+            raise moving.fail(
+                key, f"must be an array of [x, y, z], got {describe_value(value)}", allowed
+            )
+        points = np.array(
+            [[finite_number(moving, f"{key}[{i}]", c) for c in p] for i, p in enumerate(value)]
+        )
+        given.append(start_head_to_world(settings, points) if frame == "head" else points)
+    random_table = moving.table("random")
+    if random_table is not None:
+        count = random_table.integer("waypoints", MISSING, 2, 1000)
+        rng = np.random.default_rng([seed, STREAM_MOVING])
+        given.append(start_head_to_world(settings, random_points_head(random_table, count, rng)))
+        random_table.done()
+    moving.done()
+    if len(given) != 1:
+        raise moving.fail("waypoints_head_m", "missing" if not given else "given twice", allowed)
+    waypoints = tuple(tuple3(p) for p in given[0])
+    return MovingTarget(name, body, waypoints, duration, steps)
 
 
-TRACKING = register(Procedure("tracking", "default", run_tracking, fields=asdict, summary=_summary))
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment]``: ``interpolate``."""
+    return interpolate_option(table)
 
 
-__all__ = ["TRACKING", "run_tracking"]
+def _fixations(scenario: Scenario) -> int:
+    return scenario.scene.moving.steps if scenario.scene.moving else 0
+
+
+TRACKING = register(
+    Procedure(
+        "tracking",
+        "default",
+        run_tracking,
+        fields=TrackingResult.block,
+        summary=TrackingResult.summary_lines,
+        options=read_options,
+        read_scene=read_moving_scene,
+        fixations=_fixations,
+    )
+)
+
+
+__all__ = ["TRACKING", "TrackingResult", "TrackingRun", "run_tracking", "track_moving_target"]

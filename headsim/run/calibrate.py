@@ -14,6 +14,14 @@ from headsim.active.calibration import (
     calibrate_head,
     line_of_sight_truth,
 )
+from headsim.active.calibration_report import (
+    CalibrationLayout,
+    CalibrationReport,
+    KnowledgeReport,
+    LinesOfSightFit,
+    PositionOutcome,
+    VerticalReference,
+)
 from headsim.active.events import PhaseStarted
 from headsim.active.eye_servo import EyeServo
 from headsim.active.failure import Failure
@@ -27,14 +35,6 @@ from headsim.run.context import (
     told,
 )
 from headsim.run.events import CalibrationDone, Hub
-from headsim.run.outcomes import (
-    CalibrationLayout,
-    CalibrationReport,
-    KnowledgeReport,
-    LinesOfSightFit,
-    PositionOutcome,
-    VerticalReference,
-)
 from headsim.run.targets import marker_target
 from headsim.scenario.calibration_design import near_far_depths, near_fraction
 from headsim.scenario.spec import STREAM_CALIBRATION, STREAM_DEPTH_NOISE, Scenario

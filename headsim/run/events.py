@@ -23,7 +23,8 @@ from headsim.errors import raise_if_interrupted
 from headsim.sim.events import ImageKind, ImageTaken, RenderCounts
 
 if TYPE_CHECKING:
-    from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RunResult
+    from headsim.active.calibration_report import CalibrationReport
+    from headsim.run.outcomes import MeasurementRecord, RunResult
 
 
 @dataclass(frozen=True)

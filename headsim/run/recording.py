@@ -58,11 +58,12 @@ import cv2
 import numpy as np
 import rerun as rr
 
+from headsim.active.calibration_report import CalibrationReport
 from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
-from headsim.run.outcomes import CalibrationReport, MeasurementRecord, RunResult
+from headsim.run.outcomes import MeasurementRecord, RunResult
 from headsim.run.recording_layout import (
     GREEN,
     GREY,

@@ -9,8 +9,8 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from headsim.active.calibration_report import CalibrationReport
 from headsim.run import mjcf_rerun
-from headsim.run.outcomes import CalibrationReport
 from headsim.scenario.spec import Scenario
 
 GREEN = (40, 220, 90)

@@ -1,13 +1,13 @@
 """Running a scenario: calibrate if asked, run the procedure, collect the results.
 
-The procedures of :mod:`headsim.active` run unchanged.  What a run
-shows while it goes (progress, the Rerun recording) follows its events: the
-runner gives the simulator (and through it the servos and the procedures) a
-:class:`headsim.run.events.Hub` as event sink, and the hub passes every event
-on to the run's subscribers.  The runner adds its own events: each recorded
-measurement, the calibration's report and the finished run.  Each phase (the
-calibration is :mod:`headsim.run.calibrate`; each procedure is found by its name in
+The calibration is :mod:`headsim.run.calibrate`'s (or a calibration file's, as
+the scenario reader read it); the procedure is found by its name in
 :mod:`headsim.scenario.registry` (the built-in ones are :mod:`headsim.procedures`).
+What a run shows while it goes (progress, the Rerun recording) follows its
+events: the runner gives the simulator (and through it the servos and the
+procedure) a :class:`headsim.run.events.Hub` as event sink, and the hub passes
+every event on to the run's subscribers.  The runner adds its own events: the
+calibration's report and the finished run.
 """
 
 from __future__ import annotations
@@ -16,17 +16,12 @@ import time
 from collections.abc import Sequence
 from dataclasses import replace
 
+from headsim.active.calibration_file import head_hash, read_calibration
+from headsim.active.calibration_report import CalibrationReport
 from headsim.run.calibrate import calibrate
 from headsim.run.context import told
 from headsim.run.events import CalibrationDone, Hub, RunFinished, Subscriber
-from headsim.run.outcomes import (
-    CalibrationReport,
-    CalibrationSource,
-    MeasurementRecord,
-    RunRenders,
-    RunResult,
-)
-from headsim.run.serialise import calibration_from_block, render_counts_from_block
+from headsim.run.outcomes import MeasurementRecord, RunRenders, RunResult
 from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
 from headsim.sim.events import RenderCounts
@@ -59,20 +54,10 @@ def run_scenario(scenario: Scenario, subscribers: Sequence[Subscriber] = ()) -> 
     failures: list[str] = []
     spec = scenario.experiment.calibration
     if spec is not None and spec.source is not None:
-        from headsim.active.calibration_file import read_calibration
-
-        stored = read_calibration(spec.source, scenario.settings)
-        calibration = calibration_from_block(
-            stored.block,
-            renders=RenderCounts(),
-            source=CalibrationSource(
-                path=str(stored.path),
-                scenario=stored.scenario,
-                seed=stored.seed,
-                head_hash=stored.head_hash,
-                render_counts=render_counts_from_block(stored.block),
-            ),
-        )
+        stored = scenario.stored_calibration  # as the reader read it, unless the head changed
+        if stored is None or stored.head_hash != head_hash(scenario.settings):
+            stored = read_calibration(spec.source, scenario.settings)
+        calibration = stored.report
         hub.emit(CalibrationDone(calibration))
         knowledge, label = stored.knowledge, "calibrated"
     elif spec is not None:

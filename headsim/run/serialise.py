@@ -3,9 +3,9 @@
 ``results.json`` (README "Scenarios and results" documents every key) holds
 no wall time and no timestamp: the same scenario, seed and software give the
 same bytes.  SI units (m, rad, px); NaN becomes null when
-:func:`headsim.files.write_json_atomic` writes it.  A calibration read
-back from a file (``[experiment.calibration] from``) is parsed by
-:func:`calibration_from_block`, the inverse of :func:`calibration_block`.
+:func:`headsim.files.write_json_atomic` writes it.  The ``calibration`` block,
+which a calibration file (head.json) holds too, is
+:func:`headsim.active.calibration_report.calibration_block`'s.
 """
 
 from __future__ import annotations
@@ -20,22 +20,10 @@ import mujoco
 import numpy as np
 
 import headsim
-from headsim.active.failure import Failure, FailureCause
-from headsim.estimators.result import Status
+from headsim.active.calibration_report import calibration_block
 from headsim.run.accuracy import MeasurementSummary, summaries
-from headsim.run.outcomes import (
-    CalibrationLayout,
-    CalibrationReport,
-    CalibrationSource,
-    KnowledgeReport,
-    LinesOfSightFit,
-    MeasurementRecord,
-    PositionOutcome,
-    RunResult,
-    VerticalReference,
-)
+from headsim.run.outcomes import MeasurementRecord, RunResult
 from headsim.scenario.registry import get
-from headsim.sim.events import RenderCounts
 
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
 RESULTS_SCHEMA = "headsim.results/2"
@@ -156,155 +144,6 @@ def summary_entry(s: MeasurementSummary) -> dict[str, Any]:
     }
 
 
-def render_counts_from_block(block: dict[str, Any]) -> RenderCounts | None:
-    """The ``render_counts`` of a ``calibration`` block read back (None: the block has none,
-    as one written before renders counted previews, whose ``renders`` counted them apart)."""
-    entry = block.get("render_counts")
-    return None if entry is None else RenderCounts.from_dict(entry)
-
-
-# -- the calibration block -------------------------------------------------------------
-
-
-def _position_entry(p: PositionOutcome) -> dict[str, Any]:
-    return {"status": p.status_text, "failure": None if p.failure is None else p.failure.as_dict()}
-
-
-def _lines_entry(lines: LinesOfSightFit) -> dict[str, Any]:
-    return {
-        "alpha_e_rad": lines.alpha_e_rad,
-        "offset_m": lines.offset_m,
-        "std_errors": {
-            "alpha_e_rad": lines.std_errors_alpha_e_rad,
-            "offset_m": lines.std_errors_offset_m,
-        },
-        "offset_truth_m": lines.offset_truth_m,
-        "covariance": lines.covariance,  # (alpha_e1, alpha_e2, s1, s2)
-        "effective_baseline_m": lines.effective_baseline_m,
-        "effective_baseline_std_m": lines.effective_baseline_std_m,
-        "effective_baseline_truth_m": lines.effective_baseline_truth_m,
-        "separable": lines.separable,
-        "message": lines.message,
-    }
-
-
-def calibration_block(report: CalibrationReport) -> dict[str, Any]:
-    """The calibration as results.json's ``calibration`` block (and head.json's) holds it."""
-    block: dict[str, Any] = {
-        "status": report.status_text,
-        "targets": report.targets,
-        "fixated": report.fixated,
-        "render_counts": report.renders.as_dict(),
-    }
-    layout = report.layout
-    if layout is not None:
-        block.update(
-            layout={
-                "kind": layout.kind,
-                "near_fraction": layout.near_fraction,
-                "depth_m": layout.depth_m,
-                "lateral": layout.lateral,
-                "vertical": layout.vertical,
-                "positions_world_m": layout.positions_world_m,
-            },
-            depth_noise_m=report.depth_noise_m,
-            position_noise_m=report.position_noise_m,
-            lines_of_sight_fit=report.lines_of_sight_fit,
-            extended=report.extended,
-            alpha_e_rad=report.alpha_e_rad,
-            alpha_e_std_rad=report.alpha_e_std_rad,
-            alpha_e_covariance_rad2=report.alpha_e_covariance_rad2,
-            alpha_e_truth_rad=report.alpha_e_truth_rad,
-            alpha_e_error_rad=report.alpha_e_error_rad,
-            alpha_e_paper_rad=report.alpha_e_paper_rad,
-            converged=report.converged,
-            depth_residual_rms_m=report.depth_residual_rms_m,
-            vertical_reference=None
-            if report.vertical_reference is None
-            else asdict(report.vertical_reference),
-            lines_of_sight=None
-            if report.lines_of_sight is None
-            else _lines_entry(report.lines_of_sight),
-            knowledge=None if report.knowledge is None else asdict(report.knowledge),
-        )
-    block["positions"] = [_position_entry(p) for p in report.positions]
-    if report.rendered_frames is not None:
-        block["rendered_frames"] = report.rendered_frames
-    if report.source is not None:
-        counts = report.source.render_counts
-        block["from"] = {
-            **asdict(report.source),
-            "render_counts": None if counts is None else counts.as_dict(),
-        }
-    return block
-
-
-def _failure(entry: dict[str, Any] | None) -> Failure | None:
-    if entry is None:
-        return None
-    return Failure(FailureCause(entry["cause"]), entry["stage"], entry["camera"], entry["detail"])
-
-
-def calibration_from_block(
-    block: dict[str, Any],
-    *,
-    renders: RenderCounts | None = None,
-    source: CalibrationSource | None = None,
-) -> CalibrationReport:
-    """The report of a ``calibration`` block read back from JSON (head.json), as written.
-
-    ``renders`` and ``source`` replace the block's own (a calibration read from a file;
-    a block written before renders counted previews has no ``render_counts``).
-    """
-    if renders is None:
-        renders = RenderCounts.from_dict(block["render_counts"])
-    status = block["status"]
-    layout = block.get("layout")
-    lines = block.get("lines_of_sight")
-    vertical = block.get("vertical_reference")
-    knowledge = block.get("knowledge")
-    return CalibrationReport(
-        status=Status.OK if status == "ok" else Status.FAILED,
-        detail="" if status == "ok" else status,
-        targets=block["targets"],
-        fixated=block["fixated"],
-        renders=renders,
-        positions=tuple(PositionOutcome(_failure(p["failure"])) for p in block["positions"]),
-        layout=None if layout is None else CalibrationLayout(**layout),
-        depth_noise_m=block.get("depth_noise_m", 0.0),
-        position_noise_m=block.get("position_noise_m", 0.0),
-        lines_of_sight_fit=block.get("lines_of_sight_fit", False),
-        extended=block.get("extended", False),
-        alpha_e_rad=block.get("alpha_e_rad"),
-        alpha_e_std_rad=block.get("alpha_e_std_rad"),
-        alpha_e_covariance_rad2=block.get("alpha_e_covariance_rad2"),
-        alpha_e_truth_rad=block.get("alpha_e_truth_rad"),
-        alpha_e_error_rad=block.get("alpha_e_error_rad"),
-        alpha_e_paper_rad=block.get("alpha_e_paper_rad"),
-        converged=block.get("converged", False),
-        depth_residual_rms_m=block.get("depth_residual_rms_m"),
-        vertical_reference=None if vertical is None else VerticalReference(**vertical),
-        lines_of_sight=None
-        if lines is None
-        else LinesOfSightFit(
-            alpha_e_rad=lines["alpha_e_rad"],
-            offset_m=lines["offset_m"],
-            std_errors_alpha_e_rad=lines["std_errors"]["alpha_e_rad"],
-            std_errors_offset_m=lines["std_errors"]["offset_m"],
-            offset_truth_m=lines["offset_truth_m"],
-            covariance=lines["covariance"],
-            effective_baseline_m=lines["effective_baseline_m"],
-            effective_baseline_std_m=lines["effective_baseline_std_m"],
-            effective_baseline_truth_m=lines["effective_baseline_truth_m"],
-            separable=lines["separable"],
-            message=lines["message"],
-        ),
-        knowledge=None if knowledge is None else KnowledgeReport(**knowledge),
-        rendered_frames=block.get("rendered_frames"),
-        source=source,
-    )
-
-
 # -- each procedure's experiment ---------------------------------------------------------
 
 
@@ -357,10 +196,8 @@ __all__ = [
     "RESULTS_KEYS",
     "RESULTS_SCHEMA",
     "calibration_block",
-    "calibration_from_block",
     "experiment_block",
     "measurement_entry",
-    "render_counts_from_block",
     "results_payload",
     "software_versions",
     "summary_entry",

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from headsim.active.calibration_report import CalibrationReport
 from headsim.run.accuracy import summaries
-from headsim.run.outcomes import CalibrationReport, RunResult
+from headsim.run.outcomes import RunResult
 from headsim.run.table import cell as _cell
 from headsim.run.table import format_table
 from headsim.run.table import mm as _mm

@@ -160,12 +160,20 @@ def _load(
         if key not in FIRST_TABLES or key == "description":
             allowed = ", ".join(k for k in FIRST_TABLES if k != "description")
             raise ScenarioError(source, f"fast.{key}", "unknown key", allowed)
-    full = _build(doc, Context(source, None), path, False, seed)
-    quick = _build(_merge(doc, fast_doc), Context(source, fast_doc), path, True, seed)
+    files: dict[Path, dict[str, Any]] = {}  # each calibration file read once for both variants
+    full = _build(doc, Context(source, None), path, False, seed, files)
+    quick = _build(_merge(doc, fast_doc), Context(source, fast_doc), path, True, seed, files)
     return quick if fast else full
 
 
-def _build(doc: dict[str, Any], ctx: Context, path: Path, fast: bool, seed: int | None) -> Scenario:
+def _build(
+    doc: dict[str, Any],
+    ctx: Context,
+    path: Path,
+    fast: bool,
+    seed: int | None,
+    files: dict[Path, dict[str, Any]],
+) -> Scenario:
     top = Table(doc, "", ctx)
     description = top.string("description")
     file_seed = top.integer("seed", 0, 0, 2**32 - 1)
@@ -174,15 +182,22 @@ def _build(doc: dict[str, Any], ctx: Context, path: Path, fast: bool, seed: int 
     settings = replace(settings, seed=seed)
     experiment = read_experiment(top, ctx, preset_name)
     calibration = experiment.calibration
+    stored = None
     if calibration is not None and calibration.source is not None:
-        from headsim.active.calibration_file import CalibrationFileError, read_calibration
+        from headsim.active.calibration_file import (
+            CalibrationFileError,
+            calibration_for_head,
+            read_calibration_document,
+        )
 
         source = Path(calibration.source)
         if not source.is_absolute():  # relative to the scenario file, like the file's own paths
             source = path.parent / source
             experiment = replace(experiment, calibration=replace(calibration, source=str(source)))
         try:
-            read_calibration(source, settings)
+            if source not in files:
+                files[source] = read_calibration_document(source)
+            stored = calibration_for_head(files[source], source, settings)
         except CalibrationFileError as err:
             raise ctx.error("experiment.calibration.from", str(err)) from err
     if experiment.goal_columns_px is not None and calibration and calibration.source:
@@ -213,6 +228,7 @@ def _build(doc: dict[str, Any], ctx: Context, path: Path, fast: bool, seed: int 
         settle_mode=settle,
         scene=scene,
         experiment=experiment,
+        stored_calibration=stored,
     )
     _check_servo(ctx, scenario)
     check_reach(ctx, scenario)

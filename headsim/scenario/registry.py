@@ -3,6 +3,8 @@
 A :class:`Procedure` is what the generic code (the scenario reader, the runner,
 results.json, the summary, the recording) needs of a procedure, and nothing of
 its result's type: the result is handed back to the procedure's own functions.
+The scenario reader asks it for the procedure's ``[experiment]`` options and
+``[scene]`` tables, and the progress bar for its number of fixations.
 The built-in procedures register themselves in :mod:`headsim.procedures`, which
 :func:`get` loads by name the first time a procedure is looked up (a plugin
 load: this layer never imports the procedures, which sit above the runner).
@@ -20,7 +22,12 @@ if TYPE_CHECKING:
     from headsim.run.events import Hub
     from headsim.run.outcomes import MeasurementRecord
     from headsim.run.recording import Recorder
-    from headsim.scenario.spec import Scenario
+    from headsim.scenario.spec import CalibrationSpec, Scenario, SceneSpec
+    from headsim.scenario.tables import Context, Table
+    from headsim.sim.settings import HeadSettings
+
+    #: ``read_scene(scene_table, ctx, settings, seed)``: the procedure's part of ``[scene]``.
+    SceneReader = Callable[[Table, Context, HeadSettings, int], SceneSpec]
 
 #: The module whose import registers the built-in procedures.
 BUILT_IN = "headsim.procedures"
@@ -36,6 +43,14 @@ def _no_failures(result: Any) -> tuple[str, ...]:
 
 def _no_rows(result: Any, log: Recorder) -> None:
     return None
+
+
+def _no_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    return {}
+
+
+def _each_target(scenario: Scenario) -> int:
+    return len(scenario.scene.targets)
 
 
 def _measured_line(result: Any, measured: int) -> str:
@@ -54,6 +69,12 @@ class Procedure:
     succeeded; ``failures`` what failed beyond its measurements; ``rows(result, log)``
     what it adds to a recording, through ``log.rec``.  ``scene`` is the MJCF scene
     (``headsim.sim.names.SCENES``) it runs in.
+
+    Its scenario block: ``options(table, calibration)`` reads the ``[experiment]``
+    keys it takes (the :class:`~headsim.scenario.spec.ExperimentSpec` fields they
+    set) and checks them against the calibration before it; ``read_scene`` reads its
+    ``[scene]`` tables (None: it takes none); ``fixations(scenario)`` is how many
+    fixations it makes after the calibration (for the progress bar).
     """
 
     name: str
@@ -64,6 +85,9 @@ class Procedure:
     ok_line: Callable[[Any, int], str] = _measured_line
     failures: Callable[[Any], tuple[str, ...]] = _no_failures
     rows: Callable[[Any, Recorder], None] = _no_rows
+    options: Callable[[Table, CalibrationSpec | None], dict[str, Any]] = _no_options
+    read_scene: SceneReader | None = None
+    fixations: Callable[[Scenario], int] = _each_target
 
 
 #: Every registered procedure, by name.

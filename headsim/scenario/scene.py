@@ -1,5 +1,5 @@
-"""The scene tables: ``[scene]`` with its targets, random layouts, chessboard, blocks and
-objects, and the moving target.
+"""The scene tables: ``[scene]`` with its targets and random layouts, and what every
+procedure's own scene tables read with (positions, random points).
 
 Positions are metres in H at the start pose (``position_head_m``: neck and
 eyes at 0) or in W (``position_world_m``); random layouts are drawn with the
@@ -9,8 +9,7 @@ scenario's seed, one stream per use (``STREAM_*``).
 
 from __future__ import annotations
 
-from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,25 +25,24 @@ from headsim.scenario.reach import (
     target_refusal,
 )
 from headsim.scenario.registry import get
+
+if TYPE_CHECKING:
+    from headsim.scenario.registry import SceneReader
 from headsim.scenario.schema import depth_range
 from headsim.scenario.spec import (
     MARKER_BODIES,
     MAX_DEPTH_M,
-    STREAM_MOVING,
-    STREAM_OBJECTS,
     STREAM_TARGETS,
-    MovingTarget,
     Placement,
     SceneSpec,
     TargetAcceptance,
-    corner_count,
 )
-from headsim.scenario.tables import MISSING, Context, Table, describe_value
+from headsim.scenario.tables import MISSING, Context, Table
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 
 
-def _position(table: Table, settings: HeadSettings, default: Any = MISSING) -> np.ndarray:
+def read_position(table: Table, settings: HeadSettings, default: Any = MISSING) -> np.ndarray:
     """``position_head_m`` (H at the start pose) or ``position_world_m``, as a world point."""
     in_head = table.numbers("position_head_m", 3, None, -MAX_DEPTH_M, MAX_DEPTH_M, unit="m")
     in_world = table.numbers("position_world_m", 3, None, -MAX_DEPTH_M, MAX_DEPTH_M, unit="m")
@@ -52,7 +50,7 @@ def _position(table: Table, settings: HeadSettings, default: Any = MISSING) -> n
     if in_head is not None and in_world is not None:
         raise table.fail("position_world_m", "given together with position_head_m", allowed)
     if in_head is not None:
-        return _head_to_world(settings, np.array(in_head))
+        return start_head_to_world(settings, np.array(in_head))
     if in_world is not None:
         return np.array(in_world)
     if default is MISSING:
@@ -60,11 +58,12 @@ def _position(table: Table, settings: HeadSettings, default: Any = MISSING) -> n
     return np.asarray(default, dtype=float)
 
 
-def _head_to_world(settings: HeadSettings, points_head: np.ndarray) -> np.ndarray:
+def start_head_to_world(settings: HeadSettings, points_head: np.ndarray) -> np.ndarray:
+    """Points (N, 3) in H at the start pose (neck and eyes at 0) in W, m."""
     return head_to_world(points_head, 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m)
 
 
-def _random_points_head(table: Table, count: int, rng: np.random.Generator) -> np.ndarray:
+def random_points_head(table: Table, count: int, rng: np.random.Generator) -> np.ndarray:
     """Points (count, 3) in H drawn like ``calibration_layout``: depth, then angles."""
     near, far = depth_range(table, (0.5, 1.2))
     lateral = table.number("lateral", 0.12, 0.0, 1.0, unit="(|x_h / z_h|)")
@@ -103,7 +102,7 @@ def _redraw_out_of_reach(
             if refusal is None:
                 break
             refused[refusal.code] = refused.get(refusal.code, 0) + 1
-            points_world[k] = _head_to_world(settings, _random_points_head(table, 1, rng))[0]
+            points_world[k] = start_head_to_world(settings, random_points_head(table, 1, rng))[0]
         else:
             raise table.fail(
                 "within",
@@ -125,7 +124,7 @@ def _read_targets(
     for k, table in enumerate(scene.tables("targets")):
         name = table.string("name", f"target_{k + 1}", 60)
         body = table.choice("body", bodies, names.MARKERS[0])
-        position = _position(table, settings)
+        position = read_position(table, settings)
         table.done()
         targets.append(Placement(name, body, tuple3(position), table.path))
     listed = len(targets)
@@ -138,7 +137,7 @@ def _read_targets(
         body = random_table.choice("body", bodies, names.MARKERS[0])
         within = random_table.choice("within", ("box", "reach"), "box")
         rng = np.random.default_rng([seed, STREAM_TARGETS])
-        points = _head_to_world(settings, _random_points_head(random_table, count, rng))
+        points = start_head_to_world(settings, random_points_head(random_table, count, rng))
         if within == "reach":
             # What can hide them: the scene as the listed targets leave it.
             placed = {t.body: np.array(t.position_world_m) for t in targets}
@@ -179,7 +178,8 @@ def _read_targets(
     return tuple(targets), acceptance
 
 
-def _default_position(scene: str, body: str) -> np.ndarray:
+def default_position(scene: str, body: str) -> np.ndarray:
+    """Where ``body`` stands in ``scene``'s model, W, m."""
     model = scene_model(scene)
     return np.array(model.body(body).pos, dtype=float)
 
@@ -188,143 +188,34 @@ def read_scene(
     doc: Table, ctx: Context, procedure: str, settings: HeadSettings, seed: int
 ) -> SceneSpec:
     """``[scene]``: what the procedure measures, and where it is."""
-    scene_name = get(procedure).scene
+    found = get(procedure)
     table = doc.table("scene") or Table({}, "scene", ctx)
-    spec = SceneSpec(scene=scene_name)
-    if procedure in ("model2", "model1", "calibration"):
-        targets, acceptance = _read_targets(
-            table, settings, seed, required=procedure != "calibration", procedure=procedure
-        )
-        spec = replace(spec, targets=targets, acceptance=acceptance)
-    elif procedure == "chessboard":
-        spec = _read_chessboard(table, ctx, settings)
-    elif procedure == "relative_positioning":
-        spec = _read_blocks(table, ctx, settings, seed)
-    elif procedure == "tracking":
-        spec = replace(spec, moving=_read_moving(table, ctx, settings, seed))
-    elif procedure == "pursuit":
-        spec = replace(spec, pursuit=read_pursuit(table, seed, tuple(MARKER_BODIES)))
+    read = found.read_scene
+    spec = SceneSpec(scene=found.scene) if read is None else read(table, ctx, settings, seed)
     table.done()
     return spec
 
 
-def _read_chessboard(table: Table, ctx: Context, settings: HeadSettings) -> SceneSpec:
-    """``[scene.chessboard]``: where the board's top-left inner corner is; which corners."""
-    board = table.table("chessboard") or Table({}, "scene.chessboard", ctx)
-    position = _position(board, settings, _default_position("chessboard", names.CHESSBOARD))
-    count = corner_count()
-    corners_value = board.data.get("corners", "all")
-    board.has("corners")
-    allowed = f'"all" or an array of corner indices 0..{count - 1} (row-major from the top-left)'
-    if corners_value == "all":
-        corners = None
-    elif (
-        isinstance(corners_value, list)
-        and corners_value
-        and all(isinstance(c, int) and not isinstance(c, bool) for c in corners_value)
-    ):
-        if not all(0 <= c < count for c in corners_value) or len(set(corners_value)) != len(
-            corners_value
-        ):
-            raise board.fail(
-                "corners", f"{corners_value} has an index out of range or twice", allowed
-            )
-        corners = tuple(corners_value)
-    else:
-        raise board.fail(
-            "corners", f'must be "all" or indices, got {describe_value(corners_value)}', allowed
+def targets_reader(procedure: str, *, required: bool) -> SceneReader:
+    """The reader of ``[[scene.targets]]`` and ``[scene.random_targets]`` in the default
+    scene, checked for ``procedure``'s reach (``required``: at least one target)."""
+
+    def read(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+        targets, acceptance = _read_targets(
+            table, settings, seed, required=required, procedure=procedure
         )
-    board.done()
-    placement = Placement(names.CHESSBOARD, names.CHESSBOARD, tuple3(position), board.path)
-    return SceneSpec(scene="chessboard", chessboard=placement, corners=corners)
+        return SceneSpec(scene="default", targets=targets, acceptance=acceptance)
+
+    return read
 
 
-def _read_blocks(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
-    """``[scene.blocks]`` (the cross point) and ``[[scene.objects]]``/``[scene.random_objects]``."""
-    blocks = table.table("blocks") or Table({}, "scene.blocks", ctx)
-    reference = _position(blocks, settings, _default_position("blocks", names.BLOCKS))
-    blocks.done()
-    objects: list[Placement] = []
-    for entry in table.tables("objects", len(names.RELATIVE_OBJECTS)):
-        body = entry.choice("body", names.RELATIVE_OBJECTS)
-        position = _position(entry, settings)
-        entry.done()
-        if any(o.body == body for o in objects):
-            raise entry.fail("body", f"{body!r} is placed twice", "each object once")
-        objects.append(Placement(body, body, tuple3(position), entry.path))
-    random_table = table.table("random_objects")
-    if random_table is not None:
-        if objects:
-            raise random_table.fail(
-                "count", "given together with [[scene.objects]]", "one of the two"
-            )
-        count = random_table.integer("count", MISSING, 1, len(names.RELATIVE_OBJECTS))
-        rng = np.random.default_rng([seed, STREAM_OBJECTS])
-        points = _head_to_world(settings, _random_points_head(random_table, count, rng))
-        random_table.done()
-        objects = [
-            Placement(body, body, tuple3(p), f"{random_table.path} (object {k + 1})")
-            for k, (body, p) in enumerate(zip(names.RELATIVE_OBJECTS, points, strict=False))
-        ]
-    if not objects:
-        objects = [
-            Placement(
-                body, body, tuple3(_default_position("blocks", body)), "scene (model default)"
-            )
-            for body in names.RELATIVE_OBJECTS
-        ]
-    used = {o.body for o in objects}
-    parked = tuple(body for body in names.RELATIVE_OBJECTS if body not in used)
-    return SceneSpec(
-        scene="blocks",
-        blocks=Placement(names.BLOCKS, names.BLOCKS, tuple3(reference), blocks.path),
-        objects=tuple(objects),
-        parked=parked,
-    )
+def read_pursuit_scene(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
+    """``[scene.pursuit]`` in the default scene."""
+    return SceneSpec(scene="default", pursuit=read_pursuit(table, seed, tuple(MARKER_BODIES)))
 
 
-def _read_moving(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> MovingTarget:
-    """``[scene.moving_target]``: a marker moved along waypoints, explicit or random."""
-    moving = table.table("moving_target")
-    if moving is None:
-        raise table.fail("moving_target", "missing", "a [scene.moving_target] table")
-    name = moving.string("name", "moving_target", 60)
-    body = moving.choice("body", tuple(MARKER_BODIES), names.MARKERS[0])
-    duration = moving.number("duration_s", 10.0, 0.0, 3600.0, lo_open=True, unit="s")
-    steps = moving.integer("steps", MISSING, 1, 10000)
-    allowed = "waypoints_head_m or waypoints_world_m (arrays of [x, y, z], at least 2) or [scene.moving_target.random]"
-    given = []
-    for key, frame in (("waypoints_head_m", "head"), ("waypoints_world_m", "world")):
-        value = moving.data.get(key, MISSING)
-        moving.has(key)
-        if value is MISSING:
-            continue
-        if (
-            not isinstance(value, list)
-            or len(value) < 2
-            or not all(isinstance(p, list) and len(p) == 3 for p in value)
-        ):
-            raise moving.fail(
-                key, f"must be an array of [x, y, z], got {describe_value(value)}", allowed
-            )
-        points = np.array(
-            [[_finite_number(moving, f"{key}[{i}]", c) for c in p] for i, p in enumerate(value)]
-        )
-        given.append(_head_to_world(settings, points) if frame == "head" else points)
-    random_table = moving.table("random")
-    if random_table is not None:
-        count = random_table.integer("waypoints", MISSING, 2, 1000)
-        rng = np.random.default_rng([seed, STREAM_MOVING])
-        given.append(_head_to_world(settings, _random_points_head(random_table, count, rng)))
-        random_table.done()
-    moving.done()
-    if len(given) != 1:
-        raise moving.fail("waypoints_head_m", "missing" if not given else "given twice", allowed)
-    waypoints = tuple(tuple3(p) for p in given[0])
-    return MovingTarget(name, body, waypoints, duration, steps)
-
-
-def _finite_number(table: Table, key: str, value: Any) -> float:
+def finite_number(table: Table, key: str, value: Any) -> float:
+    """``value`` at ``key``, a number within +-MAX_DEPTH_M m (else the table's error)."""
     return table._check_number(
         key, value, -MAX_DEPTH_M, MAX_DEPTH_M, False, False, f"numbers within +-{MAX_DEPTH_M:g} m"
     )

@@ -273,6 +273,19 @@ def depth_range(table: Table, default: tuple[float, float]) -> tuple[float, floa
     return lo, hi
 
 
+def interpolate_option(table: Table) -> dict[str, Any]:
+    """``interpolate``: the fixation angle between the last two encoder steps (Model 1 and 2)."""
+    return {"interpolate": table.boolean("interpolate", True)}
+
+
+def near_midline_options(table: Table) -> dict[str, Any]:
+    """``midline_px``, ``remedy_px``: Model 2's near-midline remedy."""
+    return {
+        "midline_px": table.number("midline_px", 25.0, 0.0, 1000.0, unit="px"),
+        "remedy_px": table.number("remedy_px", 120.0, 0.0, 1000.0, lo_open=True, unit="px"),
+    }
+
+
 def read_experiment(doc: Table, ctx: Context, preset_name: str = "ideal") -> ExperimentSpec:
     """``[experiment]``: procedure, optional calibration first, and options."""
     table = doc.table("experiment")
@@ -280,18 +293,7 @@ def read_experiment(doc: Table, ctx: Context, preset_name: str = "ideal") -> Exp
         raise ctx.error("experiment", "missing", "an [experiment] table with a procedure")
     procedure = table.choice("procedure", registry.names())
     calibration = _read_calibration(table.table("calibration"), preset_name == "realistic")
-    if procedure == "calibration" and calibration is None:
-        raise table.fail(
-            "calibration", "missing", "an [experiment.calibration] table (the calibration to run)"
-        )
-    options: dict[str, Any] = {}
-    if procedure in ("model2", "model1", "calibration", "chessboard", "tracking"):
-        options["interpolate"] = table.boolean("interpolate", True)
-    if procedure in ("model2", "calibration", "chessboard"):
-        options["midline_px"] = table.number("midline_px", 25.0, 0.0, 1000.0, unit="px")
-        options["remedy_px"] = table.number(
-            "remedy_px", 120.0, 0.0, 1000.0, lo_open=True, unit="px"
-        )
+    options = registry.get(procedure).options(table, calibration)
     goals = table.numbers("goal_columns_px", 2, None, 0.0, MAX_IMAGE_SIDE - 1.0, unit="px")
     if goals is not None:
         options["goal_columns_px"] = (goals[0], goals[1])

@@ -9,7 +9,6 @@ OpenCV's.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -17,10 +16,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from headsim import paper
+from headsim.scenario import registry
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 
 if TYPE_CHECKING:
+    from headsim.active.calibration_file import StoredCalibration
     from headsim.scenario.pursuit import PursuitSpec
 
 #: The narrowest baseline a scenario may set, m: below it vergence carries no depth.
@@ -216,7 +217,11 @@ class SceneSpec:
 
 @dataclass(frozen=True)
 class Scenario:
-    """A checked scenario, ready to run (random parts already drawn from ``seed``)."""
+    """A checked scenario, ready to run (random parts already drawn from ``seed``).
+
+    ``stored_calibration``: the calibration file ``[experiment.calibration] from``
+    names, as the reader read and checked it (None: the scenario has none).
+    """
 
     name: str
     path: Path
@@ -228,6 +233,7 @@ class Scenario:
     settle_mode: str
     scene: SceneSpec
     experiment: ExperimentSpec
+    stored_calibration: StoredCalibration | None = field(default=None, compare=False, repr=False)
 
     @property
     def paper_cameras(self) -> bool:
@@ -239,19 +245,7 @@ class Scenario:
         """How many fixations the run makes (for the progress bar)."""
         calibration = self.experiment.calibration
         count = calibration.targets if calibration else 0
-        procedure = self.experiment.procedure
-        if procedure == "chessboard":
-            return count + len(self.scene.corners or range(corner_count()))
-        if procedure == "relative_positioning":
-            return count + 1
-        if procedure == "tracking":
-            return count + (self.scene.moving.steps if self.scene.moving else 0)
-        if procedure == "pursuit":  # one step per camera frame
-            pursuit = self.scene.pursuit
-            assert pursuit is not None  # the reader sets it for this procedure
-            return count + math.ceil(pursuit.duration_s * pursuit.live.frame_rate_hz)
-        per_target = 2 if procedure == "calibration" else 1
-        return count + per_target * len(self.scene.targets)
+        return count + registry.get(self.experiment.procedure).fixations(self)
 
 
 def corner_count() -> int:

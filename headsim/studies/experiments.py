@@ -23,9 +23,9 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement, body_target
 from headsim.active.model2 import measure_model2
 from headsim.active.placement import calibration_layout
-from headsim.active.relative import relative_positioning
 from headsim.active.servo_types import Detector
 from headsim.estimators.areas import AreaComparison
+from headsim.procedures.relative import relative_positioning
 from headsim.run.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.spec import Scenario

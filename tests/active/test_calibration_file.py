@@ -64,7 +64,14 @@ def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
 
     scenario_file = tmp_path / "measure.toml"
     scenario_file.write_text(SCENARIO.format(head=head_file, extra=""))
-    result = run_scenario(load_scenario(scenario_file))
+    scenario = load_scenario(scenario_file)
+    # The reader read the file once; the run reads it no more, unless the head changed.
+    other = replace(scenario.settings, baseline_m=0.16)
+    with pytest.raises(CalibrationFileError, match=r"different head: baseline_m"):
+        run_scenario(replace(scenario, settings=other))
+    away = head_file.rename(tmp_path / "away.json")
+    result = run_scenario(scenario)
+    away.rename(head_file)
     assert result.ok
     assert result.renders.calibration.total == 0 and result.renders.overall.total > 0
     assert result.calibration is not None and result.calibration.source is not None

@@ -8,7 +8,6 @@ from itertools import pairwise
 import numpy as np
 
 from headsim.active.calibration import calibrate_head
-from headsim.active.chessboard import measure_chessboard
 from headsim.active.events import (
     CalibrationPosition,
     Detected,
@@ -21,7 +20,8 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
-from headsim.active.tracking import track_moving_target
+from headsim.procedures.chessboard import measure_chessboard
+from headsim.procedures.tracking import track_moving_target
 from headsim.sim import names
 from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.simulator import HeadSim

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from headsim.run.outcomes import ChessboardResult, RunResult
+from headsim.procedures.chessboard import ChessboardResult
+from headsim.run.outcomes import RunResult
 
 
 def test_the_squares_measure_30_mm(fast_run: Callable[[str], RunResult]) -> None:

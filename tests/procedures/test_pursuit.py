@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from headsim.run.outcomes import PursuitResult, RunResult
+from headsim.procedures.pursuit import PursuitResult
+from headsim.run.outcomes import RunResult
 
 
 def test_the_target_is_never_lost(fast_run: Callable[[str], RunResult]) -> None:

@@ -8,8 +8,7 @@ from dataclasses import replace
 
 from headsim.active.measurement import HeadKnowledge
 from headsim.live import Visibility
-from headsim.procedures.pursuit import run_pursuit, summary_lines
-from headsim.run.outcomes import PursuitFigures, PursuitResult
+from headsim.procedures.pursuit import PursuitFigures, PursuitResult, run_pursuit
 from headsim.scenario.loading import load_scenario
 
 
@@ -67,9 +66,9 @@ def test_a_target_never_present_is_a_failure_named_before_any_image() -> None:
 
     records, experiment = run_pursuit(scenario, Sink(), HeadKnowledge(), "pursuit")
     assert records == []
-    assert experiment["failures"] == [f"{pursuit.name}: never present in the run"]
-    assert experiment["pursuit"]["duration_s"] == pursuit.duration_s
-    assert "frames" not in experiment
+    assert experiment.failures == (f"{pursuit.name}: never present in the run",)
+    assert experiment.block() == {"pursuit": experiment.pursuit}
+    assert experiment.pursuit["duration_s"] == pursuit.duration_s
     assert [type(e).__name__ for e in events] == ["PhaseStarted"]
 
 
@@ -92,9 +91,9 @@ def test_the_summary_gives_millimetres_and_milliseconds_and_n_a_for_no_figure() 
     result = PursuitResult(
         pursuit={"path_kind": "sinusoid", "duration_s": 2.0, "predictor": True}, figures=figures
     )
-    first, second, third = summary_lines(result)
+    first, second, third = result.summary_lines()
     assert first.startswith("pursuit: sinusoid path for 2.0 s;") and "predictor on" in first
     assert second.startswith("frames 60 (target present 58), lost 2")
     assert "RMS along the path 1.20 mm" in third and "(max n/a mm)" in third
     assert "pursuit lag 33.3 ms" in third and "time to fixation n/a ms" in third
-    assert summary_lines(PursuitResult(pursuit={})) == []
+    assert PursuitResult(pursuit={}).summary_lines() == []

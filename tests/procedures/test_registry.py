@@ -1,5 +1,6 @@
 """A procedure defined here, registered through the public registry and run by ``headsim run``:
-its results.json block, its summary lines and its recording rows, with no other module edited."""
+its scene table, its results.json block, its summary lines and its recording rows, with no
+other module edited."""
 
 from __future__ import annotations
 
@@ -21,6 +22,8 @@ from headsim.run.context import simulator
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.recording import Recorder
+from headsim.scenario.loading import load_scenario
+from headsim.scenario.scene import targets_reader
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
 
@@ -29,7 +32,8 @@ BODY = sorted(names.MARKER_COLOURS)[0]
 
 @dataclass(frozen=True)
 class HeightResult:
-    """How high a marker stands in W, m (the truth: this procedure only reads the scene)."""
+    """How high the scene's first target stands in W, m (the truth: this procedure only
+    reads the scene)."""
 
     body: str
     height_m: float
@@ -38,8 +42,10 @@ class HeightResult:
 def run_height(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
 ) -> tuple[list[MeasurementRecord], HeightResult]:
+    placement = scenario.scene.targets[0]
     with simulator(hub, "default", scenario) as sim:
-        return [], HeightResult(BODY, float(sim.position(BODY)[2]))
+        sim.set_body_pose(placement.body, np.array(placement.position_world_m))
+        return [], HeightResult(placement.body, float(sim.position(placement.body)[2]))
 
 
 def rows(result: HeightResult, log: Recorder) -> None:
@@ -53,6 +59,8 @@ HEIGHT = procedures.Procedure(
     fields=lambda r: {"body": r.body, "height_m": r.height_m},
     summary=lambda r, paper: [f"Marker height: {r.body} at {r.height_m * 1000:.1f} mm"],
     rows=rows,
+    read_scene=targets_reader("marker_height", required=True),
+    fixations=lambda scenario: 0,  # it fixates nothing
 )
 
 
@@ -69,14 +77,17 @@ def test_a_new_procedure_runs_through_headsim_run(
     scenario = tmp_path / "height.toml"
     scenario.write_text(
         'description = "How high a marker stands"\nseed = 0\n\n'
-        '[experiment]\nprocedure = "marker_height"\n'
+        '[experiment]\nprocedure = "marker_height"\n\n'
+        f'[[scene.targets]]\nbody = "{BODY}"\nposition_head_m = [0.02, 0.01, 0.6]\n'
     )
+    loaded = load_scenario(scenario)
+    assert [t.body for t in loaded.scene.targets] == [BODY] and loaded.fixations == 0
     out, rrd = tmp_path / "out", tmp_path / "height.rrd"
     argv = ["run", str(scenario), "--out", str(out), "--rrd", str(rrd), "--no-progress"]
     assert main(argv) == 0
     block: dict[str, Any] = json.loads((out / "results.json").read_text())["experiment"]
     assert block["procedure"] == "marker_height" and block["body"] == BODY
-    assert 0.0 < block["height_m"] < 2.0
+    assert block["height_m"] == pytest.approx(loaded.scene.targets[0].position_world_m[2])
     summary = (out / "summary.txt").read_text()
     assert f"Marker height: {BODY} at {block['height_m'] * 1000:.1f} mm" in summary
     assert "OK: 0 measurements, none failed" in summary

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from headsim.run.outcomes import RelativeResult, RunResult
+from headsim.procedures.relative import RelativeResult
+from headsim.run.outcomes import RunResult
 
 
 def test_every_object_is_in_its_true_area(fast_run: Callable[[str], RunResult]) -> None:

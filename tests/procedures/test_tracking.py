@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from headsim.run.outcomes import RunResult, TrackingResult
+from headsim.procedures.tracking import TrackingResult
+from headsim.run.outcomes import RunResult
 
 
 def test_every_fixation_is_within_3_mm(fast_run: Callable[[str], RunResult]) -> None:

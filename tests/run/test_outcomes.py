@@ -6,9 +6,10 @@ from dataclasses import FrozenInstanceError, replace
 
 import pytest
 
+from headsim.active.calibration_report import CalibrationReport, PositionOutcome
 from headsim.active.failure import Failure, FailureCause
 from headsim.estimators.result import Status
-from headsim.run.outcomes import CalibrationReport, PositionOutcome, RunRenders, RunResult
+from headsim.run.outcomes import RunRenders, RunResult
 from headsim.scenario.loading import load_scenario
 from headsim.sim.events import RenderCounts
 

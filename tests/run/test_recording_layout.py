@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 from rerun.chunk import RrdReader
 
+from headsim.active.calibration_report import CalibrationReport
 from headsim.estimators.result import Status
-from headsim.run.outcomes import CalibrationReport
 from headsim.run.recording_layout import calibration_markdown
 from headsim.sim.events import RenderCounts
 

@@ -7,29 +7,25 @@ import json
 import numpy as np
 import pytest
 
-from headsim.estimators.result import Method, Status
-from headsim.files import to_jsonable
-from headsim.run.outcomes import (
+from headsim.active.calibration_report import (
     CalibrationLayout,
     CalibrationReport,
     CalibrationSource,
     KnowledgeReport,
     LinesOfSightFit,
-    MeasurementRecord,
-    PointsResult,
     PositionOutcome,
-    PursuitResult,
-    TrackingResult,
     VerticalReference,
-)
-from headsim.run.serialise import (
-    MEASUREMENT_KEYS,
     calibration_block,
     calibration_from_block,
-    experiment_block,
-    measurement_entry,
     render_counts_from_block,
 )
+from headsim.estimators.result import Method, Status
+from headsim.files import to_jsonable
+from headsim.procedures.model2 import Model2Result
+from headsim.procedures.pursuit import PursuitResult
+from headsim.procedures.tracking import TrackingResult
+from headsim.run.outcomes import MeasurementRecord
+from headsim.run.serialise import MEASUREMENT_KEYS, experiment_block, measurement_entry
 from headsim.sim.events import RenderCounts
 
 from .helpers import LOST, measurement
@@ -150,7 +146,7 @@ def test_a_block_from_before_renders_counted_previews_says_nothing_of_them() -> 
 
 
 def test_each_experiment_writes_the_procedure_first() -> None:
-    assert experiment_block("model2", PointsResult()) == {"procedure": "model2"}
+    assert experiment_block("model2", Model2Result()) == {"procedure": "model2"}
     assert experiment_block("chessboard", None) == {"procedure": "chessboard"}
     tracking = TrackingResult(
         np.array([0.0, 1.0]), [(0.0, 0.5, 0.6)], np.array([1e-3, 2e-3]), 12, 4.0

@@ -289,7 +289,7 @@ def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
 def test_windows_change_no_chessboard_corner() -> None:
     # The corners of one board share windows that hold the whole board (its extent):
     # every detection and estimate as with full frames, on the distorted paper head.
-    from headsim.active.chessboard import measure_chessboard
+    from headsim.procedures.chessboard import measure_chessboard
     from headsim.sim import names
 
     corners = [0, 1, 8, 27, 46, 47]
@@ -324,7 +324,7 @@ def test_a_seen_boards_corners_are_looked_for_alone_in_small_windows() -> None:
     refinement's support (not the board's): where the last sight puts it after a short
     eye move, where a binned preview of the board puts it after a long one.  Same
     detections and estimates as full frames, a fraction of the pixels."""
-    from headsim.active.chessboard import measure_chessboard
+    from headsim.procedures.chessboard import measure_chessboard
     from headsim.sim import names
 
     corners = [9, 10, 11, 12]

@@ -9,7 +9,7 @@ import numpy as np
 from headsim.active.measurement import body_target
 from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import seen_by_both
-from headsim.active.tracking import track_moving_target
+from headsim.procedures.tracking import track_moving_target
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import MarkerDetector

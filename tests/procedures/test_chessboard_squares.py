@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from headsim.active.chessboard import measure_chessboard
 from headsim.active.eye_servo import EyeServo
+from headsim.procedures.chessboard import measure_chessboard
 from headsim.sim import names
 from headsim.sim.simulator import HeadSim
 

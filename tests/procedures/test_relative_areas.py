@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
-from headsim.active.relative import relative_positioning
+from headsim.procedures.relative import relative_positioning
 from headsim.sim import names
 from headsim.sim.simulator import HeadSim
 from headsim.vision.crosses import find_cross_point

@@ -1,0 +1,64 @@
+"""Model 1 (fixation with the neck, Sec. II-B) on each of the scenario's targets."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.model1 import measure_model1
+from headsim.active.neck_servo import NeckServo
+from headsim.procedures.each_target import measure_each_target
+from headsim.run.context import servo_config
+from headsim.run.events import Hub
+from headsim.run.outcomes import MeasurementRecord
+from headsim.scenario.registry import Procedure, register
+from headsim.scenario.scene import targets_reader
+from headsim.scenario.schema import interpolate_option
+from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.tables import Table
+
+
+@dataclass(frozen=True)
+class Model1Result:
+    """Model 1 on each target: nothing beyond its measurements."""
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: none."""
+        return {}
+
+
+def run_model1(
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], Model1Result]:
+    """Model 1 on each target in turn, one neck servo for all."""
+    interpolate = scenario.experiment.interpolate
+    records = measure_each_target(
+        scenario,
+        hub,
+        knowledge,
+        [(knowledge, label)],
+        lambda sim: NeckServo(sim, servo_config(scenario)),
+        lambda sim, servo, target, known: measure_model1(sim, servo, target, known, interpolate),
+    )
+    return records, Model1Result()
+
+
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment]``: ``interpolate``."""
+    return interpolate_option(table)
+
+
+MODEL1 = register(
+    Procedure(
+        "model1",
+        "default",
+        run_model1,
+        fields=Model1Result.block,
+        options=read_options,
+        read_scene=targets_reader("model1", required=True),
+    )
+)
+
+
+__all__ = ["MODEL1", "Model1Result", "run_model1"]

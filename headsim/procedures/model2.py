@@ -1,0 +1,64 @@
+"""Model 2 (the two-step measurement of Sec. II-C, the neck still) on each of the scenario's targets."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.model2 import measure_model2
+from headsim.procedures.each_target import measure_each_target
+from headsim.run.context import model2_config, servo_config
+from headsim.run.events import Hub
+from headsim.run.outcomes import MeasurementRecord
+from headsim.scenario.registry import Procedure, register
+from headsim.scenario.scene import targets_reader
+from headsim.scenario.schema import interpolate_option, near_midline_options
+from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.tables import Table
+
+
+@dataclass(frozen=True)
+class Model2Result:
+    """Model 2 on each target: nothing beyond its measurements."""
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: none."""
+        return {}
+
+
+def run_model2(
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], Model2Result]:
+    """Model 2 on each target in turn, one eye servo for all."""
+    config = model2_config(scenario)
+    records = measure_each_target(
+        scenario,
+        hub,
+        knowledge,
+        [(knowledge, label)],
+        lambda sim: EyeServo(sim, servo_config(scenario)),
+        lambda sim, servo, target, known: measure_model2(sim, servo, target, known, config),
+    )
+    return records, Model2Result()
+
+
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment]``: ``interpolate``, and the near-midline remedy's ``midline_px``, ``remedy_px``."""
+    return {**interpolate_option(table), **near_midline_options(table)}
+
+
+MODEL2 = register(
+    Procedure(
+        "model2",
+        "default",
+        run_model2,
+        fields=Model2Result.block,
+        options=read_options,
+        read_scene=targets_reader("model2", required=True),
+    )
+)
+
+
+__all__ = ["MODEL2", "Model2Result", "run_model2"]
