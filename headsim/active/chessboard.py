@@ -1,5 +1,5 @@
-"""The chessboard of Sec. VI-A as a target: each inner corner found on the whole board,
-or alone where the board places it, and the board found in a camera's next image.
+"""The chessboard of Sec. VI-A as a target: each inner corner read off the whole board,
+and the board found in a camera's next image.
 """
 
 from __future__ import annotations
@@ -15,9 +15,7 @@ from headsim.sim.simulator import HeadSim
 from headsim.stereo.views import CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M
 from headsim.vision.chessboard import (
     ChessboardDetection,
-    corner_support_px,
     find_chessboard,
-    find_corner_alone,
 )
 from headsim.vision.detection import Detection, DetectionStatus
 
@@ -47,19 +45,11 @@ def board_extent(board: ChessboardDetection, index: int) -> tuple[float, float, 
     )
 
 
-def alone_extent(spacing_px: float) -> tuple[float, float, float, float]:
-    """(left, top, right, bottom) px from a corner of what finding it alone needs: the
-    pixels its refinement reads (:func:`headsim.vision.chessboard.corner_support_px`)."""
-    reach = float(corner_support_px(spacing_px))
-    return (-reach, -reach, reach, reach)
-
-
 @dataclass(frozen=True, eq=False)
 class ChessboardCorner:
     """The detector of inner corner ``index`` of a board of ``pattern`` inner corners: the
     whole board found (a :class:`~headsim.active.look.PatternFeature`).  Every corner of one
-    board shares its windows (``window_key``); once the board was seen, a corner is looked
-    for alone, where the board places it."""
+    board shares its windows (``window_key``), which hold the whole board."""
 
     index: int
     pattern: tuple[int, int]
@@ -68,10 +58,6 @@ class ChessboardCorner:
     @property
     def window_key(self) -> tuple[str, tuple[int, int], float]:
         return ("chessboard", self.pattern, self.square_m)
-
-    @property
-    def feature_index(self) -> int:
-        return self.index
 
     def __call__(self, image: np.ndarray) -> Detection:
         board = find_chessboard(image, self.pattern)
@@ -87,15 +73,6 @@ class ChessboardCorner:
             pattern_uv=tuple((float(a), float(b)) for a, b in board.corners),
             pattern_scale_px=board.spacing_px,
         )
-
-    def find_alone(self, image: np.ndarray, spacing_px: float) -> Detection:
-        uv = find_corner_alone(image, spacing_px)
-        if uv is None:
-            return Detection(DetectionStatus.LOST, None, 0.0)
-        return Detection(DetectionStatus.FOUND, uv, 1.0, alone_extent(spacing_px))
-
-    def alone_extent_px(self, spacing_px: float) -> tuple[float, float, float, float]:
-        return alone_extent(spacing_px)
 
 
 def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: float) -> Target:
@@ -116,9 +93,8 @@ def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: flo
 
 #: The binning of the preview that places a board seen for the first time (stereo's
 #: and the zoom's views): the scene's 30 mm squares, 28.6 px at 0.85 m at the paper's
-#: focal length, stay >= 10 px at 2 x 2 to about 1.2 m (see
-#: ``look.PREVIEW_MIN_SPACING_PX``); a board the preview misses is found in
-#: the full frame.
+#: focal length, stay >= 10 px at 2 x 2 to about 1.2 m (OpenCV found every board of 14 px
+#: squares and none of 7 px); a board the preview misses is found in the full frame.
 BOARD_PREVIEW_BINNING = 2
 
 
@@ -137,7 +113,6 @@ _BOARD = chessboard_corner_target(0, CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M)
 __all__ = [
     "BOARD_PREVIEW_BINNING",
     "ChessboardCorner",
-    "alone_extent",
     "board_extent",
     "chessboard_corner_target",
     "look_for_board",

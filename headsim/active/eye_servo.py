@@ -100,11 +100,8 @@ class EyeServo:
         the last step that saw it, no render needed) and retried at half the
         length, at most ``max_retreats`` times.  Once converged, the sub-step
         fixation may be averaged over images around the crossing (see
-        ``ServoConfig.average_fixation``).  Without ``first`` a new fixation begins: a
-        pattern is seen whole again before its features are looked for alone.
+        ``ServoConfig.average_fixation``).
         """
-        if first is None:
-            self.looker.new_fixation()
         goal = self.sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
         result = self._servo(camera, detector, goal, first)
         if result.converged:

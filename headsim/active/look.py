@@ -37,15 +37,6 @@ from headsim.vision.detection import Detection
 #: distorted image, 1.44), and a lot when it moved in depth, or when the window shows
 #: another, smaller blob of its colour (the full frame's answer is the largest one).
 AREA_CHANGE = 2.0
-#: A pattern's feature is looked for alone only after an image motion of at most this
-#: many pattern spacings since the pattern was last seen: the gain's linear prediction
-#: is then good to well within the 0.3 spacing that tells the feature from its neighbours
-#: (a chessboard corner 1,300 steps of eye motion away was predicted a square off).
-ALONE_MOTION = 2.0
-#: A pattern is looked for in a binned preview only where its spacing stays at least
-#: this many pixels there: OpenCV found every chessboard of 14 px squares (the scene's
-#: board at 0.85 m binned 2 x 2) and none of 7 px (4 x 4).
-PREVIEW_MIN_SPACING_PX = 10.0
 
 Extent = tuple[float, float, float, float]
 
@@ -66,28 +57,15 @@ class BlobDetector(Protocol):
 @runtime_checkable
 class PatternFeature(Protocol):
     """A detector of one feature of a pattern (a chessboard's corner) that reports the
-    pattern's extent (``Detection.extent_px``) and, once the pattern was seen, can find
-    its feature alone where the pattern places it."""
+    pattern's extent (``Detection.extent_px``): the pattern's features share their
+    windows, which hold the whole pattern."""
 
     @property
     def window_key(self) -> Hashable:
-        """What the pattern's features share: their windows and the pattern's memory."""
-        ...
-
-    @property
-    def feature_index(self) -> int:
-        """The feature's index in ``Detection.pattern_uv``."""
+        """What the pattern's features share: their windows and the last sight."""
         ...
 
     def __call__(self, image: np.ndarray) -> Detection: ...
-
-    def find_alone(self, image: np.ndarray, spacing_px: float) -> Detection:
-        """The feature alone, in an image of its surroundings (a pattern of ``spacing_px``)."""
-        ...
-
-    def alone_extent_px(self, spacing_px: float) -> Extent:
-        """(left, top, right, bottom) px from the feature of what finding it alone needs."""
-        ...
 
 
 def finds_blob(detector: object) -> bool:
@@ -165,86 +143,6 @@ def unbinned_px(binned_px: tuple[float, ...] | np.ndarray, binning: int) -> np.n
     ``binning`` (``HeadSim.render_preview``): binned pixel i covers pixels
     b i .. b i + b - 1, so its centre is b i + (b - 1) / 2."""
     return binning * np.asarray(binned_px, dtype=np.float64) + (binning - 1) / 2.0
-
-
-@dataclass(frozen=True, eq=False)
-class SeenPattern:
-    """Every feature (N, 2) px, the spacing px, and the box (left, top, right, bottom) px
-    that finding the whole pattern needs, where the last detection put them."""
-
-    features: np.ndarray
-    spacing_px: float
-    box: np.ndarray
-
-    @classmethod
-    def from_whole(cls, detection: Detection) -> SeenPattern | None:
-        """From a detection of the whole pattern (None: not one)."""
-        if detection.uv is None or detection.pattern_uv is None or detection.extent_px is None:
-            return None
-        u, v = detection.uv
-        left, top, right, bottom = detection.extent_px
-        box = np.array([u + left, v + top, u + right, v + bottom])
-        return cls(np.array(detection.pattern_uv), detection.pattern_scale_px, box)
-
-    @classmethod
-    def from_preview(cls, detection: Detection, binning: int) -> SeenPattern | None:
-        """From a detection of the whole pattern in a preview binned ``binning`` x
-        ``binning`` (None: not one), in the full frame's pixels: binned pixel i covers
-        pixels b i .. b i + b - 1 (:func:`unbinned_px`)."""
-        binned = cls.from_whole(detection)
-        if binned is None:
-            return None
-        return cls(
-            unbinned_px(binned.features, binning),
-            binning * binned.spacing_px,
-            unbinned_px(binned.box, binning),
-        )
-
-    def found_alone(self, index: int, uv: tuple[float, float]) -> SeenPattern:
-        """Moved so that feature ``index``, found alone, is at ``uv``."""
-        shift = np.asarray(uv) - self.features[index]
-        return SeenPattern(self.features + shift, self.spacing_px, self.box + shift[[0, 1, 0, 1]])
-
-    def extent_from(self, uv: tuple[float, float]) -> Extent:
-        """The whole pattern's box from ``uv``, px: (left, top, right, bottom)."""
-        left, top, right, bottom = (float(x) for x in self.box)
-        return (left - uv[0], top - uv[1], right - uv[0], bottom - uv[1])
-
-    def expects_alone(self, index: int, motion_px: float) -> bool:
-        """Whether feature ``index`` may be looked for alone after ``motion_px`` of motion."""
-        return (
-            0 <= index < len(self.features)
-            and self.spacing_px > 0.0
-            and abs(motion_px) <= ALONE_MOTION * self.spacing_px
-        )
-
-
-def preview_binning(spacing_px: float, largest: int, image_size: tuple[int, int]) -> int:
-    """The largest binning up to ``largest`` (a power of two dividing the image) that keeps
-    the pattern's spacing at least :data:`PREVIEW_MIN_SPACING_PX`; 1: none does."""
-    width, height = image_size
-    b = 1
-    while (
-        2 * b <= largest
-        and width % (2 * b) == 0
-        and height % (2 * b) == 0
-        and spacing_px / (2 * b) >= PREVIEW_MIN_SPACING_PX
-    ):
-        b *= 2
-    return b
-
-
-def remembered(
-    kept: SeenPattern | None, detection: Detection, found_alone: int | None
-) -> SeenPattern | None:
-    """What to keep after ``detection`` (FOUND): the pattern it saw whole; the kept one
-    moved to it when it is feature ``found_alone`` found alone; else nothing (a blob)."""
-    whole = SeenPattern.from_whole(detection)
-    if whole is not None:
-        return whole
-    if found_alone is not None and kept is not None and detection.uv is not None:
-        return kept.found_alone(found_alone, detection.uv)
-    return None
 
 
 # -- where a window goes (pure) ------------------------------------------------------
@@ -374,15 +272,10 @@ class LookCounts:
 
 @dataclass
 class _Memory:
-    """Per camera: the last sight, the extent of the pattern last seen (None: a blob),
-    where the last detection puts its pattern (a board seen whole, then moved with each
-    feature found alone), and the cameras that saw the pattern whole in this fixation
-    (only they look for a feature alone: the board may have moved by whole squares)."""
+    """Per camera: the last sight, and the extent of the pattern last seen (None: a blob)."""
 
     sight: dict[int, Sight] = field(default_factory=dict)
     extent: dict[int, Extent | None] = field(default_factory=dict)
-    pattern: dict[int, SeenPattern] = field(default_factory=dict)
-    confirmed: set[int] = field(default_factory=set)
 
 
 class Looker:
@@ -406,11 +299,6 @@ class Looker:
         self.sizes = {
             n: (camera.width, camera.height) for n, camera in enumerate(sim.settings.cameras, 1)
         }
-
-    def new_fixation(self) -> None:
-        """A new fixation begins: a pattern is seen whole again before its features are
-        looked for alone."""
-        self._memory.confirmed.clear()
 
     def look(self, camera: int, detector: Detector, hint: Hint) -> Detection:
         """``detector``'s answer on ``camera``'s next image, from as few pixels as the full
@@ -540,44 +428,30 @@ class Looker:
         window is rendered: around where the head expects the target from that sight and
         the eye steps moved since (u + gain * steps), of half-side 3 blob radii plus the
         margin and a quarter of the predicted motion (blob detectors), or the pattern's
-        box so grown.  A miss is looked for again in a preview, then in the same
-        instant's full frame.  A new target, or a pattern's feature after a move too long
-        to find it alone, is first found in a binned preview; ``preview=False`` renders
-        the full frame instead (a search's look)."""
+        box so grown.  A blob's miss is looked for again in a preview, then in the same
+        instant's full frame.  A new blob is first found in a binned preview;
+        ``preview=False`` renders the full frame instead (a search's look)."""
         key = detector if hint.key is None else hint.key
-        sim, cfg, memory, counts = self.sim, self.config, self._memory, self.counts
+        sim, cfg, counts = self.sim, self.config, self.counts
         steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
         feature = pattern_feature(key)
         if feature is not None:  # a pattern's features share their windows
             key = feature.window_key
-        window, spacing, whole = None, 0.0, False
+        window = None
         if feature is not None or finds_blob(key):
-            window, spacing, whole = self._window(
-                camera, key, steps, neck, hint.gain_px_per_step, feature
-            )
+            window = self._window(camera, key, steps, neck, hint.gain_px_per_step)
         # A blob's window placed from the last sight of it: a guess the image confirms.
-        guessed = memory.sight[camera].area_px if window is not None and feature is None else None
-        looked = None
-        if hint.preview and feature is not None and not spacing and not whole:
-            looked = self._pattern_preview(camera, key, detector, feature)
-        if looked is not None:
-            window, spacing = looked
-        elif hint.preview and window is None and feature is None and finds_blob(key):
+        guessed = (
+            self._memory.sight[camera].area_px if window is not None and feature is None else None
+        )
+        if hint.preview and window is None and feature is None and finds_blob(key):
             window = self._blob_preview(camera, key, neck)
         detection = None
-        found_alone: int | None = None  # the feature's index when found alone
         if window is not None:
             counts.window_renders += 1
-            look = (
-                partial(feature.find_alone, spacing_px=spacing)
-                if spacing and feature is not None
-                else detector
-            )
             detection = self._in_window(
-                camera, reporting(look, self.sink, camera, window), window, guessed
+                camera, reporting(detector, self.sink, camera, window), window, guessed
             )
-            if detection is not None and spacing and feature is not None:
-                found_alone = feature.feature_index
             if detection is None:
                 counts.window_misses += 1
             if (
@@ -596,38 +470,14 @@ class Looker:
                 detection = reporting(detector, self.sink, camera)(self._take(camera, retake=True))
         if detection is None:
             detection = reporting(detector, self.sink, camera)(self._take(camera))
-        self._remember(camera, detection, (key, steps, neck), looked is not None, found_alone)
-        return detection
-
-    def _remember(
-        self,
-        camera: int,
-        detection: Detection,
-        where: tuple[object, int, tuple[float, float]],
-        previewed: bool,
-        found_alone: int | None,
-    ) -> None:
-        """Keep what ``detection`` tells the next look: ``where`` the head was (key, eye
-        steps, neck encoders), whether a preview showed the pattern, and the feature's
-        index when it was found alone.  Only detections with a centroid and an area
-        predict a window."""
         memory = self._memory
+        # Only detections with a centroid and an area predict a window.
         if isinstance(detection, Detection) and detection.found and detection.uv is not None:
-            if previewed or detection.pattern_uv is not None:
-                memory.confirmed.add(camera)  # the pattern seen whole (or its preview)
-            memory.sight[camera] = Sight(*where, detection.uv, detection.area_px)
+            memory.sight[camera] = Sight(key, steps, neck, detection.uv, detection.area_px)
             memory.extent[camera] = detection.extent_px
-            kept = remembered(memory.pattern.get(camera), detection, found_alone)
-            if kept is None:
-                memory.pattern.pop(camera, None)
-            else:
-                memory.pattern[camera] = kept
-                if found_alone is not None:  # the next whole-pattern window is its box
-                    memory.extent[camera] = kept.extent_from(detection.uv)
         else:
             memory.sight.pop(camera, None)
-            memory.pattern.pop(camera, None)
-            memory.confirmed.discard(camera)
+        return detection
 
     def _blob_preview(self, camera: int, key: object, neck: tuple[float, float]) -> Window | None:
         """A preview's window for ``key``'s blob where no sight predicts where it is (a
@@ -640,35 +490,6 @@ class Looker:
         self.counts.previews += 1
         return self._preview_window(camera, key)
 
-    def _pattern_preview(
-        self, camera: int, key: object, detector: Detector, feature: PatternFeature
-    ) -> tuple[Window | None, float] | None:
-        """After a move too long to find ``feature`` alone, where a binned preview of the
-        whole view puts it and the pattern's spacing there.  None: no preview (no binning
-        keeps the pattern findable), or one that did not show the pattern (its window, as
-        before)."""
-        seen, kept = self._memory.sight.get(camera), self._memory.pattern.get(camera)
-        if not self.config.windows or kept is None or seen is None or seen.key != key:
-            return None
-        size = self.sizes[camera]
-        b = preview_binning(kept.spacing_px, self.config.preview_binning, size)
-        if b <= 1:
-            return None
-        self.counts.previews += 1
-        found = SeenPattern.from_preview(detector(self._take(camera, binning=b)), b)
-        if found is None:
-            return None
-        u, v = found.features[feature.feature_index]
-        # The preview places each feature to within about b px.
-        window = pattern_window(
-            size, (u, v), feature.alone_extent_px(found.spacing_px), 4.0 * b,
-            self.config.window_margin_px,
-        )  # fmt: skip
-        if window is None:
-            return None
-        self._memory.pattern[camera] = found
-        return window, found.spacing_px
-
     def _window(
         self,
         camera: int,
@@ -676,45 +497,26 @@ class Looker:
         steps: int,
         neck: tuple[float, float],
         gain: float | None,
-        feature: PatternFeature | None,
-    ) -> tuple[Window | None, float, bool]:
-        """Where to look for ``key``'s target in ``camera`` (None: the full frame), the
-        pattern's spacing, px, when it is a ``feature`` looked for alone (else 0), and
-        whether it is the whole pattern's window that tells the features apart first (in
-        a new fixation): around where the last sight of the pattern puts it."""
+    ) -> Window | None:
+        """Where to look for ``key``'s target in ``camera`` (None: the full frame): around
+        where the last sight puts it, the whole pattern's box for a pattern."""
         cfg, memory = self.config, self._memory
         seen = memory.sight.get(camera)
         if not cfg.windows or seen is None or gain is None:
-            return None, 0.0, False
+            return None
         if seen.key != key or seen.neck != neck:
-            return None, 0.0, False
+            return None
         size = self.sizes[camera]
         motion = gain * (steps - seen.steps)
-        kept, extent = memory.pattern.get(camera), memory.extent.get(camera)
-        expected, margin, whole = (seen.uv[0] + motion, seen.uv[1]), cfg.window_margin_px, False
-        if (
-            feature is not None
-            and kept is not None
-            and kept.expects_alone(feature.feature_index, motion)
-        ):
-            if camera in memory.confirmed:
-                u, v = kept.features[feature.feature_index]
-                spacing = kept.spacing_px
-                window = pattern_window(
-                    size, (u + motion, v), feature.alone_extent_px(spacing), motion, margin
-                )
-                return window, spacing if window is not None else 0.0, False
-            whole = True  # a new fixation: the whole pattern first
+        expected, margin = (seen.uv[0] + motion, seen.uv[1]), cfg.window_margin_px
+        extent = memory.extent.get(camera)
         if extent is not None:  # a pattern: the whole of it
-            window = pattern_window(size, expected, extent, motion, margin)
-            return window, 0.0, whole and window is not None
-        return expected_window(size, expected, seen.area_px, motion, margin), 0.0, False
+            return pattern_window(size, expected, extent, motion, margin)
+        return expected_window(size, expected, seen.area_px, motion, margin)
 
 
 __all__ = [
-    "ALONE_MOTION",
     "AREA_CHANGE",
-    "PREVIEW_MIN_SPACING_PX",
     "Anew",
     "Around",
     "BlobDetector",
@@ -723,7 +525,6 @@ __all__ = [
     "LookCounts",
     "Looker",
     "PatternFeature",
-    "SeenPattern",
     "Sight",
     "Since",
     "Whole",
@@ -732,8 +533,6 @@ __all__ = [
     "look_once",
     "pattern_feature",
     "pattern_window",
-    "preview_binning",
-    "remembered",
     "reporting",
     "stands_for_frame",
     "unbinned_px",

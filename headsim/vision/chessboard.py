@@ -131,44 +131,6 @@ def refinement(spacing_px: float) -> tuple[int, float]:
     return half_window, sigma
 
 
-def corner_support_px(spacing_px: float) -> int:
-    """How far from a corner the pixels its refinement reads reach, px: the half window,
-    one pixel of gradient, and the blur's kernel radius (OpenCV's 4 sigma)."""
-    half_window, sigma = refinement(spacing_px)
-    return half_window + 1 + round(4.0 * sigma)
-
-
-def find_corner_alone(
-    image: np.ndarray, spacing_px: float, *, min_contrast: float = 40.0
-) -> tuple[float, float] | None:
-    """The chessboard corner nearest the image's centre, without the board: (u, v) px, or
-    None when no X-junction of at least ``min_contrast`` grey levels lies within 0.3 of
-    a square of the centre.
-
-    Refined as :func:`find_chessboard` refines a corner of a board whose corners are
-    ``spacing_px`` apart (the same window and blur): in an image that holds
-    :func:`corner_support_px` around it, the same position to cornerSubPix's tolerance.
-    For a corner whose place is known to well within half a square (a tracked board).
-    """
-    grey = to_grey(image)
-    height, width = grey.shape
-    half_window, sigma = refinement(spacing_px)
-    response = junction_response(cv2.GaussianBlur(grey, (0, 0), 1.0))
-    peaks = junction_peaks(response, 8.0 * min_contrast, suppression_px=4)
-    if len(peaks) == 0:
-        return None
-    centre = np.array([(width - 1) / 2.0, (height - 1) / 2.0])
-    distance = np.linalg.norm(peaks - centre, axis=1)
-    nearest = int(np.argmin(distance))
-    seed = peaks[nearest]
-    if distance[nearest] > 0.3 * spacing_px or not inside(seed, width, height, half_window + 1):
-        return None
-    u, v = refine_corners(grey, seed.reshape(1, 2), half_window, sigma)[0]
-    if float(np.hypot(u - seed[0], v - seed[1])) > 0.25 * spacing_px:
-        return None  # it ran to another feature: not this corner's
-    return float(u), float(v)
-
-
 def _junctions_at_border(grey: np.ndarray, min_contrast: float, min_count: int = 3) -> bool:
     """Whether several X-junctions are visible, one of them near the border."""
     response = junction_response(cv2.GaussianBlur(grey, (0, 0), 1.0))

@@ -157,11 +157,11 @@ def test_the_neck_servo_finds_a_moved_target_from_its_images() -> None:
     assert misses >= 1
 
 
-def test_a_board_moved_by_whole_squares_is_seen_whole_before_a_corner_alone() -> None:
+def test_a_board_moved_by_whole_squares_gives_the_corner_a_fresh_head_measures() -> None:
     """A chessboard's corners all look alike: after the board moved by exactly two squares,
-    the window where the last fixation put corner 19 holds corner 17.  A new fixation
-    looks at the whole board first, so the corner measured is corner 19, as a fresh
-    head measures it."""
+    the place where the last fixation put corner 19 holds corner 17.  Each corner is read
+    off the whole board, so the corner measured is corner 19, as a fresh head measures
+    it."""
     shifted = np.array([0.06, 0.0, 0.0])  # two 30 mm squares along the board's rows
     target = chessboard_corner_target(19, (8, 6), 0.03)
     estimates: list[np.ndarray] = []

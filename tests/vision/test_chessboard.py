@@ -18,9 +18,7 @@ from headsim.sim.settings import (
 )
 from headsim.sim.simulator import HeadSim
 from headsim.vision.chessboard import (
-    corner_support_px,
     find_chessboard,
-    find_corner_alone,
     orient_grid,
 )
 from headsim.vision.detection import DetectionStatus
@@ -134,38 +132,3 @@ def test_a_board_half_out_of_view_is_cut_and_a_missing_one_lost() -> None:
 def test_a_pattern_too_small_names_the_problem() -> None:
     with pytest.raises(ValueError, match="pattern must be at least"):
         find_chessboard(np.zeros((48, 64, 3), np.uint8), (1, 6))
-
-
-@pytest.mark.parametrize("preset", sorted(PRESETS))
-def test_a_corner_found_alone_is_where_the_whole_board_puts_it(preset: str) -> None:
-    """In a crop that holds its refinement's support, a corner found alone (nearest the
-    crop's centre) is the board's corner to cornerSubPix's tolerance; half a square off
-    the centre nothing is taken."""
-    rng = np.random.default_rng(5)
-    with HeadSim("chessboard", PRESETS[preset]()) as sim:
-        figures = []
-        for _ in range(3):
-            depth = rng.uniform(0.55, 0.95)
-            rotation = facing_head(sim, names.CHESSBOARD) @ rotation_z(rng.uniform(-0.2, 0.2))
-            centre = sim.transform_points([0.0, 0.0, depth], "head", "world")[0]
-            place(sim, names.CHESSBOARD, rotation, centre, BOARD_CENTRE)
-            sim.move(eye=float(np.arctan2(0.075, depth)))
-            image = sim.render(1)
-            board = find_chessboard(image, PATTERN)
-            assert board.found and board.spacing_px > 8.0
-            reach = corner_support_px(board.spacing_px)
-            for index in rng.choice(len(board.corners), 6, replace=False):
-                u, v = board.corners[index]
-                # A crop around where the board puts it, a few px off centre.
-                du, dv = rng.integers(-3, 4, size=2)
-                x0, y0 = round(u) + int(du) - reach - 4, round(v) + int(dv) - reach - 4
-                side = 2 * (reach + 4) + 1
-                crop = image[y0 : y0 + side, x0 : x0 + side]
-                alone = find_corner_alone(crop, board.spacing_px)
-                assert alone is not None
-                figures.append(np.hypot(alone[0] + x0 - u, alone[1] + y0 - v))
-                # Centred half a square away (between corners): not taken.
-                half = round(board.spacing_px / 2)
-                off = image[y0 + half : y0 + half + side, x0 + half : x0 + half + side]
-                assert find_corner_alone(off, board.spacing_px) is None
-    assert max(figures) <= 1e-3, figures
