@@ -37,7 +37,7 @@ def dotted_overrides(overrides: Mapping[str, Any], prefix: str = "") -> dict[str
     flat: dict[str, Any] = {}
     for key, value in overrides.items():
         dotted = f"{prefix}{key}"
-        if isinstance(value, Mapping) and value:
+        if isinstance(value, Mapping):  # an empty table changes nothing
             flat.update(dotted_overrides(value, dotted + "."))
         else:
             flat[dotted] = value

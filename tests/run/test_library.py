@@ -99,6 +99,7 @@ def test_overrides_as_tables_and_dotted_keys() -> None:
         "cam1.kx": 7.0,
         "scene.count": 2,
     }
+    assert dotted_overrides({"cam1": {}}) == {}  # merging no key changes nothing
     by_table = headsim.load_scenario("quickstart", fast=True, cam1={"noise_std": 3.0})
     by_key = headsim.load_scenario("quickstart", fast=True, overrides={"cam1.noise_std": 3.0})
     assert by_table == by_key
