@@ -3,6 +3,7 @@ description, name, target name or key shows as ``\\u001b`` and never acts on it.
 
 from __future__ import annotations
 
+import io
 import re
 from pathlib import Path
 
@@ -48,7 +49,7 @@ def test_list_shows_a_description_escaped(
 def test_run_shows_the_summary_escaped(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "hostile.toml"
     path.write_text(HOSTILE)
-    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--no-progress"]) == 0
+    assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 0  # progress too
     out, err = capsys.readouterr()
     assert not RAW.search(out + err)
     assert r"bell\u0007" in out and r"\u001b[2J" in out
@@ -65,3 +66,18 @@ def test_an_error_shows_a_file_key_escaped(
     out, err = capsys.readouterr()
     assert not RAW.search(out + err)
     assert r"cam1.\u001b]0;owned\u0007: unknown key" in err and err.count("\n") == 1
+
+
+def test_progress_lines_show_a_target_name_escaped() -> None:
+    from headsim.run.progress import Counter
+
+    stream = io.StringIO()
+    counter = Counter(
+        2, unit="fixations", stream=stream, terminal=False, interval_s=0.0, notes_in_lines=True
+    )
+    counter.phase("measurement\x1b[2J")
+    counter.update(1, "bell\x07")
+    counter.close()
+    text = stream.getvalue()
+    assert not RAW.search(text)
+    assert r"measurement\u001b[2J: 1/2 fixations bell\u0007" in text
