@@ -1,4 +1,17 @@
-"""headsim: a MuJoCo testbed for vergence-based active stereo vision on humanoid heads."""
+"""headsim: a MuJoCo testbed for vergence-based active stereo vision on humanoid heads.
+
+From Python (``docs/python.md``)::
+
+    import headsim
+    scenario = headsim.load_scenario("quickstart", fast=True)
+    result = headsim.run(scenario)              # headsim.RunResult
+    result.measurements                         # typed rows
+    result.table()                              # pandas.DataFrame(result.table())
+
+The names below load on first use, so ``import headsim`` stays cheap.
+"""
+
+from typing import TYPE_CHECKING, Any
 
 from headsim.sim.backend import choose_default_backend
 
@@ -6,3 +19,47 @@ from headsim.sim.backend import choose_default_backend
 choose_default_backend()
 
 __version__ = "0.1.0"
+
+if TYPE_CHECKING:
+    from headsim.run.library import load_scenario
+    from headsim.run.outcomes import MeasurementRow, RunResult
+    from headsim.scenario.spec import Scenario
+    from headsim.scenario.tables import ScenarioError
+    from headsim.sim.simulator import HeadSim
+
+#: Each lazily loaded name and the module that defines it.
+_LAZY = {
+    "load_scenario": "headsim.run.library",
+    "RunResult": "headsim.run.outcomes",
+    "MeasurementRow": "headsim.run.outcomes",
+    "Scenario": "headsim.scenario.spec",
+    "ScenarioError": "headsim.scenario.tables",
+    "HeadSim": "headsim.sim.simulator",
+}
+
+__all__ = [
+    "HeadSim",
+    "MeasurementRow",
+    "RunResult",
+    "Scenario",
+    "ScenarioError",
+    "__version__",
+    "load_scenario",
+    "run",
+]
+
+
+def __getattr__(name: str) -> Any:
+    import importlib
+
+    if name == "run":  # the package headsim.run, which is callable (headsim.run.library.run)
+        return importlib.import_module("headsim.run")
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

@@ -15,6 +15,10 @@ user (``headsim --debug ...`` shows one):
 Raise :class:`BadInput` or :class:`EnvironmentProblem` (or a subclass) anywhere
 below a command; :func:`guarded` maps them, and any other exception, to a code
 and one line on stderr.  New subcommands get this for free from ``cli.main``.
+
+Text that comes from a file (a scenario's name, description, target names, keys)
+reaches the terminal through :func:`printable`, so that a control character in it
+is shown escaped and never acts on the user's terminal.
 """
 
 from __future__ import annotations
@@ -25,6 +29,20 @@ import traceback
 from collections.abc import Callable
 from enum import IntEnum
 from typing import TextIO
+
+#: Characters shown escaped: C0 and C1 controls and DEL (not the newline), and the
+#: bidirectional embeddings, overrides and isolates that reorder what follows them.
+_UNPRINTABLE = {
+    code: f"\\u{code:04x}"
+    for code in (*range(0x20), *range(0x7F, 0xA0), *range(0x202A, 0x202F), *range(0x2066, 0x206A))
+    if code != 0x0A
+}
+
+
+def printable(text: str) -> str:
+    """``text`` for the terminal: each control character (but the newline) written as
+    TOML and Python write it, ``\\u001b`` for ESC, so it shows and does nothing."""
+    return text.translate(_UNPRINTABLE)
 
 
 class ExitCode(IntEnum):
@@ -179,7 +197,7 @@ def guarded(body: Callable[[], int], *, debug: bool = False, stream: TextIO | No
             traceback.print_exception(err, file=stream)
         try:
             print(
-                f"headsim: {'' if code == ExitCode.INTERRUPTED else 'error: '}{message}",
+                f"headsim: {'' if code == ExitCode.INTERRUPTED else 'error: '}{printable(message)}",
                 file=stream,
             )
             stream.flush()

@@ -24,6 +24,7 @@ from headsim.cli.writing import (
 from headsim.errors import (
     ExitCode,
     OutputNotWritable,
+    printable,
     raise_if_interrupted,
 )
 from headsim.run.outputs import Outputs
@@ -105,10 +106,14 @@ def run_command(args: argparse.Namespace) -> int:
         )
     finally:
         outputs.remove_empty_created()
-    print(text)
-    print(f"\nwall time {wall:.1f} s; results in {out / 'results.json'} (summary.txt, timing.json)")
+    print(printable(text))
+    print(
+        printable(
+            f"\nwall time {wall:.1f} s; results in {out / 'results.json'} (summary.txt, timing.json)"
+        )
+    )
     if rrd is not None:
-        print(f"recording {rrd} ({file_size(rrd)}): open it with  rerun {rrd}")
+        print(printable(f"recording {rrd} ({file_size(rrd)}): open it with  rerun {rrd}"))
     if recorder is not None and target.serve:
         serve_until_interrupted(recorder, target.web_viewer_url)
     return 0 if result.ok else 1
@@ -172,16 +177,18 @@ def calibrate_command(args: argparse.Namespace) -> int:
     alpha, std = report.alpha_e_rad, report.alpha_e_std_rad
     assert alpha is not None and std is not None and report.rendered_frames is not None
     print(
-        f"{scenario.name}{' (fast)' if scenario.fast else ''}: {report.fixated} of "
-        f"{report.targets} ball positions fixated, {report.renders.total} renders "
-        f"({report.rendered_frames:.1f} full frames of pixels) in {wall:.1f} s"
+        printable(
+            f"{scenario.name}{' (fast)' if scenario.fast else ''}: {report.fixated} of "
+            f"{report.targets} ball positions fixated, {report.renders.total} renders "
+            f"({report.rendered_frames:.1f} full frames of pixels) in {wall:.1f} s"
+        )
     )
     for index in (0, 1):
         print(f"  alpha_e{index + 1} = {alpha[index]:+.5f} rad (std {std[index]:.1e})")
     known = report.knowledge
     print(f"  v0 = {known.v0_px} px; kx/ky = {known.kx_over_ky}")
-    print(f"head {head_hash(scenario.settings)[:12]}; written to {out}")
-    print(f'use it with  [experiment.calibration] from = "{out.resolve()}"')
+    print(printable(f"head {head_hash(scenario.settings)[:12]}; written to {out}"))
+    print(printable(f'use it with  [experiment.calibration] from = "{out.resolve()}"'))
     return 0
 
 
@@ -191,10 +198,11 @@ def list_command(args: argparse.Namespace) -> int:
     directory = Path(args.dir) if args.dir else SCENARIOS_DIR
     rows = list(describe_scenarios(directory))
     if not rows:
-        print(f"no scenario files (*.toml) in {directory}")
+        print(printable(f"no scenario files (*.toml) in {directory}"))
         return 0
-    print(f"scenarios in {directory} (run one with: headsim run NAME --out DIR)")
-    width = max(len(name) for name, _ in rows)
-    for name, description in rows:
+    print(printable(f"scenarios in {directory} (run one with: headsim run NAME --out DIR)"))
+    shown = [(printable(name), printable(description)) for name, description in rows]
+    width = max(len(name) for name, _ in shown)
+    for name, description in shown:
         print(f"  {name.ljust(width)}  {description}")
     return 0 if all(not d.startswith("INVALID") for _, d in rows) else 2

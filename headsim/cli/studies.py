@@ -14,6 +14,7 @@ from headsim.cli.interrupts import sigterm_interrupts
 from headsim.errors import (
     BadInput,
     ExitCode,
+    printable,
 )
 from headsim.run.outputs import Outputs
 
@@ -68,9 +69,12 @@ def sweep_command(args: argparse.Namespace) -> int:
     outputs = Outputs()
     try:
         outputs.directory(args.out, "--out")  # before anything is printed or run
-        print(f"sweep {spec.path.name}: {spec.description}")
+        print(printable(f"sweep {spec.path.name}: {spec.description}"))
         print(
-            f"  {len(spec.jobs)} jobs of {Path(spec.scenario).stem}{' (fast)' if spec.fast else ''}"
+            printable(
+                f"  {len(spec.jobs)} jobs of {Path(spec.scenario).stem}"
+                f"{' (fast)' if spec.fast else ''}"
+            )
         )
         where = (
             f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers} local process(es)"
@@ -94,7 +98,7 @@ def sweep_command(args: argparse.Namespace) -> int:
                 return ExitCode.INTERRUPTED
     finally:
         outputs.remove_empty_created()
-    print(summary_table(spec, outcome.records.values()))
+    print(printable(summary_table(spec, outcome.records.values())))
     rate = 60 * outcome.ran / outcome.wall_s if outcome.wall_s > 0 else 0.0
     print(
         f"{outcome.ran} jobs run ({outcome.skipped} already done) in {outcome.wall_s:.1f} s, "

@@ -2,9 +2,13 @@
 
 Observation (``Dict``): ``cam1``, ``cam2`` -- both cameras' RGB images
 (default 128 x 96); ``encoders`` -- (neck yaw, neck pitch, eye motor), rad.
-Action (``Box``): velocity commands for (neck yaw, neck pitch, eye motor),
-rad/s, within the motors' speed limits; each is held for one frame period
-while the motor ramps to it within its acceleration limit (physics).
+Action (``Box``): velocity commands for (neck yaw, neck pitch, eye motor), each
+held for one frame period while the motor ramps to it within its acceleration
+limit (physics).  ``action_space="normalised"`` (default): ``Box(-1, 1)``, the
+share of each motor's speed limit (:data:`MOTOR_SPEED_LIMITS_RAD_S`), as
+reinforcement-learning libraries expect; ``"physical"``: rad/s, within those
+limits.  ``env.unwrapped.action_scale_rad_s`` is the speed one unit of action
+commands.
 
 Reward ``"offsets"`` (default): minus the mean of the absolute image offsets
 ``(u1 - u10)/(W/2), (u2 - u20)/(W/2), ((v1 + v2)/2 - v0)/(H/2)``, each 1 when
@@ -74,6 +78,12 @@ CAMERA_FIELDS = CAMERA_NUMBER_FIELDS  # their order fixes the random draws
 HEAD_FIELDS = ("baseline_m",)
 TARGET_FIELDS = ("depth_m", "bearing_rad", "speed_m_s")
 REWARDS = ("offsets", "position")
+#: What an action is: the share of each motor's speed limit, or rad/s.
+ACTION_SPACES = ("normalised", "physical")
+#: The motors' speed limits, rad/s, in the action's order: neck yaw, neck pitch, eye.
+MOTOR_SPEED_LIMITS_RAD_S = np.array(
+    [NECK_LIMITS.max_speed, NECK_LIMITS.max_speed, EYE_LIMITS.max_speed], np.float32
+)
 
 
 def _check_ranges(randomise: dict[str, Any]) -> dict[str, tuple[float, float]]:
@@ -110,7 +120,12 @@ class FixateEnv(gymnasium.Env):
         multisamples: int = 0,
         render_mode: str | None = None,
         belief: HeadBelief | None = None,
+        action_space: str = "normalised",
     ) -> None:
+        if action_space not in ACTION_SPACES:
+            raise SettingsError(
+                f"action_space must be one of {', '.join(ACTION_SPACES)}, got {action_space!r}"
+            )
         if reward not in REWARDS:
             raise SettingsError(f"reward must be one of {', '.join(REWARDS)}, got {reward!r}")
         if render_mode not in (None, "rgb_array"):
@@ -151,10 +166,11 @@ class FixateEnv(gymnasium.Env):
                 "encoders": spaces.Box(low, -low, (3,), np.float32),
             }
         )
-        limits = np.array(
-            [NECK_LIMITS.max_speed, NECK_LIMITS.max_speed, EYE_LIMITS.max_speed], np.float32
-        )
-        self.action_space: spaces.Box = spaces.Box(-limits, limits, (3,), np.float32)
+        limits = MOTOR_SPEED_LIMITS_RAD_S
+        #: The speed one unit of action commands to each motor, rad/s.
+        self.action_scale_rad_s = limits if action_space == "normalised" else np.ones(3, np.float32)
+        bound = limits / self.action_scale_rad_s
+        self.action_space: spaces.Box = spaces.Box(-bound, bound, (3,), np.float32)
         self._sim: HeadSim | None = None
         self._settings: HeadSettings | None = None
         self._live: LiveHead | None = None
@@ -227,7 +243,8 @@ class FixateEnv(gymnasium.Env):
     ) -> tuple[dict[str, np.ndarray], float, bool, bool, dict[str, Any]]:
         if self._live is None or self._frame is None:
             raise RuntimeError("call reset() before step()")
-        speeds = np.clip(np.asarray(action, float), self.action_space.low, self.action_space.high)
+        space = self.action_space
+        speeds = np.clip(np.asarray(action, float), space.low, space.high) * self.action_scale_rad_s
 
         def command(motors, _now: float) -> None:
             for index, speed in enumerate(speeds):
@@ -338,4 +355,4 @@ class FixateEnv(gymnasium.Env):
             self._sim = None
 
 
-__all__ = ["FixateEnv"]
+__all__ = ["ACTION_SPACES", "MOTOR_SPEED_LIMITS_RAD_S", "FixateEnv"]

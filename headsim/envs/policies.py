@@ -1,7 +1,7 @@
 """Reference policies for ``headsim/Fixate-v0``: the paper's servo as a policy, and a random one.
 
 Both see only what an agent sees: the observation (images, encoders) and the
-action space.  :class:`ServoPolicy` is the paper's uncalibrated servo
+action space (normalised, or in rad/s: ``FixateEnv``'s ``action_space`` option).  :class:`ServoPolicy` is the paper's uncalibrated servo
 (``headsim.active.neck_servo.NeckServo``) recast for velocity commands: it measures its
 image Jacobian (px per rad) by probing each joint once, moves by
 ``-J^-1 e`` in one frame period, and refines J with Broyden's rule from every
@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 from gymnasium import spaces
 
+from headsim.envs.fixate import MOTOR_SPEED_LIMITS_RAD_S
 from headsim.vision.markers import find_marker
 
 #: Probe size per joint, rad.
@@ -22,11 +23,33 @@ PROBE_RAD = 0.02
 MIN_SECANT_RAD = 2e-3
 
 
-class ServoPolicy:
-    """The paper's image servo as a policy ``action = policy(observation)``."""
+def action_scale(action_space: spaces.Box) -> np.ndarray:
+    """rad/s per unit of action: the motors' speed limits for a normalised ``Box(-1, 1)``,
+    else 1 (the action is in rad/s)."""
+    normalised = bool(np.all(action_space.low == -1.0) and np.all(action_space.high == 1.0))
+    return MOTOR_SPEED_LIMITS_RAD_S.astype(float) if normalised else np.ones(3)
 
-    def __init__(self, action_space: spaces.Box, period_s: float, colour: str = "red") -> None:
+
+class ServoPolicy:
+    """The paper's image servo as a policy ``action = policy(observation)``.
+
+    ``action_scale_rad_s``: the speed one unit of action commands (the env's
+    ``action_scale_rad_s``); default from the space (:func:`action_scale`).
+    """
+
+    def __init__(
+        self,
+        action_space: spaces.Box,
+        period_s: float,
+        colour: str = "red",
+        action_scale_rad_s: np.ndarray | None = None,
+    ) -> None:
         self.action_space = action_space
+        self.action_scale_rad_s = (
+            action_scale(action_space)
+            if action_scale_rad_s is None
+            else np.asarray(action_scale_rad_s, float)
+        )
         self.period_s = period_s
         self.colour = colour
         self.jacobian: np.ndarray | None = None  # px per rad, rows (u1, u2, v), columns joints
@@ -80,7 +103,9 @@ class ServoPolicy:
             return np.zeros(3, np.float32)
         return self._clip(move / self.period_s)
 
-    def _clip(self, action: np.ndarray) -> np.ndarray:
+    def _clip(self, speeds_rad_s: np.ndarray) -> np.ndarray:
+        """The action commanding ``speeds_rad_s``, within the action space."""
+        action = speeds_rad_s / self.action_scale_rad_s
         return np.clip(action, self.action_space.low, self.action_space.high).astype(np.float32)
 
 

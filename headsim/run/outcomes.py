@@ -10,8 +10,10 @@ in the names: m, rad, px; positions in W unless named otherwise.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
+
+import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.active.measurement import Measurement
@@ -29,6 +31,86 @@ class MeasurementRecord:
     knowledge: str
     step: int
     time_s: float | None = None
+
+
+Vector3 = tuple[float, float, float]
+
+
+def _vector(values: np.ndarray) -> Vector3:
+    x, y, z = (float(v) for v in values)
+    return (x, y, z)
+
+
+@dataclass(frozen=True)
+class MeasurementRow:
+    """One measurement as plain values, for scripts and tables (NaN where it failed).
+
+    ``status``: "ok", or why it failed; ``knowledge``: what the head knew
+    (``"none"``, ``"calibrated"``).  Positions in m, world (W) or head (H) frame
+    as named; ``error_m``: |estimate - truth|; ``error_pct_of_depth``: that
+    error as a percentage of the true depth ``depth_m`` (z in H).  ``renders``:
+    images this measurement took.  The same values as results.json's
+    ``measurements``, without the covariance and the details.
+    """
+
+    name: str
+    method: str
+    knowledge: str
+    status: str
+    ok: bool
+    step: int
+    time_s: float | None
+    estimate_world_m: Vector3
+    truth_world_m: Vector3
+    estimate_head_m: Vector3
+    truth_head_m: Vector3
+    error_m: float
+    depth_m: float
+    error_pct_of_depth: float
+    renders: int
+    search_renders: int
+    scan_renders: int
+
+    @classmethod
+    def of(cls, record: MeasurementRecord) -> MeasurementRow:
+        m = record.measurement
+        return cls(
+            name=m.name,
+            method=m.method.value,
+            knowledge=record.knowledge,
+            status=m.status_text,
+            ok=m.ok,
+            step=record.step,
+            time_s=record.time_s,
+            estimate_world_m=_vector(m.estimate_world_m),
+            truth_world_m=_vector(m.truth_world_m),
+            estimate_head_m=_vector(m.estimate_head_m),
+            truth_head_m=_vector(m.truth_head_m),
+            error_m=float(np.linalg.norm(m.error_head_m)),
+            depth_m=m.depth_m,
+            error_pct_of_depth=m.error_pct_of_depth,
+            renders=m.renders,
+            search_renders=m.search_renders,
+            scan_renders=m.scan_renders,
+        )
+
+
+#: The fields of :class:`MeasurementRow` that hold a 3-vector.
+_VECTOR_FIELDS = ("estimate_world_m", "truth_world_m", "estimate_head_m", "truth_head_m")
+
+
+def measurement_table(rows: tuple[MeasurementRow, ...]) -> dict[str, list[Any]]:
+    """Columns of equal length, one entry per row: a position ``p_m`` becomes
+    ``p_x_m``, ``p_y_m``, ``p_z_m``.  ``pandas.DataFrame`` takes it as it is."""
+    table: dict[str, list[Any]] = {}
+    for f in fields(MeasurementRow):
+        if f.name in _VECTOR_FIELDS:
+            stem = f.name[: -len("_m")]
+            for axis, letter in enumerate("xyz"):
+                table[f"{stem}_{letter}_m"] = [getattr(r, f.name)[axis] for r in rows]
+        else:
+            table[f.name] = [getattr(r, f.name) for r in rows]
+    return table
 
 
 @dataclass(frozen=True)
@@ -94,9 +176,20 @@ class RunResult:
     def ok(self) -> bool:
         return not self.failures
 
+    @property
+    def measurements(self) -> tuple[MeasurementRow, ...]:
+        """Every measurement, in the order taken, as a :class:`MeasurementRow`."""
+        return tuple(MeasurementRow.of(r) for r in self.records)
+
+    def table(self) -> dict[str, list[Any]]:
+        """The measurements as columns (:func:`measurement_table`): ``pandas.DataFrame(result.table())``."""
+        return measurement_table(self.measurements)
+
 
 __all__ = [
     "MeasurementRecord",
+    "MeasurementRow",
     "RunRenders",
     "RunResult",
+    "measurement_table",
 ]

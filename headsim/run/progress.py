@@ -27,6 +27,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TextIO
 
 from headsim.active.events import FixationStarted, PhaseStarted
+from headsim.errors import printable
 from headsim.run.events import RunFinished, Stamp
 
 if TYPE_CHECKING:
@@ -128,7 +129,7 @@ class Counter:
 
     def phase(self, name: str) -> None:
         """A new phase begins: a line in a log, the bar's description on a terminal."""
-        self.phase_name = name
+        self.phase_name = name = printable(name)
         if self._bar is not None:
             self._bar.set_description_str(name)
         else:
@@ -137,9 +138,9 @@ class Counter:
     def update(self, done: int | None = None, note: str = "") -> None:
         """``done`` so far (default: one more); ``note``: what it was (the bar's postfix)."""
         done = self.done + 1 if done is None else done
-        self.done, self.note = done, note
+        self.done, self.note = done, printable(note)
         if self._bar is not None:
-            self._bar.set_postfix_str(note, refresh=False)
+            self._bar.set_postfix_str(self.note, refresh=False)
             self._bar.update(min(done, self.total) - self._bar.n)
         elif self.clock() - self._printed_at >= self.interval_s:
             self._print(self.line())

@@ -29,10 +29,19 @@ from headsim.scenario.spec import (
 from headsim.scenario.tables import Context
 from headsim.sim import names
 
+#: What a refused random target's message adds: how to keep the box and still run.
+REDRAW_HINT = (
+    'or within = "reach" in [scene.random_targets], which draws each target the head '
+    "cannot fixate again from the same box (counted in results.json)"
+)
 
-def _raise(ctx: Context, source: str, refusal: Refusal | None) -> None:
+
+def _raise(ctx: Context, source: str, refusal: Refusal | None, *, drawn: bool = False) -> None:
+    """Refuse the scenario for ``refusal``, if any; ``drawn``: a random target of a box
+    drawn without ``within = "reach"``, whose message says how to have it drawn again."""
     if refusal is not None:
-        raise ctx.error(source, refusal.message, refusal.allowed)
+        allowed = f"{refusal.allowed}; {REDRAW_HINT}" if drawn else refusal.allowed
+        raise ctx.error(source, refusal.message, allowed)
 
 
 def _check_in_front(ctx: Context, source: str, p_head: np.ndarray, what: str) -> None:
@@ -60,12 +69,16 @@ def check_reach(ctx: Context, scenario: Scenario) -> None:
     scene = scenario.scene
     procedure = scenario.experiment.procedure
     placed: dict[str, np.ndarray] = {}
-    for target in scene.targets:
+    acceptance = scene.acceptance
+    # Random targets follow the listed ones; "box" keeps every draw as drawn.
+    first_drawn = None if acceptance is None or acceptance.within != "box" else acceptance.listed
+    for index, target in enumerate(scene.targets):
         # What can hide it: the scene as the earlier targets left it.
         p = np.array(target.position_world_m)
         occluders = scene_occluders(scene.scene, placed, target.body)
         refusal = target_refusal(head, procedure, p, "target", body_radius(target.body), occluders)
-        _raise(ctx, target.source, refusal)
+        drawn = first_drawn is not None and index >= first_drawn
+        _raise(ctx, target.source, refusal, drawn=drawn)
         placed[target.body] = p
     if scene.chessboard is not None:
         indices = range(corner_count()) if scene.corners is None else scene.corners

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import replace
 
 import gymnasium
@@ -10,6 +11,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import headsim.envs
+from headsim.envs.fixate import MOTOR_SPEED_LIMITS_RAD_S
 from headsim.envs.policies import ServoPolicy
 from headsim.geometry.kinematics import head_to_world
 from headsim.paper import ENCODER_RESOLUTION_RAD
@@ -18,11 +20,32 @@ from headsim.sim.settings import HeadBelief, SettingsError
 ID = headsim.envs.FIXATE_ID
 
 
-@pytest.mark.filterwarnings("ignore:.*symmetric and normalized space")  # rad/s by design
-def test_env_passes_gymnasiums_checker() -> None:
+def test_env_passes_gymnasiums_checker_without_a_warning() -> None:
     env = gymnasium.make(ID)
-    check_env(env.unwrapped)
+    assert env.action_space == gymnasium.spaces.Box(-1.0, 1.0, (3,), np.float32)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_env(env.unwrapped)
+    assert [str(w.message) for w in caught] == []
     env.close()
+
+
+def test_a_normalised_action_commands_the_share_of_each_motors_speed_limit() -> None:
+    """One unit of the default action is the limit; the physical space takes rad/s."""
+    moved = {}
+    for units, action in (("normalised", [0.5, -0.25, 0.1]), ("physical", [1.5, -0.75, 0.8])):
+        env = gymnasium.make(ID, action_space=units)
+        env.reset(seed=4)
+        moved[units] = env.step(np.array(action, np.float32))[0]["encoders"]
+        env.close()
+    np.testing.assert_array_equal(moved["normalised"], moved["physical"])
+    assert np.all(np.abs(moved["physical"]) > 0)
+    physical = gymnasium.make(ID, action_space="physical")
+    np.testing.assert_array_equal(physical.action_space.high, MOTOR_SPEED_LIMITS_RAD_S)
+    np.testing.assert_array_equal(physical.unwrapped.action_scale_rad_s, np.ones(3))
+    with pytest.warns(UserWarning, match="symmetric and normalized"):
+        check_env(physical.unwrapped)  # the checker's advice, taken by the default
+    physical.close()
 
 
 def test_same_seed_gives_identical_observations_and_another_seed_does_not() -> None:
@@ -72,6 +95,8 @@ def test_bad_options_name_the_field() -> None:
         gymnasium.make(ID, randomise={"focal": (1, 2)})
     with pytest.raises(SettingsError, match="reward must be one of offsets, position"):
         gymnasium.make(ID, reward="distance")
+    with pytest.raises(SettingsError, match="action_space must be one of normalised, physical"):
+        gymnasium.make(ID, action_space="rad/s")
 
 
 def test_vector_env_runs_two_spawned_workers() -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import gymnasium
 import numpy as np
+import pytest
 
 import headsim.envs
 from headsim.envs.policies import RandomPolicy, ServoPolicy
@@ -11,8 +12,9 @@ from headsim.envs.policies import RandomPolicy, ServoPolicy
 ID = headsim.envs.FIXATE_ID
 
 
-def test_paper_servo_policy_fixates_and_the_episode_terminates() -> None:
-    env = gymnasium.make(ID)
+@pytest.mark.parametrize("units", ["normalised", "physical"])
+def test_paper_servo_policy_fixates_and_the_episode_terminates(units: str) -> None:
+    env = gymnasium.make(ID, action_space=units)
     policy = ServoPolicy(env.action_space, env.unwrapped.period_s)
     lengths = []
     for seed in range(4):

@@ -203,3 +203,47 @@ def test_other_scenes_check_their_own_things(tmp_path: Path) -> None:
         load_scenario(
             write_scenario(tmp_path, blocks + "[[scene.targets]]\nposition_head_m = [0, 0, 1]\n")
         )
+
+
+WIDE_FIELD = """description = "16 random targets over the whole shared field at 1.3x focal"
+[head]
+preset = "ideal"
+[cam1]
+kx = 753.2
+ky = 753.2
+[cam2]
+kx = 753.2
+ky = 753.2
+[experiment]
+procedure = "model2"
+[scene.random_targets]
+count = 16
+depth_m = [0.3, 1.5]
+lateral = 0.6
+vertical = 0.4
+"""
+
+
+def test_a_refused_random_target_says_how_to_have_it_drawn_again(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from headsim.cli import main
+
+    path = tmp_path / "wide.toml"
+    path.write_text(WIDE_FIELD)
+    assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "scene.random_targets (target 1):" in err
+    assert 'within = "reach" in [scene.random_targets], which draws each target' in err
+    assert not (tmp_path / "out").exists()
+    path.write_text(WIDE_FIELD + 'within = "reach"\n')
+    redrawn = load_scenario(path)
+    assert redrawn.scene.acceptance is not None and redrawn.scene.acceptance.refused_total > 0
+    assert len(redrawn.scene.targets) == 16
+
+
+def test_a_refused_listed_target_gets_no_redraw_hint(tmp_path: Path) -> None:
+    path = write_scenario(tmp_path, MINIMAL.replace("[0.02, 0.01, 0.6]", "[0.6, 0.0, 0.3]"))
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario(path)
+    assert 'within = "reach"' not in str(caught.value)
