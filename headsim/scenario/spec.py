@@ -97,7 +97,11 @@ class CalibrationSpec:
 
 @dataclass(frozen=True)
 class ServoSpec:
-    """The servo's bounds and tolerances (``headsim.active.servo_types.ServoConfig``)."""
+    """The servo's bounds and tolerances (``headsim.active.servo_types.ServoConfig``).
+
+    ``windows``: render only a window around where the target is expected (false:
+    every image a full frame; the same answers, more pixels).
+    """
 
     tolerance_px: float = 0.1
     max_iterations: int = 25
@@ -105,6 +109,7 @@ class ServoSpec:
     min_probe_px: float = 2.0
     min_secant_steps: int = 8
     average_fixation: bool = False
+    windows: bool = True
 
 
 @dataclass(frozen=True)

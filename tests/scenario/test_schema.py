@@ -137,6 +137,10 @@ BAD = [
         "experiment.servo.average_fixation: must be true or false, got integer 1",
     ),
     (
+        "[experiment.servo]\nwindows = 'off'\n",
+        "experiment.servo.windows: must be true or false, got string 'off'",
+    ),
+    (
         "[experiment.calibration]\ndepth_m = [0.6, 0.3]\n",
         "experiment.calibration.depth_m: [0.6, 0.3] is empty",
     ),
@@ -177,3 +181,11 @@ def test_an_unknown_procedure_is_named_with_every_registered_one(tmp_path: Path)
     message = f"{path}: experiment.procedure: unknown value 'model3' (allowed: {allowed})"
     with pytest.raises(ScenarioError, match=re.escape(message)):
         load_scenario(path)
+
+
+def test_servo_windows_reach_the_servo(tmp_path: Path) -> None:
+    from headsim.run.context import servo_config
+
+    assert servo_config(load_scenario(write_scenario(tmp_path, MINIMAL))).windows is True
+    path = write_scenario(tmp_path, MINIMAL + "[experiment.servo]\nwindows = false\n", "off.toml")
+    assert servo_config(load_scenario(path)).windows is False
