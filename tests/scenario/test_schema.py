@@ -183,9 +183,14 @@ def test_an_unknown_procedure_is_named_with_every_registered_one(tmp_path: Path)
         load_scenario(path)
 
 
-def test_servo_windows_reach_the_servo(tmp_path: Path) -> None:
+def test_servo_windows_reach_the_servo_and_are_recorded_when_set(tmp_path: Path) -> None:
     from headsim.run.context import servo_config
+    from headsim.scenario.spec import servo_record
 
-    assert servo_config(load_scenario(write_scenario(tmp_path, MINIMAL))).windows is True
+    default = load_scenario(write_scenario(tmp_path, MINIMAL))
+    assert servo_config(default).windows is True
+    assert "windows" not in servo_record(default.experiment.servo)
     path = write_scenario(tmp_path, MINIMAL + "[experiment.servo]\nwindows = false\n", "off.toml")
-    assert servo_config(load_scenario(path)).windows is False
+    off = load_scenario(path)
+    assert servo_config(off).windows is False
+    assert servo_record(off.experiment.servo)["windows"] is False
