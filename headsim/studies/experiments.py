@@ -14,7 +14,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 
@@ -23,9 +23,7 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement, body_target
 from headsim.active.model2 import measure_model2
 from headsim.active.placement import calibration_layout
-from headsim.active.servo_types import Detector
-from headsim.estimators.areas import AreaComparison
-from headsim.procedures.relative import relative_positioning
+from headsim.estimators.areas import AreaComparison, tally_areas
 from headsim.run.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.spec import Scenario
@@ -34,7 +32,6 @@ from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
 from headsim.studies.scenario_runs import knowledge_file, preset_of
 from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
-from headsim.vision.crosses import find_cross_point
 from headsim.vision.markers import MarkerDetector
 
 RED = body_target("marker_red", MarkerDetector("red"))
@@ -331,26 +328,42 @@ def relative_areas(
     layout_runs: list[tuple[int, AreaComparison | None]] = []
     areas_seen: set[int] = set()
     renders = []
-    with HeadSim("blocks", settings) as sim:
-        servo = EyeServo(sim)
-        # Status and uv are all the servo reads of a cross point (never windowed).
-        reference = body_target(names.BLOCKS, cast(Detector, find_cross_point))
-        for layout in range(layouts):
-            for name in names.RELATIVE_OBJECTS:
-                z = rng.uniform(0.8, 1.9)
-                p_head = np.array([rng.uniform(-0.3, 0.3) * z, rng.uniform(-0.15, 0.1) * z, z])
-                place_in_head(sim, name, p_head)
-            run = relative_positioning(sim, servo, reference, names.RELATIVE_OBJECT_COLOURS)
-            progress(f"relative positioning: layout {layout + 1}/{layouts}")
-            renders.append(run.renders)
-            layout_runs.append((len(run.missing), run.comparison))
-            if run.comparison is not None:
-                areas_seen.update(a for a in run.true_areas.values() if a)
+    settings = settings or HeadSettings()
+    for layout in range(layouts):
+        objects = []
+        for name in names.RELATIVE_OBJECTS:
+            z = rng.uniform(0.8, 1.9)
+            p_head = [rng.uniform(-0.3, 0.3) * z, rng.uniform(-0.15, 0.1) * z, z]
+            objects.append({"body": name, "position_head_m": [float(v) for v in p_head]})
+        doc = {
+            "description": "Eq. (12) on one random layout of the six objects",
+            "seed": settings.seed,
+            "head": {"preset": preset_of(settings)},
+            "experiment": {"procedure": "relative_positioning"},
+            "scene": {"objects": objects},
+        }
+        run: Any = run_scenario(scenario_from_document(doc, "relative_layout")).experiment
+        progress(f"relative positioning: layout {layout + 1}/{layouts}")
+        renders.append(run.renders)
+        layout_runs.append((len(run.missing), _comparison(run)))
+        if run.margin_threshold_px is not None:
+            areas_seen.update(o.true_area for o in run.objects if o.true_area)
     return {
         **area_tally(len(names.RELATIVE_OBJECTS), layout_runs),
         "distinct_true_areas": sorted(areas_seen),
         "renders_per_layout": float(np.mean(renders)),
     }
+
+
+def _comparison(run: Any) -> AreaComparison | None:
+    """Eq. (12)'s comparison over the objects a relative-positioning result saw in all
+    four images (None: the reference was not fixated, nothing compared)."""
+    if run.margin_threshold_px is None:
+        return None
+    seen = [o for o in run.objects if o.name not in run.missing]
+    return tally_areas(
+        [o.margin_px for o in seen], [o.agree for o in seen], run.margin_threshold_px
+    )
 
 
 SERVO_CASES = {
