@@ -30,7 +30,7 @@ from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
-from headsim.studies.scenario_runs import knowledge_file, preset_of
+from headsim.studies.scenario_runs import knowledge_file, preset_of, scenario_with_head
 from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
 from headsim.vision.markers import MarkerDetector
 
@@ -383,12 +383,20 @@ def servo_robustness(
     """The servo, told nothing, over focal lengths 0.5x-2x and shifted principal points."""
     out = {}
     for label, cam in SERVO_CASES.items():
-        with HeadSim("default", HeadSettings(cameras=(cam, cam))) as sim:
-            servo = EyeServo(sim)
-            ms = []
-            for p_head in random_targets_head(rng, points, (0.4, 1.4), vertical=(-0.1, 0.1)):
-                place_in_head(sim, "marker_red", p_head)
-                ms.append(measure_model2(sim, servo, RED))
+        targets_head = random_targets_head(rng, points, (0.4, 1.4), vertical=(-0.1, 0.1))
+        doc = {
+            "description": f"The servo, told nothing, with cameras {label}",
+            "experiment": {"procedure": "model2"},
+            "scene": {
+                "targets": [
+                    {"name": f"point_{k}", "position_head_m": [float(v) for v in p]}
+                    for k, p in enumerate(targets_head)
+                ]
+            },
+        }
+        settings = HeadSettings(cameras=(cam, cam))
+        result = run_scenario(scenario_with_head(doc, "servo_robustness", settings))
+        ms = [r.measurement for r in result.records]
         progress(f"servo: {label}")
         ok = [m for m in ms if m.ok]
         residuals = np.array([abs(r) for m in ok for r in m.servo_residual_px])
