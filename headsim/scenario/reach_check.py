@@ -5,6 +5,8 @@ refused, naming the field and why.  Geometry only, no rendering.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import mujoco
 import numpy as np
 
@@ -55,18 +57,31 @@ def _chessboard_corners_world(placement: Placement, corners: tuple[int, ...] | N
     return np.asarray(placement.position_world_m) + local @ rotation.reshape(3, 3).T
 
 
+def target_refusals(
+    head: ReachHead, procedure: str, scene: str, targets: Sequence[tuple[str, np.ndarray]]
+) -> list[Refusal | None]:
+    """Why ``procedure`` cannot measure each of ``targets`` (body, position in W, m) in turn
+    (None: it can), in ``scene`` as the earlier accepted targets left it."""
+    placed: dict[str, np.ndarray] = {}
+    refusals: list[Refusal | None] = []
+    for body, p in targets:
+        occluders = scene_occluders(scene, placed, body)
+        refusal = target_refusal(head, procedure, p, "target", body_radius(body), occluders)
+        refusals.append(refusal)
+        if refusal is None:
+            placed[body] = p
+    return refusals
+
+
 def check_reach(ctx: Context, scenario: Scenario) -> None:
     head = ReachHead.of(scenario.settings)
     scene = scenario.scene
     procedure = scenario.experiment.procedure
-    placed: dict[str, np.ndarray] = {}
-    for target in scene.targets:
-        # What can hide it: the scene as the earlier targets left it.
-        p = np.array(target.position_world_m)
-        occluders = scene_occluders(scene.scene, placed, target.body)
-        refusal = target_refusal(head, procedure, p, "target", body_radius(target.body), occluders)
+    listed = [(t.body, np.array(t.position_world_m)) for t in scene.targets]
+    for target, refusal in zip(
+        scene.targets, target_refusals(head, procedure, scene.scene, listed), strict=True
+    ):
         _raise(ctx, target.source, refusal)
-        placed[target.body] = p
     if scene.chessboard is not None:
         indices = range(corner_count()) if scene.corners is None else scene.corners
         for k, p in zip(
@@ -110,4 +125,4 @@ def check_reach(ctx: Context, scenario: Scenario) -> None:
             _raise(ctx, "scene.moving_target", refusal)
 
 
-__all__ = ["check_reach"]
+__all__ = ["check_reach", "target_refusals"]
