@@ -126,18 +126,28 @@ def relative_areas() -> str:
 # --- windows and averaged fixation on the bench's ideal-camera points ---------------
 
 
+class _Detections:
+    """Where the servo found its target in each image it looked at (None: not found), px."""
+
+    def __init__(self) -> None:
+        self.seen: list[tuple[float, float] | None] = []
+
+    def notify(self, event: object, at: Any) -> None:
+        from headsim.active.events import Detected
+
+        if isinstance(event, Detected):
+            self.seen.append(event.uv_px)
+
+
 @functools.cache
 def _bench_points(windows: bool = True, average: bool = False) -> dict[str, Any]:
-    """Model 2 on ``headsim bench``'s 12 ideal-camera targets (seed 0) with this servo config:
-    the measurements, every detection the servo made, renders and full frames per point."""
-    from headsim.active.eye_servo import EyeServo
-    from headsim.active.measurement import HeadKnowledge
-    from headsim.active.model2 import measure_model2
-    from headsim.active.servo_types import ServoConfig
-    from headsim.sim.settings import HeadSettings
-    from headsim.sim.simulator import HeadSim
+    """Model 2 on ``headsim bench``'s 12 ideal-camera targets (seed 0) with this servo config,
+    run as a scenario: the measurements, every detection the servo made, renders and full
+    frames per point."""
+    from headsim.run.runner import run_scenario
+    from headsim.scenario.loading import scenario_from_document
     from headsim.studies import experiments
-    from headsim.studies.targets import place_in_head, random_targets_head
+    from headsim.studies.targets import random_targets_head
 
     rng = np.random.default_rng(0)
     points = np.concatenate(
@@ -146,28 +156,30 @@ def _bench_points(windows: bool = True, average: bool = False) -> dict[str, Any]
             for band in experiments.DEPTH_BANDS_M
         ]
     )
-    seen: list[Any] = []
-    with HeadSim("default", HeadSettings()) as sim:
-        servo = EyeServo(sim, ServoConfig(windows=windows, average_fixation=average))
-        look = servo.observe
-
-        def observe(*args: Any, **kwargs: Any) -> Any:
-            detection = look(*args, **kwargs)
-            seen.append(detection.uv)
-            return detection
-
-        servo.observe = observe  # type: ignore[method-assign]
-        measured = []
-        for p in points:
-            place_in_head(sim, "marker_red", p)
-            measured.append(measure_model2(sim, servo, experiments.RED, HeadKnowledge()))
-        frames = sim.rendered_frames
+    doc = {
+        "description": "Model 2 on the bench's ideal-camera targets",
+        "seed": 0,
+        "head": {"preset": "ideal"},
+        "experiment": {
+            "procedure": "model2",
+            "servo": {"windows": windows, "average_fixation": average},
+        },
+        "scene": {
+            "targets": [
+                {"name": f"point_{k}", "position_head_m": [float(v) for v in p]}
+                for k, p in enumerate(points)
+            ]
+        },
+    }
+    detections = _Detections()
+    result = run_scenario(scenario_from_document(doc, "bench_points"), [detections])
+    measured = [r.measurement for r in result.records]
     return {
         "measured": measured,
-        "seen": seen,
+        "seen": detections.seen,
         # The first point probes the servo's gain: the bench leaves it out of renders per point.
         "renders_per_point": float(np.mean([m.renders for m in measured[1:]])),
-        "frames_per_point": frames / len(points),
+        "frames_per_point": result.rendered_frames["experiment"] / len(points),
         "rms_pct": float(np.sqrt(np.mean([m.error_pct_of_depth**2 for m in measured if m.ok]))),
     }
 

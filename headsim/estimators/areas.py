@@ -26,6 +26,7 @@ __all__ = [
     "compare_areas",
     "q1_columns",
     "q1_side",
+    "tally_areas",
 ]
 
 # Area labels of the mirror image x_h -> -x_h (camera 1 <-> 2, step 1 <-> 2).
@@ -165,7 +166,12 @@ def compare_areas(
     uses_step1 = np.isin(pa, (3, 4, 7, 8)) | np.isin(ta, (3, 4, 7, 8))
     margin = np.where(uses_step1, np.minimum(margin, mag_step1), margin)
     margin = np.where(np.isfinite(margin), margin, 0.0)
-    agree = pa == ta
+    return tally_areas(margin, pa == ta, threshold_px)
+
+
+def tally_areas(margin: ArrayLike, agree: ArrayLike, threshold_px: float = 2.0) -> AreaComparison:
+    """The :class:`AreaComparison` of objects with these margins, px, and agreements."""
+    margin, agree = np.asarray(margin, float), np.asarray(agree, bool)
     inside = margin <= threshold_px
     return AreaComparison(
         margin=margin,

@@ -5,6 +5,8 @@ refused, naming the field and why.  Geometry only, no rendering.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import mujoco
 import numpy as np
 
@@ -64,22 +66,34 @@ def _chessboard_corners_world(placement: Placement, corners: tuple[int, ...] | N
     return np.asarray(placement.position_world_m) + local @ rotation.reshape(3, 3).T
 
 
+def target_refusals(
+    head: ReachHead, procedure: str, scene: str, targets: Sequence[tuple[str, np.ndarray]]
+) -> list[Refusal | None]:
+    """Why ``procedure`` cannot measure each of ``targets`` (body, position in W, m) in turn
+    (None: it can), in ``scene`` as the earlier accepted targets left it."""
+    placed: dict[str, np.ndarray] = {}
+    refusals: list[Refusal | None] = []
+    for body, p in targets:
+        occluders = scene_occluders(scene, placed, body)
+        refusal = target_refusal(head, procedure, p, "target", body_radius(body), occluders)
+        refusals.append(refusal)
+        if refusal is None:
+            placed[body] = p
+    return refusals
+
+
 def check_reach(ctx: Context, scenario: Scenario) -> None:
     head = ReachHead.of(scenario.settings)
     scene = scenario.scene
     procedure = scenario.experiment.procedure
-    placed: dict[str, np.ndarray] = {}
     acceptance = scene.acceptance
     # Random targets follow the listed ones; "box" keeps every draw as drawn.
     first_drawn = None if acceptance is None or acceptance.within != "box" else acceptance.listed
-    for index, target in enumerate(scene.targets):
-        # What can hide it: the scene as the earlier targets left it.
-        p = np.array(target.position_world_m)
-        occluders = scene_occluders(scene.scene, placed, target.body)
-        refusal = target_refusal(head, procedure, p, "target", body_radius(target.body), occluders)
+    listed = [(t.body, np.array(t.position_world_m)) for t in scene.targets]
+    refusals = target_refusals(head, procedure, scene.scene, listed)
+    for index, (target, refusal) in enumerate(zip(scene.targets, refusals, strict=True)):
         drawn = first_drawn is not None and index >= first_drawn
         _raise(ctx, target.source, refusal, drawn=drawn)
-        placed[target.body] = p
     if scene.chessboard is not None:
         indices = range(corner_count()) if scene.corners is None else scene.corners
         for k, p in zip(
@@ -123,4 +137,4 @@ def check_reach(ctx: Context, scenario: Scenario) -> None:
             _raise(ctx, "scene.moving_target", refusal)
 
 
-__all__ = ["check_reach"]
+__all__ = ["check_reach", "target_refusals"]

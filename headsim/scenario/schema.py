@@ -311,6 +311,7 @@ def read_experiment(doc: Table, ctx: Context, preset_name: str = "ideal") -> Exp
             ),
             min_secant_steps=servo_table.integer("min_secant_steps", 8, 1, 1000),
             average_fixation=servo_table.boolean("average_fixation", False),
+            windows=servo_table.boolean("windows", True),
         )
         servo_table.done()
     table.done()

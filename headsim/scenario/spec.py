@@ -9,9 +9,9 @@ OpenCV's.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -97,7 +97,12 @@ class CalibrationSpec:
 
 @dataclass(frozen=True)
 class ServoSpec:
-    """The servo's bounds and tolerances (``headsim.active.servo_types.ServoConfig``)."""
+    """The servo's bounds and tolerances (``headsim.active.servo_types.ServoConfig``).
+
+    ``windows``: render only a window around where the target is expected (false:
+    every image a full frame; the same answers, more pixels).  It changes no answer,
+    so results.json records it only when set (:data:`UNANSWERED_SERVO_KEYS`).
+    """
 
     tolerance_px: float = 0.1
     max_iterations: int = 25
@@ -105,6 +110,22 @@ class ServoSpec:
     min_probe_px: float = 2.0
     min_secant_steps: int = 8
     average_fixation: bool = False
+    windows: bool = True
+
+
+#: Servo keys that change only the renders, never an answer: results.json records
+#: each only where it differs from its default.
+UNANSWERED_SERVO_KEYS = ("windows",)
+
+
+def servo_record(servo: ServoSpec) -> dict[str, Any]:
+    """The servo's keys as results.json records them (see :data:`UNANSWERED_SERVO_KEYS`)."""
+    default = ServoSpec()
+    return {
+        key: value
+        for key, value in asdict(servo).items()
+        if key not in UNANSWERED_SERVO_KEYS or value != getattr(default, key)
+    }
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -21,14 +22,17 @@ from typing import Any
 import numpy as np
 
 from headsim.active.calibration import calibrate_head, line_of_sight_truth
+from headsim.active.events import Detected, PhaseStarted
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
-from headsim.active.model2 import measure_model2
 from headsim.active.placement import calibration_layout
-from headsim.active.servo_types import ServoConfig
 from headsim.estimators.throughput import run as estimator_throughput
 from headsim.files import write_json_atomic
+from headsim.run.events import MeasurementRecorded, Stamp
 from headsim.run.progress import Status
+from headsim.run.runner import run_scenario
+from headsim.scenario.loading import load_scenario, scenario_from_document
+from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, paper_head, preset
 from headsim.sim.simulator import HeadSim
@@ -36,7 +40,9 @@ from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
 from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
 from headsim.studies.calibrations import calibrate_realistic
-from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
+from headsim.studies.render_clock import RenderClock
+from headsim.studies.scenario_runs import knowledge_file, preset_of
+from headsim.studies.targets import random_targets_head, visible_vertical_range
 
 Progress = Callable[[str], None]
 
@@ -58,20 +64,56 @@ class Faults:
     double_renders: bool = False
 
 
-def _servo(sim: HeadSim, windows: bool, faults: Faults, seen: list[Any]) -> EyeServo:
-    """The eye servo, logging every detection's uv into ``seen`` (and the injected fault)."""
-    servo = EyeServo(sim, ServoConfig(windows=windows))
-    look = servo.observe
+class _PointsWatch:
+    """Follows a bench run: every detection's uv (None: not found), px; the wall time from
+    the measurement phase's start to its last measurement, s; and with ``double_renders``
+    one more render of each detection's camera (the injected fault)."""
 
-    def observe(camera: int, detector: Any, key: object = None, preview: bool = True) -> Any:
-        if faults.double_renders:
-            sim.render(camera)
-        detection = look(camera, detector, key, preview)
-        seen.append(detection.uv)
-        return detection
+    def __init__(self, double_renders: bool = False) -> None:
+        self.double_renders = double_renders
+        self.seen: list[tuple[float, float] | None] = []
+        self.started = self.ended = 0.0
+        self._sim: HeadSim | None = None
 
-    servo.observe = observe  # type: ignore[method-assign]
-    return servo
+    def notify(self, event: object, at: Stamp) -> None:
+        if isinstance(event, PhaseStarted) and event.name == "measurement":
+            self._sim, self.started = event.sim, time.perf_counter()
+        elif isinstance(event, Detected):
+            self.seen.append(event.uv_px)
+            if self.double_renders and self._sim is not None:
+                self._sim.render(event.camera)
+        elif isinstance(event, MeasurementRecorded):
+            self.ended = time.perf_counter()
+
+    @property
+    def wall_s(self) -> float:
+        return self.ended - self.started
+
+
+def _points_scenario(
+    settings: HeadSettings,
+    told: Path | None,
+    points_head: np.ndarray,
+    windows: bool,
+) -> Scenario:
+    """Model 2 on each of ``points_head`` (N, 3) m by the preset head ``settings``, told the
+    calibration file ``told`` (None: nothing), its servo windowed or not."""
+    experiment: dict[str, Any] = {"procedure": "model2", "servo": {"windows": windows}}
+    if told is not None:
+        experiment["calibration"] = {"from": str(told)}
+    doc = {
+        "description": "The bench's Model 2 points",
+        "seed": settings.seed,
+        "head": {"preset": preset_of(settings)},
+        "experiment": experiment,
+        "scene": {
+            "targets": [
+                {"name": f"point_{k}", "position_head_m": [float(v) for v in p]}
+                for k, p in enumerate(points_head)
+            ]
+        },
+    }
+    return scenario_from_document(doc, "bench_points")
 
 
 def _measure_points(
@@ -82,37 +124,38 @@ def _measure_points(
     windows: bool = True,
     passes: int = 1,
 ) -> tuple[list[Any], float, float, list[Any], float]:
-    """Model 2 on each point; returns the measurements, the median render time, s, the
-    pixels rendered for the points in full frames, every detection the servo made, and
-    the wall time of the points alone, s (not the simulator's set-up or the render timing).
+    """Model 2 on each point, run as a scenario; returns the measurements, the median render
+    time, s, the pixels rendered for the points in full frames, every detection the servo
+    made, and the wall time of the points alone, s (not the simulator's set-up).
 
-    The timed points follow one untimed point on a simulator of their own: the one-time
-    costs of a process (module imports on first use, the pooled renderer's window
-    buffers) are not a point's, and timed cold they moved the ratio by +-0.5 run to run.
-    ``passes`` > 1 times the points again on fresh simulators (their answers unused) and
-    keeps the shortest wall time: a busy machine only ever adds time."""
-    with HeadSim("default", settings) as warm:
-        place_in_head(warm, "marker_red", points_head[0])
-        measure_model2(warm, _servo(warm, windows, faults, []), experiments.RED, knowledge)
-    seen: list[Any] = []
-    walls = []
-    for k in range(passes):
-        with HeadSim("default", settings) as sim:
-            servo = _servo(sim, windows, faults, seen if k == 0 else [])
-            if k == 0:
-                render_s = experiments.render_time_s(sim)
-                frames = sim.rendered_frames
-            start = time.perf_counter()
-            measured = []
-            for p in points_head:
-                place_in_head(sim, "marker_red", p)
-                measured.append(measure_model2(sim, servo, experiments.RED, knowledge))
-            walls.append(time.perf_counter() - start)
-            if k == 0:
-                out, frames = measured, sim.rendered_frames - frames
-                # Timed again after the points: the machine's load moves while they run.
-                render_s = (render_s + experiments.render_time_s(sim)) / 2
-    return out, render_s, frames, seen, min(walls)
+    The timed points follow one untimed point in a run of its own: the one-time costs of
+    a process (module imports on first use, the pooled renderer's window buffers) are not
+    a point's, and timed cold they moved the ratio by +-0.5 run to run.  ``passes`` > 1
+    runs the points again (their answers unused) and keeps the shortest wall time: a busy
+    machine only ever adds time.  Renders are timed on a simulator of the same head
+    before and after the points."""
+    with tempfile.TemporaryDirectory() as folder:
+        told = None
+        if knowledge != HeadKnowledge():
+            told = knowledge_file(Path(folder) / "told.json", settings, knowledge)
+        run_scenario(_points_scenario(settings, told, points_head[:1], windows))
+        clock = RenderClock(settings)
+        try:
+            render_s = clock.sample(10)
+            watches, results = [], []
+            for _ in range(passes):
+                watch = _PointsWatch(faults.double_renders)
+                scenario = _points_scenario(settings, told, points_head, windows)
+                results.append(run_scenario(scenario, [watch]))
+                watches.append(watch)
+            # Timed again after the points: the machine's load moves while they run.
+            render_s = (render_s + clock.sample(10)) / 2
+        finally:
+            clock.close()
+    first = results[0]
+    measured = [r.measurement for r in first.records]
+    frames = first.rendered_frames["experiment"]
+    return measured, render_s, frames, watches[0].seen, min(w.wall_s for w in watches)
 
 
 #: The suite's parts, in order (the regression cases of :mod:`headsim.studies.bench_cases`);
@@ -207,17 +250,16 @@ def _ideal_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
 def _quickstart_over_render() -> float:
     """Wall time of the quick start scenario at full size over one 640x480 render,
     the render timed just before and just after it."""
-    from headsim.run.runner import run_scenario
-    from headsim.scenario.loading import load_scenario
-
     scenario = load_scenario("quickstart")
-    with HeadSim("default", HeadSettings()) as sim:
-        sim.move(eye=0.05)
-        before = experiments.render_time_s(sim)
+    clock = RenderClock()
+    try:
+        before = clock.sample(10)
         start = time.perf_counter()
         run_scenario(scenario)
         wall = time.perf_counter() - start
-        after = experiments.render_time_s(sim)
+        after = clock.sample(10)
+    finally:
+        clock.close()
     return wall / ((before + after) / 2)
 
 
@@ -326,9 +368,6 @@ PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "trackin
 
 def scenario_metrics(name: str) -> Metrics:
     """Run a scenario's fast variant: failures, RMS error (% of depth) and renders."""
-    from headsim.run.runner import run_scenario
-    from headsim.scenario.loading import load_scenario
-
     scenario = load_scenario(name, fast=True)
     result = run_scenario(scenario)
     # Measurements made without the scenario's calibration (its "before" checks) do not count.

@@ -8,33 +8,30 @@ the true z_h.
 
 from __future__ import annotations
 
-import statistics
+import math
 import tempfile
-import time
 from collections.abc import Callable, Sequence
-from dataclasses import replace
+from dataclasses import asdict, replace
 from pathlib import Path
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 
-from headsim.active.calibration import calibrate_head
-from headsim.active.eye_servo import EyeServo
+from headsim.active.calibration_file import knowledge_from_block
 from headsim.active.measurement import HeadKnowledge, Measurement, body_target
-from headsim.active.model2 import measure_model2
-from headsim.active.placement import calibration_layout
-from headsim.active.servo_types import Detector
-from headsim.estimators.areas import AreaComparison
-from headsim.procedures.relative import relative_positioning
+from headsim.estimators.areas import AreaComparison, tally_areas
+from headsim.run.outcomes import RunResult
 from headsim.run.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
+from headsim.scenario.reach import ReachHead
+from headsim.scenario.reach_check import target_refusals
+from headsim.scenario.scene import start_head_to_world
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
-from headsim.sim.simulator import HeadSim
-from headsim.studies.scenario_runs import knowledge_file, preset_of
-from headsim.studies.targets import place_in_head, random_targets_head, visible_vertical_range
-from headsim.vision.crosses import find_cross_point
+from headsim.studies.render_clock import RenderClock
+from headsim.studies.scenario_runs import knowledge_file, preset_of, scenario_with_head
+from headsim.studies.targets import random_targets_head, visible_vertical_range
 from headsim.vision.markers import MarkerDetector
 
 RED = body_target("marker_red", MarkerDetector("red"))
@@ -50,21 +47,11 @@ def _quiet(_: str) -> None:
     pass
 
 
-def render_time_s(sim: HeadSim, repeats: int = 10) -> float:
-    """Median wall time of one render of camera 1 in ``sim``, s (not counted as work)."""
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        sim.render(1)
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
-
-
-def centre_row_offset_px(sim: HeadSim, m: Measurement) -> float:
+def centre_row_offset_px(settings: HeadSettings, m: Measurement) -> float:
     """Largest |v - centre row| of the target over both cameras' y images, px."""
     return max(
-        abs(m.details["v11_px"] - sim.camera_settings(1).image_centre[1]),
-        abs(m.details["v21_px"] - sim.camera_settings(2).image_centre[1]),
+        abs(m.details["v11_px"] - settings.cameras[0].image_centre[1]),
+        abs(m.details["v21_px"] - settings.cameras[1].image_centre[1]),
     )
 
 
@@ -86,6 +73,38 @@ def error_figures(measurements: Sequence[Measurement]) -> dict[str, Any]:
     }
 
 
+def reachable(settings: HeadSettings, targets_head: Sequence[np.ndarray]) -> list[bool]:
+    """Whether a model2 scenario accepts each red-marker target (H, m) in turn: in reach,
+    seen by both cameras, hidden by nothing (:func:`headsim.scenario.reach_check.target_refusals`)."""
+    world = start_head_to_world(settings, np.asarray(targets_head, dtype=float).reshape(-1, 3))
+    listed = [("marker_red", p) for p in world]
+    refusals = target_refusals(ReachHead.of(settings), "model2", "default", listed)
+    return [r is None for r in refusals]
+
+
+def _model2_points(
+    settings: HeadSettings,
+    targets_head: Sequence[np.ndarray],
+    calibration: dict[str, Any] | None = None,
+) -> RunResult:
+    """Model 2 on each of ``targets_head`` (H, m) by the head ``settings``, after the
+    ``[experiment.calibration]`` table ``calibration`` (None: none)."""
+    experiment: dict[str, Any] = {"procedure": "model2"}
+    if calibration is not None:
+        experiment["calibration"] = calibration
+    doc = {
+        "description": "Model 2 on a study's targets",
+        "experiment": experiment,
+        "scene": {
+            "targets": [
+                {"name": f"point_{k}", "position_head_m": [float(v) for v in p]}
+                for k, p in enumerate(targets_head)
+            ]
+        },
+    }
+    return run_scenario(scenario_with_head(doc, "model2_points", settings))
+
+
 def model2_accuracy(
     settings: HeadSettings,
     rng: np.random.Generator,
@@ -98,65 +117,68 @@ def model2_accuracy(
 ) -> dict[str, Any]:
     """Model 2 over the depth bands, after Sec. V calibration if ``calibrate``.
 
+    Each is a scenario: the calibration's balls are the scenario's own (drawn
+    from its seed), the targets drawn from ``rng``, those a scenario refuses
+    (out of reach, hidden) left out and counted (``refused_targets``).
     Returns errors per band and overall, split by rows near the centre row,
-    renders per point, servo residuals, wall time per point and per render,
-    the calibration's recovered offsets beside the truth, and y errors under
-    three conditions: image-centre rows (Table VI), principal rows given
-    (Table V) and the extended calibration.
+    renders per point, servo residuals, wall time per point (the run's
+    measurement phase, its simulator's set-up included) and per render, the
+    calibration's recovered offsets beside the truth, and y errors under three
+    conditions: image-centre rows (Table VI), principal rows given (Table V)
+    and the extended calibration.
     """
     out: dict[str, Any] = {}
     vertical = vertical or visible_vertical_range(settings)
-    with HeadSim("default", settings) as sim:
-        servo = EyeServo(sim)
-        knowledge = HeadKnowledge()
-        if calibrate:
-            progress("calibrating the initial directions")
-            run = calibrate_head(
-                sim,
-                servo,
-                BALL,
-                names.CALIBRATION_BALL,
-                calibration_layout(sim, rng, calibration_targets),
-            )
-            knowledge = run.knowledge
-            out["calibration"] = {
-                "alpha_e_rad": list(run.fit.alpha_e),
-                "truth_alpha_e_rad": list(run.truth_alpha_e),
-                "error_rad": [float(e) for e in run.alpha_e_error],
-                "std_error_rad": [float(s) for s in run.fit.std_errors],
-                "samples": run.samples,
-                "renders": run.renders,
-                "v0_px": [v.v0 for v in run.vertical] if run.vertical else None,
-                "kx_over_ky": [v.kx_over_ky for v in run.vertical] if run.vertical else None,
-            }
+    keys, drawn = [], []
+    for low, high in DEPTH_BANDS_M:
+        for p_head in random_targets_head(rng, targets_per_band, (low, high), vertical=vertical):
+            keys.append(f"{low:.1f}-{high:.1f} m")
+            drawn.append(p_head)
+    accepted = reachable(settings, drawn)
+    keys = [k for k, ok in zip(keys, accepted, strict=True) if ok]
+    targets_head = [p for p, ok in zip(drawn, accepted, strict=True) if ok]
+    out["refused_targets"] = len(drawn) - len(targets_head)
+    progress("calibrating the initial directions" if calibrate else "model 2")
+    calibration = {"targets": calibration_targets} if calibrate else None
+    result = _model2_points(settings, targets_head, calibration)
+    measurements = [r.measurement for r in result.records]
+    report = result.calibration
+    knowledge = HeadKnowledge()
+    if report is not None and report.knowledge is not None:
+        knowledge = knowledge_from_block({"knowledge": asdict(report.knowledge)})
+        vertical_reference = report.vertical_reference
+        out["calibration"] = {
+            "alpha_e_rad": report.alpha_e_rad,
+            "truth_alpha_e_rad": report.alpha_e_truth_rad,
+            "error_rad": report.alpha_e_error_rad,
+            "std_error_rad": report.alpha_e_std_rad,
+            "samples": report.fixated,
+            "renders": report.renders.total,
+            "v0_px": None if vertical_reference is None else vertical_reference.v0_px,
+            "kx_over_ky": None if vertical_reference is None else vertical_reference.kx_over_ky,
+        }
+    bands: dict[str, list[Measurement]] = {f"{lo:.1f}-{hi:.1f} m": [] for lo, hi in DEPTH_BANDS_M}
+    for key, m in zip(keys, measurements, strict=True):
+        bands[key].append(m)
+    clock = RenderClock(settings)
+    try:
+        tenth_render = clock.sample(10)
+    finally:
+        clock.close()
+    wall = result.timing_s.get("experiment", math.nan)
+    extra: dict[str, list[Measurement]] = {}
+    if calibrate:  # the same targets with less knowledge, for the y budget
         plain = HeadKnowledge(alpha_e=knowledge.alpha_e)
         principal = replace(plain, v0=tuple(c.principal[1] for c in settings.cameras))  # type: ignore[arg-type]
-        tenth_render = render_time_s(sim)
-        measurements: list[Measurement] = []
-        bands: dict[str, list[Measurement]] = {}
-        extra: dict[str, list[Measurement]] = {"plain": [], "principal": []}
-        start = time.perf_counter()
-        for low, high in DEPTH_BANDS_M:
-            key = f"{low:.1f}-{high:.1f} m"
-            bands[key] = []
-            for p_head in random_targets_head(
-                rng, targets_per_band, (low, high), vertical=vertical
-            ):
-                place_in_head(sim, "marker_red", p_head)
-                m = measure_model2(sim, servo, RED, knowledge)
-                bands[key].append(m)
-                measurements.append(m)
-                progress(f"model 2: {len(measurements)} points")
-        wall = time.perf_counter() - start
-        if calibrate:  # the same targets with less knowledge, for the y budget
-            for m in measurements:
-                sim.set_body_pose("marker_red", m.truth_world_m)
-                extra["plain"].append(measure_model2(sim, servo, RED, plain))
-                extra["principal"].append(measure_model2(sim, servo, RED, principal))
+        with tempfile.TemporaryDirectory() as folder:
+            for label, know in (("plain", plain), ("principal", principal)):
+                told = knowledge_file(Path(folder) / f"{label}.json", settings, know)
+                run = _model2_points(settings, targets_head, {"from": str(told)})
+                extra[label] = [r.measurement for r in run.records]
     ok = [m for m in measurements if m.ok]
     renders = [m.renders for m in ok]
     residuals = [abs(r) for m in ok for r in m.servo_residual_px]
-    near = [m for m in ok if centre_row_offset_px(sim, m) <= CENTRE_ROW_BAND_PX]
+    near = [m for m in ok if centre_row_offset_px(settings, m) <= CENTRE_ROW_BAND_PX]
     out.update(
         {
             "overall": error_figures(measurements),
@@ -331,26 +353,42 @@ def relative_areas(
     layout_runs: list[tuple[int, AreaComparison | None]] = []
     areas_seen: set[int] = set()
     renders = []
-    with HeadSim("blocks", settings) as sim:
-        servo = EyeServo(sim)
-        # Status and uv are all the servo reads of a cross point (never windowed).
-        reference = body_target(names.BLOCKS, cast(Detector, find_cross_point))
-        for layout in range(layouts):
-            for name in names.RELATIVE_OBJECTS:
-                z = rng.uniform(0.8, 1.9)
-                p_head = np.array([rng.uniform(-0.3, 0.3) * z, rng.uniform(-0.15, 0.1) * z, z])
-                place_in_head(sim, name, p_head)
-            run = relative_positioning(sim, servo, reference, names.RELATIVE_OBJECT_COLOURS)
-            progress(f"relative positioning: layout {layout + 1}/{layouts}")
-            renders.append(run.renders)
-            layout_runs.append((len(run.missing), run.comparison))
-            if run.comparison is not None:
-                areas_seen.update(a for a in run.true_areas.values() if a)
+    settings = settings or HeadSettings()
+    for layout in range(layouts):
+        objects = []
+        for name in names.RELATIVE_OBJECTS:
+            z = rng.uniform(0.8, 1.9)
+            p_head = [rng.uniform(-0.3, 0.3) * z, rng.uniform(-0.15, 0.1) * z, z]
+            objects.append({"body": name, "position_head_m": [float(v) for v in p_head]})
+        doc = {
+            "description": "Eq. (12) on one random layout of the six objects",
+            "seed": settings.seed,
+            "head": {"preset": preset_of(settings)},
+            "experiment": {"procedure": "relative_positioning"},
+            "scene": {"objects": objects},
+        }
+        run: Any = run_scenario(scenario_from_document(doc, "relative_layout")).experiment
+        progress(f"relative positioning: layout {layout + 1}/{layouts}")
+        renders.append(run.renders)
+        layout_runs.append((len(run.missing), _comparison(run)))
+        if run.margin_threshold_px is not None:
+            areas_seen.update(o.true_area for o in run.objects if o.true_area)
     return {
         **area_tally(len(names.RELATIVE_OBJECTS), layout_runs),
         "distinct_true_areas": sorted(areas_seen),
         "renders_per_layout": float(np.mean(renders)),
     }
+
+
+def _comparison(run: Any) -> AreaComparison | None:
+    """Eq. (12)'s comparison over the objects a relative-positioning result saw in all
+    four images (None: the reference was not fixated, nothing compared)."""
+    if run.margin_threshold_px is None:
+        return None
+    seen = [o for o in run.objects if o.name not in run.missing]
+    return tally_areas(
+        [o.margin_px for o in seen], [o.agree for o in seen], run.margin_threshold_px
+    )
 
 
 SERVO_CASES = {
@@ -370,12 +408,20 @@ def servo_robustness(
     """The servo, told nothing, over focal lengths 0.5x-2x and shifted principal points."""
     out = {}
     for label, cam in SERVO_CASES.items():
-        with HeadSim("default", HeadSettings(cameras=(cam, cam))) as sim:
-            servo = EyeServo(sim)
-            ms = []
-            for p_head in random_targets_head(rng, points, (0.4, 1.4), vertical=(-0.1, 0.1)):
-                place_in_head(sim, "marker_red", p_head)
-                ms.append(measure_model2(sim, servo, RED))
+        targets_head = random_targets_head(rng, points, (0.4, 1.4), vertical=(-0.1, 0.1))
+        doc = {
+            "description": f"The servo, told nothing, with cameras {label}",
+            "experiment": {"procedure": "model2"},
+            "scene": {
+                "targets": [
+                    {"name": f"point_{k}", "position_head_m": [float(v) for v in p]}
+                    for k, p in enumerate(targets_head)
+                ]
+            },
+        }
+        settings = HeadSettings(cameras=(cam, cam))
+        result = run_scenario(scenario_with_head(doc, "servo_robustness", settings))
+        ms = [r.measurement for r in result.records]
         progress(f"servo: {label}")
         ok = [m for m in ms if m.ok]
         residuals = np.array([abs(r) for m in ok for r in m.servo_residual_px])

@@ -7,6 +7,8 @@ import resource
 import statistics
 import time
 
+from headsim.sim.settings import HeadSettings
+
 
 def cpu_s() -> float:
     """CPU time, user and system, of this process and its children that ended, s."""
@@ -17,16 +19,15 @@ def cpu_s() -> float:
 
 
 class RenderClock:
-    """Times 640x480 renders of the default scene in this process, while no worker of
-    the run works: once they started and wait, idle, for their first jobs, and a few
-    after they ended.  The unit is the quieter of the two medians (the machine's
-    other load only adds time); both are reported."""
+    """Times renders of the default scene in this process (by default the ideal head's,
+    640x480), while no worker of the run works: once they started and wait, idle, for
+    their first jobs, and a few after they ended.  The unit is the quieter of the two
+    medians (the machine's other load only adds time); both are reported."""
 
-    def __init__(self) -> None:
-        from headsim.sim.settings import HeadSettings
+    def __init__(self, settings: HeadSettings | None = None) -> None:
         from headsim.sim.simulator import for_settings
 
-        self._sim = for_settings(HeadSettings())
+        self._sim = for_settings(settings or HeadSettings())
         self._sim.move(eye=0.05)
         for camera in (1, 2):
             self._sim.render(camera)

@@ -10,9 +10,13 @@ calibration file that the scenario names (``experiment.calibration.from``).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from headsim.active.calibration_file import write_calibration
 from headsim.active.measurement import HeadKnowledge
+from headsim.scenario.loading import scenario_from_document
+from headsim.scenario.spec import Scenario
+from headsim.sim import names
 from headsim.sim.settings import PRESETS, HeadSettings
 
 
@@ -24,6 +28,52 @@ def preset_of(settings: HeadSettings) -> str:
     raise ValueError(
         "the head is no preset's: describe it in the scenario's [head], [cam1] and [cam2]"
     )
+
+
+#: Each camera's keys of ``[cam1]``/``[cam2]`` (:class:`CameraSettings` fields of the same name).
+_CAMERA_KEYS = (
+    "width",
+    "height",
+    "kx",
+    "ky",
+    "cx",
+    "cy",
+    "k1",
+    "k2",
+    "noise_std",
+    "nodal_offset_m",
+    "side_offset_m",
+    "eye_axis_tilt_rad",
+)
+
+
+def head_document(settings: HeadSettings) -> dict[str, Any]:
+    """The scenario tables ``[head]``, ``[cam1]``, ``[cam2]`` (and ``seed``) of the ideal
+    head with the cameras of ``settings``: every camera key given, the mount yaws, pitches
+    and rolls.  :func:`scenario_with_head` checks that the scenario's head is ``settings``."""
+    cams = settings.cameras
+    doc: dict[str, Any] = {
+        "seed": settings.seed,
+        "head": {
+            "preset": "ideal",
+            "mount_yaw_rad": [c.mount_yaw_rad for c in cams],
+            "mount_pitch_rad": [c.mount_pitch_rad for c in cams],
+            "mount_roll_rad": [c.mount_roll_rad for c in cams],
+        },
+    }
+    for key, cam in zip(names.CAMERAS, cams, strict=True):
+        values = {k: getattr(cam, k) for k in _CAMERA_KEYS}
+        doc[key] = {k: v for k, v in values.items() if v is not None}
+    return doc
+
+
+def scenario_with_head(doc: dict[str, Any], name: str, settings: HeadSettings) -> Scenario:
+    """The scenario ``doc`` (without its head's tables) on the head ``settings``, told by
+    :func:`head_document` (ValueError if the scenario's head came out otherwise)."""
+    scenario = scenario_from_document({**doc, **head_document(settings)}, name)
+    if scenario.settings != settings:
+        raise ValueError("the head has settings that [head], [cam1] and [cam2] cannot state")
+    return scenario
 
 
 def knowledge_file(path: Path, settings: HeadSettings, knowledge: HeadKnowledge) -> Path:
@@ -53,4 +103,4 @@ def knowledge_file(path: Path, settings: HeadSettings, knowledge: HeadKnowledge)
     return write_calibration(path, settings, block, "told", settings.seed)
 
 
-__all__ = ["knowledge_file", "preset_of"]
+__all__ = ["head_document", "knowledge_file", "preset_of", "scenario_with_head"]

@@ -137,6 +137,10 @@ BAD = [
         "experiment.servo.average_fixation: must be true or false, got integer 1",
     ),
     (
+        "[experiment.servo]\nwindows = 'off'\n",
+        "experiment.servo.windows: must be true or false, got string 'off'",
+    ),
+    (
         "[experiment.calibration]\ndepth_m = [0.6, 0.3]\n",
         "experiment.calibration.depth_m: [0.6, 0.3] is empty",
     ),
@@ -177,3 +181,16 @@ def test_an_unknown_procedure_is_named_with_every_registered_one(tmp_path: Path)
     message = f"{path}: experiment.procedure: unknown value 'model3' (allowed: {allowed})"
     with pytest.raises(ScenarioError, match=re.escape(message)):
         load_scenario(path)
+
+
+def test_servo_windows_reach_the_servo_and_are_recorded_when_set(tmp_path: Path) -> None:
+    from headsim.run.context import servo_config
+    from headsim.scenario.spec import servo_record
+
+    default = load_scenario(write_scenario(tmp_path, MINIMAL))
+    assert servo_config(default).windows is True
+    assert "windows" not in servo_record(default.experiment.servo)
+    path = write_scenario(tmp_path, MINIMAL + "[experiment.servo]\nwindows = false\n", "off.toml")
+    off = load_scenario(path)
+    assert servo_config(off).windows is False
+    assert servo_record(off.experiment.servo)["windows"] is False

@@ -86,3 +86,24 @@ def test_tracking_through_the_runner_fixates_every_time_within_a_millimetre() ->
     assert figures["fixations"] == 3 and figures["ok"] == 3
     assert 0.0 < figures["error_world_mm_rms"] <= figures["error_world_mm_max"] < 1.0
     assert figures["renders_first"] > figures["renders_per_fixation_after_first"] > 0
+
+
+def test_a_target_a_scenario_would_refuse_is_not_reachable() -> None:
+    from headsim.sim.settings import paper_head
+    from headsim.studies.experiments import reachable
+
+    # Behind the green marker, for camera 1; then one straight ahead.
+    targets = [np.array([-0.087, 0.003, 0.764]), np.array([0.0, 0.0, 0.8])]
+    assert reachable(paper_head(), targets) == [False, True]
+
+
+def test_model2_accuracy_runs_its_targets_as_a_scenario() -> None:
+    from headsim.sim.settings import HeadSettings
+    from headsim.studies.experiments import model2_accuracy
+
+    figures = model2_accuracy(HeadSettings(), np.random.default_rng(0), targets_per_band=1)
+    assert figures["refused_targets"] == 0
+    assert figures["overall"]["count"] == 3 and figures["overall"]["failed"] == 0
+    assert [f["count"] for f in figures["bands"].values()] == [1, 1, 1]
+    assert figures["overall"]["rms_3d_pct_depth"] < 0.05
+    assert figures["render_s"] > 0 and "calibration" not in figures

@@ -9,8 +9,8 @@ import pytest
 
 from headsim.active.calibration_file import read_calibration
 from headsim.active.measurement import HeadKnowledge
-from headsim.sim.settings import PRESETS, paper_head
-from headsim.studies.scenario_runs import knowledge_file, preset_of
+from headsim.sim.settings import PRESETS, CameraSettings, HeadSettings, paper_head
+from headsim.studies.scenario_runs import knowledge_file, preset_of, scenario_with_head
 
 
 @pytest.mark.parametrize("name", list(PRESETS))
@@ -55,3 +55,32 @@ def test_a_knowledge_with_its_own_belief_is_not_written(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="no belief"):
         knowledge_file(tmp_path / "told.json", paper_head(), HeadKnowledge(belief=HeadBelief()))
     assert not (tmp_path / "told.json").exists()
+
+
+MODEL2_DOC = {
+    "description": "one target",
+    "experiment": {"procedure": "model2"},
+    "scene": {"targets": [{"position_head_m": [0.0, 0.0, 0.8]}]},
+}
+
+
+@pytest.mark.parametrize(
+    "settings",
+    [
+        HeadSettings(cameras=(paper_head().cameras[0], paper_head().cameras[0])),
+        HeadSettings(
+            seed=4,
+            cameras=(CameraSettings(cx=279.5, cy=199.5), CameraSettings().with_zoom(1.5)),
+        ),
+    ],
+    ids=["paper camera 1 twice", "shifted and zoomed"],
+)
+def test_a_heads_cameras_are_stated_key_by_key(settings: HeadSettings) -> None:
+    scenario = scenario_with_head(MODEL2_DOC, "cameras", settings)
+    assert scenario.settings == settings
+    assert scenario.seed == settings.seed
+
+
+def test_a_head_the_tables_cannot_state_is_refused() -> None:
+    with pytest.raises(ValueError, match=r"\[head\], \[cam1\] and \[cam2\] cannot state"):
+        scenario_with_head(MODEL2_DOC, "backlash", HeadSettings(backlash_rad=0.0003))
