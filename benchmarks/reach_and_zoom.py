@@ -159,7 +159,7 @@ def run_zoom(
         # only near-central ones, which leave the two offsets' difference
         # undetermined (x/z spread 0.023 against 0.074, 0.42 against 0.09 mrad).
         positions = calibration_layout(
-            sim, np.random.default_rng([seed, 7]), calibration, eye_angles_rad=CALIBRATION_EYES
+            sim.stereo_views(CALIBRATION_EYES), np.random.default_rng([seed, 7]), calibration
         )
         try:
             run = calibrate_head(

@@ -52,7 +52,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
     with simulator(hub, "default", scenario) as sim:
         try:
             positions = calibration_layout(
-                sim,
+                sim.stereo_views(),
                 np.random.default_rng([seed, STREAM_CALIBRATION]),
                 spec.targets,
                 spec.depth_m,

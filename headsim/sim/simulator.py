@@ -24,7 +24,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from headsim.geometry.transforms import homogeneous, invert_transform
+from headsim.geometry.stereo_view import StereoView
+from headsim.geometry.transforms import apply_transform, homogeneous, invert_transform
 from headsim.sim import names
 from headsim.sim.events import NO_EVENTS, EventSink, ImageKind, ImageTaken
 from headsim.sim.joints import (
@@ -288,11 +289,39 @@ class HeadSim:
             raise SettingsError(f"no body or site named {name!r} in this scene")
         return self.transform_points(p_world, "world", frame)[0]
 
+    def transform(self, src: str, dst: str) -> np.ndarray:
+        """``dst_from_src``, 4 x 4, between frames "world", "head", "cam1" and "cam2"."""
+        return self.frame_from_world(dst) @ invert_transform(self.frame_from_world(src))
+
     def transform_points(self, points: np.ndarray, src: str, dst: str) -> np.ndarray:
         """Map points (N, 3) from frame ``src`` to frame ``dst``, m."""
-        points = np.atleast_2d(np.asarray(points, dtype=float))
-        transform = self.frame_from_world(dst) @ invert_transform(self.frame_from_world(src))
-        return points @ transform[:3, :3].T + transform[:3, 3]
+        return apply_transform(self.transform(src, dst), points)
+
+    def stereo_view(self) -> StereoView:
+        """Both cameras' true intrinsics and poses, and the head's pose, as they are now."""
+        return StereoView(
+            cameras=(self.camera_settings(1).pinhole(), self.camera_settings(2).pinhole()),
+            camera_from_world=(
+                self.transform("world", names.CAMERAS[0]),
+                self.transform("world", names.CAMERAS[1]),
+            ),
+            world_from_head=self.transform("head", "world"),
+        )
+
+    def stereo_views(self, eye_angles_rad: Sequence[float] = ()) -> tuple[StereoView, ...]:
+        """The view from the current pose, then from each eye-encoder angle (rad, to the
+        nearest step; neck still), after which the eyes go back to their current step."""
+        views = [self.stereo_view()]
+        if eye_angles_rad:
+            resolution = self.settings.encoder_resolution_rad
+            before = self.eye_encoder_steps()
+            for angle in eye_angles_rad:
+                self.command_eye_steps(round(angle / resolution))
+                self.settle()
+                views.append(self.stereo_view())
+            self.command_eye_steps(before)
+            self.settle()
+        return tuple(views)
 
     def set_body_pose(
         self,

@@ -161,7 +161,7 @@ def calibration_positions(sim: HeadSim, settings: HeadSettings, config: StudyCon
     """The Sec. V ball positions of every method (seeded by ``config.seed``)."""
     scale = view_scale(settings)
     return calibration_layout(
-        sim,
+        sim.stereo_views(),
         np.random.default_rng(config.seed + 2),
         config.calibration_targets,
         depth_range_m=(0.25 * scale, 0.6 * scale),
@@ -252,7 +252,7 @@ def calibrate_realistic(sim: HeadSim, rng: np.random.Generator, seed: int) -> Ca
         EyeServo(sim),
         BALL,
         names.CALIBRATION_BALL,
-        calibration_layout(sim, rng, 30, depth_range_m=(0.25, 1.5)),
+        calibration_layout(sim.stereo_views(), rng, 30, depth_range_m=(0.25, 1.5)),
         position_noise_m=0.001,
         rng=np.random.default_rng([seed, 7]),
         lines_of_sight=True,

@@ -116,7 +116,7 @@ def model2_accuracy(
                 servo,
                 BALL,
                 names.CALIBRATION_BALL,
-                calibration_layout(sim, rng, calibration_targets),
+                calibration_layout(sim.stereo_views(), rng, calibration_targets),
             )
             knowledge = run.knowledge
             out["calibration"] = {

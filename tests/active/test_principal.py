@@ -93,7 +93,7 @@ def test_servoing_on_the_fixed_point_keeps_the_calibration_through_a_zoom() -> N
     columns = (found.principal_px[0][0], found.principal_px[1][0])
     p_head = np.array([0.06, 0.02, 0.8])
     with HeadSim("default", head) as sim:
-        positions = calibration_layout(sim, np.random.default_rng(2), 16)
+        positions = calibration_layout(sim.stereo_views(), np.random.default_rng(2), 16)
         run = calibrate_head(
             sim,
             EyeServo(sim),
