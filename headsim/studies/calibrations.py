@@ -19,6 +19,7 @@ from headsim.active.principal import (
     PrincipalPointRun,
     principal_points_by_zoom,
     view_scale,
+    zoomed,
 )
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
@@ -152,9 +153,17 @@ def zhang_stereo(
 
 def zoom_fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:
     """The zoom fixed points of ``settings``' cameras, seeded by ``config.seed``."""
-    return principal_points_by_zoom(
-        settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
-    )
+    with (
+        HeadSim("chessboard", settings) as before,
+        HeadSim("chessboard", zoomed(settings, PROBE_ZOOM)) as after,
+    ):
+        return principal_points_by_zoom(
+            before,
+            after,
+            PROBE_ZOOM,
+            np.random.default_rng(config.seed + 1),
+            config.principal_poses,
+        )
 
 
 def calibration_positions(sim: HeadSim, settings: HeadSettings, config: StudyConfig) -> np.ndarray:
