@@ -12,7 +12,7 @@ near the midline the y images are taken again at an intermediate eye angle
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -27,7 +27,7 @@ from headsim.active.measurement import (
     estimated_measurement,
     failed_measurement,
 )
-from headsim.active.search import find_view, nearest_seen, scan_eyes
+from headsim.active.search import find_view, scan_eyes
 from headsim.active.servo_types import ServoOutcome, ServoResult
 from headsim.estimators import Uncertainty, model2
 from headsim.sim.simulator import HeadSim
@@ -58,6 +58,20 @@ class Model2Config:
     interpolate: bool = True
     midline_px: float = 25.0
     remedy_px: float = 120.0
+
+
+def _nearest_seen(
+    seen: Iterable[tuple[int, float, float]], steps: int, goal_u: float, midline_px: float
+) -> tuple[int, float, float] | None:
+    """From a servo's memory (eye step, u, v), the image nearest eye step ``steps`` whose target is at least
+    ``midline_px`` off the goal column (else the one farthest off it)."""
+    memory = list(seen)
+    if not memory:
+        return None
+    off = [m for m in memory if abs(m[1] - goal_u) >= midline_px]
+    if off:
+        return min(off, key=lambda m: abs(m[0] - steps))
+    return max(memory, key=lambda m: abs(m[1] - goal_u))
 
 
 @dataclass
@@ -139,7 +153,7 @@ def _two_steps(
     uv1_seen = seen1.uv if seen1.found else None
     if uv1_seen is None:
         # Ca1 does not see P where Ca2 fixates it: its y image is one step 1 took.
-        memory = nearest_seen(step1.seen, step2.steps, u10, midline_px)
+        memory = _nearest_seen(step1.seen, step2.steps, u10, midline_px)
         if memory is None:
             return _Failed(detection_failure(seen1, "step 2", 1), residuals)
         gamma1_steps, uv1_seen = memory[0], (memory[1], memory[2])
