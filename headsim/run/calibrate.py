@@ -50,6 +50,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
     seed = scenario.seed
     start = hub.renders  # every image this phase draws is one of its renders
     near_far = spec.layout == "near_far"
+    config, known = servo_config(scenario), told(scenario)
     with simulator(hub, "default", scenario) as sim:
         try:
             depths_m = (
@@ -109,7 +110,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
         try:
             run = calibrate_head(
                 sim,
-                EyeServo(sim, servo_config(scenario)),
+                EyeServo(sim, config),
                 ball,
                 names.CALIBRATION_BALL,
                 positions,
@@ -118,7 +119,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
                 extended=spec.extended,
                 position_noise_m=spec.position_noise_m,
                 lines_of_sight=spec.lines_of_sight,
-                knowledge=told(scenario),
+                knowledge=known,
             )
         except ValueError as err:
             outcomes = err.outcomes if isinstance(err, CalibrationError) else ()
