@@ -24,6 +24,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from headsim.geometry.kinematics import eye_from_camera_rotation
 from headsim.geometry.stereo_view import StereoView
 from headsim.geometry.transforms import apply_transform, homogeneous, invert_transform
 from headsim.sim import names
@@ -35,7 +36,7 @@ from headsim.sim.joints import (
     SettleResult,
     true_targets,
 )
-from headsim.sim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
+from headsim.sim.model import CV_FROM_MJCAM, BuiltModel, build_model
 from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
 from headsim.sim.render import EyeRenderer, Window, context_key
 from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
@@ -369,7 +370,13 @@ class HeadSim:
         u_c, v_c = cam.image_centre
         pixel = np.array([u_c if goal_u is None else goal_u, v_c])
         xy = cam.pinhole().normalise(pixel)  # raises if no ray
-        ray_eye = eye_from_camera_rotation(cam, index) @ np.array([xy[0], xy[1], 1.0])
+        eye_from_cv = eye_from_camera_rotation(
+            names.EYE_CAMERAS[index].inward,
+            cam.mount_yaw_rad,
+            cam.mount_pitch_rad,
+            cam.mount_roll_rad,
+        )
+        ray_eye = eye_from_cv @ np.array([xy[0], xy[1], 1.0])
         yaw = math.atan2(ray_eye[0], ray_eye[2])
         return yaw if index == 0 else -yaw
 
