@@ -311,18 +311,19 @@ class HeadSim:
 
     def stereo_views(self, eye_angles_rad: Sequence[float] = ()) -> tuple[StereoView, ...]:
         """The view from the current pose, then from each eye-encoder angle (rad, to the
-        nearest step; neck still), after which the eyes go back to their current step."""
-        views = [self.stereo_view()]
+        nearest step; neck still).  The eyes go back to their current step, and the first
+        view is taken there (with joint errors, where they settle on the way back)."""
+        turned = []
         if eye_angles_rad:
             resolution = self.settings.encoder_resolution_rad
             before = self.eye_encoder_steps()
             for angle in eye_angles_rad:
                 self.command_eye_steps(round(angle / resolution))
                 self.settle()
-                views.append(self.stereo_view())
+                turned.append(self.stereo_view())
             self.command_eye_steps(before)
             self.settle()
-        return tuple(views)
+        return (self.stereo_view(), *turned)
 
     def set_body_pose(
         self,
