@@ -187,6 +187,9 @@ def measure_model2(
     gamma1_steps, uv1_seen = fixed.gamma1_steps, fixed.uv1
     gamma2_steps = fixed.gamma2_steps
 
+    # The fixation angles come from the two steps; the remedy below replaces y images only.
+    alpha1 = _fixation_angle(sim, step1, config.interpolate)
+    alpha2 = _fixation_angle(sim, step2, config.interpolate)
     uv1, uv2 = np.array(uv1_seen), np.array(fixed.uv2)
     gamma1, gamma2 = gamma1_steps * resolution, gamma2_steps * resolution
     if min(abs(uv1[0] - u10), abs(uv2[0] - u20)) < config.midline_px:
@@ -198,8 +201,6 @@ def measure_model2(
             if r2 is not None and abs(r2[0] - u20) > abs(uv2[0] - u20):
                 uv2, gamma2 = r2, gamma
 
-    alpha1 = _fixation_angle(sim, step1, config.interpolate)
-    alpha2 = _fixation_angle(sim, step2, config.interpolate)
     gains = [abs(r.gain_px_per_step or 1.0) for r in (step1, step2)]
     angle_sigma = (
         resolution * NOMINAL_PIXEL_SIGMA / min(gains)
