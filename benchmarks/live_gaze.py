@@ -39,6 +39,7 @@ import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.active.measurement import HeadKnowledge
+from headsim.active.neck_servo import NeckServo
 from headsim.files import write_json_atomic
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Sinusoid, Waypoints
 from headsim.live.gaze import GazeConfig, GazeMode, SaccadeProfile, acquire, pursue
@@ -100,7 +101,7 @@ def pursuit_case(
     """One pursuit run of ``duration`` s on ``path``: losses, error along the path, lag, offsets."""
     with HeadSim(settings=head.settings) as sim:
         live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path)  # type: ignore[arg-type]
-        estimator = acquire(live, RED, head.knowledge)
+        estimator = acquire(live, NeckServo(sim), RED, head.knowledge)
         if estimator is None:
             return {"acquired": 0.0}
         run = pursue(live, RED, estimator, duration, GazeConfig(mode=mode, predictor=predictor))
@@ -137,7 +138,7 @@ def saccade_case(
     path = Jump(tuple(start), tuple(end), jump_s)
     with HeadSim(settings=head.settings) as sim:
         live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path)
-        estimator = acquire(live, RED, head.knowledge)
+        estimator = acquire(live, NeckServo(sim), RED, head.knowledge)
         if estimator is None:
             return {"acquired": 0.0}
         run = pursue(live, RED, estimator, jump_s + 1.0, GazeConfig(saccade=profile))

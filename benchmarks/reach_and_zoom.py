@@ -37,7 +37,8 @@ from headsim.active.model1 import measure_model1
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.placement import calibration_layout
-from headsim.active.principal import principal_points_by_zoom
+from headsim.active.principal import PROBE_ZOOM, principal_points_by_zoom
+from headsim.active.principal import zoomed as zoomed_head
 from headsim.active.servo_types import ServoConfig
 from headsim.files import write_json_atomic
 from headsim.run.targets import marker_target
@@ -145,7 +146,11 @@ def run_zoom(
     base = HeadKnowledge()
     if goal == "fixed-point":
         # The goal columns through each camera's zoom fixed point, from images alone.
-        found = principal_points_by_zoom(settings, rng=np.random.default_rng(seed))
+        with (
+            HeadSim("chessboard", settings) as before,
+            HeadSim("chessboard", zoomed_head(settings, PROBE_ZOOM)) as after,
+        ):
+            found = principal_points_by_zoom(before, after, rng=np.random.default_rng(seed))
         base = HeadKnowledge(u0=(found.principal_px[0][0], found.principal_px[1][0]))
         out["goal_columns_px"] = [base.u0[0], base.u0[1]]
         out["goal_column_error_px"] = [float(e) for e in found.errors_px[:, 0]]
@@ -159,7 +164,7 @@ def run_zoom(
         # only near-central ones, which leave the two offsets' difference
         # undetermined (x/z spread 0.023 against 0.074, 0.42 against 0.09 mrad).
         positions = calibration_layout(
-            sim, np.random.default_rng([seed, 7]), calibration, eye_angles_rad=CALIBRATION_EYES
+            sim.stereo_views(CALIBRATION_EYES), np.random.default_rng([seed, 7]), calibration
         )
         try:
             run = calibrate_head(

@@ -78,18 +78,23 @@ def _run_elsewhere(tmp_path: Path, python: Path) -> list[Path]:
     return [Path(line).resolve() for line in where]
 
 
+def _install_and_run(tmp_path: Path, *target: str) -> tuple[Path, list[Path]]:
+    """pip-install ``target`` (pip's arguments) with --no-deps into a fresh venv and run it
+    from another folder: the venv's resolved site-packages and :func:`_run_elsewhere`'s paths."""
+    python, site = _venv(tmp_path)
+    _run(
+        [sys.executable, "-m", "pip", "--python", str(python), "install", "-q", "--no-deps",
+         *target]
+    )  # fmt: skip
+    return site.resolve(), _run_elsewhere(tmp_path, python)
+
+
 def test_pip_install_runs_the_quick_start_from_another_folder(tmp_path: Path) -> None:
     source = _sources(tmp_path)
     wheels = tmp_path / "wheels"
     _run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(wheels), str(source)])
     (wheel,) = wheels.glob("headsim-*.whl")
-    python, site = _venv(tmp_path)
-    _run(
-        [sys.executable, "-m", "pip", "--python", str(python), "install", "-q", "--no-deps",
-         "--no-index", str(wheel)]
-    )  # fmt: skip
-    module, models, scenarios = _run_elsewhere(tmp_path, python)
-    site = site.resolve()
+    site, (module, models, scenarios) = _install_and_run(tmp_path, "--no-index", str(wheel))
     assert module.is_relative_to(site), module  # the wheel, not the checkout
     assert models == site / "headsim" / "models", models
     assert scenarios == site / "headsim" / "scenarios", scenarios
@@ -97,12 +102,7 @@ def test_pip_install_runs_the_quick_start_from_another_folder(tmp_path: Path) ->
 
 def test_editable_install_finds_the_top_level_models_and_scenarios(tmp_path: Path) -> None:
     source = _sources(tmp_path)
-    python, _ = _venv(tmp_path)
-    _run(
-        [sys.executable, "-m", "pip", "--python", str(python), "install", "-q", "--no-deps",
-         "-e", str(source)]
-    )  # fmt: skip
-    module, models, scenarios = _run_elsewhere(tmp_path, python)
+    _, (module, models, scenarios) = _install_and_run(tmp_path, "-e", str(source))
     source = source.resolve()
     assert module == source / "headsim" / "sim" / "model.py", module
     assert models == source / "models", models

@@ -140,15 +140,17 @@ def calibrate_head(
     parked = sim.position(body)  # put the target back afterwards: it must not hide others
     alpha1, alpha2, depths, rows = [], [], [], []
     outcomes: list[Failure | None] = []
-    plain = Model2Config(midline_px=0.0)
+    # Plain first; near the midline the y images hold almost no x offset (NO_Y,
+    # an estimator failure): then again, taking them at an intermediate eye angle
+    # (the near-midline remedy).
+    configs = (Model2Config(midline_px=0.0), Model2Config())
     for index, position in enumerate(np.atleast_2d(positions_world)):
         sink.emit(FixationStarted(f"calibration {index + 1}"))
         sim.set_body_pose(body, position)
-        m = measure_model2(sim, servo, target, base, plain)
-        if m.failure is not None and m.failure.cause is FailureCause.ESTIMATOR:
-            # Near the midline the y images hold almost no x offset (NO_Y): take
-            # them again at an intermediate eye angle, the near-midline remedy.
-            m = measure_model2(sim, servo, target, base, Model2Config())
+        for config in configs:
+            m = measure_model2(sim, servo, target, base, config)
+            if m.failure is None or m.failure.cause is not FailureCause.ESTIMATOR:
+                break
         sink.emit(CalibrationPosition(index, position, m))
         outcomes.append(m.failure)
         if not m.ok:

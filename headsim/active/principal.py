@@ -165,7 +165,8 @@ class PrincipalPointRun:
 
 
 def principal_points_by_zoom(
-    settings: HeadSettings,
+    before: HeadSim,
+    after: HeadSim,
     zoom: float = PROBE_ZOOM,
     rng: np.random.Generator | None = None,
     poses: int = 2,
@@ -173,42 +174,45 @@ def principal_points_by_zoom(
 ) -> PrincipalPointRun:
     """Find each camera's principal point as the fixed point of a zoom, from chessboard images.
 
-    The chessboard is placed in ``poses`` seeded poses (seen whole at both
-    focal lengths: the poses are drawn for the longer one); for each, both
-    eyes at angle 0 render it at the head's focal lengths and at ``zoom``
-    times them, and the corners found in both images of one camera are
+    ``before`` and ``after``: the head in the chessboard scene at its focal
+    lengths and at ``zoom`` times them (``after.settings`` is
+    ``zoomed(before.settings, zoom)``).  The chessboard is placed in ``poses``
+    seeded poses (seen whole at both focal lengths: the poses are drawn for
+    the longer one); for each, both eyes at angle 0 render it in both
+    simulators, and the corners found in both images of one camera are
     matched by their board order.  Only pixels enter the fit.
     ``distance_range_m`` of the board defaults to 0.5-0.9 m times the zoomed
     head's :func:`view_scale` (a narrower view needs the board further away).
     """
+    settings = before.settings
+    if after.settings != zoomed(settings, zoom):
+        raise ValueError(
+            f"principal points: after.settings must be before.settings zoomed {zoom}x "
+            "(zoomed(before.settings, zoom))"
+        )
     rng = rng or np.random.default_rng(0)
-    after_settings = zoomed(settings, zoom)
-    narrow = after_settings if zoom > 1 else settings
+    narrow = after.settings if zoom > 1 else settings
     if distance_range_m is None:
         scale = view_scale(narrow)
         distance_range_m = (0.5 * scale, 0.9 * scale)
     matched: list[list[tuple[np.ndarray, np.ndarray]]] = [[], []]
     renders = views = 0
-    with (
-        HeadSim("chessboard", settings) as before,
-        HeadSim("chessboard", after_settings) as after,
-    ):
-        sims = (before, after)
+    sims = (before, after)
+    for sim in sims:
+        sim.move(eye=0.0, neck_yaw=0.0, neck_pitch=0.0)
+    sampler = after if zoom > 1 else before
+    for _ in range(poses):
+        head_from_board = sample_board_pose(sampler, rng, distance_range_m, max_tilt_rad=0.4)
         for sim in sims:
-            sim.move(eye=0.0, neck_yaw=0.0, neck_pitch=0.0)
-        sampler = after if narrow is after_settings else before
-        for _ in range(poses):
-            head_from_board = sample_board_pose(sampler, rng, distance_range_m, max_tilt_rad=0.4)
-            for sim in sims:
-                place_chessboard(sim, head_from_board)
-            found_any = False
-            for camera in (1, 2):
-                corners = [look_for_board(sim, camera) for sim in sims]
-                renders += 2
-                if corners[0] is not None and corners[1] is not None:
-                    matched[camera - 1].append((corners[0], corners[1]))
-                    found_any = True
-            views += found_any
+            place_chessboard(sim, head_from_board)
+        found_any = False
+        for camera in (1, 2):
+            corners = [look_for_board(sim, camera) for sim in sims]
+            renders += 2
+            if corners[0] is not None and corners[1] is not None:
+                matched[camera - 1].append((corners[0], corners[1]))
+                found_any = True
+        views += found_any
     fits = []
     for camera in (1, 2):
         if not matched[camera - 1]:

@@ -295,20 +295,6 @@ def find_neck_view(
     return None
 
 
-def nearest_seen(
-    seen: Iterable[tuple[int, float, float]], steps: int, goal_u: float, midline_px: float
-) -> tuple[int, float, float] | None:
-    """From a servo's memory, the image nearest eye step ``steps`` whose target is at least
-    ``midline_px`` off the goal column (else the one farthest off it)."""
-    memory = list(seen)
-    if not memory:
-        return None
-    off = [m for m in memory if abs(m[1] - goal_u) >= midline_px]
-    if off:
-        return min(off, key=lambda m: abs(m[0] - steps))
-    return max(memory, key=lambda m: abs(m[1] - goal_u))
-
-
 __all__ = [
     "MAX_SCAN_POSES",
     "SCAN_DIVISIONS",
@@ -317,7 +303,6 @@ __all__ = [
     "Scan",
     "find_neck_view",
     "find_view",
-    "nearest_seen",
     "neck_search_poses",
     "scan_eye_poses",
     "scan_eyes",

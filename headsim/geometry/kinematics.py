@@ -12,11 +12,13 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from headsim.geometry.transforms import rotation_x, rotation_y, rotation_z
 from headsim.paper import ENCODER_RESOLUTION_RAD
 
 __all__ = [
     "ENCODER_RESOLUTION",
     "camera_centre",
+    "eye_from_camera_rotation",
     "head_from_camera",
     "head_to_camera",
     "head_to_world",
@@ -62,6 +64,23 @@ def world_to_head(
     p = _points(points_w, "points_w")
     t = world_from_head(theta1, theta2, d1, a2)
     return np.einsum("...ji,...j->...i", t[..., :3, :3], p - t[..., :3, 3])
+
+
+def eye_from_camera_rotation(
+    inward: float, mount_yaw_rad: float, mount_pitch_rad: float = 0.0, mount_roll_rad: float = 0.0
+) -> np.ndarray:
+    """Rotation (3, 3) of a camera's OpenCV frame in its eye frame (eye angle 0).
+
+    The eye frame is parallel to H.  ``inward``: the camera's inward sign
+    (``names.EYE_CAMERAS[i].inward``, +1 or -1).  Mount yaw turns the camera
+    inward like the eye angle (about +y for Ca1, -y for Ca2); pitch turns it up
+    (about its x); roll turns it about its optical axis.
+    """
+    return (
+        rotation_y(inward * mount_yaw_rad)
+        @ rotation_x(mount_pitch_rad)
+        @ rotation_z(mount_roll_rad)
+    )
 
 
 def camera_centre(camera: int, baseline: float) -> np.ndarray:

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 __all__ = [
+    "apply_transform",
     "frame_deviation",
     "homogeneous",
     "invert_transform",
@@ -34,6 +35,12 @@ def invert_transform(transform: np.ndarray) -> np.ndarray:
     """Inverse of a rigid 4 x 4 transform."""
     rotation, translation = transform[:3, :3], transform[:3, 3]
     return homogeneous(rotation.T, -rotation.T @ translation)
+
+
+def apply_transform(dst_from_src: np.ndarray, points_src: np.ndarray) -> np.ndarray:
+    """Points (N, 3) in frame dst of points (N, 3) in frame src, m."""
+    points_src = np.atleast_2d(np.asarray(points_src, dtype=float))
+    return points_src @ dst_from_src[:3, :3].T + dst_from_src[:3, 3]
 
 
 def rotation_x(angle: float) -> np.ndarray:

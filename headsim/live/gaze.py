@@ -23,7 +23,7 @@ import numpy as np
 
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
-from headsim.active.servo_types import Detector, ServoConfig
+from headsim.active.servo_types import Detector
 from headsim.live.estimator import GazeEstimator
 from headsim.live.head import Frame, LiveHead
 from headsim.live.motors import MotorDriver, bang_bang_duration, min_jerk_duration
@@ -301,24 +301,26 @@ def pursue(
 
 def acquire(
     live: LiveHead,
+    servo: NeckServo,
     detector: Detector,
     knowledge: HeadKnowledge | None = None,
-    config: ServoConfig | None = None,
 ) -> GazeEstimator | None:
-    """Fixate the target at rest with the paper's Model 1 servo and keep its image Jacobian.
+    """Fixate the target at rest with ``servo`` (the paper's Model 1 servo on the live
+    head's simulator) and keep its image Jacobian.
 
     The head is at rest (the target held where it is at the present time);
     the servo's probes and moves settle kinematically, as the at-rest
-    procedures do.  ``config``: the servo's (None: the defaults).  None when
-    the servo did not converge.  The estimator measures with ``knowledge``'s
-    belief of the head's geometry, never the simulator's true one; the encoder
-    resolution is the encoders' specification (counts per turn), known to the
-    head exactly, as in the at-rest procedures.
+    procedures do.  None when the servo did not converge.  The estimator
+    measures with ``knowledge``'s belief of the head's geometry, never the
+    simulator's true one; the encoder resolution is the encoders'
+    specification (counts per turn), known to the head exactly, as in the
+    at-rest procedures.
     """
     sim = live.sim
+    if servo.sim is not sim:
+        raise ValueError("acquire: servo must drive the live head's simulator (live.sim)")
     knowledge = knowledge or HeadKnowledge()
     goals = (knowledge.reference(sim, 1), knowledge.reference(sim, 2))
-    servo = NeckServo(sim, config)
     result = servo.run(detector, goals=(goals[0][0], goals[1][0], (goals[0][1] + goals[1][1]) / 2))
     if not result.converged or servo.jacobian is None:
         return None

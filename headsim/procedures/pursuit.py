@@ -23,6 +23,7 @@ import numpy as np
 
 from headsim.active.events import FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
+from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import ServoConfig
 from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
@@ -180,7 +181,9 @@ def run_pursuit(
             )
         live.advance_to(first)
         # Whole frames, no windows or previews: the acquisition as it has always run.
-        estimator = acquire(live, target.detector, knowledge, ServoConfig(windows=False))
+        estimator = acquire(
+            live, NeckServo(sim, ServoConfig(windows=False)), target.detector, knowledge
+        )
         if estimator is None:
             return [], PursuitResult(described, failures=(f"{spec.name}: not acquired at rest",))
 

@@ -49,18 +49,24 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
     assert spec is not None
     seed = scenario.seed
     start = hub.renders  # every image this phase draws is one of its renders
+    near_far = spec.layout == "near_far"
+    config, known = servo_config(scenario), told(scenario)
     with simulator(hub, "default", scenario) as sim:
         try:
+            depths_m = (
+                near_far_depths(spec.targets, spec.depth_m, spec.near_fraction)
+                if near_far
+                else None
+            )
+            near = (spec.near_fraction or near_fraction(spec.depth_m)) if near_far else None
             positions = calibration_layout(
-                sim,
+                sim.stereo_views(),
                 np.random.default_rng([seed, STREAM_CALIBRATION]),
                 spec.targets,
                 spec.depth_m,
                 spec.lateral,
                 spec.vertical,
-                depths_m=near_far_depths(spec.targets, spec.depth_m, spec.near_fraction)
-                if spec.layout == "near_far"
-                else None,
+                depths_m=depths_m,
             )
         except ValueError as err:
             report = CalibrationReport(
@@ -88,11 +94,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
             positions=(),
             layout=CalibrationLayout(
                 kind=spec.layout,
-                near_fraction=(
-                    (spec.near_fraction or near_fraction(spec.depth_m))
-                    if spec.layout == "near_far"
-                    else None
-                ),
+                near_fraction=near,
                 depth_m=list(spec.depth_m),
                 lateral=spec.lateral,
                 vertical=spec.vertical,
@@ -108,7 +110,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
         try:
             run = calibrate_head(
                 sim,
-                EyeServo(sim, servo_config(scenario)),
+                EyeServo(sim, config),
                 ball,
                 names.CALIBRATION_BALL,
                 positions,
@@ -117,7 +119,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
                 extended=spec.extended,
                 position_noise_m=spec.position_noise_m,
                 lines_of_sight=spec.lines_of_sight,
-                knowledge=told(scenario),
+                knowledge=known,
             )
         except ValueError as err:
             outcomes = err.outcomes if isinstance(err, CalibrationError) else ()

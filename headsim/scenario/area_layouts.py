@@ -15,7 +15,6 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from headsim.active.placement import seen_by_both
 from headsim.estimators.areas import areas_from_geometry
 from headsim.geometry.sampling import sample_points_head
 from headsim.sim.simulator import HeadSim
@@ -34,15 +33,9 @@ def seen_in_four_images(
     sim: HeadSim, points_world: np.ndarray, alpha1: float, alpha2: float, radius_m: float
 ) -> np.ndarray:
     """(N,) whether both cameras see each point whole at both eye angles (no render)."""
-    before = sim.eye_encoder_steps()
-    resolution = sim.settings.encoder_resolution_rad
     ok = np.ones(len(points_world), dtype=bool)
-    for alpha in (alpha1, alpha2):
-        sim.command_eye_steps(round(alpha / resolution))
-        sim.settle()
-        ok &= seen_by_both(sim, points_world, radius_m)
-    sim.command_eye_steps(before)
-    sim.settle()
+    for view in sim.stereo_views((alpha1, alpha2))[1:]:
+        ok &= view.sees_whole(points_world, radius_m)
     return ok
 
 

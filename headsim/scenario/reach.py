@@ -26,7 +26,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from headsim.geometry.kinematics import head_to_world, world_to_head
+from headsim.geometry.kinematics import eye_from_camera_rotation, head_to_world, world_to_head
 from headsim.scenario.occlusion import Occluder, hidden_by, scene_model, scene_occluders
 from headsim.scenario.spec import (
     MAX_DEPTH_M,
@@ -34,7 +34,6 @@ from headsim.scenario.spec import (
 )
 from headsim.sim import names
 from headsim.sim.forward import effective_directions
-from headsim.sim.model import eye_from_camera_rotation
 from headsim.sim.settings import HeadSettings
 
 
@@ -84,7 +83,9 @@ class ReachHead:
         centre = np.array([sign * -self.settings.baseline_m / 2, 0.0, 0.0])
         c, s = math.cos(sign * eye), math.sin(sign * eye)
         eye_rotation = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-        rotation = eye_rotation @ eye_from_camera_rotation(camera, index)
+        rotation = eye_rotation @ eye_from_camera_rotation(
+            sign, camera.mount_yaw_rad, camera.mount_pitch_rad, camera.mount_roll_rad
+        )
         p = rotation.T @ (point_head - centre)
         if p[2] <= 0.01:
             return False

@@ -14,10 +14,10 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from headsim.geometry.transforms import rotation_x, rotation_y, rotation_z
+from headsim.geometry.kinematics import eye_from_camera_rotation
 from headsim.sim import names
 from headsim.sim.optics import DistortionCanvas, distortion_canvas
-from headsim.sim.settings import MAX_IMAGE_SIDE, CameraSettings, HeadSettings, SettingsError
+from headsim.sim.settings import MAX_IMAGE_SIDE, HeadSettings, SettingsError
 
 #: The head and scene MJCF files: the repository's models/, installed as package data.
 MODELS_DIR = Path(str(resources.files("headsim.models")))
@@ -39,21 +39,6 @@ def scene_path(scene: str | Path) -> Path:
 
 #: MuJoCo camera axes (x right, y up, looking down -z) in OpenCV camera axes, and back.
 CV_FROM_MJCAM = np.diag([1.0, -1.0, -1.0])
-
-
-def eye_from_camera_rotation(camera: CameraSettings, index: int) -> np.ndarray:
-    """Rotation of camera ``index``'s OpenCV frame in its eye frame (eye angle 0).
-
-    The eye frame is parallel to H.  Mount yaw turns the camera inward like the
-    eye angle (about +y for Ca1, -y for Ca2); pitch turns it up (about its x);
-    roll turns it about its optical axis.
-    """
-    inward = names.EYE_CAMERAS[index].inward
-    return (
-        rotation_y(inward * camera.mount_yaw_rad)
-        @ rotation_x(camera.mount_pitch_rad)
-        @ rotation_z(camera.mount_roll_rad)
-    )
 
 
 def _quat_from_matrix(matrix: np.ndarray) -> np.ndarray:
@@ -104,12 +89,17 @@ def apply_settings(
         # sign of OpenCV's habit: cx = (W - 1) / 2 - principalpixel_x (checked by
         # rendering, tests/sim/test_render.py); supersampled, every term scales by k.
         mj_cam.principal_pixel = [k * ((width_c - 1) / 2 - pcx), k * ((height_c - 1) / 2 - pcy)]
-        eye_from_mjcam = eye_from_camera_rotation(cam, index) @ CV_FROM_MJCAM
+        eye_from_cv = eye_from_camera_rotation(
+            names.EYE_CAMERAS[index].inward,
+            cam.mount_yaw_rad,
+            cam.mount_pitch_rad,
+            cam.mount_roll_rad,
+        )
         mj_cam.alt.type = mujoco.mjtOrientation.mjORIENTATION_QUAT  # drop the XML's xyaxes
-        mj_cam.quat = _quat_from_matrix(eye_from_mjcam)
+        mj_cam.quat = _quat_from_matrix(eye_from_cv @ CV_FROM_MJCAM)
         # Optical centre off the yaw axis: forward along the optical axis, sideways along x.
         offset_cv = np.array([cam.side_offset_m, 0.0, cam.nodal_offset_m])
-        mj_cam.pos = eye_from_camera_rotation(cam, index) @ offset_cv
+        mj_cam.pos = eye_from_cv @ offset_cv
         # Yaw axis leaning forward about H's x (eye2's axis is -y, mirrored).
         tilt = cam.eye_axis_tilt_rad
         axis_sign = names.EYE_CAMERAS[index].inward

@@ -24,7 +24,9 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from headsim.geometry.transforms import homogeneous, invert_transform
+from headsim.geometry.kinematics import eye_from_camera_rotation
+from headsim.geometry.stereo_view import StereoView
+from headsim.geometry.transforms import apply_transform, homogeneous, invert_transform
 from headsim.sim import names
 from headsim.sim.events import NO_EVENTS, EventSink, ImageKind, ImageTaken
 from headsim.sim.joints import (
@@ -34,7 +36,7 @@ from headsim.sim.joints import (
     SettleResult,
     true_targets,
 )
-from headsim.sim.model import CV_FROM_MJCAM, BuiltModel, build_model, eye_from_camera_rotation
+from headsim.sim.model import CV_FROM_MJCAM, BuiltModel, build_model
 from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
 from headsim.sim.render import EyeRenderer, Window, context_key
 from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
@@ -288,11 +290,40 @@ class HeadSim:
             raise SettingsError(f"no body or site named {name!r} in this scene")
         return self.transform_points(p_world, "world", frame)[0]
 
+    def transform(self, src: str, dst: str) -> np.ndarray:
+        """``dst_from_src``, 4 x 4, between frames "world", "head", "cam1" and "cam2"."""
+        return self.frame_from_world(dst) @ invert_transform(self.frame_from_world(src))
+
     def transform_points(self, points: np.ndarray, src: str, dst: str) -> np.ndarray:
         """Map points (N, 3) from frame ``src`` to frame ``dst``, m."""
-        points = np.atleast_2d(np.asarray(points, dtype=float))
-        transform = self.frame_from_world(dst) @ invert_transform(self.frame_from_world(src))
-        return points @ transform[:3, :3].T + transform[:3, 3]
+        return apply_transform(self.transform(src, dst), points)
+
+    def stereo_view(self) -> StereoView:
+        """Both cameras' true intrinsics and poses, and the head's pose, as they are now."""
+        return StereoView(
+            cameras=(self.camera_settings(1).pinhole(), self.camera_settings(2).pinhole()),
+            camera_from_world=(
+                self.transform("world", names.CAMERAS[0]),
+                self.transform("world", names.CAMERAS[1]),
+            ),
+            world_from_head=self.transform("head", "world"),
+        )
+
+    def stereo_views(self, eye_angles_rad: Sequence[float] = ()) -> tuple[StereoView, ...]:
+        """The view from the current pose, then from each eye-encoder angle (rad, to the
+        nearest step; neck still).  The eyes go back to their current step, and the first
+        view is taken there (with joint errors, where they settle on the way back)."""
+        turned = []
+        if eye_angles_rad:
+            resolution = self.settings.encoder_resolution_rad
+            before = self.eye_encoder_steps()
+            for angle in eye_angles_rad:
+                self.command_eye_steps(round(angle / resolution))
+                self.settle()
+                turned.append(self.stereo_view())
+            self.command_eye_steps(before)
+            self.settle()
+        return (self.stereo_view(), *turned)
 
     def set_body_pose(
         self,
@@ -340,7 +371,13 @@ class HeadSim:
         u_c, v_c = cam.image_centre
         pixel = np.array([u_c if goal_u is None else goal_u, v_c])
         xy = cam.pinhole().normalise(pixel)  # raises if no ray
-        ray_eye = eye_from_camera_rotation(cam, index) @ np.array([xy[0], xy[1], 1.0])
+        eye_from_cv = eye_from_camera_rotation(
+            names.EYE_CAMERAS[index].inward,
+            cam.mount_yaw_rad,
+            cam.mount_pitch_rad,
+            cam.mount_roll_rad,
+        )
+        ray_eye = eye_from_cv @ np.array([xy[0], xy[1], 1.0])
         yaw = math.atan2(ray_eye[0], ray_eye[2])
         return yaw if index == 0 else -yaw
 

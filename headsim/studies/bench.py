@@ -274,7 +274,7 @@ def _paper_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
             EyeServo(sim),
             experiments.BALL,
             names.CALIBRATION_BALL,
-            calibration_layout(sim, rng, 30),
+            calibration_layout(sim.stereo_views(), rng, 30),
         )
     knowledge = run.knowledge
     if faults.mount_sign:

@@ -19,6 +19,7 @@ from headsim.active.principal import (
     PrincipalPointRun,
     principal_points_by_zoom,
     view_scale,
+    zoomed,
 )
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
@@ -152,16 +153,24 @@ def zhang_stereo(
 
 def zoom_fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:
     """The zoom fixed points of ``settings``' cameras, seeded by ``config.seed``."""
-    return principal_points_by_zoom(
-        settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
-    )
+    with (
+        HeadSim("chessboard", settings) as before,
+        HeadSim("chessboard", zoomed(settings, PROBE_ZOOM)) as after,
+    ):
+        return principal_points_by_zoom(
+            before,
+            after,
+            PROBE_ZOOM,
+            np.random.default_rng(config.seed + 1),
+            config.principal_poses,
+        )
 
 
 def calibration_positions(sim: HeadSim, settings: HeadSettings, config: StudyConfig) -> np.ndarray:
     """The Sec. V ball positions of every method (seeded by ``config.seed``)."""
     scale = view_scale(settings)
     return calibration_layout(
-        sim,
+        sim.stereo_views(),
         np.random.default_rng(config.seed + 2),
         config.calibration_targets,
         depth_range_m=(0.25 * scale, 0.6 * scale),
@@ -252,7 +261,7 @@ def calibrate_realistic(sim: HeadSim, rng: np.random.Generator, seed: int) -> Ca
         EyeServo(sim),
         BALL,
         names.CALIBRATION_BALL,
-        calibration_layout(sim, rng, 30, depth_range_m=(0.25, 1.5)),
+        calibration_layout(sim.stereo_views(), rng, 30, depth_range_m=(0.25, 1.5)),
         position_noise_m=0.001,
         rng=np.random.default_rng([seed, 7]),
         lines_of_sight=True,

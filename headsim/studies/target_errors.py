@@ -12,7 +12,7 @@ import numpy as np
 from headsim.active.eye_servo import EyeServo
 from headsim.active.look import look_once
 from headsim.active.model2 import measure_model2
-from headsim.active.principal import PROBE_ZOOM, principal_points_by_zoom
+from headsim.active.principal import PROBE_ZOOM, principal_points_by_zoom, zoomed
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.triangulation import measure_point_stereo
@@ -74,9 +74,17 @@ def measure_methods(
         servo = EyeServo(sim)
         refound = None
         if "active_refound" in methods:
-            refound = principal_points_by_zoom(
-                settings, PROBE_ZOOM, np.random.default_rng(config.seed + 1), config.principal_poses
-            )
+            with (
+                HeadSim("chessboard", settings) as before,
+                HeadSim("chessboard", zoomed(settings, PROBE_ZOOM)) as after,
+            ):
+                refound = principal_points_by_zoom(
+                    before,
+                    after,
+                    PROBE_ZOOM,
+                    np.random.default_rng(config.seed + 1),
+                    config.principal_poses,
+                )
         for index, p_head in enumerate(np.atleast_2d(np.asarray(targets_head, dtype=float))):
             place_in_head(sim, TARGET.name, p_head)
             truth = sim.position(TARGET.name, "head")

@@ -38,7 +38,11 @@ def test_calibration_recovers_effective_initial_directions_and_corrects_measurem
         servo = EyeServo(sim)
         rng = np.random.default_rng(4)
         run = calibrate_head(
-            sim, servo, BALL, names.CALIBRATION_BALL, calibration_layout(sim, rng, 24)
+            sim,
+            servo,
+            BALL,
+            names.CALIBRATION_BALL,
+            calibration_layout(sim.stereo_views(), rng, 24),
         )
         assert run.samples >= 22  # a target or two may fall out of one camera's view
         # The ball is parked again where it was, not left in front of other targets.
@@ -94,7 +98,7 @@ def test_paper_cameras_after_calibration_measure_within_the_papers_accuracy() ->
             servo,
             BALL,
             names.CALIBRATION_BALL,
-            calibration_layout(sim, np.random.default_rng(0), 30),
+            calibration_layout(sim.stereo_views(), np.random.default_rng(0), 30),
         )
         assert np.abs(run.alpha_e_error).max() < 4e-4
         for p_head in ([0.04, 0.01, 0.6], [-0.06, -0.02, 1.0]):
@@ -114,7 +118,7 @@ def test_the_calibration_fits_the_believed_baseline_not_the_true_one() -> None:
     true_d, believed_d = 0.153, 0.150
     settings = HeadSettings(baseline_m=true_d, belief=HeadBelief(baseline_m=believed_d))
     with HeadSim("default", settings) as sim:
-        layout = calibration_layout(sim, np.random.default_rng(1), 8)
+        layout = calibration_layout(sim.stereo_views(), np.random.default_rng(1), 8)
         points = sim.transform_points(layout, "world", "head")
         run = calibrate_head(
             sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, layout, extended=False

@@ -148,7 +148,7 @@ def test_a_rendered_calibrations_residuals_scatter_as_its_tape() -> None:
     sigma_p, sigma_d = 1e-3, 4e-3
     sigma_z = math.hypot(sigma_p, sigma_d)
     with HeadSim("default", ideal_head()) as sim:
-        layout = calibration_layout(sim, np.random.default_rng(5), 12)
+        layout = calibration_layout(sim.stereo_views(), np.random.default_rng(5), 12)
         run = calibrate_head(
             sim,
             EyeServo(sim),

@@ -60,7 +60,15 @@ def test_no_zoom_or_too_few_features_is_a_clear_error(rng) -> None:
 
 
 def test_rendered_chessboards_give_the_papers_off_centre_principal_points() -> None:
-    run = principal_points_by_zoom(paper_head(), 1.3, np.random.default_rng(0), poses=1)
+    with (
+        HeadSim("chessboard", paper_head()) as before,
+        HeadSim("chessboard", zoomed(paper_head(), 1.3)) as after,
+    ):
+        run = principal_points_by_zoom(before, after, 1.3, np.random.default_rng(0), poses=1)
+        with pytest.raises(
+            ValueError, match=r"after\.settings must be before\.settings zoomed 1\.5x"
+        ):
+            principal_points_by_zoom(before, after, 1.5)
     assert run.views == 1 and run.renders == 4
     # (303.8, 306.3) and (345.1, 197.3): off the image centre by up to 67 px.
     assert np.abs(run.errors_px).max() < 0.15
@@ -89,11 +97,15 @@ def test_the_principal_column_points_along_the_mount_yaw() -> None:
 
 def test_servoing_on_the_fixed_point_keeps_the_calibration_through_a_zoom() -> None:
     head = paper_head()
-    found = principal_points_by_zoom(head, 1.3, np.random.default_rng(1), poses=1)
+    with (
+        HeadSim("chessboard", head) as before,
+        HeadSim("chessboard", zoomed(head, 1.3)) as after,
+    ):
+        found = principal_points_by_zoom(before, after, 1.3, np.random.default_rng(1), poses=1)
     columns = (found.principal_px[0][0], found.principal_px[1][0])
     p_head = np.array([0.06, 0.02, 0.8])
     with HeadSim("default", head) as sim:
-        positions = calibration_layout(sim, np.random.default_rng(2), 16)
+        positions = calibration_layout(sim.stereo_views(), np.random.default_rng(2), 16)
         run = calibrate_head(
             sim,
             EyeServo(sim),

@@ -13,7 +13,7 @@ from headsim.active.measurement import HeadKnowledge, body_target
 from headsim.active.model1 import measure_model1
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
-from headsim.active.placement import calibration_layout, seen_by_both
+from headsim.active.placement import calibration_layout
 from headsim.active.search import neck_search_poses
 from headsim.geometry.kinematics import head_to_world
 from headsim.scenario.reach import ReachHead, model2_refusal, reach_refusal
@@ -144,10 +144,10 @@ def test_a_calibration_layout_with_the_eyes_turned_in_spreads_wider_and_is_all_f
     base = paper_head()
     cams = tuple(replace(c, kx=c.kx * 2, ky=c.ky * 2) for c in base.cameras)
     with HeadSim("default", replace(base, cameras=cams)) as sim:  # type: ignore[arg-type]
-        narrow = calibration_layout(sim, np.random.default_rng(5), 16)
-        wide = calibration_layout(sim, np.random.default_rng(5), 16, eye_angles_rad=(0.1, 0.2, 0.3))
-        assert seen_by_both(sim, wide[:1], 0.008)[0]  # the first one from the start pose
-        assert not seen_by_both(sim, wide, 0.008).all()  # others need the eyes turned in
+        narrow = calibration_layout(sim.stereo_views(), np.random.default_rng(5), 16)
+        wide = calibration_layout(sim.stereo_views((0.1, 0.2, 0.3)), np.random.default_rng(5), 16)
+        assert sim.stereo_view().sees_whole(wide[:1], 0.008)[0]  # the first one from the start pose
+        assert not sim.stereo_view().sees_whole(wide, 0.008).all()  # others need the eyes turned in
 
         def spread(p: np.ndarray) -> float:
             p_head = sim.transform_points(p, "world", "head")

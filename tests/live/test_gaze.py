@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from headsim.active.measurement import HeadKnowledge
+from headsim.active.neck_servo import NeckServo
 from headsim.estimators import model2
 from headsim.geometry.kinematics import head_to_world
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Static, Visibility, Waypoints
@@ -23,7 +24,7 @@ def pursuit_run(seed: int, predictor: bool = True, duration_s: float = 0.6):
     with HeadSim(settings=small_head()) as sim:
         path = RandomWalk((0.0, 0.8, 0.3), max_speed_m_s=0.3, duration_s=2.0, seed=seed)
         live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path)
-        estimator = acquire(live, RED)
+        estimator = acquire(live, NeckServo(sim), RED)
         assert estimator is not None
         run = pursue(live, RED, estimator, duration_s, GazeConfig(predictor=predictor))
         return run, live.capture().images
@@ -65,7 +66,7 @@ def test_losses_reacquisitions_and_a_target_that_disappears_and_reappears_elsewh
     for name, path, visibility in (("lost", lost_path, None), ("jump", jump, windows)):
         with HeadSim(settings=small_head()) as sim:
             live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path, visibility)
-            estimator = acquire(live, RED)
+            estimator = acquire(live, NeckServo(sim), RED)
             assert estimator is not None
             runs[name] = pursue(live, RED, estimator, 1.0)
     lost, jumped = runs["lost"], runs["jump"]
@@ -93,7 +94,7 @@ def test_acquiring_with_the_servos_windows_off_looks_at_whole_frames_only() -> N
         sink = Sink()
         with HeadSim(settings=small_head(), sink=sink) as sim:
             live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.28)))
-            estimator = acquire(live, RED, config=ServoConfig(windows=windows))
+            estimator = acquire(live, NeckServo(sim, ServoConfig(windows=windows)), RED)
             assert estimator is not None
         kinds[windows] = sink.kinds
     assert set(kinds[False]) == {ImageKind.FULL}
@@ -112,7 +113,7 @@ def test_the_live_estimate_measures_with_the_heads_belief_not_its_true_geometry(
     ):
         with HeadSim(settings=settings) as sim:
             live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.24)))
-            estimator = acquire(live, RED, knowledge)
+            estimator = acquire(live, NeckServo(sim), RED, knowledge)
             assert estimator is not None
             frame = live.capture()
             uv = tuple(RED(image).uv for image in frame.images)
@@ -157,3 +158,10 @@ def test_the_live_lines_of_sight_cross_where_model_2s_do_offsets_included() -> N
     )
     estimate = live.measure(uv, encoders).estimate_head_m
     np.testing.assert_allclose(estimate[[0, 2]], rest.positions[0][[0, 2]], rtol=1e-12)
+
+
+def test_acquire_refuses_a_servo_on_another_simulator() -> None:
+    with HeadSim(settings=small_head()) as sim, HeadSim(settings=small_head()) as other:
+        live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.28)))
+        with pytest.raises(ValueError, match=r"servo must drive the live head's simulator"):
+            acquire(live, NeckServo(other), RED)

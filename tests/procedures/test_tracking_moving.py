@@ -8,7 +8,6 @@ import numpy as np
 
 from headsim.active.measurement import body_target
 from headsim.active.neck_servo import NeckServo
-from headsim.active.placement import seen_by_both
 from headsim.procedures.tracking import track_moving_target
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
@@ -41,7 +40,7 @@ def test_tracking_searches_around_its_last_fixation_for_a_target_that_left_both_
         def path(t: float) -> np.ndarray:
             return np.array([0.25 * t, 0.8, 0.3])
 
-        assert not seen_by_both(sim, path(1.0)[None], 0.01)[0]  # not from the start pose
+        assert not sim.stereo_view().sees_whole(path(1.0)[None], 0.01)[0]  # not from the start pose
         servo = NeckServo(sim)
         run = track_moving_target(sim, servo, RED, "marker_red", path, [0.0, 1.0, 2.0, 2.6])
     assert all(m.ok for m in run.measurements), [m.status for m in run.measurements]

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from headsim.geometry.kinematics import eye_from_camera_rotation
 from headsim.sim import names
-from headsim.sim.model import eye_from_camera_rotation, load_spec
-from headsim.sim.settings import CameraSettings
+from headsim.sim.model import load_spec
 
 
 def test_a_camera_is_found_by_number_name_or_itself() -> None:
@@ -24,7 +24,7 @@ def test_a_camera_is_found_by_number_name_or_itself() -> None:
 def test_a_positive_mount_yaw_turns_each_camera_towards_the_midline() -> None:
     spec = load_spec("base")
     for camera in names.EYE_CAMERAS:
-        rotation = eye_from_camera_rotation(CameraSettings(mount_yaw_rad=0.2), camera.index)
+        rotation = eye_from_camera_rotation(camera.inward, 0.2)
         axis_h = rotation @ np.array([0.0, 0.0, 1.0])  # the optical axis in the eye (= H) frame
         eye_x = spec.body(names.EYE_BODIES[camera.index]).pos[0]  # the eye's side of the midline
         assert np.sign(axis_h[0]) == -np.sign(eye_x) == camera.inward
