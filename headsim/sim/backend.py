@@ -15,7 +15,7 @@ imports mujoco:
 
 from __future__ import annotations
 
-import ctypes.util
+import ctypes
 import os
 
 from headsim.errors import EnvironmentProblem
@@ -33,6 +33,28 @@ LIBRARIES: dict[str, tuple[tuple[str, str], ...]] = {
     "osmesa": (("OSMesa", "libosmesa6"),),
     "glfw": (("GL", "libgl1"),),
 }
+
+
+#: The name each library is loaded by where it is installed (glvnd's and Mesa's sonames):
+#: loading it answers at once, where a search of the linker's cache starts a subprocess.
+SONAMES = {
+    "EGL": "libEGL.so.1",
+    "OpenGL": "libOpenGL.so.0",
+    "OSMesa": "libOSMesa.so.8",
+    "GL": "libGL.so.1",
+}
+
+
+def installed(lib: str) -> bool:
+    """Whether the shared library ``lib`` (as in ``libEGL``: ``"EGL"``) is there: its usual
+    soname loads, or the linker's cache lists it under another."""
+    try:
+        ctypes.CDLL(SONAMES.get(lib, f"lib{lib}.so"))
+        return True
+    except OSError:
+        from ctypes.util import find_library
+
+        return find_library(lib) is not None
 
 
 class RenderBackendError(EnvironmentProblem, RuntimeError):
@@ -58,7 +80,7 @@ def choose_default_backend() -> str:
     current = _current()
     if not current:
         current = "egl"
-        if ctypes.util.find_library("EGL") is None and ctypes.util.find_library("OSMesa"):
+        if not installed("EGL") and installed("OSMesa"):
             current = "osmesa"
         os.environ["MUJOCO_GL"] = current
     if current not in DISABLED:
@@ -81,7 +103,7 @@ def diagnose() -> str | None:
             f"MUJOCO_GL={name!r} is not a backend headsim can render with; allowed: "
             f"{', '.join(ALLOWED)}. {INSTALL_HINT}"
         )
-    missing = [(lib, pkg) for lib, pkg in LIBRARIES[name] if ctypes.util.find_library(lib) is None]
+    missing = [(lib, pkg) for lib, pkg in LIBRARIES[name] if not installed(lib)]
     if missing:
         libs = " and ".join(f"lib{lib}" for lib, _ in missing)
         pkgs = " ".join(pkg for _, pkg in missing)
