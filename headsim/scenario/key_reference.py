@@ -78,6 +78,7 @@ VARIANTS: tuple[tuple[str, Edit], ...] = (
             ),
         ),
     ),
+    ("chessboard", _edits(("belief", {}))),  # the paper's preset: other belief defaults
     (
         "relative_positioning",
         _edits(("scene.objects", None), ("scene.random_objects", {"count": 3})),
