@@ -150,13 +150,18 @@ def collect_uses() -> dict[str, KeyUse]:
 
 
 def _fold(uses: dict[str, KeyUse], seen: dict[str, KeyUse]) -> None:
-    """Add this document's uses; a default that differs between documents depends on others."""
+    """Add this document's uses; a default or a range that differs between documents
+    depends on other keys (the range is then shown as an example)."""
     for path, use in seen.items():
         old = uses.get(path)
         if old is None or not old.kind:
             uses[path] = use
-        elif use.kind and use.default != old.default:
-            uses[path] = KeyUse(path, old.kind, old.allowed, "depends on other keys")
+        elif use.kind:
+            default = old.default if use.default == old.default else "depends on other keys"
+            allowed = old.allowed
+            if use.allowed != old.allowed and not allowed.startswith("e.g. "):
+                allowed = f"e.g. {allowed}"
+            uses[path] = KeyUse(path, old.kind, allowed, default)
     seen.clear()
 
 
