@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 export MUJOCO_GL ?= egl
 
-.PHONY: setup demo test regress bench figures clean
+.PHONY: setup demo test regress bench figures docs clean
 
 $(BIN)/headsim: pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -30,7 +30,7 @@ test: setup
 regress: setup
 	$(BIN)/headsim bench
 
-# Every figure block of the README regenerated and checked (about 10 minutes; CI checks
+# Every figure block of the documentation (docs/results.md) regenerated and checked (about 10 minutes; CI checks
 # all but the longest): after an intended change, `python tools/readme_figures.py --write`.
 figures: setup
 	$(BIN)/python tools/readme_figures.py
@@ -40,6 +40,13 @@ figures: setup
 # `headsim bench --case reach_and_zoom -- --targets 50`.
 bench: setup
 	$(BIN)/headsim bench --all
+
+# The documentation site in out/site, warnings as errors (a broken link fails); the
+# reference pages are made from the code at build time (tools/docs_pages.py).
+docs: setup
+	@$(BIN)/python -c "import mkdocs, material, mkdocstrings_handlers.python" 2>/dev/null \
+		|| $(BIN)/pip install -q -e '.[docs]'
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 clean:
 	rm -rf $(VENV) out

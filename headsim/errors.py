@@ -55,7 +55,18 @@ class ExitCode(IntEnum):
     INTERRUPTED = 130
 
 
-#: The contract as text, for ``--help`` and the README.
+#: What each code means, for the documentation's exit-code reference.
+EXIT_MEANINGS: dict[ExitCode, str] = {
+    ExitCode.OK: "everything succeeded",
+    ExitCode.FAILED: "a measurement or job failed (or the calibration it needed, or an internal error)",
+    ExitCode.BAD_INPUT: "bad input or arguments (a scenario or sweep file, an option), "
+    "found before anything runs or is written",
+    ExitCode.ENVIRONMENT: "the environment: no GL backend, output not writable, disk full "
+    "(or `ulimit -f` reached), a dependency missing",
+    ExitCode.INTERRUPTED: "interrupted (Ctrl-C or SIGTERM)",
+}
+
+#: The contract as text, for ``--help``.
 EXIT_CODES_HELP = (
     "exit status: 0 everything succeeded; 1 a measurement or job failed; 2 bad input or "
     "arguments, found before anything runs; 3 the environment (no GL backend, output not "

@@ -1,5 +1,5 @@
-"""Every ``python`` block in docs/*.md runs: a page's blocks in order, in one
-namespace, in a fresh interpreter, in an empty folder, so the examples cannot rot."""
+"""Every ``python`` block on the documentation's pages runs: a page's blocks in order, in
+one namespace, in a fresh interpreter, in an empty folder, so the examples cannot rot."""
 
 from __future__ import annotations
 
@@ -10,6 +10,8 @@ import sys
 from pathlib import Path
 
 import pytest
+
+from headsim.cli import main
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 #: A fenced block opened by ```python (nothing else on the line) up to its closing fence.
@@ -32,7 +34,9 @@ def blocks(page: Path) -> list[str]:
     return BLOCK.findall(page.read_text())
 
 
-PAGES = sorted(p for p in DOCS.glob("*.md") if blocks(p))
+PAGES = sorted(p for p in DOCS.rglob("*.md") if blocks(p))
+#: What a page's examples may read that the quick start writes (made before they run).
+QUICKSTART_RECORDING = "out/quickstart/recording.rrd"
 
 
 def test_the_python_page_has_examples() -> None:
@@ -46,8 +50,12 @@ def test_the_block_pattern_finds_only_python_blocks(tmp_path: Path) -> None:
     assert blocks(page) == ["print(1)\n", "x = 2\n"]
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: str(p.relative_to(DOCS)))
 def test_every_python_example_runs(page: Path, tmp_path: Path) -> None:
+    if QUICKSTART_RECORDING in page.read_text():
+        out = tmp_path / "out" / "quickstart"
+        args = ["run", "quickstart", "--fast", "--out", str(out), "--rrd", str(out / "recording.rrd")]
+        assert main([*args, "--no-progress", "--quiet"]) == 0
     env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
     done = subprocess.run(
         [sys.executable, "-c", RUNNER, str(page), BLOCK.pattern],

@@ -1,7 +1,8 @@
-"""The README's figures are today's: the cheap blocks regenerated from runs must match."""
+"""The documentation's figures are today's: the cheap blocks regenerated from runs must match."""
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -16,29 +17,38 @@ def _run(*args: str) -> subprocess.CompletedProcess[str]:
     )
 
 
-def test_the_readmes_cheap_figure_blocks_match_a_run_of_todays_code() -> None:
+def _copy(tmp_path: Path) -> Path:
+    """The README and the pages, where the tool may change them."""
+    shutil.copy(ROOT / "README.md", tmp_path / "README.md")
+    shutil.copytree(ROOT / "docs", tmp_path / "docs")
+    return tmp_path
+
+
+def test_the_cheap_figure_blocks_match_a_run_of_todays_code() -> None:
     done = _run("--cheap")
     assert done.returncode == 0, done.stdout + done.stderr
 
 
-def test_a_stale_figure_is_caught_and_named(tmp_path: Path) -> None:
-    readme = tmp_path / "README.md"
-    text = (ROOT / "README.md").read_text()
+def test_a_stale_figure_is_caught_and_named_on_its_page(tmp_path: Path) -> None:
+    root = _copy(tmp_path)
+    page = root / "docs" / "results.md"
+    text = page.read_text()
     start = text.index("<!-- figures:quickstart -->")
     end = text.index("<!-- /figures:quickstart -->")
-    stale = text[:start] + "<!-- figures:quickstart -->\n0.100 % of depth\n" + text[end:]
-    readme.write_text(stale)
-    done = _run("--only", "quickstart", "--readme", str(readme))
+    page.write_text(text[:start] + "<!-- figures:quickstart -->\n0.100 % of depth\n" + text[end:])
+    done = _run("--only", "quickstart", "--root", str(root))
     assert done.returncode == 1
-    assert "-0.100 % of depth" in done.stdout and "README quickstart" in done.stdout
-    assert _run("--only", "quickstart", "--readme", str(readme), "--write").returncode == 0
-    assert readme.read_text() == text
+    assert "-0.100 % of depth" in done.stdout and "docs/results.md quickstart" in done.stdout
+    assert _run("--only", "quickstart", "--root", str(root), "--write").returncode == 0
+    assert page.read_text() == text
 
 
-def test_a_block_without_a_generator_is_refused(tmp_path: Path) -> None:
-    readme = tmp_path / "README.md"
-    readme.write_text(
-        (ROOT / "README.md").read_text() + "\n<!-- figures:nothing -->\n<!-- /figures:nothing -->\n"
-    )
-    done = _run("--cheap", "--readme", str(readme))
+def test_a_block_without_a_generator_or_on_two_pages_is_refused(tmp_path: Path) -> None:
+    root = _copy(tmp_path)
+    page = root / "docs" / "python.md"
+    page.write_text(page.read_text() + "\n<!-- figures:nothing -->\n<!-- /figures:nothing -->\n")
+    done = _run("--cheap", "--root", str(root))
     assert done.returncode == 2 and "['nothing']" in done.stderr
+    page.write_text(page.read_text() + "\n<!-- figures:gym -->\n<!-- /figures:gym -->\n")
+    done = _run("--cheap", "--root", str(root))
+    assert done.returncode == 2 and "two pages: ['gym']" in done.stderr

@@ -1,4 +1,4 @@
-"""What the README's figure generators share: runs of today's code and how to read them.
+"""What the documentation's figure generators share: runs of today's code and how to read them.
 
 Every key of results.json that a generator reads goes through :func:`summary`,
 :func:`effort` or :func:`bands`, so that a renamed key is changed in one place.

@@ -1,4 +1,4 @@
-"""The README's figures of whole studies and the head in time: reproduce, live gaze, Gymnasium."""
+"""The documentation's figures of whole studies and the head in time: reproduce, live gaze, Gymnasium."""
 
 from __future__ import annotations
 

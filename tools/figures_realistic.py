@@ -1,4 +1,4 @@
-"""The README's figures of the realistic head: the forward model's and the rendered ones."""
+"""The documentation's figures of the realistic head: the forward model's and the rendered ones."""
 
 from __future__ import annotations
 
@@ -123,7 +123,7 @@ def forward_field() -> str:
     )
 
 
-#: The README's names of ``realistic_head.budget_conditions``' rows, in its order.
+#: The results page's names of ``realistic_head.budget_conditions``' rows, in its order.
 FORWARD_BUDGET_ROWS = (
     "realistic, all on",
     "optical-centre offsets off",

@@ -1,4 +1,4 @@
-"""The README's figures of rendering and the servo: fidelity floors, windows, reach and zoom, areas."""
+"""The documentation's figures of rendering and the servo: fidelity floors, windows, reach and zoom, areas."""
 
 from __future__ import annotations
 

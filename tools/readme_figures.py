@@ -1,6 +1,7 @@
-"""The figures the README quotes from runs, regenerated from today's code.
+"""The figures the documentation quotes from runs, regenerated from today's code.
 
-Each block of figures in README.md sits between two markers::
+Each block of figures, in README.md or a page under docs/ (most on docs/results.md),
+sits between two markers::
 
     <!-- figures:NAME -->
     ...text written by the generator NAME...
@@ -10,7 +11,7 @@ Each block of figures in README.md sits between two markers::
 written by the generator of that name below (``figures_*.py`` beside this file),
 from fresh runs of today's code: scenarios through the runner, studies, the
 benchmark scripts' functions.  Every run is seeded, so a block is the same on
-every run on one machine.  Usage::
+every run on one machine; a name appears once over all pages.  Usage::
 
     python tools/readme_figures.py              # check every block; exit 1 naming each stale one
     python tools/readme_figures.py --cheap      # only the blocks that take seconds (a test runs these)
@@ -20,7 +21,8 @@ every run on one machine.  Usage::
     python tools/readme_figures.py --jobs 1     # in this process only (default: 2 processes)
 
 Exit codes: 0 every block checked matches, 1 a block differs (its diff is
-printed), 2 bad arguments or a marker without its generator (or the reverse).
+printed), 2 bad arguments, a marker without its generator (or the reverse) or a
+name on two pages.
 """
 
 from __future__ import annotations
@@ -53,7 +55,12 @@ from figures_common import (
     table,
 )
 
-README = ROOT / "README.md"
+
+def pages(root: Path) -> list[Path]:
+    """The files that may hold blocks: the README and every page of the site."""
+    return [p for p in [root / "README.md", *sorted((root / "docs").rglob("*.md"))] if p.is_file()]
+
+
 _BLOCK = re.compile(
     r"(<!-- figures:(?P<name>[\w.-]+) -->\n)(?P<body>.*?)([ \t]*<!-- /figures:(?P=name) -->)", re.S
 )
@@ -230,6 +237,18 @@ def blocks(text: str) -> dict[str, str]:
     return {m["name"]: m["body"] for m in _BLOCK.finditer(text)}
 
 
+def located(root: Path) -> tuple[dict[str, tuple[Path, str]], list[str]]:
+    """Each block's page and body under ``root``, and the names found on two pages."""
+    found: dict[str, tuple[Path, str]] = {}
+    twice: list[str] = []
+    for page in pages(root):
+        for name, body in blocks(page.read_text()).items():
+            if name in found:
+                twice.append(name)
+            found[name] = (page, body)
+    return found, twice
+
+
 def rewrite(text: str, bodies: dict[str, str]) -> str:
     """``text`` with the named blocks' bodies replaced."""
 
@@ -272,19 +291,22 @@ def generate(names: Sequence[str], jobs: int = 1) -> dict[str, str]:
     return {name: made[name] for name in names if name in made}
 
 
-def check(names: Sequence[str], text: str, jobs: int = 1) -> tuple[dict[str, str], list[str]]:
+def check(
+    names: Sequence[str], current: dict[str, tuple[Path, str]], root: Path, jobs: int = 1
+) -> tuple[dict[str, str], list[str]]:
     """The regenerated bodies, and a diff per block that no longer matches."""
-    current = blocks(text)
     fresh = generate(names, jobs)
     stale: list[str] = []
     for name in names:
+        page, body = current[name]
+        where = f"{page.relative_to(root)} {name}"
         if name not in fresh:
-            stale.append(f"README {name}: its generator failed (above)")
-        elif fresh[name] != current[name]:
+            stale.append(f"{where}: its generator failed (above)")
+        elif fresh[name] != body:
             diff = difflib.unified_diff(
-                current[name].splitlines(),
+                body.splitlines(),
                 fresh[name].splitlines(),
-                f"README {name}",
+                where,
                 "today",
                 lineterm="",
             )
@@ -307,10 +329,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         metavar="N",
         help="processes that make the blocks (default: 2, or 1 on one CPU)",
     )
-    parser.add_argument("--readme", type=Path, default=README, help=argparse.SUPPRESS)
+    parser.add_argument("--root", type=Path, default=ROOT, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
-    text = args.readme.read_text()
-    present = blocks(text)
+    present, twice = located(args.root)
+    if twice:
+        print(f"readme_figures: blocks on two pages: {sorted(twice)}", file=sys.stderr)
+        return 2
     unknown = sorted(set(present) - set(GENERATORS))
     missing = sorted(set(GENERATORS) - set(present))
     if unknown or missing:
@@ -332,9 +356,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         for n, g in GENERATORS.items()
         if (g.cheap or not args.cheap) and (g.ci or g.cheap or not args.ci)
     ]
-    fresh, stale = check(names, text, args.jobs)
+    fresh, stale = check(names, present, args.root, args.jobs)
     if args.write:
-        args.readme.write_text(rewrite(text, fresh))
+        for page in {present[name][0] for name in fresh}:
+            page.write_text(rewrite(page.read_text(), fresh))
         print(f"readme_figures: wrote {len(fresh)} blocks ({', '.join(fresh)})")
         return 0 if len(fresh) == len(names) else 1
     for diff in stale:

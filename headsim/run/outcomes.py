@@ -2,7 +2,7 @@
 
 Frozen dataclasses, read by the summary, the recording and the studies;
 :mod:`headsim.run.serialise` is the one place that turns them into
-results.json (README "Scenarios and results" documents every key).  Each
+results.json (docs/reference/results-json.md documents every key).  Each
 procedure's own result is its module's (:mod:`headsim.procedures`); the
 calibration's report is :mod:`headsim.active.calibration_report`'s.  Units are
 in the names: m, rad, px; positions in W unless named otherwise.

@@ -3,7 +3,7 @@
 A :class:`Recorder` is a :class:`headsim.run.events.Subscriber`: it logs the
 experiment's own images and detections as the procedures make them (no
 render is made for the record) and the results as they come.  Entity paths
-and timelines (README "Scenarios and results" lists them):
+and timelines (docs/how-to/record.md lists them):
 
 - timelines ``frame`` (images rendered in the run, from 0) and ``step``
   (fixations: calibration samples, then measurements, from 0); every entity

@@ -2,7 +2,7 @@
 ``[experiment]`` and ``[experiment.calibration]``.
 
 Each ``read_*``/``_read_*`` function lists the keys of one table with their
-ranges (README "Scenarios and results" shows them with examples); missing keys
+ranges (the documentation's scenario-key reference lists them, made from these getters); missing keys
 come from the head's preset.  Lengths in metres, angles in radians, pixels as
 OpenCV's.
 """

@@ -3,12 +3,19 @@
 A :class:`Table` wraps one TOML table; each getter checks one key's type and
 range and names the field and what is allowed when it is wrong
 (:class:`ScenarioError`: ``FILE: FIELD: what is wrong (allowed: ...)``);
-:meth:`Table.done` rejects the keys no getter asked for.
+:meth:`Table.done` rejects the keys no getter asked for.  Inside
+:func:`collecting_keys` every getter also notes the key it read, its type, what is
+allowed and its default (:class:`KeyUse`): the scenario reference is made from those.
 """
 
 from __future__ import annotations
 
 import math
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
 from typing import Any
 
 from headsim.errors import BadInput
@@ -56,6 +63,51 @@ def _range_text(lo: float | None, hi: float | None, lo_open: bool, hi_open: bool
     return f"{text} {unit}".rstrip()
 
 
+@dataclass(frozen=True)
+class KeyUse:
+    """One key as a getter read it: its dotted path (``[]`` for any index), type and limits."""
+
+    path: str
+    kind: str
+    allowed: str
+    default: str  # the default as TOML would write it, or "" when the key is required
+
+
+_COLLECTED: ContextVar[dict[str, KeyUse] | None] = ContextVar("_COLLECTED", default=None)
+
+
+@contextmanager
+def collecting_keys() -> Iterator[dict[str, KeyUse]]:
+    """Note every key the getters read while inside, by normalised path."""
+    seen: dict[str, KeyUse] = {}
+    token = _COLLECTED.set(seen)
+    try:
+        yield seen
+    finally:
+        _COLLECTED.reset(token)
+
+
+def key_path(field_path: str) -> str:
+    """``field_path`` with list indices as ``[]``: ``scene.targets[3].name`` -> ``scene.targets[].name``."""
+    return re.sub(r"\[\d+\]", "[]", field_path)
+
+
+def _toml_value(value: Any) -> str:
+    if value is MISSING:
+        return ""
+    if value is None:
+        return "none"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, (tuple, list)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    return str(value)
+
+
 class Context:
     """Where a document came from, for messages: the file and the fields ``--fast`` set."""
 
@@ -92,7 +144,20 @@ class Table:
     def has(self, key: str) -> bool:
         if key not in self.known:
             self.known.append(key)
+        self._note(key, "", "", MISSING, first=True)
         return key in self.data
+
+    def _note(
+        self, key: str, kind: str, allowed: str, default: Any, *, first: bool = False
+    ) -> None:
+        """Record the key's use while :func:`collecting_keys` is active."""
+        seen = _COLLECTED.get()
+        if seen is None:
+            return
+        path = key_path(self.field(key))
+        if first and path in seen:
+            return
+        seen[path] = KeyUse(path, kind, key_path(allowed), _toml_value(default))
 
     def _get(self, key: str) -> Any:
         return self.data[key] if self.has(key) else MISSING
@@ -113,6 +178,7 @@ class Table:
     ) -> float:
         value = self._get(key)
         allowed = f"a number {_range_text(lo, hi, lo_open, hi_open, unit)}"
+        self._note(key, "number", allowed, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", allowed)
@@ -147,6 +213,7 @@ class Table:
     def integer(self, key: str, default: Any = MISSING, lo: int = 0, hi: int = 10**6) -> int:
         value = self._get(key)
         allowed = f"an integer from {lo} to {hi}"
+        self._note(key, "integer", allowed, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", allowed)
@@ -159,6 +226,7 @@ class Table:
 
     def boolean(self, key: str, default: bool) -> bool:
         value = self._get(key)
+        self._note(key, "boolean", "true, false", default)
         if value is MISSING:
             return default
         if not isinstance(value, bool):
@@ -170,6 +238,7 @@ class Table:
     def string(self, key: str, default: Any = MISSING, max_length: int = 200) -> str:
         value = self._get(key)
         allowed = f"one line of text, at most {max_length} characters"
+        self._note(key, "string", allowed, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", allowed)
@@ -183,6 +252,7 @@ class Table:
     def choice(self, key: str, allowed: tuple[str, ...] | list[str], default: Any = MISSING) -> str:
         value = self._get(key)
         text = ", ".join(allowed)
+        self._note(key, "choice", text, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", text)
@@ -208,6 +278,7 @@ class Table:
         value = self._get(key)
         each = _range_text(lo, hi, lo_open, hi_open, unit)
         allowed = f"an array of {length} numbers, each {each}"
+        self._note(key, "numbers", allowed, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", allowed)
@@ -223,6 +294,7 @@ class Table:
 
     def table(self, key: str) -> Table | None:
         value = self._get(key)
+        self._note(key, "table", f"a [{self.field(key)}] table", MISSING)
         if value is MISSING:
             return None
         if not isinstance(value, dict):
@@ -236,6 +308,7 @@ class Table:
         if value is MISSING:
             return []
         allowed = f"an array of tables, [[{self.field(key)}]], at most {max_count}"
+        self._note(key, "tables", allowed, MISSING)
         if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
             raise self.fail(
                 key, f"must be an array of tables, got {describe_value(value)}", allowed

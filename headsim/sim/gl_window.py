@@ -6,7 +6,7 @@ outside it (:func:`clipped_to`), with the frame's viewport moved by whole
 pixels so that the window's corner is the origin of an off-screen buffer only
 as large as the window (:class:`WindowBuffer`): every vertex lands where it
 does in the frame, less the window's offset, so the window's pixels are the
-frame's crop (README, windows).
+frame's crop (docs/concepts/servo.md, windows).
 """
 
 from __future__ import annotations

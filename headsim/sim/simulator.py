@@ -1,6 +1,6 @@
 """The simulated head: commands, settling, encoders, ground truth and images.
 
-Frames (README "Frames"): W world, H head, and per camera its OpenCV frame
+Frames (docs/concepts/frames.md): W world, H head, and per camera its OpenCV frame
 (x right, y down, z along the optical axis).  Transforms are 4 x 4 homogeneous
 matrices named ``dst_from_src``: ``p_world = world_from_head @ p_head``.
 

@@ -1,6 +1,6 @@
 """The head frame H from a stereo calibration (how far two poses differ: geometry.transforms).
 
-Frames (README "Frames"): Ci is camera i's OpenCV frame, H the head frame.
+Frames (docs/concepts/frames.md): Ci is camera i's OpenCV frame, H the head frame.
 OpenCV's stereo extrinsics ``(R, T)`` map camera 1 to camera 2,
 ``x2 = R x1 + T``, i.e. ``cam2_from_cam1 = [[R, T], [0, 1]]``.  Units: m, rad.
 

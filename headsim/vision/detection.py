@@ -18,7 +18,7 @@ marker centroids 0.04-0.06 px RMS, also with noise_std = 2; chessboard
 corners 0.05 px RMS on a board turned in the image, 0.10 px on one square to
 the pixel grid; cross points 0.065 px RMS, max 0.18 px.  The default
 rendering, (4, 2), renders twice as large and area-averages back, which
-halves the floor (README, rendering fidelity).
+halves the floor (docs/how-to/realistic-head.md, rendering fidelity).
 """
 
 from __future__ import annotations

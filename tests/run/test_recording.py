@@ -23,8 +23,8 @@ from headsim.run.recording import RowColumns
 
 from .rrd import rows
 
-README = Path(__file__).resolve().parents[2] / "README.md"
-ROOT = README.parent
+ROOT = Path(__file__).resolve().parents[2]
+RECORDING_PAGE = ROOT / "docs" / "how-to" / "record.md"
 
 
 def test_the_file_is_complete_with_its_blueprint(recorded: tuple[Path, dict]) -> None:
@@ -66,7 +66,7 @@ def test_the_command_line_leaves_only_once_the_recording_is_complete(
 
 def test_every_recorded_entity_is_documented(recorded: tuple[Path, dict]) -> None:
     rrd, _ = recorded
-    text = README.read_text()
+    text = RECORDING_PAGE.read_text()
     table = text[text.index("| entity | type | what |") :].split("\n\n")[0]
     documented = set()
     for cell in re.findall(r"^\| ([^|]+) \|", table, re.M):
@@ -81,7 +81,7 @@ def test_every_recorded_entity_is_documented(recorded: tuple[Path, dict]) -> Non
         for chunk in RrdReader(rrd).stream()
         if not chunk.entity_path.startswith("/__")
     }
-    # The model's bodies and geoms: one README row stands for them (tests/run/test_mjcf_rerun.py).
+    # The model's bodies and geoms: one row of the page stands for them (tests/run/test_mjcf_rerun.py).
     assert "`/world/model/BODY`" in table
     recorded_entities = {e for e in recorded_entities if not e.startswith("/world/model/")}
     assert recorded_entities <= documented, recorded_entities - documented

@@ -1,0 +1,113 @@
+"""MkDocs hook: the reference pages made from the code at build time.
+
+``mkdocs.yml`` names this file under ``hooks``; each page below is added to the
+site as a generated file (nothing generated is committed):
+
+- ``reference/scenario-keys.md``: every key the scenario loader accepts, from the
+  getters themselves (:mod:`headsim.scenario.key_reference`);
+- ``reference/command-line.md``: every command's ``--help``, from the parser;
+- ``reference/exit-codes.md``: the exit-code contract (:mod:`headsim.errors`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from typing import Any
+
+from mkdocs.structure.files import File, Files
+
+from headsim.cli.parser import build_parser
+from headsim.errors import EXIT_MEANINGS
+from headsim.scenario.key_reference import accepted_keys
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def scenario_keys_page() -> str:
+    """Every accepted key as one table per top-level table."""
+    out = [
+        "# Scenario keys\n",
+        "Every key the scenario loader accepts, made at build time by running the real "
+        "readers over every shipped scenario (and variants that take their other branches): "
+        "the type, what is allowed and the default are the readers' own, the meaning is "
+        "`headsim.scenario.key_reference.DESCRIPTIONS`. Lengths m, angles rad, pixels as "
+        "OpenCV's; `[]` stands for any entry of an array of tables. *required* means "
+        "the file must give it where its table is read; a default that other keys set "
+        "(a preset, the image size) says so. How to write a file: "
+        "[Write a scenario](../how-to/write-a-scenario.md).\n",
+    ]
+    keys = accepted_keys()
+    groups: dict[str, list[Any]] = {}
+    for key in keys:
+        groups.setdefault(key.path.split(".")[0].split("[")[0], []).append(key)
+    for group, members in groups.items():
+        out.append(
+            f"\n## `{group}`\n\n| key | type | allowed | default | meaning |\n|---|---|---|---|---|"
+        )
+        for k in members:
+            kind = k.kind or "see meaning"
+            default = (
+                "-"
+                if k.kind in ("table", "tables", "")
+                else (f"`{k.default}`" if k.default else "*required*")
+            )
+            if k.default == "depends on other keys":
+                default = "depends on other keys"
+            out.append(
+                f"| `{k.path}` | {kind} | {_cell(k.allowed) or '-'} | {_cell(default)} | "
+                f"{_cell(k.description)} |"
+            )
+    return "\n".join(out) + "\n"
+
+
+def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
+    for action in parser._actions:  # argparse keeps its subcommands only here
+        if isinstance(action, argparse._SubParsersAction):
+            return dict(action.choices)
+    return {}
+
+
+def command_line_page() -> str:
+    """``headsim --help`` and every command's ``--help``, as the parser prints them."""
+    os.environ.setdefault("COLUMNS", "100")
+    parser = build_parser()
+    out = [
+        "# Command line\n",
+        "Made at build time from the argument parser (`headsim.cli.parser.build_parser`); "
+        "`headsim COMMAND --help` prints the same. Every command ends with one of the "
+        "[exit codes](exit-codes.md); `--debug` anywhere adds a traceback to an error, "
+        "`--quiet` anywhere leaves only errors on stderr.\n",
+        "```text\n" + parser.format_help().rstrip() + "\n```\n",
+    ]
+    for name, sub in _subcommands(parser).items():
+        out.append(f"## `headsim {name}`\n\n```text\n{sub.format_help().rstrip()}\n```\n")
+    return "\n".join(out)
+
+
+def exit_codes_page() -> str:
+    """The exit-code contract, from :data:`headsim.errors.EXIT_MEANINGS`."""
+    rows = "\n".join(
+        f"| {int(code)} | `{code.name}` | {text} |" for code, text in EXIT_MEANINGS.items()
+    )
+    return (
+        "# Exit codes\n\nThe same for every command (`headsim.errors.ExitCode`). Every failure "
+        "ends with one line `headsim: error: ...` on stderr and no Python traceback "
+        "(`--debug` adds it).\n\n| code | name | meaning |\n|---|---|---|\n" + rows + "\n"
+    )
+
+
+PAGES = {
+    "reference/scenario-keys.md": scenario_keys_page,
+    "reference/command-line.md": command_line_page,
+    "reference/exit-codes.md": exit_codes_page,
+}
+
+
+def on_files(files: Files, config: Any) -> Files:
+    """Add the generated pages to the site."""
+    for uri, make in PAGES.items():
+        files.append(File.generated(config, uri, content=make()))
+    return files
