@@ -54,7 +54,15 @@ def test_the_block_pattern_finds_only_python_blocks(tmp_path: Path) -> None:
 def test_every_python_example_runs(page: Path, tmp_path: Path) -> None:
     if QUICKSTART_RECORDING in page.read_text():
         out = tmp_path / "out" / "quickstart"
-        args = ["run", "quickstart", "--fast", "--out", str(out), "--rrd", str(out / "recording.rrd")]
+        args = [
+            "run",
+            "quickstart",
+            "--fast",
+            "--out",
+            str(out),
+            "--rrd",
+            str(out / "recording.rrd"),
+        ]
         assert main([*args, "--no-progress", "--quiet"]) == 0
     env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
     done = subprocess.run(

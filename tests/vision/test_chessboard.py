@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from headsim.geometry.transforms import rotation_x, rotation_y, rotation_z
 from headsim.sim import names
-from headsim.sim.model import rotation_x, rotation_y, rotation_z
 from headsim.sim.settings import (
     paper_head,
 )

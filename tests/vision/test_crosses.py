@@ -14,8 +14,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from headsim.geometry.transforms import rotation_x, rotation_y, rotation_z
 from headsim.sim import names
-from headsim.sim.model import rotation_x, rotation_y, rotation_z
 from headsim.sim.settings import (
     CameraSettings,
     HeadSettings,
