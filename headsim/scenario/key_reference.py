@@ -246,6 +246,7 @@ DESCRIPTIONS: dict[str, str] = {
     "experiment.calibration.layout": "Depths uniform in `depth_m`, or most balls at the near end and the rest far.",
     "experiment.calibration.near_fraction": "`near_far` only: share of balls at the near end (default b / (a + b)).",
     "experiment.servo": "The eye and neck servo (`headsim.active.servo_types.ServoConfig`).",
+    "experiment.servo.windows": "Render only a window around where the target is expected (false: every image a full frame; same answers, more pixels).",
     "experiment.servo.tolerance_px": "Stop when the target's column is this close to the goal (or within half an encoder step's motion), px.",
     "experiment.servo.max_iterations": "Servo steps before the fixation gives up.",
     "experiment.servo.probe_steps": "Encoder steps of the first probe when no gain is known (grown x4 until the image moves `min_probe_px`).",
