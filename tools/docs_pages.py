@@ -5,6 +5,8 @@ site as a generated file (nothing generated is committed):
 
 - ``reference/scenario-keys.md``: every key the scenario loader accepts, from the
   getters themselves (:mod:`headsim.scenario.key_reference`);
+- ``reference/results-json.md``: every key of results.json, from
+  :mod:`headsim.run.results_reference`;
 - ``reference/command-line.md``: every command's ``--help``, from the parser;
 - ``reference/exit-codes.md``: the exit-code contract (:mod:`headsim.errors`).
 """
@@ -19,6 +21,7 @@ from mkdocs.structure.files import File, Files
 
 from headsim.cli.parser import build_parser
 from headsim.errors import EXIT_MEANINGS
+from headsim.run.results_reference import EXPERIMENT_FIELDS, RESULTS_FIELDS
 from headsim.scenario.key_reference import accepted_keys
 
 
@@ -63,6 +66,50 @@ def scenario_keys_page() -> str:
     return "\n".join(out) + "\n"
 
 
+_RESULTS_INTRO = (
+    "# results.json\n\n"
+    "Written atomically at the end of a run (also when a measurement failed; not when the "
+    "input was bad or the run was interrupted). It holds no wall time or date: the same "
+    "scenario, seed and software give the same bytes. SI units; NaN is written as `null`. "
+    "Made at build time from `headsim.run.results_reference`: `a[]` stands for each entry "
+    "of the list `a`, `a.*` for each key of a table whose keys are data (a knowledge, a "
+    "phase); a key whose keys are not listed is described as a whole.\n"
+)
+
+
+def _field_tables(fields: dict[str, str], top: str) -> list[str]:
+    """One table per path whose keys are listed: the top level first, then in order."""
+    parents: dict[str, list[str]] = {}
+    for path in fields:
+        head, sep, _ = path.rpartition(".")
+        parent = head if sep else ""
+        parents.setdefault(parent, []).append(path)
+    out = []
+    for parent, children in parents.items():
+        out.append(f"\n## `{parent}`\n" if parent else f"\n## {top}\n")
+        out.append("| key | meaning |\n|---|---|")
+        for path in children:
+            out.append(f"| `{path.rpartition('.')[2]}` | {_cell(fields[path])} |")
+    return out
+
+
+def results_json_page() -> str:
+    """Every key of results.json, and each procedure's ``experiment`` keys."""
+    out = [_RESULTS_INTRO, *_field_tables(RESULTS_FIELDS, "Top level")]
+    out.append(
+        "\n## `experiment` by procedure\n\nBeside `procedure`, each procedure's own keys "
+        "(its result's fields; `headsim.run.results_reference.EXPERIMENT_FIELDS`)."
+    )
+    for procedure, fields in EXPERIMENT_FIELDS.items():
+        out.append(f"\n### `{procedure}`\n")
+        if not fields:
+            out.append("No keys beyond its measurements.")
+            continue
+        out.append("| key | meaning |\n|---|---|")
+        out.extend(f"| `{key}` | {_cell(text)} |" for key, text in fields.items())
+    return "\n".join(out) + "\n"
+
+
 def _subcommands(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
     for action in parser._actions:  # argparse keeps its subcommands only here
         if isinstance(action, argparse._SubParsersAction):
@@ -101,6 +148,7 @@ def exit_codes_page() -> str:
 
 PAGES = {
     "reference/scenario-keys.md": scenario_keys_page,
+    "reference/results-json.md": results_json_page,
     "reference/command-line.md": command_line_page,
     "reference/exit-codes.md": exit_codes_page,
 }

@@ -1,6 +1,6 @@
 """results.json from the typed results: the one place that knows its keys and their order.
 
-``results.json`` (docs/reference/results-json.md documents every key) holds
+``results.json`` (:mod:`headsim.run.results_reference` documents every key) holds
 no wall time and no timestamp: the same scenario, seed and software give the
 same bytes.  SI units (m, rad, px); NaN becomes null when
 :func:`headsim.files.write_json_atomic` writes it.  The ``calibration`` block,
@@ -29,7 +29,7 @@ from headsim.scenario.spec import servo_record
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
 RESULTS_SCHEMA = "headsim.results/2"
 
-#: Keys of results.json and of each measurement in it (docs/reference/results-json.md documents each).
+#: Keys of results.json and of each measurement in it (:mod:`headsim.run.results_reference` gives each its meaning).
 RESULTS_KEYS = (
     "schema",
     "scenario",

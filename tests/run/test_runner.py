@@ -10,10 +10,15 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
+from headsim.run.results_reference import (
+    EXPERIMENT_FIELDS,
+    RESULTS_FIELDS,
+    documented_paths,
+    undocumented,
+)
 from headsim.run.serialise import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
 from headsim.scenario.loading import load_scenario, scenario_files
 
-RESULTS_PAGE = Path(__file__).resolve().parents[2] / "docs" / "reference" / "results-json.md"
 FILES = scenario_files()
 
 
@@ -22,22 +27,12 @@ def _run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str]
     return code, capsys.readouterr().out
 
 
-def _documented_keys(heading: str) -> list[str]:
-    """The first-column keys of the table under ``heading`` on the results.json page."""
-    text = RESULTS_PAGE.read_text()
-    section = text[text.index(heading) :]
-    table = section[section.index("| key |") :]
-    keys = []
-    for line in table.splitlines()[2:]:
-        if not line.startswith("|"):
-            break
-        keys.append(re.match(r"\| `([a-z_0-9]+)` \|", line).group(1))  # type: ignore[union-attr]
-    return keys
-
-
-def test_the_reference_documents_every_key_of_results_json() -> None:
-    assert _documented_keys("# results.json") == list(RESULTS_KEYS)
-    assert _documented_keys("Each measurement:") == list(MEASUREMENT_KEYS)
+def test_the_reference_gives_every_key_of_results_json_a_meaning_in_order() -> None:
+    top = [path for path in RESULTS_FIELDS if "." not in path]
+    prefix = "measurements[]."
+    each = [p.removeprefix(prefix) for p in RESULTS_FIELDS if p.startswith(prefix)]
+    assert top == list(RESULTS_KEYS)
+    assert [key for key in each if "." not in key] == list(MEASUREMENT_KEYS)
 
 
 def _check_schema(results: dict, scenario_name: str) -> None:
@@ -87,6 +82,13 @@ def test_every_scenario_runs_in_its_fast_variant(
     assert code == 0, out
     results = json.loads((tmp_path / "results.json").read_text())
     _check_schema(results, path.stem)
+    # Every key the run wrote has a meaning; every meaning of its procedure names a key it wrote.
+    assert undocumented(results) == []
+    procedure = results["experiment"]["procedure"]
+    held = {p for p in documented_paths(results) if p.startswith("experiment.")}
+    assert held - {"experiment.procedure"} == {
+        f"experiment.{k}" for k in EXPERIMENT_FIELDS[procedure]
+    }
     assert (tmp_path / "summary.txt").read_text().strip() in out
     assert json.loads((tmp_path / "timing.json").read_text())["wall_s"] > 0
     scenario = load_scenario(path, fast=True)

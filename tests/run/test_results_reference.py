@@ -1,0 +1,73 @@
+"""The results.json reference: every key a real run writes has a meaning, every meaning a key."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+from headsim.cli import main
+from headsim.run.results_reference import (
+    EXPERIMENT_FIELDS,
+    RESULTS_FIELDS,
+    documented_paths,
+    undocumented,
+)
+from headsim.scenario.registry import names
+
+TOOLS = Path(__file__).resolve().parents[2] / "tools"
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict]:
+    """results.json of quickstart and tracking, fast: between them every key outside
+    ``experiment`` (a calibration, random targets, Model 1 and Model 2)."""
+    out = {}
+    for name in ("quickstart", "tracking"):
+        folder = tmp_path_factory.mktemp(name)
+        assert main(["--quiet", "run", name, "--fast", "--out", str(folder), "--no-progress"]) == 0
+        out[name] = json.loads((folder / "results.json").read_text())
+    return out
+
+
+def test_every_meaning_names_a_key_that_a_real_run_writes(runs: dict[str, dict]) -> None:
+    held = set().union(*(documented_paths(r) for r in runs.values()))
+    assert [p for p in RESULTS_FIELDS if p not in held] == []
+    assert all(undocumented(r) == [] for r in runs.values())
+    assert {p for p in held if p.startswith("experiment.")} == {
+        "experiment.procedure",
+        *(f"experiment.{k}" for k in EXPERIMENT_FIELDS["tracking"]),
+    }
+
+
+def test_a_key_without_a_meaning_is_named_by_its_path(runs: dict[str, dict]) -> None:
+    results = json.loads(json.dumps(runs["quickstart"]))
+    results["summary"]["calibrated"]["by_depth"][0]["median"] = 1.0
+    results["scenario"]["scene"]["acceptance"]["kept"] = 3
+    results["measurements"][0]["speed"] = 2.0
+    results["experiment"]["times_s"] = []  # a tracking key in a model2 run
+    assert undocumented(results) == [
+        "experiment.times_s",
+        "measurements[].speed",
+        "scenario.scene.acceptance.kept",
+        "summary.*.by_depth[].median",
+    ]
+
+
+def test_every_registered_procedure_has_its_experiment_keys_documented() -> None:
+    assert set(EXPERIMENT_FIELDS) == set(names())
+
+
+def test_the_generated_page_lists_every_key_under_its_table() -> None:
+    sys.path.insert(0, str(TOOLS))
+    try:
+        import docs_pages
+    finally:
+        sys.path.remove(str(TOOLS))
+    page = docs_pages.results_json_page()
+    assert "## `summary.*.by_depth[]`\n" in page and "| `band` | the band |" in page
+    assert "### `relative_positioning`\n" in page and "| `objects[].margin_px` |" in page
+    for path in RESULTS_FIELDS:
+        assert f"| `{path.rpartition('.')[2]}` |" in page, path
