@@ -52,3 +52,16 @@ def test_a_block_without_a_generator_or_on_two_pages_is_refused(tmp_path: Path) 
     page.write_text(page.read_text() + "\n<!-- figures:gym -->\n<!-- /figures:gym -->\n")
     done = _run("--cheap", "--root", str(root))
     assert done.returncode == 2 and "two pages: ['gym']" in done.stderr
+
+
+def test_a_timed_block_is_checked_by_its_words_and_every_other_by_its_numbers_too() -> None:
+    sys.path.insert(0, str(ROOT / "tools"))
+    try:
+        import readme_figures as figures
+    finally:
+        sys.path.remove(str(ROOT / "tools"))
+    assert figures.GENERATORS["speed"].timed and not figures.GENERATORS["quickstart"].timed
+    ours, later = "took 71 renders' time; reproduce 484.5", "took 90 renders' time; reproduce 350.0"
+    assert figures._compared("speed", ours) == figures._compared("speed", later)
+    assert figures._compared("speed", ours) != figures._compared("speed", "took 71 frames' time")
+    assert figures._compared("quickstart", "0.111 %") != figures._compared("quickstart", "0.112 %")

@@ -50,6 +50,33 @@ def reproduce() -> str:
     )
 
 
+def speed() -> str:
+    """Wall times as ratios to a 640x480 render timed in the same process: the quick start
+    and ``headsim reproduce --fast`` (its report's own ratio)."""
+    import time
+
+    from headsim.run.runner import run_scenario
+    from headsim.scenario.loading import load_scenario
+    from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock
+    from headsim.studies.reproduce import reproduce as run
+
+    render_s = RenderClock().sample(CLOCK_RENDERS[0])
+    start = time.perf_counter()
+    run_scenario(load_scenario("quickstart"))
+    quickstart_s = time.perf_counter() - start
+    with tempfile.TemporaryDirectory(prefix="readme-figures-") as out:
+        state = run(out, fast=True, workers=2)
+        if state["status"] != "ok":
+            raise RuntimeError(f"headsim reproduce --fast: {state['status']}")
+        report = json.loads((Path(out) / "report.json").read_text())
+    return (
+        f"`headsim run quickstart` took {quickstart_s / render_s:.0f} renders' time (the wall "
+        f"time over one 640x480 render of the ideal head, timed in the same process); "
+        f"`headsim reproduce --fast --workers 2` {report['wall_over_render']:.0f} (its report's "
+        f"`wall_over_render`).\n"
+    )
+
+
 # --- the live head ------------------------------------------------------------------
 
 #: ``live_gaze.py --fast``'s size: one depth, 1 s of pursuit, three jump sizes.

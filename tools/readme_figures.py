@@ -11,7 +11,8 @@ sits between two markers::
 written by the generator of that name below (``figures_*.py`` beside this file),
 from fresh runs of today's code: scenarios through the runner, studies, the
 benchmark scripts' functions.  Every run is seeded, so a block is the same on
-every run on one machine; a name appears once over all pages.  Usage::
+every run on one machine (but a timed block's numbers, wall-time ratios, which the
+check leaves out); a name appears once over all pages.  Usage::
 
     python tools/readme_figures.py              # check every block; exit 1 naming each stale one
     python tools/readme_figures.py --cheap      # only the blocks that take seconds (a test runs these)
@@ -108,6 +109,34 @@ def realistic_field() -> str:
     )
 
 
+#: The head presets, each with the scenario's own targets and balls (the same seed).
+PRESETS = ("ideal", "paper", "realistic")
+
+
+def accuracy_by_preset() -> str:
+    """``realistic_field`` at seed 0 on each preset: 3-D error RMS by depth band."""
+    rows = []
+    for preset in PRESETS:
+        # realistic_field's own preset runs unchanged, shared with its block.
+        p = (
+            payload("realistic_field")
+            if preset == "realistic"
+            else payload("realistic_field", **{"head.preset": preset})
+        )
+        s, a = summary(p), acceptance(p)
+        cells = [f"{pct(b['error_pct_of_depth_rms'])} ({b['count']})" for b in s["by_depth"]]
+        rows.append(
+            [
+                f"`{p['scenario']['preset']}`",
+                *cells,
+                f"{pct(s['error_pct_of_depth_rms'])} ({s['count']})",
+                f"{s['ok']} / {a['drawn']}",
+            ]
+        )
+    (first,) = {tuple(b["band"] for b in summary(payload("realistic_field"))["by_depth"])}
+    return table(("preset", *first, "all", "measured / drawn"), rows)
+
+
 def _calibration_line(p: dict[str, Any]) -> str:
     """What the calibration found against the truth, beside its stated standard errors."""
     if p["calibration"] is None:
@@ -189,7 +218,9 @@ def stress() -> str:
 class Generator:
     """A block's generator: its text from fresh runs.
 
-    ``cheap``: seconds, not minutes (the test suite checks it).  ``ci``: CI checks it
+    ``cheap``: seconds, not minutes (the test suite checks it).  ``timed``: its numbers are
+    wall-time ratios, which vary from run to run: the check compares its words, ``--write``
+    rewrites its numbers.  ``ci``: CI checks it
     (every block but those of several minutes; ``make figures`` checks them all).  ``group``: blocks that
     share runs (cached per process) are made in one process.  ``seconds``: roughly how
     long the block takes with a core of its own, its own runs only (the longest groups
@@ -198,6 +229,7 @@ class Generator:
 
     make: Callable[[], str]
     cheap: bool
+    timed: bool = False
     ci: bool = True
     group: str = ""
     seconds: float = 1.0
@@ -206,6 +238,7 @@ class Generator:
 GENERATORS: dict[str, Generator] = {
     "quickstart": Generator(quickstart, cheap=True, seconds=3),
     "reproduce": Generator(live.reproduce, cheap=False, seconds=45),
+    "speed": Generator(live.speed, cheap=False, timed=True, seconds=15),
     "chessboard_windows": Generator(servo.chessboard_windows, cheap=False, seconds=7),
     "windows": Generator(servo.windows, cheap=False, group="bench points", seconds=5),
     "averaged_fixation": Generator(
@@ -221,7 +254,10 @@ GENERATORS: dict[str, Generator] = {
     "pursuit_belief": Generator(live.pursuit_belief, cheap=False, seconds=12),
     "forward_field": Generator(realistic.forward_field, cheap=True, group="forward", seconds=4),
     "forward_budget": Generator(realistic.forward_budget, cheap=True, group="forward", seconds=1),
-    "realistic_field": Generator(realistic_field, cheap=False, seconds=8),
+    "realistic_field": Generator(realistic_field, cheap=False, group="realistic field", seconds=8),
+    "accuracy_by_preset": Generator(
+        accuracy_by_preset, cheap=False, group="realistic field", seconds=30
+    ),
     "stress": Generator(stress, cheap=False, seconds=100),
     "layouts": Generator(realistic.layouts, cheap=False, group="forward", seconds=35),
     "budget": Generator(realistic.budget, cheap=False, ci=False, seconds=75),
@@ -291,6 +327,14 @@ def generate(names: Sequence[str], jobs: int = 1) -> dict[str, str]:
     return {name: made[name] for name in names if name in made}
 
 
+_NUMBER = re.compile(r"\d+(\.\d+)?")
+
+
+def _compared(name: str, body: str) -> str:
+    """What the check compares of a block: its text, a timed block's without its numbers."""
+    return _NUMBER.sub("#", body) if GENERATORS[name].timed else body
+
+
 def check(
     names: Sequence[str], current: dict[str, tuple[Path, str]], root: Path, jobs: int = 1
 ) -> tuple[dict[str, str], list[str]]:
@@ -302,7 +346,7 @@ def check(
         where = f"{page.relative_to(root)} {name}"
         if name not in fresh:
             stale.append(f"{where}: its generator failed (above)")
-        elif fresh[name] != body:
+        elif _compared(name, fresh[name]) != _compared(name, body):
             diff = difflib.unified_diff(
                 body.splitlines(),
                 fresh[name].splitlines(),
