@@ -6,7 +6,7 @@ the chessboard in seeded poses at eye angle 0, each camera calibrated
 (``calibrateCamera``, k1, k2) and the pair (``stereoCalibrate``); print the
 reprojection RMS and the recovered parameters beside the simulator's, then the
 scenario's markers at 0.4-1.5 m triangulated, with their 3-D errors in the head
-frame H.  Issue 6's figure: reprojection RMS <= 0.2 px and focal lengths within 0.5 %.
+frame H.  The acceptance figure: reprojection RMS <= 0.2 px and focal lengths within 0.5 %.
 
     python benchmarks/stereo_calibration.py [--poses 24] [--seed 0] [--json out.json]
 """

@@ -28,8 +28,8 @@ Its scenario block, all keys optional::
 
 Its results.json block: the views kept and their renders, the detected corners'
 errors, each camera's parameters (truth, mono, stereo), the extrinsics beside the
-truth, issue 6's figure (``max_rms_px`` <= 0.2 px, ``max_abs_focal_error_pct`` <=
-0.5 %, ``passed``), each way of placing camera 1 in H with its targets' worst and
+truth, the baseline's acceptance figure (``max_rms_px`` <= 0.2 px,
+``max_abs_focal_error_pct`` <= 0.5 %, ``passed``), each way of placing camera 1 in H with its targets' worst and
 mean error, and each target (truth, estimate, error in H, m, from the extrinsics).
 A target not found in both images is a failure.
 """
@@ -69,7 +69,7 @@ from headsim.stereo.views import (
 if TYPE_CHECKING:
     from headsim.run.recording import Recorder
 
-#: Issue 6's figure: every reprojection RMS at most this, px ...
+#: The baseline's acceptance figure: every reprojection RMS at most this, px ...
 RMS_BOUND_PX = 0.2
 #: ... and every focal length within this fraction of the truth.
 FOCAL_BOUND = 0.005
@@ -242,6 +242,30 @@ class StereoResult:
             )
 
 
+@dataclass(frozen=True)
+class NotCalibrated:
+    """The board views left too few to calibrate from: ``reason`` says how many were kept."""
+
+    poses: int
+    reason: str
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: the poses and why no calibration."""
+        return asdict(self)
+
+    def failures(self) -> tuple[str, ...]:
+        return (f"stereo calibration: {self.reason}",)
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        return [f"Calibrated stereo (Zhang): not calibrated: {self.reason}"]
+
+    def ok_line(self, measured: int) -> str:
+        return "OK"  # never shown: a run without a calibration fails
+
+    def log_rows(self, log: Recorder) -> None:
+        return None
+
+
 def camera_parameters(calib: StereoCalibration) -> tuple[dict[str, Parameter], ...]:
     """Per camera: kx, ky, cx, cy, k1, k2 and the RMS, truth beside mono and stereo."""
 
@@ -326,13 +350,16 @@ def calibrate(
 
 def run_stereo(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
-) -> tuple[list[MeasurementRecord], StereoResult]:
+) -> tuple[list[MeasurementRecord], StereoResult | NotCalibrated]:
     """Calibrate the pair from board views, then triangulate each target (module docstring)."""
     spec = scenario.experiment.block
     assert isinstance(spec, StereoSpec)
     with simulator(hub, "chessboard", scenario) as sim:
         hub.emit(PhaseStarted("board views", sim, knowledge, {}))
-        calib, views = calibrate(sim, spec, scenario.seed)
+        try:
+            calib, views = calibrate(sim, spec, scenario.seed)
+        except StereoError as error:
+            return [], NotCalibrated(spec.views, str(error))
     targets = scenario.scene.targets
     rows: list[StereoTarget] = []
     frame_errors: dict[str, list[tuple[float, float]]] = {name: [] for name in HEAD_FRAMES}
@@ -440,11 +467,12 @@ STEREO = register(
         "stereo",
         "default",
         run_stereo,
-        fields=StereoResult.block,
-        summary=StereoResult.summary_lines,
-        ok_line=StereoResult.ok_line,
-        failures=StereoResult.failures,
-        rows=StereoResult.log_rows,
+        # The result is a StereoResult, or NotCalibrated where the views were too few.
+        fields=lambda result: result.block(),
+        summary=lambda result, paper: result.summary_lines(paper),
+        ok_line=lambda result, measured: result.ok_line(measured),
+        failures=lambda result: result.failures(),
+        rows=lambda result, log: result.log_rows(log),
         options=read_options,
         read_scene=targets_reader("stereo", required=True),
     )
@@ -457,6 +485,7 @@ __all__ = [
     "RMS_BOUND_PX",
     "STEREO",
     "HeadFrame",
+    "NotCalibrated",
     "Parameter",
     "StereoResult",
     "StereoSpec",

@@ -41,7 +41,9 @@ def fast(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     return out, rrd
 
 
-def test_the_calibration_meets_issue_6s_figure_beside_the_truth(fast: tuple[Path, Path]) -> None:
+def test_the_calibration_meets_its_acceptance_figure_beside_the_truth(
+    fast: tuple[Path, Path],
+) -> None:
     results = json.loads((fast[0] / "results.json").read_text())
     block: dict[str, Any] = results["experiment"]
     assert block["procedure"] == "stereo" and results["status"] == "ok"
@@ -109,3 +111,22 @@ def test_a_bad_stereo_key_is_one_line_naming_it(
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err, err
     assert not (tmp_path / "out").exists()
+
+
+def test_too_few_board_views_fail_the_run_with_the_reason(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A board 5 m away is too small to be found: no view is kept, no calibration made.
+    path = tmp_path / "far.toml"
+    path.write_text(SMALL.format(line="views = 5\ndistance_m = [4.9, 5.0]"))
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--no-progress"]) == ExitCode.FAILED
+    results = json.loads((out / "results.json").read_text())
+    assert results["status"] == "failed" and len(results["failures"]) == 1
+    assert results["failures"][0].startswith("stereo calibration: need at least 5 views")
+    assert results["experiment"] == {
+        "procedure": "stereo",
+        "poses": 5,
+        "reason": results["failures"][0].removeprefix("stereo calibration: "),
+    }
+    assert "not calibrated: need at least 5 views" in capsys.readouterr().out
