@@ -15,6 +15,8 @@ from rerun.chunk import RrdReader
 from headsim.cli import main
 from headsim.errors import ExitCode
 from headsim.procedures.stereo import FOCAL_BOUND, HEAD_FRAMES, RMS_BOUND_PX
+from headsim.scenario.loading import load_scenario
+from headsim.scenario.spec import experiment_record
 
 #: A stereo scenario whose ``[experiment.stereo]`` table the bad-key tests fill in.
 SMALL = """description = "a bad stereo key"
@@ -130,3 +132,14 @@ def test_too_few_board_views_fail_the_run_with_the_reason(
         "reason": results["failures"][0].removeprefix("stereo calibration: "),
     }
     assert "not calibrated: need at least 5 views" in capsys.readouterr().out
+
+
+def test_results_json_records_a_procedures_own_table_only_where_it_has_one() -> None:
+    stereo = experiment_record(load_scenario("stereo", fast=True).experiment)
+    assert stereo["block"] == {
+        "views": 8,
+        "distance_m": (0.4, 1.0),
+        "max_tilt_rad": 0.6,
+        "refine_intrinsics": True,
+    }
+    assert "block" not in experiment_record(load_scenario("quickstart", fast=True).experiment)
