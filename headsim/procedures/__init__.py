@@ -14,7 +14,7 @@ from __future__ import annotations
 # isort: off
 # The order of registration is the order a scenario's error lists the procedures in.
 from headsim.procedures import model2, model1, calibration, tracking, chessboard
-from headsim.procedures import relative, pursuit
+from headsim.procedures import relative, pursuit, stereo
 
 # isort: on
 from headsim.scenario.registry import REGISTRY, Procedure, get, names, register
@@ -31,5 +31,6 @@ __all__ = [
     "pursuit",
     "register",
     "relative",
+    "stereo",
     "tracking",
 ]

@@ -24,7 +24,7 @@ from headsim.active.calibration_report import calibration_block
 from headsim.run.accuracy import MeasurementSummary, summaries
 from headsim.run.outcomes import MeasurementRecord, RunResult
 from headsim.scenario.registry import get
-from headsim.scenario.spec import servo_record
+from headsim.scenario.spec import experiment_record
 
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
 RESULTS_SCHEMA = "headsim.results/2"
@@ -170,7 +170,7 @@ def results_payload(result: RunResult) -> dict[str, Any]:
             "fast": s.fast,
             "preset": s.preset,
             "scene": asdict(s.scene),
-            "experiment": {**asdict(s.experiment), "servo": servo_record(s.experiment.servo)},
+            "experiment": experiment_record(s.experiment),
         },
         "seed": s.seed,
         "status": "ok" if result.ok else "failed",

@@ -141,6 +141,17 @@ class ExperimentSpec:
     #: The servo's goal column (u10, u20) of Ca1, Ca2, px, as the user tells the head
     #: (e.g. the principal point's, found with ``headsim.active.principal``); None: image centres.
     goal_columns_px: tuple[float, float] | None = None
+    #: The procedure's own ``[experiment.<procedure>]`` table, as its ``options`` reader
+    #: typed it (a dataclass; None: it has none, and results.json records no ``block``).
+    block: Any = None
+
+
+def experiment_record(experiment: ExperimentSpec) -> dict[str, Any]:
+    """The ``[experiment]`` spec as results.json records it (see :func:`servo_record`)."""
+    record = {**asdict(experiment), "servo": servo_record(experiment.servo)}
+    if experiment.block is None:
+        del record["block"]
+    return record
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,498 @@
+"""The calibrated stereo baseline: Zhang's calibration from chessboard views, then each
+target triangulated at eye angle 0.
+
+The run: the chessboard scene's board in ``views`` seeded random poses, both eyes at
+eye angle 0 (:func:`headsim.stereo.views.chessboard_views`); each camera calibrated
+(``calibrateCamera``, k1, k2), then the pair (``stereoCalibrate``:
+:func:`headsim.stereo.calibration.calibrate_stereo`); then, in the default scene, each
+of the scenario's targets found in both full frames and triangulated
+(:func:`headsim.stereo.triangulation.measure_point_stereo`).  Every target's
+position in H is computed with camera 1 placed in H in several ways (from the
+extrinsics, and from the eye geometry: :data:`HEAD_FRAMES`).  Nothing is fixated,
+so the run makes no Model 2 measurement records (each target is one step).
+
+Its scenario block, all keys optional::
+
+    [experiment]
+    procedure = "stereo"
+
+    [experiment.stereo]
+    views = 24                  # board poses rendered (at least 5 must show the board)
+    distance_m = [0.4, 1.0]     # the board centre's distance from camera 1, m
+    max_tilt_rad = 0.6          # the board's tilt about its x and y axes, at most, rad
+    refine_intrinsics = true    # stereoCalibrate refines each camera's K, k1, k2
+    pattern = [8, 6]            # the board's inner corners (the scene's board: 8 x 6)
+
+    [[scene.targets]]           # what to triangulate, as for Model 2
+    position_head_m = [0.0, 0.0, 0.4]
+
+Its results.json block: the views kept and their renders, the detected corners'
+errors, each camera's parameters (truth, mono, stereo), the extrinsics beside the
+truth, the baseline's acceptance figure (``max_rms_px`` <= 0.2 px,
+``max_abs_focal_error_pct`` <= 0.5 %, ``passed``), each way of placing camera 1 in H with its targets' worst and
+mean error, and each target (truth, estimate, error in H, m, from the extrinsics).
+A target not found in both images is a failure.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import rerun as rr
+
+from headsim.active.events import PhaseStarted
+from headsim.active.measurement import HeadKnowledge
+from headsim.geometry.transforms import frame_deviation
+from headsim.run.context import simulator
+from headsim.run.events import Hub
+from headsim.run.outcomes import MeasurementRecord
+from headsim.run.recording_layout import GREEN
+from headsim.run.table import cell, format_table, mm
+from headsim.scenario.registry import Procedure, register
+from headsim.scenario.scene import targets_reader
+from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.tables import Table
+from headsim.sim.simulator import HeadSim
+from headsim.stereo.calibration import MIN_VIEWS, CameraCalibration, StereoCalibration
+from headsim.stereo.calibration import calibrate_stereo as zhang_calibration
+from headsim.stereo.frames import head_from_cam1_from_eye
+from headsim.stereo.triangulation import measure_point_stereo, triangulate
+from headsim.stereo.views import (
+    CHESSBOARD_PATTERN,
+    ChessboardViews,
+    StereoError,
+    chessboard_views,
+)
+
+if TYPE_CHECKING:
+    from headsim.run.recording import Recorder
+
+#: The baseline's acceptance figure: every reprojection RMS at most this, px ...
+RMS_BOUND_PX = 0.2
+#: ... and every focal length within this fraction of the truth.
+FOCAL_BOUND = 0.005
+
+#: The ways camera 1 is placed in H, in the order results.json lists them
+#: (:func:`head_frames`).
+HEAD_FRAMES = (
+    "from extrinsics",
+    "eye, true mount yaw",
+    "eye, effective direction",
+    "eye, effective - centre ray",
+    "parallel (yaw 0)",
+    "truth",
+)
+
+
+@dataclass(frozen=True)
+class StereoSpec:
+    """``[experiment.stereo]``: board poses rendered, their distance range from camera 1,
+    m, and tilt, rad; whether ``stereoCalibrate`` refines the intrinsics."""
+
+    views: int = 24
+    distance_m: tuple[float, float] = (0.4, 1.0)
+    max_tilt_rad: float = 0.6
+    refine_intrinsics: bool = True
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One camera parameter: the simulator's, ``calibrateCamera``'s, ``stereoCalibrate``'s."""
+
+    truth: float
+    mono: float
+    stereo: float
+
+
+@dataclass(frozen=True)
+class HeadFrame:
+    """Camera 1 placed in H one way: its pose's error, rad and m, and the targets' 3-D
+    errors with it (worst in m, worst and mean as % of the true depth)."""
+
+    label: str
+    rotation_error_rad: float
+    translation_error_m: float
+    max_error_m: float
+    max_error_pct_depth: float
+    mean_error_pct_depth: float
+
+
+@dataclass(frozen=True)
+class StereoTarget:
+    """One target triangulated with camera 1 placed in H from the extrinsics, m.
+
+    ``status``: "ok" or why not (estimate NaN then); ``uv1_px``/``uv2_px`` its detections.
+    """
+
+    name: str
+    status: str
+    truth_head_m: np.ndarray
+    estimate_head_m: np.ndarray
+    estimate_world_m: np.ndarray
+    uv1_px: tuple[float, float] | None
+    uv2_px: tuple[float, float] | None
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def error_head_m(self) -> np.ndarray:
+        return self.estimate_head_m - self.truth_head_m
+
+    @property
+    def error_pct_depth(self) -> float:
+        """3-D error as a percentage of the true depth z_h."""
+        return float(100 * np.linalg.norm(self.error_head_m) / self.truth_head_m[2])
+
+
+@dataclass(frozen=True)
+class StereoResult:
+    """The baseline's calibration beside the truth, and its targets (module docstring).
+
+    ``cameras``: per camera, kx, ky, cx, cy (px), k1, k2 and ``rms_px``;
+    ``t_m``/``r`` OpenCV's T (camera 1's origin in camera 2's frame, m) and R.
+    """
+
+    poses: int
+    views: int
+    renders: int
+    corner_rms_px: float
+    corner_max_px: float
+    cameras: tuple[dict[str, Parameter], dict[str, Parameter]]
+    stereo_rms_px: float
+    baseline_m: float
+    true_baseline_m: float
+    t_m: np.ndarray
+    true_t_m: np.ndarray
+    r: np.ndarray
+    true_r: np.ndarray
+    rotation_error_rad: float
+    max_rms_px: float
+    max_abs_focal_error_pct: float
+    passed: bool
+    head_frames: tuple[HeadFrame, ...]
+    targets: tuple[StereoTarget, ...]
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: every field, in order."""
+        return asdict(self)
+
+    def failures(self) -> tuple[str, ...]:
+        """Each target not found in both images."""
+        return tuple(f"{t.name}: {t.status}" for t in self.targets if not t.ok)
+
+    def ok_line(self, measured: int) -> str:
+        count = len(self.targets)
+        return f"OK: {count} target{'' if count == 1 else 's'} triangulated, none failed"
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        """The calibration beside the truth, each way of placing camera 1, each target."""
+        verdict = "PASS" if self.passed else "FAIL"
+        lines = [
+            f"Calibrated stereo (Zhang): {self.views} of {self.poses} board views kept, "
+            f"{self.renders} renders; corners vs truth RMS {self.corner_rms_px:.3f} px",
+            f"  max RMS {self.max_rms_px:.3f} px (<= {RMS_BOUND_PX}), max focal error "
+            f"{self.max_abs_focal_error_pct:.3f} % (<= {FOCAL_BOUND * 100:g}): {verdict}",
+            f"  baseline {mm(self.baseline_m, '.3f')} mm (truth {mm(self.true_baseline_m, '.3f')}),"
+            f" R error {self.rotation_error_rad * 1e3:.3f} mrad",
+        ]
+        lines += format_table(
+            ["camera 1 in H", "rot mrad", "trans mm", "max mm", "max %z", "mean %z"],
+            [
+                [
+                    f.label,
+                    cell(f.rotation_error_rad * 1e3, ".3f"),
+                    mm(f.translation_error_m, ".4f"),
+                    mm(f.max_error_m, ".2f"),
+                    cell(f.max_error_pct_depth, ".3f"),
+                    cell(f.mean_error_pct_depth, ".3f"),
+                ]
+                for f in self.head_frames
+            ],
+        )
+        lines += format_table(
+            ["target", "true z mm", "|e| mm", "% z"],
+            [
+                [
+                    t.name,
+                    mm(float(t.truth_head_m[2]), ".1f"),
+                    mm(float(np.linalg.norm(t.error_head_m)), ".2f") if t.ok else t.status,
+                    cell(t.error_pct_depth, ".3f") if t.ok else "-",
+                ]
+                for t in self.targets
+            ],
+        )
+        return lines
+
+    def log_rows(self, log: Recorder) -> None:
+        """Each triangulated target's estimate in W."""
+        seen = [t for t in self.targets if t.ok]
+        if seen:
+            log.rec.log(
+                "/world/stereo/estimates",
+                rr.Points3D(
+                    [t.estimate_world_m for t in seen],
+                    radii=0.006,
+                    colors=[GREEN] * len(seen),
+                    labels=[f"{t.name} (stereo)" for t in seen],
+                ),
+            )
+
+
+@dataclass(frozen=True)
+class NotCalibrated:
+    """The board views left too few to calibrate from: ``reason`` says how many were kept."""
+
+    poses: int
+    reason: str
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: the poses and why no calibration."""
+        return asdict(self)
+
+    def failures(self) -> tuple[str, ...]:
+        return (f"stereo calibration: {self.reason}",)
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        return [f"Calibrated stereo (Zhang): not calibrated: {self.reason}"]
+
+    def ok_line(self, measured: int) -> str:
+        return "OK"  # never shown: a run without a calibration fails
+
+    def log_rows(self, log: Recorder) -> None:
+        return None
+
+
+def camera_parameters(calib: StereoCalibration) -> tuple[dict[str, Parameter], ...]:
+    """Per camera: kx, ky, cx, cy, k1, k2 and the RMS, truth beside mono and stereo."""
+
+    def picks(c: CameraCalibration) -> dict[str, float]:
+        return {
+            "kx": float(c.K[0, 0]),
+            "ky": float(c.K[1, 1]),
+            "cx": float(c.K[0, 2]),
+            "cy": float(c.K[1, 2]),
+            "k1": float(c.dist[0]),
+            "k2": float(c.dist[1]),
+        }
+
+    tables = []
+    for mono, final in ((calib.mono1, calib.cam1), (calib.mono2, calib.cam2)):
+        truth = {
+            "kx": float(mono.true_K[0, 0]),
+            "ky": float(mono.true_K[1, 1]),
+            "cx": float(mono.true_K[0, 2]),
+            "cy": float(mono.true_K[1, 2]),
+            "k1": float(mono.true_dist[0]),
+            "k2": float(mono.true_dist[1]),
+        }
+        m, s = picks(mono), picks(final)
+        table = {key: Parameter(truth[key], m[key], s[key]) for key in truth}
+        table["rms_px"] = Parameter(0.0, mono.rms_px, calib.stereo_rms_px)
+        tables.append(table)
+    return tuple(tables)
+
+
+def head_frames(sim: HeadSim, calib: StereoCalibration) -> dict[str, np.ndarray]:
+    """Ways to place camera 1 in H (:data:`HEAD_FRAMES`): from the extrinsics, and the
+    paper's eye-geometry ones, which turn camera 1 about H's y by the true mount yaw; the
+    true effective initial direction (what a perfect Sec. V calibration returns); that
+    minus the calibrated centre-ray angle; and 0 (cameras parallel to H)."""
+    baseline = sim.settings.baseline_m
+    effective = sim.effective_initial_direction(1)
+    frames = (
+        calib.head_from_cam1,
+        head_from_cam1_from_eye(sim.settings.cameras[0].mount_yaw_rad, baseline),
+        head_from_cam1_from_eye(effective, baseline),
+        head_from_cam1_from_eye(effective - calib.cam1.centre_ray_yaw_rad, baseline),
+        head_from_cam1_from_eye(0.0, baseline),
+        calib.true_head_from_cam1,
+    )
+    return dict(zip(HEAD_FRAMES, frames, strict=True))
+
+
+def head_frame(
+    label: str,
+    head_from_cam1: np.ndarray,
+    calib: StereoCalibration,
+    errors: list[tuple[float, float]],
+) -> HeadFrame:
+    """Camera 1 placed in H as ``head_from_cam1``, and its targets' ``errors`` (3-D error,
+    m; that over the true depth)."""
+    rotation, translation = frame_deviation(head_from_cam1, calib.true_head_from_cam1)
+    if not errors:
+        nan = float("nan")
+        return HeadFrame(label, rotation, translation, nan, nan, nan)
+    values = np.array(errors)
+    return HeadFrame(
+        label,
+        rotation,
+        translation,
+        float(values[:, 0].max()),
+        float(100 * values[:, 1].max()),
+        float(100 * np.mean(values[:, 1])),
+    )
+
+
+def calibrate(
+    sim: HeadSim, spec: StereoSpec, seed: int
+) -> tuple[StereoCalibration, ChessboardViews]:
+    """Zhang's calibration from ``spec.views`` seeded board poses in ``sim`` (the chessboard
+    scene); the calibration and its views."""
+    views = chessboard_views(
+        sim, spec.views, np.random.default_rng(seed), spec.distance_m, spec.max_tilt_rad
+    )
+    return zhang_calibration(sim, views, spec.refine_intrinsics), views
+
+
+def run_stereo(
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], StereoResult | NotCalibrated]:
+    """Calibrate the pair from board views, then triangulate each target (module docstring)."""
+    spec = scenario.experiment.block
+    assert isinstance(spec, StereoSpec)
+    with simulator(hub, "chessboard", scenario) as sim:
+        hub.emit(PhaseStarted("board views", sim, knowledge, {}))
+        try:
+            calib, views = calibrate(sim, spec, scenario.seed)
+        except StereoError as error:
+            return [], NotCalibrated(spec.views, str(error))
+    targets = scenario.scene.targets
+    rows: list[StereoTarget] = []
+    frame_errors: dict[str, list[tuple[float, float]]] = {name: [] for name in HEAD_FRAMES}
+    with simulator(hub, "default", scenario) as sim:
+        truth = {t.name: np.array(t.position_world_m) for t in targets}
+        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
+        sim.move(eye=0.0)
+        world_from_head = sim.world_from_head()
+        frames = head_frames(sim, calib)
+        for placement in targets:
+            hub.begin(placement.name)
+            sim.set_body_pose(placement.body, np.array(placement.position_world_m))
+            try:
+                m = measure_point_stereo(sim, calib, placement.body)
+            except StereoError as missed:
+                unknown = np.full(3, np.nan)
+                truth_head = sim.position(placement.body, "head")
+                rows.append(
+                    StereoTarget(
+                        placement.name, str(missed), truth_head, unknown, unknown, None, None
+                    )
+                )
+                continue
+            for name, head_from_cam1 in frames.items():
+                p_head = triangulate(calib, np.array([m.uv1]), np.array([m.uv2]), head_from_cam1)
+                error_m = float(np.linalg.norm(p_head[0] - m.true_p_head))
+                frame_errors[name].append((error_m, error_m / float(m.true_p_head[2])))
+            rows.append(
+                StereoTarget(
+                    placement.name,
+                    "ok",
+                    m.true_p_head,
+                    m.p_head,
+                    world_from_head[:3, :3] @ m.p_head + world_from_head[:3, 3],
+                    m.uv1,
+                    m.uv2,
+                )
+            )
+    summary = [
+        head_frame(name, head_from_cam1, calib, frame_errors[name])
+        for name, head_from_cam1 in frames.items()
+    ]
+    corner_errors = views.corner_errors_px()
+    focal_errors = [
+        e
+        for cam in (calib.mono1, calib.mono2, calib.cam1, calib.cam2)
+        for e in cam.focal_rel_errors
+    ]
+    max_rms = max(calib.mono1.rms_px, calib.mono2.rms_px, calib.stereo_rms_px)
+    max_focal = max(abs(e) for e in focal_errors)
+    cameras = camera_parameters(calib)
+    result = StereoResult(
+        poses=views.poses_tried,
+        views=views.count,
+        renders=views.renders,
+        corner_rms_px=float(np.sqrt(np.mean(corner_errors**2))),
+        corner_max_px=float(corner_errors.max()),
+        cameras=(cameras[0], cameras[1]),
+        stereo_rms_px=calib.stereo_rms_px,
+        baseline_m=calib.baseline_m,
+        true_baseline_m=calib.true_baseline_m,
+        t_m=calib.T,
+        true_t_m=calib.true_cam2_from_cam1[:3, 3],
+        r=calib.R,
+        true_r=calib.true_cam2_from_cam1[:3, :3],
+        rotation_error_rad=calib.rotation_error_rad,
+        max_rms_px=max_rms,
+        max_abs_focal_error_pct=max_focal * 100,
+        passed=max_rms <= RMS_BOUND_PX and max_focal <= FOCAL_BOUND,
+        head_frames=tuple(summary),
+        targets=tuple(rows),
+    )
+    return [], result
+
+
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment.stereo]``: the board views (:class:`StereoSpec`), and the pattern."""
+    stereo = table.table("stereo") or Table({}, table.field("stereo"), table.ctx)
+    default = StereoSpec()
+    views = stereo.integer("views", default.views, MIN_VIEWS, 1000)
+    low, high = stereo.numbers(
+        "distance_m", 2, default.distance_m, 0.1, 5.0, lo_open=False, unit="m"
+    )
+    if low > high:
+        raise stereo.fail(
+            "distance_m", f"[{low:g}, {high:g}] is reversed", "[low, high], low <= high"
+        )
+    tilt = stereo.number("max_tilt_rad", default.max_tilt_rad, 0.0, 1.2, unit="rad")
+    refine = stereo.boolean("refine_intrinsics", default.refine_intrinsics)
+    pattern = stereo.data.get("pattern", list(CHESSBOARD_PATTERN))
+    stereo.has("pattern")
+    if pattern != list(CHESSBOARD_PATTERN):
+        columns, rows = CHESSBOARD_PATTERN
+        raise stereo.fail(
+            "pattern",
+            f"{pattern!r} is not the scene's board",
+            f"[{columns}, {rows}] (the chessboard scene's inner corners)",
+        )
+    stereo.done()
+    return {"block": StereoSpec(views, (low, high), tilt, refine)}
+
+
+STEREO = register(
+    Procedure(
+        "stereo",
+        "default",
+        run_stereo,
+        # The result is a StereoResult, or NotCalibrated where the views were too few.
+        fields=lambda result: result.block(),
+        summary=lambda result, paper: result.summary_lines(paper),
+        ok_line=lambda result, measured: result.ok_line(measured),
+        failures=lambda result: result.failures(),
+        rows=lambda result, log: result.log_rows(log),
+        options=read_options,
+        read_scene=targets_reader("stereo", required=True),
+    )
+)
+
+
+__all__ = [
+    "FOCAL_BOUND",
+    "HEAD_FRAMES",
+    "RMS_BOUND_PX",
+    "STEREO",
+    "HeadFrame",
+    "NotCalibrated",
+    "Parameter",
+    "StereoResult",
+    "StereoSpec",
+    "StereoTarget",
+    "calibrate",
+    "camera_parameters",
+    "head_frame",
+    "head_frames",
+    "run_stereo",
+]
