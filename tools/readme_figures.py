@@ -248,7 +248,7 @@ GENERATORS: dict[str, Generator] = {
     "reach_zoom_angles": Generator(
         servo.reach_zoom_angles, cheap=False, ci=False, group="zoom", seconds=15
     ),
-    "relative_areas": Generator(servo.relative_areas, cheap=False, seconds=80),
+    "relative_areas": Generator(servo.relative_areas, cheap=False, ci=False, seconds=80),
     "live_gaze": Generator(live.live_gaze, cheap=False, ci=False, seconds=70),
     "gym": Generator(live.gym_policies, cheap=False, seconds=5),
     "pursuit_belief": Generator(live.pursuit_belief, cheap=False, seconds=12),
@@ -258,7 +258,7 @@ GENERATORS: dict[str, Generator] = {
     "accuracy_by_preset": Generator(
         accuracy_by_preset, cheap=False, group="realistic field", seconds=30
     ),
-    "stress": Generator(stress, cheap=False, seconds=100),
+    "stress": Generator(stress, cheap=False, ci=False, seconds=100),
     "layouts": Generator(realistic.layouts, cheap=False, group="forward", seconds=35),
     "budget": Generator(realistic.budget, cheap=False, ci=False, seconds=75),
     "render_fidelity": Generator(servo.render_fidelity, cheap=False, group="fidelity", seconds=30),
