@@ -59,14 +59,18 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
                 else None
             )
             near = (spec.near_fraction or near_fraction(spec.depth_m)) if near_far else None
-            positions = calibration_layout(
-                sim.stereo_views(),
-                np.random.default_rng([seed, STREAM_CALIBRATION]),
-                spec.targets,
-                spec.depth_m,
-                spec.lateral,
-                spec.vertical,
-                depths_m=depths_m,
+            positions = (
+                calibration_layout(
+                    sim.stereo_views(),
+                    np.random.default_rng([seed, STREAM_CALIBRATION]),
+                    spec.targets,
+                    spec.depth_m,
+                    spec.lateral,
+                    spec.vertical,
+                    depths_m=depths_m,
+                )
+                if spec.positions_world_m is None
+                else np.array(spec.positions_world_m)
             )
         except ValueError as err:
             report = CalibrationReport(
@@ -93,7 +97,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
             renders=RenderCounts(),
             positions=(),
             layout=CalibrationLayout(
-                kind=spec.layout,
+                kind=spec.layout if spec.positions_world_m is None else "given",
                 near_fraction=near,
                 depth_m=list(spec.depth_m),
                 lateral=spec.lateral,

@@ -97,8 +97,8 @@ RESULTS_FIELDS: dict[str, str] = {
     "calibration.positions": "each layout position's `status` and `failure`, as a measurement's",
     "calibration.render_counts": "as the run's, for the calibration (in `from`, a stored "
     "calibration's, `null` for one written before schema 2)",
-    "calibration.layout": "the drawn positions: `kind`, `near_fraction`, `depth_m`, `lateral`, "
-    "`vertical`, `positions_world_m`",
+    "calibration.layout": "the positions: `kind` (a layout, or `given`), `near_fraction`, "
+    "`depth_m`, `lateral`, `vertical`, `positions_world_m`",
     "calibration.depth_noise_m": "error of the tape-measured depth of each ball, m",
     "calibration.position_noise_m": "error of every measured coordinate of every ball, m",
     "calibration.lines_of_sight_fit": "whether the extended line-of-sight fit was asked for",

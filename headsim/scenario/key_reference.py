@@ -244,6 +244,7 @@ DESCRIPTIONS: dict[str, str] = {
     "experiment.calibration.extended": "Also fit each camera's v0, kx/ky and line-of-sight offset (beyond the paper).",
     "experiment.calibration.lines_of_sight": "With `extended`: also fit each eye's line-of-sight offset.",
     "experiment.calibration.layout": "Depths uniform in `depth_m`, or most balls at the near end and the rest far.",
+    "experiment.calibration.positions_world_m": "The ball positions [[x, y, z], ...] in W, m, given instead of drawn (`targets` is their number).",
     "experiment.calibration.near_fraction": "`near_far` only: share of balls at the near end (default b / (a + b)).",
     "experiment.stereo": "The calibrated stereo baseline (procedure `stereo`): Zhang's calibration from chessboard views, then each target triangulated at eye angle 0.",
     "experiment.stereo.views": "Chessboard poses rendered for the calibration (at least 5 must show the whole board).",

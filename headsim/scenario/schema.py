@@ -25,7 +25,7 @@ from headsim.scenario.spec import (
     ExperimentSpec,
     ServoSpec,
 )
-from headsim.scenario.tables import Context, Table
+from headsim.scenario.tables import Context, Table, describe_value
 from headsim.sim import names
 from headsim.sim.optics import centre_ray_yaw
 from headsim.sim.settings import (
@@ -236,8 +236,9 @@ def _read_calibration(table: Table | None, lines_default: bool = False) -> Calib
     """``[experiment.calibration]``: Sec. V before the experiment."""
     if table is None:
         return None
+    positions = _calibration_positions(table)
     spec = CalibrationSpec(
-        targets=table.integer("targets", 60, 3, 1000),
+        targets=table.integer("targets", 60 if positions is None else len(positions), 3, 1000),
         depth_m=depth_range(table, (0.25, 0.6)),
         lateral=table.number("lateral", 0.16, 0.0, 1.0, lo_open=True, unit="(|x_h / z_h|)"),
         vertical=table.number("vertical", 0.08, 0.0, 1.0, unit="(|y_h / z_h|)"),
@@ -250,8 +251,19 @@ def _read_calibration(table: Table | None, lines_default: bool = False) -> Calib
         near_fraction=table.number(
             "near_fraction", None, 0.0, 1.0, lo_open=True, hi_open=True, unit="(share of balls)"
         ),
+        positions_world_m=positions,
     )
     table.done()
+    if positions is not None and spec.targets != len(positions):
+        raise table.fail(
+            "targets",
+            f"{spec.targets} with {len(positions)} positions_world_m",
+            "the number of positions_world_m, or no targets",
+        )
+    if positions is not None and spec.layout != "uniform":
+        raise table.fail(
+            "layout", f'"{spec.layout}" with positions_world_m', "no layout with given positions"
+        )
     if spec.near_fraction is not None and spec.layout != "near_far":
         raise table.fail(
             "near_fraction", f'given with layout = "{spec.layout}"', 'layout = "near_far"'
@@ -264,6 +276,33 @@ def _read_calibration(table: Table | None, lines_default: bool = False) -> Calib
             "a vertical spread > 0 (e.g. 0.08), or extended = false",
         )
     return spec
+
+
+def _calibration_positions(table: Table) -> tuple[tuple[float, float, float], ...] | None:
+    """``positions_world_m``: the calibration ball's positions, given (None: drawn)."""
+    key = "positions_world_m"
+    value = table.data.get(key)
+    table.has(key)
+    if value is None:
+        return None
+    allowed = "an array of 3 to 1000 [x, y, z] positions in W, m"
+    if (
+        not isinstance(value, list)
+        or not 3 <= len(value) <= 1000
+        or not all(isinstance(p, list) and len(p) == 3 for p in value)
+    ):
+        raise table.fail(
+            key, f"must be an array of [x, y, z], got {describe_value(value)}", allowed
+        )
+
+    def coordinate(i: int, value: Any) -> float:
+        return table._check_number(
+            f"{key}[{i}]", value, -MAX_DEPTH_M, MAX_DEPTH_M, False, False, allowed
+        )
+
+    return tuple(
+        (coordinate(i, p[0]), coordinate(i, p[1]), coordinate(i, p[2])) for i, p in enumerate(value)
+    )
 
 
 def depth_range(table: Table, default: tuple[float, float]) -> tuple[float, float]:

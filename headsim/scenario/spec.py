@@ -79,7 +79,9 @@ class CalibrationSpec:
     line-of-sight offset best, see :mod:`headsim.scenario.calibration_design`).
     ``source``: a calibration file (``headsim calibrate``) to use instead of
     calibrating (a relative path is relative to the scenario file's
-    directory); the other fields are then not used.
+    directory); the other fields are then not used.  ``positions_world_m``: the
+    ball positions in W, m, given instead of drawn (``targets`` is their number;
+    ``depth_m``, ``lateral``, ``vertical`` and ``layout`` are then not used).
     """
 
     targets: int = 60
@@ -93,6 +95,7 @@ class CalibrationSpec:
     source: str | None = None
     layout: str = "uniform"
     near_fraction: float | None = None
+    positions_world_m: tuple[tuple[float, float, float], ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -151,6 +154,9 @@ def experiment_record(experiment: ExperimentSpec) -> dict[str, Any]:
     record = {**asdict(experiment), "servo": servo_record(experiment.servo)}
     if experiment.block is None:
         del record["block"]
+    calibration = record["calibration"]
+    if calibration is not None and calibration["positions_world_m"] is None:
+        del calibration["positions_world_m"]  # recorded only when given
     return record
 
 
