@@ -440,3 +440,10 @@ def for_settings(
     """The simulator for ``settings`` in ``scene``: the one builder that code outside the
     simulator, the procedures, the runner and the tests goes through."""
     return HeadSim(scene, settings, settle_mode=settle_mode, sink=sink)
+
+
+def start_views(settings: HeadSettings, scene: str = "default") -> tuple[StereoView, ...]:
+    """The view of the head ``settings`` at its start pose in ``scene``: what a fresh
+    simulator's :meth:`HeadSim.stereo_views` gives (e.g. for a calibration layout)."""
+    with HeadSim(scene, settings) as sim:
+        return sim.stereo_views()

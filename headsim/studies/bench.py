@@ -21,9 +21,8 @@ from typing import Any
 
 import numpy as np
 
-from headsim.active.calibration import calibrate_head, line_of_sight_truth
+from headsim.active.calibration import line_of_sight_truth
 from headsim.active.events import Detected, PhaseStarted
-from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
 from headsim.estimators.throughput import run as estimator_throughput
@@ -33,15 +32,14 @@ from headsim.run.progress import Status
 from headsim.run.runner import run_scenario
 from headsim.scenario.loading import load_scenario, scenario_from_document
 from headsim.scenario.spec import Scenario
-from headsim.sim import names
 from headsim.sim.settings import HeadSettings, paper_head, preset
-from headsim.sim.simulator import HeadSim
+from headsim.sim.simulator import HeadSim, start_views
 from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
 from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
 from headsim.studies.calibrations import calibrate_realistic
 from headsim.studies.render_clock import RenderClock
-from headsim.studies.scenario_runs import knowledge_file, preset_of
+from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
 from headsim.studies.targets import random_targets_head, visible_vertical_range
 
 Progress = Callable[[str], None]
@@ -268,22 +266,17 @@ def _paper_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     metrics: Metrics = {}
     progress("paper's cameras: Sec. V calibration")
     settings = paper_head()
-    with HeadSim("default", settings) as sim:
-        run = calibrate_head(
-            sim,
-            EyeServo(sim),
-            experiments.BALL,
-            names.CALIBRATION_BALL,
-            calibration_layout(sim.stereo_views(), rng, 30),
-        )
-    knowledge = run.knowledge
+    knowledge, report = calibration_run(
+        settings, calibration_layout(start_views(settings), rng, 30)
+    )
     if faults.mount_sign:
         knowledge = HeadKnowledge(
             alpha_e=(-knowledge.alpha_e[0], knowledge.alpha_e[1]),
             v0=knowledge.v0,
             kx_over_ky=knowledge.kx_over_ky,
         )
-    metrics["paper.calibration.max_error_rad"] = float(np.abs(run.alpha_e_error).max())
+    assert report.alpha_e_error_rad is not None  # calibration_run raises if it failed
+    metrics["paper.calibration.max_error_rad"] = float(np.abs(report.alpha_e_error_rad).max())
 
     progress("paper's cameras: Model 2 near the centre row")
     low, high = visible_vertical_range(settings)

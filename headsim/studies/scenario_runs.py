@@ -9,11 +9,14 @@ calibration file that the scenario names (``experiment.calibration.from``).
 
 from __future__ import annotations
 
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from headsim.active.calibration_file import write_calibration
+from headsim.active.calibration_file import knowledge_from_block, write_calibration
+from headsim.active.calibration_report import CalibrationReport
 from headsim.active.measurement import HeadKnowledge
+from headsim.run.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
@@ -103,4 +106,22 @@ def knowledge_file(path: Path, settings: HeadSettings, knowledge: HeadKnowledge)
     return write_calibration(path, settings, block, "told", settings.seed)
 
 
-__all__ = ["head_document", "knowledge_file", "preset_of", "scenario_with_head"]
+def calibration_run(
+    settings: HeadSettings, positions_world_m: Any, **keys: Any
+) -> tuple[HeadKnowledge, CalibrationReport]:
+    """Sec. V on the head ``settings`` with the ball at ``positions_world_m`` ((N, 3), W,
+    m), through the runner; ``keys``: more ``[experiment.calibration]`` keys.  Returns what
+    the head learnt and the report (ValueError if the calibration failed)."""
+    calibration = {"positions_world_m": [[float(c) for c in p] for p in positions_world_m]}
+    doc = {
+        "description": "Sec. V on a study's ball layout",
+        "experiment": {"procedure": "calibration", "calibration": {**calibration, **keys}},
+    }
+    result = run_scenario(scenario_with_head(doc, "study_calibration", settings))
+    report = result.calibration
+    if not result.ok or report is None or report.knowledge is None:
+        raise ValueError(f"study calibration failed: {'; '.join(result.failures)}")
+    return knowledge_from_block({"knowledge": asdict(report.knowledge)}), report
+
+
+__all__ = ["calibration_run", "head_document", "knowledge_file", "preset_of", "scenario_with_head"]
