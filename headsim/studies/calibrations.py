@@ -4,6 +4,7 @@ cache that calibrates each head of a study once."""
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -21,6 +22,7 @@ from headsim.active.principal import (
     view_scale,
     zoomed,
 )
+from headsim.geometry.stereo_view import StereoView
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
@@ -166,11 +168,14 @@ def zoom_fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalP
         )
 
 
-def calibration_positions(sim: HeadSim, settings: HeadSettings, config: StudyConfig) -> np.ndarray:
-    """The Sec. V ball positions of every method (seeded by ``config.seed``)."""
+def calibration_positions(
+    views: Sequence[StereoView], settings: HeadSettings, config: StudyConfig
+) -> np.ndarray:
+    """The Sec. V ball positions of every method (seeded by ``config.seed``) in the
+    ``views`` of the head ``settings`` (e.g. :func:`headsim.sim.simulator.start_views`)."""
     scale = view_scale(settings)
     return calibration_layout(
-        sim.stereo_views(),
+        views,
         np.random.default_rng(config.seed + 2),
         config.calibration_targets,
         depth_range_m=(0.25 * scale, 0.6 * scale),
@@ -197,7 +202,7 @@ def calibrate_methods(
         + " px"
     )
     with HeadSim("default", settings) as sim:
-        positions = calibration_positions(sim, settings, config)
+        positions = calibration_positions(sim.stereo_views(), settings, config)
         active = calibrate_head(sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, positions)
         progress(
             f"  Sec. V, image centre: {active.samples} samples, alpha_e error "

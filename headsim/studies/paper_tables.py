@@ -35,22 +35,21 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from headsim.active.calibration import CalibrationRun, calibrate_head
 from headsim.active.eye_servo import EyeServo
 from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import measure_model2
 from headsim.active.principal import PrincipalPointRun, zoomed
 from headsim.estimators import model2
-from headsim.sim import names
 from headsim.sim.settings import HeadSettings
-from headsim.sim.simulator import HeadSim
+from headsim.sim.simulator import HeadSim, start_views
 from headsim.stereo.calibration import StereoCalibration
 from headsim.stereo.triangulation import measure_point_stereo
 from headsim.stereo.views import StereoError
 from headsim.studies.calibrations import calibration_positions, zhang_stereo, zoom_fixed_points
 from headsim.studies.conditions import Condition, ConditionResult
-from headsim.studies.methods import BALL, METHODS, TARGET, StudyConfig
+from headsim.studies.methods import METHODS, TARGET, StudyConfig
+from headsim.studies.scenario_runs import calibration_run
 from headsim.studies.study_experiments import Experiment, ExperimentResult
 from headsim.studies.target_errors import TargetError, summarise
 from headsim.studies.targets import place_in_head, table_targets
@@ -76,7 +75,8 @@ class FixedPoint:
     their columns, and the renders both took."""
 
     principal: PrincipalPointRun
-    calibration: CalibrationRun
+    #: What Sec. V on the fixed points' columns taught the head.
+    calibrated: HeadKnowledge
     renders: int
     #: The head and seed the fixed points were found on (None: not recorded).
     settings: HeadSettings | None = None
@@ -86,28 +86,19 @@ class FixedPoint:
         """``active_fixed_point``'s knowledge, or with ``refound``'s columns and rows
         (``active_refound``)."""
         if refound is None:
-            return self.calibration.knowledge
+            return self.calibrated
         (u1, v1), (u2, v2) = refound.principal_px
-        return replace(self.calibration.knowledge, u0=(u1, u2), v0=(v1, v2))
+        return replace(self.calibrated, u0=(u1, u2), v0=(v1, v2))
 
 
 def fixed_point_calibration(settings: HeadSettings, config: StudyConfig) -> FixedPoint:
     """The fixed points of a zoom (images only) and Sec. V with the servo on their columns."""
     principal = zoom_fixed_points(settings, config)
-    with HeadSim("default", settings) as sim:
-        positions = calibration_positions(sim, settings, config)
-        (u1, _), (u2, _) = principal.principal_px
-        start = sim.render_count
-        calibration = calibrate_head(
-            sim,
-            EyeServo(sim),
-            BALL,
-            names.CALIBRATION_BALL,
-            positions,
-            knowledge=HeadKnowledge(u0=(u1, u2)),
-        )
-        renders = principal.renders + sim.render_count - start
-    return FixedPoint(principal, calibration, renders, settings, config.seed)
+    positions = calibration_positions(start_views(settings), settings, config)
+    (u1, _), (u2, _) = principal.principal_px
+    knowledge, report = calibration_run(settings, positions, goal_columns_px=(u1, u2))
+    renders = principal.renders + report.renders.total
+    return FixedPoint(principal, knowledge, renders, settings, config.seed)
 
 
 def active_knowledge(stored: HeadKnowledge, zhang: StereoCalibration) -> dict[str, HeadKnowledge]:

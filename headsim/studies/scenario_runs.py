@@ -107,16 +107,23 @@ def knowledge_file(path: Path, settings: HeadSettings, knowledge: HeadKnowledge)
 
 
 def calibration_run(
-    settings: HeadSettings, positions_world_m: Any, **keys: Any
+    settings: HeadSettings,
+    positions_world_m: Any,
+    goal_columns_px: tuple[float, float] | None = None,
+    **keys: Any,
 ) -> tuple[HeadKnowledge, CalibrationReport]:
     """Sec. V on the head ``settings`` with the ball at ``positions_world_m`` ((N, 3), W,
-    m), through the runner; ``keys``: more ``[experiment.calibration]`` keys.  Returns what
-    the head learnt and the report (ValueError if the calibration failed)."""
+    m), through the runner, the servo on ``goal_columns_px`` (None: the image centres);
+    ``keys``: more ``[experiment.calibration]`` keys.  Returns what the head learnt and
+    the report (ValueError if the calibration failed)."""
     calibration = {"positions_world_m": [[float(c) for c in p] for p in positions_world_m]}
-    doc = {
-        "description": "Sec. V on a study's ball layout",
-        "experiment": {"procedure": "calibration", "calibration": {**calibration, **keys}},
+    experiment: dict[str, Any] = {
+        "procedure": "calibration",
+        "calibration": {**calibration, **keys},
     }
+    if goal_columns_px is not None:
+        experiment["goal_columns_px"] = [float(u) for u in goal_columns_px]
+    doc = {"description": "Sec. V on a study's ball layout", "experiment": experiment}
     result = run_scenario(scenario_with_head(doc, "study_calibration", settings))
     report = result.calibration
     if not result.ok or report is None or report.knowledge is None:
