@@ -9,8 +9,8 @@ import pytest
 
 from headsim.sim import names
 from headsim.sim.joints import JointLimitError, SettleOutcome
-from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
-from headsim.sim.simulator import HeadSim
+from headsim.sim.settings import CameraSettings, HeadSettings, paper_head, preset
+from headsim.sim.simulator import HeadSim, start_views
 
 
 @pytest.fixture
@@ -181,3 +181,20 @@ def test_effective_initial_direction_agrees_with_the_forward_model() -> None:
                 camera, cam.mount_yaw_rad, pinhole, cam.image_centre[0]
             )
             assert sim.effective_initial_direction(camera) == pytest.approx(expected, abs=1e-12)
+
+
+def test_start_views_are_a_fresh_simulators_views_of_the_same_head() -> None:
+    settings = preset("realistic")  # joint errors: the start pose is not the design's
+    views = start_views(settings)
+    with HeadSim("default", settings) as sim:
+        (fresh,) = sim.stereo_views()
+        sim.move(eye=0.1)
+        (turned,) = sim.stereo_views()
+    (view,) = views
+    np.testing.assert_array_equal(view.world_from_head, fresh.world_from_head)
+    for mine, theirs, moved in zip(
+        view.camera_from_world, fresh.camera_from_world, turned.camera_from_world, strict=True
+    ):
+        np.testing.assert_array_equal(mine, theirs)
+        assert not np.array_equal(mine, moved)
+    assert view.cameras == fresh.cameras
