@@ -77,6 +77,8 @@ class FixedPoint:
     principal: PrincipalPointRun
     #: What Sec. V on the fixed points' columns taught the head.
     calibrated: HeadKnowledge
+    #: Its effective initial directions minus the truth, rad (camera 1, 2).
+    alpha_e_error_rad: tuple[float, float]
     renders: int
     #: The head and seed the fixed points were found on (None: not recorded).
     settings: HeadSettings | None = None
@@ -98,7 +100,9 @@ def fixed_point_calibration(settings: HeadSettings, config: StudyConfig) -> Fixe
     (u1, _), (u2, _) = principal.principal_px
     knowledge, report = calibration_run(settings, positions, goal_columns_px=(u1, u2))
     renders = principal.renders + report.renders.total
-    return FixedPoint(principal, knowledge, renders, settings, config.seed)
+    assert report.alpha_e_error_rad is not None  # calibration_run raises if it failed
+    error1, error2 = report.alpha_e_error_rad
+    return FixedPoint(principal, knowledge, (error1, error2), renders, settings, config.seed)
 
 
 def active_knowledge(stored: HeadKnowledge, zhang: StereoCalibration) -> dict[str, HeadKnowledge]:

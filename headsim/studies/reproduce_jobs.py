@@ -186,7 +186,7 @@ def tables_job(
                 "renders": fixed["fixed"].renders,
                 "targets": fixed["targets"],
                 "principal_error_px": fixed["fixed"].principal.errors_px,
-                "alpha_e_error_mrad": [1e3 * e for e in fixed["fixed"].calibration.alpha_e_error],
+                "alpha_e_error_mrad": [1e3 * e for e in fixed["fixed"].alpha_e_error_rad],
             },
             "renders": zhang["renders"]
             + fixed["fixed"].renders
