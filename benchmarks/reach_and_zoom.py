@@ -6,7 +6,9 @@ scenario's reach check (``headsim.scenario.reach.reach_refusal``) accepts or
 refuses each one (with its reason), the head calibrates on a layout drawn
 from the same seed (``calibration_layout`` with the eyes allowed to turn in,
 every position's outcome recorded), and every accepted point is measured
-with Model 2 and Model 1 (the neck left where the last target was).  Prints
+with Model 2 and Model 1 (the neck left where the last target was): each a
+scenario run through the runner, the calibration's knowledge told to the
+measurements as a calibration file.  Prints
 per zoom and model: accepted, measured, failures by cause, 3-D error RMS
 (mm, % of depth), renders per point over all targets and without the ones
 that needed a search, the search's extra renders, the Model 2 fixation
@@ -22,30 +24,30 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 import time
 from collections import Counter
-from dataclasses import replace
+from dataclasses import asdict, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.active.calibration import CalibrationError, calibrate_head
-from headsim.active.eye_servo import EyeServo
-from headsim.active.measurement import HeadKnowledge, Measurement
-from headsim.active.model1 import measure_model1
-from headsim.active.model2 import measure_model2
-from headsim.active.neck_servo import NeckServo
+from headsim.active.calibration_file import knowledge_from_block
+from headsim.active.measurement import Measurement
 from headsim.active.placement import calibration_layout
-from headsim.active.principal import PROBE_ZOOM, principal_points_by_zoom
-from headsim.active.principal import zoomed as zoomed_head
-from headsim.active.servo_types import ServoConfig
 from headsim.files import write_json_atomic
-from headsim.run.targets import marker_target
+from headsim.run.runner import run_scenario
+from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.reach import reach_refusal
+from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.settings import FINE_RENDERING, HeadSettings, paper_head
-from headsim.sim.simulator import HeadSim
+from headsim.sim.simulator import effective_initial_direction, start_views
+from headsim.studies.calibrations import zoom_fixed_points
+from headsim.studies.methods import StudyConfig
+from headsim.studies.scenario_runs import head_document, knowledge_file
 
 ZOOMS = (0.5, 0.7, 1.0, 1.3, 1.6, 2.0)
 BODY = names.MARKERS[0]
@@ -124,6 +126,24 @@ def stats(ms: list[Measurement]) -> dict[str, Any]:
     }
 
 
+def _scenario(
+    settings: HeadSettings, experiment: dict[str, Any], scene: dict[str, Any] | None = None
+) -> Scenario:
+    """The scenario of ``experiment`` (and ``scene``) on the head ``settings``."""
+    tables = head_document(settings)
+    tables["head"].update(
+        render_offsamples=settings.render.offsamples,
+        render_supersample=settings.render.supersample,
+    )
+    doc = {"description": "reach and zoom", **tables, "experiment": experiment}
+    if scene is not None:
+        doc["scene"] = scene
+    scenario = scenario_from_document(doc, "reach_and_zoom")
+    if scenario.settings != settings:
+        raise ValueError("the zoomed head has settings its scenario cannot state")
+    return scenario
+
+
 def run_zoom(
     zoom: float,
     points_head: np.ndarray,
@@ -135,7 +155,8 @@ def run_zoom(
     average_fixation: bool = False,
 ) -> dict[str, Any]:
     """Calibrate (the layout drawn from the same seed at every zoom, where this zoom's
-    cameras see it) and measure every point the reach check accepts at ``zoom``."""
+    cameras see it) and measure every point the reach check accepts at ``zoom``: the
+    calibration, Model 2 and Model 1 each a scenario run."""
     settings = zoomed(zoom, seed, fine)
     accepted, refused = check_targets(settings, points_head)
     out: dict[str, Any] = {
@@ -143,60 +164,71 @@ def run_zoom(
         "accepted": int(accepted.sum()),
         "refused": dict(refused),
     }
-    base = HeadKnowledge()
+    servo = {"average_fixation": average_fixation}
+    goal_columns: dict[str, Any] = {}
     if goal == "fixed-point":
         # The goal columns through each camera's zoom fixed point, from images alone.
-        with (
-            HeadSim("chessboard", settings) as before,
-            HeadSim("chessboard", zoomed_head(settings, PROBE_ZOOM)) as after,
-        ):
-            found = principal_points_by_zoom(before, after, rng=np.random.default_rng(seed))
-        base = HeadKnowledge(u0=(found.principal_px[0][0], found.principal_px[1][0]))
-        out["goal_columns_px"] = [base.u0[0], base.u0[1]]
+        found = zoom_fixed_points(settings, StudyConfig(seed=seed, principal_poses=2))
+        columns = [float(found.principal_px[0][0]), float(found.principal_px[1][0])]
+        goal_columns["goal_columns_px"] = columns
+        out["goal_columns_px"] = columns
         out["goal_column_error_px"] = [float(e) for e in found.errors_px[:, 0]]
-    errors = {m: np.full(len(points_head), np.nan) for m in ("model2", "model1")}
-    with HeadSim("default", settings) as sim:
-        config = ServoConfig(average_fixation=average_fixation)
-        servo = EyeServo(sim, config)
-        ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
-        # Balls where both cameras see them at the start pose or with the eyes
-        # turned in (0.1-0.3 rad): at 1.6x-2x the start pose's common view holds
-        # only near-central ones, which leave the two offsets' difference
-        # undetermined (x/z spread 0.023 against 0.074, 0.42 against 0.09 mrad).
-        positions = calibration_layout(
-            sim.stereo_views(CALIBRATION_EYES), np.random.default_rng([seed, 7]), calibration
+    # Balls where both cameras see them at the start pose or with the eyes
+    # turned in (0.1-0.3 rad): at 1.6x-2x the start pose's common view holds
+    # only near-central ones, which leave the two offsets' difference
+    # undetermined (x/z spread 0.023 against 0.074, 0.42 against 0.09 mrad).
+    positions = calibration_layout(
+        start_views(settings, "default", CALIBRATION_EYES),
+        np.random.default_rng([seed, 7]),
+        calibration,
+    )
+    calibrated = run_scenario(
+        _scenario(
+            settings,
+            {
+                "procedure": "calibration",
+                "calibration": {"positions_world_m": [[float(c) for c in p] for p in positions]},
+                "servo": servo,
+                **goal_columns,
+            },
         )
-        try:
-            run = calibrate_head(
-                sim, servo, ball, names.CALIBRATION_BALL, positions, knowledge=base
-            )
-            knowledge = run.knowledge
-            outcomes = run.outcomes
-            out["calibration"] = {
-                "positions": len(outcomes),
-                "fixated": sum(o is None for o in outcomes),
-                "not_fixated": dict(Counter(o.message for o in outcomes if o is not None)),
-                "alpha_e_error_rad": [float(x) for x in run.alpha_e_error],
-            }
-        except CalibrationError as err:
-            out["calibration"] = {"failed": str(err), "positions": len(err.outcomes)}
-            out["calibration"]["fixated"] = sum(o is None for o in err.outcomes)
-            return out
-        if oracle:  # diagnostic: the true initial directions instead of the calibrated ones
-            knowledge = replace(knowledge, alpha_e=run.truth_alpha_e)
-        world = [_head_to_world(settings, p) for p in points_head]
-        index = np.flatnonzero(accepted)
-        m2 = []
-        for k in index:
-            sim.set_body_pose(BODY, world[k])
-            m2.append(measure_model2(sim, servo, marker_target(f"t{k}", BODY), knowledge))
-        sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
-        sim.settle()
-        neck = NeckServo(sim, config)
-        m1 = []
-        for k in index:
-            sim.set_body_pose(BODY, world[k])
-            m1.append(measure_model1(sim, neck, marker_target(f"t{k}", BODY), knowledge))
+    )
+    report = calibrated.calibration
+    assert report is not None
+    outcomes = report.positions
+    fixated = sum(o.failure is None for o in outcomes)
+    if not calibrated.ok or report.knowledge is None:
+        out["calibration"] = {
+            "failed": report.detail,
+            "positions": len(outcomes),
+            "fixated": fixated,
+        }
+        return out
+    assert report.alpha_e_error_rad is not None
+    out["calibration"] = {
+        "positions": len(outcomes),
+        "fixated": fixated,
+        "not_fixated": dict(Counter(o.status_text for o in outcomes if o.failure is not None)),
+        "alpha_e_error_rad": [float(x) for x in report.alpha_e_error_rad],
+    }
+    knowledge = knowledge_from_block({"knowledge": asdict(report.knowledge)})
+    # The true initial directions through the servo's goal columns (scoring only).
+    truth_alpha_e = tuple(effective_initial_direction(settings, i, knowledge.u0[i]) for i in (0, 1))
+    if oracle:  # diagnostic: the true initial directions instead of the calibrated ones
+        knowledge = replace(knowledge, alpha_e=(truth_alpha_e[0], truth_alpha_e[1]))
+    index = np.flatnonzero(accepted)
+    targets = [
+        {"name": f"t{k}", "body": BODY, "position_head_m": [float(c) for c in points_head[k]]}
+        for k in index
+    ]
+    measured: dict[str, list[Measurement]] = {}
+    with tempfile.TemporaryDirectory() as folder:
+        told = knowledge_file(Path(folder) / "calibration.json", settings, knowledge)
+        for model in ("model2", "model1"):
+            experiment = {"procedure": model, "calibration": {"from": str(told)}, "servo": servo}
+            run = run_scenario(_scenario(settings, experiment, {"targets": targets}))
+            measured[model] = [r.measurement for r in run.records]
+    m2 = measured["model2"]
     # Scoring only: each Model 2 fixation angle against the true one (the angle
     # resolution the images give, no calibration in it), mrad.
     half = settings.baseline_m / 2
@@ -204,15 +236,16 @@ def run_zoom(
     for m in m2:
         if m.ok:
             x, _, z = m.truth_head_m
-            true1 = np.arctan2(x + half, z) - run.truth_alpha_e[0]
-            true2 = np.arctan2(half - x, z) - run.truth_alpha_e[1]
+            true1 = np.arctan2(x + half, z) - truth_alpha_e[0]
+            true2 = np.arctan2(half - x, z) - truth_alpha_e[1]
             fixation.append((m.details["alpha1_rad"] - true1, m.details["alpha2_rad"] - true2))
     fix = np.array(fixation) * 1e3
     out["fixation_error_mrad"] = {
         "mean": [float(v) for v in fix.mean(axis=0)],
         "std": [float(v) for v in fix.std(axis=0)],
     }
-    for model, ms in (("model2", m2), ("model1", m1)):
+    errors = {m: np.full(len(points_head), np.nan) for m in ("model2", "model1")}
+    for model, ms in measured.items():
         out[model] = stats(ms)
         for k, m in zip(index, ms, strict=True):
             if m.ok:

@@ -3,8 +3,9 @@
 Layouts place the six objects of the blocks scene so that every area S1..S12
 gets at least ``--per-area`` objects (``headsim.scenario.area_layouts``: rejection from
 the true geometry, all four images seeing each object), around a reference
-drawn at 0.7-1.4 m.  Each layout runs ``relative_positioning`` (the reference
-with Model 2, four images, eq. 12).  Prints per true area: objects, and for
+drawn at 0.7-1.4 m.  Each layout is a scenario of the ``relative_positioning``
+procedure (the reference with Model 2, four images, eq. 12), run on a fresh
+simulator through the runner.  Prints per true area: objects, and for
 the paper's test (pixel offsets) and the gain-normalised test (offsets over
 each camera's servo-learnt px per encoder step, no intrinsics) the agreement
 with the geometric truth, all and outside a 2 px margin.  Then the paper's
@@ -24,19 +25,36 @@ from typing import Any
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.active.eye_servo import EyeServo
-from headsim.active.measurement import body_target
 from headsim.files import write_json_atomic
-from headsim.procedures.relative import relative_positioning
-from headsim.run.context import PARKED_WORLD_M
+from headsim.procedures.relative import RelativeResult
+from headsim.run.runner import run_scenario
 from headsim.scenario.area_layouts import area_layout
+from headsim.scenario.loading import scenario_from_document
 from headsim.sim import names
 from headsim.sim.settings import preset
-from headsim.sim.simulator import HeadSim
-from headsim.vision.crosses import find_cross_point
 
 MAGNITUDE_AREAS = (1, 2, 3, 4, 7, 8)
 OBJECT_RADIUS_M = 0.006
+
+
+def layout_document(
+    preset_name: str, seed: int, reference_head: np.ndarray, placed_head: dict[str, np.ndarray]
+) -> dict[str, Any]:
+    """The scenario of one layout: the cross point at ``reference_head`` and each placed
+    object (body -> position in H at the start pose, m); the others parked."""
+    return {
+        "description": "Relative positioning on one area layout",
+        "seed": seed,
+        "head": {"preset": preset_name},
+        "experiment": {"procedure": "relative_positioning"},
+        "scene": {
+            "blocks": {"position_head_m": [float(v) for v in reference_head]},
+            "objects": [
+                {"body": body, "position_head_m": [float(v) for v in p]}
+                for body, p in placed_head.items()
+            ],
+        },
+    }
 
 
 def area_study(
@@ -47,101 +65,91 @@ def area_study(
     progress: bool = True,
 ) -> dict[str, Any]:
     """Layouts until every area holds ``per_area`` objects seen in all four images, then
-    ``near_axis`` near Z_h; every object's row (``rows``), and the layouts' counts.
-    ``progress``: each layout's number on stderr."""
+    ``near_axis`` near Z_h, each a scenario run; every object's row (``rows``), and the
+    layouts' counts.  ``progress``: each layout's number on stderr."""
     rng = np.random.default_rng(seed)
+    settings = preset(preset_name, seed=seed)
     objects = names.RELATIVE_OBJECTS
     n_layouts = int(np.ceil(12 * per_area / len(objects)))
     rows: list[dict[str, Any]] = []
-    reference = body_target(names.BLOCKS, find_cross_point)
     layout_failures = 0
-    with HeadSim("blocks", preset(preset_name, seed=seed)) as sim:
-        servo = EyeServo(sim)
-        seen_per_area = dict.fromkeys(range(1, 13), 0)
-        spread_layouts = 0
-        layout = -1
-        # Spread layouts until every area holds ``per_area`` objects seen in all four
-        # images (at most three times the planned count), then the near-axis ones.
-        while True:
-            layout += 1
-            near = min(seen_per_area.values()) >= per_area or layout >= 3 * n_layouts
-            if near and layout - spread_layouts >= near_axis:
-                break
-            if near:  # magnitude-test areas only, within |x/z| <= 0.02 of the Z_h axis
-                wanted = [MAGNITUDE_AREAS[(layout + j) % 6] for j in range(len(objects))]
-            else:
-                spread_layouts += 1
-                short = sorted(seen_per_area, key=lambda a: (seen_per_area[a], a))
-                wanted = [short[j % len(short)] for j in range(len(objects))]
-            placed = None
-            for _attempt in range(12):  # a reference where the wanted areas exist in view
-                # Near the midline and not far: the step-2 lines of sight then cross
-                # within 3 m, so S1 and S2 (beyond that crossing) exist in view.
-                # Near-axis layouts put the reference aside, so that its plate hides
-                # nothing on the axis.
-                z = rng.uniform(0.6, 1.1)
-                side = rng.choice((-1.0, 1.0)) * rng.uniform(0.06, 0.1)
-                lateral = side if near else rng.uniform(-0.04, 0.04)
-                ref_head = np.array([lateral * z, rng.uniform(-0.05, 0.05) * z, z])
-                sim.command_eye_steps(0)
-                sim.settle()
-                sim.set_body_pose(names.BLOCKS, sim.transform_points(ref_head, "head", "world")[0])
-                try:
-                    placed = area_layout(
-                        sim,
-                        ref_head,
-                        wanted,
-                        rng,
-                        radius_m=OBJECT_RADIUS_M,
-                        depth_m=(0.3, 3.0),
-                        lateral=0.02 if near else 0.4,
-                        partial=True,
-                    )
-                    break
-                except ValueError as err:
-                    last_error = str(err)
-            if placed is None:
-                layout_failures += 1
-                if progress:
-                    print(f"  layout {layout + 1}: {last_error}", file=sys.stderr)
-                continue
-            world = sim.transform_points(np.nan_to_num(placed), "head", "world")
-            colours = {}
-            for body, p, p_head in zip(objects, world, placed, strict=True):
-                unplaced = bool(np.isnan(p_head).any())
-                sim.set_body_pose(body, PARKED_WORLD_M if unplaced else p)
-                if not unplaced:
-                    colours[body] = names.RELATIVE_OBJECT_COLOURS[body]
-            run = relative_positioning(sim, servo, reference, colours)
-            if progress:
-                print(f"  layout {layout + 1}", end="\r", file=sys.stderr, flush=True)
-            seen = [o for o in colours if o not in run.missing]
-            margin = dict(zip(seen, run.comparison.margin, strict=True)) if run.comparison else {}
-            gain_margin = (
-                dict(zip(seen, run.gain_comparison.margin, strict=True))
-                if run.gain_comparison
-                else {}
-            )
-            for body, want, p in zip(objects, wanted, placed, strict=True):
-                if body not in colours:
-                    continue
-                if not near and body in seen and run.true_areas.get(body, 0):
-                    seen_per_area[run.true_areas[body]] += 1
-                rows.append(
-                    {
-                        "near_axis": near,
-                        "wanted": want,
-                        "true": run.true_areas.get(body, 0),
-                        "paper": run.areas.get(body, 0),
-                        "gain": run.gain_areas.get(body, 0),
-                        "margin_px": float(margin.get(body, np.nan)),
-                        "gain_margin_px": float(gain_margin.get(body, np.nan)),
-                        "seen": body in seen,
-                        "reference_ok": run.reference.ok,
-                        "x_over_z": float(p[0] / p[2]),
-                        "x_h_m": float(p[0]),
-                    }
+    seen_per_area = dict.fromkeys(range(1, 13), 0)
+    spread_layouts = 0
+    layout = -1
+    # Spread layouts until every area holds ``per_area`` objects seen in all four
+    # images (at most three times the planned count), then the near-axis ones.
+    while True:
+        layout += 1
+        near = min(seen_per_area.values()) >= per_area or layout >= 3 * n_layouts
+        if near and layout - spread_layouts >= near_axis:
+            break
+        if near:  # magnitude-test areas only, within |x/z| <= 0.02 of the Z_h axis
+            wanted = [MAGNITUDE_AREAS[(layout + j) % 6] for j in range(len(objects))]
+        else:
+            spread_layouts += 1
+            short = sorted(seen_per_area, key=lambda a: (seen_per_area[a], a))
+            wanted = [short[j % len(short)] for j in range(len(objects))]
+        placed = None
+        for _attempt in range(12):  # a reference where the wanted areas exist in view
+            # Near the midline and not far: the step-2 lines of sight then cross
+            # within 3 m, so S1 and S2 (beyond that crossing) exist in view.
+            # Near-axis layouts put the reference aside, so that its plate hides
+            # nothing on the axis.
+            z = rng.uniform(0.6, 1.1)
+            side = rng.choice((-1.0, 1.0)) * rng.uniform(0.06, 0.1)
+            lateral = side if near else rng.uniform(-0.04, 0.04)
+            ref_head = np.array([lateral * z, rng.uniform(-0.05, 0.05) * z, z])
+            try:
+                placed = area_layout(
+                    settings,
+                    ref_head,
+                    wanted,
+                    rng,
+                    radius_m=OBJECT_RADIUS_M,
+                    depth_m=(0.3, 3.0),
+                    lateral=0.02 if near else 0.4,
+                    partial=True,
                 )
+                break
+            except ValueError as err:
+                last_error = str(err)
+        if placed is None:
+            layout_failures += 1
+            if progress:
+                print(f"  layout {layout + 1}: {last_error}", file=sys.stderr)
+            continue
+        placed_head = {
+            body: p for body, p in zip(objects, placed, strict=True) if not np.isnan(p).any()
+        }
+        doc = layout_document(preset_name, seed, ref_head, placed_head)
+        result = run_scenario(scenario_from_document(doc, "relative_area_layout"))
+        run: RelativeResult = result.experiment
+        (reference,) = result.records
+        if progress:
+            print(f"  layout {layout + 1}", end="\r", file=sys.stderr, flush=True)
+        by_body = {o.name: o for o in run.objects}
+        for body, want, p in zip(objects, wanted, placed, strict=True):
+            if body not in placed_head:
+                continue
+            o = by_body[body]
+            seen = body not in run.missing
+            if not near and seen and o.true_area:
+                seen_per_area[o.true_area] += 1
+            rows.append(
+                {
+                    "near_axis": near,
+                    "wanted": want,
+                    "true": o.true_area,
+                    "paper": o.area,
+                    "gain": o.gain_area,
+                    "margin_px": float(o.margin_px),
+                    "gain_margin_px": float(o.gain_margin_px),
+                    "seen": seen,
+                    "reference_ok": reference.measurement.ok,
+                    "x_over_z": float(p[0] / p[2]),
+                    "x_h_m": float(p[0]),
+                }
+            )
     if progress:
         print(file=sys.stderr)
     return {

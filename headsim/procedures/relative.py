@@ -69,6 +69,9 @@ class RelativeObject:
     gain_agree: bool
     columns_px: list[float]
     position_head_m: np.ndarray
+    #: The gain-normalised test's distance from an area boundary, px (NaN: not compared);
+    #: for studies, not written to results.json.
+    gain_margin_px: float
 
 
 @dataclass(frozen=True)
@@ -97,8 +100,12 @@ class RelativeResult:
     paper: RelativePaper
 
     def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: every field, in order."""
-        return asdict(self)
+        """results.json's ``experiment`` fields: every field, in order (each object's but
+        ``gain_margin_px``)."""
+        block = asdict(self)
+        for entry in block["objects"]:
+            del entry["gain_margin_px"]
+        return block
 
     def failures(self) -> tuple[str, ...]:
         """Each object not seen in all four images."""
@@ -337,6 +344,9 @@ def run_relative(
     comparison = run.comparison
     seen = [name for name in colours if name not in run.missing]
     margins = dict(zip(seen, comparison.margin, strict=True)) if comparison is not None else {}
+    gain_margins = (
+        dict(zip(seen, run.gain_comparison.margin, strict=True)) if run.gain_comparison else {}
+    )
     objects = tuple(
         RelativeObject(
             name=name,
@@ -349,6 +359,7 @@ def run_relative(
             gain_agree=name in run.gain_areas and run.gain_areas[name] == run.true_areas[name],
             columns_px=list(run.columns.get(name, (float("nan"),) * 4)),
             position_head_m=positions_head[name],
+            gain_margin_px=gain_margins.get(name, float("nan")),
         )
         for name, colour in colours.items()
     )

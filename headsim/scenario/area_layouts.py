@@ -17,24 +17,27 @@ import numpy as np
 
 from headsim.estimators.areas import areas_from_geometry
 from headsim.geometry.sampling import sample_points_head
-from headsim.sim.simulator import HeadSim
+from headsim.geometry.stereo_view import StereoView
+from headsim.scenario.scene import start_head_to_world
+from headsim.sim.settings import HeadSettings
+from headsim.sim.simulator import effective_initial_direction, start_views
 
 
-def reference_angles(sim: HeadSim, reference_head: np.ndarray) -> tuple[float, float]:
+def reference_angles(settings: HeadSettings, reference_head: np.ndarray) -> tuple[float, float]:
     """True encoder angles (alpha1, alpha2) at which Ca1, Ca2 fixate a point in H, rad."""
-    half = sim.settings.baseline_m / 2
+    half = settings.baseline_m / 2
     x, _, z = reference_head
-    alpha1 = math.atan2(x + half, z) - sim.effective_initial_direction(1)
-    alpha2 = math.atan2(half - x, z) - sim.effective_initial_direction(2)
+    alpha1 = math.atan2(x + half, z) - effective_initial_direction(settings, 0)
+    alpha2 = math.atan2(half - x, z) - effective_initial_direction(settings, 1)
     return alpha1, alpha2
 
 
 def seen_in_four_images(
-    sim: HeadSim, points_world: np.ndarray, alpha1: float, alpha2: float, radius_m: float
+    views: Sequence[StereoView], points_world: np.ndarray, radius_m: float
 ) -> np.ndarray:
-    """(N,) whether both cameras see each point whole at both eye angles (no render)."""
+    """(N,) whether both cameras see each point whole in every one of ``views`` (no render)."""
     ok = np.ones(len(points_world), dtype=bool)
-    for view in sim.stereo_views((alpha1, alpha2))[1:]:
+    for view in views:
         ok &= view.sees_whole(points_world, radius_m)
     return ok
 
@@ -80,7 +83,7 @@ def _overlaps(
 
 
 def area_layout(
-    sim: HeadSim,
+    settings: HeadSettings,
     reference_head: np.ndarray,
     wanted: Sequence[int],
     rng: np.random.Generator,
@@ -93,6 +96,7 @@ def area_layout(
     batches: int = 40,
     partial: bool = False,
     gap_rad: float = 0.01,
+    scene: str = "blocks",
 ) -> np.ndarray:
     """Positions in H (len(wanted), 3), m: object k in true area ``wanted[k]``, seen in all four images.
 
@@ -103,17 +107,20 @@ def area_layout(
     the reference's distance) or more from the reference's.  Nor where its
     image would touch another placed object's (``gap_rad`` between the balls'
     edges, seen from either camera): a partly hidden ball's centroid moves by
-    up to its radius, which the images cannot tell from a shift.
+    up to its radius, which the images cannot tell from a shift.  The head
+    ``settings`` at its start pose in ``scene`` (the neck at 0), the eyes
+    turned to the reference's fixations.
     """
-    alpha1, alpha2 = reference_angles(sim, reference_head)
-    effective = (sim.effective_initial_direction(1), sim.effective_initial_direction(2))
+    alpha1, alpha2 = reference_angles(settings, reference_head)
+    effective = (effective_initial_direction(settings, 0), effective_initial_direction(settings, 1))
+    views = start_views(settings, scene, (alpha1, alpha2))[1:]
     chosen: list[np.ndarray | None] = [None] * len(wanted)
     for _ in range(batches):
         n = 4000
         points = sample_points_head(rng, n, (-lateral, lateral), vertical, depth_range_m=depth_m)
-        areas = areas_from_geometry(points, alpha1, alpha2, sim.settings.baseline_m, effective)
-        areas[_hides_or_hidden(points, reference_head, sim.settings.baseline_m, clear_m)] = 0
-        world = sim.transform_points(points, "head", "world")
+        areas = areas_from_geometry(points, alpha1, alpha2, settings.baseline_m, effective)
+        areas[_hides_or_hidden(points, reference_head, settings.baseline_m, clear_m)] = 0
+        world = start_head_to_world(settings, points)
         for k, area in enumerate(wanted):
             if chosen[k] is not None:
                 continue
@@ -121,13 +128,13 @@ def area_layout(
             placed = [c for c in chosen if c is not None]
             if placed and candidates.size:
                 apart = ~_overlaps(
-                    points[candidates], placed, sim.settings.baseline_m, radius_m, gap_rad
+                    points[candidates], placed, settings.baseline_m, radius_m, gap_rad
                 )
                 candidates = candidates[apart]
             candidates = candidates[:50]
             if candidates.size == 0:
                 continue
-            seen = seen_in_four_images(sim, world[candidates], alpha1, alpha2, radius_m)
+            seen = seen_in_four_images(views, world[candidates], radius_m)
             if seen.any():
                 pick = int(candidates[np.flatnonzero(seen)[0]])
                 chosen[k] = points[pick]

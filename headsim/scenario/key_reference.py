@@ -278,7 +278,7 @@ DESCRIPTIONS: dict[str, str] = {
     },
     "scene.blocks": "The blocks' cross point (procedure `relative_positioning`).",
     **{f"scene.blocks.{k}": "Cross point: " + v[0].lower() + v[1:] for k, v in _POSITION.items()},
-    "scene.objects": "Objects measured relative to the cross point; those not listed are parked out of view.",
+    "scene.objects": "Objects measured relative to the cross point, each seen by both cameras at the start pose or in all four images at the cross point's fixations; those not listed are parked out of view.",
     "scene.objects[].body": "The object body (`object_1`..`object_6`).",
     **{f"scene.objects[].{k}": v for k, v in _POSITION.items()},
     "scene.random_objects": "Objects at random positions instead of `[[scene.objects]]`, drawn from the seed.",

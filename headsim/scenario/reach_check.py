@@ -104,14 +104,21 @@ def check_reach(ctx: Context, scenario: Scenario) -> None:
     if scene.blocks is not None:
         p = np.array(scene.blocks.position_world_m)
         _raise(ctx, scene.blocks.source, model2_refusal(head, p, "cross point", start_view=True))
+        # The procedure reads each object in the four images at the cross point's two
+        # fixations (both eyes at alpha1, then at alpha2).
+        fixations = head.model2_angles(head.to_head(p))
         for placement in scene.objects:
             p = head.to_head(np.array(placement.position_world_m))
             _check_in_front(ctx, placement.source, p, placement.name)
-            if not (head.in_view(p, 0) and head.in_view(p, 1)):
+            at_start = head.in_view(p, 0) and head.in_view(p, 1)
+            at_fixations = all(head.in_view(p, k, eye) for k in (0, 1) for eye in fixations)
+            if not (at_start or at_fixations):
                 raise ctx.error(
                     placement.source,
-                    f"{placement.name} at {fmt_point(p)} m in H is outside a camera's view at the start pose",
-                    "objects that both cameras see with neck and eyes at 0",
+                    f"{placement.name} at {fmt_point(p)} m in H is outside a camera's view at "
+                    "the start pose and at the cross point's fixations",
+                    "objects that both cameras see with neck and eyes at 0, or in all four "
+                    "images at the cross point's fixations",
                 )
     if scene.pursuit is not None:
         pursuit = scene.pursuit

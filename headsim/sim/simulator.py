@@ -366,20 +366,7 @@ class HeadSim:
         that column's ray is off the optical axis.  At the principal point's
         column it is the mount yaw, on every row.
         """
-        index = self.camera_index(camera)
-        cam = self.settings.cameras[index]
-        u_c, v_c = cam.image_centre
-        pixel = np.array([u_c if goal_u is None else goal_u, v_c])
-        xy = cam.pinhole().normalise(pixel)  # raises if no ray
-        eye_from_cv = eye_from_camera_rotation(
-            names.EYE_CAMERAS[index].inward,
-            cam.mount_yaw_rad,
-            cam.mount_pitch_rad,
-            cam.mount_roll_rad,
-        )
-        ray_eye = eye_from_cv @ np.array([xy[0], xy[1], 1.0])
-        yaw = math.atan2(ray_eye[0], ray_eye[2])
-        return yaw if index == 0 else -yaw
+        return effective_initial_direction(self.settings, self.camera_index(camera), goal_u)
 
     # -- images ------------------------------------------------------------
     def render(self, camera: CameraId) -> np.ndarray:
@@ -442,8 +429,31 @@ def for_settings(
     return HeadSim(scene, settings, settle_mode=settle_mode, sink=sink)
 
 
-def start_views(settings: HeadSettings, scene: str = "default") -> tuple[StereoView, ...]:
-    """The view of the head ``settings`` at its start pose in ``scene``: what a fresh
-    simulator's :meth:`HeadSim.stereo_views` gives (e.g. for a calibration layout)."""
+def start_views(
+    settings: HeadSettings, scene: str = "default", eye_angles_rad: Sequence[float] = ()
+) -> tuple[StereoView, ...]:
+    """The view of the head ``settings`` at its start pose in ``scene``, then from each
+    eye-encoder angle (rad): what a fresh simulator's :meth:`HeadSim.stereo_views` gives
+    (e.g. for a calibration or an area layout)."""
     with HeadSim(scene, settings) as sim:
-        return sim.stereo_views()
+        return sim.stereo_views(eye_angles_rad)
+
+
+def effective_initial_direction(
+    settings: HeadSettings, index: int, goal_u: float | None = None
+) -> float:
+    """:meth:`HeadSim.effective_initial_direction` of camera ``index`` (0: Ca1, 1: Ca2), rad,
+    from the head's settings alone."""
+    cam = settings.cameras[index]
+    u_c, v_c = cam.image_centre
+    pixel = np.array([u_c if goal_u is None else goal_u, v_c])
+    xy = cam.pinhole().normalise(pixel)  # raises if no ray
+    eye_from_cv = eye_from_camera_rotation(
+        names.EYE_CAMERAS[index].inward,
+        cam.mount_yaw_rad,
+        cam.mount_pitch_rad,
+        cam.mount_roll_rad,
+    )
+    ray_eye = eye_from_cv @ np.array([xy[0], xy[1], 1.0])
+    yaw = math.atan2(ray_eye[0], ray_eye[2])
+    return yaw if index == 0 else -yaw

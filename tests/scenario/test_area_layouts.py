@@ -21,7 +21,12 @@ def test_objects_placed_in_the_magnitude_areas_are_classified_by_both_tests() ->
         ref_head = np.array([0.01, 0.0, 0.8])
         sim.set_body_pose(names.BLOCKS, sim.transform_points(ref_head, "head", "world")[0])
         placed = area_layout(
-            sim, ref_head, wanted, np.random.default_rng(1), radius_m=0.006, depth_m=(0.3, 3.0)
+            sim.settings,
+            ref_head,
+            wanted,
+            np.random.default_rng(1),
+            radius_m=0.006,
+            depth_m=(0.3, 3.0),
         )
         for body, p in zip(names.RELATIVE_OBJECTS, placed, strict=True):
             sim.set_body_pose(body, sim.transform_points(p, "head", "world")[0])
@@ -51,7 +56,7 @@ def test_placed_objects_never_touch_in_any_image_so_each_centroid_is_unbiased() 
     with HeadSim("blocks", paper_head()) as sim:
         ref_head = np.array([0.01, 0.0, 0.8])
         placed = area_layout(
-            sim,
+            sim.settings,
             ref_head,
             wanted,
             np.random.default_rng(3),
@@ -61,7 +66,7 @@ def test_placed_objects_never_touch_in_any_image_so_each_centroid_is_unbiased() 
         )
         placed = placed[~np.isnan(placed).any(axis=1)]
         assert len(placed) >= 8
-        alpha1, alpha2 = reference_angles(sim, ref_head)
+        alpha1, alpha2 = reference_angles(sim.settings, ref_head)
         world = sim.transform_points(placed, "head", "world")
         resolution = sim.settings.encoder_resolution_rad
         closest = np.inf

@@ -247,3 +247,43 @@ def test_a_refused_listed_target_gets_no_redraw_hint(tmp_path: Path) -> None:
     with pytest.raises(ScenarioError) as caught:
         load_scenario(path)
     assert 'within = "reach"' not in str(caught.value)
+
+
+def test_a_relative_object_seen_only_at_the_cross_points_fixations_is_accepted(
+    tmp_path: Path,
+) -> None:
+    # The procedure reads objects in the four images at the cross point's two
+    # fixations: one those images see whole is accepted though the start pose misses it.
+    reference_head = np.array([0.06, 0.0, 0.6])
+    text = (
+        'description = "r"\n[head]\npreset = "paper"\n'
+        '[experiment]\nprocedure = "relative_positioning"\n'
+        "[scene.blocks]\nposition_head_m = [0.06, 0.0, 0.6]\n"
+    )
+    settings = load_scenario(write_scenario(tmp_path, text)).settings
+    head = ReachHead.of(settings)
+    fixations = head.model2_angles(reference_head)
+    candidates = sample_points_head(
+        np.random.default_rng(0), 4000, (-0.6, 0.6), (-0.1, 0.1), depth_range_m=(0.3, 1.5)
+    )
+
+    def seen(p: np.ndarray, eyes: tuple[float, ...]) -> bool:
+        return all(head.in_view(p, k, eye) for k in (0, 1) for eye in eyes)
+
+    only_fixations = next(p for p in candidates if seen(p, fixations) and not seen(p, (0.0,)))
+    neither = next(p for p in candidates if not seen(p, fixations) and not seen(p, (0.0,)))
+
+    def with_object(p: np.ndarray) -> Path:
+        position = [float(v) for v in p]
+        return write_scenario(
+            tmp_path, text + f"[[scene.objects]]\nbody = 'object_1'\nposition_head_m = {position}\n"
+        )
+
+    scenario = load_scenario(with_object(only_fixations))
+    assert [o.body for o in scenario.scene.objects] == ["object_1"]
+    with pytest.raises(
+        ScenarioError,
+        match=r"scene.objects\[0\]: object_1 at .* is outside a camera's view at the start pose "
+        r"and at the cross point's fixations \(allowed: objects that both cameras see",
+    ):
+        load_scenario(with_object(neither))
