@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from headsim.active.measurement import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.procedures.stereo import StoredStereoResult
 from headsim.run.runner import run_scenario
 from headsim.sim.settings import HeadSettings
@@ -84,6 +84,27 @@ def stereo_errors(
     ]
 
 
+def model2_measurements(
+    settings: HeadSettings,
+    label: str,
+    knowledge: HeadKnowledge,
+    targets_head: np.ndarray,
+    folder: Path,
+) -> list[Measurement]:
+    """Model 2 on each of ``targets_head`` (N, 3) m by the head ``settings`` told ``knowledge``
+    (a calibration file ``label``.json in ``folder``), through the runner: one per target."""
+    told = knowledge_file(folder / f"{label}.json", settings, knowledge)
+    doc = {
+        "description": "Model 2 on a study's targets with a method's knowledge",
+        "experiment": {"procedure": "model2", "calibration": {"from": str(told)}},
+        "scene": _targets_scene(targets_head),
+    }
+    result = run_scenario(scenario_with_head(doc, f"study_{label}", settings))
+    if len(result.records) != len(targets_head):
+        raise ValueError(f"study Model 2 run failed: {'; '.join(result.failures)}")
+    return [r.measurement for r in result.records]
+
+
 def model2_errors(
     settings: HeadSettings,
     method: str,
@@ -91,20 +112,12 @@ def model2_errors(
     targets_head: np.ndarray,
     folder: Path,
 ) -> list[TargetError]:
-    """Model 2 on each of ``targets_head`` (N, 3) m by the head ``settings`` told ``knowledge``
-    (a calibration file in ``folder``), through the runner, as ``method``'s errors."""
-    told = knowledge_file(folder / f"{method}.json", settings, knowledge)
-    doc = {
-        "description": "Model 2 on a study's targets with a method's knowledge",
-        "experiment": {"procedure": "model2", "calibration": {"from": str(told)}},
-        "scene": _targets_scene(targets_head),
-    }
-    result = run_scenario(scenario_with_head(doc, f"study_{method}", settings))
-    if len(result.records) != len(targets_head):
-        raise ValueError(f"study Model 2 run failed: {'; '.join(result.failures)}")
+    """:func:`model2_measurements` as ``method``'s errors."""
     return [
         TargetError(method, k, m.truth_head_m, m.estimate_head_m, m.status_text, m.renders)
-        for k, m in enumerate(r.measurement for r in result.records)
+        for k, m in enumerate(
+            model2_measurements(settings, method, knowledge, targets_head, folder)
+        )
     ]
 
 
