@@ -20,7 +20,7 @@ from headsim.active.servo_types import Detector
 from headsim.estimators import PositionEstimate
 from headsim.estimators.result import Method, Status
 from headsim.geometry.kinematics import head_to_world
-from headsim.sim.settings import HeadBelief
+from headsim.sim.settings import HeadBelief, HeadSettings
 from headsim.sim.simulator import HeadSim
 
 #: Centroid precision assumed for covariances, px (measured: ~0.03-0.06 px).
@@ -54,17 +54,29 @@ class HeadKnowledge:
 
     def head_belief(self, sim: HeadSim) -> HeadBelief:
         """The geometry the head believes it has."""
-        return self.belief if self.belief is not None else sim.belief
+        return self.head_belief_of(sim.settings)
+
+    def head_belief_of(self, settings: HeadSettings) -> HeadBelief:
+        """The geometry the head ``settings`` believes it has."""
+        return self.belief if self.belief is not None else settings.believed
 
     def line_of_sight_offsets(self, sim: HeadSim) -> tuple[float, float]:
         """(s1, s2), m: calibrated, else the believed side offsets."""
+        return self.line_of_sight_offsets_of(sim.settings)
+
+    def line_of_sight_offsets_of(self, settings: HeadSettings) -> tuple[float, float]:
+        """(s1, s2), m, of the head ``settings``: calibrated, else the believed side offsets."""
         if self.los_offset_m is not None:
             return self.los_offset_m
-        return self.head_belief(sim).side_offset_m
+        return self.head_belief_of(settings).side_offset_m
 
     def reference(self, sim: HeadSim, camera: int) -> tuple[float, float]:
         """(u_i0, v_i0): the servo's goal column and the reference row of camera 1 or 2, px."""
-        u_c, v_c = sim.camera_settings(camera).image_centre
+        return self.reference_of(sim.settings, camera)
+
+    def reference_of(self, settings: HeadSettings, camera: int) -> tuple[float, float]:
+        """(u_i0, v_i0) of camera 1 or 2 of the head ``settings``, px (:meth:`reference`)."""
+        u_c, v_c = settings.cameras[camera - 1].image_centre
         u0, v0 = self.u0[camera - 1], self.v0[camera - 1]
         return (u_c if u0 is None else u0, v_c if v0 is None else v0)
 

@@ -22,6 +22,9 @@ Its scenario block, all keys optional::
     max_tilt_rad = 0.6          # the board's tilt about its x and y axes, at most, rad
     refine_intrinsics = true    # stereoCalibrate refines each camera's K, k1, k2
     pattern = [8, 6]            # the board's inner corners (the scene's board: 8 x 6)
+    # or, instead of the board keys, a stored calibration to triangulate with:
+    # from = "zhang.json"       # headsim.stereo.calibration_file, relative to this file
+    # look = "once"             # with from: a binned preview, then a window (or "full_frame")
 
     [[scene.targets]]           # what to triangulate, as for Model 2
     position_head_m = [0.0, 0.0, 0.4]
@@ -31,18 +34,21 @@ errors, each camera's parameters (truth, mono, stereo), the extrinsics beside th
 truth, the baseline's acceptance figure (``max_rms_px`` <= 0.2 px,
 ``max_abs_focal_error_pct`` <= 0.5 %, ``passed``), each way of placing camera 1 in H with its targets' worst and
 mean error, and each target (truth, estimate, error in H, m, from the extrinsics).
-A target not found in both images is a failure.
+A target not found in both images is a failure.  With ``from``, nothing is calibrated
+and the block holds only ``head_frames`` and ``targets``.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import rerun as rr
 
 from headsim.active.events import PhaseStarted
+from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge
 from headsim.geometry.transforms import frame_deviation
 from headsim.run.context import simulator
@@ -57,8 +63,9 @@ from headsim.scenario.tables import Table
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.calibration import MIN_VIEWS, CameraCalibration, StereoCalibration
 from headsim.stereo.calibration import calibrate_stereo as zhang_calibration
+from headsim.stereo.calibration_file import StereoCalibrationFileError, read_stereo_calibration
 from headsim.stereo.frames import head_from_cam1_from_eye
-from headsim.stereo.triangulation import measure_point_stereo, triangulate
+from headsim.stereo.triangulation import Look, measure_point_stereo, triangulate
 from headsim.stereo.views import (
     CHESSBOARD_PATTERN,
     ChessboardViews,
@@ -148,6 +155,53 @@ class StereoTarget:
         return float(100 * np.linalg.norm(self.error_head_m) / self.truth_head_m[2])
 
 
+def target_lines(
+    head_frames: tuple[HeadFrame, ...], targets: tuple[StereoTarget, ...]
+) -> list[str]:
+    """Each way of placing camera 1 in H, then each target, as tables."""
+    lines = format_table(
+        ["camera 1 in H", "rot mrad", "trans mm", "max mm", "max %z", "mean %z"],
+        [
+            [
+                f.label,
+                cell(f.rotation_error_rad * 1e3, ".3f"),
+                mm(f.translation_error_m, ".4f"),
+                mm(f.max_error_m, ".2f"),
+                cell(f.max_error_pct_depth, ".3f"),
+                cell(f.mean_error_pct_depth, ".3f"),
+            ]
+            for f in head_frames
+        ],
+    )
+    return lines + format_table(
+        ["target", "true z mm", "|e| mm", "% z"],
+        [
+            [
+                t.name,
+                mm(float(t.truth_head_m[2]), ".1f"),
+                mm(float(np.linalg.norm(t.error_head_m)), ".2f") if t.ok else t.status,
+                cell(t.error_pct_depth, ".3f") if t.ok else "-",
+            ]
+            for t in targets
+        ],
+    )
+
+
+def log_estimates(log: Recorder, targets: tuple[StereoTarget, ...]) -> None:
+    """Each triangulated target's estimate in W."""
+    seen = [t for t in targets if t.ok]
+    if seen:
+        log.rec.log(
+            "/world/stereo/estimates",
+            rr.Points3D(
+                [t.estimate_world_m for t in seen],
+                radii=0.006,
+                colors=[GREEN] * len(seen),
+                labels=[f"{t.name} (stereo)" for t in seen],
+            ),
+        )
+
+
 @dataclass(frozen=True)
 class StereoResult:
     """The baseline's calibration beside the truth, and its targets (module docstring).
@@ -199,47 +253,58 @@ class StereoResult:
             f"  baseline {mm(self.baseline_m, '.3f')} mm (truth {mm(self.true_baseline_m, '.3f')}),"
             f" R error {self.rotation_error_rad * 1e3:.3f} mrad",
         ]
-        lines += format_table(
-            ["camera 1 in H", "rot mrad", "trans mm", "max mm", "max %z", "mean %z"],
-            [
-                [
-                    f.label,
-                    cell(f.rotation_error_rad * 1e3, ".3f"),
-                    mm(f.translation_error_m, ".4f"),
-                    mm(f.max_error_m, ".2f"),
-                    cell(f.max_error_pct_depth, ".3f"),
-                    cell(f.mean_error_pct_depth, ".3f"),
-                ]
-                for f in self.head_frames
-            ],
-        )
-        lines += format_table(
-            ["target", "true z mm", "|e| mm", "% z"],
-            [
-                [
-                    t.name,
-                    mm(float(t.truth_head_m[2]), ".1f"),
-                    mm(float(np.linalg.norm(t.error_head_m)), ".2f") if t.ok else t.status,
-                    cell(t.error_pct_depth, ".3f") if t.ok else "-",
-                ]
-                for t in self.targets
-            ],
-        )
-        return lines
+        return lines + target_lines(self.head_frames, self.targets)
 
     def log_rows(self, log: Recorder) -> None:
         """Each triangulated target's estimate in W."""
-        seen = [t for t in self.targets if t.ok]
-        if seen:
-            log.rec.log(
-                "/world/stereo/estimates",
-                rr.Points3D(
-                    [t.estimate_world_m for t in seen],
-                    radii=0.006,
-                    colors=[GREEN] * len(seen),
-                    labels=[f"{t.name} (stereo)" for t in seen],
-                ),
-            )
+        log_estimates(log, self.targets)
+
+
+@dataclass(frozen=True)
+class StoredStereoSpec:
+    """``[experiment.stereo] from``: triangulate with the calibration in the file ``source``
+    (:mod:`headsim.stereo.calibration_file`) instead of calibrating."""
+
+    source: str
+    #: How each camera looks for a target: ``"full_frame"``, or ``"once"`` (a binned
+    #: preview, then a window where it shows the target: ``headsim.active.look.look_once``).
+    look: str = "full_frame"
+
+
+#: ``[experiment.stereo] look``'s choices (with ``from``).
+LOOKS = ("full_frame", "once")
+
+
+@dataclass(frozen=True)
+class StoredStereoResult:
+    """The targets triangulated with a stored calibration (``source``): each way of placing
+    camera 1 in H, each target, and (not in results.json) each target's renders."""
+
+    source: str
+    head_frames: tuple[HeadFrame, ...]
+    targets: tuple[StereoTarget, ...]
+    target_renders: tuple[int, ...]
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields: ``head_frames`` and ``targets``."""
+        return {"head_frames": asdict(self)["head_frames"], "targets": asdict(self)["targets"]}
+
+    def failures(self) -> tuple[str, ...]:
+        """Each target not found in both images."""
+        return tuple(f"{t.name}: {t.status}" for t in self.targets if not t.ok)
+
+    def ok_line(self, measured: int) -> str:
+        count = len(self.targets)
+        return f"OK: {count} target{'' if count == 1 else 's'} triangulated, none failed"
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        """The calibration's file, each way of placing camera 1, each target."""
+        lines = [f"Stereo with a stored calibration ({Path(self.source).name})"]
+        return lines + target_lines(self.head_frames, self.targets)
+
+    def log_rows(self, log: Recorder) -> None:
+        """Each triangulated target's estimate in W."""
+        log_estimates(log, self.targets)
 
 
 @dataclass(frozen=True)
@@ -348,20 +413,19 @@ def calibrate(
     return zhang_calibration(sim, views, spec.refine_intrinsics), views
 
 
-def run_stereo(
-    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
-) -> tuple[list[MeasurementRecord], StereoResult | NotCalibrated]:
-    """Calibrate the pair from board views, then triangulate each target (module docstring)."""
-    spec = scenario.experiment.block
-    assert isinstance(spec, StereoSpec)
-    with simulator(hub, "chessboard", scenario) as sim:
-        hub.emit(PhaseStarted("board views", sim, knowledge, {}))
-        try:
-            calib, views = calibrate(sim, spec, scenario.seed)
-        except StereoError as error:
-            return [], NotCalibrated(spec.views, str(error))
+def measure_targets(
+    scenario: Scenario,
+    hub: Hub,
+    knowledge: HeadKnowledge,
+    calib: StereoCalibration,
+    look: Look | None = None,
+) -> tuple[tuple[StereoTarget, ...], tuple[HeadFrame, ...], tuple[int, ...]]:
+    """Each of the scenario's targets triangulated with ``calib`` in the default scene, each
+    camera looking with ``look`` (None: the full frame): the targets, each way of placing
+    camera 1 in H, and each target's renders."""
     targets = scenario.scene.targets
     rows: list[StereoTarget] = []
+    renders: list[int] = []
     frame_errors: dict[str, list[tuple[float, float]]] = {name: [] for name in HEAD_FRAMES}
     with simulator(hub, "default", scenario) as sim:
         truth = {t.name: np.array(t.position_world_m) for t in targets}
@@ -372,9 +436,11 @@ def run_stereo(
         for placement in targets:
             hub.begin(placement.name)
             sim.set_body_pose(placement.body, np.array(placement.position_world_m))
+            start = sim.render_count
             try:
-                m = measure_point_stereo(sim, calib, placement.body)
+                m = measure_point_stereo(sim, calib, placement.body, look=look)
             except StereoError as missed:
+                renders.append(sim.render_count - start)
                 unknown = np.full(3, np.nan)
                 truth_head = sim.position(placement.body, "head")
                 rows.append(
@@ -383,6 +449,7 @@ def run_stereo(
                     )
                 )
                 continue
+            renders.append(sim.render_count - start)
             for name, head_from_cam1 in frames.items():
                 p_head = triangulate(calib, np.array([m.uv1]), np.array([m.uv2]), head_from_cam1)
                 error_m = float(np.linalg.norm(p_head[0] - m.true_p_head))
@@ -398,10 +465,32 @@ def run_stereo(
                     m.uv2,
                 )
             )
-    summary = [
+    summary = tuple(
         head_frame(name, head_from_cam1, calib, frame_errors[name])
         for name, head_from_cam1 in frames.items()
-    ]
+    )
+    return tuple(rows), summary, tuple(renders)
+
+
+def run_stereo(
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], StereoResult | NotCalibrated | StoredStereoResult]:
+    """Calibrate the pair from board views (or read ``from``'s calibration), then
+    triangulate each target (module docstring)."""
+    spec = scenario.experiment.block
+    if isinstance(spec, StoredStereoSpec):
+        stored = read_stereo_calibration(spec.source)
+        look = look_once if spec.look == "once" else None
+        rows, summary, renders = measure_targets(scenario, hub, knowledge, stored, look)
+        return [], StoredStereoResult(spec.source, summary, rows, renders)
+    assert isinstance(spec, StereoSpec)
+    with simulator(hub, "chessboard", scenario) as sim:
+        hub.emit(PhaseStarted("board views", sim, knowledge, {}))
+        try:
+            calib, views = calibrate(sim, spec, scenario.seed)
+        except StereoError as error:
+            return [], NotCalibrated(spec.views, str(error))
+    rows, summary, _ = measure_targets(scenario, hub, knowledge, calib)
     corner_errors = views.corner_errors_px()
     focal_errors = [
         e
@@ -429,15 +518,42 @@ def run_stereo(
         max_rms_px=max_rms,
         max_abs_focal_error_pct=max_focal * 100,
         passed=max_rms <= RMS_BOUND_PX and max_focal <= FOCAL_BOUND,
-        head_frames=tuple(summary),
-        targets=tuple(rows),
+        head_frames=summary,
+        targets=rows,
     )
     return [], result
 
 
+#: The keys of ``[experiment.stereo]`` that only a calibration from board views reads.
+BOARD_KEYS = ("views", "distance_m", "max_tilt_rad", "refine_intrinsics", "pattern")
+
+
+def _stored_spec(stereo: Table, source: str) -> StoredStereoSpec:
+    """``from``: the stored calibration's file (relative to the scenario file), read and
+    checked now so that a bad file fails the scenario, not the run."""
+    for key in BOARD_KEYS:
+        if key in stereo.data:
+            raise stereo.fail(key, "given with from", "no board keys with a stored calibration")
+    path = Path(source)
+    if not path.is_absolute():
+        path = Path(stereo.ctx.source).parent / path
+    try:
+        read_stereo_calibration(path)
+    except StereoCalibrationFileError as err:
+        raise stereo.fail("from", str(err), "a stereo calibration file") from err
+    look = stereo.choice("look", LOOKS, "full_frame")
+    stereo.done()
+    return StoredStereoSpec(str(path), look)
+
+
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
-    """``[experiment.stereo]``: the board views (:class:`StereoSpec`), and the pattern."""
+    """``[experiment.stereo]``: the board views (:class:`StereoSpec`), and the pattern; or ``from``, a stored calibration (:class:`StoredStereoSpec`)."""
     stereo = table.table("stereo") or Table({}, table.field("stereo"), table.ctx)
+    source = stereo.string("from", None, max_length=1000)
+    if source is not None:
+        return {"block": _stored_spec(stereo, source)}
+    if stereo.has("look"):
+        raise stereo.fail("look", "given without from", "look with a stored calibration only")
     default = StereoSpec()
     views = stereo.integer("views", default.views, MIN_VIEWS, 1000)
     low, high = stereo.numbers(
@@ -467,7 +583,8 @@ STEREO = register(
         "stereo",
         "default",
         run_stereo,
-        # The result is a StereoResult, or NotCalibrated where the views were too few.
+        # The result is a StereoResult, NotCalibrated where the views were too few, or a
+        # StoredStereoResult with a stored calibration.
         fields=lambda result: result.block(),
         summary=lambda result, paper: result.summary_lines(paper),
         ok_line=lambda result, measured: result.ok_line(measured),
@@ -480,8 +597,10 @@ STEREO = register(
 
 
 __all__ = [
+    "BOARD_KEYS",
     "FOCAL_BOUND",
     "HEAD_FRAMES",
+    "LOOKS",
     "RMS_BOUND_PX",
     "STEREO",
     "HeadFrame",
@@ -490,9 +609,14 @@ __all__ = [
     "StereoResult",
     "StereoSpec",
     "StereoTarget",
+    "StoredStereoResult",
+    "StoredStereoSpec",
     "calibrate",
     "camera_parameters",
     "head_frame",
     "head_frames",
+    "log_estimates",
+    "measure_targets",
     "run_stereo",
+    "target_lines",
 ]

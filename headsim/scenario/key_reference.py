@@ -251,6 +251,8 @@ DESCRIPTIONS: dict[str, str] = {
     "experiment.stereo.distance_m": "The board centre's distance from camera 1, [low, high], m.",
     "experiment.stereo.max_tilt_rad": "The board's largest tilt about its x and y axes, rad.",
     "experiment.stereo.refine_intrinsics": "stereoCalibrate refines each camera's K, k1, k2 (false: keeps each camera's own calibration).",
+    "experiment.stereo.from": "A stored stereo calibration file (`headsim.stereo.calibration_file`) to triangulate with instead of calibrating (no board keys then).",
+    "experiment.stereo.look": "With `from`: each camera's look for a target, the full frame or `once` (a binned preview, then a window where it shows the target).",
     "experiment.stereo.pattern": "The board's inner corners, [columns, rows]: the chessboard scene's board, [8, 6].",
     "experiment.servo": "The eye and neck servo (`headsim.active.servo_types.ServoConfig`).",
     "experiment.servo.windows": "Render only a window around where the target is expected (false: every image a full frame; same answers, more pixels).",

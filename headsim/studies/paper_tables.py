@@ -30,29 +30,33 @@ principal-point and k1 changes) are left to ``python -m headsim.studies.study``.
 
 from __future__ import annotations
 
+import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
-from headsim.active.eye_servo import EyeServo
-from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge, Measurement
-from headsim.active.model2 import measure_model2
 from headsim.active.principal import PrincipalPointRun, zoomed
 from headsim.estimators import model2
 from headsim.sim.settings import HeadSettings
-from headsim.sim.simulator import HeadSim, start_views
+from headsim.sim.simulator import start_views
 from headsim.stereo.calibration import StereoCalibration
-from headsim.stereo.triangulation import measure_point_stereo
-from headsim.stereo.views import StereoError
 from headsim.studies.calibrations import calibration_positions, zhang_stereo, zoom_fixed_points
 from headsim.studies.conditions import Condition, ConditionResult
-from headsim.studies.methods import METHODS, TARGET, StudyConfig
+from headsim.studies.methods import METHODS, StudyConfig
 from headsim.studies.scenario_runs import calibration_run
 from headsim.studies.study_experiments import Experiment, ExperimentResult
-from headsim.studies.target_errors import TargetError, summarise
-from headsim.studies.targets import place_in_head, table_targets
+from headsim.studies.target_errors import (
+    TargetError,
+    model2_errors,
+    model2_measurements,
+    stereo_errors,
+    summarise,
+)
+from headsim.studies.targets import table_targets
 
 #: The active methods that servo on the image centre's column.
 CENTRE_METHODS = METHODS[1:4]
@@ -118,31 +122,57 @@ def active_knowledge(stored: HeadKnowledge, zhang: StereoCalibration) -> dict[st
     }
 
 
-def recompute(sim: HeadSim, measured: Measurement, knowledge: HeadKnowledge) -> np.ndarray:
-    """Model 2's estimate in H, m, from ``measured``'s fixations and images with ``knowledge``.
+def recompute(
+    settings: HeadSettings, measured: Measurement, knowledge: HeadKnowledge
+) -> np.ndarray:
+    """Model 2's estimate in H, m, from ``measured``'s fixations and images by the head
+    ``settings`` with ``knowledge``.
 
     ``knowledge`` must have ``measured``'s servo column (u0); only what Model
     2 computes differs (alpha_e, v0, kx/ky, line-of-sight offsets).
     """
     d = measured.details
-    (u10, v10), (u20, v20) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+    (u10, v10), (u20, v20) = (
+        knowledge.reference_of(settings, 1),
+        knowledge.reference_of(settings, 2),
+    )
     estimate = model2(
         [d["alpha1_rad"]],
         [d["alpha2_rad"]],
         np.array([[d["u11_px"], d["v11_px"]]]),
         np.array([[d["u21_px"], d["v21_px"]]]),
-        knowledge.head_belief(sim).baseline_m,
+        knowledge.head_belief_of(settings).baseline_m,
         uv10=(u10, v10),
         uv20=(u20, v20),
         alpha_e=knowledge.alpha_e,
         gamma1=[d["gamma1_rad"]],
         gamma2=[d["gamma2_rad"]],
         kx_over_ky=knowledge.kx_over_ky,
-        los_offset_m=knowledge.line_of_sight_offsets(sim),
+        los_offset_m=knowledge.line_of_sight_offsets_of(settings),
     )
     if not bool(estimate.valid[0]):
         return np.full(3, np.nan)
     return np.asarray(estimate.positions[0], dtype=float)
+
+
+def shared_errors(
+    settings: HeadSettings, measured: Sequence[Measurement], knowledges: dict[str, HeadKnowledge]
+) -> list[TargetError]:
+    """Each of ``knowledges``' methods on the images of ``measured`` (one per target, taken
+    with ``knowledges[SERVOED]``), whose renders count on :data:`SERVOED` only."""
+    out = []
+    for index, m in enumerate(measured):
+        for method, knowledge in knowledges.items():
+            if not m.ok:
+                estimate, status = np.full(3, np.nan), m.status_text
+            elif method == SERVOED:
+                estimate, status = m.estimate_head_m, "ok"
+            else:
+                estimate = recompute(settings, m, knowledge)
+                status = "ok" if bool(np.all(np.isfinite(estimate))) else "estimate invalid"
+            own = m.renders if method == SERVOED else 0
+            out.append(TargetError(method, index, m.truth_head_m, estimate, status, own))
+    return out
 
 
 def measure_paired(
@@ -153,71 +183,36 @@ def measure_paired(
     fixed: FixedPoint | None = None,
     config: StudyConfig | None = None,
 ) -> list[TargetError]:
-    """The red marker at each of ``targets_head`` (N, 3) m: stereo, then one servo for
-    the image-centre methods (``knowledges``), then with ``fixed`` the fixed-point
-    methods, each its own servo (``active_refound`` first finds the fixed points on
-    ``settings``, seeded as ``config``'s)."""
-    out: list[TargetError] = []
+    """The red marker at each of ``targets_head`` (N, 3) m, each a run through the runner:
+    stereo, then one servo for the image-centre methods (``knowledges``), then with
+    ``fixed`` the fixed-point methods, each its own servo (``active_refound`` first
+    finds the fixed points on ``settings``, seeded as ``config``'s).  The errors in
+    target order, then that order of methods."""
     config = config or StudyConfig()
-    refound = None
-    if fixed is not None:
-        # On the head they were calibrated on, found again they are the same images
-        # and the same answer (deterministic from the seed): taken from ``fixed``.
-        refound = (
-            fixed.principal
-            if fixed.settings == settings and fixed.seed == config.seed
-            else zoom_fixed_points(settings, config)
-        )
-    with HeadSim("default", settings) as sim:
-        servo = EyeServo(sim)
-        for index, p_head in enumerate(np.atleast_2d(np.asarray(targets_head, dtype=float))):
-            place_in_head(sim, TARGET.name, p_head)
-            truth = sim.position(TARGET.name, "head")
-            start = sim.render_count
-            try:
-                m = measure_point_stereo(sim, zhang, TARGET.name, look=look_once)
-                estimate, status = m.p_head, "ok"
-            except StereoError as error:
-                estimate, status = np.full(3, np.nan), str(error)
-            out.append(
-                TargetError("stereo", index, truth, estimate, status, sim.render_count - start)
+    targets = np.atleast_2d(np.asarray(targets_head, dtype=float))
+    methods = ["stereo", *knowledges]
+    out: list[TargetError] = []
+    with tempfile.TemporaryDirectory() as name:
+        folder = Path(name)
+        out += stereo_errors(settings, zhang, targets, folder)
+        shared = model2_measurements(settings, SERVOED, knowledges[SERVOED], targets, folder)
+        out += shared_errors(settings, shared, knowledges)
+        if fixed is not None:
+            # On the head they were calibrated on, found again they are the same images
+            # and the same answer (deterministic from the seed): taken from ``fixed``.
+            refound = (
+                fixed.principal
+                if fixed.settings == settings and fixed.seed == config.seed
+                else zoom_fixed_points(settings, config)
             )
-            sim.move(eye=0.0)
-            start = sim.render_count
-            measured = measure_model2(sim, servo, TARGET, knowledges[SERVOED])
-            renders = sim.render_count - start
-            for method, knowledge in knowledges.items():
-                if not measured.ok:
-                    estimate, status = np.full(3, np.nan), measured.status_text
-                elif method == SERVOED:
-                    estimate, status = measured.estimate_head_m, "ok"
-                else:
-                    estimate = recompute(sim, measured, knowledge)
-                    finite = bool(np.all(np.isfinite(estimate)))
-                    status = "ok" if finite else "estimate invalid"
-                own = renders if method == SERVOED else 0
-                out.append(TargetError(method, index, truth, estimate, status, own))
-            sim.move(eye=0.0)
-            if fixed is None:
-                continue
             for method, knowledge in (
                 ("active_fixed_point", fixed.knowledge()),
                 ("active_refound", fixed.knowledge(refound)),
             ):
-                start = sim.render_count
-                m2 = measure_model2(sim, servo, TARGET, knowledge)
-                out.append(
-                    TargetError(
-                        method,
-                        index,
-                        truth,
-                        m2.estimate_head_m,
-                        m2.status_text,
-                        sim.render_count - start,
-                    )
-                )
-                sim.move(eye=0.0)
-    return out
+                methods.append(method)
+                out += model2_errors(settings, method, knowledge, targets, folder)
+    order = {method: k for k, method in enumerate(methods)}
+    return sorted(out, key=lambda e: (e.index, order[e.method]))
 
 
 def tables_experiment(settings: HeadSettings, config: StudyConfig) -> Experiment:

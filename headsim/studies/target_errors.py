@@ -1,25 +1,27 @@
-"""Measuring targets with every method on one head, and each method's errors summarised
-(estimate minus truth in H, m; "% of depth" divides by the true z_h)."""
+"""Measuring targets with every method on one head, each method a run of its own through
+the runner, and each method's errors summarised (estimate minus truth in H, m; "% of
+depth" divides by the true z_h)."""
 
 from __future__ import annotations
 
 import math
+import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from headsim.active.eye_servo import EyeServo
-from headsim.active.look import look_once
-from headsim.active.model2 import measure_model2
-from headsim.active.principal import PROBE_ZOOM, principal_points_by_zoom, zoomed
+from headsim.active.measurement import HeadKnowledge, Measurement
+from headsim.procedures.stereo import StoredStereoResult
+from headsim.run.runner import run_scenario
 from headsim.sim.settings import HeadSettings
-from headsim.sim.simulator import HeadSim
-from headsim.stereo.triangulation import measure_point_stereo
-from headsim.stereo.views import StereoError
-from headsim.studies.calibrations import Calibrations
+from headsim.stereo.calibration import StereoCalibration
+from headsim.stereo.calibration_file import write_stereo_calibration
+from headsim.studies.calibrations import Calibrations, zoom_fixed_points
 from headsim.studies.methods import METHODS, SWEEP_METHODS, TARGET, StudyConfig
-from headsim.studies.targets import place_in_head
+from headsim.studies.scenario_runs import knowledge_file, scenario_with_head
 
 
 @dataclass(frozen=True)
@@ -51,6 +53,74 @@ class TargetError:
         return float(100 * np.linalg.norm(self.error_m) / self.truth_head_m[2])
 
 
+def _targets_scene(targets_head: np.ndarray) -> dict[str, Any]:
+    """``[scene]``: the red marker at each of ``targets_head`` (N, 3), H at the start pose, m."""
+    return {
+        "targets": [
+            {"name": f"point_{k}", "body": TARGET.name, "position_head_m": [float(v) for v in p]}
+            for k, p in enumerate(targets_head)
+        ]
+    }
+
+
+def stereo_errors(
+    settings: HeadSettings, zhang: StereoCalibration, targets_head: np.ndarray, folder: Path
+) -> list[TargetError]:
+    """Each of ``targets_head`` (N, 3) m triangulated by the head ``settings`` with the stored
+    calibration ``zhang`` (written to ``folder``), through the runner's ``stereo`` procedure."""
+    source = write_stereo_calibration(folder / "zhang.json", zhang)
+    doc = {
+        "description": "A study's targets triangulated with a stored Zhang calibration",
+        "experiment": {"procedure": "stereo", "stereo": {"from": str(source), "look": "once"}},
+        "scene": _targets_scene(targets_head),
+    }
+    result = run_scenario(scenario_with_head(doc, "study_stereo", settings))
+    stored = result.experiment
+    if not isinstance(stored, StoredStereoResult):
+        raise ValueError(f"study stereo run failed: {'; '.join(result.failures)}")
+    return [
+        TargetError("stereo", k, t.truth_head_m, t.estimate_head_m, t.status, renders)
+        for k, (t, renders) in enumerate(zip(stored.targets, stored.target_renders, strict=True))
+    ]
+
+
+def model2_measurements(
+    settings: HeadSettings,
+    label: str,
+    knowledge: HeadKnowledge,
+    targets_head: np.ndarray,
+    folder: Path,
+) -> list[Measurement]:
+    """Model 2 on each of ``targets_head`` (N, 3) m by the head ``settings`` told ``knowledge``
+    (a calibration file ``label``.json in ``folder``), through the runner: one per target."""
+    told = knowledge_file(folder / f"{label}.json", settings, knowledge)
+    doc = {
+        "description": "Model 2 on a study's targets with a method's knowledge",
+        "experiment": {"procedure": "model2", "calibration": {"from": str(told)}},
+        "scene": _targets_scene(targets_head),
+    }
+    result = run_scenario(scenario_with_head(doc, f"study_{label}", settings))
+    if len(result.records) != len(targets_head):
+        raise ValueError(f"study Model 2 run failed: {'; '.join(result.failures)}")
+    return [r.measurement for r in result.records]
+
+
+def model2_errors(
+    settings: HeadSettings,
+    method: str,
+    knowledge: HeadKnowledge,
+    targets_head: np.ndarray,
+    folder: Path,
+) -> list[TargetError]:
+    """:func:`model2_measurements` as ``method``'s errors."""
+    return [
+        TargetError(method, k, m.truth_head_m, m.estimate_head_m, m.status_text, m.renders)
+        for k, m in enumerate(
+            model2_measurements(settings, method, knowledge, targets_head, folder)
+        )
+    ]
+
+
 def measure_methods(
     settings: HeadSettings,
     calibrations: Calibrations,
@@ -58,7 +128,8 @@ def measure_methods(
     methods: Sequence[str] = SWEEP_METHODS,
     config: StudyConfig | None = None,
 ) -> list[TargetError]:
-    """Measure the red marker at each of ``targets_head`` (N, 3) m with each method.
+    """Measure the red marker at each of ``targets_head`` (N, 3) m with each method, one
+    run each; the errors in target order, then ``methods``' order.
 
     The head is ``settings`` (which may differ from the one calibrated);
     every method uses ``calibrations`` as they are, except that
@@ -69,43 +140,19 @@ def measure_methods(
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
         raise ValueError(f"unknown methods {unknown}; allowed: {', '.join(METHODS)}")
+    targets = np.atleast_2d(np.asarray(targets_head, dtype=float))
+    refound = zoom_fixed_points(settings, config) if "active_refound" in methods else None
     out: list[TargetError] = []
-    with HeadSim("default", settings) as sim:
-        servo = EyeServo(sim)
-        refound = None
-        if "active_refound" in methods:
-            with (
-                HeadSim("chessboard", settings) as before,
-                HeadSim("chessboard", zoomed(settings, PROBE_ZOOM)) as after,
-            ):
-                refound = principal_points_by_zoom(
-                    before,
-                    after,
-                    PROBE_ZOOM,
-                    np.random.default_rng(config.seed + 1),
-                    config.principal_poses,
-                )
-        for index, p_head in enumerate(np.atleast_2d(np.asarray(targets_head, dtype=float))):
-            place_in_head(sim, TARGET.name, p_head)
-            truth = sim.position(TARGET.name, "head")
-            for method in methods:
-                start = sim.render_count
-                if method == "stereo":
-                    try:
-                        m = measure_point_stereo(
-                            sim, calibrations.stereo, TARGET.name, look=look_once
-                        )
-                        estimate, status = m.p_head, "ok"
-                    except StereoError as error:
-                        estimate, status = np.full(3, np.nan), str(error)
-                else:
-                    m2 = measure_model2(sim, servo, TARGET, calibrations.knowledge(method, refound))
-                    estimate, status = m2.estimate_head_m, m2.status_text
-                out.append(
-                    TargetError(method, index, truth, estimate, status, sim.render_count - start)
-                )
-                sim.move(eye=0.0)
-    return out
+    with tempfile.TemporaryDirectory() as name:
+        folder = Path(name)
+        for method in methods:
+            if method == "stereo":
+                out += stereo_errors(settings, calibrations.stereo, targets, folder)
+            else:
+                knowledge = calibrations.knowledge(method, refound)
+                out += model2_errors(settings, method, knowledge, targets, folder)
+    order = {method: k for k, method in enumerate(methods)}
+    return sorted(out, key=lambda e: (e.index, order[e.method]))
 
 
 @dataclass(frozen=True)

@@ -14,9 +14,12 @@ from rerun.chunk import RrdReader
 
 from headsim.cli import main
 from headsim.errors import ExitCode
-from headsim.procedures.stereo import FOCAL_BOUND, HEAD_FRAMES, RMS_BOUND_PX
+from headsim.procedures.stereo import FOCAL_BOUND, HEAD_FRAMES, RMS_BOUND_PX, StereoSpec, calibrate
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.spec import experiment_record
+from headsim.sim.settings import ideal_head
+from headsim.sim.simulator import HeadSim
+from headsim.stereo.calibration_file import write_stereo_calibration
 
 #: A stereo scenario whose ``[experiment.stereo]`` table the bad-key tests fill in.
 SMALL = """description = "a bad stereo key"
@@ -143,3 +146,56 @@ def test_results_json_records_a_procedures_own_table_only_where_it_has_one() -> 
         "refine_intrinsics": True,
     }
     assert "block" not in experiment_record(load_scenario("quickstart", fast=True).experiment)
+
+
+@pytest.fixture(scope="module")
+def stored(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A Zhang calibration of the ideal head from eight real board views, as a file."""
+    with HeadSim("chessboard", ideal_head()) as sim:
+        calibration, _ = calibrate(sim, StereoSpec(views=8), seed=0)
+    return write_stereo_calibration(tmp_path_factory.mktemp("zhang") / "zhang.json", calibration)
+
+
+@pytest.mark.parametrize(("look", "renders"), [("", 2), ('look = "once"', 4)])
+def test_a_stored_calibration_triangulates_without_calibrating(
+    look: str, renders: int, stored: Path, tmp_path: Path
+) -> None:
+    path = tmp_path / "told.toml"
+    path.write_text(SMALL.format(line=f'from = "{stored}"\n{look}'))
+    out = tmp_path / "out"
+    assert main(["--quiet", "run", str(path), "--out", str(out), "--no-progress"]) == 0
+    results = json.loads((out / "results.json").read_text())
+    block = results["experiment"]
+    assert set(block) == {"procedure", "head_frames", "targets"}
+    (target,) = block["targets"]
+    error = np.subtract(target["estimate_head_m"], target["truth_head_m"])
+    assert target["status"] == "ok" and np.linalg.norm(error) < 1e-3
+    # No board view is rendered: each camera looks once for the target.
+    assert results["render_counts"]["overall"]["total"] == renders
+    assert results["scenario"]["experiment"]["block"]["source"] == str(stored)
+    assert "Stereo with a stored calibration (zhang.json)" in (out / "summary.txt").read_text()
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [
+        ('from = "missing.json"', "experiment.stereo.from: cannot read"),
+        ('from = "bad.json"', "experiment.stereo.from: "),
+        ('from = "other.json"', "is not a headsim-stereo-calibration file"),
+        ('from = "ok.json"\nviews = 8', "experiment.stereo.views: given with from"),
+        ('from = "ok.json"\nlook = "twice"', "experiment.stereo.look: "),
+        ('look = "once"', "experiment.stereo.look: given without from"),
+    ],
+)
+def test_a_bad_stored_calibration_is_one_line_naming_its_key(
+    line: str, message: str, stored: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "bad.json").write_text("{not json")
+    (tmp_path / "other.json").write_text('{"format": "headsim-calibration"}')
+    (tmp_path / "ok.json").write_text(stored.read_text())
+    path = tmp_path / "stereo.toml"
+    path.write_text(SMALL.format(line=line))
+    assert main(["run", str(path), "--out", str(tmp_path / "out")]) == ExitCode.BAD_INPUT
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err, err
+    assert not (tmp_path / "out").exists()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import cv2
 import numpy as np
 import pytest
@@ -14,6 +16,12 @@ from headsim.stereo.calibration import (
     calibrate_stereo,
     undistort_normalized_points,
 )
+from headsim.stereo.calibration_file import (
+    StereoCalibrationFileError,
+    read_stereo_calibration,
+    write_stereo_calibration,
+)
+from headsim.stereo.triangulation import triangulate
 from headsim.stereo.views import StereoError, chessboard_views
 
 
@@ -49,3 +57,37 @@ def test_undistortion_converges_over_the_whole_image_where_opencv_defaults_do_no
     assert np.abs(ours - reference).max() * cam.kx < 1e-6  # px
     default = cv2.undistortPoints(uv.reshape(-1, 1, 2), K, dist).reshape(-1, 2)
     assert np.abs(default - reference).max() * cam.kx > 0.3  # px, in the image corners
+
+
+def test_a_calibration_written_and_read_back_triangulates_exactly_as_before(
+    calibrated, tmp_path
+) -> None:
+    _, _, calib = calibrated
+    back = read_stereo_calibration(write_stereo_calibration(tmp_path / "zhang.json", calib))
+    for key in ("mono1", "mono2", "cam1", "cam2"):
+        a, b = getattr(calib, key), getattr(back, key)
+        assert np.array_equal(a.K, b.K) and np.array_equal(a.dist, b.dist)
+        assert a.rms_px == b.rms_px and a.image_size == b.image_size
+        assert np.array_equal(a.true_K, b.true_K) and np.array_equal(a.true_dist, b.true_dist)
+    for key in ("cam2_from_cam1", "true_cam2_from_cam1", "true_head_from_cam1"):
+        assert np.array_equal(getattr(calib, key), getattr(back, key))
+    assert (back.stereo_rms_px, back.views, back.refined) == (
+        calib.stereo_rms_px,
+        calib.views,
+        calib.refined,
+    )
+    uv1, uv2 = np.array([[300.0, 200.0]]), np.array([[280.0, 201.0]])
+    assert np.array_equal(triangulate(calib, uv1, uv2), triangulate(back, uv1, uv2))
+
+
+def test_a_malformed_stereo_calibration_file_says_what_is_wrong(calibrated, tmp_path) -> None:
+    _, _, calib = calibrated
+    path = write_stereo_calibration(tmp_path / "zhang.json", calib)
+    doc = json.loads(path.read_text())
+    doc["cam1"]["K"] = [[1.0, 0.0]]
+    path.write_text(json.dumps(doc))
+    with pytest.raises(StereoCalibrationFileError, match=r"zhang.json is malformed: not 3 x 3"):
+        read_stereo_calibration(path)
+    path.write_text(json.dumps({**doc, "version": 9}))
+    with pytest.raises(StereoCalibrationFileError, match="has version 9; this headsim reads 1"):
+        read_stereo_calibration(path)

@@ -38,11 +38,11 @@ def test_a_method_computed_from_shared_images_equals_its_own_measurement() -> No
             sim.move(eye=0.0)
             own = measure_model2(sim, EyeServo(sim), TARGET, knowledge)
             assert own.ok, own.status
-            computed = paper_tables.recompute(sim, shared, knowledge)
+            computed = paper_tables.recompute(sim.settings, shared, knowledge)
             np.testing.assert_allclose(computed, own.estimate_head_m, rtol=0, atol=1e-12)
         # The v0 the methods differ by moves the estimate: the check could fail.
-        centre = paper_tables.recompute(sim, shared, knowledges["active_centre"])
-        v_known = paper_tables.recompute(sim, shared, knowledges["active_v_known"])
+        centre = paper_tables.recompute(sim.settings, shared, knowledges["active_centre"])
+        v_known = paper_tables.recompute(sim.settings, shared, knowledges["active_v_known"])
         assert np.linalg.norm(centre - v_known) > 1e-4
 
 
