@@ -19,9 +19,7 @@ from headsim.active.placement import calibration_layout
 from headsim.active.principal import (
     PROBE_ZOOM,
     PrincipalPointRun,
-    principal_points_by_zoom,
     view_scale,
-    zoomed,
 )
 from headsim.geometry.stereo_view import StereoView
 from headsim.sim import names
@@ -30,7 +28,7 @@ from headsim.sim.simulator import HeadSim, start_views
 from headsim.stereo.calibration import StereoCalibration, calibrate_stereo
 from headsim.stereo.views import ChessboardViews, chessboard_views
 from headsim.studies.methods import BALL, METHODS, Progress, StudyConfig, quiet
-from headsim.studies.scenario_runs import calibration_run
+from headsim.studies.scenario_runs import calibration_run, zoom_fixed_points_run
 
 
 @dataclass(frozen=True)
@@ -181,17 +179,7 @@ def zhang_stereo(
 
 def zoom_fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:
     """The zoom fixed points of ``settings``' cameras, seeded by ``config.seed``."""
-    with (
-        HeadSim("chessboard", settings) as before,
-        HeadSim("chessboard", zoomed(settings, PROBE_ZOOM)) as after,
-    ):
-        return principal_points_by_zoom(
-            before,
-            after,
-            PROBE_ZOOM,
-            np.random.default_rng(config.seed + 1),
-            config.principal_poses,
-        )
+    return zoom_fixed_points_run(settings, PROBE_ZOOM, config.principal_poses, config.seed + 1)
 
 
 def calibration_positions(
