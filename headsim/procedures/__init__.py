@@ -14,7 +14,7 @@ from __future__ import annotations
 # isort: off
 # The order of registration is the order a scenario's error lists the procedures in.
 from headsim.procedures import model2, model1, calibration, tracking, chessboard
-from headsim.procedures import relative, pursuit, stereo
+from headsim.procedures import relative, pursuit, stereo, zoom_fixed_points
 
 # isort: on
 from headsim.scenario.registry import REGISTRY, Procedure, get, names, register
@@ -33,4 +33,5 @@ __all__ = [
     "relative",
     "stereo",
     "tracking",
+    "zoom_fixed_points",
 ]

@@ -21,7 +21,6 @@ from typing import Any
 
 import numpy as np
 
-from headsim.active.calibration import line_of_sight_truth
 from headsim.active.events import Detected, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
@@ -37,7 +36,6 @@ from headsim.sim.simulator import HeadSim, start_views
 from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
 from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
-from headsim.studies.calibrations import calibrate_realistic
 from headsim.studies.render_clock import RenderClock
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
 from headsim.studies.targets import random_targets_head, visible_vertical_range
@@ -326,15 +324,19 @@ def _realistic_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     metrics: Metrics = {}
     progress("realistic head: extended calibration (30 balls, 1 mm tape)")
     settings = preset("realistic")
-    with HeadSim("default", settings) as sim:
-        run = calibrate_realistic(sim, rng, seed)
-        truth = line_of_sight_truth(sim, run.knowledge)
-    knowledge = run.knowledge
+    knowledge, report = calibration_run(
+        settings,
+        calibration_layout(start_views(settings), rng, 30, depth_range_m=(0.25, 1.5)),
+        position_noise_m=0.001,
+        lines_of_sight=True,
+    )
     if faults.mount_sign:
         knowledge = replace(knowledge, alpha_e=(-knowledge.alpha_e[0], knowledge.alpha_e[1]))
-    lines = run.lines
+    lines = report.lines_of_sight
     metrics["realistic.calibration.effective_baseline_error_mm"] = (
-        abs(1e3 * (lines.effective_baseline_m - truth.effective_baseline_m)) if lines else math.inf
+        abs(1e3 * (lines.effective_baseline_m - lines.effective_baseline_truth_m))
+        if lines
+        else math.inf
     )
     progress("realistic head: Model 2 over the whole field")
     points = np.concatenate(

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from headsim.active.calibration import CalibrationRun, calibrate_head
+from headsim.active.calibration_report import CalibrationReport
 from headsim.active.chessboard import look_for_board
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
@@ -18,17 +19,40 @@ from headsim.active.placement import calibration_layout
 from headsim.active.principal import (
     PROBE_ZOOM,
     PrincipalPointRun,
-    principal_points_by_zoom,
     view_scale,
-    zoomed,
 )
 from headsim.geometry.stereo_view import StereoView
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
-from headsim.sim.simulator import HeadSim
+from headsim.sim.simulator import HeadSim, start_views
 from headsim.stereo.calibration import StereoCalibration, calibrate_stereo
 from headsim.stereo.views import ChessboardViews, chessboard_views
 from headsim.studies.methods import BALL, METHODS, Progress, StudyConfig, quiet
+from headsim.studies.scenario_runs import calibration_run, zoom_fixed_points_run
+
+
+@dataclass(frozen=True)
+class SecV:
+    """A Sec. V calibration run through the runner: what the head learnt and the report."""
+
+    knowledge: HeadKnowledge
+    report: CalibrationReport
+
+    @property
+    def alpha_e_error_rad(self) -> tuple[float, float]:
+        """Each camera's alpha_e minus the truth, rad."""
+        errors = self.report.alpha_e_error_rad
+        assert errors is not None  # calibration_run raises if the calibration failed
+        return (errors[0], errors[1])
+
+    @property
+    def truth_alpha_e_rad(self) -> tuple[float, float]:
+        """Each camera's true alpha_e on the servo's goal column, rad (the report's
+        ``alpha_e_truth_rad`` is the image centre's)."""
+        fitted = self.report.alpha_e_rad
+        assert fitted is not None  # calibration_run raises if the calibration failed
+        e1, e2 = self.alpha_e_error_rad
+        return (fitted[0] - e1, fitted[1] - e2)
 
 
 @dataclass(frozen=True)
@@ -43,9 +67,9 @@ class Calibrations:
 
     settings: HeadSettings
     stereo: StereoCalibration
-    active: CalibrationRun
+    active: SecV
     principal: PrincipalPointRun
-    fixed_point: CalibrationRun
+    fixed_point: SecV
     seconds: float
     renders: int
 
@@ -101,11 +125,11 @@ class Calibrations:
                 "rotation_error_mrad": s.rotation_error_rad * 1e3,
             },
             "active": {
-                "samples": active.samples,
-                "renders": active.renders,
-                "alpha_e_rad": active.fit.alpha_e,
-                "truth_alpha_e_rad": active.truth_alpha_e,
-                "alpha_e_error_mrad": active.alpha_e_error * 1e3,
+                "samples": active.report.fixated,
+                "renders": active.report.renders.total,
+                "alpha_e_rad": active.report.alpha_e_rad,
+                "truth_alpha_e_rad": active.truth_alpha_e_rad,
+                "alpha_e_error_mrad": [1e3 * e for e in active.alpha_e_error_rad],
                 "v0_px": active.knowledge.v0,
                 "kx_over_ky": active.knowledge.kx_over_ky,
                 "truth_principal_px": [c.principal for c in self.settings.cameras],
@@ -122,14 +146,14 @@ class Calibrations:
                 "renders": self.principal.renders,
             },
             "fixed_point": {
-                "samples": fixed.samples,
-                "renders": fixed.renders,
+                "samples": fixed.report.fixated,
+                "renders": fixed.report.renders.total,
                 "goal_columns_px": self.goal_columns(),
-                "alpha_e_rad": fixed.fit.alpha_e,
+                "alpha_e_rad": fixed.report.alpha_e_rad,
                 # On the principal point's column the offsets are the mount yaws.
-                "truth_alpha_e_rad": fixed.truth_alpha_e,
+                "truth_alpha_e_rad": fixed.truth_alpha_e_rad,
                 "mount_yaw_rad": mount_yaws,
-                "alpha_e_error_mrad": fixed.alpha_e_error * 1e3,
+                "alpha_e_error_mrad": [1e3 * e for e in fixed.alpha_e_error_rad],
                 "v0_px": fixed.knowledge.v0,
                 "kx_over_ky": fixed.knowledge.kx_over_ky,
             },
@@ -155,17 +179,7 @@ def zhang_stereo(
 
 def zoom_fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:
     """The zoom fixed points of ``settings``' cameras, seeded by ``config.seed``."""
-    with (
-        HeadSim("chessboard", settings) as before,
-        HeadSim("chessboard", zoomed(settings, PROBE_ZOOM)) as after,
-    ):
-        return principal_points_by_zoom(
-            before,
-            after,
-            PROBE_ZOOM,
-            np.random.default_rng(config.seed + 1),
-            config.principal_poses,
-        )
+    return zoom_fixed_points_run(settings, PROBE_ZOOM, config.principal_poses, config.seed + 1)
 
 
 def calibration_positions(
@@ -201,27 +215,19 @@ def calibrate_methods(
         + ", ".join(f"({e[0]:+.2f}, {e[1]:+.2f})" for e in principal.errors_px)
         + " px"
     )
-    with HeadSim("default", settings) as sim:
-        positions = calibration_positions(sim.stereo_views(), settings, config)
-        active = calibrate_head(sim, EyeServo(sim), BALL, names.CALIBRATION_BALL, positions)
-        progress(
-            f"  Sec. V, image centre: {active.samples} samples, alpha_e error "
-            + ", ".join(f"{1e3 * e:+.3f}" for e in active.alpha_e_error)
-            + " mrad"
-        )
-        (u1, _), (u2, _) = principal.principal_px
-        fixed = calibrate_head(
-            sim,
-            EyeServo(sim),
-            BALL,
-            names.CALIBRATION_BALL,
-            positions,
-            knowledge=HeadKnowledge(u0=(u1, u2)),
-        )
-        renders += active.renders + fixed.renders
+    positions = calibration_positions(start_views(settings), settings, config)
+    active = SecV(*calibration_run(settings, positions))
     progress(
-        f"  Sec. V, fixed point: {fixed.samples} samples, alpha_e error "
-        + ", ".join(f"{1e3 * e:+.3f}" for e in fixed.alpha_e_error)
+        f"  Sec. V, image centre: {active.report.fixated} samples, alpha_e error "
+        + ", ".join(f"{1e3 * e:+.3f}" for e in active.alpha_e_error_rad)
+        + " mrad"
+    )
+    (u1, _), (u2, _) = principal.principal_px
+    fixed = SecV(*calibration_run(settings, positions, goal_columns_px=(u1, u2)))
+    renders += active.report.renders.total + fixed.report.renders.total
+    progress(
+        f"  Sec. V, fixed point: {fixed.report.fixated} samples, alpha_e error "
+        + ", ".join(f"{1e3 * e:+.3f}" for e in fixed.alpha_e_error_rad)
         + " mrad"
     )
     return Calibrations(

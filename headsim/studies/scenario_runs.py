@@ -16,6 +16,8 @@ from typing import Any
 from headsim.active.calibration_file import knowledge_from_block, write_calibration
 from headsim.active.calibration_report import CalibrationReport
 from headsim.active.measurement import HeadKnowledge
+from headsim.active.principal import PrincipalPointRun
+from headsim.procedures.zoom_fixed_points import ZoomFixedPoints
 from headsim.run.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.spec import Scenario
@@ -72,11 +74,18 @@ def head_document(settings: HeadSettings) -> dict[str, Any]:
 
 def scenario_with_head(doc: dict[str, Any], name: str, settings: HeadSettings) -> Scenario:
     """The scenario ``doc`` (without its head's tables) on the head ``settings``, told by
-    :func:`head_document` (ValueError if the scenario's head came out otherwise)."""
+    :func:`head_document`, or by its preset's name where those tables cannot state it
+    (ValueError if the scenario's head came out otherwise)."""
     scenario = scenario_from_document({**doc, **head_document(settings)}, name)
-    if scenario.settings != settings:
-        raise ValueError("the head has settings that [head], [cam1] and [cam2] cannot state")
-    return scenario
+    if scenario.settings == settings:
+        return scenario
+    try:
+        head = {"seed": settings.seed, "head": {"preset": preset_of(settings)}}
+    except ValueError:
+        raise ValueError(
+            "the head has settings that [head], [cam1] and [cam2] cannot state"
+        ) from None
+    return scenario_from_document({**doc, **head}, name)
 
 
 def knowledge_file(path: Path, settings: HeadSettings, knowledge: HeadKnowledge) -> Path:
@@ -131,4 +140,29 @@ def calibration_run(
     return knowledge_from_block({"knowledge": asdict(report.knowledge)}), report
 
 
-__all__ = ["calibration_run", "head_document", "knowledge_file", "preset_of", "scenario_with_head"]
+def zoom_fixed_points_run(
+    settings: HeadSettings, zoom: float, poses: int, board_seed: int
+) -> PrincipalPointRun:
+    """The zoom fixed points of the head ``settings`` at ``zoom``, from ``poses`` board
+    poses drawn from ``default_rng(board_seed)``, through the runner (ValueError if
+    they could not be found)."""
+    experiment = {
+        "procedure": "zoom_fixed_points",
+        "zoom_fixed_points": {"zoom": zoom, "poses": poses, "board_seed": board_seed},
+    }
+    doc = {"description": "a study's zoom fixed points", "experiment": experiment}
+    result = run_scenario(scenario_with_head(doc, "study_zoom_fixed_points", settings))
+    found = result.experiment
+    if not result.ok or not isinstance(found, ZoomFixedPoints):
+        raise ValueError(f"study zoom fixed points failed: {'; '.join(result.failures)}")
+    return found.run
+
+
+__all__ = [
+    "calibration_run",
+    "head_document",
+    "knowledge_file",
+    "preset_of",
+    "scenario_with_head",
+    "zoom_fixed_points_run",
+]

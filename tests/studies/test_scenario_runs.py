@@ -9,7 +9,7 @@ import pytest
 
 from headsim.active.calibration_file import read_calibration
 from headsim.active.measurement import HeadKnowledge
-from headsim.sim.settings import PRESETS, CameraSettings, HeadSettings, paper_head
+from headsim.sim.settings import PRESETS, CameraSettings, HeadSettings, paper_head, preset
 from headsim.studies.scenario_runs import knowledge_file, preset_of, scenario_with_head
 
 
@@ -84,3 +84,10 @@ def test_a_heads_cameras_are_stated_key_by_key(settings: HeadSettings) -> None:
 def test_a_head_the_tables_cannot_state_is_refused() -> None:
     with pytest.raises(ValueError, match=r"\[head\], \[cam1\] and \[cam2\] cannot state"):
         scenario_with_head(MODEL2_DOC, "backlash", HeadSettings(backlash_rad=0.0003))
+
+
+def test_a_preset_the_tables_cannot_state_is_named_by_its_preset() -> None:
+    settings = preset("realistic", seed=3)
+    scenario = scenario_with_head(MODEL2_DOC, "realistic", settings)
+    assert scenario.settings == settings
+    assert scenario.seed == 3

@@ -1,0 +1,179 @@
+"""The zoom fixed points procedure: each camera's principal point as the point a zoom
+leaves in place, from chessboard images at the head's focal lengths and at ``zoom``
+times them (:func:`headsim.active.principal.principal_points_by_zoom`).  Only pixels
+enter the fit; each fixed point is reported beside the simulator's principal point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import rerun as rr
+
+from headsim.active.events import PhaseStarted
+from headsim.active.measurement import HeadKnowledge
+from headsim.active.principal import (
+    PROBE_ZOOM,
+    PrincipalPointError,
+    PrincipalPointRun,
+    principal_points_by_zoom,
+    zoomed,
+)
+from headsim.run.context import simulator
+from headsim.run.events import Hub
+from headsim.run.outcomes import MeasurementRecord
+from headsim.run.recording_layout import GREEN
+from headsim.run.table import format_table
+from headsim.scenario.registry import Procedure, register
+from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.tables import Table
+from headsim.sim import names
+from headsim.sim.simulator import HeadSim
+
+if TYPE_CHECKING:
+    from headsim.run.recording import Recorder
+
+
+@dataclass(frozen=True)
+class ZoomSpec:
+    """``[experiment.zoom_fixed_points]``: the focal length ratio, the board poses, and
+    the seed of their draws (None: the scenario's seed)."""
+
+    zoom: float = PROBE_ZOOM
+    poses: int = 2
+    board_seed: int | None = None
+
+
+@dataclass(frozen=True)
+class ZoomFixedPoints:
+    """Each camera's zoom fixed point beside the truth (``run``: the fits themselves)."""
+
+    run: PrincipalPointRun
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment`` fields."""
+        r = self.run
+        return {
+            "zoom": r.zoom,
+            "views": r.views,
+            "renders": r.renders,
+            "fixed_point_px": [list(p) for p in r.principal_px],
+            "truth_px": [list(p) for p in r.truth_px],
+            "error_px": r.errors_px.tolist(),
+            "std_px": [f.std_px.tolist() for f in r.fits],
+            "scale": [f.scale for f in r.fits],
+            "residual_rms_px": [f.residual_rms_px for f in r.fits],
+            "points": [f.points for f in r.fits],
+        }
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        """Each camera's fixed point beside the principal point."""
+        rows = [
+            [cam, f"{u:.2f}, {v:.2f}", f"{tu:.2f}, {tv:.2f}", f"{eu:+.2f}, {ev:+.2f}"]
+            for cam, (u, v), (tu, tv), (eu, ev) in zip(
+                names.CAMERAS,
+                self.run.principal_px,
+                self.run.truth_px,
+                self.run.errors_px,
+                strict=True,
+            )
+        ]
+        return [
+            f"Zoom fixed points ({self.run.zoom:g}x, {self.run.views} board views)",
+            *format_table(["camera", "fixed point px", "truth px", "error px"], rows),
+        ]
+
+    def ok_line(self, measured: int) -> str:
+        return f"OK: both fixed points found from {self.run.views} board views"
+
+    def log_rows(self, log: Recorder) -> None:
+        """Each camera's fixed point in its image."""
+        for cam, uv in zip(names.CAMERAS, self.run.principal_px, strict=True):
+            log.rec.log(
+                f"/world/head/{cam}/zoom_fixed_point", rr.Points2D([uv], radii=4.0, colors=[GREEN])
+            )
+
+
+@dataclass(frozen=True)
+class NotFound:
+    """The fixed points could not be fitted: ``reason`` says why."""
+
+    reason: str
+
+    def block(self) -> dict[str, Any]:
+        return {"reason": self.reason}
+
+    def failures(self) -> tuple[str, ...]:
+        return (f"zoom fixed points: {self.reason}",)
+
+    def summary_lines(self, paper: bool) -> list[str]:
+        return [f"Zoom fixed points: not found: {self.reason}"]
+
+    def ok_line(self, measured: int) -> str:
+        return "OK"  # never shown: a run without the fixed points fails
+
+    def log_rows(self, log: Recorder) -> None:
+        return None
+
+
+def run_zoom_fixed_points(
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
+) -> tuple[list[MeasurementRecord], ZoomFixedPoints | NotFound]:
+    """The board in ``poses`` seeded poses, rendered at both focal lengths; the fits."""
+    spec = scenario.experiment.block
+    assert isinstance(spec, ZoomSpec)
+    seed = scenario.seed if spec.board_seed is None else spec.board_seed
+    zoomed_head = zoomed(scenario.settings, spec.zoom)
+    with (
+        simulator(hub, "chessboard", scenario) as before,
+        HeadSim("chessboard", zoomed_head, settle_mode=scenario.settle_mode, sink=hub) as after,
+    ):
+        hub.emit(PhaseStarted("board views", before, knowledge, {}))
+        try:
+            run = principal_points_by_zoom(
+                before, after, spec.zoom, np.random.default_rng(seed), spec.poses
+            )
+        except PrincipalPointError as error:
+            return [], NotFound(str(error))
+    return [], ZoomFixedPoints(run)
+
+
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    """``[experiment.zoom_fixed_points]``: :class:`ZoomSpec`."""
+    block = table.table("zoom_fixed_points") or Table(
+        {}, table.field("zoom_fixed_points"), table.ctx
+    )
+    default = ZoomSpec()
+    zoom = block.number("zoom", default.zoom, 1.05, 3.0)
+    poses = block.integer("poses", default.poses, 1, 100)
+    board_seed: int | None = block.integer("board_seed", None, 0, 2**32 - 1)
+    block.done()
+    return {"block": ZoomSpec(zoom, poses, board_seed)}
+
+
+ZOOM_FIXED_POINTS = register(
+    Procedure(
+        "zoom_fixed_points",
+        "chessboard",
+        run_zoom_fixed_points,
+        fields=lambda result: result.block(),
+        summary=lambda result, paper: result.summary_lines(paper),
+        ok_line=lambda result, measured: result.ok_line(measured),
+        failures=lambda result: result.failures() if isinstance(result, NotFound) else (),
+        rows=lambda result, log: result.log_rows(log),
+        options=read_options,
+        fixations=lambda scenario: 0,
+    )
+)
+
+
+__all__ = [
+    "ZOOM_FIXED_POINTS",
+    "NotFound",
+    "ZoomFixedPoints",
+    "ZoomSpec",
+    "read_options",
+    "run_zoom_fixed_points",
+]
