@@ -40,13 +40,14 @@ and the block holds only ``head_frames`` and ``targets``.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import rerun as rr
 
+from headsim.active.chessboard import look_for_board
 from headsim.active.events import PhaseStarted
 from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge
@@ -58,7 +59,7 @@ from headsim.run.recording_layout import GREEN
 from headsim.run.table import cell, format_table, mm
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
-from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.spec import WHEN_GIVEN, CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.calibration import MIN_VIEWS, CameraCalibration, StereoCalibration
@@ -102,6 +103,15 @@ class StereoSpec:
     distance_m: tuple[float, float] = (0.4, 1.0)
     max_tilt_rad: float = 0.6
     refine_intrinsics: bool = True
+    #: The board poses' seed (None: the scenario's seed).
+    board_seed: int | None = field(default=None, metadata={WHEN_GIVEN: True})
+    #: How each camera finds the board: ``"full_frame"``, or ``"windowed"`` (a preview,
+    #: then a window: :func:`headsim.active.chessboard.look_for_board`).
+    board_look: str = field(default="full_frame", metadata={WHEN_GIVEN: True})
+
+
+#: ``[experiment.stereo] board_look``'s choices.
+BOARD_LOOKS = ("full_frame", "windowed")
 
 
 @dataclass(frozen=True)
@@ -158,7 +168,9 @@ class StereoTarget:
 def target_lines(
     head_frames: tuple[HeadFrame, ...], targets: tuple[StereoTarget, ...]
 ) -> list[str]:
-    """Each way of placing camera 1 in H, then each target, as tables."""
+    """Each way of placing camera 1 in H, then each target, as tables (none without targets)."""
+    if not targets:
+        return []
     lines = format_table(
         ["camera 1 in H", "rot mrad", "trans mm", "max mm", "max %z", "mean %z"],
         [
@@ -229,10 +241,14 @@ class StereoResult:
     passed: bool
     head_frames: tuple[HeadFrame, ...]
     targets: tuple[StereoTarget, ...]
+    #: The calibration itself, for a study that triangulates with it later (not in results.json).
+    calibration: StereoCalibration | None = field(default=None, compare=False, repr=False)
 
     def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: every field, in order."""
-        return asdict(self)
+        """results.json's ``experiment`` fields: every field but the calibration, in order."""
+        block = asdict(self)
+        del block["calibration"]
+        return block
 
     def failures(self) -> tuple[str, ...]:
         """Each target not found in both images."""
@@ -408,7 +424,12 @@ def calibrate(
     """Zhang's calibration from ``spec.views`` seeded board poses in ``sim`` (the chessboard
     scene); the calibration and its views."""
     views = chessboard_views(
-        sim, spec.views, np.random.default_rng(seed), spec.distance_m, spec.max_tilt_rad
+        sim,
+        spec.views,
+        np.random.default_rng(seed if spec.board_seed is None else spec.board_seed),
+        spec.distance_m,
+        spec.max_tilt_rad,
+        look=look_for_board if spec.board_look == "windowed" else None,
     )
     return zhang_calibration(sim, views, spec.refine_intrinsics), views
 
@@ -424,6 +445,8 @@ def measure_targets(
     camera looking with ``look`` (None: the full frame): the targets, each way of placing
     camera 1 in H, and each target's renders."""
     targets = scenario.scene.targets
+    if not targets:
+        return (), (), ()
     rows: list[StereoTarget] = []
     renders: list[int] = []
     frame_errors: dict[str, list[tuple[float, float]]] = {name: [] for name in HEAD_FRAMES}
@@ -520,12 +543,21 @@ def run_stereo(
         passed=max_rms <= RMS_BOUND_PX and max_focal <= FOCAL_BOUND,
         head_frames=summary,
         targets=rows,
+        calibration=calib,
     )
     return [], result
 
 
 #: The keys of ``[experiment.stereo]`` that only a calibration from board views reads.
-BOARD_KEYS = ("views", "distance_m", "max_tilt_rad", "refine_intrinsics", "pattern")
+BOARD_KEYS = (
+    "views",
+    "distance_m",
+    "max_tilt_rad",
+    "refine_intrinsics",
+    "pattern",
+    "board_seed",
+    "board_look",
+)
 
 
 def _stored_spec(stereo: Table, source: str) -> StoredStereoSpec:
@@ -565,6 +597,8 @@ def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str,
         )
     tilt = stereo.number("max_tilt_rad", default.max_tilt_rad, 0.0, 1.2, unit="rad")
     refine = stereo.boolean("refine_intrinsics", default.refine_intrinsics)
+    board_seed = stereo.integer("board_seed", None, 0, 2**32 - 1)
+    board_look = stereo.choice("board_look", BOARD_LOOKS, default.board_look)
     pattern = stereo.data.get("pattern", list(CHESSBOARD_PATTERN))
     stereo.has("pattern")
     if pattern != list(CHESSBOARD_PATTERN):
@@ -575,7 +609,7 @@ def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str,
             f"[{columns}, {rows}] (the chessboard scene's inner corners)",
         )
     stereo.done()
-    return {"block": StereoSpec(views, (low, high), tilt, refine)}
+    return {"block": StereoSpec(views, (low, high), tilt, refine, board_seed, board_look)}
 
 
 STEREO = register(
@@ -591,7 +625,7 @@ STEREO = register(
         failures=lambda result: result.failures(),
         rows=lambda result, log: result.log_rows(log),
         options=read_options,
-        read_scene=targets_reader("stereo", required=True),
+        read_scene=targets_reader("stereo", required=False),
     )
 )
 

@@ -251,6 +251,8 @@ DESCRIPTIONS: dict[str, str] = {
     "experiment.stereo.distance_m": "The board centre's distance from camera 1, [low, high], m.",
     "experiment.stereo.max_tilt_rad": "The board's largest tilt about its x and y axes, rad.",
     "experiment.stereo.refine_intrinsics": "stereoCalibrate refines each camera's K, k1, k2 (false: keeps each camera's own calibration).",
+    "experiment.stereo.board_seed": "The board poses' seed (default: the scenario's seed), so that a study can calibrate with the poses it drew before.",
+    "experiment.stereo.board_look": "How each camera finds the board: `full_frame`, or `windowed` (a binned preview, then a window on the board: the same corners).",
     "experiment.stereo.from": "A stored stereo calibration file (`headsim.stereo.calibration_file`) to triangulate with instead of calibrating (no board keys then).",
     "experiment.stereo.look": "With `from`: each camera's look for a target, the full frame or `once` (a binned preview, then a window where it shows the target).",
     "experiment.stereo.pattern": "The board's inner corners, [columns, rows]: the chessboard scene's board, [8, 6].",

@@ -9,7 +9,7 @@ OpenCV's.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -149,11 +149,20 @@ class ExperimentSpec:
     block: Any = None
 
 
+#: Field metadata of a procedure's block: results.json records the field only when it is
+#: not its default (keys that studies give, so shipped scenarios' results stay as they are).
+WHEN_GIVEN = "recorded_when_given"
+
+
 def experiment_record(experiment: ExperimentSpec) -> dict[str, Any]:
     """The ``[experiment]`` spec as results.json records it (see :func:`servo_record`)."""
     record = {**asdict(experiment), "servo": servo_record(experiment.servo)}
     if experiment.block is None:
         del record["block"]
+    elif is_dataclass(experiment.block):
+        for f in fields(experiment.block):
+            if f.metadata.get(WHEN_GIVEN) and getattr(experiment.block, f.name) == f.default:
+                del record["block"][f.name]
     calibration = record["calibration"]
     if calibration is not None and calibration["positions_world_m"] is None:
         del calibration["positions_world_m"]  # recorded only when given

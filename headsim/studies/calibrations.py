@@ -12,7 +12,6 @@ import numpy as np
 
 from headsim.active.calibration import CalibrationRun, calibrate_head
 from headsim.active.calibration_report import CalibrationReport
-from headsim.active.chessboard import look_for_board
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
@@ -22,13 +21,13 @@ from headsim.active.principal import (
     view_scale,
 )
 from headsim.geometry.stereo_view import StereoView
+from headsim.procedures.stereo import StereoResult
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim, start_views
-from headsim.stereo.calibration import StereoCalibration, calibrate_stereo
-from headsim.stereo.views import ChessboardViews, chessboard_views
+from headsim.stereo.calibration import StereoCalibration
 from headsim.studies.methods import BALL, METHODS, Progress, StudyConfig, quiet
-from headsim.studies.scenario_runs import calibration_run, zoom_fixed_points_run
+from headsim.studies.scenario_runs import calibration_run, zhang_run, zoom_fixed_points_run
 
 
 @dataclass(frozen=True)
@@ -162,19 +161,13 @@ class Calibrations:
 
 def zhang_stereo(
     settings: HeadSettings, config: StudyConfig
-) -> tuple[StereoCalibration, ChessboardViews]:
+) -> tuple[StereoCalibration, StereoResult]:
     """Zhang's calibration of ``settings``' pair from ``config.board_poses`` chessboard
-    poses (seeded by ``config.seed``), and the views it used."""
+    poses (seeded by ``config.seed``), and the stereo run's result (views kept, renders)."""
     scale = view_scale(settings)
-    with HeadSim("chessboard", settings) as sim:
-        views = chessboard_views(
-            sim,
-            config.board_poses,
-            np.random.default_rng(config.seed),
-            distance_range_m=(0.4 * scale, 1.0 * scale),
-            look=look_for_board,
-        )
-        return calibrate_stereo(sim, views), views
+    result = zhang_run(settings, config.board_poses, (0.4 * scale, 1.0 * scale), config.seed)
+    assert result.calibration is not None  # zhang_run raises otherwise
+    return result.calibration, result
 
 
 def zoom_fixed_points(settings: HeadSettings, config: StudyConfig) -> PrincipalPointRun:
@@ -205,7 +198,7 @@ def calibrate_methods(
     stereo_calibration, views = zhang_stereo(settings, config)
     renders = views.renders
     progress(
-        f"  stereo: {views.count} views, RMS {stereo_calibration.stereo_rms_px:.3f} px, "
+        f"  stereo: {views.views} views, RMS {stereo_calibration.stereo_rms_px:.3f} px, "
         f"focal errors {', '.join(f'{100 * e:+.2f} %' for e in stereo_calibration.cam1.focal_rel_errors)}"
     )
     principal = zoom_fixed_points(settings, config)

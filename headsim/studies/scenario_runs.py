@@ -17,6 +17,7 @@ from headsim.active.calibration_file import knowledge_from_block, write_calibrat
 from headsim.active.calibration_report import CalibrationReport
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.principal import PrincipalPointRun
+from headsim.procedures.stereo import StereoResult
 from headsim.procedures.zoom_fixed_points import ZoomFixedPoints
 from headsim.run.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
@@ -158,11 +159,36 @@ def zoom_fixed_points_run(
     return found.run
 
 
+def zhang_run(
+    settings: HeadSettings, poses: int, distance_m: tuple[float, float], board_seed: int
+) -> StereoResult:
+    """Zhang's calibration of the head ``settings``' pair from ``poses`` board poses drawn
+    from ``default_rng(board_seed)`` at ``distance_m`` from camera 1 (m), each board found
+    through a window, through the runner; the result carries the calibration (ValueError
+    if too few views showed the board)."""
+    stereo = {
+        "views": poses,
+        "distance_m": [float(d) for d in distance_m],
+        "board_seed": board_seed,
+        "board_look": "windowed",
+    }
+    doc = {
+        "description": "a study's Zhang calibration",
+        "experiment": {"procedure": "stereo", "stereo": stereo},
+    }
+    result = run_scenario(scenario_with_head(doc, "study_zhang", settings))
+    calibrated = result.experiment
+    if not isinstance(calibrated, StereoResult) or calibrated.calibration is None:
+        raise ValueError(f"study Zhang calibration failed: {'; '.join(result.failures)}")
+    return calibrated
+
+
 __all__ = [
     "calibration_run",
     "head_document",
     "knowledge_file",
     "preset_of",
     "scenario_with_head",
+    "zhang_run",
     "zoom_fixed_points_run",
 ]

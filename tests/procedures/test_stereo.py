@@ -105,6 +105,8 @@ def test_the_recording_holds_each_estimate(fast: tuple[Path, Path]) -> None:
         ("refine_intrinsics = 1", "experiment.stereo.refine_intrinsics: must be true or false"),
         ("pattern = [9, 6]", "experiment.stereo.pattern: [9, 6] is not the scene's board"),
         ("board = 1", "experiment.stereo.board: unknown key"),
+        ("board_seed = -1", "experiment.stereo.board_seed: "),
+        ('board_look = "preview"', "experiment.stereo.board_look: "),
     ],
 )
 def test_a_bad_stereo_key_is_one_line_naming_it(
@@ -146,6 +148,36 @@ def test_results_json_records_a_procedures_own_table_only_where_it_has_one() -> 
         "refine_intrinsics": True,
     }
     assert "block" not in experiment_record(load_scenario("quickstart", fast=True).experiment)
+
+
+def test_a_run_without_targets_calibrates_from_the_board_poses_it_is_given(
+    tmp_path: Path,
+) -> None:
+    """A study's Zhang calibration: its own board seed, windowed board looks, no targets.
+    The same seed as the scenario's gives the same calibration as the full-frame looks
+    (through previews); another seed gives another; both keys are recorded when given."""
+    template = 'description = "calibrate only"\nseed = 0\n[experiment]\nprocedure = "stereo"\n'
+    template += "[experiment.stereo]\nviews = 6\n{line}\n"
+    runs = {}
+    for label, line in [
+        ("default", ""),
+        ("windowed", 'board_look = "windowed"\nboard_seed = 0'),
+        ("other", "board_seed = 1"),
+    ]:
+        path = tmp_path / f"{label}.toml"
+        path.write_text(template.format(line=line))
+        out = tmp_path / label
+        assert main(["--quiet", "run", str(path), "--out", str(out), "--no-progress"]) == 0
+        runs[label] = json.loads((out / "results.json").read_text())
+    default, windowed, other = runs["default"], runs["windowed"], runs["other"]
+    assert default["experiment"]["targets"] == [] and default["experiment"]["head_frames"] == []
+    assert windowed["experiment"]["cameras"] == default["experiment"]["cameras"]
+    assert default["render_counts"]["overall"]["previews"] == 0
+    assert windowed["render_counts"]["overall"]["previews"] > 0
+    assert other["experiment"]["cameras"] != default["experiment"]["cameras"]
+    assert "board_seed" not in default["scenario"]["experiment"]["block"]
+    assert windowed["scenario"]["experiment"]["block"]["board_look"] == "windowed"
+    assert other["scenario"]["experiment"]["block"]["board_seed"] == 1
 
 
 @pytest.fixture(scope="module")
