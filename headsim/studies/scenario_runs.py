@@ -72,8 +72,17 @@ def head_document(settings: HeadSettings) -> dict[str, Any]:
 
 def scenario_with_head(doc: dict[str, Any], name: str, settings: HeadSettings) -> Scenario:
     """The scenario ``doc`` (without its head's tables) on the head ``settings``, told by
-    :func:`head_document` (ValueError if the scenario's head came out otherwise)."""
+    :func:`head_document`, else (a head built off its design) as its preset (ValueError
+    if the scenario's head came out otherwise)."""
     scenario = scenario_from_document({**doc, **head_document(settings)}, name)
+    if scenario.settings == settings:
+        return scenario
+    try:
+        head = {"seed": settings.seed, "head": {"preset": preset_of(settings)}}
+    except ValueError:
+        head = {}
+    if head:
+        scenario = scenario_from_document({**doc, **head}, name)
     if scenario.settings != settings:
         raise ValueError("the head has settings that [head], [cam1] and [cam2] cannot state")
     return scenario

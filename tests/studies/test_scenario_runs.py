@@ -84,3 +84,10 @@ def test_a_heads_cameras_are_stated_key_by_key(settings: HeadSettings) -> None:
 def test_a_head_the_tables_cannot_state_is_refused() -> None:
     with pytest.raises(ValueError, match=r"\[head\], \[cam1\] and \[cam2\] cannot state"):
         scenario_with_head(MODEL2_DOC, "backlash", HeadSettings(backlash_rad=0.0003))
+
+
+def test_a_head_built_off_its_design_is_stated_as_its_preset() -> None:
+    settings = PRESETS["realistic"](seed=3)
+    assert HeadSettings(cameras=settings.cameras) != settings  # not the cameras alone
+    scenario = scenario_with_head(MODEL2_DOC, "realistic", settings)
+    assert scenario.settings == settings and scenario.seed == 3
