@@ -16,7 +16,7 @@ its record a ``PursuitFrame`` event.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
@@ -63,12 +63,14 @@ class PursuitFigures:
 @dataclass(frozen=True)
 class PursuitResult:
     """The live pursuit: the spec as run, its figures and each frame (None when it never
-    started), and why it failed, one line each."""
+    started), and why it failed, one line each; ``run``: the gaze loop's own record, for a
+    study's figures beyond these (not in results.json)."""
 
     pursuit: dict[str, Any]
     figures: PursuitFigures | None = None
     per_frame: dict[str, Any] | None = None
     failures: tuple[str, ...] = ()
+    run: PursuitRun | None = field(default=None, compare=False, repr=False)
 
     def block(self) -> dict[str, Any]:
         """results.json's ``experiment`` fields: the spec, then the figures and each frame."""
@@ -197,6 +199,7 @@ def run_pursuit(
         figures=figures(run, spec),
         per_frame=_per_frame(run.records),
         failures=(f"{spec.name}: lost {run.losses} times",) if run.losses else (),
+        run=run,
     )
 
 

@@ -116,6 +116,7 @@ VARIANTS: tuple[tuple[str, Edit], ...] = (
                     "start_world_m": [0.0, 1.0, 0.21],
                     "max_speed_m_s": 0.3,
                     "box_half_m": [0.2, 0.2, 0.1],
+                    "seed": 5,
                 },
             ),
         ),
@@ -131,6 +132,20 @@ VARIANTS: tuple[tuple[str, Edit], ...] = (
         ),
     ),
     ("pursuit", _edits((_PATH, {"kind": "static", "point_world_m": [0.0, 1.0, 0.21]}))),
+    (
+        "pursuit",
+        _edits(
+            (
+                _PATH,
+                {
+                    "kind": "jump",
+                    "start_world_m": [0.0, 1.0, 0.21],
+                    "end_world_m": [0.1, 1.0, 0.25],
+                    "time_s": 0.1,
+                },
+            ),
+        ),
+    ),
 )
 
 
@@ -314,9 +329,12 @@ DESCRIPTIONS: dict[str, str] = {
     f"{_PURSUIT}.path.amplitude_m": "`sinusoid`: the amplitude along x, y, z of W, m.",
     f"{_PURSUIT}.path.frequency_hz": "`sinusoid`: the frequency, Hz.",
     f"{_PURSUIT}.path.phase_rad": "`sinusoid`: the phase along x, y, z, rad.",
-    f"{_PURSUIT}.path.start_world_m": "`random_walk`, `throw`: the start in W, m.",
-    f"{_PURSUIT}.path.max_speed_m_s": "`random_walk`: the largest speed, m/s (seeded by `seed`).",
+    f"{_PURSUIT}.path.start_world_m": "`random_walk`, `throw`, `jump`: the start in W, m.",
+    f"{_PURSUIT}.path.max_speed_m_s": "`random_walk`: the largest speed, m/s.",
     f"{_PURSUIT}.path.box_half_m": "`random_walk`: half the box it stays in, along x, y, z, m.",
+    f"{_PURSUIT}.path.seed": "`random_walk`: the walk's seed; default the scenario's `seed`.",
+    f"{_PURSUIT}.path.end_world_m": "`jump`: where the target is from `time_s` on, in W, m.",
+    f"{_PURSUIT}.path.time_s": "`jump`: when the target jumps from the start to the end, s.",
     f"{_PURSUIT}.path.velocity_m_s": "`throw`: the initial velocity in W, m/s (then gravity).",
     f"{_PURSUIT}.path.point_world_m": "`static`: the point in W, m.",
     f"{_PURSUIT}.path.windows_s": "When the target is visible: [[appear_s, disappear_s], ...]; default always.",

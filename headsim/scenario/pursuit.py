@@ -5,10 +5,11 @@
 
 - ``waypoints``: ``points_world_m`` (>= 2 points), ``speeds_m_s`` (one per leg);
 - ``sinusoid``: ``centre_world_m``, ``amplitude_m``, ``frequency_hz``, ``phase_rad``;
-- ``random_walk``: ``start_world_m``, ``max_speed_m_s``, ``box_half_m``
-  (seeded from the scenario's seed);
+- ``random_walk``: ``start_world_m``, ``max_speed_m_s``, ``box_half_m``, ``seed``
+  (default: the scenario's seed);
 - ``throw``: ``start_world_m``, ``velocity_m_s`` (under gravity);
 - ``static``: ``point_world_m``;
+- ``jump``: ``start_world_m`` until ``time_s``, then at once ``end_world_m`` (a saccade's target);
 
 and ``windows_s`` (``[[appear, disappear], ...]``: when the target is
 present; none: always).  ``[scene.pursuit.live]``: ``frame_rate_hz``,
@@ -29,11 +30,20 @@ import numpy as np
 from headsim.live.gaze import GazeConfig, GazeMode, SaccadeProfile
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, LiveConfig
 from headsim.live.motors import MotorLimits
-from headsim.live.paths import Path, RandomWalk, Sinusoid, Static, Throw, Visibility, Waypoints
+from headsim.live.paths import (
+    Jump,
+    Path,
+    RandomWalk,
+    Sinusoid,
+    Static,
+    Throw,
+    Visibility,
+    Waypoints,
+)
 from headsim.scenario.tables import Table
 from headsim.sim.settings import SettingsError
 
-PATH_KINDS = ("waypoints", "sinusoid", "random_walk", "throw", "static")
+PATH_KINDS = ("waypoints", "sinusoid", "random_walk", "throw", "static", "jump")
 #: Largest coordinate of a path point, m.
 MAX_COORDINATE_M = 10.0
 
@@ -108,11 +118,17 @@ def _path(table: Table, seed: int, duration_s: float) -> tuple[str, Path, Visibi
             _point(table, "start_world_m"),
             table.number("max_speed_m_s", lo=0.0, hi=10.0, lo_open=True, unit="m/s"),
             duration_s + 1.0,
-            seed=seed,
+            seed=table.integer("seed", seed, 0, 2**32 - 1),
             box_half_m=table.numbers("box_half_m", 3, (0.2, 0.2, 0.1), 0.0, 2.0, unit="m"),  # type: ignore[arg-type]
         )
     elif kind == "throw":
         path = Throw(_point(table, "start_world_m"), _point(table, "velocity_m_s"))
+    elif kind == "jump":
+        path = Jump(
+            _point(table, "start_world_m"),
+            _point(table, "end_world_m"),
+            table.number("time_s", lo=0.0, hi=3600.0, unit="s"),
+        )
     else:
         path = Static(_point(table, "point_world_m"))
     windows = table.data.get("windows_s", [])

@@ -10,9 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from headsim.active.calibration import CalibrationRun, calibrate_head
 from headsim.active.calibration_report import CalibrationReport
-from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
 from headsim.active.principal import (
@@ -22,11 +20,10 @@ from headsim.active.principal import (
 )
 from headsim.geometry.stereo_view import StereoView
 from headsim.procedures.stereo import StereoResult
-from headsim.sim import names
 from headsim.sim.settings import HeadSettings
-from headsim.sim.simulator import HeadSim, start_views
+from headsim.sim.simulator import start_views
 from headsim.stereo.calibration import StereoCalibration
-from headsim.studies.methods import BALL, METHODS, Progress, StudyConfig, quiet
+from headsim.studies.methods import METHODS, Progress, StudyConfig, quiet
 from headsim.studies.scenario_runs import calibration_run, zhang_run, zoom_fixed_points_run
 
 
@@ -255,18 +252,3 @@ class CalibrationCache:
     @property
     def calibrations(self) -> list[Calibrations]:
         return list(self._cache.values())
-
-
-def calibrate_realistic(sim: HeadSim, rng: np.random.Generator, seed: int) -> CalibrationRun:
-    """The bench's extended calibration of a realistic head: 30 balls at 0.25-1.5 m drawn
-    from ``rng``, a 1 mm tape seeded by ``seed``."""
-    return calibrate_head(
-        sim,
-        EyeServo(sim),
-        BALL,
-        names.CALIBRATION_BALL,
-        calibration_layout(sim.stereo_views(), rng, 30, depth_range_m=(0.25, 1.5)),
-        position_noise_m=0.001,
-        rng=np.random.default_rng([seed, 7]),
-        lines_of_sight=True,
-    )

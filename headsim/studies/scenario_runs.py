@@ -9,6 +9,7 @@ calibration file that the scenario names (``experiment.calibration.from``).
 
 from __future__ import annotations
 
+from contextlib import suppress
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
@@ -75,18 +76,17 @@ def head_document(settings: HeadSettings) -> dict[str, Any]:
 
 def scenario_with_head(doc: dict[str, Any], name: str, settings: HeadSettings) -> Scenario:
     """The scenario ``doc`` (without its head's tables) on the head ``settings``, told by
-    :func:`head_document`, or by its preset's name where those tables cannot state it
-    (ValueError if the scenario's head came out otherwise)."""
-    scenario = scenario_from_document({**doc, **head_document(settings)}, name)
-    if scenario.settings == settings:
-        return scenario
-    try:
-        head = {"seed": settings.seed, "head": {"preset": preset_of(settings)}}
-    except ValueError:
-        raise ValueError(
-            "the head has settings that [head], [cam1] and [cam2] cannot state"
-        ) from None
-    return scenario_from_document({**doc, **head}, name)
+    :func:`head_document` where only its cameras differ from the ideal head's, else (a
+    head built off its design) as its preset (ValueError if the scenario's head came out
+    otherwise)."""
+    head = head_document(settings)
+    if HeadSettings(seed=settings.seed, cameras=settings.cameras) != settings:
+        with suppress(ValueError):  # no preset's either: refused below
+            head = {"seed": settings.seed, "head": {"preset": preset_of(settings)}}
+    scenario = scenario_from_document({**doc, **head}, name)
+    if scenario.settings != settings:
+        raise ValueError("the head has settings that [head], [cam1] and [cam2] cannot state")
+    return scenario
 
 
 def knowledge_file(path: Path, settings: HeadSettings, knowledge: HeadKnowledge) -> Path:

@@ -9,7 +9,7 @@ import pytest
 
 from headsim.active.calibration_file import read_calibration
 from headsim.active.measurement import HeadKnowledge
-from headsim.sim.settings import PRESETS, CameraSettings, HeadSettings, paper_head, preset
+from headsim.sim.settings import PRESETS, CameraSettings, HeadSettings, paper_head
 from headsim.studies.scenario_runs import knowledge_file, preset_of, scenario_with_head
 
 
@@ -86,8 +86,8 @@ def test_a_head_the_tables_cannot_state_is_refused() -> None:
         scenario_with_head(MODEL2_DOC, "backlash", HeadSettings(backlash_rad=0.0003))
 
 
-def test_a_preset_the_tables_cannot_state_is_named_by_its_preset() -> None:
-    settings = preset("realistic", seed=3)
+def test_a_head_built_off_its_design_is_stated_as_its_preset() -> None:
+    settings = PRESETS["realistic"](seed=3)
+    assert HeadSettings(cameras=settings.cameras) != settings  # not the cameras alone
     scenario = scenario_with_head(MODEL2_DOC, "realistic", settings)
-    assert scenario.settings == settings
-    assert scenario.seed == 3
+    assert scenario.settings == settings and scenario.seed == 3
