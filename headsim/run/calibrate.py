@@ -86,7 +86,10 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
         truth = {f"calibration {k + 1}": p for k, p in enumerate(positions)}
         hub.emit(PhaseStarted("calibration", sim, HeadKnowledge(), truth))
         ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
-        truth_alpha_e = [sim.effective_initial_direction(c) for c in (1, 2)]
+        # At the servo's goal columns, as the fit's error is (the image centres by default).
+        truth_alpha_e = [
+            sim.effective_initial_direction(c, known.reference(sim, c)[0]) for c in (1, 2)
+        ]
         truth_v0 = [sim.camera_settings(c).principal[1] for c in (1, 2)]
         truth_ratio = [sim.camera_settings(c).kx / sim.camera_settings(c).ky for c in (1, 2)]
         planned = CalibrationReport(

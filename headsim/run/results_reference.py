@@ -177,6 +177,9 @@ RESULTS_FIELDS: dict[str, str] = {
 _NONE: dict[str, str] = {}
 
 #: Each procedure's ``experiment`` keys beside ``procedure``, relative to ``experiment``.
+#: ``experiment`` keys a procedure writes only when it failed.
+FAILED_ONLY = frozenset({"reason"})
+
 EXPERIMENT_FIELDS: dict[str, dict[str, str]] = {
     "model2": _NONE,
     "model1": _NONE,
@@ -252,6 +255,7 @@ EXPERIMENT_FIELDS: dict[str, dict[str, str]] = {
         "passed": "both acceptance figures met",
         "head_frames": "each way of placing camera 1 in H (`label`, `rotation_error_rad`, `translation_error_m`, `max_error_m`, `max_error_pct_depth`, `mean_error_pct_depth`)",
         "targets": "each target (`name`, `status`, `truth_head_m`, `estimate_head_m`, `estimate_world_m`, `uv1_px`, `uv2_px`), m, px",
+        "reason": "why the pair was not calibrated (only then, beside `poses`)",
     },
     "zoom_fixed_points": {
         "zoom": "the focal length ratio of the second images",
@@ -345,4 +349,4 @@ def documented_paths(results: Mapping[str, Any]) -> set[str]:
     return {documented for _, documented in _pairs(results) if documented is not None}
 
 
-__all__ = ["EXPERIMENT_FIELDS", "RESULTS_FIELDS", "documented_paths", "undocumented"]
+__all__ = ["EXPERIMENT_FIELDS", "FAILED_ONLY", "RESULTS_FIELDS", "documented_paths", "undocumented"]

@@ -52,3 +52,22 @@ def test_given_positions_calibrate_as_the_same_positions_drawn() -> None:
     assert given.calibration.layout.kind == "given"
     assert given.calibration.targets == 6
     assert given.calibration.alpha_e_rad == drawn.calibration.alpha_e_rad
+
+
+def test_the_reported_truth_is_the_goal_columns_own() -> None:
+    """With the servo on other columns than the image centres, the report's truth is the
+    effective direction through those columns: fitted minus truth is the reported error,
+    and the truth differs from the image centres' by the columns' angle."""
+    doc = _doc({"targets": 6})
+    centre = run_scenario(scenario_from_document(doc, "centre")).calibration
+    doc["experiment"]["goal_columns_px"] = [300.0, 340.0]
+    goal = run_scenario(scenario_from_document(doc, "goal")).calibration
+    for report in (centre, goal):
+        assert report is not None and report.alpha_e_rad is not None
+        assert report.alpha_e_truth_rad is not None and report.alpha_e_error_rad is not None
+        fitted_minus_truth = np.subtract(report.alpha_e_rad, report.alpha_e_truth_rad)
+        np.testing.assert_allclose(fitted_minus_truth, report.alpha_e_error_rad, atol=1e-12)
+    assert centre is not None and goal is not None
+    assert centre.alpha_e_truth_rad is not None and goal.alpha_e_truth_rad is not None
+    # 20 px off the centre is about 24 mrad at the paper head's 835 px focal length.
+    assert np.all(np.abs(np.subtract(goal.alpha_e_truth_rad, centre.alpha_e_truth_rad)) > 0.01)
