@@ -199,6 +199,17 @@ def target_lines(
     )
 
 
+def target_failures(targets: tuple[StereoTarget, ...]) -> tuple[str, ...]:
+    """Each target not found in both images."""
+    return tuple(f"{t.name}: {t.status}" for t in targets if not t.ok)
+
+
+def triangulated_line(targets: tuple[StereoTarget, ...]) -> str:
+    """The summary's OK line of a run whose every target was triangulated."""
+    count = len(targets)
+    return f"OK: {count} target{'' if count == 1 else 's'} triangulated, none failed"
+
+
 def log_estimates(log: Recorder, targets: tuple[StereoTarget, ...]) -> None:
     """Each triangulated target's estimate in W."""
     seen = [t for t in targets if t.ok]
@@ -251,12 +262,10 @@ class StereoResult:
         return block
 
     def failures(self) -> tuple[str, ...]:
-        """Each target not found in both images."""
-        return tuple(f"{t.name}: {t.status}" for t in self.targets if not t.ok)
+        return target_failures(self.targets)
 
     def ok_line(self, measured: int) -> str:
-        count = len(self.targets)
-        return f"OK: {count} target{'' if count == 1 else 's'} triangulated, none failed"
+        return triangulated_line(self.targets)
 
     def summary_lines(self, paper: bool) -> list[str]:
         """The calibration beside the truth, each way of placing camera 1, each target."""
@@ -303,15 +312,14 @@ class StoredStereoResult:
 
     def block(self) -> dict[str, Any]:
         """results.json's ``experiment`` fields: ``head_frames`` and ``targets``."""
-        return {"head_frames": asdict(self)["head_frames"], "targets": asdict(self)["targets"]}
+        block = asdict(self)
+        return {"head_frames": block["head_frames"], "targets": block["targets"]}
 
     def failures(self) -> tuple[str, ...]:
-        """Each target not found in both images."""
-        return tuple(f"{t.name}: {t.status}" for t in self.targets if not t.ok)
+        return target_failures(self.targets)
 
     def ok_line(self, measured: int) -> str:
-        count = len(self.targets)
-        return f"OK: {count} target{'' if count == 1 else 's'} triangulated, none failed"
+        return triangulated_line(self.targets)
 
     def summary_lines(self, paper: bool) -> list[str]:
         """The calibration's file, each way of placing camera 1, each target."""
