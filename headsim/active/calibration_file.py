@@ -55,6 +55,9 @@ def head_fields(settings: HeadSettings) -> dict[str, Any]:
             flat[prefix[:-1]] = to_jsonable(value)
 
     raw = asdict(settings)
+    raw.pop("head")
+    if not settings.head.is_paper:  # the paper's head is the one every older file was for
+        raw["head_model"] = settings.head.name
     cameras = raw.pop("cameras")
     walk("", raw)
     for index, camera in enumerate(cameras):

@@ -33,7 +33,6 @@ from headsim.active.servo_types import (
     ServoOutcome,
     ServoResult,
 )
-from headsim.sim import names
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection, DetectionStatus
@@ -49,7 +48,7 @@ class EyeServo:
         self.config = config or ServoConfig()
         #: Where detections and moves are reported (None: the simulator's sink).
         self.sink = sim.sink if sink is None else sink
-        low, high = sim.joint_range(names.EYE_MOTOR_JOINT)
+        low, high = sim.joint_range("eye")
         resolution = sim.settings.encoder_resolution_rad
         self._step_range = (math.ceil(low / resolution), math.floor(high / resolution))
         #: Gain per camera, px per encoder step, carried from one target to the next.

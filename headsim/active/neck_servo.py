@@ -19,7 +19,6 @@ from headsim.active.servo_types import (
     ServoConfig,
     ServoOutcome,
 )
-from headsim.sim import names
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection, DetectionStatus
@@ -35,11 +34,18 @@ class NeckServo:
     fixation (tracking).
     """
 
-    JOINTS = (names.NECK_YAW, names.NECK_PITCH, names.EYE_MOTOR_JOINT)
+    JOINTS = ("neck_yaw", "neck_pitch", "eye")
 
     def __init__(
-        self, sim: HeadSim, config: ServoConfig | None = None, sink: EventSink | None = None
+        self,
+        sim: HeadSim,
+        config: ServoConfig | None = None,
+        sink: EventSink | None = None,
+        motors: tuple[str, str, str] = JOINTS,
     ) -> None:
+        #: The three motors it drives, in the order of ``steps``: Model 1's neck yaw,
+        #: pitch and eye motor, or a one-step fixation's two eyes and the pitch.
+        self.motors = motors
         self.sim = sim
         self.config = config or ServoConfig()
         #: Where detections and moves are reported (None: the simulator's sink).
@@ -47,7 +53,7 @@ class NeckServo:
         resolution = sim.settings.encoder_resolution_rad
         self._ranges = [
             (math.ceil(lo / resolution), math.floor(hi / resolution))
-            for lo, hi in (sim.joint_range(j) for j in self.JOINTS)
+            for lo, hi in (sim.joint_range(j) for j in self.motors)
         ]
         self.jacobian: np.ndarray | None = None
         #: The last images' detections the windows are predicted from:
@@ -65,14 +71,16 @@ class NeckServo:
         self._goals = np.zeros(3)
 
     def _steps(self) -> np.ndarray:
+        if self.motors != self.JOINTS:
+            return np.array([self.sim.encoder_steps(m) for m in self.motors])
         resolution = self.sim.settings.encoder_resolution_rad
         yaw, pitch = (round(a / resolution) for a in self.sim.neck_encoders())
         return np.array([yaw, pitch, self.sim.eye_encoder_steps()])
 
     def _move(self, steps: np.ndarray) -> None:
         resolution = self.sim.settings.encoder_resolution_rad
-        yaw, pitch, eye = (float(s) * resolution for s in steps)
-        self.sim.command(neck_yaw=yaw, neck_pitch=pitch, eye=eye)
+        angles = {m: float(s) * resolution for m, s in zip(self.motors, steps, strict=True)}
+        self.sim.command(**angles)
         self.sim.settle()
 
     def _looks(self, detector: Detector) -> list[Detection]:
@@ -178,6 +186,8 @@ class NeckServo:
         columns evenly over one pixel around the goals (the eye servo's rule, see
         ``ServoConfig.average_fixation``; two renders a pose); back to ``result.steps``."""
         cfg, sim, jac = self.config, self.sim, result.jacobian
+        if self.motors != self.JOINTS:  # one eye motor to spread the columns over: Model 1's
+            return result
         if not cfg.average_fixation or jac is None or not finds_blob(self._key):
             return result
         gain = float(np.max(np.abs(jac[:2, 2])))  # px per eye step in the faster camera

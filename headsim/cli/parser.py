@@ -82,6 +82,11 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         "--fast", action="store_true", help="the scenario's fast variant (its [fast] table)"
     )
     run.add_argument(
+        "--head",
+        metavar="HEAD",
+        help="run on another shipped head: paper, independent_eyes (sets head.model)",
+    )
+    run.add_argument(
         "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"
     )
     from headsim.run.rerun_cli import add_recording_arguments

@@ -41,7 +41,8 @@ def run_command(args: argparse.Namespace) -> int:
     from headsim.run.summary import summary_text
     from headsim.scenario.loading import load_scenario
 
-    scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed)
+    overrides = None if getattr(args, "head", None) is None else {"head.model": args.head}
+    scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed, overrides=overrides)
     target = recording_target(args)  # a bad --url or port is bad input (exit 2)
     raise_if_interrupted()  # an interrupt swallowed while loading: nothing written yet
     outputs = Outputs()
@@ -201,8 +202,10 @@ def list_command(args: argparse.Namespace) -> int:
         print(printable(f"no scenario files (*.toml) in {directory}"))
         return 0
     print(printable(f"scenarios in {directory} (run one with: headsim run NAME --out DIR)"))
-    shown = [(printable(name), printable(description)) for name, description in rows]
-    width = max(len(name) for name, _ in shown)
-    for name, description in shown:
-        print(f"  {name.ljust(width)}  {description}")
-    return 0 if all(not d.startswith("INVALID") for _, d in rows) else 2
+    shown = [tuple(printable(cell) for cell in row) for row in rows]
+    name_width = max(len(name) for name, _, _ in shown)
+    head_width = max(len("head"), *(len(head) for _, head, _ in shown))
+    print(f"  {'name'.ljust(name_width)}  {'head'.ljust(head_width)}  description")
+    for name, head, description in shown:
+        print(f"  {name.ljust(name_width)}  {head.ljust(head_width)}  {description}")
+    return 0 if all(head for _, head, _ in rows) else 2

@@ -61,6 +61,8 @@ from headsim.active.measurement import HeadKnowledge, to_world
 from headsim.estimators.model1 import model1
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, Frame, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
+from headsim.sim.heads import HeadModel, shipped
+from headsim.sim.model import on_head
 from headsim.sim.settings import (
     CAMERA_NUMBER_FIELDS,
     IDEAL_FOCAL_PX,
@@ -121,6 +123,7 @@ class FixateEnv(gymnasium.Env):
         render_mode: str | None = None,
         belief: HeadBelief | None = None,
         action_space: str = "normalised",
+        head: str | HeadModel = "paper",
     ) -> None:
         if action_space not in ACTION_SPACES:
             raise SettingsError(
@@ -149,7 +152,10 @@ class FixateEnv(gymnasium.Env):
         self.live_config = LiveConfig(frame_rate_hz=frame_rate_hz, latency_frames=latency_frames)
         focal = IDEAL_FOCAL_PX * height / 480.0
         camera = CameraSettings(width=width, height=height, kx=focal, ky=focal)
-        self.base_settings = HeadSettings(cameras=(camera, camera), belief=belief)
+        head_model = shipped(head) if isinstance(head, str) else head
+        self.base_settings = on_head(
+            HeadSettings(cameras=(camera, camera), belief=belief), head_model
+        )
         self.knowledge = HeadKnowledge()  # uncalibrated: the simulator's belief, no alpha_e
         self.defaults = {
             "depth_m": (0.5, 1.5),

@@ -21,6 +21,8 @@ class Method(enum.Enum):
     MODEL1 = "model1"
     #: Model 2 (:mod:`headsim.estimators.model2`), fixated by the eye servo
     MODEL2 = "model2"
+    #: One-step fixation with independent eyes (:mod:`headsim.estimators.fixation`)
+    FIXATION = "fixation"
 
 
 class Status(enum.Enum):

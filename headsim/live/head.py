@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from headsim.live.motors import MOTOR_JOINTS, MotorDriver, MotorLimits
+from headsim.live.motors import MotorDriver, MotorLimits, motor_joints
 from headsim.live.paths import Path, Visibility
 from headsim.sim.settings import SettingsError
 from headsim.sim.simulator import HeadSim
@@ -127,8 +127,10 @@ class LiveHead:
         self.config = config or LiveConfig()
         self.dt = float(sim.model.opt.timestep)
         limits = (self.config.neck_limits, self.config.neck_limits, self.config.eye_limits)
-        self.motors = MotorDriver(sim.model, sim.data, limits, self.config.servo_bandwidth_hz)
-        self._qadr = [int(sim.model.joint(j).qposadr[0]) for j in MOTOR_JOINTS]
+        self.motors = MotorDriver(
+            sim.model, sim.data, limits, self.config.servo_bandwidth_hz, sim.names
+        )
+        self._qadr = [int(sim.model.joint(j).qposadr[0]) for j in motor_joints(sim.names)]
         self._mocap = -1
         if target_body is not None:
             body_id = mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_BODY, target_body)

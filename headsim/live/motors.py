@@ -24,13 +24,19 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from headsim.sim import names
+from headsim.sim.heads import PAPER, HeadMapping, actuator_on
 from headsim.sim.settings import SettingsError
 
 #: The motors in the order of every 3-vector here: (neck yaw, neck pitch, eye).
 MOTORS = ("neck_yaw", "neck_pitch", "eye")
-MOTOR_JOINTS = (names.NECK_YAW, names.NECK_PITCH, names.EYE_MOTOR_JOINT)
-MOTOR_ACTUATORS = (names.NECK_YAW_MOTOR, names.NECK_PITCH_MOTOR, names.EYE_MOTOR)
+
+
+def motor_joints(mapping: HeadMapping) -> tuple[str, str, str]:
+    """The joint each of :data:`MOTORS` reads: neck yaw, pitch and Ca1's eye."""
+    if mapping.neck_yaw is None:
+        raise SettingsError("the live head needs a neck yaw joint (head.mapping.neck_yaw)")
+    return (mapping.neck_yaw, mapping.neck_pitch, mapping.left_eye)
+
 
 #: Peak speed and acceleration of a minimum-jerk move of amplitude 1 over time 1.
 MIN_JERK_PEAK_SPEED = 1.875
@@ -107,7 +113,8 @@ class _Motor:
 class MotorDriver:
     """The three motors of a head in a MuJoCo model: rate-limited references to the actuators.
 
-    The actuators are retuned to a stiff critically damped servo of natural
+    With independent eyes the eye motor's reference drives both eyes' actuators (the
+    counter-yaw of the paper's one motor).  The actuators are retuned to a stiff critically damped servo of natural
     frequency ``bandwidth_hz`` on each joint's effective inertia (at the home
     pose), so that with feed-forward the joints follow their references to a
     small fraction of a degree even at the acceleration limits.
@@ -119,41 +126,62 @@ class MotorDriver:
         data: mujoco.MjData,
         limits: tuple[MotorLimits, MotorLimits, MotorLimits],
         bandwidth_hz: float = 20.0,
+        mapping: HeadMapping = PAPER.mapping,
     ) -> None:
         self.model, self.data = model, data
-        self._qadr = [int(model.joint(j).qposadr[0]) for j in MOTOR_JOINTS]
-        self._act = [int(model.actuator(a).id) for a in MOTOR_ACTUATORS]
+        joints = motor_joints(mapping)
+        self._qadr = [int(model.joint(j).qposadr[0]) for j in joints]
+        # (actuator, joint it moves) per motor: Ca2's eye too when it has its own motor.
+        driven = [[(actuator_on(model, j), j)] for j in joints]
+        if mapping.independent:
+            driven[2].append((actuator_on(model, mapping.right_eye), mapping.right_eye))
+        for pairs in driven:
+            for act, joint in pairs:
+                if act < 0:
+                    raise SettingsError(f"joint {joint!r} has no position actuator to drive it")
         omega = 2 * math.pi * bandwidth_hz
-        inertia = self._effective_inertia()
-        self._ff_vel, self._ff_acc = [], []
-        for act, mass in zip(self._act, inertia, strict=True):
-            kp, kv = mass * omega**2, 2.0 * mass * omega
-            model.actuator_gainprm[act, 0] = kp
-            model.actuator_biasprm[act, :3] = (0.0, -kp, -kv)
-            model.actuator_forcelimited[act] = 0
-            self._ff_vel.append(kv / kp)
-            self._ff_acc.append(1.0 / omega**2)
+        inertia = self._effective_inertia(mapping, driven)
+        #: (actuator, velocity feed-forward, acceleration feed-forward) per motor.
+        self._act: list[list[tuple[int, float, float]]] = []
+        for pairs, masses in zip(driven, inertia, strict=True):
+            tuned = []
+            for (act, _), mass in zip(pairs, masses, strict=True):
+                kp, kv = mass * omega**2, 2.0 * mass * omega
+                model.actuator_gainprm[act, 0] = kp
+                model.actuator_biasprm[act, :3] = (0.0, -kp, -kv)
+                model.actuator_forcelimited[act] = 0
+                tuned.append((act, kv / kp, 1.0 / omega**2))
+            self._act.append(tuned)
         self.motors: list[_Motor] = []
-        for lim, j in zip(limits, MOTOR_JOINTS, strict=True):
+        for lim, j in zip(limits, joints, strict=True):
             low, high = model.joint(j).range
             self.motors.append(_Motor(lim, float(low), float(high)))
         self.sync()
 
-    def _effective_inertia(self) -> list[float]:
-        """Diagonal of the joint-space inertia at the current pose; the eye motor carries both eyes."""
+    def _effective_inertia(
+        self, mapping: HeadMapping, driven: list[list[tuple[int, str]]]
+    ) -> list[list[float]]:
+        """Diagonal of the joint-space inertia at the current pose, per actuator; the one
+        motor of coupled eyes carries both eyes."""
         mujoco.mj_forward(self.model, self.data)
         full = np.zeros((self.model.nv, self.model.nv))
         mujoco.mj_fullM(self.model, self.data, full)
-        dof = {j: int(self.model.joint(j).dofadr[0]) for j in (*MOTOR_JOINTS, names.EYE_JOINTS[1])}
-        eyes = (
-            full[dof[names.EYE_JOINTS[0]], dof[names.EYE_JOINTS[0]]]
-            + full[dof[names.EYE_JOINTS[1]], dof[names.EYE_JOINTS[1]]]
-        )
-        return [
-            full[dof[names.NECK_YAW]][dof[names.NECK_YAW]],
-            full[dof[names.NECK_PITCH]][dof[names.NECK_PITCH]],
-            eyes,
-        ]
+
+        def diagonal(joint: str) -> float:
+            dof = int(self.model.joint(joint).dofadr[0])
+            return float(full[dof, dof])
+
+        masses = [[diagonal(joint) for _, joint in pairs] for pairs in driven]
+        if not mapping.independent:
+            masses[2] = [
+                full[int(self.model.joint(mapping.left_eye).dofadr[0])][
+                    int(self.model.joint(mapping.left_eye).dofadr[0])
+                ]
+                + full[int(self.model.joint(mapping.right_eye).dofadr[0])][
+                    int(self.model.joint(mapping.right_eye).dofadr[0])
+                ]
+            ]
+        return masses
 
     def sync(self) -> None:
         """Start the references where the joints are, at rest."""
@@ -214,10 +242,9 @@ class MotorDriver:
         self._write()
 
     def _write(self) -> None:
-        for motor, act, fv, fa in zip(
-            self.motors, self._act, self._ff_vel, self._ff_acc, strict=True
-        ):
-            self.data.ctrl[act] = motor.ref + fv * motor.vel + fa * motor.acc
+        for motor, actuators in zip(self.motors, self._act, strict=True):
+            for act, fv, fa in actuators:
+                self.data.ctrl[act] = motor.ref + fv * motor.vel + fa * motor.acc
 
     @property
     def references(self) -> np.ndarray:

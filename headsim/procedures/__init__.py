@@ -14,7 +14,7 @@ from __future__ import annotations
 # isort: off
 # The order of registration is the order a scenario's error lists the procedures in.
 from headsim.procedures import model2, model1, calibration, tracking, chessboard
-from headsim.procedures import relative, pursuit, stereo, zoom_fixed_points
+from headsim.procedures import relative, pursuit, stereo, zoom_fixed_points, fixation
 
 # isort: on
 from headsim.scenario.registry import REGISTRY, Procedure, get, names, register
@@ -24,6 +24,7 @@ __all__ = [
     "Procedure",
     "calibration",
     "chessboard",
+    "fixation",
     "get",
     "model1",
     "model2",

@@ -57,6 +57,7 @@ MODEL1 = register(
         fields=Model1Result.block,
         options=read_options,
         read_scene=targets_reader("model1", required=True),
+        needs=frozenset({"neck_yaw"}),
     )
 )
 

@@ -67,6 +67,11 @@ RESULTS_FIELDS: dict[str, str] = {
     "settings.backlash_rad": "play of every joint's gearing, rad",
     "settings.count_error": "whether the true angle lies anywhere within the count read, not on it",
     "settings.render": "the rendering fidelity: `offsamples`, `supersample`",
+    "settings.head": "the head, only when it is not the paper's (absent: the paper's head)",
+    "settings.head.name": "its name: a shipped head's, or the MJCF file's stem",
+    "settings.head.path": "its MJCF file",
+    "settings.head.mapping": "the names headsim uses in it (the scenario's `[head.mapping]`): "
+    "`head_body`, `neck_yaw`, `neck_pitch`, `eyes`, `left_eye`, `right_eye`, `cameras`",
     "settings.settle_mode": "how the servo waits for the joints to settle",
     "belief": "what the head believed and measured with",
     "belief.baseline_m": "the believed baseline, m",
@@ -183,6 +188,7 @@ FAILED_ONLY = frozenset({"reason"})
 EXPERIMENT_FIELDS: dict[str, dict[str, str]] = {
     "model2": _NONE,
     "model1": _NONE,
+    "fixation": _NONE,
     "calibration": {
         "check_targets": "each check target, before and after the calibration",
         "check_targets[].name": "the target",

@@ -25,6 +25,7 @@ from headsim.run.accuracy import MeasurementSummary, summaries
 from headsim.run.outcomes import MeasurementRecord, RunResult
 from headsim.scenario.registry import get
 from headsim.scenario.spec import experiment_record
+from headsim.sim.settings import settings_record
 
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
 RESULTS_SCHEMA = "headsim.results/2"
@@ -176,7 +177,7 @@ def results_payload(result: RunResult) -> dict[str, Any]:
         "status": "ok" if result.ok else "failed",
         "failures": list(result.failures),
         "software": software_versions(),
-        "settings": {**asdict(s.settings), "settle_mode": s.settle_mode},
+        "settings": {**settings_record(s.settings), "settle_mode": s.settle_mode},
         # The truth above; what the head believes (and its estimators use) here.
         "belief": asdict(s.settings.believed),
         "render_counts": result.renders.as_dict(),

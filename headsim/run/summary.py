@@ -16,7 +16,7 @@ from headsim.run.table import cell as _cell
 from headsim.run.table import format_table
 from headsim.run.table import mm as _mm
 from headsim.scenario.registry import get
-from headsim.scenario.spec import TargetAcceptance
+from headsim.scenario.spec import Scenario, TargetAcceptance
 from headsim.sim.events import RenderCounts
 
 # -- the summary table ------------------------------------------------------------
@@ -215,6 +215,12 @@ def _renders_text(counts: RenderCounts) -> str:
     )
 
 
+def _head_text(scenario: Scenario) -> str:
+    """Which head ran, where it is not the paper's (the line's start)."""
+    head = scenario.settings.head
+    return "" if head.is_paper else f"{head.name} ({head.mapping.eyes} eyes), "
+
+
 def summary_text(result: RunResult) -> str:
     """The table printed at the end of a run (figures of the paper beside ours for its head)."""
     s = result.scenario
@@ -222,7 +228,7 @@ def summary_text(result: RunResult) -> str:
     e = result.experiment
     lines = [
         f"{s.name}{' (fast variant)' if s.fast else ''}: {s.description}",
-        f"head: {s.preset} preset; seed {s.seed}; procedure {s.experiment.procedure}; "
+        f"head: {_head_text(s)}{s.preset} preset; seed {s.seed}; procedure {s.experiment.procedure}; "
         f"{_renders_text(result.renders.overall)}"
         + (
             f"; {result.rendered_frames['total']:.1f} full frames of pixels"

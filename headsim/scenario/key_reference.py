@@ -22,6 +22,7 @@ from headsim.scenario.loading import (
     set_field,
 )
 from headsim.scenario.tables import KeyUse, collecting_keys
+from headsim.sim.model import MODELS_DIR
 
 
 @dataclass(frozen=True)
@@ -146,6 +147,24 @@ VARIANTS: tuple[tuple[str, Edit], ...] = (
             ),
         ),
     ),
+    (  # a head as an MJCF file and its mapping: the shipped independent_eyes file's
+        "quickstart",
+        _edits(
+            ("head.model", str(MODELS_DIR / "independent_eyes.xml")),
+            (
+                "head.mapping",
+                {
+                    "head_body": "head_frame",
+                    "neck_yaw": "neck_yaw_joint",
+                    "neck_pitch": "neck_pitch_joint",
+                    "eyes": "independent",
+                    "left_eye": "left_eye_pan",
+                    "right_eye": "right_eye_pan",
+                    "cameras": ["left_camera", "right_camera"],
+                },
+            ),
+        ),
+    ),
 )
 
 
@@ -221,6 +240,15 @@ DESCRIPTIONS: dict[str, str] = {
     "seed": "Seed of the image noise and of every random layout; `--seed` replaces it.",
     "fast": "Fields merged over the file by `--fast`: tables key by key, other values replaced.",
     "head": "The head's geometry and joints; missing keys come from `head.preset`.",
+    "head.model": "Which head: a shipped one (paper, independent_eyes) or a path to your head's MJCF file.",
+    "head.mapping": "With an MJCF `head.model`: the names of its joints, body H and cameras.",
+    "head.mapping.head_body": "The body whose frame is H at all joints zero (midway between the optical centres, x right, y down, z forward).",
+    "head.mapping.neck_yaw": "The neck's yaw joint, about W's +z at the base (leave out on a head without one: Model 2 only).",
+    "head.mapping.neck_pitch": "The neck's pitch joint, about the yawed +x, positive looking up.",
+    "head.mapping.eyes": "How the eyes are driven: one motor on `left_eye` with `right_eye` following (coupled), or a motor each.",
+    "head.mapping.left_eye": "The pan joint of the eye carrying Ca1 (at -x in H), positive inward.",
+    "head.mapping.right_eye": "The pan joint of the eye carrying Ca2 (at +x in H), positive inward.",
+    "head.mapping.cameras": "The two eye cameras, [Ca1, Ca2]: left, then right.",
     "head.preset": "Defaults for the head and both cameras: the ideal head, the paper's, or a realistic one.",
     "head.baseline_m": "Distance between the two optical centres, m.",
     "head.neck_d1_m": "Height of the neck's pitch axis above its yaw base (D-H d1 of eq. 1), m.",

@@ -17,6 +17,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from headsim.scenario import registry
 from headsim.scenario.reach import ReachHead
 from headsim.scenario.reach_check import check_reach
 from headsim.scenario.scene import read_scene
@@ -24,6 +25,7 @@ from headsim.scenario.schema import FIRST_TABLES, read_experiment, read_head
 from headsim.scenario.spec import Scenario
 from headsim.scenario.tables import Context, ScenarioError, Table, describe_value
 from headsim.scenario.toml_file import deep_line, read_toml, text_or_empty
+from headsim.sim.settings import HeadSettings
 
 #: Where ``headsim list`` and ``headsim run NAME`` look for scenario files: the
 #: repository's scenarios/, installed as package data.
@@ -126,6 +128,24 @@ def scenario_from_document(
     return _load(doc, path, fast=fast, seed=seed, overrides=overrides)
 
 
+def _check_head_fits(settings: HeadSettings, procedure: str, ctx: Context) -> None:
+    """The procedure's needs of the head (``Procedure.needs``), named where they fail."""
+    needs = registry.get(procedure).needs
+    mapping, head = settings.head.mapping, settings.head.name
+    if "independent_eyes" in needs and not mapping.independent:
+        raise ctx.error(
+            "experiment.procedure",
+            f"{procedure} needs a motor per eye, and head {head!r} couples its eyes",
+            'head.model = "independent_eyes", or an MJCF head whose head.mapping.eyes = "independent"',
+        )
+    if "neck_yaw" in needs and mapping.neck_yaw is None:
+        raise ctx.error(
+            "head.mapping.neck_yaw",
+            f"not given, and {procedure} turns the neck to the midline",
+            "the neck's yaw joint, or a procedure that keeps the neck still (model2)",
+        )
+
+
 def _load(
     doc: dict[str, Any],
     path: Path,
@@ -178,9 +198,10 @@ def _build(
     description = top.string("description")
     file_seed = top.integer("seed", 0, 0, 2**32 - 1)
     seed = file_seed if seed is None else seed
-    settings, preset_name, settle = read_head(top, ctx)
+    settings, preset_name, settle = read_head(top, ctx, path.parent)
     settings = replace(settings, seed=seed)
     experiment = read_experiment(top, ctx, preset_name)
+    _check_head_fits(settings, experiment.procedure, ctx)
     calibration = experiment.calibration
     stored = None
     if calibration is not None and calibration.source is not None:
@@ -257,12 +278,14 @@ def scenario_files(directory: Path | None = None) -> list[Path]:
     return sorted(directory.glob("*.toml")) if directory.is_dir() else []
 
 
-def describe_scenarios(directory: Path | None = None) -> Iterator[tuple[str, str]]:
-    """(name, description) of each scenario file; an unreadable file says why."""
+def describe_scenarios(directory: Path | None = None) -> Iterator[tuple[str, str, str]]:
+    """(name, head, description) of each scenario file; an unreadable file has head ""
+    and a description that says why."""
     for path in scenario_files(directory):
         try:
-            yield path.stem, load_scenario(path).description
+            scenario = load_scenario(path)
+            yield path.stem, scenario.settings.head.name, scenario.description
         except ScenarioError as err:
-            yield path.stem, f"INVALID: {err}"
+            yield path.stem, "", f"INVALID: {err}"
         except Exception as err:  # one unreadable file must not end the listing
-            yield path.stem, f"INVALID: cannot be checked: {type(err).__name__}: {err}"
+            yield path.stem, "", f"INVALID: cannot be checked: {type(err).__name__}: {err}"

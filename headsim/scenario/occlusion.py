@@ -13,13 +13,15 @@ import mujoco
 import numpy as np
 
 from headsim.sim import names
+from headsim.sim.heads import PAPER, HeadModel
 from headsim.sim.model import load_spec
 
 
 @cache
-def scene_model(scene: str) -> mujoco.MjModel:
-    """The compiled scene as in the XML (joint ranges, default poses); no rendering."""
-    return load_spec(scene).compile()
+def scene_model(scene: str, head: HeadModel = PAPER) -> mujoco.MjModel:
+    """The compiled scene as in the XML (joint ranges, default poses), with ``head``;
+    no rendering."""
+    return load_spec(scene, head).compile()
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,7 @@ from headsim.scenario.spec import (
 )
 from headsim.sim import names
 from headsim.sim.forward import effective_directions
+from headsim.sim.model import head_names
 from headsim.sim.settings import HeadSettings
 
 
@@ -50,7 +51,8 @@ class ReachHead:
 
     @classmethod
     def of(cls, settings: HeadSettings) -> ReachHead:
-        model = scene_model("base")
+        model = scene_model("base", settings.head)
+        mapping = head_names(settings.head)
 
         def rng(joint: str) -> tuple[float, float]:
             lo, hi = model.joint(joint).range
@@ -59,9 +61,9 @@ class ReachHead:
         directions = effective_directions(settings)
         return cls(
             settings,
-            rng(names.EYE_MOTOR_JOINT),
-            rng(names.NECK_YAW),
-            rng(names.NECK_PITCH),
+            rng(mapping.left_eye),
+            rng(mapping.neck_yaw) if mapping.neck_yaw is not None else (0.0, 0.0),
+            rng(mapping.neck_pitch),
             directions,
         )
 

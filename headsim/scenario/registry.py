@@ -88,6 +88,7 @@ class Procedure:
     options: Callable[[Table, CalibrationSpec | None], dict[str, Any]] = _no_options
     read_scene: SceneReader | None = None
     fixations: Callable[[Scenario], int] = _each_target
+    needs: frozenset[str] = frozenset()
 
 
 #: Every registered procedure, by name.

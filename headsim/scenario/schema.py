@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 from typing import Any
 
 from headsim.geometry.synthetic import mount_yaw_for_direction
@@ -25,8 +26,10 @@ from headsim.scenario.spec import (
     ExperimentSpec,
     ServoSpec,
 )
-from headsim.scenario.tables import Context, Table, describe_value
-from headsim.sim import names
+from headsim.scenario.tables import MISSING, Context, Table, describe_value, short_value
+from headsim.sim import heads, names
+from headsim.sim.heads import HeadModel
+from headsim.sim.model import design, on_head
 from headsim.sim.optics import centre_ray_yaw
 from headsim.sim.settings import (
     MAX_IMAGE_SIDE,
@@ -129,11 +132,88 @@ def _lens_problem(camera: CameraSettings) -> tuple[str, str] | None:
     )
 
 
-def read_head(doc: Table, ctx: Context) -> tuple[HeadSettings, str, str]:
-    """``[head]`` with ``[cam1]``, ``[cam2]``: the head's settings, preset name, settle mode."""
+def _read_head_model(head: Table, ctx: Context, directory: Path) -> HeadModel:
+    """``head.model`` and ``[head.mapping]``: a shipped head, or an MJCF file and its names."""
+    allowed = f"{', '.join(heads.SHIPPED)}, or a path to a head's MJCF .xml file"
+    name = head.string("model", "paper", max_length=1000)
+    mapping_table = head.table("mapping")
+    if name in heads.SHIPPED:
+        if mapping_table is not None:
+            raise ctx.error(
+                "head.mapping",
+                f"given for the shipped head {name!r}, which has its own",
+                "a mapping only with an MJCF file (head.model = a path to a .xml)",
+            )
+        return heads.shipped(name)
+    path = Path(name)
+    path = path if path.is_absolute() else directory / path
+    if path.suffix != ".xml" or not path.is_file():
+        raise head.fail("model", f"no shipped head or MJCF file {short_value(name)}", allowed)
+    if mapping_table is None:
+        raise ctx.error(
+            "head.mapping",
+            "missing for an MJCF head",
+            "a [head.mapping] table naming its joints and cameras",
+        )
+    m = mapping_table
+
+    def joint_name(key: str, default: Any = MISSING) -> Any:
+        return m.string(key, default)
+
+    cameras = m._get("cameras")
+    if not (
+        isinstance(cameras, list)
+        and len(cameras) == 2
+        and all(isinstance(c, str) and c for c in cameras)
+    ):
+        raise m.fail(
+            "cameras",
+            "must name two cameras",
+            "an array of two camera names [left (Ca1), right (Ca2)]",
+        )
+    m._note("cameras", "strings", "an array of two camera names [left (Ca1), right (Ca2)]", MISSING)
+    mapping = heads.HeadMapping(
+        head_body=joint_name("head_body"),
+        neck_yaw=joint_name("neck_yaw", None),
+        neck_pitch=joint_name("neck_pitch"),
+        eyes=m.choice("eyes", heads.EYE_KINDS),
+        left_eye=joint_name("left_eye"),
+        right_eye=joint_name("right_eye"),
+        cameras=(cameras[0], cameras[1]),
+    )
+    m.done()
+    return heads.HeadModel(path.stem, path, mapping)
+
+
+def _designed(model: HeadModel, ctx: Context) -> None:
+    """Check the head's mapping against its model, naming the key that fails."""
+    if model.is_paper:
+        return
+    try:
+        design(model)
+    except heads.HeadError as err:
+        raise ctx.error(f"head.mapping.{err.key}", err.problem, err.allowed) from None
+    except ValueError as err:  # MuJoCo's own: the file does not load or compile
+        # MuJoCo's message runs over lines (the error, then where): one line of its parts.
+        parts = [line.strip().rstrip(":") for line in str(err).splitlines() if line.strip()]
+        said = "; ".join(parts)[:300] or type(err).__name__
+        raise ctx.error(
+            "head.model", f"cannot load {model.path}: {said}", "an MJCF file MuJoCo compiles"
+        ) from None
+
+
+def read_head(
+    doc: Table, ctx: Context, directory: Path | None = None
+) -> tuple[HeadSettings, str, str]:
+    """``[head]`` with ``[cam1]``, ``[cam2]``: the head's settings, preset name, settle mode.
+
+    On another head than the paper's, the lengths start from its design: a preset's
+    departure from the paper's design is added to it."""
     head = doc.table("head") or Table({}, "head", ctx)
+    head_model = _read_head_model(head, ctx, Path.cwd() if directory is None else directory)
+    _designed(head_model, ctx)
     preset_name = head.choice("preset", _PRESETS, "ideal")
-    base = preset(preset_name)
+    base = on_head(preset(preset_name), head_model)
     baseline = head.number(
         "baseline_m",
         base.baseline_m,
@@ -202,6 +282,7 @@ def read_head(doc: Table, ctx: Context) -> tuple[HeadSettings, str, str]:
             count_error=count_error,
             belief=_read_belief(doc.table("belief"), base),
             render=RenderFidelity(offsamples=offsamples, supersample=supersample),
+            head=head_model,
         )
     except SettingsError as err:  # pragma: no cover - the checks above are stricter
         raise ctx.error("head", str(err)) from err

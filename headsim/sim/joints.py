@@ -43,15 +43,19 @@ class Commands:
     neck_yaw: float = 0.0
     neck_pitch: float = 0.0
     eye: float = 0.0
+    #: Ca2's eye motor, on a head with independent eyes.
+    eye2: float = 0.0
     pending: set[str] = field(default_factory=set)
     #: Direction each joint last moved in (+1, -1; 0 before any move): backlash side.
     approach: dict[str, float] = field(
-        default_factory=lambda: {"neck_yaw": 0.0, "neck_pitch": 0.0, "eye": 0.0}
+        default_factory=lambda: {"neck_yaw": 0.0, "neck_pitch": 0.0, "eye": 0.0, "eye2": 0.0}
     )
 
 
 #: Index of each motor in the seeded count-error draw.
-MOTOR_INDEX = {"neck_yaw": 0, "neck_pitch": 1, "eye": 2}
+MOTOR_INDEX = {"neck_yaw": 0, "neck_pitch": 1, "eye": 2, "eye2": 3}
+#: The motors of the paper's head.
+PAPER_MOTORS = ("neck_yaw", "neck_pitch", "eye")
 
 
 def joint_offset(settings: HeadSettings, commands: Commands, motor: str, command: float) -> float:
@@ -67,13 +71,14 @@ def joint_offset(settings: HeadSettings, commands: Commands, motor: str, command
     return offset
 
 
-def true_targets(settings: HeadSettings, commands: Commands) -> dict[str, float]:
-    """Where each motor's joint truly settles, rad, by motor name."""
-    c = commands
-    angles = {"neck_yaw": c.neck_yaw, "neck_pitch": c.neck_pitch, "eye": c.eye}
+def true_targets(
+    settings: HeadSettings, commands: Commands, motors: tuple[str, ...] = PAPER_MOTORS
+) -> dict[str, float]:
+    """Where each of ``motors``' joints truly settles, rad, by motor name."""
+    angles = {motor: float(getattr(commands, motor)) for motor in motors}
     if not settings.joint_errors:
         return angles
-    return {m: a + joint_offset(settings, c, m, a) for m, a in angles.items()}
+    return {m: a + joint_offset(settings, commands, m, a) for m, a in angles.items()}
 
 
 __all__ = [

@@ -7,8 +7,8 @@ and compiles it.  Props (markers, chessboards) can be added the same way.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from importlib import resources
+import functools
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import mujoco
@@ -16,11 +16,18 @@ import numpy as np
 
 from headsim.geometry.kinematics import eye_from_camera_rotation
 from headsim.sim import names
+from headsim.sim.heads import (
+    MODELS_DIR,
+    PAPER,
+    HeadError,
+    HeadGeometry,
+    HeadMapping,
+    HeadModel,
+    check_head,
+)
 from headsim.sim.optics import DistortionCanvas, distortion_canvas
 from headsim.sim.settings import MAX_IMAGE_SIDE, HeadSettings, SettingsError
 
-#: The head and scene MJCF files: the repository's models/, installed as package data.
-MODELS_DIR = Path(str(resources.files("headsim.models")))
 #: Sensor pixel pitch used to express pixel intrinsics in MuJoCo's length units, m.
 PIXEL_PITCH_M = 1e-5
 
@@ -49,33 +56,128 @@ def _quat_from_matrix(matrix: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class BuiltModel:
-    """A compiled scene and, per camera, how it is rendered."""
+    """A compiled scene and, per camera, how it is rendered; ``names``: the head's
+    mapping with the names as compiled into the scene."""
 
     model: mujoco.MjModel
     spec: mujoco.MjSpec
     canvases: tuple[DistortionCanvas, DistortionCanvas]
+    names: HeadMapping = PAPER.mapping
 
 
-def load_spec(scene: str | Path = "default") -> mujoco.MjSpec:
-    """A fresh, editable spec of a scene."""
-    return mujoco.MjSpec.from_file(str(scene_path(scene)))
+#: What a head attached to a scene has its names prefixed with.
+HEAD_PREFIX = "head:"
+
+
+def load_spec(scene: str | Path = "default", head: HeadModel = PAPER) -> mujoco.MjSpec:
+    """A fresh, editable spec of a scene, with ``head`` in place of the scenes' own."""
+    spec = mujoco.MjSpec.from_file(str(scene_path(scene)))
+    if head.is_paper:
+        return spec
+    spec.delete(spec.body(names.NECK_BASE))  # its joints, actuators and equality go with it
+    for key in list(spec.keys):
+        spec.delete(key)
+    head_spec = mujoco.MjSpec.from_file(str(head.path))
+    for key in list(head_spec.keys):  # home is all joints zero, the scene's qpos0
+        head_spec.delete(key)
+    head_spec.nkey = spec.nkey  # a <size nkey> the file may carry
+    spec.attach(head_spec, frame=spec.worldbody.add_frame(), prefix=HEAD_PREFIX)
+    return spec
+
+
+def head_names(head: HeadModel) -> HeadMapping:
+    """``head``'s mapping with its names as they are in a scene built by :func:`load_spec`."""
+    return head.mapping if head.is_paper else head.mapping.prefixed(HEAD_PREFIX)
+
+
+@dataclass(frozen=True)
+class _Frames:
+    """Where the settings' lengths and mounts act in a head's spec (all joints zero)."""
+
+    pitch_body: str
+    head_body: str
+    eye_bodies: tuple[str, str]
+    #: W's z in the pitch body's parent and in H's parent; H's x in each eye body's parent.
+    up_in_pitch_parent: np.ndarray
+    up_in_head_parent: np.ndarray
+    x_in_eye_parents: tuple[np.ndarray, np.ndarray]
+    #: Each eye body's frame from H (rotation) and its designed camera position, m.
+    eye_from_head: tuple[np.ndarray, np.ndarray]
+    designed: HeadGeometry
+
+
+def _frames(spec: mujoco.MjSpec, mapping: HeadMapping) -> _Frames:
+    """The designed head of ``spec``, checked against ``mapping``."""
+    model = spec.compile()
+    designed = check_head(model, mapping)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+
+    def rot(body: int) -> np.ndarray:
+        return data.xmat[body].reshape(3, 3)
+
+    pitch_body = int(model.jnt_bodyid[model.joint(mapping.neck_pitch).id])
+    head_body = int(model.body(mapping.head_body).id)
+    eyes = [int(model.jnt_bodyid[model.joint(j).id]) for j in (mapping.left_eye, mapping.right_eye)]
+    x_w = rot(head_body)[:, 0]
+    up = np.array([0.0, 0.0, 1.0])
+    parent = model.body_parentid
+    return _Frames(
+        pitch_body=model.body(pitch_body).name,
+        head_body=mapping.head_body,
+        eye_bodies=(model.body(eyes[0]).name, model.body(eyes[1]).name),
+        up_in_pitch_parent=rot(parent[pitch_body]).T @ up,
+        up_in_head_parent=rot(parent[head_body]).T @ up,
+        x_in_eye_parents=(rot(parent[eyes[0]]).T @ x_w, rot(parent[eyes[1]]).T @ x_w),
+        eye_from_head=(rot(eyes[0]).T @ rot(head_body), rot(eyes[1]).T @ rot(head_body)),
+        designed=designed,
+    )
+
+
+def _apply_lengths(spec: mujoco.MjSpec, settings: HeadSettings, frames: _Frames) -> None:
+    """Move a head's links by the settings' lengths minus the designed ones."""
+    d = frames.designed
+    pitch = spec.body(frames.pitch_body)
+    pitch.pos = (
+        np.asarray(pitch.pos) + (settings.neck_d1_m - d.neck_d1_m) * frames.up_in_pitch_parent
+    )
+    head = spec.body(frames.head_body)
+    head.pos = np.asarray(head.pos) + (settings.neck_a2_m - d.neck_a2_m) * frames.up_in_head_parent
+    half = (settings.baseline_m - d.baseline_m) / 2
+    for sign, name, x_parent in zip(
+        (-1.0, 1.0), frames.eye_bodies, frames.x_in_eye_parents, strict=True
+    ):
+        body = spec.body(name)
+        body.pos = np.asarray(body.pos) + sign * half * x_parent
 
 
 def apply_settings(
     spec: mujoco.MjSpec, settings: HeadSettings
 ) -> tuple[DistortionCanvas, DistortionCanvas]:
     """Write baseline, neck D-H offsets, cameras (with optical-centre offsets and yaw-axis
-    tilts) into ``spec``; return the render canvases."""
-    spec.body(names.NECK_PITCH_LINK).pos = [0.0, 0.0, settings.neck_d1_m]
-    spec.body(names.HEAD).pos = [0.0, 0.0, settings.neck_a2_m]
-    half = settings.baseline_m / 2
-    spec.body(names.EYE_BODIES[0]).pos = [-half, 0.0, 0.0]
-    spec.body(names.EYE_BODIES[1]).pos = [half, 0.0, 0.0]
+    tilts) into ``spec``; return the render canvases.  The paper's head takes the lengths
+    as they are; another head is moved by them less its design (:mod:`headsim.sim.heads`)."""
+    head = settings.head
+    mapping = head_names(head)
+    if head.is_paper:
+        spec.body(names.NECK_PITCH_LINK).pos = [0.0, 0.0, settings.neck_d1_m]
+        spec.body(names.HEAD).pos = [0.0, 0.0, settings.neck_a2_m]
+        half = settings.baseline_m / 2
+        spec.body(names.EYE_BODIES[0]).pos = [-half, 0.0, 0.0]
+        spec.body(names.EYE_BODIES[1]).pos = [half, 0.0, 0.0]
+        eye_from_head: tuple[np.ndarray | None, np.ndarray | None] = (None, None)
+        designed_pos: list[np.ndarray | None] = [None, None]
+    else:
+        frames = _frames(spec, mapping)
+        _apply_lengths(spec, settings, frames)
+        eye_from_head = frames.eye_from_head
+        designed_pos = [np.asarray(spec.camera(c).pos, dtype=float) for c in mapping.cameras]
 
     canvases = []
     k = settings.render.supersample
     spec.visual.quality.offsamples = settings.render.offsamples
-    for index, (cam_name, cam) in enumerate(zip(names.CAMERAS, settings.cameras, strict=True)):
+    eye_joints = (mapping.left_eye, mapping.right_eye)
+    for index, (cam_name, cam) in enumerate(zip(mapping.cameras, settings.cameras, strict=True)):
         canvas = distortion_canvas(cam, MAX_IMAGE_SIDE // k)
         width_c, height_c = canvas.size
         pcx, pcy = canvas.principal
@@ -95,6 +197,9 @@ def apply_settings(
             cam.mount_pitch_rad,
             cam.mount_roll_rad,
         )
+        body_from_head = eye_from_head[index]
+        if body_from_head is not None:
+            eye_from_cv = body_from_head @ eye_from_cv
         mj_cam.alt.type = mujoco.mjtOrientation.mjORIENTATION_QUAT  # drop the XML's xyaxes
         mj_cam.quat = _quat_from_matrix(eye_from_cv @ CV_FROM_MJCAM)
         # Optical centre off the yaw axis: forward along the optical axis, sideways along x.
@@ -103,11 +208,11 @@ def apply_settings(
         # Yaw axis leaning forward about H's x (eye2's axis is -y, mirrored).
         tilt = cam.eye_axis_tilt_rad
         axis_sign = names.EYE_CAMERAS[index].inward
-        spec.joint(names.EYE_JOINTS[index]).axis = [
-            0.0,
-            axis_sign * np.cos(tilt),
-            axis_sign * np.sin(tilt),
-        ]
+        axis_head = [0.0, axis_sign * np.cos(tilt), axis_sign * np.sin(tilt)]
+        if body_from_head is not None:
+            mj_cam.pos = designed_pos[index] + mj_cam.pos
+            axis_head = list(body_from_head @ np.array(axis_head))
+        spec.joint(eye_joints[index]).axis = axis_head
         canvases.append(canvas)
 
     spec.visual.global_.offwidth = k * max(c.size[0] for c in canvases)
@@ -118,9 +223,11 @@ def apply_settings(
 def build_model(scene: str | Path = "default", settings: HeadSettings | None = None) -> BuiltModel:
     """Load ``scene``, apply ``settings`` (default: ideal head) and compile."""
     settings = settings or HeadSettings()
-    spec = load_spec(scene)
+    spec = load_spec(scene, settings.head)
     canvases = apply_settings(spec, settings)
-    return BuiltModel(model=spec.compile(), spec=spec, canvases=canvases)
+    return BuiltModel(
+        model=spec.compile(), spec=spec, canvases=canvases, names=head_names(settings.head)
+    )
 
 
 def add_marker(
@@ -144,4 +251,49 @@ def add_marker(
         material=material.name,
         contype=0,
         conaffinity=0,
+    )
+
+
+@functools.cache
+def design(head: HeadModel) -> HeadGeometry:
+    """``head``'s designed geometry in the base scene, its mapping checked
+    (:func:`check_head`).  Raises :class:`HeadError`, or MuJoCo's ValueError for a file
+    that does not compile."""
+    try:
+        return check_head(load_spec("base", head).compile(), head_names(head))
+    except HeadError as err:  # say the names as the user's file and mapping spell them
+        quoted = repr(HEAD_PREFIX)[:-1]  # 'head:
+
+        def unprefixed(text: str) -> str:
+            return text if head.is_paper else text.replace(quoted, quoted[0])
+
+        raise HeadError(err.key, unprefixed(err.problem), unprefixed(err.allowed)) from None
+
+
+def on_head(settings: HeadSettings, head: HeadModel) -> HeadSettings:
+    """``settings`` (of the paper's head, e.g. a preset) moved onto ``head``: each length
+    is its design plus the settings' departure from the paper's design, in truth and in
+    belief; the paper's head takes them as they are."""
+    if head.is_paper:
+        return replace(settings, head=head)
+    designed, nominal = design(head), HeadSettings()
+
+    def moved(value: float, name: str) -> float:
+        return value - float(getattr(nominal, name)) + float(getattr(designed, name))
+
+    belief = settings.belief
+    if belief is not None:
+        belief = replace(
+            belief,
+            baseline_m=moved(belief.baseline_m, "baseline_m"),
+            neck_d1_m=moved(belief.neck_d1_m, "neck_d1_m"),
+            neck_a2_m=moved(belief.neck_a2_m, "neck_a2_m"),
+        )
+    return replace(
+        settings,
+        head=head,
+        belief=belief,
+        baseline_m=moved(settings.baseline_m, "baseline_m"),
+        neck_d1_m=moved(settings.neck_d1_m, "neck_d1_m"),
+        neck_a2_m=moved(settings.neck_a2_m, "neck_a2_m"),
     )

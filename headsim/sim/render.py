@@ -124,6 +124,7 @@ class EyeRenderer:
         seed: int = 0,
         key: Hashable | None = None,
         supersample: int = 1,
+        camera_names: tuple[str, str] = names.CAMERAS,
     ) -> None:
         """``supersample``: the model's cameras render at this many times each
         canvas's size (``headsim.sim.settings.RenderFidelity``); images are area-averaged
@@ -143,8 +144,9 @@ class EyeRenderer:
         self._taken = [0, 0]
         self._previews = [0, 0]
         self._cam_ids = [
-            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, name) for name in names.CAMERAS
+            mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, name) for name in camera_names
         ]
+        self._camera_names = camera_names
         self.render_count = 0
         #: Pixels rendered, in full frames of the camera that rendered them.
         self.rendered_frames = 0.0
@@ -186,7 +188,7 @@ class EyeRenderer:
             model.cam_sensorsize[cam] = pitch * np.array([k * rect.width, k * rect.height])
             model.cam_intrinsic[cam][2:4] = window_offset * pitch
         try:
-            renderer.update_scene(data, camera=names.CAMERAS[index], scene_option=self._option)
+            renderer.update_scene(data, camera=self._camera_names[index], scene_option=self._option)
         finally:
             if saved is not None:
                 (

@@ -8,12 +8,14 @@ pixel (i, j) is at (i, j), so the geometric centre of a W x H image is
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
+from typing import Any
 
 from headsim.errors import BadInput
 from headsim.geometry.camera_model import PinholeCamera, image_centre
 from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import BASELINE_M, ENCODER_RESOLUTION_RAD, INITIAL_DIRECTIONS_RAD, INTRINSICS
+from headsim.sim.heads import PAPER, HeadModel
 from headsim.sim.tolerances import REALISTIC_BUDGET
 
 #: Largest image side the off-screen buffer is allowed to grow to, px.
@@ -260,8 +262,12 @@ class HeadSettings:
     backlash_rad: float = 0.0
     count_error: bool = False
     render: RenderFidelity = field(default_factory=RenderFidelity)
+    #: Which head: its MJCF and mapping (:mod:`headsim.sim.heads`); the lengths above are
+    #: its true ones, and on another head than the paper's they start from its design.
+    head: HeadModel = PAPER
 
     def __post_init__(self) -> None:
+        _check(isinstance(self.head, HeadModel), "head must be a headsim.sim.heads.HeadModel")
         _finite("backlash_rad", self.backlash_rad)
         _check(
             0 <= self.backlash_rad <= 0.01,
@@ -316,6 +322,16 @@ class HeadSettings:
     def joint_errors(self) -> bool:
         """Whether true joint angles differ from the commanded counts (backlash or count error)."""
         return self.backlash_rad > 0.0 or self.count_error
+
+
+def settings_record(settings: HeadSettings) -> dict[str, Any]:
+    """The settings as results.json and snapshots record them: the head model only when
+    it is not the paper's (whose records predate the choice of head)."""
+    record = asdict(settings)
+    head = record.pop("head")
+    if not settings.head.is_paper:
+        record["head"] = {**head, "path": str(settings.head.path)}
+    return record
 
 
 def ideal_head(**overrides: object) -> HeadSettings:

@@ -29,6 +29,7 @@ from headsim.geometry.stereo_view import StereoView
 from headsim.geometry.transforms import apply_transform, homogeneous, invert_transform
 from headsim.sim import names
 from headsim.sim.events import NO_EVENTS, EventSink, ImageKind, ImageTaken
+from headsim.sim.heads import actuator_on
 from headsim.sim.joints import (
     Commands,
     JointLimitError,
@@ -36,7 +37,7 @@ from headsim.sim.joints import (
     SettleResult,
     true_targets,
 )
-from headsim.sim.model import CV_FROM_MJCAM, BuiltModel, build_model
+from headsim.sim.model import CV_FROM_MJCAM, HEAD_PREFIX, BuiltModel, build_model
 from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
 from headsim.sim.render import EyeRenderer, Window, context_key
 from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
@@ -71,18 +72,27 @@ class HeadSim:
         self.built: BuiltModel = build_model(scene, self.settings)
         self.model = self.built.model
         self.data = mujoco.MjData(self.model)
-        self._qadr = {
-            joint: int(self.model.joint(joint).qposadr[0])
-            for joint in (names.NECK_YAW, names.NECK_PITCH, *names.EYE_JOINTS)
+        #: The head's names as compiled into the scene (:mod:`headsim.sim.heads`).
+        self.names = self.built.names
+        mapping = self.names
+        #: Each motor's joint, by motor: the neck's, "eye" (Ca1's eye: the one motor of
+        #: coupled eyes) and, with independent eyes, "eye2" (Ca2's eye).
+        self._motor_joint = {
+            motor: joint
+            for motor, joint in (
+                ("neck_yaw", mapping.neck_yaw),
+                ("neck_pitch", mapping.neck_pitch),
+                ("eye", mapping.left_eye),
+                ("eye2", mapping.right_eye if mapping.independent else None),
+            )
+            if joint is not None
         }
+        self.motors = tuple(self._motor_joint)
+        self._home = names.HOME if self.settings.head.is_paper else HEAD_PREFIX + names.HOME
+        self._qadr = {joint: int(self.model.joint(joint).qposadr[0]) for joint in mapping.joints}
         self._dofadr = {joint: int(self.model.joint(joint).dofadr[0]) for joint in self._qadr}
         self._actuator = {
-            key: int(self.model.actuator(name).id)
-            for key, name in (
-                ("neck_yaw", names.NECK_YAW_MOTOR),
-                ("neck_pitch", names.NECK_PITCH_MOTOR),
-                ("eye", names.EYE_MOTOR),
-            )
+            motor: actuator_on(self.model, joint) for motor, joint in self._motor_joint.items()
         }
         self._commands = Commands()
         #: Bodies placed so far (targets moved: earlier images are out of date).
@@ -93,6 +103,7 @@ class HeadSim:
             self.built.canvases,
             seed=self.settings.seed,
             key=context_key(str(scene), self.model),
+            camera_names=mapping.cameras,
             supersample=self.settings.render.supersample,
         )
         self.reset()
@@ -100,7 +111,11 @@ class HeadSim:
     # -- lifecycle -------------------------------------------------------
     def reset(self) -> None:
         """Back to the ``home`` keyframe (all joints 0)."""
-        mujoco.mj_resetDataKeyframe(self.model, self.data, self.model.key(names.HOME).id)
+        key = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_KEY, self._home)
+        if key >= 0:
+            mujoco.mj_resetDataKeyframe(self.model, self.data, key)
+        else:
+            mujoco.mj_resetData(self.model, self.data)
         self._commands = Commands()
         mujoco.mj_forward(self.model, self.data)
 
@@ -115,15 +130,27 @@ class HeadSim:
         self.close()
 
     # -- commands ----------------------------------------------------------
-    def joint_range(self, joint: str) -> tuple[float, float]:
-        """Range of a joint (``names.NECK_YAW``, ...), rad."""
-        low, high = self.model.joint(joint).range
+    def joint_range(self, motor: str) -> tuple[float, float]:
+        """Range of a motor's joint ("neck_yaw", "neck_pitch", "eye", "eye2"), or of a
+        joint of the head by its MJCF name, rad."""
+        low, high = self.model.joint(self._joint_of(motor)).range
         return float(low), float(high)
 
-    def _checked(self, joint: str, angle: float) -> float:
+    def _joint_of(self, motor: str) -> str:
+        if motor in self._qadr:
+            return motor
+        try:
+            return self._motor_joint[motor]
+        except KeyError:
+            raise SettingsError(
+                f"this head has no motor {motor!r}; allowed: {', '.join(self.motors)}"
+            ) from None
+
+    def _checked(self, motor: str, angle: float) -> float:
+        joint = self._joint_of(motor)
         if not math.isfinite(angle):
             raise JointLimitError(f"command for {joint} must be finite, got {angle}")
-        low, high = self.joint_range(joint)
+        low, high = self.joint_range(motor)
         if not low <= angle <= high:
             raise JointLimitError(
                 f"command {angle:.6f} rad for {joint} is outside its range [{low}, {high}] rad"
@@ -136,26 +163,31 @@ class HeadSim:
         neck_yaw: float | None = None,
         neck_pitch: float | None = None,
         eye: float | None = None,
+        eye2: float | None = None,
     ) -> None:
-        """Set joint targets, rad (eye: the eye-motor angle, positive inward)."""
-        previous = {
-            "neck_yaw": self._commands.neck_yaw,
-            "neck_pitch": self._commands.neck_pitch,
-            "eye": self._commands.eye,
-        }
+        """Set joint targets, rad.  ``eye``: the eye angle, positive inward: the one motor
+        of coupled eyes, or both motors of independent eyes (counter-yaw); ``eye2``:
+        Ca2's eye alone, on a head with independent eyes (then ``eye`` moves Ca1's alone)."""
+        c = self._commands
+        previous = {motor: getattr(c, motor) for motor in self.motors}
         if neck_yaw is not None:
-            self._commands.neck_yaw = self._checked(names.NECK_YAW, neck_yaw)
+            c.neck_yaw = self._checked("neck_yaw", neck_yaw)
         if neck_pitch is not None:
-            self._commands.neck_pitch = self._checked(names.NECK_PITCH, neck_pitch)
+            c.neck_pitch = self._checked("neck_pitch", neck_pitch)
+        if eye2 is not None:
+            c.eye2 = self._checked("eye2", eye2)
         if eye is not None:
-            self._commands.eye = self._checked(names.EYE_MOTOR_JOINT, eye)
+            c.eye = self._checked("eye", eye)
+            if eye2 is None and "eye2" in self.motors:
+                c.eye2 = self._checked("eye2", eye)
         for motor, old in previous.items():
-            new = getattr(self._commands, motor)
+            new = getattr(c, motor)
             if new != old:
-                self._commands.approach[motor] = 1.0 if new > old else -1.0
+                c.approach[motor] = 1.0 if new > old else -1.0
         true = self._true_targets()
-        for motor in ("neck_yaw", "neck_pitch", "eye"):
-            self.data.ctrl[self._actuator[motor]] = true[motor]
+        for motor in self.motors:
+            if self._actuator[motor] >= 0:
+                self.data.ctrl[self._actuator[motor]] = true[motor]
 
     def command_eye_steps(self, steps: int) -> None:
         """Command the eye motor to a whole number of encoder steps."""
@@ -168,16 +200,14 @@ class HeadSim:
 
     def _true_targets(self) -> dict[str, float]:
         """Where each motor's joint truly settles, rad, by motor name."""
-        return true_targets(self.settings, self._commands)
+        return true_targets(self.settings, self._commands, self.motors)
 
     def _targets(self) -> dict[str, float]:
         true = self._true_targets()
-        return {
-            names.NECK_YAW: true["neck_yaw"],
-            names.NECK_PITCH: true["neck_pitch"],
-            names.EYE_JOINTS[0]: true["eye"],
-            names.EYE_JOINTS[1]: true["eye"],
-        }
+        targets = {self._motor_joint[motor]: angle for motor, angle in true.items()}
+        if "eye2" not in true:  # coupled: Ca2's eye follows the one motor
+            targets[self.names.right_eye] = true["eye"]
+        return targets
 
     def settle(self) -> SettleResult:
         """Bring the joints to their targets (see the module docstring for modes)."""
@@ -217,20 +247,34 @@ class HeadSim:
         return float(self.data.qpos[self._qadr[joint]])
 
     def eye_encoder(self) -> float:
-        """Eye-motor encoder reading, rad, a whole multiple of the resolution."""
-        return self._quantise(self._read("eye", names.EYE_MOTOR_JOINT))
+        """Eye-motor encoder reading, rad, a whole multiple of the resolution (with
+        independent eyes, Ca1's eye's)."""
+        return self._quantise(self._read("eye", self.names.left_eye))
+
+    def eye_encoders(self) -> tuple[float, float]:
+        """Each eye's encoder reading (Ca1's, Ca2's), rad: the one motor's twice when the
+        eyes are coupled."""
+        if "eye2" not in self.motors:
+            reading = self.eye_encoder()
+            return reading, reading
+        return self.eye_encoder(), self._quantise(self._read("eye2", self.names.right_eye))
 
     def eye_encoder_steps(self) -> int:
         """Eye-motor encoder reading, whole steps."""
-        return round(
-            self._read("eye", names.EYE_MOTOR_JOINT) / self.settings.encoder_resolution_rad
-        )
+        return round(self._read("eye", self.names.left_eye) / self.settings.encoder_resolution_rad)
+
+    def encoder_steps(self, motor: str) -> int:
+        """A motor's encoder reading ("neck_yaw", "neck_pitch", "eye", "eye2"), whole steps."""
+        joint = self._joint_of(motor)
+        return round(self._read(motor, joint) / self.settings.encoder_resolution_rad)
 
     def neck_encoders(self) -> tuple[float, float]:
-        """Neck (yaw, pitch) encoder readings, rad, quantised like the eye encoder."""
+        """Neck (yaw, pitch) encoder readings, rad, quantised like the eye encoder (a head
+        with no neck yaw reads 0)."""
+        yaw = self.names.neck_yaw
         return (
-            self._quantise(self._read("neck_yaw", names.NECK_YAW)),
-            self._quantise(self._read("neck_pitch", names.NECK_PITCH)),
+            0.0 if yaw is None else self._quantise(self._read("neck_yaw", yaw)),
+            self._quantise(self._read("neck_pitch", self.names.neck_pitch)),
         )
 
     @property
@@ -256,12 +300,12 @@ class HeadSim:
 
     def world_from_head(self) -> np.ndarray:
         """Pose of H in W, 4 x 4 (eq. (1) of the paper)."""
-        body = self.data.body(names.HEAD)
+        body = self.data.body(self.names.head_body)
         return homogeneous(body.xmat.reshape(3, 3), body.xpos)
 
     def world_from_camera(self, camera: CameraId) -> np.ndarray:
         """Pose of a camera's OpenCV frame in W, 4 x 4."""
-        cam = self.data.camera(names.CAMERAS[self.camera_index(camera)])
+        cam = self.data.camera(self.names.cameras[self.camera_index(camera)])
         return homogeneous(cam.xmat.reshape(3, 3) @ CV_FROM_MJCAM, cam.xpos)
 
     def head_from_camera(self, camera: CameraId) -> np.ndarray:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -13,7 +12,7 @@ import numpy as np
 import headsim
 from headsim.files import write_json_atomic, write_png_atomic
 from headsim.sim import names
-from headsim.sim.settings import HeadSettings
+from headsim.sim.settings import HeadSettings, settings_record
 from headsim.sim.simulator import HeadSim
 
 
@@ -115,7 +114,7 @@ def take_snapshot(
             "headsim_version": headsim.__version__,
             "mujoco_version": mujoco.__version__,
             "scene": str(scene),
-            "settings": asdict(sim.settings),
+            "settings": settings_record(sim.settings),
             "command_rad": {"neck_yaw": neck_yaw, "neck_pitch": neck_pitch, "eye": eye},
             "renders": sim.render_count,
             "truth": truth,

@@ -31,12 +31,19 @@ def test_run_with_a_bad_file_exits_2_and_writes_nothing(
     assert not out.exists()
 
 
-def test_list_shows_every_scenario_with_its_description(capsys: pytest.CaptureFixture[str]) -> None:
+def test_list_shows_every_scenario_with_its_head_and_description(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     assert main(["list"]) == 0
     out = capsys.readouterr().out
+    assert re.search(r"^  name\s+head\s+description$", out, re.M)
+    heads = set()
     for path in FILES:
-        description = load_scenario(path).description
-        assert re.search(rf"^  {path.stem}\s+{re.escape(description)}$", out, re.M)
+        scenario = load_scenario(path)
+        head, description = scenario.settings.head.name, scenario.description
+        heads.add(head)
+        assert re.search(rf"^  {path.stem}\s+{head}\s+{re.escape(description)}$", out, re.M)
+    assert {"paper", "independent_eyes"} <= heads
 
 
 def test_list_flags_an_invalid_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -45,7 +52,10 @@ def test_list_flags_an_invalid_file(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert main(["list", "--dir", str(tmp_path)]) == 2
     out = capsys.readouterr().out
     assert "good" in out and "a test" in out
-    assert "broken  INVALID:" in out and "head.baseline_m: 0 is out of range" in out
+    assert (
+        re.search(r"^  broken {3,}INVALID:", out, re.M)
+        and "head.baseline_m: 0 is out of range" in out
+    )
 
 
 def test_progress_is_shown_unless_quiet_or_turned_off() -> None:

@@ -68,7 +68,7 @@ def test_every_geom_of_every_model_file_is_logged_where_mujoco_puts_it(
     model = mujoco.MjModel.from_xml_path(str(model_file))
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
-    data.qpos[:] = [0.3, -0.2, 0.1, 0.1][: model.nq]  # a pose other than home
+    data.qpos[:] = np.resize([0.3, -0.2, 0.1, 0.1], model.nq)  # a pose other than home
     mujoco.mj_forward(model, data)
     path, geometry = _record(tmp_path, model, data)
     assert geometry.skipped == () and geometry.invisible == ()

@@ -22,10 +22,11 @@ TOOLS = Path(__file__).resolve().parents[2] / "tools"
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict]:
-    """results.json of quickstart and tracking, fast: between them every key outside
-    ``experiment`` (a calibration, random targets, Model 1 and Model 2)."""
+    """results.json of quickstart, tracking and independent_eyes, fast: between them every
+    key outside ``experiment`` (a calibration, random targets, Model 1, Model 2, fixation
+    and a head other than the paper's)."""
     out = {}
-    for name in ("quickstart", "tracking"):
+    for name in ("quickstart", "tracking", "independent_eyes"):
         folder = tmp_path_factory.mktemp(name)
         assert main(["--quiet", "run", name, "--fast", "--out", str(folder), "--no-progress"]) == 0
         out[name] = json.loads((folder / "results.json").read_text())

@@ -138,9 +138,9 @@ def test_list_survives_abusive_files(tmp_path: Path, capsys: pytest.CaptureFixtu
     (tmp_path / "binary.toml").write_bytes(b"\xff\xfe\x00garbage")
     assert main(["list", "--dir", str(tmp_path)]) == 2
     out = capsys.readouterr().out
-    assert re.search(r"^  good +Quick start", out, re.M)
+    assert re.search(r"^  good +paper +Quick start", out, re.M)
     for name in ("deep", "huge", "binary"):
-        assert re.search(rf"^  {name} +INVALID: .*line \d+", out, re.M), out
+        assert re.search(rf"^  {name} {{3,}}INVALID: .*line \d+", out, re.M), out
 
 
 def test_10000_tracking_steps_validate(tmp_path: Path) -> None:

@@ -92,7 +92,7 @@ def test_every_imperfection_key_reaches_the_settings(tmp_path: Path, line, where
 BAD = [
     (
         "[head]\nbaseline = 0.1\n",
-        "head.baseline: unknown key (allowed: preset, baseline_m, neck_d1_m, neck_a2_m, "
+        "head.baseline: unknown key (allowed: model, mapping, preset, baseline_m, neck_d1_m, neck_a2_m, "
         "encoder_resolution_rad, initial_direction_rad, mount_yaw_rad, mount_pitch_rad, "
         "mount_roll_rad, settle, backlash_rad, count_error, render_offsamples, render_supersample)",
     ),
@@ -179,7 +179,7 @@ def test_an_unknown_procedure_is_named_with_every_registered_one(tmp_path: Path)
     path = write_scenario(tmp_path, MINIMAL.replace('"model2"', '"model3"'))
     allowed = (
         "model2, model1, calibration, tracking, chessboard, relative_positioning, pursuit, stereo, "
-        "zoom_fixed_points"
+        "zoom_fixed_points, fixation"
     )
     message = f"{path}: experiment.procedure: unknown value 'model3' (allowed: {allowed})"
     with pytest.raises(ScenarioError, match=re.escape(message)):

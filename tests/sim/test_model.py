@@ -26,7 +26,9 @@ def test_model_loads_and_steps_without_warnings(path: Path) -> None:
     model = mujoco.MjModel.from_xml_path(str(path))
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, model.key(names.HOME).id)
-    data.ctrl[:] = [0.3, -0.2, 0.1]
+    # Off-home targets for every motor (the heads have 3 to 6), inside each motor's range.
+    targets = np.resize([0.3, -0.2, 0.1], model.nu)
+    data.ctrl[:] = np.clip(targets, model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1])
     for _ in range(500):
         mujoco.mj_step(model, data)
     assert np.all(data.warning.number == 0), f"MuJoCo warnings: {data.warning.number}"

@@ -1,0 +1,362 @@
+"""Heads as data: a head's MJCF file and the mapping that names its joints and cameras.
+
+A scenario names its head as a shipped one (:data:`SHIPPED`: ``paper``,
+``independent_eyes``) or as a user's MJCF file with a :class:`HeadMapping`.  The
+simulator takes every joint, body and camera name from the mapping, and the head's
+true kinematics from the compiled model.  :func:`check_head` holds a mapping
+against the model and says, naming the mapping's key, what the method needs
+(docs/equations.md, "Other heads").
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from headsim.errors import BadInput
+from headsim.sim import names
+
+#: How a head drives its two eye pan joints.
+EYE_KINDS = ("coupled", "independent")
+#: Largest angle between the two eye pan axes, or of one axis from perpendicular to
+#: the baseline, that the measurement equations tolerate, rad (about 0.06 degrees:
+#: a 1 mm target error at 1 m; real heads are built to this or calibrated).
+AXIS_TOLERANCE_RAD = 1e-3
+#: Largest offset of a neck axis from eq. (1)'s chain, m.
+NECK_TOLERANCE_M = 1e-6
+
+
+class HeadError(BadInput, ValueError):
+    """A head mapping does not fit its model, or the model not the method; names the key."""
+
+    def __init__(self, key: str, problem: str, allowed: str) -> None:
+        super().__init__(f"head.mapping.{key}: {problem} (allowed: {allowed})")
+        self.key, self.problem, self.allowed = key, problem, allowed
+
+
+@dataclass(frozen=True)
+class HeadMapping:
+    """The names in a head's MJCF that headsim uses.
+
+    ``neck_yaw``, ``neck_pitch``: the neck joints (yaw about W's z at the base, pitch
+    about the yawed x, eq. (1)); ``neck_yaw`` may be None for a head with no neck yaw
+    (Model 2 only).  ``eyes``: ``"coupled"`` (one motor on ``left_eye`` drives
+    ``right_eye`` through an equality: the paper's head) or ``"independent"`` (a motor
+    per eye).  ``left_eye``/``right_eye``: the pan joints of the eyes carrying
+    ``cameras[0]`` (Ca1, at -x in H) and ``cameras[1]`` (Ca2); positive turns the eye
+    inward.  ``head_body``: the body whose frame is H at all joints zero.
+    """
+
+    head_body: str = names.HEAD
+    neck_yaw: str | None = names.NECK_YAW
+    neck_pitch: str = names.NECK_PITCH
+    eyes: str = "coupled"
+    left_eye: str = names.EYE_JOINTS[0]
+    right_eye: str = names.EYE_JOINTS[1]
+    cameras: tuple[str, str] = names.CAMERAS
+
+    def __post_init__(self) -> None:
+        if self.eyes not in EYE_KINDS:
+            raise HeadError("eyes", f"{self.eyes!r} is not a kind of eyes", ", ".join(EYE_KINDS))
+
+    def prefixed(self, prefix: str) -> HeadMapping:
+        """The same mapping with every name prefixed (a head attached to a scene)."""
+        return HeadMapping(
+            head_body=prefix + self.head_body,
+            neck_yaw=None if self.neck_yaw is None else prefix + self.neck_yaw,
+            neck_pitch=prefix + self.neck_pitch,
+            eyes=self.eyes,
+            left_eye=prefix + self.left_eye,
+            right_eye=prefix + self.right_eye,
+            cameras=(prefix + self.cameras[0], prefix + self.cameras[1]),
+        )
+
+    @property
+    def joints(self) -> tuple[str, ...]:
+        """Every joint the simulator moves: neck yaw (if any), pitch, left and right eye."""
+        neck = (self.neck_yaw,) if self.neck_yaw is not None else ()
+        return (*neck, self.neck_pitch, self.left_eye, self.right_eye)
+
+    @property
+    def independent(self) -> bool:
+        """Whether each eye has its own motor."""
+        return self.eyes == "independent"
+
+
+@dataclass(frozen=True)
+class HeadModel:
+    """A head: its name, its MJCF file (``None``: the scenes' own, the paper's head)
+    and its mapping."""
+
+    name: str = "paper"
+    path: Path | None = None
+    mapping: HeadMapping = HeadMapping()
+
+    @property
+    def is_paper(self) -> bool:
+        """Whether this is the scenes' own head (models/head.xml), built in."""
+        return self.path is None
+
+
+#: The paper's head: models/head.xml, which every scene file includes.
+PAPER = HeadModel()
+
+
+#: The head and scene MJCF files: the repository's models/, installed as package data.
+MODELS_DIR = Path(str(resources.files("headsim.models")))
+
+
+def shipped(name: str) -> HeadModel:
+    """A shipped head by name (:data:`SHIPPED`)."""
+    if name == "paper":
+        return PAPER
+    if name == "independent_eyes":
+        return HeadModel(
+            name,
+            MODELS_DIR / "independent_eyes.xml",
+            HeadMapping(
+                head_body="head_frame",
+                neck_yaw="neck_yaw_joint",
+                neck_pitch="neck_pitch_joint",
+                eyes="independent",
+                left_eye="left_eye_pan",
+                right_eye="right_eye_pan",
+                cameras=("left_camera", "right_camera"),
+            ),
+        )
+    raise HeadError("model", f"unknown head {name!r}", f"{', '.join(SHIPPED)} or an MJCF file")
+
+
+#: Shipped heads by name, with a line each for ``headsim list``.
+SHIPPED = {
+    "paper": "the paper's head: 2-DOF neck, one motor counter-yawing both eyes",
+    "independent_eyes": "the paper's neck with a motor per eye",
+}
+
+
+@dataclass(frozen=True)
+class HeadGeometry:
+    """A head's kinematics as its model was designed (all joints zero), m.
+
+    ``baseline_m``: distance between the two optical centres; ``neck_d1_m``, ``neck_a2_m``:
+    eq. (1)'s pitch-axis height above the base and H's height above the pitch axis.
+    """
+
+    baseline_m: float
+    neck_d1_m: float
+    neck_a2_m: float
+
+
+def _joint(model: mujoco.MjModel, key: str, name: str | None) -> int:
+    if name is None:
+        raise HeadError(key, "is not given", "a hinge joint of the model")
+    try:
+        joint = model.joint(name)
+    except KeyError:
+        raise HeadError(key, f"the model has no joint {name!r}", _list(model, "joint")) from None
+    if int(model.jnt_type[joint.id]) != mujoco.mjtJoint.mjJNT_HINGE:
+        raise HeadError(key, f"joint {name!r} is not a hinge", "a hinge (revolute) joint")
+    return int(joint.id)
+
+
+def _list(model: mujoco.MjModel, kind: str) -> str:
+    count = {"joint": model.njnt, "camera": model.ncam, "body": model.nbody}[kind]
+    found = [getattr(model, "cam" if kind == "camera" else kind)(i).name for i in range(count)]
+    shown = ", ".join(repr(n) for n in found[:12] if n) + (", ..." if len(found) > 12 else "")
+    return f"one of the model's {kind}s: {shown}" if shown else f"a named {kind}"
+
+
+def _carries(model: mujoco.MjModel, ancestor: int, body: int) -> bool:
+    while body > 0:
+        if body == ancestor:
+            return True
+        body = int(model.body_parentid[body])
+    return False
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    return math.acos(min(1.0, abs(float(a @ b)) / float(np.linalg.norm(a) * np.linalg.norm(b))))
+
+
+def check_head(
+    model: mujoco.MjModel, mapping: HeadMapping, *, needs_yaw: bool = False
+) -> HeadGeometry:
+    """Hold ``mapping`` against the compiled ``model`` at its home pose; the head's
+    designed geometry.  ``needs_yaw``: the procedure turns the neck to the midline
+    (Model 1).  Raises :class:`HeadError` naming the mapping's key."""
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    try:
+        head = model.body(mapping.head_body)
+    except KeyError:
+        raise HeadError(
+            "head_body", f"the model has no body {mapping.head_body!r}", _list(model, "body")
+        ) from None
+    if mapping.neck_yaw is None and needs_yaw:
+        raise HeadError(
+            "neck_yaw",
+            "is not given, and this procedure turns the neck to the midline (Model 1)",
+            "the neck's yaw joint, or a procedure that keeps the neck still (Model 2)",
+        )
+    yaw = _joint(model, "neck_yaw", mapping.neck_yaw) if mapping.neck_yaw is not None else None
+    pitch = _joint(model, "neck_pitch", mapping.neck_pitch)
+    eyes = [_joint(model, key, getattr(mapping, key)) for key in ("left_eye", "right_eye")]
+    cams = []
+    for index, (key, name) in enumerate(
+        zip(("cameras[0]", "cameras[1]"), mapping.cameras, strict=True)
+    ):
+        try:
+            cam = model.camera(name)
+        except KeyError:
+            raise HeadError(
+                key, f"the model has no camera {name!r}", _list(model, "camera")
+            ) from None
+        eye_body = int(model.jnt_bodyid[eyes[index]])
+        if not _carries(model, eye_body, int(model.cam_bodyid[cam.id])):
+            side = ("left_eye", "right_eye")[index]
+            raise HeadError(
+                key,
+                f"camera {name!r} is not on the body of {side} joint {getattr(mapping, side)!r}",
+                f"a camera on (or below) the body of the {side} joint",
+            )
+        cams.append(int(cam.id))
+
+    world_from_head = np.eye(4)
+    world_from_head[:3, :3] = data.xmat[head.id].reshape(3, 3)
+    world_from_head[:3, 3] = data.xpos[head.id]
+    for key, cam in zip(("cameras[0]", "cameras[1]"), cams, strict=True):
+        # MuJoCo cameras look down their -z with y up: OpenCV's z is -z, y is -y.
+        cam_mat = data.cam_xmat[cam].reshape(3, 3)
+        looks = _angle(-cam_mat[:, 2], world_from_head[:3, 2])
+        if looks > AXIS_TOLERANCE_RAD or float(cam_mat[:, 2] @ world_from_head[:3, 2]) > 0:
+            raise HeadError(
+                key,
+                f"camera {model.cam(cam).name!r} looks {looks:.4g} rad off H's z at all joints zero",
+                "a camera looking along H's z (forward) with its image x along H's x at home",
+            )
+    centres = [data.cam_xpos[c] for c in cams]
+    baseline = centres[1] - centres[0]
+    baseline_m = float(np.linalg.norm(baseline))
+    if baseline_m <= 1e-4:
+        raise HeadError(
+            "cameras",
+            f"the two cameras are {baseline_m:.2g} m apart",
+            "cameras at least 0.1 mm apart",
+        )
+    axes = [data.xaxis[j] for j in eyes]
+    between = _angle(axes[0], axes[1])
+    if between > AXIS_TOLERANCE_RAD:
+        raise HeadError(
+            "right_eye",
+            f"the eye pan axes are {between:.4g} rad from parallel",
+            f"parallel axes, within {AXIS_TOLERANCE_RAD:g} rad",
+        )
+    for key, axis in zip(("left_eye", "right_eye"), axes, strict=True):
+        off = abs(math.pi / 2 - _angle(axis, baseline))
+        if off > AXIS_TOLERANCE_RAD:
+            raise HeadError(
+                key,
+                f"its pan axis is {off:.4g} rad from perpendicular to the baseline",
+                f"an axis perpendicular to the line between the cameras, within {AXIS_TOLERANCE_RAD:g} rad",
+            )
+    for key, axis, sign in zip(("left_eye", "right_eye"), axes, (1.0, -1.0), strict=True):
+        if sign * float(world_from_head[:3, 1] @ axis) <= 0.0:
+            raise HeadError(
+                key,
+                "a positive angle turns its eye outward",
+                "a pan joint whose positive angle turns the eye inward (axis +y of H for the "
+                "left eye, -y for the right)",
+            )
+    midpoint = (centres[0] + centres[1]) / 2
+    if np.linalg.norm(midpoint - world_from_head[:3, 3]) > NECK_TOLERANCE_M:
+        raise HeadError(
+            "head_body",
+            f"body {mapping.head_body!r} is {np.linalg.norm(midpoint - world_from_head[:3, 3]):.3g} m from the cameras' midpoint",
+            "the body whose origin is midway between the two optical centres (frame H)",
+        )
+    x_h = baseline / baseline_m
+    if abs(float(world_from_head[:3, 0] @ x_h) - 1.0) > AXIS_TOLERANCE_RAD:
+        raise HeadError(
+            "head_body",
+            f"body {mapping.head_body!r}'s x axis is not along the baseline (Ca1 -> Ca2)",
+            "frame H: x from the left camera to the right one, y down, z forward",
+        )
+    d1, a2 = _neck(model, data, mapping, yaw, pitch, world_from_head)
+    return HeadGeometry(baseline_m=baseline_m, neck_d1_m=d1, neck_a2_m=a2)
+
+
+def actuator_on(model: mujoco.MjModel, joint: str) -> int:
+    """The id of the actuator driving ``joint`` directly, or -1 (kinematic settling only)."""
+    joint_id = int(model.joint(joint).id)
+    for actuator in range(model.nu):
+        if (
+            int(model.actuator_trntype[actuator]) == mujoco.mjtTrn.mjTRN_JOINT
+            and int(model.actuator_trnid[actuator, 0]) == joint_id
+        ):
+            return actuator
+    return -1
+
+
+def _neck(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    mapping: HeadMapping,
+    yaw: int | None,
+    pitch: int,
+    world_from_head: np.ndarray,
+) -> tuple[float, float]:
+    """eq. (1)'s d1, a2 of the model's neck, after checking that it is eq. (1)'s chain."""
+    expected = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]]).T  # H's axes in W at zero
+    if not np.allclose(world_from_head[:3, :3], expected, atol=AXIS_TOLERANCE_RAD):
+        raise HeadError(
+            "head_body",
+            "at all joints zero frame H does not look along W's +y with its y down",
+            "a head that looks forward (+y) at home, H's x to the right, y down",
+        )
+    if yaw is not None:
+        axis, anchor = data.xaxis[yaw], data.xanchor[yaw]
+        if float(axis[2]) < 1.0 - AXIS_TOLERANCE_RAD or np.hypot(*anchor[:2]) > NECK_TOLERANCE_M:
+            raise HeadError(
+                "neck_yaw",
+                f"joint {mapping.neck_yaw!r} is not W's +z axis through the world origin",
+                "the neck's yaw about W's +z at the base, positive turning left (eq. (1))",
+            )
+    axis, anchor = data.xaxis[pitch], data.xanchor[pitch]
+    if (
+        float(axis[0]) < 1.0 - AXIS_TOLERANCE_RAD
+        or np.hypot(anchor[0], anchor[1]) > NECK_TOLERANCE_M
+    ):
+        raise HeadError(
+            "neck_pitch",
+            f"joint {mapping.neck_pitch!r} is not along W's +x above the base",
+            "the neck's pitch about the yawed +x axis above the yaw axis, positive looking up (eq. (1))",
+        )
+    head = world_from_head[:3, 3]
+    if np.hypot(head[0], head[1]) > NECK_TOLERANCE_M:
+        raise HeadError(
+            "head_body",
+            f"H's origin is {np.hypot(head[0], head[1]):.3g} m off the neck's axis",
+            "H above the pitch axis, on the yaw axis (eq. (1))",
+        )
+    d1 = float(anchor[2])
+    return d1, float(head[2]) - d1
+
+
+__all__ = [
+    "AXIS_TOLERANCE_RAD",
+    "EYE_KINDS",
+    "PAPER",
+    "SHIPPED",
+    "HeadError",
+    "HeadGeometry",
+    "HeadMapping",
+    "HeadModel",
+    "actuator_on",
+    "check_head",
+    "shipped",
+]
