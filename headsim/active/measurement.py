@@ -19,7 +19,7 @@ from headsim.active.failure import Failure, FailureCause
 from headsim.active.servo_types import Detector
 from headsim.estimators import PositionEstimate
 from headsim.estimators.result import Method, Status
-from headsim.geometry.kinematics import head_to_world
+from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadBelief, HeadSettings
 from headsim.sim.simulator import HeadSim
 
@@ -227,11 +227,12 @@ def to_world(
     neck_rad: tuple[float, float] | None = None,
     belief: HeadBelief | None = None,
 ) -> np.ndarray:
-    """A head-frame estimate in W through eq. (3) with the believed D-H lengths
-    (default ``sim.belief``), with the neck encoder readings by default."""
+    """A head-frame estimate in W through eq. (3) (or the head's own neck, (H10)) with the
+    believed D-H lengths (default ``sim.belief``), with the neck encoder readings by default."""
     theta1, theta2 = sim.neck_encoders() if neck_rad is None else neck_rad
     b = belief if belief is not None else sim.belief
-    return head_to_world(point_head, theta1, theta2, b.neck_d1_m, b.neck_a2_m)
+    neck = neck_of(sim.settings.head)
+    return neck.head_to_world(point_head, theta1, theta2, b.neck_d1_m, b.neck_a2_m)
 
 
 __all__ = [

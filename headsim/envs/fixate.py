@@ -54,6 +54,7 @@ from dataclasses import replace
 from typing import Any
 
 import gymnasium
+import mujoco
 import numpy as np
 from gymnasium import spaces
 
@@ -62,7 +63,7 @@ from headsim.estimators.model1 import model1
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, Frame, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
 from headsim.sim.heads import HeadModel, shipped
-from headsim.sim.model import on_head
+from headsim.sim.model import design, neck_of, on_head
 from headsim.sim.settings import (
     CAMERA_NUMBER_FIELDS,
     IDEAL_FOCAL_PX,
@@ -73,6 +74,24 @@ from headsim.sim.settings import (
 )
 from headsim.sim.simulator import HeadSim, for_settings
 from headsim.vision.markers import find_marker
+
+
+def _encoder_bounds(head: HeadModel) -> np.ndarray:
+    """The largest |angle| of the neck yaw, neck pitch and eye joints, rad (models/head.xml's
+    for the paper's head, else the head's MJCF)."""
+    if head.is_paper:
+        return np.array([1.5708, 0.8, 0.7], np.float32)
+    assert head.path is not None
+    model = mujoco.MjModel.from_xml_path(str(head.path))
+    joints = (head.mapping.neck_yaw, head.mapping.neck_pitch, head.mapping.left_eye)
+    return np.array([np.abs(model.joint(j).range).max() for j in joints], np.float32)
+
+
+def _head_at_home(settings: HeadSettings) -> np.ndarray:
+    """H's origin in W with the neck at zero, m."""
+    neck = neck_of(settings.head)
+    return neck.world_from_head(0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m)[:3, 3]
+
 
 TARGET_BODY = "marker_red"
 TARGET_COLOUR = "red"
@@ -150,11 +169,14 @@ class FixateEnv(gymnasium.Env):
         self.max_steps = max_steps
         self.tolerance_px = float(tolerance_px)
         self.live_config = LiveConfig(frame_rate_hz=frame_rate_hz, latency_frames=latency_frames)
-        focal = IDEAL_FOCAL_PX * height / 480.0
-        camera = CameraSettings(width=width, height=height, kx=focal, ky=focal)
         head_model = shipped(head) if isinstance(head, str) else head
-        self.base_settings = on_head(
-            HeadSettings(cameras=(camera, camera), belief=belief), head_model
+        # The head's own field of view (the paper's: 45 degrees vertical) at this image size.
+        own = None if head_model.is_paper else design(head_model).cameras[0]
+        focal = (IDEAL_FOCAL_PX / 480.0 if own is None else own.fy_px / own.height) * height
+        camera = CameraSettings(width=width, height=height, kx=focal, ky=focal)
+        self.base_settings = replace(
+            on_head(HeadSettings(cameras=(camera, camera), belief=belief), head_model),
+            cameras=(camera, camera),
         )
         self.knowledge = HeadKnowledge()  # uncalibrated: the simulator's belief, no alpha_e
         self.defaults = {
@@ -164,7 +186,7 @@ class FixateEnv(gymnasium.Env):
         }
         self.randomise = _check_ranges(randomise or {})
         image = spaces.Box(0, 255, (height, width, 3), np.uint8)
-        low = np.array([-1.5708, -0.8, -0.7], np.float32)  # joint ranges, models/head.xml
+        low = -_encoder_bounds(head_model)
         self.observation_space = spaces.Dict(
             {
                 "cam1": image,
@@ -220,12 +242,11 @@ class FixateEnv(gymnasium.Env):
         sim.reset()
         depth = self._draw(ranges, "depth_m")
         azimuth, elevation = self._draw(ranges, "bearing_rad"), self._draw(ranges, "bearing_rad")
-        eye_height = settings.neck_d1_m + settings.neck_a2_m
-        start = np.array(
+        start = _head_at_home(settings) + depth * np.array(
             [
-                depth * math.sin(azimuth) * math.cos(elevation),
-                depth * math.cos(azimuth) * math.cos(elevation),
-                eye_height + depth * math.sin(elevation),
+                math.sin(azimuth) * math.cos(elevation),
+                math.cos(azimuth) * math.cos(elevation),
+                math.sin(elevation),
             ]
         )
         if "target_world_m" in options:
@@ -326,7 +347,7 @@ class FixateEnv(gymnasium.Env):
         if truth is None or estimate is None:
             return -1.0
         s = self._settings
-        distance = float(np.linalg.norm(truth - np.array([0.0, 0.0, s.neck_d1_m + s.neck_a2_m])))
+        distance = float(np.linalg.norm(truth - _head_at_home(s)))
         return -min(float(np.linalg.norm(estimate - truth)) / distance, 1.0)
 
     def _observation(self) -> dict[str, np.ndarray]:

@@ -17,12 +17,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from headsim.geometry import kinematics
 from headsim.geometry.synthetic import StereoHead, fixation_angles
 from headsim.geometry.transforms import homogeneous
 
 __all__ = [
+    "NECK_ORDERS",
     "EyeAxesAlignment",
     "EyePans",
+    "Neck",
     "RevoluteJoint",
     "SerialChain",
     "VersionVergence",
@@ -304,6 +307,85 @@ def pitch_roll_yaw_neck(
     last = at(head_from_yaw_m, "head_from_yaw_m")
     last[:3, :3] = _WORLD_FROM_HEAD_AT_ZERO
     return SerialChain(joints, last)
+
+
+#: The two-joint necks headsim runs: eq. (1)'s yaw at the base, or pitch at the base.
+NECK_ORDERS = ("yaw_pitch", "pitch_yaw")
+
+
+@dataclass(frozen=True)
+class Neck:
+    """A neck of a yaw and a pitch joint, by which is at the base (H10).
+
+    ``order``: ``"yaw_pitch"`` is eq. (1) (yaw about W's z at the base, pitch above it,
+    H ``a2`` above the pitch axis, ``d1`` up); ``"pitch_yaw"`` pitches about W's x at
+    W's origin, then yaws about the pitched z through ``(0, 0, d1)``, H ``a2`` above and
+    ``forward_m`` ahead of that point: (H6) with its roll held at zero (the iCub's).
+    Angles as eq. (1)'s: ``theta1`` yaw, positive turns left; ``theta2`` pitch, positive
+    looks up.
+    """
+
+    order: str = "yaw_pitch"
+    forward_m: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.order not in NECK_ORDERS:
+            raise ValueError(f"order must be one of {', '.join(NECK_ORDERS)}, got {self.order!r}")
+        if not math.isfinite(self.forward_m):
+            raise ValueError(f"forward_m must be finite, got {self.forward_m!r}")
+        if self.order == "yaw_pitch" and self.forward_m != 0.0:
+            raise ValueError("forward_m is for a pitch_yaw neck; eq. (1) has H on the yaw axis")
+
+    def world_from_head(
+        self, theta1: ArrayLike, theta2: ArrayLike, d1: float, a2: float
+    ) -> np.ndarray:
+        """W_T_H (..., 4, 4); angles rad, broadcast; d1, a2 m."""
+        if self.order == "yaw_pitch":
+            return kinematics.world_from_head(theta1, theta2, d1, a2)
+        t1, t2 = np.broadcast_arrays(np.asarray(theta1, float), np.asarray(theta2, float))
+        c1, s1, c2, s2 = np.cos(t1), np.sin(t1), np.cos(t2), np.sin(t2)
+        zero, one = np.zeros_like(t1), np.ones_like(t1)
+        # Rx(theta2) Rz(theta1) R0, and Rx(theta2) [(0, 0, d1) + Rz(theta1) (0, f, a2)].
+        f, h = self.forward_m, d1 + a2
+        px, py = -f * s1, f * c1
+        rows = [
+            [c1, zero, -s1, px],
+            [c2 * s1, s2, c2 * c1, c2 * py - s2 * h],
+            [s2 * s1, -c2, s2 * c1, s2 * py + c2 * h],
+            [zero, zero, zero, one],
+        ]
+        return np.stack([np.stack(row, axis=-1) for row in rows], axis=-2)
+
+    def head_to_world(
+        self, points_h: ArrayLike, theta1: ArrayLike, theta2: ArrayLike, d1: float, a2: float
+    ) -> np.ndarray:
+        """Points (..., 3) from H to W."""
+        if self.order == "yaw_pitch":
+            return kinematics.head_to_world(points_h, theta1, theta2, d1, a2)
+        p = _points(points_h, "points_h")
+        t = self.world_from_head(theta1, theta2, d1, a2)
+        return np.einsum("...ij,...j->...i", t[..., :3, :3], p) + t[..., :3, 3]
+
+    def world_to_head(
+        self, points_w: ArrayLike, theta1: ArrayLike, theta2: ArrayLike, d1: float, a2: float
+    ) -> np.ndarray:
+        """Points (..., 3) from W to H, the inverse of :meth:`head_to_world`."""
+        if self.order == "yaw_pitch":
+            return kinematics.world_to_head(points_w, theta1, theta2, d1, a2)
+        p = _points(points_w, "points_w")
+        t = self.world_from_head(theta1, theta2, d1, a2)
+        return np.einsum("...ji,...j->...i", t[..., :3, :3], p - t[..., :3, 3])
+
+    def as_chain(self, d1: float, a2: float) -> SerialChain:
+        """The same neck as a :class:`SerialChain` of (yaw, pitch) or (pitch, yaw)."""
+        if self.order == "yaw_pitch":
+            return paper_neck(d1, a2)
+        pitch = RevoluteJoint(np.eye(4), np.array([1.0, 0.0, 0.0]), "pitch")
+        yaw = RevoluteJoint(
+            homogeneous(np.eye(3), np.array([0.0, 0.0, d1])), np.array([0.0, 0.0, 1.0]), "yaw"
+        )
+        last = homogeneous(_WORLD_FROM_HEAD_AT_ZERO, np.array([0.0, self.forward_m, a2]))
+        return SerialChain((pitch, yaw), last)
 
 
 # --- version and vergence --------------------------------------------------------------

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from headsim.active.measurement import HeadKnowledge
-from headsim.geometry.kinematics import head_to_world
+from headsim.geometry.heads import Neck
 from headsim.sim.settings import HeadBelief
 
 
@@ -45,7 +45,8 @@ class GazeEstimator:
     ``belief``: the head's believed geometry (baseline, neck D-H lengths, m);
     ``los_offset_m``: each goal column's line of sight's offset from its yaw
     axis, m (:meth:`HeadKnowledge.line_of_sight_offsets`); ``knowledge``: the
-    initial directions and kx/ky ratios.  Nothing here is the true head.
+    initial directions and kx/ky ratios; ``neck``: the neck's designed layout.  Nothing
+    here is the true head.
     """
 
     def __init__(
@@ -56,12 +57,15 @@ class GazeEstimator:
         belief: HeadBelief,
         knowledge: HeadKnowledge | None = None,
         los_offset_m: tuple[float, float] = (0.0, 0.0),
+        neck: Neck | None = None,
     ) -> None:
         self.jacobian_per_rad = np.asarray(jacobian_px_per_step, float) / encoder_resolution_rad
         self.belief = belief
         self.los_offset_m = (float(los_offset_m[0]), float(los_offset_m[1]))
         self.goals = np.asarray(goals_px, float)  # ((u10, v10), (u20, v20))
         self.knowledge = knowledge or HeadKnowledge()
+        #: The neck's layout (H10), as the head was designed: eq. (1) by default.
+        self.neck = neck or Neck()
 
     def measure(
         self, uv: tuple[tuple[float, float], tuple[float, float]], encoders_rad: np.ndarray
@@ -87,7 +91,9 @@ class GazeEstimator:
         y = float(np.mean(rows * ratio / np.abs(gains) * reach))
         head = np.array([x, y, z])
         b = self.belief
-        world = head_to_world(head, encoders_rad[0], encoders_rad[1], b.neck_d1_m, b.neck_a2_m)
+        world = self.neck.head_to_world(
+            head, encoders_rad[0], encoders_rad[1], b.neck_d1_m, b.neck_a2_m
+        )
         return Offsets(error, rows, fixation, np.asarray(world, float), head)
 
     def eye_fixation(self, offsets: Offsets, encoders_rad: np.ndarray) -> float:

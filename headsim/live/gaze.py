@@ -27,6 +27,7 @@ from headsim.active.servo_types import Detector
 from headsim.live.estimator import GazeEstimator
 from headsim.live.head import Frame, LiveHead
 from headsim.live.motors import MotorDriver, bang_bang_duration, min_jerk_duration
+from headsim.sim.model import neck_of
 
 
 class GazeMode(enum.Enum):
@@ -332,4 +333,5 @@ def acquire(
         knowledge.head_belief(sim),
         knowledge,
         knowledge.line_of_sight_offsets(sim),
+        neck_of(sim.settings.head),
     )

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from headsim.sim.heads import PAPER, HeadMapping, actuator_on
+from headsim.sim.heads import PAPER, HeadMapping, actuator_coefficients, actuator_on
 from headsim.sim.settings import SettingsError
 
 #: The motors in the order of every 3-vector here: (neck yaw, neck pitch, eye).
@@ -131,26 +131,25 @@ class MotorDriver:
         self.model, self.data = model, data
         joints = motor_joints(mapping)
         self._qadr = [int(model.joint(j).qposadr[0]) for j in joints]
-        # (actuator, joint it moves) per motor: Ca2's eye too when it has its own motor.
-        driven = [[(actuator_on(model, j), j)] for j in joints]
-        if mapping.independent:
-            driven[2].append((actuator_on(model, mapping.right_eye), mapping.right_eye))
-        for pairs in driven:
-            for act, joint in pairs:
-                if act < 0:
-                    raise SettingsError(f"joint {joint!r} has no position actuator to drive it")
         omega = 2 * math.pi * bandwidth_hz
-        inertia = self._effective_inertia(mapping, driven)
-        #: (actuator, velocity feed-forward, acceleration feed-forward) per motor.
-        self._act: list[list[tuple[int, float, float]]] = []
-        for pairs, masses in zip(driven, inertia, strict=True):
+        mujoco.mj_forward(model, data)
+        #: (actuator, gear: its length per unit of the motor's reference, velocity and
+        #: acceleration feed-forward) per motor.
+        self._act: list[list[tuple[int, float, float, float]]] = []
+        for motor, pairs in enumerate(self._driven(mapping, joints)):
             tuned = []
-            for (act, _), mass in zip(pairs, masses, strict=True):
+            for act, gear, row in pairs:
+                mass = self._inertia(row)
+                if motor == 2 and mapping.eyes == "coupled":  # one motor carries both eyes
+                    mass = sum(
+                        self._inertia(self._joint_row(j))
+                        for j in (mapping.left_eye, mapping.right_eye)
+                    )
                 kp, kv = mass * omega**2, 2.0 * mass * omega
                 model.actuator_gainprm[act, 0] = kp
                 model.actuator_biasprm[act, :3] = (0.0, -kp, -kv)
                 model.actuator_forcelimited[act] = 0
-                tuned.append((act, kv / kp, 1.0 / omega**2))
+                tuned.append((act, gear, kv / kp, 1.0 / omega**2))
             self._act.append(tuned)
         self.motors: list[_Motor] = []
         for lim, j in zip(limits, joints, strict=True):
@@ -158,30 +157,47 @@ class MotorDriver:
             self.motors.append(_Motor(lim, float(low), float(high)))
         self.sync()
 
-    def _effective_inertia(
-        self, mapping: HeadMapping, driven: list[list[tuple[int, str]]]
-    ) -> list[list[float]]:
-        """Diagonal of the joint-space inertia at the current pose, per actuator; the one
-        motor of coupled eyes carries both eyes."""
-        mujoco.mj_forward(self.model, self.data)
+    def _joint_row(self, joint: str) -> np.ndarray:
+        row = np.zeros(self.model.nv)
+        row[int(self.model.joint(joint).dofadr[0])] = 1.0
+        return row
+
+    def _driven(
+        self, mapping: HeadMapping, joints: tuple[str, str, str]
+    ) -> list[list[tuple[int, float, np.ndarray]]]:
+        """(actuator, gear, its length's row over the dofs) for each motor.  The eye
+        motor's reference is each eye's inward angle (the counter-yaw): with independent
+        eyes both eyes' actuators follow it; with version and vergence the vergence
+        follows twice it and the version holds zero (gear 0)."""
+        model = self.model
+        driven = [[(actuator_on(model, j), 1.0, self._joint_row(j))] for j in joints[:2]]
+        if mapping.version is not None and mapping.vergence is not None:
+            eye = []
+            for name, gear in ((mapping.version, 0.0), (mapping.vergence, 2.0)):
+                act = int(model.actuator(name).id)
+                row = np.zeros(model.nv)
+                for joint, coef in actuator_coefficients(model, act).items():
+                    row[int(model.jnt_dofadr[joint])] += coef
+                eye.append((act, gear, row))
+            driven.append(eye)
+        else:
+            eye_joints = [joints[2]] + ([mapping.right_eye] if mapping.independent else [])
+            driven.append([(actuator_on(model, j), 1.0, self._joint_row(j)) for j in eye_joints])
+        for pairs in driven:
+            for act, _, _ in pairs:
+                if act < 0:
+                    raise SettingsError("a motor's joint has no position actuator to drive it")
+        return driven
+
+    def _inertia(self, row: np.ndarray) -> float:
+        """The inertia an actuator of length ``row . q`` moves, at the current pose: a joint's
+        diagonal entry of the joint-space inertia; a tendon's 1 / (J M^-1 J^T)."""
         full = np.zeros((self.model.nv, self.model.nv))
         mujoco.mj_fullM(self.model, self.data, full)
-
-        def diagonal(joint: str) -> float:
-            dof = int(self.model.joint(joint).dofadr[0])
+        if np.count_nonzero(row) == 1:
+            dof = int(np.flatnonzero(row)[0])
             return float(full[dof, dof])
-
-        masses = [[diagonal(joint) for _, joint in pairs] for pairs in driven]
-        if not mapping.independent:
-            masses[2] = [
-                full[int(self.model.joint(mapping.left_eye).dofadr[0])][
-                    int(self.model.joint(mapping.left_eye).dofadr[0])
-                ]
-                + full[int(self.model.joint(mapping.right_eye).dofadr[0])][
-                    int(self.model.joint(mapping.right_eye).dofadr[0])
-                ]
-            ]
-        return masses
+        return 1.0 / float(row @ np.linalg.solve(full, row))
 
     def sync(self) -> None:
         """Start the references where the joints are, at rest."""
@@ -243,8 +259,8 @@ class MotorDriver:
 
     def _write(self) -> None:
         for motor, actuators in zip(self.motors, self._act, strict=True):
-            for act, fv, fa in actuators:
-                self.data.ctrl[act] = motor.ref + fv * motor.vel + fa * motor.acc
+            for act, gear, fv, fa in actuators:
+                self.data.ctrl[act] = gear * (motor.ref + fv * motor.vel + fa * motor.acc)
 
     @property
     def references(self) -> np.ndarray:

@@ -21,7 +21,6 @@ from headsim.estimators.areas import (
     areas_from_pixels,
     compare_areas,
 )
-from headsim.geometry.kinematics import head_to_world
 from headsim.run.context import (
     PAPER,
     PARKED_WORLD_M,
@@ -45,6 +44,7 @@ from headsim.scenario.spec import STREAM_OBJECTS, Placement, Scenario, SceneSpec
 from headsim.scenario.tables import MISSING, Context, Table
 from headsim.sim import names
 from headsim.sim.events import EventSink
+from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 from headsim.vision.crosses import find_cross_point
@@ -166,7 +166,9 @@ class RelativeResult:
                 start = np.array([-sign * baseline / 2, 0.0, 0.0])
                 end = start + far * np.array([sign * math.sin(yaw), 0.0, math.cos(yaw)])
                 strips.append(
-                    head_to_world(np.array([start, end]), 0.0, 0.0, s.neck_d1_m, s.neck_a2_m)
+                    neck_of(s.head).head_to_world(
+                        np.array([start, end]), 0.0, 0.0, s.neck_d1_m, s.neck_a2_m
+                    )
                 )
                 labels.append(f"L{camera}{step_index + 1}")
         log.rec.log(

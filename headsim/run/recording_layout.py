@@ -12,6 +12,7 @@ import rerun.blueprint as rrb
 from headsim.active.calibration_report import CalibrationReport
 from headsim.run import mjcf_rerun
 from headsim.scenario.spec import Scenario
+from headsim.sim.model import neck_of
 
 GREEN = (40, 220, 90)
 
@@ -52,7 +53,8 @@ def eye_controls(scenario: Scenario | None = None) -> rrb.EyeControls3D:
     """The 3-D view's starting eye: behind and above the head, looking past it at the targets."""
     head = np.array([0.0, 0.0, 0.21])
     if scenario is not None:
-        head = np.array([0.0, 0.0, scenario.settings.neck_d1_m + scenario.settings.neck_a2_m])
+        s = scenario.settings
+        head = neck_of(s.head).world_from_head(0.0, 0.0, s.neck_d1_m, s.neck_a2_m)[:3, 3]
     points = [head] + [np.asarray(p, dtype=float) for p in _placements(scenario)]
     targets = np.array(points[1:]) if len(points) > 1 else head + np.array([[0.0, 0.8, 0.0]])
     reach = float(np.max(np.linalg.norm(targets - head, axis=1)))

@@ -26,7 +26,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from headsim.geometry.kinematics import eye_from_camera_rotation, head_to_world, world_to_head
+from headsim.geometry.kinematics import eye_from_camera_rotation
 from headsim.scenario.occlusion import Occluder, hidden_by, scene_model, scene_occluders
 from headsim.scenario.spec import (
     MAX_DEPTH_M,
@@ -34,7 +34,8 @@ from headsim.scenario.spec import (
 )
 from headsim.sim import names
 from headsim.sim.forward import effective_directions
-from headsim.sim.model import head_names
+from headsim.sim.heads import eye_motor_range
+from headsim.sim.model import head_names, neck_of
 from headsim.sim.settings import HeadSettings
 
 
@@ -61,7 +62,7 @@ class ReachHead:
         directions = effective_directions(settings)
         return cls(
             settings,
-            rng(mapping.left_eye),
+            eye_motor_range(model, mapping),
             rng(mapping.neck_yaw) if mapping.neck_yaw is not None else (0.0, 0.0),
             rng(mapping.neck_pitch),
             directions,
@@ -105,13 +106,15 @@ class ReachHead:
     def to_head(self, point_world: np.ndarray, yaw: float = 0.0, pitch: float = 0.0) -> np.ndarray:
         """A world point in H with the neck at (``yaw``, ``pitch``), rad (default: the start pose)."""
         s = self.settings
-        return world_to_head(point_world, yaw, pitch, s.neck_d1_m, s.neck_a2_m)
+        return neck_of(s.head).world_to_head(point_world, yaw, pitch, s.neck_d1_m, s.neck_a2_m)
 
     def eye_centres(self, yaw: float = 0.0, pitch: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """Each eye's centre (on its yaw axis) in W with the neck at (``yaw``, ``pitch``), m."""
         s, half = self.settings, self.settings.baseline_m / 2
         return tuple(  # type: ignore[return-value]
-            head_to_world(np.array([x, 0.0, 0.0]), yaw, pitch, s.neck_d1_m, s.neck_a2_m)
+            neck_of(s.head).head_to_world(
+                np.array([x, 0.0, 0.0]), yaw, pitch, s.neck_d1_m, s.neck_a2_m
+            )
             for x in (-half, half)
         )
 
@@ -253,13 +256,24 @@ def model2_refusal(
 def _model1_angles(head: ReachHead, p_world: np.ndarray) -> tuple[float, float, float]:
     """Neck yaw, neck pitch and eye angle that fixate a world point with Model 1, rad."""
     s = head.settings
-    yaw = math.atan2(-p_world[0], p_world[1])
-    rho, height = math.hypot(p_world[0], p_world[1]), p_world[2] - s.neck_d1_m
-    reach = math.hypot(rho, height)
-    if reach <= s.neck_a2_m:
-        return yaw, math.nan, math.nan
-    pitch = math.atan2(height, rho) - math.asin(s.neck_a2_m / reach)
-    depth = math.sqrt(max(reach**2 - s.neck_a2_m**2, 0.0))
+    neck = neck_of(s.head)
+    if neck.order == "pitch_yaw":  # (H10): pitch brings the point to H's height, yaw ahead
+        height = s.neck_d1_m + s.neck_a2_m
+        rho = math.hypot(p_world[1], p_world[2])
+        if rho <= height:
+            return math.nan, math.nan, math.nan
+        pitch = math.atan2(p_world[2], p_world[1]) - math.asin(height / rho)
+        ahead = math.cos(pitch) * p_world[1] + math.sin(pitch) * p_world[2]
+        yaw = math.atan2(-p_world[0], ahead)
+        depth = math.hypot(p_world[0], ahead) - neck.forward_m
+    else:
+        yaw = math.atan2(-p_world[0], p_world[1])
+        rho, height = math.hypot(p_world[0], p_world[1]), p_world[2] - s.neck_d1_m
+        reach = math.hypot(rho, height)
+        if reach <= s.neck_a2_m:
+            return yaw, math.nan, math.nan
+        pitch = math.atan2(height, rho) - math.asin(s.neck_a2_m / reach)
+        depth = math.sqrt(max(reach**2 - s.neck_a2_m**2, 0.0))
     eye = math.atan2(s.baseline_m / 2, depth) - 0.5 * (
         head.effective_direction(0) + head.effective_direction(1)
     )

@@ -13,7 +13,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from headsim.geometry.kinematics import head_to_world
 from headsim.geometry.sampling import sample_points_head
 from headsim.scenario.pursuit import read_pursuit
 from headsim.scenario.reach import (
@@ -39,6 +38,7 @@ from headsim.scenario.spec import (
 )
 from headsim.scenario.tables import MISSING, Context, Table
 from headsim.sim import names
+from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadSettings
 
 
@@ -60,7 +60,8 @@ def read_position(table: Table, settings: HeadSettings, default: Any = MISSING) 
 
 def start_head_to_world(settings: HeadSettings, points_head: np.ndarray) -> np.ndarray:
     """Points (N, 3) in H at the start pose (neck and eyes at 0) in W, m."""
-    return head_to_world(points_head, 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m)
+    neck = neck_of(settings.head)
+    return neck.head_to_world(points_head, 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m)
 
 
 def random_points_head(table: Table, count: int, rng: np.random.Generator) -> np.ndarray:

@@ -29,7 +29,7 @@ from headsim.scenario.spec import (
 from headsim.scenario.tables import MISSING, Context, Table, describe_value, short_value
 from headsim.sim import heads, names
 from headsim.sim.heads import HeadModel
-from headsim.sim.model import design, on_head
+from headsim.sim.model import design, has_own_cameras, on_head
 from headsim.sim.optics import centre_ray_yaw
 from headsim.sim.settings import (
     MAX_IMAGE_SIDE,
@@ -57,13 +57,14 @@ _PRESETS = ("ideal", "paper", "realistic")
 
 
 def _read_camera(
-    table: Table | None, index: int, default_preset: str
+    table: Table | None, index: int, default_preset: str, head: HeadModel
 ) -> tuple[CameraSettings, str]:
-    """``[cam1]``/``[cam2]``: one camera; missing keys from its preset."""
+    """``[cam1]``/``[cam2]``: one camera; missing keys from its preset, on ``head``'s own
+    camera (:func:`headsim.sim.model.on_head`)."""
     if table is None:
-        return preset(default_preset).cameras[index], default_preset
+        return on_head(preset(default_preset), head).cameras[index], default_preset
     name = table.choice("preset", _PRESETS, default_preset)
-    base = preset(name).cameras[index]
+    base = on_head(preset(name), head).cameras[index]
     width = table.integer("width", base.width, 16, MAX_IMAGE_SIDE)
     height = table.integer("height", base.height, 16, MAX_IMAGE_SIDE)
     kx = table.number("kx", base.kx, 1.0, 1e5, unit="px")
@@ -172,15 +173,22 @@ def _read_head_model(head: Table, ctx: Context, directory: Path) -> HeadModel:
             "an array of two camera names [left (Ca1), right (Ca2)]",
         )
     m._note("cameras", "strings", "an array of two camera names [left (Ca1), right (Ca2)]", MISSING)
-    mapping = heads.HeadMapping(
-        head_body=joint_name("head_body"),
-        neck_yaw=joint_name("neck_yaw", None),
-        neck_pitch=joint_name("neck_pitch"),
-        eyes=m.choice("eyes", heads.EYE_KINDS),
-        left_eye=joint_name("left_eye"),
-        right_eye=joint_name("right_eye"),
-        cameras=(cameras[0], cameras[1]),
-    )
+    try:
+        mapping = heads.HeadMapping(
+            head_body=joint_name("head_body"),
+            neck_yaw=joint_name("neck_yaw", None),
+            neck_pitch=joint_name("neck_pitch"),
+            eyes=m.choice("eyes", heads.EYE_KINDS),
+            left_eye=joint_name("left_eye"),
+            right_eye=joint_name("right_eye"),
+            cameras=(cameras[0], cameras[1]),
+            neck_roll=joint_name("neck_roll", None),
+            eye_tilt=joint_name("eye_tilt", None),
+            version=joint_name("version", None),
+            vergence=joint_name("vergence", None),
+        )
+    except heads.HeadError as err:
+        raise ctx.error(f"head.mapping.{err.key}", err.problem, err.allowed) from None
     m.done()
     return heads.HeadModel(path.stem, path, mapping)
 
@@ -243,9 +251,15 @@ def read_head(
     head.done()
 
     cameras = []
+    own_cameras = has_own_cameras(head_model)  # not the paper's: nor its initial directions
     for index, key in enumerate(names.CAMERAS):
-        camera, camera_preset = _read_camera(doc.table(key), index, preset_name)
-        if initial is None and yaw is None and camera_preset in ("paper", "realistic"):
+        camera, camera_preset = _read_camera(doc.table(key), index, preset_name, head_model)
+        if (
+            initial is None
+            and yaw is None
+            and camera_preset in ("paper", "realistic")
+            and not own_cameras
+        ):
             direction = INITIAL_DIRECTIONS_RAD[index]
         elif initial is not None:
             direction = initial[index]

@@ -11,7 +11,7 @@ against the model and says, naming the mapping's key, what the method needs
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
@@ -19,10 +19,11 @@ import mujoco
 import numpy as np
 
 from headsim.errors import BadInput
+from headsim.geometry.heads import Neck
 from headsim.sim import names
 
 #: How a head drives its two eye pan joints.
-EYE_KINDS = ("coupled", "independent")
+EYE_KINDS = ("coupled", "independent", "version_vergence")
 #: Largest angle between the two eye pan axes, or of one axis from perpendicular to
 #: the baseline, that the measurement equations tolerate, rad (about 0.06 degrees:
 #: a 1 mm target error at 1 m; real heads are built to this or calibrated).
@@ -50,6 +51,10 @@ class HeadMapping:
     per eye).  ``left_eye``/``right_eye``: the pan joints of the eyes carrying
     ``cameras[0]`` (Ca1, at -x in H) and ``cameras[1]`` (Ca2); positive turns the eye
     inward.  ``head_body``: the body whose frame is H at all joints zero.
+    ``eyes = "version_vergence"``: the pans are driven by two actuators, ``version``
+    (``(left - right) / 2``) and ``vergence`` (``left + right``), e.g. on fixed tendons
+    (the iCub's, (H7)); both eyes can be pointed on their own.  ``neck_roll`` and
+    ``eye_tilt``: joints the method holds at zero, where the head has them.
     """
 
     head_body: str = names.HEAD
@@ -59,10 +64,25 @@ class HeadMapping:
     left_eye: str = names.EYE_JOINTS[0]
     right_eye: str = names.EYE_JOINTS[1]
     cameras: tuple[str, str] = names.CAMERAS
+    neck_roll: str | None = None
+    eye_tilt: str | None = None
+    version: str | None = None
+    vergence: str | None = None
 
     def __post_init__(self) -> None:
         if self.eyes not in EYE_KINDS:
             raise HeadError("eyes", f"{self.eyes!r} is not a kind of eyes", ", ".join(EYE_KINDS))
+        for key in ("version", "vergence"):
+            given = getattr(self, key) is not None
+            if given != (self.eyes == "version_vergence"):
+                raise HeadError(
+                    key,
+                    "is given without eyes = 'version_vergence'"
+                    if given
+                    else "is not given, and eyes = 'version_vergence'",
+                    "the version and vergence actuators with eyes = 'version_vergence', "
+                    "else neither",
+                )
 
     def prefixed(self, prefix: str) -> HeadMapping:
         """The same mapping with every name prefixed (a head attached to a scene)."""
@@ -74,6 +94,10 @@ class HeadMapping:
             left_eye=prefix + self.left_eye,
             right_eye=prefix + self.right_eye,
             cameras=(prefix + self.cameras[0], prefix + self.cameras[1]),
+            neck_roll=_prefixed(prefix, self.neck_roll),
+            eye_tilt=_prefixed(prefix, self.eye_tilt),
+            version=_prefixed(prefix, self.version),
+            vergence=_prefixed(prefix, self.vergence),
         )
 
     @property
@@ -84,8 +108,18 @@ class HeadMapping:
 
     @property
     def independent(self) -> bool:
-        """Whether each eye has its own motor."""
-        return self.eyes == "independent"
+        """Whether each eye can be pointed on its own (its own motor, or version and
+        vergence)."""
+        return self.eyes != "coupled"
+
+    @property
+    def held(self) -> tuple[str, ...]:
+        """The joints held at zero: neck roll and eye tilt, where given."""
+        return tuple(j for j in (self.neck_roll, self.eye_tilt) if j is not None)
+
+
+def _prefixed(prefix: str, name: str | None) -> str | None:
+    return None if name is None else prefix + name
 
 
 @dataclass(frozen=True)
@@ -115,6 +149,24 @@ def shipped(name: str) -> HeadModel:
     """A shipped head by name (:data:`SHIPPED`)."""
     if name == "paper":
         return PAPER
+    if name == "icub":
+        return HeadModel(
+            name,
+            MODELS_DIR / "icub.xml",
+            HeadMapping(
+                head_body="head_center",
+                neck_yaw="neck_yaw",
+                neck_pitch="neck_pitch",
+                eyes="version_vergence",
+                left_eye="l_eye_pan",
+                right_eye="r_eye_pan",
+                cameras=("l_eye_camera", "r_eye_camera"),
+                neck_roll="neck_roll",
+                eye_tilt="eyes_tilt",
+                version="eyes_version_motor",
+                vergence="eyes_vergence_motor",
+            ),
+        )
     if name == "independent_eyes":
         return HeadModel(
             name,
@@ -136,7 +188,22 @@ def shipped(name: str) -> HeadModel:
 SHIPPED = {
     "paper": "the paper's head: 2-DOF neck, one motor counter-yawing both eyes",
     "independent_eyes": "the paper's neck with a motor per eye",
+    "icub": "iCub 2.0 kinematics: neck pitch, roll, yaw; eye tilt, version and vergence; "
+    "320 x 240 cameras",
 }
+
+
+@dataclass(frozen=True)
+class DesignedCamera:
+    """An eye camera's intrinsics as its MJCF gives them: image size, px; focal lengths
+    and principal point (OpenCV's convention), px."""
+
+    width: int
+    height: int
+    fx_px: float
+    fy_px: float
+    cx_px: float
+    cy_px: float
 
 
 @dataclass(frozen=True)
@@ -144,12 +211,16 @@ class HeadGeometry:
     """A head's kinematics as its model was designed (all joints zero), m.
 
     ``baseline_m``: distance between the two optical centres; ``neck_d1_m``, ``neck_a2_m``:
-    eq. (1)'s pitch-axis height above the base and H's height above the pitch axis.
+    eq. (1)'s pitch-axis height above the base and H's height above the pitch axis, or
+    for a neck that pitches at the base the yaw joint's height above the pitch axis and
+    H's above that (H10); ``neck``: the joints' order and H's offset ahead of the yaw.
     """
 
     baseline_m: float
     neck_d1_m: float
     neck_a2_m: float
+    neck: Neck = field(default_factory=Neck)
+    cameras: tuple[DesignedCamera, ...] = ()
 
 
 def _joint(model: mujoco.MjModel, key: str, name: str | None) -> int:
@@ -206,6 +277,12 @@ def check_head(
     yaw = _joint(model, "neck_yaw", mapping.neck_yaw) if mapping.neck_yaw is not None else None
     pitch = _joint(model, "neck_pitch", mapping.neck_pitch)
     eyes = [_joint(model, key, getattr(mapping, key)) for key in ("left_eye", "right_eye")]
+    for key in ("neck_roll", "eye_tilt"):
+        if getattr(mapping, key) is not None:
+            _joint(model, key, getattr(mapping, key))
+    if mapping.eyes == "version_vergence":
+        for key, coefs in (("version", (0.5, -0.5)), ("vergence", (1.0, 1.0))):
+            _eye_actuator(model, data, key, getattr(mapping, key), eyes, coefs)
     cams = []
     for index, (key, name) in enumerate(
         zip(("cameras[0]", "cameras[1]"), mapping.cameras, strict=True)
@@ -286,8 +363,92 @@ def check_head(
             f"body {mapping.head_body!r}'s x axis is not along the baseline (Ca1 -> Ca2)",
             "frame H: x from the left camera to the right one, y down, z forward",
         )
-    d1, a2 = _neck(model, data, mapping, yaw, pitch, world_from_head)
-    return HeadGeometry(baseline_m=baseline_m, neck_d1_m=d1, neck_a2_m=a2)
+    d1, a2, neck = _neck(model, data, mapping, yaw, pitch, world_from_head)
+    return HeadGeometry(
+        baseline_m=baseline_m,
+        neck_d1_m=d1,
+        neck_a2_m=a2,
+        neck=neck,
+        cameras=tuple(_designed_camera(model, cam) for cam in cams),
+    )
+
+
+def _designed_camera(model: mujoco.MjModel, cam: int) -> DesignedCamera:
+    """A camera's intrinsics in pixels, from its resolution and its sensor size (or fovy)."""
+    width, height = (int(v) for v in model.cam_resolution[cam])
+    sensor = model.cam_sensorsize[cam]
+    if float(sensor[0]) > 0.0 and float(sensor[1]) > 0.0:
+        fx, fy, px, py = model.cam_intrinsic[cam]
+        per_x, per_y = width / float(sensor[0]), height / float(sensor[1])
+        fx_px, fy_px = float(fx) * per_x, float(fy) * per_y
+        # MuJoCo's principal offset runs opposite to OpenCV's (see sim/model.py).
+        cx, cy = (width - 1) / 2 - float(px) * per_x, (height - 1) / 2 - float(py) * per_y
+    else:
+        fx_px = fy_px = (height / 2) / math.tan(math.radians(float(model.cam_fovy[cam])) / 2)
+        cx, cy = (width - 1) / 2, (height - 1) / 2
+    return DesignedCamera(width, height, fx_px, fy_px, cx, cy)
+
+
+def _eye_actuator(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    key: str,
+    name: str | None,
+    eyes: list[int],
+    coefs: tuple[float, float],
+) -> int:
+    """The version or vergence actuator: its length must be ``coefs`` . (left, right)."""
+    try:
+        actuator = int(model.actuator(name).id)
+    except KeyError:
+        found = ", ".join(repr(model.actuator(i).name) for i in range(min(model.nu, 12)))
+        raise HeadError(
+            key, f"the model has no actuator {name!r}", f"one of the model's actuators: {found}"
+        ) from None
+    per_joint = actuator_coefficients(model, actuator)
+    moment = np.array([per_joint.pop(j, 0.0) for j in eyes])
+    others = np.array(list(per_joint.values()))
+    if not np.allclose(moment, coefs, atol=1e-9) or np.abs(others).max(initial=0.0) > 0:
+        raise HeadError(
+            key,
+            f"actuator {name!r} moves the pans by {np.round(moment, 6).tolist()} "
+            "(left, right) per unit",
+            f"an actuator whose length is {coefs[0]:g} left {coefs[1]:+g} right and nothing else "
+            "((H7): version (l - r) / 2, vergence l + r)",
+        )
+    return actuator
+
+
+def actuator_coefficients(model: mujoco.MjModel, actuator: int) -> dict[int, float]:
+    """An actuator's length per unit of each joint it moves (joint id: coefficient), for a
+    joint or a fixed-tendon transmission; empty for any other."""
+    gear = float(model.actuator_gear[actuator, 0])
+    target = int(model.actuator_trnid[actuator, 0])
+    kind = int(model.actuator_trntype[actuator])
+    if kind == mujoco.mjtTrn.mjTRN_JOINT:
+        return {target: gear}
+    if kind != mujoco.mjtTrn.mjTRN_TENDON:
+        return {}
+    start, count = int(model.tendon_adr[target]), int(model.tendon_num[target])
+    coefs: dict[int, float] = {}
+    for w in range(start, start + count):
+        if int(model.wrap_type[w]) != mujoco.mjtWrap.mjWRAP_JOINT:
+            return {}
+        joint = int(model.wrap_objid[w])
+        coefs[joint] = coefs.get(joint, 0.0) + gear * float(model.wrap_prm[w])
+    return coefs
+
+
+def eye_motor_range(model: mujoco.MjModel, mapping: HeadMapping) -> tuple[float, float]:
+    """The range of the eye motor as the counter-yaw (both eyes inward by one angle), rad:
+    the left pan's, within half the vergence actuator's range where eyes are so driven."""
+    low, high = (float(v) for v in model.joint(mapping.left_eye).range)
+    if mapping.vergence is not None:
+        actuator = int(model.actuator(mapping.vergence).id)
+        if bool(model.actuator_ctrllimited[actuator]):
+            v_low, v_high = (float(v) / 2 for v in model.actuator_ctrlrange[actuator])
+            low, high = max(low, v_low), min(high, v_high)
+    return low, high
 
 
 def actuator_on(model: mujoco.MjModel, joint: str) -> int:
@@ -309,8 +470,8 @@ def _neck(
     yaw: int | None,
     pitch: int,
     world_from_head: np.ndarray,
-) -> tuple[float, float]:
-    """eq. (1)'s d1, a2 of the model's neck, after checking that it is eq. (1)'s chain."""
+) -> tuple[float, float, Neck]:
+    """d1, a2 and the layout of the model's neck (H10), after checking that it is one."""
     expected = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]]).T  # H's axes in W at zero
     if not np.allclose(world_from_head[:3, :3], expected, atol=AXIS_TOLERANCE_RAD):
         raise HeadError(
@@ -318,6 +479,42 @@ def _neck(
             "at all joints zero frame H does not look along W's +y with its y down",
             "a head that looks forward (+y) at home, H's x to the right, y down",
         )
+    pitch_first = yaw is not None and _carries(
+        model, int(model.jnt_bodyid[pitch]), int(model.jnt_bodyid[yaw])
+    )
+    head = world_from_head[:3, 3]
+    if pitch_first:
+        assert yaw is not None
+        axis, anchor = data.xaxis[pitch], data.xanchor[pitch]
+        if (
+            float(axis[0]) < 1.0 - AXIS_TOLERANCE_RAD
+            or np.hypot(anchor[1], anchor[2]) > NECK_TOLERANCE_M
+        ):
+            raise HeadError(
+                "neck_pitch",
+                f"joint {mapping.neck_pitch!r} is not W's +x axis through the world origin",
+                "a neck pitch at the base about W's +x through W's origin, positive looking up "
+                "(H10), or a yaw at the base (eq. (1))",
+            )
+        axis, anchor = data.xaxis[yaw], data.xanchor[yaw]
+        if (
+            float(axis[2]) < 1.0 - AXIS_TOLERANCE_RAD
+            or np.hypot(anchor[0], anchor[1]) > NECK_TOLERANCE_M
+        ):
+            raise HeadError(
+                "neck_yaw",
+                f"joint {mapping.neck_yaw!r} is not along W's +z through the pitch axis",
+                "the neck's yaw about the pitched +z, meeting the pitch axis, positive turning "
+                "left (H10)",
+            )
+        if abs(head[0]) > NECK_TOLERANCE_M:
+            raise HeadError(
+                "head_body",
+                f"H's origin is {abs(head[0]):.3g} m to the side of the neck's axes",
+                "H in the plane of the yaw axis and W's y (H10)",
+            )
+        d1 = float(anchor[2])
+        return d1, float(head[2]) - d1, Neck("pitch_yaw", float(head[1]))
     if yaw is not None:
         axis, anchor = data.xaxis[yaw], data.xanchor[yaw]
         if float(axis[2]) < 1.0 - AXIS_TOLERANCE_RAD or np.hypot(*anchor[:2]) > NECK_TOLERANCE_M:
@@ -336,7 +533,6 @@ def _neck(
             f"joint {mapping.neck_pitch!r} is not along W's +x above the base",
             "the neck's pitch about the yawed +x axis above the yaw axis, positive looking up (eq. (1))",
         )
-    head = world_from_head[:3, 3]
     if np.hypot(head[0], head[1]) > NECK_TOLERANCE_M:
         raise HeadError(
             "head_body",
@@ -344,7 +540,7 @@ def _neck(
             "H above the pitch axis, on the yaw axis (eq. (1))",
         )
     d1 = float(anchor[2])
-    return d1, float(head[2]) - d1
+    return d1, float(head[2]) - d1, Neck()
 
 
 __all__ = [
@@ -352,11 +548,14 @@ __all__ = [
     "EYE_KINDS",
     "PAPER",
     "SHIPPED",
+    "DesignedCamera",
     "HeadError",
     "HeadGeometry",
     "HeadMapping",
     "HeadModel",
+    "actuator_coefficients",
     "actuator_on",
     "check_head",
+    "eye_motor_range",
     "shipped",
 ]

@@ -8,17 +8,20 @@ and compiles it.  Props (markers, chessboards) can be added the same way.
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
+from headsim.geometry.heads import Neck
 from headsim.geometry.kinematics import eye_from_camera_rotation
 from headsim.sim import names
 from headsim.sim.heads import (
     MODELS_DIR,
     PAPER,
+    DesignedCamera,
     HeadError,
     HeadGeometry,
     HeadMapping,
@@ -26,7 +29,7 @@ from headsim.sim.heads import (
     check_head,
 )
 from headsim.sim.optics import DistortionCanvas, distortion_canvas
-from headsim.sim.settings import MAX_IMAGE_SIDE, HeadSettings, SettingsError
+from headsim.sim.settings import MAX_IMAGE_SIDE, CameraSettings, HeadSettings, SettingsError
 
 #: Sensor pixel pitch used to express pixel intrinsics in MuJoCo's length units, m.
 PIXEL_PITCH_M = 1e-5
@@ -94,11 +97,12 @@ def head_names(head: HeadModel) -> HeadMapping:
 class _Frames:
     """Where the settings' lengths and mounts act in a head's spec (all joints zero)."""
 
-    pitch_body: str
+    #: The body that d1 moves: the pitch joint's (eq. (1)) or the yaw joint's (H10).
+    d1_body: str
     head_body: str
     eye_bodies: tuple[str, str]
-    #: W's z in the pitch body's parent and in H's parent; H's x in each eye body's parent.
-    up_in_pitch_parent: np.ndarray
+    #: W's z in the d1 body's parent and in H's parent; H's x in each eye body's parent.
+    up_in_d1_parent: np.ndarray
     up_in_head_parent: np.ndarray
     x_in_eye_parents: tuple[np.ndarray, np.ndarray]
     #: Each eye body's frame from H (rotation) and its designed camera position, m.
@@ -116,17 +120,18 @@ def _frames(spec: mujoco.MjSpec, mapping: HeadMapping) -> _Frames:
     def rot(body: int) -> np.ndarray:
         return data.xmat[body].reshape(3, 3)
 
-    pitch_body = int(model.jnt_bodyid[model.joint(mapping.neck_pitch).id])
+    d1_joint = mapping.neck_yaw if designed.neck.order == "pitch_yaw" else mapping.neck_pitch
+    d1_body = int(model.jnt_bodyid[model.joint(d1_joint).id])
     head_body = int(model.body(mapping.head_body).id)
     eyes = [int(model.jnt_bodyid[model.joint(j).id]) for j in (mapping.left_eye, mapping.right_eye)]
     x_w = rot(head_body)[:, 0]
     up = np.array([0.0, 0.0, 1.0])
     parent = model.body_parentid
     return _Frames(
-        pitch_body=model.body(pitch_body).name,
+        d1_body=model.body(d1_body).name,
         head_body=mapping.head_body,
         eye_bodies=(model.body(eyes[0]).name, model.body(eyes[1]).name),
-        up_in_pitch_parent=rot(parent[pitch_body]).T @ up,
+        up_in_d1_parent=rot(parent[d1_body]).T @ up,
         up_in_head_parent=rot(parent[head_body]).T @ up,
         x_in_eye_parents=(rot(parent[eyes[0]]).T @ x_w, rot(parent[eyes[1]]).T @ x_w),
         eye_from_head=(rot(eyes[0]).T @ rot(head_body), rot(eyes[1]).T @ rot(head_body)),
@@ -137,10 +142,8 @@ def _frames(spec: mujoco.MjSpec, mapping: HeadMapping) -> _Frames:
 def _apply_lengths(spec: mujoco.MjSpec, settings: HeadSettings, frames: _Frames) -> None:
     """Move a head's links by the settings' lengths minus the designed ones."""
     d = frames.designed
-    pitch = spec.body(frames.pitch_body)
-    pitch.pos = (
-        np.asarray(pitch.pos) + (settings.neck_d1_m - d.neck_d1_m) * frames.up_in_pitch_parent
-    )
+    lower = spec.body(frames.d1_body)
+    lower.pos = np.asarray(lower.pos) + (settings.neck_d1_m - d.neck_d1_m) * frames.up_in_d1_parent
     head = spec.body(frames.head_body)
     head.pos = np.asarray(head.pos) + (settings.neck_a2_m - d.neck_a2_m) * frames.up_in_head_parent
     half = (settings.baseline_m - d.baseline_m) / 2
@@ -281,6 +284,9 @@ def on_head(settings: HeadSettings, head: HeadModel) -> HeadSettings:
     def moved(value: float, name: str) -> float:
         return value - float(getattr(nominal, name)) + float(getattr(designed, name))
 
+    cameras = tuple(
+        _own_camera(cam, own) for cam, own in zip(settings.cameras, designed.cameras, strict=True)
+    )
     belief = settings.belief
     if belief is not None:
         belief = replace(
@@ -293,7 +299,51 @@ def on_head(settings: HeadSettings, head: HeadModel) -> HeadSettings:
         settings,
         head=head,
         belief=belief,
+        cameras=(cameras[0], cameras[1]),
         baseline_m=moved(settings.baseline_m, "baseline_m"),
         neck_d1_m=moved(settings.neck_d1_m, "neck_d1_m"),
         neck_a2_m=moved(settings.neck_a2_m, "neck_a2_m"),
     )
+
+
+def _nominal(own: DesignedCamera) -> bool:
+    """Whether a head's camera is the nominal one (640 x 480, 45 degree fovy, centred)."""
+    nominal = CameraSettings()
+    return (own.width, own.height) == (nominal.width, nominal.height) and all(
+        math.isclose(a, b, rel_tol=1e-5)
+        for a, b in zip(
+            (own.fx_px, own.fy_px, own.cx_px, own.cy_px),
+            (nominal.kx, nominal.ky, *nominal.principal),
+            strict=True,
+        )
+    )
+
+
+def has_own_cameras(head: HeadModel) -> bool:
+    """Whether ``head``'s MJCF cameras are not the nominal ones: the presets then take
+    the head's image size, focal lengths and principal points, and not the paper's
+    cameras' initial directions."""
+    return not head.is_paper and not all(_nominal(c) for c in design(head).cameras)
+
+
+def _own_camera(cam: CameraSettings, own: DesignedCamera) -> CameraSettings:
+    """``cam`` (a preset's) on a head whose MJCF camera is ``own``: the head's image size,
+    focal lengths and principal point, the preset's lens distortion, mount, offsets and
+    noise.  A head with the nominal camera (640 x 480, 45 degree fovy) keeps ``cam``."""
+    if _nominal(own):
+        return cam
+    return replace(
+        cam,
+        width=own.width,
+        height=own.height,
+        kx=own.fx_px,
+        ky=own.fy_px,
+        cx=own.cx_px,
+        cy=own.cy_px,
+    )
+
+
+def neck_of(head: HeadModel) -> Neck:
+    """The layout of ``head``'s neck (H10): eq. (1)'s for the paper's head; with the
+    lengths of a :class:`HeadSettings` or its belief it maps H to W."""
+    return Neck() if head.is_paper else design(head).neck

@@ -29,7 +29,7 @@ from headsim.geometry.stereo_view import StereoView
 from headsim.geometry.transforms import apply_transform, homogeneous, invert_transform
 from headsim.sim import names
 from headsim.sim.events import NO_EVENTS, EventSink, ImageKind, ImageTaken
-from headsim.sim.heads import actuator_on
+from headsim.sim.heads import actuator_on, eye_motor_range
 from headsim.sim.joints import (
     Commands,
     JointLimitError,
@@ -94,6 +94,15 @@ class HeadSim:
         self._actuator = {
             motor: actuator_on(self.model, joint) for motor, joint in self._motor_joint.items()
         }
+        #: The version and vergence actuators of eyes driven so ((H7)), else None.
+        self._version_vergence = (
+            (
+                int(self.model.actuator(mapping.version).id),
+                int(self.model.actuator(mapping.vergence).id),
+            )
+            if mapping.version is not None and mapping.vergence is not None
+            else None
+        )
         self._commands = Commands()
         #: Bodies placed so far (targets moved: earlier images are out of date).
         self.placements = 0
@@ -132,7 +141,10 @@ class HeadSim:
     # -- commands ----------------------------------------------------------
     def joint_range(self, motor: str) -> tuple[float, float]:
         """Range of a motor's joint ("neck_yaw", "neck_pitch", "eye", "eye2"), or of a
-        joint of the head by its MJCF name, rad."""
+        joint of the head by its MJCF name, rad.  With version and vergence actuators
+        the eye motor's is its range as the counter-yaw (:func:`eye_motor_range`)."""
+        if motor == "eye" and self._version_vergence is not None:
+            return eye_motor_range(self.model, self.names)
         low, high = self.model.joint(self._joint_of(motor)).range
         return float(low), float(high)
 
@@ -180,6 +192,8 @@ class HeadSim:
             c.eye = self._checked("eye", eye)
             if eye2 is None and "eye2" in self.motors:
                 c.eye2 = self._checked("eye2", eye)
+        if self._version_vergence is not None:
+            self._check_version_vergence(c.eye, c.eye2)
         for motor, old in previous.items():
             new = getattr(c, motor)
             if new != old:
@@ -188,6 +202,26 @@ class HeadSim:
         for motor in self.motors:
             if self._actuator[motor] >= 0:
                 self.data.ctrl[self._actuator[motor]] = true[motor]
+        if self._version_vergence is not None:
+            version, vergence = self._version_vergence
+            self.data.ctrl[version] = (true["eye"] - true["eye2"]) / 2
+            self.data.ctrl[vergence] = true["eye"] + true["eye2"]
+
+    def _check_version_vergence(self, left: float, right: float) -> None:
+        """Eyes driven by version and vergence ((H7)) reach only their actuators' ranges."""
+        assert self._version_vergence is not None
+        for actuator, value, what in zip(
+            self._version_vergence,
+            ((left - right) / 2, left + right),
+            ("version (left - right) / 2", "vergence left + right"),
+            strict=True,
+        ):
+            low, high = (float(v) for v in self.model.actuator_ctrlrange[actuator])
+            if bool(self.model.actuator_ctrllimited[actuator]) and not low <= value <= high:
+                raise JointLimitError(
+                    f"eye commands {left:.6f}, {right:.6f} rad need a {what} of {value:.6f} rad, "
+                    f"outside its range [{low}, {high}] rad"
+                )
 
     def command_eye_steps(self, steps: int) -> None:
         """Command the eye motor to a whole number of encoder steps."""

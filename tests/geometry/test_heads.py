@@ -8,6 +8,7 @@ import pytest
 
 from headsim.estimators import model2
 from headsim.geometry.heads import (
+    Neck,
     RevoluteJoint,
     SerialChain,
     check_eye_axes,
@@ -23,7 +24,12 @@ from headsim.geometry.heads import (
     tilt_to_plane,
     version_vergence,
 )
-from headsim.geometry.kinematics import head_from_camera, head_to_camera, world_from_head
+from headsim.geometry.kinematics import (
+    head_from_camera,
+    head_to_camera,
+    head_to_world,
+    world_from_head,
+)
 from headsim.geometry.transforms import (
     homogeneous,
     invert_transform,
@@ -269,6 +275,48 @@ def test_only_a_top_yaw_keeps_the_point_in_the_plane_of_the_optical_axes():
     np.testing.assert_allclose(y_icub, y_icub[0], atol=1e-15)
     y_paper = _to(_inverse(world_from_head(yaws, 0.3, 0.12, 0.09)), np.tile(point_w, (20, 1)))[:, 1]
     assert np.ptp(y_paper) > 0.05
+
+
+def test_a_yaw_pitch_neck_is_eq1_exactly():
+    rng = np.random.default_rng(35)
+    angles, points = rng.uniform(-1.0, 1.0, (40, 2)), rng.uniform(-1.0, 1.0, (40, 3))
+    neck = Neck()
+    assert np.array_equal(
+        neck.world_from_head(angles[:, 0], angles[:, 1], 0.12, 0.09),
+        world_from_head(angles[:, 0], angles[:, 1], 0.12, 0.09),
+    )
+    assert np.array_equal(
+        neck.head_to_world(points, angles[:, 0], angles[:, 1], 0.12, 0.09),
+        head_to_world(points, angles[:, 0], angles[:, 1], 0.12, 0.09),
+    )
+
+
+def test_a_pitch_yaw_neck_is_h6_with_the_roll_held_at_zero_and_its_own_chain():
+    """(H10): the closed form, the (pitch, roll = 0, yaw) chain of (H6) and as_chain agree."""
+    rng = np.random.default_rng(36)
+    d1, a2, forward = 0.0095, 0.08205, 0.0509  # the iCub 2.0's, models/icub.xml
+    neck = Neck("pitch_yaw", forward)
+    icub = pitch_roll_yaw_neck((0.0, 0.0, d1), (0.0, 0.0, 0.0), (0.0, forward, a2))
+    yaw, pitch = rng.uniform(-1.5, 1.5, 60), rng.uniform(-1.5, 1.5, 60)
+    closed = neck.world_from_head(yaw, pitch, d1, a2)
+    chain = icub.world_from_head(np.column_stack([pitch, np.zeros(60), yaw]))
+    np.testing.assert_allclose(closed, chain, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(
+        neck.as_chain(d1, a2).world_from_head(np.column_stack([pitch, yaw])), chain, atol=1e-15
+    )
+    points_h = rng.uniform(-1.0, 1.0, (60, 3))
+    points_w = neck.head_to_world(points_h, yaw, pitch, d1, a2)
+    np.testing.assert_allclose(
+        neck.world_to_head(points_w, yaw, pitch, d1, a2), points_h, atol=1e-14
+    )
+    home = neck.world_from_head(0.0, 0.0, d1, a2)
+    np.testing.assert_allclose(home[:3, 3], [0.0, forward, d1 + a2], atol=1e-16)
+    assert neck.world_from_head(0.0, 0.3, d1, a2)[2, 2] > 0.0  # pitch up
+    assert neck.world_from_head(0.3, 0.0, d1, a2)[0, 2] < 0.0  # yaw left
+    with pytest.raises(ValueError, match="order must be one of yaw_pitch, pitch_yaw"):
+        Neck("roll_pitch")
+    with pytest.raises(ValueError, match="forward_m is for a pitch_yaw neck"):
+        Neck("yaw_pitch", 0.01)
 
 
 def test_chain_inputs_are_checked():
