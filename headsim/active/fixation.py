@@ -1,6 +1,6 @@
 """One-step fixation with independent eyes: both eye motors and the neck pitch put the
 target on both goal columns and the goal row at once; the position follows from the two
-eye angles and the baseline (docs/equations.md, "Other heads")."""
+eye angles and the baseline (docs/equations.md, "Beyond the paper: other heads")."""
 
 from __future__ import annotations
 

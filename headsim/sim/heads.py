@@ -5,7 +5,7 @@ A scenario names its head as a shipped one (:data:`SHIPPED`: ``paper``,
 simulator takes every joint, body and camera name from the mapping, and the head's
 true kinematics from the compiled model.  :func:`check_head` holds a mapping
 against the model and says, naming the mapping's key, what the method needs
-(docs/equations.md, "Other heads").
+(docs/equations.md, "Beyond the paper: other heads").
 """
 
 from __future__ import annotations

@@ -11,8 +11,9 @@ import pytest
 import rerun as rr
 from rerun.chunk import RrdReader
 
+from headsim.cli import main
 from headsim.run import mjcf_rerun
-from headsim.sim.model import MODELS_DIR
+from headsim.sim.model import HEAD_PREFIX, MODELS_DIR
 
 MODEL_FILES = sorted(MODELS_DIR.glob("*.xml"))
 
@@ -188,3 +189,30 @@ def test_body_poses_are_logged_only_when_a_body_moved() -> None:
     data.qpos[model.joint("eye1_yaw").qposadr[0]] = 0.1
     mujoco.mj_forward(model, data)
     assert poses.log(rec, data) == 1
+
+
+def test_a_run_on_another_head_draws_that_head_s_geoms(tmp_path: Path) -> None:
+    """``headsim run independent_eyes --rrd``: the attached head's bodies and geoms, named
+    as the scene names them (``head:`` escaped as Rerun escapes it), each body posed."""
+    rrd = tmp_path / "run.rrd"
+    argv = ["run", "independent_eyes", "--fast", "--out", str(tmp_path / "out"), "--rrd", str(rrd)]
+    assert main([*argv, "--no-progress"]) == 0
+    columns = _columns(rrd)
+    head = mujoco.MjModel.from_xml_path(str(MODELS_DIR / "independent_eyes.xml"))
+    prefix = f"{mjcf_rerun.ROOT}/{rr.escape_entity_path_part(HEAD_PREFIX)}"
+    assert prefix == "/world/model/head\\:"
+    for body in range(1, head.nbody):
+        values = columns[prefix + rr.escape_entity_path_part(head.body(body).name)]
+        assert "Transform3D:translation" in values, head.body(body).name
+    # One drawn instance per geom of the head's file, all under its prefixed bodies.
+    drawn = sum(
+        len(values)
+        for entity, components in columns.items()
+        if entity.startswith(prefix)
+        for component, values in components.items()
+        if component in _SIZE_COMPONENT.values()
+    )
+    assert drawn == head.ngeom > 0
+    # The scenes' own head (models/head.xml) is not drawn beside it.
+    assert not any(entity.startswith(f"{mjcf_rerun.ROOT}/head/") for entity in columns)
+    assert f"{mjcf_rerun.ROOT}/eye1" not in columns
