@@ -71,7 +71,8 @@ RESULTS_FIELDS: dict[str, str] = {
     "settings.head.name": "its name: a shipped head's, or the MJCF file's stem",
     "settings.head.path": "its MJCF file",
     "settings.head.mapping": "the names headsim uses in it (the scenario's `[head.mapping]`): "
-    "`head_body`, `neck_yaw`, `neck_pitch`, `eyes`, `left_eye`, `right_eye`, `cameras`",
+    "`head_body`, `neck_yaw`, `neck_pitch`, `eyes`, `left_eye`, `right_eye`, `cameras`, "
+    "`neck_roll`, `eye_tilt`, `version`, `vergence` (`null`: none)",
     "settings.settle_mode": "how the servo waits for the joints to settle",
     "belief": "what the head believed and measured with",
     "belief.baseline_m": "the believed baseline, m",
