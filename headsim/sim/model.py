@@ -174,7 +174,8 @@ def apply_settings(
         frames = _frames(spec, mapping)
         _apply_lengths(spec, settings, frames)
         eye_from_head = frames.eye_from_head
-        designed_pos = [np.asarray(spec.camera(c).pos, dtype=float) for c in mapping.cameras]
+        # A copy: np.asarray would view the spec's own array, which the loop below rewrites.
+        designed_pos = [np.array(spec.camera(c).pos, dtype=float) for c in mapping.cameras]
 
     canvases = []
     k = settings.render.supersample

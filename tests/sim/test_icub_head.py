@@ -112,3 +112,20 @@ def test_the_eyes_cannot_diverge_beyond_the_vergence_actuators_range() -> None:
         with pytest.raises(JointLimitError, match=r"vergence left \+ right of -0\.400000 rad"):
             sim.command(eye=0.0, eye2=-0.4)
         sim.command(eye=low)
+
+
+def test_a_cameras_offsets_act_once_on_another_head_as_on_the_papers() -> None:
+    """independent_eyes is the paper's geometry with a motor per eye: under the realistic
+    preset (entrance pupils 20 mm ahead, sideways offsets, tilted axes) its cameras sit
+    exactly where the paper head's do, at every eye angle (joint errors off: each eye's
+    own motor draws its own count error)."""
+    realistic = replace(preset("realistic"), backlash_rad=0.0, count_error=False)
+    other = on_head(realistic, heads.shipped("independent_eyes"))
+    with HeadSim(settings=realistic) as paper, HeadSim(settings=other) as sim:
+        for eye in (0.0, 0.2, -0.1):
+            paper.move(eye=eye)
+            sim.move(eye=eye)
+            for camera in (1, 2):
+                np.testing.assert_allclose(
+                    sim.head_from_camera(camera), paper.head_from_camera(camera), atol=1e-9
+                )
