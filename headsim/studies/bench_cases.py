@@ -84,6 +84,7 @@ CASES: dict[str, BenchCase] = {
         BenchCase("reach_and_zoom", "long", "reach_and_zoom.py"),
         BenchCase("realistic_head", "long", "realistic_head.py"),
         BenchCase("insensitivity_study", "long", "insensitivity_study.py"),
+        BenchCase("heads", "long", "heads.py"),
     )
 }
 
