@@ -211,25 +211,30 @@ def table(args: argparse.Namespace) -> list[dict[str, Any]]:
                 }
             )
     progress.close()
-    print("3-D error RMS, % of depth (points); realistic heads after calibration, seed", args.seed)
+    return rows
+
+
+def table_text(rows: list[dict[str, Any]], seed: int) -> str:
+    """The table of :func:`table`'s rows."""
+    lines = [f"3-D error RMS, % of depth (points); realistic heads after calibration, seed {seed}"]
     header = f"{'head':18} {'procedure':22} {'accepted':>8} {'refused':>8} {'all':>14}"
     header += "".join(f" {label:>14}" for _, _, label in BANDS) + f" {'renders/pt':>10}"
-    print(header)
+    lines.append(header)
     for r in rows:
         refused = sum(r.get("refused", {}).values()) if isinstance(r.get("refused"), dict) else "-"
         rms = "-" if r["rms_pct"] is None else f"{r['rms_pct']:.3f} ({r['ok']}/{r['count']})"
         rpp = "-" if r["renders_per_point"] is None else f"{r['renders_per_point']:.1f}"
         line = f"{r['head']:18} {r['procedure']:22} {r['count']:>8} {refused!s:>8} {rms:>14}"
         line += "".join(f" {fmt_band(r[label]):>14}" for _, _, label in BANDS) + f" {rpp:>10}"
-        print(line)
+        lines.append(line)
         if r.get("camera_frame_mean_pct") is not None:
-            print(
+            lines.append(
                 f"{'':18} {'  in camera 1 (truth-placed)':22} mean {r['camera_frame_mean_pct']:.3f} "
                 f"max {r['camera_frame_max_pct']:.3f} % of depth"
             )
         if r["failures"]:
-            print(f"{'':18} failures: {'; '.join(r['failures'])}")
-    return rows
+            lines.append(f"{'':18} failures: {'; '.join(r['failures'])}")
+    return "\n".join(lines) + "\n"
 
 
 def study(args: argparse.Namespace) -> list[dict[str, Any]]:
@@ -245,8 +250,14 @@ def study(args: argparse.Namespace) -> list[dict[str, Any]]:
                         doc = field_document(
                             head, procedure, args.targets, args.balls, args.seed, {}
                         )
+                        # Built and believed scaled alike: a head built to another design.
+                        believed = settings.believed
                         doc["head"]["baseline_m"] = settings.baseline_m * scale
-                        value = settings.baseline_m * scale
+                        doc["belief"] = {
+                            "baseline_m": believed.baseline_m * scale,
+                            "nodal_offset_m": list(believed.nodal_offset_m),
+                        }
+                        value = believed.baseline_m * scale
                     else:
                         cameras = {"kx": camera.kx * scale, "ky": camera.ky * scale}
                         doc = field_document(
@@ -269,10 +280,15 @@ def study(args: argparse.Namespace) -> list[dict[str, Any]]:
                         }
                     )
     progress.close()
-    print("\nstudy: whole-field 3-D error RMS, % of depth, with one quantity scaled")
-    print(
+    return points
+
+
+def study_text(points: list[dict[str, Any]]) -> str:
+    """The study's figures, one row per head, procedure and quantity scaled."""
+    lines = ["study: whole-field 3-D error RMS, % of depth (points measured), one quantity scaled"]
+    lines.append(
         f"{'head':18} {'procedure':10} {'varied':9} "
-        + " ".join(f"{'x' + str(s):>14}" for s in SCALES)
+        + " ".join(f"{'x' + str(s):>13}" for s in SCALES)
     )
     for head, (_, procedures) in HEADS.items():
         for procedure in procedures:
@@ -286,8 +302,8 @@ def study(args: argparse.Namespace) -> list[dict[str, Any]]:
                     f"{'-' if p['rms_pct'] is None else format(p['rms_pct'], '.3f'):>8} ({p['ok']:>2})"
                     for p in cells
                 )
-                print(f"{head:18} {procedure:10} {what:9} {shown}")
-    return points
+                lines.append(f"{head:18} {procedure:10} {what:9} {shown}")
+    return "\n".join(lines) + "\n"
 
 
 def plot(points: list[dict[str, Any]], path: str) -> None:
@@ -343,8 +359,10 @@ def main() -> None:
     args.targets = args.targets or (4 if args.fast else 20)
     args.balls = args.balls or (12 if args.fast else 20)
     figures: dict[str, Any] = {"table": table(args)}
+    print(table_text(figures["table"], args.seed), end="")
     if args.study or args.plot:
         figures["study"] = study(args)
+        print("\n" + study_text(figures["study"]), end="")
         if args.plot:
             plot(figures["study"], args.plot)
     if args.json:
