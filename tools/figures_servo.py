@@ -371,3 +371,20 @@ def reach_zoom_angles() -> str:
         )
         + f", on the {q['model2']['targets']} points both zooms measured.\n"
     )
+
+
+# --- the shipped heads beside their stereo, and the baseline/focal study -------------
+
+
+def heads() -> str:
+    """benchmarks/heads.py's table and study (20 targets, 20 balls, seed 0)."""
+    import argparse
+
+    bench = benchmark("heads")
+    args = argparse.Namespace(targets=20, balls=20, seed=0)
+    rows = bench.table(args)
+    points = bench.study(args)
+    return (
+        "`python benchmarks/heads.py --targets 20 --balls 20 --study --plot docs/heads-study.png`:\n\n"
+        "```\n" + bench.table_text(rows, args.seed) + "\n" + bench.study_text(points) + "```\n"
+    )

@@ -261,6 +261,7 @@ GENERATORS: dict[str, Generator] = {
     "stress": Generator(stress, cheap=False, ci=False, seconds=100),
     "layouts": Generator(realistic.layouts, cheap=False, group="forward", seconds=35),
     "budget": Generator(realistic.budget, cheap=False, ci=False, seconds=75),
+    "heads": Generator(servo.heads, cheap=False, ci=False, seconds=200),
     "render_fidelity": Generator(servo.render_fidelity, cheap=False, group="fidelity", seconds=30),
     "render_fidelity_presets": Generator(
         servo.render_fidelity_presets, cheap=False, group="fidelity", seconds=20
