@@ -79,6 +79,7 @@ CASES: dict[str, BenchCase] = {
         BenchCase("procedures_accuracy", "figures", "procedures_accuracy.py"),
         BenchCase("live_gaze", "figures", "live_gaze.py"),
         BenchCase("gym_env", "figures", "gym_env.py"),
+        BenchCase("batch_render", "figures", "batch_render.py"),
         BenchCase("render_fidelity", "long", "render_fidelity.py"),
         BenchCase("relative_areas", "long", "relative_areas.py"),
         BenchCase("reach_and_zoom", "long", "reach_and_zoom.py"),
