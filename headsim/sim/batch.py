@@ -46,13 +46,14 @@ class _Warp:
 def _warp() -> _Warp:
     try:
         wp = importlib.import_module("warp")
+        # Warnings only (not each kernel module's load time), before mujoco_warp starts Warp.
+        wp.config.log_level = wp.LOG_WARNING
         mjw = importlib.import_module("mujoco_warp")
     except ImportError as err:
         raise BatchError(
             f"the batch renderer needs MuJoCo Warp ({err.name} is not installed); "
             "allowed: pip install 'headsim[batch]'"
         ) from None
-    wp.config.quiet = True
     return _Warp(wp, mjw)
 
 
