@@ -463,6 +463,24 @@ def actuator_on(model: mujoco.MjModel, joint: str) -> int:
     return -1
 
 
+def _check_axis(
+    data: mujoco.MjData,
+    joint: int,
+    along: int,
+    across: tuple[int, int],
+    key: str,
+    problem: str,
+    allowed: str,
+) -> np.ndarray:
+    """A neck joint's anchor in W, after checking that its axis is W's axis ``along`` and
+    passes through W's ``across`` coordinates zero; else :class:`HeadError` on ``key``."""
+    axis, anchor = data.xaxis[joint], data.xanchor[joint]
+    off = float(np.hypot(anchor[across[0]], anchor[across[1]]))
+    if float(axis[along]) < 1.0 - AXIS_TOLERANCE_RAD or off > NECK_TOLERANCE_M:
+        raise HeadError(key, problem, allowed)
+    return np.asarray(anchor)
+
+
 def _neck(
     model: mujoco.MjModel,
     data: mujoco.MjData,
@@ -485,28 +503,26 @@ def _neck(
     head = world_from_head[:3, 3]
     if pitch_first:
         assert yaw is not None
-        axis, anchor = data.xaxis[pitch], data.xanchor[pitch]
-        if (
-            float(axis[0]) < 1.0 - AXIS_TOLERANCE_RAD
-            or np.hypot(anchor[1], anchor[2]) > NECK_TOLERANCE_M
-        ):
-            raise HeadError(
-                "neck_pitch",
-                f"joint {mapping.neck_pitch!r} is not W's +x axis through the world origin",
-                "a neck pitch at the base about W's +x through W's origin, positive looking up "
-                "(H10), or a yaw at the base (eq. (1))",
-            )
-        axis, anchor = data.xaxis[yaw], data.xanchor[yaw]
-        if (
-            float(axis[2]) < 1.0 - AXIS_TOLERANCE_RAD
-            or np.hypot(anchor[0], anchor[1]) > NECK_TOLERANCE_M
-        ):
-            raise HeadError(
-                "neck_yaw",
-                f"joint {mapping.neck_yaw!r} is not along W's +z through the pitch axis",
-                "the neck's yaw about the pitched +z, meeting the pitch axis, positive turning "
-                "left (H10)",
-            )
+        _check_axis(
+            data,
+            pitch,
+            0,
+            (1, 2),
+            "neck_pitch",
+            f"joint {mapping.neck_pitch!r} is not W's +x axis through the world origin",
+            "a neck pitch at the base about W's +x through W's origin, positive looking up "
+            "(H10), or a yaw at the base (eq. (1))",
+        )
+        anchor = _check_axis(
+            data,
+            yaw,
+            2,
+            (0, 1),
+            "neck_yaw",
+            f"joint {mapping.neck_yaw!r} is not along W's +z through the pitch axis",
+            "the neck's yaw about the pitched +z, meeting the pitch axis, positive turning "
+            "left (H10)",
+        )
         if abs(head[0]) > NECK_TOLERANCE_M:
             raise HeadError(
                 "head_body",
@@ -516,23 +532,24 @@ def _neck(
         d1 = float(anchor[2])
         return d1, float(head[2]) - d1, Neck("pitch_yaw", float(head[1]))
     if yaw is not None:
-        axis, anchor = data.xaxis[yaw], data.xanchor[yaw]
-        if float(axis[2]) < 1.0 - AXIS_TOLERANCE_RAD or np.hypot(*anchor[:2]) > NECK_TOLERANCE_M:
-            raise HeadError(
-                "neck_yaw",
-                f"joint {mapping.neck_yaw!r} is not W's +z axis through the world origin",
-                "the neck's yaw about W's +z at the base, positive turning left (eq. (1))",
-            )
-    axis, anchor = data.xaxis[pitch], data.xanchor[pitch]
-    if (
-        float(axis[0]) < 1.0 - AXIS_TOLERANCE_RAD
-        or np.hypot(anchor[0], anchor[1]) > NECK_TOLERANCE_M
-    ):
-        raise HeadError(
-            "neck_pitch",
-            f"joint {mapping.neck_pitch!r} is not along W's +x above the base",
-            "the neck's pitch about the yawed +x axis above the yaw axis, positive looking up (eq. (1))",
+        _check_axis(
+            data,
+            yaw,
+            2,
+            (0, 1),
+            "neck_yaw",
+            f"joint {mapping.neck_yaw!r} is not W's +z axis through the world origin",
+            "the neck's yaw about W's +z at the base, positive turning left (eq. (1))",
         )
+    anchor = _check_axis(
+        data,
+        pitch,
+        0,
+        (0, 1),
+        "neck_pitch",
+        f"joint {mapping.neck_pitch!r} is not along W's +x above the base",
+        "the neck's pitch about the yawed +x axis above the yaw axis, positive looking up (eq. (1))",
+    )
     if np.hypot(head[0], head[1]) > NECK_TOLERANCE_M:
         raise HeadError(
             "head_body",
