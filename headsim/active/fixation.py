@@ -4,13 +4,12 @@ eye angles and the baseline (docs/equations.md, "Beyond the paper: other heads")
 
 from __future__ import annotations
 
-import math
-
 from headsim.active.failure import neck_failure
 from headsim.active.measurement import (
     HeadKnowledge,
     Measurement,
     Target,
+    encoder_sigma_rad,
     estimated_measurement,
     failed_measurement,
 )
@@ -58,7 +57,7 @@ def measure_fixation(
         s * resolution for s in (result.subpixel_steps if interpolate else result.steps)
     )
     yaw = sim.neck_encoders()[0]
-    sigma = resolution * (0.3 if interpolate else 1 / math.sqrt(12.0))
+    sigma = encoder_sigma_rad(resolution, interpolate)
     belief = knowledge.head_belief(sim)
     estimate = fixation(
         [alpha1],

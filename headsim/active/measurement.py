@@ -10,6 +10,7 @@ simulator's truth and the error, in H and W, m.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -221,6 +222,12 @@ def estimated_measurement(
     )
 
 
+def encoder_sigma_rad(resolution_rad: float, interpolate: bool) -> float:
+    """The std of an encoder angle the servo hands an estimator, rad: 0.3 of a step when
+    interpolated between steps, a step's rounding, step / sqrt(12), when whole."""
+    return resolution_rad * (0.3 if interpolate else 1 / math.sqrt(12.0))
+
+
 def to_world(
     sim: HeadSim,
     point_head: np.ndarray,
@@ -241,6 +248,7 @@ __all__ = [
     "Measurement",
     "Target",
     "body_target",
+    "encoder_sigma_rad",
     "estimated_measurement",
     "failed_measurement",
     "to_world",

@@ -4,7 +4,6 @@ both goal columns, then eqs. (2)-(3) give its position in H and W.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import replace
 
@@ -13,6 +12,7 @@ from headsim.active.measurement import (
     HeadKnowledge,
     Measurement,
     Target,
+    encoder_sigma_rad,
     estimated_measurement,
     failed_measurement,
 )
@@ -101,7 +101,7 @@ def measure_model1(
     yaw, pitch, eye = (
         s * resolution for s in (result.subpixel_steps if interpolate else result.steps)
     )
-    angle_sigma = resolution * (0.3 if interpolate else 1 / math.sqrt(12.0))
+    angle_sigma = encoder_sigma_rad(resolution, interpolate)
     belief = knowledge.head_belief(sim)
     estimate = model1(
         [eye],
