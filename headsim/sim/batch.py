@@ -1,40 +1,63 @@
-"""Both eye cameras of many heads at once, through MuJoCo Warp's batch ray-cast renderer.
+"""Many heads at once: their eye images rendered in batches by MuJoCo Warp's ray caster.
 
-N *worlds* share one compiled model (one head's settings: cameras, mounts, lengths)
-and differ in their joint angles.  :class:`BatchRenderer` renders both eye cameras of
-every world in one call and then treats each image as :class:`headsim.sim.render`
-does a full frame: the supersampled pinhole image averaged down, the lens's
-distortion by remap (:func:`headsim.sim.optics.apply_canvas`) and Gaussian noise, from
-a stream of each world's own.  The head's own geoms (group 3) stay hidden, as from
-the classic renderer.
+A :class:`BatchSession` runs N calls in lockstep (scenario runs, environment steps), each
+on a thread of its own with its own :class:`~headsim.sim.simulator.HeadSim`: its own
+settings (cameras, mounts, tolerances, belief), targets, commands and noise streams.
+Every head moves, settles and reads its encoders on the CPU as it does alone (MuJoCo,
+microseconds a head); only the images, where the time goes, are batched.  A simulator
+made inside a session renders through a :class:`BatchEyeRenderer`: each image it asks
+for waits until every head still running has asked for one (or finished), and then
+all are ray-cast in one Warp call per kind of world.  A head that converges ends its
+call; the batch ends when the last one does.
+
+Each image is then finished exactly as the classic renderer finishes its own
+(:class:`~headsim.sim.render.EyeRenderer`): the lens by remap, the camera's noise from
+the same stream, the same counts.  A window is the full frame's crop, a preview its
+b x b area average.  Anti-aliasing: Warp's sub-pixel samples on a regular
+``samples_per_pixel`` x ``samples_per_pixel`` grid, by default the head's
+``render.supersample`` (the classic path's supersampling, without its MSAA).
+
+Worlds that differ only in poses share one Warp scene; at one sample per pixel so do
+worlds whose cameras differ in their intrinsics (focal length, principal point), each
+read from Warp's per-world camera parameters.  Otherwise worlds are grouped by camera.
 
 This module is the one adapter to ``mujoco_warp`` and ``warp`` (the ``batch`` extra:
-``pip install 'headsim[batch]'``); they are imported only when a renderer is made.
+``pip install 'headsim[batch]'``); they are imported only when a session is made.
 Warp runs on the CPU by default, on a GPU with ``device="cuda"`` where it finds one.
 """
 
 from __future__ import annotations
 
+import hashlib
 import importlib
+import threading
+import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import Any, TypeVar
 
 import mujoco
 import numpy as np
 
 from headsim.errors import BadInput
+from headsim.sim import render
+from headsim.sim.gl_window import Window
 from headsim.sim.optics import GaussianNoise, apply_canvas
 from headsim.sim.simulator import HeadSim
 
-#: The devices a batch renderer runs on.
+#: The devices a batch session runs on.
 DEVICES = ("cpu", "cuda")
-#: The noise stream of batch images, apart from the classic renderer's.
+#: The noise stream of :class:`BatchRenderer`'s images, apart from the classic renderer's.
 BATCH_STREAM = 0xBA7C
+#: The most sub-pixel samples per axis a session takes.
+MAX_SAMPLES_PER_PIXEL = 8
+
+T = TypeVar("T")
 
 
 class BatchError(BadInput, ValueError):
-    """A batch renderer cannot be made as asked: what is missing and what is allowed."""
+    """A batch session cannot be made or run as asked: what is wrong and what is allowed."""
 
 
 @dataclass(frozen=True)
@@ -51,7 +74,7 @@ def _warp() -> _Warp:
         mjw = importlib.import_module("mujoco_warp")
     except ImportError as err:
         raise BatchError(
-            f"the batch renderer needs MuJoCo Warp ({err.name} is not installed); "
+            f"the batch back-end needs MuJoCo Warp ({err.name} is not installed); "
             "allowed: pip install 'headsim[batch]'"
         ) from None
     return _Warp(wp, mjw)
@@ -65,12 +88,403 @@ def cuda_available() -> bool:
         return False
 
 
+def check_device(device: str) -> _Warp:
+    """Warp, once ``device`` is known to run here; else a :class:`BatchError` saying why."""
+    if device not in DEVICES:
+        raise BatchError(f"device must be one of {', '.join(DEVICES)}, got {device!r}")
+    warp = _warp()
+    if device == "cuda" and not warp.wp.is_cuda_available():
+        raise BatchError("device 'cuda': Warp finds no CUDA device here; allowed: cpu")
+    return warp
+
+
+def _check_samples(samples_per_pixel: int | None) -> None:
+    if samples_per_pixel is None:
+        return
+    if not (
+        isinstance(samples_per_pixel, int)
+        and not isinstance(samples_per_pixel, bool)
+        and 1 <= samples_per_pixel <= MAX_SAMPLES_PER_PIXEL
+    ):
+        raise BatchError(
+            f"samples_per_pixel must be a whole number from 1 to {MAX_SAMPLES_PER_PIXEL}, "
+            f"got {samples_per_pixel!r}"
+        )
+
+
+# -- what a world's image depends on ---------------------------------------------------
+
+#: What Warp reads of a model beside the poses: geoms, materials, textures, meshes, lights.
+_SCENE_ARRAYS = (
+    "geom_type",
+    "geom_size",
+    "geom_rgba",
+    "geom_matid",
+    "geom_dataid",
+    "geom_group",
+    "mat_rgba",
+    "mat_texid",
+    "mat_texrepeat",
+    "mat_emission",
+    "mat_specular",
+    "mat_shininess",
+    "mesh_vert",
+    "mesh_face",
+    "tex_data",
+    "light_type",
+    "light_castshadow",
+    "light_active",
+    "light_ambient",
+    "light_diffuse",
+    "light_specular",
+    "light_attenuation",
+    "light_cutoff",
+    "light_exponent",
+    "cam_projection",
+    "cam_sensorsize",
+)
+
+
+def _scene_digest(model: mujoco.MjModel) -> str:
+    digest = hashlib.sha1()
+    for name in _SCENE_ARRAYS:
+        digest.update(name.encode())
+        digest.update(np.ascontiguousarray(getattr(model, name)).tobytes())
+    vis = model.vis
+    digest.update(
+        np.array(
+            [vis.map.znear, vis.map.zfar, model.stat.extent, *vis.headlight.ambient],
+            dtype=float,
+        ).tobytes()
+    )
+    return digest.hexdigest()
+
+
+@dataclass(frozen=True)
+class _Pose:
+    """What the ray caster reads of one world's state (MjData after forward kinematics)."""
+
+    geom_xpos: np.ndarray
+    geom_xmat: np.ndarray
+    cam_xpos: np.ndarray
+    cam_xmat: np.ndarray
+    light_xpos: np.ndarray
+    light_xdir: np.ndarray
+
+    @classmethod
+    def of(cls, model: mujoco.MjModel, data: mujoco.MjData) -> _Pose:
+        return cls(
+            data.geom_xpos.copy(),
+            data.geom_xmat.reshape(model.ngeom, 3, 3).copy(),
+            data.cam_xpos.copy(),
+            data.cam_xmat.reshape(model.ncam, 3, 3).copy(),
+            data.light_xpos.copy(),
+            data.light_xdir.copy(),
+        )
+
+
+@dataclass(frozen=True)
+class _Kind:
+    """What worlds rendered together share: the scene, the camera, the image, the samples
+    (and, with more than one sample per pixel, the camera's intrinsics)."""
+
+    digest: str
+    camera: int
+    size: tuple[int, int]
+    samples: int
+    intrinsics: bytes | None
+
+
+@dataclass
+class _Request:
+    model: mujoco.MjModel
+    kind: _Kind
+    pose: _Pose
+    fovy: float
+    intrinsic: np.ndarray
+    image: np.ndarray | None = None
+    error: BaseException | None = None
+
+
+class _Scene:
+    """One Warp model, data and render context for up to ``nworld`` worlds of one kind."""
+
+    def __init__(
+        self, warp: _Warp, device: str, model: mujoco.MjModel, kind: _Kind, nworld: int
+    ) -> None:
+        wp, mjw = warp.wp, warp.mjw
+        self._warp, self._device, self.nworld, self.kind = warp, device, nworld, kind
+        self._per_world = kind.intrinsics is None
+        width, height = kind.size
+        with wp.ScopedDevice(device):
+            self._m = mjw.put_model(model)
+            self._d = mjw.put_data(model, mujoco.MjData(model), nworld=nworld)
+            self._rc = mjw.create_render_context(
+                model,
+                nworld=nworld,
+                cam_res=[(width, height)],
+                render_rgb=True,
+                render_depth=False,
+                cam_active=[kind.camera],
+                samples_per_pixel=kind.samples,
+                use_precomputed_rays=not self._per_world,
+                deterministic=True,
+            )
+            self._out = wp.zeros((nworld, height, width), dtype=wp.vec3)
+        self._ncam = model.ncam
+        self._fovy = np.tile(model.cam_fovy.astype(np.float32), (nworld, 1))
+        self._intrinsic = np.tile(model.cam_intrinsic.astype(np.float32), (nworld, 1, 1))
+
+    def render(self, requests: Sequence[_Request]) -> list[np.ndarray]:
+        """Each request's pinhole canvas, uint8 (h, w, 3)."""
+        wp, mjw = self._warp.wp, self._warp.mjw
+        n = len(requests)
+        rows = [requests[min(i, n - 1)] for i in range(self.nworld)]  # idle worlds repeat
+
+        def stacked(name: str) -> np.ndarray:
+            return np.stack([getattr(r.pose, name) for r in rows]).astype(np.float32)
+
+        d = self._d
+        with wp.ScopedDevice(self._device):
+            d.geom_xpos.assign(stacked("geom_xpos"))
+            d.geom_xmat.assign(stacked("geom_xmat"))
+            d.cam_xpos.assign(stacked("cam_xpos"))
+            d.cam_xmat.assign(stacked("cam_xmat"))
+            if d.light_xpos.shape[1]:
+                d.light_xpos.assign(stacked("light_xpos"))
+                d.light_xdir.assign(stacked("light_xdir"))
+            if self._per_world:
+                camera = self.kind.camera
+                for i, r in enumerate(rows):
+                    self._fovy[i, camera] = r.fovy
+                    self._intrinsic[i, camera] = r.intrinsic
+                self._m.cam_fovy = wp.array(self._fovy, dtype=float)
+                self._m.cam_intrinsic = wp.array(self._intrinsic, dtype=wp.vec4)
+            mjw.refit_bvh(self._m, d, self._rc)
+            mjw.render(self._m, d, self._rc)
+            mjw.get_rgb(self._rc, 0, self._out)
+            rgb = self._out.numpy()[:n]
+        return list(np.clip(rgb * 255.0 + 0.5, 0.0, 255.0).astype(np.uint8))
+
+
+@dataclass
+class BatchStats:
+    """What a session rendered: Warp calls, images, the most worlds in one call, seconds."""
+
+    calls: int = 0
+    images: int = 0
+    largest: int = 0
+    render_s: float = 0.0
+    scenes: int = 0
+
+    @property
+    def mean_batch(self) -> float:
+        return self.images / self.calls if self.calls else 0.0
+
+
+class BatchSession:
+    """N heads in lockstep, their images rendered together through MuJoCo Warp.
+
+    ``device``: ``"cpu"`` or ``"cuda"``.  ``samples_per_pixel``: Warp's sub-pixel samples
+    per axis (None: each head's ``render.supersample``).  :meth:`run` calls its functions
+    in lockstep; a simulator made inside one renders through this session.
+    """
+
+    def __init__(self, device: str = "cpu", samples_per_pixel: int | None = None) -> None:
+        self._warp = check_device(device)
+        _check_samples(samples_per_pixel)
+        self.device = device
+        self.samples_per_pixel = samples_per_pixel
+        self.stats = BatchStats()
+        self._cond = threading.Condition()
+        self._live = 0
+        self._pending: list[_Request] = []
+        self._scenes: dict[tuple[_Kind, int], _Scene] = {}
+        self._digests: dict[int, tuple[mujoco.MjModel, str]] = {}
+
+    def describe(self) -> str:
+        """Which device ran and what it rendered, in words."""
+        s = self.stats
+        return (
+            f"MuJoCo Warp on {self.device}: {s.images} images in {s.calls} batches "
+            f"(mean {s.mean_batch:.1f}, largest {s.largest}), {s.render_s:.1f} s rendering"
+        )
+
+    # -- lockstep --------------------------------------------------------------
+    def run(self, calls: Sequence[Callable[[], T]]) -> list[T]:
+        """Each of ``calls`` on a thread of its own, their images rendered in batches; their
+        results in order (the first call to raise is raised, once all have ended)."""
+        results: list[Any] = [None] * len(calls)
+        errors: list[BaseException | None] = [None] * len(calls)
+        with self._cond:
+            self._live += len(calls)
+
+        def work(index: int) -> None:
+            token = render.renderer_factory.set(self._renderer)
+            try:
+                results[index] = calls[index]()
+            except BaseException as err:  # raised in the caller's thread below
+                errors[index] = err
+            finally:
+                render.renderer_factory.reset(token)
+                self._leave()
+
+        threads = [
+            threading.Thread(target=work, args=(i,), name=f"headsim-batch-{i}", daemon=True)
+            for i in range(len(calls))
+        ]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        for error in errors:
+            if error is not None:
+                raise error
+        return results
+
+    def _renderer(self, *args: Any, **kwargs: Any) -> render.EyeRenderer:
+        return BatchEyeRenderer(self, *args, **kwargs)
+
+    def _leave(self) -> None:
+        with self._cond:
+            self._live -= 1
+            if self._pending and len(self._pending) >= self._live:
+                self._flush()
+
+    def draw(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        camera: int,
+        size: tuple[int, int],
+        supersample: int,
+    ) -> np.ndarray:
+        """Camera ``camera``'s pinhole canvas of ``size`` now, uint8 (h, w, 3): rendered once
+        every head still running has asked for an image (at once outside :meth:`run`)."""
+        request = self._request(model, _Pose.of(model, data), camera, size, supersample)
+        with self._cond:
+            self._pending.append(request)
+            if len(self._pending) >= self._live:
+                self._flush()
+            while request.image is None and request.error is None:
+                self._cond.wait()
+        if request.error is not None:
+            raise request.error
+        assert request.image is not None
+        return request.image
+
+    def cast(
+        self,
+        model: mujoco.MjModel,
+        data: Sequence[mujoco.MjData],
+        camera: int,
+        size: tuple[int, int],
+        supersample: int = 1,
+    ) -> list[np.ndarray]:
+        """Camera ``camera``'s pinhole canvas of ``size`` in each of ``data`` (one model's
+        worlds), uint8 (h, w, 3), in one Warp call now."""
+        requests = [
+            self._request(model, _Pose.of(model, d), camera, size, supersample) for d in data
+        ]
+        with self._cond:
+            self._pending.extend(requests)
+            self._flush()
+        for request in requests:
+            if request.error is not None:
+                raise request.error
+        return [r.image for r in requests if r.image is not None]
+
+    def _request(
+        self,
+        model: mujoco.MjModel,
+        pose: _Pose,
+        camera: int,
+        size: tuple[int, int],
+        supersample: int,
+    ) -> _Request:
+        samples = self.samples_per_pixel or supersample
+        intrinsic = model.cam_intrinsic[camera].astype(np.float32)
+        fovy = float(model.cam_fovy[camera])
+        exact = None if samples == 1 else np.array([fovy, *intrinsic], np.float32).tobytes()
+        kind = _Kind(self._digest(model), int(camera), size, samples, exact)
+        return _Request(model, kind, pose, fovy, intrinsic)
+
+    def _digest(self, model: mujoco.MjModel) -> str:
+        known = self._digests.get(id(model))
+        if known is None or known[0] is not model:
+            known = (model, _scene_digest(model))
+            self._digests[id(model)] = known
+        return known[1]
+
+    def _flush(self) -> None:
+        """Render every pending request, one Warp call per kind (the lock held)."""
+        pending, self._pending = self._pending, []
+        start = time.perf_counter()
+        try:
+            kinds: dict[_Kind, list[_Request]] = {}
+            for request in pending:
+                kinds.setdefault(request.kind, []).append(request)
+            for kind, requests in kinds.items():
+                images = self._scene(kind, requests[0].model, len(requests)).render(requests)
+                for request, image in zip(requests, images, strict=True):
+                    request.image = image
+                self.stats.calls += 1
+                self.stats.images += len(requests)
+                self.stats.largest = max(self.stats.largest, len(requests))
+        except Exception as err:  # every waiting head hears of it
+            for request in pending:
+                if request.image is None:
+                    request.error = err
+        finally:
+            self.stats.render_s += time.perf_counter() - start
+            self._cond.notify_all()
+
+    def _scene(self, kind: _Kind, model: mujoco.MjModel, n: int) -> _Scene:
+        """The scene of ``kind`` for the fewest worlds, a power of two, that hold ``n``."""
+        nworld = 1 << max(n - 1, 0).bit_length()
+        scene = self._scenes.get((kind, nworld))
+        if scene is None:
+            scene = _Scene(self._warp, self.device, model, kind, nworld)
+            self._scenes[(kind, nworld)] = scene
+            self.stats.scenes += 1
+        return scene
+
+
+class BatchEyeRenderer(render.EyeRenderer):
+    """The classic renderer's images with the pinhole canvas ray-cast by a batch session:
+    the lens, noise and counts are :class:`~headsim.sim.render.EyeRenderer`'s own."""
+
+    def __init__(self, session: BatchSession, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._session = session
+
+    def _draw(
+        self, data: mujoco.MjData, index: int, rect: Window | None, binning: int = 1
+    ) -> np.ndarray:
+        canvas = self._canvases[index]
+        image = self._session.draw(
+            self._mj_model, data, self._cam_ids[index], canvas.size, self._supersample
+        )
+        self.rendered_frames += 1.0  # the whole frame is cast, whatever is kept
+        if binning > 1:
+            h, w = (image.shape[0] // binning) * binning, (image.shape[1] // binning) * binning
+            blocks = image[:h, :w].reshape(h // binning, binning, w // binning, binning, 3)
+            return np.clip(blocks.mean(axis=(1, 3)) + 0.5, 0, 255).astype(np.uint8)
+        if rect is not None:
+            return np.ascontiguousarray(image[rect.y0 : rect.y1, rect.x0 : rect.x1])
+        return image
+
+    def close(self) -> None:
+        """Nothing to free: the session holds the Warp scenes."""
+
+
 class BatchRenderer:
-    """Both eye cameras of ``nworld`` copies of ``sim``'s head and scene.
+    """Both eye cameras of ``nworld`` copies of ``sim``'s head and scene at given joint
+    positions, for comparisons with the classic renderer.
 
     ``render(qpos)`` takes each world's joint positions, (nworld, nq), and returns
-    (nworld, 2, height, width, 3) uint8 images, camera Ca1 then Ca2.  ``device``:
-    ``"cpu"`` or ``"cuda"``; ``samples_per_pixel``: Warp's sub-pixel rays (anti-aliasing).
+    (nworld, 2, height, width, 3) uint8 images, camera Ca1 then Ca2: the lens by remap and
+    noise from each world's own stream ``(seed, BATCH_STREAM, world, camera)``.
     """
 
     def __init__(
@@ -84,38 +498,14 @@ class BatchRenderer:
     ) -> None:
         if not (isinstance(nworld, int) and nworld >= 1):
             raise BatchError(f"nworld must be a whole number >= 1, got {nworld!r}")
-        if device not in DEVICES:
-            raise BatchError(f"device must be one of {', '.join(DEVICES)}, got {device!r}")
-        if not (isinstance(samples_per_pixel, int) and 1 <= samples_per_pixel <= 64):
-            raise BatchError(f"samples_per_pixel must be 1 to 64, got {samples_per_pixel!r}")
-        warp = _warp()
-        if device == "cuda" and not warp.wp.is_cuda_available():
-            raise BatchError("device 'cuda': Warp finds no CUDA device here; allowed: cpu")
+        self._session = BatchSession(device, samples_per_pixel)
         self.device, self.nworld = device, nworld
         self.model: mujoco.MjModel = sim.model
-        self._warp = warp
         self._cameras = [int(self.model.camera(name).id) for name in sim.names.cameras]
         self._canvases = sim.built.canvases
-        self._supersample = sim.settings.render.supersample
         self._noise = tuple(GaussianNoise.of(c.noise_std) for c in sim.settings.cameras)
         self._seed = sim.settings.seed if seed is None else seed
         self._frame = 0
-        resolution = [tuple(int(v) for v in self.model.cam_resolution[c]) for c in self._cameras]
-        self._resolution = resolution
-        with warp.wp.ScopedDevice(device):
-            self._m = warp.mjw.put_model(self.model)
-            self._d = warp.mjw.put_data(self.model, mujoco.MjData(self.model), nworld=nworld)
-            self._rc = warp.mjw.create_render_context(
-                self.model,
-                nworld=nworld,
-                cam_res=resolution,
-                render_rgb=True,
-                render_depth=False,
-                cam_active=self._cameras,
-                samples_per_pixel=samples_per_pixel,
-                deterministic=True,
-            )
-            self._out = [warp.wp.zeros((nworld, h, w), dtype=warp.wp.vec3) for w, h in resolution]
 
     def describe(self) -> str:
         """Which device ran, in words."""
@@ -129,29 +519,39 @@ class BatchRenderer:
                 f"qpos must have shape ({self.nworld}, {self.model.nq}), one row per world, "
                 f"got {q.shape}"
             )
-        wp, mjw = self._warp.wp, self._warp.mjw
-        with wp.ScopedDevice(self.device):
-            self._d.qpos.assign(q.astype(np.float32))
-            mjw.kinematics(self._m, self._d)
-            mjw.camlight(self._m, self._d)
-            mjw.render(self._m, self._d, self._rc)
-            for index, out in enumerate(self._out):
-                mjw.get_rgb(self._rc, index, out)
-            raw = [out.numpy() for out in self._out]
-        images = [[self._finish(raw[c][w], c, w) for c in range(2)] for w in range(self.nworld)]
+        worlds = []
+        for row in q:
+            data = mujoco.MjData(self.model)
+            data.qpos[:] = row
+            mujoco.mj_kinematics(self.model, data)
+            mujoco.mj_camlight(self.model, data)
+            worlds.append(data)
+        images = [
+            self._session.cast(self.model, worlds, self._cameras[c], self._canvases[c].size)
+            for c in range(2)
+        ]
+        out = np.stack(
+            [
+                np.stack([self._finish(images[c][w], c, w) for c in range(2)])
+                for w in range(self.nworld)
+            ]
+        )
         self._frame += 1
-        return np.stack([np.stack(pair) for pair in images])
+        return out
 
-    def _finish(self, rgb: np.ndarray, camera: int, world: int) -> np.ndarray:
-        """A world's raw float image as the classic renderer finishes a frame."""
-        k = self._supersample
-        if k > 1:
-            h, w = rgb.shape[0] // k, rgb.shape[1] // k
-            rgb = rgb.reshape(h, k, w, k, 3).mean(axis=(1, 3))
-        image = np.clip(rgb * 255.0 + 0.5, 0.0, 255.0).astype(np.uint8)
+    def _finish(self, image: np.ndarray, camera: int, world: int) -> np.ndarray:
         image = apply_canvas(image, self._canvases[camera])
         key: Any = (self._seed, BATCH_STREAM, world, camera)
         return self._noise[camera].apply(image, key, self._frame)
 
 
-__all__ = ["DEVICES", "BatchError", "BatchRenderer", "cuda_available"]
+__all__ = [
+    "DEVICES",
+    "BatchError",
+    "BatchEyeRenderer",
+    "BatchRenderer",
+    "BatchSession",
+    "BatchStats",
+    "check_device",
+    "cuda_available",
+]

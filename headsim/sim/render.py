@@ -25,7 +25,9 @@ from __future__ import annotations
 import hashlib
 import math
 from collections import OrderedDict
-from collections.abc import Hashable
+from collections.abc import Callable, Hashable
+from contextvars import ContextVar
+from typing import Any
 
 import cv2
 import mujoco
@@ -315,6 +317,19 @@ class EyeRenderer:
             renderer = _POOL.pop(self._key, None)
             if renderer is not None:
                 renderer.close()
+
+
+#: What makes the eye renderers of simulators made in this context (None: :class:`EyeRenderer`);
+#: a batch session (:mod:`headsim.sim.batch`) sets it in each of its threads.
+renderer_factory: ContextVar[Callable[..., EyeRenderer] | None] = ContextVar(
+    "headsim_renderer_factory", default=None
+)
+
+
+def make_eye_renderer(*args: Any, **kwargs: Any) -> EyeRenderer:
+    """An :class:`EyeRenderer` (arguments as its), or the batch session's in one's thread."""
+    factory = renderer_factory.get()
+    return EyeRenderer(*args, **kwargs) if factory is None else factory(*args, **kwargs)
 
 
 #: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.

@@ -39,7 +39,7 @@ from headsim.sim.joints import (
 )
 from headsim.sim.model import CV_FROM_MJCAM, HEAD_PREFIX, BuiltModel, build_model
 from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
-from headsim.sim.render import EyeRenderer, Window, context_key
+from headsim.sim.render import Window, context_key, make_eye_renderer
 from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
 
 #: A camera: 1 or 2 (the paper's Ca1, Ca2), its MJCF name "cam1"/"cam2", or a names.Camera.
@@ -106,7 +106,7 @@ class HeadSim:
         self._commands = Commands()
         #: Bodies placed so far (targets moved: earlier images are out of date).
         self.placements = 0
-        self._renderer = EyeRenderer(
+        self._renderer = make_eye_renderer(
             self.model,
             self.settings.cameras,
             self.built.canvases,

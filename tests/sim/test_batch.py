@@ -4,13 +4,14 @@ per world, and its refusals."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from headsim.sim.batch import BatchError, BatchRenderer, cuda_available
-from headsim.sim.settings import preset
+from headsim.sim.batch import BatchError, BatchRenderer, BatchSession, cuda_available
+from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import find_marker
 
@@ -90,3 +91,79 @@ def test_the_cuda_path_runs_where_warp_finds_a_device_and_is_refused_elsewhere(
         found = find_marker(images[0, 0], "red")
         assert found.uv is not None and classic[0][0].uv is not None
         assert np.hypot(*np.subtract(found.uv, classic[0][0].uv)) <= CENTROID_TOLERANCE_PX
+
+
+def _kx(settings_name: str, kx: float) -> HeadSettings:
+    settings = preset(settings_name)
+    return replace(settings, cameras=tuple(replace(c, kx=kx, ky=kx) for c in settings.cameras))
+
+
+def _look(sim: HeadSim, eyes: list[float]) -> list[tuple[float, float]]:
+    """The red marker's centroid in Ca1 at each eye angle (one image each)."""
+    found = []
+    for eye in eyes:
+        sim.move(eye=eye)
+        uv = find_marker(sim.render(1), "red").uv
+        assert uv is not None
+        found.append(uv)
+    return found
+
+
+def test_heads_in_lockstep_render_together_and_each_sees_what_it_sees_alone() -> None:
+    """Three heads of three focal lengths, a different number of images each: at one sample
+    per pixel they share one Warp scene (Warp's per-world camera parameters), the batch
+    shrinks as heads finish, and every centroid is the classic renderer's."""
+    focals, eyes = (700.0, 835.0, 1000.0), [[0.0, 0.04, 0.08], [0.02, 0.06], [0.05]]
+    sims = [HeadSim(settings=_kx("ideal", kx)) for kx in focals]
+    classic = [_look(sim, e) for sim, e in zip(sims, eyes, strict=True)]
+    for sim in sims:
+        sim.close()
+    session = BatchSession(samples_per_pixel=1)
+
+    def head(kx: float, angles: list[float]) -> Callable[[], list[tuple[float, float]]]:
+        return lambda: _look(HeadSim(settings=_kx("ideal", kx)), angles)
+
+    batch = session.run([head(kx, e) for kx, e in zip(focals, eyes, strict=True)])
+    offsets = [
+        float(np.hypot(*np.subtract(b, c)))
+        for bs, cs in zip(batch, classic, strict=True)
+        for b, c in zip(bs, cs, strict=True)
+    ]
+    assert max(offsets) <= CENTROID_TOLERANCE_PX, offsets
+    # The focal length moved the marker: kx 700 and 1000 differ by tens of pixels at eye 0.05.
+    assert abs(batch[0][2][0] - batch[2][0][0]) > 5
+    stats = session.stats
+    # Every head renders in one call per step while it runs: 3 + 2 + 1 images in 3 calls.
+    assert (stats.images, stats.calls, stats.largest) == (6, 3, 3), stats
+    assert "MuJoCo Warp on cpu: 6 images in 3 batches" in session.describe()
+
+
+def test_with_sub_pixel_samples_worlds_are_grouped_by_camera() -> None:
+    session = BatchSession(samples_per_pixel=2)
+    session.run(
+        [lambda kx=kx: _look(HeadSim(settings=_kx("ideal", kx)), [0.03]) for kx in (700.0, 900.0)]
+    )
+    assert (session.stats.images, session.stats.calls, session.stats.largest) == (2, 2, 1)
+
+
+def test_an_error_in_one_head_is_raised_once_the_others_end() -> None:
+    session = BatchSession(samples_per_pixel=1)
+    ended = []
+
+    def fine() -> None:
+        _look(HeadSim(settings=preset("ideal")), [0.0, 0.05])
+        ended.append(True)
+
+    def broken() -> None:
+        raise RuntimeError("this head broke")
+
+    with pytest.raises(RuntimeError, match="this head broke"):
+        session.run([fine, broken])
+    assert ended == [True]  # the healthy head was not left waiting for the broken one
+
+
+def test_bad_sessions_name_what_is_allowed() -> None:
+    with pytest.raises(BatchError, match="samples_per_pixel must be a whole number from 1 to 8"):
+        BatchSession(samples_per_pixel=0)
+    with pytest.raises(BatchError, match="device must be one of cpu, cuda, got 'gpu'"):
+        BatchSession(device="gpu")
