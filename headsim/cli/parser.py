@@ -188,6 +188,11 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         metavar="tcp://HOST:PORT",
         help="run the jobs on this Dask scheduler instead (pip install 'headsim[dask]')",
     )
+    sweep.add_argument(
+        "--device",
+        choices=("cpu", "cuda"),
+        help="the batch back-end's device (backend = \"batch\"; default: the file's, else cpu)",
+    )
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     from headsim.run.rerun_cli import add_recording_arguments
 

@@ -17,7 +17,16 @@ A sweep file (TOML) names a scenario and the fields to vary::
     "head.baseline_m" = [0.10, 0.20]   # uniform in [low, high]
 
 Each job is one scenario run with those fields set (``seed`` sets the run's
-seed).  Jobs are appended to ``DIR/jobs.jsonl`` as they finish, so an
+seed).  ``backend = "batch"`` runs the jobs in lockstep batches instead, each batch's
+images rendered together by MuJoCo Warp (``headsim[batch]``)::
+
+    backend = "batch"
+    [batch]
+    worlds = 32                      # heads per batch (default 32)
+    samples_per_pixel = 1            # Warp's sub-pixel samples per axis (default: the head's)
+    device = "cpu"                   # or "cuda"
+
+  Jobs are appended to ``DIR/jobs.jsonl`` as they finish, so an
 interrupted sweep resumes where it stopped; a job that fails or crashes its
 process is retried once, then recorded as failed, and the rest go on.  At the
 end ``DIR/aggregate.csv``, ``DIR/aggregate.json`` and a plot per swept field.
@@ -31,16 +40,17 @@ import os
 import signal
 import time
 import traceback
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from headsim.errors import BadInput
 from headsim.run.progress import Counter
 from headsim.studies.jobs import dask_client, execute, local_pool
 from headsim.studies.sweep_output import write_aggregate
-from headsim.studies.sweep_spec import Job, SweepSpec
+from headsim.studies.sweep_spec import BatchOptions, Job, SweepSpec
 
 #: Fault injection for tests: job indices (comma-separated) whose process dies.
 CRASH_ENV = "HEADSIM_SWEEP_CRASH_JOBS"
@@ -65,6 +75,130 @@ def run_job(job: Job, marker_dir: str | None = None, recording: Any = None) -> d
     finally:
         if marker is not None:
             marker.unlink(missing_ok=True)
+
+
+@dataclass(frozen=True)
+class Batch:
+    """Jobs run together in one batch session; an id and an index as a job's, for the pool."""
+
+    index: int
+    id: str
+    jobs: tuple[Job, ...]
+
+
+def run_batch(batch: Batch, marker_dir: str | None, options: BatchOptions) -> dict[str, Any]:
+    """Run ``batch``'s jobs in lockstep in this process: its record, with each job's under
+    ``records`` and what the session rendered under ``rendered``; never raises."""
+    marker = Path(marker_dir) / batch.id if marker_dir else None
+    if marker is not None:
+        marker.touch()
+    crash = {int(i) for i in os.environ.get(CRASH_ENV, "").split(",") if i.strip()}
+    if any(job.index in crash for job in batch.jobs):
+        os.kill(os.getpid(), signal.SIGKILL)
+    start = time.perf_counter()
+    record: dict[str, Any] = {"id": batch.id, "index": batch.index}
+    try:
+        from headsim.sim.batch import BatchSession
+
+        session = BatchSession(options.device, options.samples_per_pixel)
+        records = session.run([functools.partial(_run_job, job) for job in batch.jobs])
+        for job_record in records:
+            job_record["backend"] = "batch"
+        stats = session.stats
+        record.update(
+            status="ok",
+            records=records,
+            rendered={
+                "images": stats.images,
+                "calls": stats.calls,
+                "largest": stats.largest,
+                "render_s": stats.render_s,
+            },
+        )
+    except Exception as err:  # Warp failed: the batch's jobs are recorded as errors
+        record.update(status="error", error=f"{type(err).__name__}: {err}")
+    finally:
+        if marker is not None:
+            marker.unlink(missing_ok=True)
+    record["wall_s"] = time.perf_counter() - start
+    return record
+
+
+def _batches(jobs: list[Job], size: int, workers: int, attempt: int) -> list[Batch]:
+    """``jobs`` in order, cut into batches of at most ``size``, at least one per worker."""
+    size = max(1, min(size, -(-len(jobs) // workers)))
+    return [
+        Batch(i, f"batch{attempt}-{i}", tuple(jobs[start : start + size]))
+        for i, start in enumerate(range(0, len(jobs), size))
+    ]
+
+
+def _failed_batch(batch: Batch, record: dict[str, Any]) -> list[dict[str, Any]]:
+    """Each of ``batch``'s jobs recorded as failed with it (Warp's error, or a crash)."""
+    return [
+        {
+            "id": job.id,
+            "index": job.index,
+            "params": job.params,
+            "status": record.get("status", "error"),
+            "error": record.get("error", ""),
+            "backend": "batch",
+        }
+        for job in batch.jobs
+    ]
+
+
+def _execute_batches(
+    jobs: list[Job],
+    options: BatchOptions,
+    make_executor: Any,
+    on_record: Any,
+    stop_after: int | None,
+    marker_dir: Path | None,
+    workers: int,
+    rendered: dict[str, float],
+) -> int:
+    """Run ``jobs`` in batches of ``options.worlds``.  A job that errors, and every job of a
+    batch that fails whole (a crash, twice: :func:`~headsim.studies.jobs.execute`), runs
+    once more in a batch of its own, so that one bad job takes no other down with it."""
+    finished = 0
+    tries: dict[str, int] = {}
+    rounds = [(_batches(jobs, options.worlds, workers, 1), True)]
+    while rounds:
+        batches, first = rounds.pop()
+        by_id = {b.id: b for b in batches}
+        again: list[Job] = []
+
+        def on_batch(record: dict[str, Any]) -> None:
+            nonlocal finished
+            batch = by_id[record["id"]]  # noqa: B023  called only within this round's execute()
+            done = record.get("rendered", {})
+            for key in ("images", "calls", "render_s"):
+                rendered[key] = rendered.get(key, 0) + done.get(key, 0)
+            rendered["largest"] = max(rendered.get("largest", 0), done.get("largest", 0))
+            ok = record.get("status") == "ok"
+            records = record["records"] if ok else _failed_batch(batch, record)
+            for job, job_record in zip(batch.jobs, records, strict=True):
+                tries[job.id] = tries.get(job.id, 0) + (1 if ok else record.get("attempts", 1))
+                if first and job_record["status"] in ("error", "crashed"):  # noqa: B023
+                    again.append(job)  # noqa: B023
+                    continue
+                job_record["attempts"] = tries[job.id]
+                on_record(job_record)
+                finished += 1
+
+        limit = None if stop_after is None else -(-stop_after // options.worlds)
+        execute(
+            batches,
+            make_executor,
+            on_batch,
+            limit,
+            marker_dir,
+            functools.partial(run_batch, options=options),
+        )
+        if again and stop_after is None:
+            rounds.append((_batches(sorted(again, key=lambda j: j.index), 1, 1, 2), False))
+    return finished
 
 
 def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
@@ -130,6 +264,8 @@ class SweepOutcome:
     skipped: int
     wall_s: float
     files: dict[str, Path] = field(default_factory=dict)
+    #: The batch back-end's totals: images, Warp calls, the largest call, seconds rendering.
+    rendered: dict[str, float] | None = None
 
     @property
     def failed(self) -> list[dict[str, Any]]:
@@ -172,14 +308,26 @@ def run_sweep(
     progress: bool = True,
     stop_after: int | None = None,
     recording: Any = None,
+    device: str | None = None,
 ) -> SweepOutcome:
     """Run the jobs not yet in ``out_dir/jobs.jsonl``; then write the aggregate and plots.
 
     ``workers``: local processes (spawn start method).  ``scheduler``: a Dask
     scheduler address (``tcp://host:8786``) instead; needs ``headsim[dask]``.
     ``stop_after``: stop after that many jobs (for tests of resuming).
-    ``recording``: record every job (:func:`run_job`).
+    ``recording``: record every job (:func:`run_job`; the classic back-end only).
+    ``device``: the batch back-end's device instead of the file's ``batch.device``.
     """
+    options = spec.batch if device is None else replace(spec.batch, device=device)
+    if spec.backend == "batch":
+        from headsim.sim.batch import check_device
+
+        check_device(options.device)  # a missing extra or GPU is said before any job runs
+        if recording is not None:
+            raise BadInput(
+                'recording (--rrd, --connect) is not available with backend = "batch"; '
+                'allowed: backend = "classic"'
+            )
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     log = out / "jobs.jsonl"
@@ -206,10 +354,27 @@ def run_sweep(
         if bar is not None:
             bar.update(note="" if record.get("status") == "ok" else "(this one failed)")
 
+    rendered: dict[str, float] | None = {} if spec.backend == "batch" else None
+
+    def run_all(make_executor: Any, markers: Path | None, pool_size: int) -> int:
+        if rendered is not None:
+            return _execute_batches(
+                remaining,
+                options,
+                make_executor,
+                on_record,
+                stop_after,
+                markers,
+                pool_size,
+                rendered,
+            )
+        return execute(remaining, make_executor, on_record, stop_after, markers, job_function)
+
     if scheduler is not None:
         client = dask_client(scheduler)
         try:
-            ran = execute(remaining, client.get_executor, on_record, stop_after, None, job_function)
+            cores = sum(client.nthreads().values()) or 1
+            ran = run_all(client.get_executor, None, cores)
         finally:
             client.close()
     else:
@@ -219,14 +384,7 @@ def run_sweep(
         markers.mkdir(exist_ok=True)
         for stale in markers.iterdir():
             stale.unlink()
-        ran = execute(
-            remaining,
-            lambda: local_pool(workers),
-            on_record,
-            stop_after,
-            markers,
-            job_function,
-        )
+        ran = run_all(lambda: local_pool(workers), markers, workers)
     if bar is not None:
         bar.close()
     wall = time.perf_counter() - start
@@ -235,6 +393,7 @@ def run_sweep(
         ran=ran,
         skipped=len(spec.jobs) - len(remaining),
         wall_s=wall,
+        rendered=rendered,
     )
     if len(outcome.records) == len(spec.jobs):
         outcome.files = write_aggregate(spec, outcome.records, out)

@@ -8,7 +8,7 @@ import itertools
 import json
 import math
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +36,23 @@ class Job:
     params: dict[str, Any]
 
 
+#: How a sweep's jobs run: one scenario run at a time per process, or in lockstep batches
+#: whose images MuJoCo Warp renders together (``headsim[batch]``).
+BACKENDS = ("classic", "batch")
+#: The most heads one batch holds.
+MAX_WORLDS = 4096
+
+
+@dataclass(frozen=True)
+class BatchOptions:
+    """A ``[batch]`` table: heads per batch, Warp's sub-pixel samples per axis (None: each
+    head's ``render.supersample``) and the device."""
+
+    worlds: int = 32
+    samples_per_pixel: int | None = None
+    device: str = "cpu"
+
+
 @dataclass(frozen=True)
 class SweepSpec:
     """A checked sweep file."""
@@ -46,6 +63,8 @@ class SweepSpec:
     fast: bool
     fields: tuple[str, ...]
     jobs: tuple[Job, ...]
+    backend: str = "classic"
+    batch: BatchOptions = BatchOptions()
 
 
 def _job_id(scenario: str, fast: bool, params: dict[str, Any]) -> str:
@@ -74,7 +93,7 @@ def load_sweep(path: str | Path) -> SweepSpec:
         raise SweepError(source, "", "no such sweep file") from err
     except tomllib.TOMLDecodeError as err:
         raise SweepError(source, "", f"not valid TOML: {err}") from err
-    allowed_top = ("description", "scenario", "fast", "grid", "random")
+    allowed_top = ("description", "scenario", "fast", "backend", "batch", "grid", "random")
     for key in doc:
         if key not in allowed_top:
             raise SweepError(source, key, "unknown key", ", ".join(allowed_top))
@@ -93,6 +112,12 @@ def load_sweep(path: str | Path) -> SweepSpec:
     fast = doc.get("fast", False)
     if not isinstance(fast, bool):
         raise SweepError(source, "fast", f"must be true or false, got {fast!r}", "true, false")
+    backend = doc.get("backend", "classic")
+    if backend not in BACKENDS:
+        raise SweepError(source, "backend", f"{backend!r} is not a back-end", ", ".join(BACKENDS))
+    batch = _batch_options(source, doc.get("batch", {}))
+    if "batch" in doc and backend != "batch":
+        raise SweepError(source, "batch", 'is read only with backend = "batch"')
     if ("grid" in doc) == ("random" in doc):
         raise SweepError(source, "", "needs exactly one of [grid] and [random]", "[grid], [random]")
     if "grid" in doc:
@@ -113,7 +138,44 @@ def load_sweep(path: str | Path) -> SweepSpec:
         except ScenarioError as err:
             raise SweepError(source, f"job {index} {params}", str(err)) from err
         jobs.append(Job(index, _job_id(scenario_path, fast, params), scenario_path, fast, params))
-    return SweepSpec(path, description.strip(), scenario_path, fast, fields, tuple(jobs))
+    return SweepSpec(
+        path, description.strip(), scenario_path, fast, fields, tuple(jobs), backend, batch
+    )
+
+
+def _batch_options(source: str, table: Any) -> BatchOptions:
+    from headsim.sim.batch import DEVICES, MAX_SAMPLES_PER_PIXEL
+
+    if not isinstance(table, dict):
+        raise SweepError(source, "batch", "must be a table", "worlds, samples_per_pixel, device")
+    for key in table:
+        if key not in ("worlds", "samples_per_pixel", "device"):
+            raise SweepError(
+                source, f"batch.{key}", "unknown key", "worlds, samples_per_pixel, device"
+            )
+
+    def whole(key: str, high: int) -> Any:
+        value = table[key]
+        if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= high:
+            raise SweepError(
+                source, f"batch.{key}", f"{value!r} is not allowed", f"an integer from 1 to {high}"
+            )
+        return value
+
+    options = BatchOptions()
+    if "worlds" in table:
+        options = replace(options, worlds=whole("worlds", MAX_WORLDS))
+    if "samples_per_pixel" in table:
+        options = replace(
+            options, samples_per_pixel=whole("samples_per_pixel", MAX_SAMPLES_PER_PIXEL)
+        )
+    if "device" in table:
+        if table["device"] not in DEVICES:
+            raise SweepError(
+                source, "batch.device", f"{table['device']!r} is not a device", ", ".join(DEVICES)
+            )
+        options = replace(options, device=table["device"])
+    return options
 
 
 def _random_params(source: str, table: Any) -> tuple[list[dict[str, Any]], tuple[str, ...]]:

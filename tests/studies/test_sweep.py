@@ -83,3 +83,71 @@ def test_a_crashing_job_is_retried_once_reported_and_the_rest_complete(
     assert [records[i]["status"] for i in (0, 2, 3)] == ["ok"] * 3
     rows = _rows(out / "aggregate.csv")
     assert [r["status"] for r in rows] == ["ok", "crashed", "ok", "ok"]
+
+
+def _batched(grid: Path, worlds: int) -> Path:
+    text = grid.read_text().replace(
+        "[grid]", f'backend = "batch"\n\n[batch]\nworlds = {worlds}\n\n[grid]', 1
+    )
+    path = grid.with_name("batched.toml")
+    path.write_text(text)
+    return path
+
+
+def test_a_batch_sweep_gives_the_classic_outputs_and_resumes(
+    grid: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two batches of two heads on MuJoCo Warp (CPU): the first, then a resume for the
+    second; the aggregate has the classic sweep's rows, columns and plots, and each job's
+    error is the classic job's within the servo's noise."""
+    classic = run_sweep(load_sweep(grid), tmp_path / "classic", progress=False)
+    spec = load_sweep(_batched(grid, 2))
+    assert spec.backend == "batch" and spec.batch.worlds == 2
+    out = tmp_path / "batch"
+    first = run_sweep(spec, out, progress=False, stop_after=2)
+    assert first.ran == 2 and first.rendered is not None
+    assert first.rendered["largest"] == 2  # both heads of the batch in one Warp call
+    assert main(["sweep", str(spec.path), "--out", str(out), "--no-progress"]) == 0
+    printed = capsys.readouterr().out
+    assert "batch back-end: MuJoCo Warp on cpu" in printed
+    assert "2 jobs run (2 already done)" in printed
+    rows, expected = _rows(out / "aggregate.csv"), _rows(tmp_path / "classic" / "aggregate.csv")
+    assert list(rows[0]) == list(expected[0])
+    assert [r["status"] for r in rows] == ["ok"] * 4
+    for row, ref in zip(rows, expected, strict=True):
+        assert row["head.baseline_m"] == ref["head.baseline_m"]
+        # The servo's noise: both converge within ~0.1 px, about 0.05 % of depth here.
+        assert abs(float(row["rms_error_pct_depth"]) - float(ref["rms_error_pct_depth"])) < 0.05
+    assert {r["backend"] for r in read_log(out / "jobs.jsonl").values()} == {"batch"}
+    assert (out / "error_vs_head_baseline_m.png").stat().st_size > 1000
+    assert not classic.failed
+
+
+def test_a_crashing_job_in_a_batch_takes_no_other_job_down(
+    grid: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Job 1 kills its process: its batch fails whole (twice), then each of its jobs runs
+    on its own; only job 1 is recorded as crashed."""
+    monkeypatch.setenv(CRASH_ENV, "1")
+    outcome = run_sweep(load_sweep(_batched(grid, 2)), tmp_path / "out", progress=False)
+    status = {r["index"]: r["status"] for r in outcome.records.values()}
+    assert status == {0: "ok", 1: "crashed", 2: "ok", 3: "ok"}
+    attempts = {r["index"]: r["attempts"] for r in outcome.records.values()}
+    assert attempts == {0: 3, 1: 4, 2: 1, 3: 1}
+
+
+def test_a_batch_sweep_on_a_missing_device_is_refused_before_it_runs(
+    grid: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from headsim.sim.batch import cuda_available
+
+    out = tmp_path / "out"
+    code = main(["sweep", str(_batched(grid, 2)), "--out", str(out), "--device", "cuda"])
+    if cuda_available():
+        assert code == 0
+        return
+    assert code == 2
+    assert "Warp finds no CUDA device here; allowed: cpu" in capsys.readouterr().err
+    assert not (out / "jobs.jsonl").exists()
+    assert main(["sweep", str(grid), "--out", str(out), "--device", "cpu"]) == 2
+    assert "allowed only with backend" in capsys.readouterr().err

@@ -69,6 +69,26 @@ def test_random_sample_is_seeded(tmp_path: Path) -> None:
             'description = "x"\nscenario = "sweep_base.toml"\n[random]\ncount = 2\n[random.fields]\nseed = [5, 1]\n',
             "not a range",
         ),
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\nbackend = "gpu"\n[grid]\nseed = [1]\n',
+            r"backend: 'gpu' is not a back-end \(allowed: classic, batch\)",
+        ),
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\nbackend = "batch"\n[batch]\nworlds = 0\n[grid]\nseed = [1]\n',
+            r"batch.worlds: 0 is not allowed \(allowed: an integer from 1 to 4096\)",
+        ),
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\nbackend = "batch"\n[batch]\nsamples_per_pixel = 9\n[grid]\nseed = [1]\n',
+            r"batch.samples_per_pixel: 9 is not allowed \(allowed: an integer from 1 to 8\)",
+        ),
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\nbackend = "batch"\n[batch]\ndevice = "tpu"\n[grid]\nseed = [1]\n',
+            r"batch.device: 'tpu' is not a device \(allowed: cpu, cuda\)",
+        ),
+        (
+            'description = "x"\nscenario = "sweep_base.toml"\n[batch]\nworlds = 4\n[grid]\nseed = [1]\n',
+            'batch: is read only with backend = "batch"',
+        ),
     ],
 )
 def test_bad_sweep_files_name_the_field(tmp_path: Path, text: str, message: str) -> None:
