@@ -13,13 +13,14 @@ call; the batch ends when the last one does.
 Each image is then finished exactly as the classic renderer finishes its own
 (:class:`~headsim.sim.render.EyeRenderer`): the lens by remap, the camera's noise from
 the same stream, the same counts.  A window is the full frame's crop, a preview its
-b x b area average.  Anti-aliasing: Warp's sub-pixel samples on a regular
-``samples_per_pixel`` x ``samples_per_pixel`` grid, by default the head's
-``render.supersample`` (the classic path's supersampling, without its MSAA).
+b x b area average.  Anti-aliasing: ``samples_per_pixel`` x ``samples_per_pixel``
+rays per pixel on a regular grid, averaged, by default the head's ``render.supersample``
+(the classic path's supersampling, without its MSAA).
 
-Worlds that differ only in poses share one Warp scene; at one sample per pixel so do
-worlds whose cameras differ in their intrinsics (focal length, principal point), each
-read from Warp's per-world camera parameters.  Otherwise worlds are grouped by camera.
+Worlds share one Warp call when they share the scene, the camera, the image size and the
+samples; their poses and their cameras' intrinsics (focal length, principal point) are
+each world's own, read from Warp's per-world camera parameters.  Other worlds are
+grouped by camera.
 
 This module is the one adapter to ``mujoco_warp`` and ``warp`` (the ``batch`` extra:
 ``pip install 'headsim[batch]'``); they are imported only when a session is made.
@@ -37,6 +38,7 @@ from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, TypeVar
 
+import cv2
 import mujoco
 import numpy as np
 
@@ -185,14 +187,12 @@ class _Pose:
 
 @dataclass(frozen=True)
 class _Kind:
-    """What worlds rendered together share: the scene, the camera, the image, the samples
-    (and, with more than one sample per pixel, the camera's intrinsics)."""
+    """What worlds rendered together share: the scene, the camera, the image, the samples."""
 
     digest: str
     camera: int
     size: tuple[int, int]
     samples: int
-    intrinsics: bytes | None
 
 
 @dataclass
@@ -207,14 +207,19 @@ class _Request:
 
 
 class _Scene:
-    """One Warp model, data and render context for up to ``nworld`` worlds of one kind."""
+    """One Warp model, data and render context for up to ``nworld`` worlds of one kind.
+
+    Rays are cast one per sub-pixel sample, on a grid ``samples`` times finer than the
+    image, from each world's own camera parameters (focal length, principal point); each
+    pixel is its samples' mean.  This is the classic renderer's supersampling, and lets
+    worlds whose cameras differ share one call at any number of samples (Warp's own
+    sub-pixel samples need rays precomputed for one camera)."""
 
     def __init__(
         self, warp: _Warp, device: str, model: mujoco.MjModel, kind: _Kind, nworld: int
     ) -> None:
         wp, mjw = warp.wp, warp.mjw
         self._warp, self._device, self.nworld, self.kind = warp, device, nworld, kind
-        self._per_world = kind.intrinsics is None
         width, height = kind.size
         with wp.ScopedDevice(device):
             self._m = mjw.put_model(model)
@@ -222,16 +227,13 @@ class _Scene:
             self._rc = mjw.create_render_context(
                 model,
                 nworld=nworld,
-                cam_res=[(width, height)],
+                cam_res=[(width * kind.samples, height * kind.samples)],
                 render_rgb=True,
                 render_depth=False,
                 cam_active=[kind.camera],
-                samples_per_pixel=kind.samples,
-                use_precomputed_rays=not self._per_world,
+                use_precomputed_rays=False,
                 deterministic=True,
             )
-            self._out = wp.zeros((nworld, height, width), dtype=wp.vec3)
-        self._ncam = model.ncam
         self._fovy = np.tile(model.cam_fovy.astype(np.float32), (nworld, 1))
         self._intrinsic = np.tile(model.cam_intrinsic.astype(np.float32), (nworld, 1, 1))
 
@@ -244,7 +246,10 @@ class _Scene:
         def stacked(name: str) -> np.ndarray:
             return np.stack([getattr(r.pose, name) for r in rows]).astype(np.float32)
 
-        d = self._d
+        d, camera = self._d, self.kind.camera
+        for i, r in enumerate(rows):
+            self._fovy[i, camera] = r.fovy
+            self._intrinsic[i, camera] = r.intrinsic
         with wp.ScopedDevice(self._device):
             d.geom_xpos.assign(stacked("geom_xpos"))
             d.geom_xmat.assign(stacked("geom_xmat"))
@@ -253,18 +258,21 @@ class _Scene:
             if d.light_xpos.shape[1]:
                 d.light_xpos.assign(stacked("light_xpos"))
                 d.light_xdir.assign(stacked("light_xdir"))
-            if self._per_world:
-                camera = self.kind.camera
-                for i, r in enumerate(rows):
-                    self._fovy[i, camera] = r.fovy
-                    self._intrinsic[i, camera] = r.intrinsic
-                self._m.cam_fovy = wp.array(self._fovy, dtype=float)
-                self._m.cam_intrinsic = wp.array(self._intrinsic, dtype=wp.vec4)
+            self._m.cam_fovy = wp.array(self._fovy, dtype=float)
+            self._m.cam_intrinsic = wp.array(self._intrinsic, dtype=wp.vec4)
             mjw.refit_bvh(self._m, d, self._rc)
             mjw.render(self._m, d, self._rc)
-            mjw.get_rgb(self._rc, 0, self._out)
-            rgb = self._out.numpy()[:n]
-        return list(np.clip(rgb * 255.0 + 0.5, 0.0, 255.0).astype(np.uint8))
+            packed = self._rc.rgb_data.numpy()[:n]  # ABGR in a uint32 per ray, one camera
+        width, height = self.kind.size
+        s = self.kind.samples
+        bgra = packed.view(np.uint8).reshape(n, height * s, width * s, 4)
+        images = []
+        for world in bgra:
+            rgb = cv2.cvtColor(world, cv2.COLOR_BGRA2RGB)
+            if s > 1:  # each pixel the mean of its s x s samples (an exact area mean)
+                rgb = cv2.resize(rgb, (width, height), interpolation=cv2.INTER_AREA)
+            images.append(rgb)
+        return images
 
 
 @dataclass
@@ -403,11 +411,9 @@ class BatchSession:
         supersample: int,
     ) -> _Request:
         samples = self.samples_per_pixel or supersample
+        kind = _Kind(self._digest(model), int(camera), size, samples)
         intrinsic = model.cam_intrinsic[camera].astype(np.float32)
-        fovy = float(model.cam_fovy[camera])
-        exact = None if samples == 1 else np.array([fovy, *intrinsic], np.float32).tobytes()
-        kind = _Kind(self._digest(model), int(camera), size, samples, exact)
-        return _Request(model, kind, pose, fovy, intrinsic)
+        return _Request(model, kind, pose, float(model.cam_fovy[camera]), intrinsic)
 
     def _digest(self, model: mujoco.MjModel) -> str:
         known = self._digests.get(id(model))

@@ -138,12 +138,21 @@ def test_heads_in_lockstep_render_together_and_each_sees_what_it_sees_alone() ->
     assert "MuJoCo Warp on cpu: 6 images in 3 batches" in session.describe()
 
 
-def test_with_sub_pixel_samples_worlds_are_grouped_by_camera() -> None:
+def test_with_sub_pixel_samples_heads_of_two_focal_lengths_still_share_a_call() -> None:
+    """Two samples per axis (rays on a grid twice as fine, averaged): the classic renderer's
+    supersampling, and each world still casts from its own focal length."""
+    focals = (700.0, 900.0)
+    classic = []
+    for kx in focals:
+        with HeadSim(settings=_kx("ideal", kx)) as sim:
+            classic.append(_look(sim, [0.03]))
     session = BatchSession(samples_per_pixel=2)
-    session.run(
-        [lambda kx=kx: _look(HeadSim(settings=_kx("ideal", kx)), [0.03]) for kx in (700.0, 900.0)]
+    batch = session.run(
+        [lambda kx=kx: _look(HeadSim(settings=_kx("ideal", kx)), [0.03]) for kx in focals]
     )
-    assert (session.stats.images, session.stats.calls, session.stats.largest) == (2, 2, 1)
+    assert (session.stats.images, session.stats.calls, session.stats.largest) == (2, 1, 2)
+    for (b,), (c,) in zip(batch, classic, strict=True):
+        assert np.hypot(*np.subtract(b, c)) <= CENTROID_TOLERANCE_PX
 
 
 def test_an_error_in_one_head_is_raised_once_the_others_end() -> None:
