@@ -185,6 +185,50 @@ class _Pose:
         )
 
 
+def _sensor_for(sensor_m: np.ndarray, size: tuple[int, int]) -> tuple[float, float]:
+    """The sensor Warp casts an image of ``size`` from: cut to the image's aspect."""
+    width_m, height_m = float(sensor_m[0]), float(sensor_m[1])
+    aspect = size[0] / size[1]
+    if aspect > width_m / height_m:
+        return width_m, width_m / aspect
+    if aspect < width_m / height_m:
+        return height_m * aspect, height_m
+    return width_m, height_m
+
+
+def window_intrinsic(
+    intrinsic_m: np.ndarray,
+    sensor_m: np.ndarray,
+    canvas_size: tuple[int, int],
+    corners_px: tuple[float, float, float, float],
+    size: tuple[int, int],
+) -> np.ndarray:
+    """The camera (fx, fy, cx, cy, m, MuJoCo's ``cam_intrinsic``) whose image of ``size``
+    px on the same sensor covers the canvas's rectangle ``corners_px`` (x0, y0, x1, y1, in
+    the canvas's pixels): the same rays as the canvas's pixels there, fewer to cast."""
+    fx, fy, cx, cy = (float(v) for v in intrinsic_m)
+    width, height = canvas_size
+    sensor_w, sensor_h = _sensor_for(sensor_m, canvas_size)
+    left, right = -(sensor_w / 2 - cx) / fx, (sensor_w / 2 + cx) / fx  # at unit depth
+    top, bottom = (sensor_h / 2 - cy) / fy, -(sensor_h / 2 + cy) / fy
+    x0, y0, x1, y1 = corners_px
+    window_left = left + (right - left) * x0 / width
+    window_right = left + (right - left) * x1 / width
+    window_top = top + (bottom - top) * y0 / height
+    window_bottom = top + (bottom - top) * y1 / height
+    sensor_w, sensor_h = _sensor_for(sensor_m, size)
+    fx_w = sensor_w / (window_right - window_left)
+    fy_w = sensor_h / (window_top - window_bottom)
+    cx_w = sensor_w / 2 + window_left * fx_w
+    cy_w = sensor_h / 2 - window_top * fy_w
+    return np.array([fx_w, fy_w, cx_w, cy_w], np.float32)
+
+
+#: Windows are cast on sizes rounded up to this many pixels, so that heads whose windows
+#: differ a little share a Warp call; the extra pixels are cut off.
+WINDOW_STEP_PX = 32
+
+
 @dataclass(frozen=True)
 class _Kind:
     """What worlds rendered together share: the scene, the camera, the image, the samples."""
@@ -202,6 +246,7 @@ class _Request:
     pose: _Pose
     fovy: float
     intrinsic: np.ndarray
+    keep: tuple[int, int]
     image: np.ndarray | None = None
     error: BaseException | None = None
 
@@ -267,10 +312,11 @@ class _Scene:
         s = self.kind.samples
         bgra = packed.view(np.uint8).reshape(n, height * s, width * s, 4)
         images = []
-        for world in bgra:
-            rgb = cv2.cvtColor(world, cv2.COLOR_BGRA2RGB)
+        for world, request in zip(bgra, requests, strict=False):
+            keep_w, keep_h = request.keep
+            rgb = cv2.cvtColor(world[: keep_h * s, : keep_w * s], cv2.COLOR_BGRA2RGB)
             if s > 1:  # each pixel the mean of its s x s samples (an exact area mean)
-                rgb = cv2.resize(rgb, (width, height), interpolation=cv2.INTER_AREA)
+                rgb = cv2.resize(rgb, (keep_w, keep_h), interpolation=cv2.INTER_AREA)
             images.append(rgb)
         return images
 
@@ -364,12 +410,17 @@ class BatchSession:
         model: mujoco.MjModel,
         data: mujoco.MjData,
         camera: int,
+        canvas_size: tuple[int, int],
+        rect: Window,
         size: tuple[int, int],
-        supersample: int,
+        samples: int,
     ) -> np.ndarray:
-        """Camera ``camera``'s pinhole canvas of ``size`` now, uint8 (h, w, 3): rendered once
-        every head still running has asked for an image (at once outside :meth:`run`)."""
-        request = self._request(model, _Pose.of(model, data), camera, size, supersample)
+        """Camera ``camera``'s pinhole canvas (of ``canvas_size``) within ``rect``, as an
+        image of ``size`` cast with ``samples`` x ``samples`` rays a pixel: uint8 (h, w, 3).
+        Rendered once every head still running has asked for an image (at once outside
+        :meth:`run`)."""
+        pose = _Pose.of(model, data)
+        request = self._request(model, pose, camera, canvas_size, rect, size, samples)
         with self._cond:
             self._pending.append(request)
             if len(self._pending) >= self._live:
@@ -391,8 +442,11 @@ class BatchSession:
     ) -> list[np.ndarray]:
         """Camera ``camera``'s pinhole canvas of ``size`` in each of ``data`` (one model's
         worlds), uint8 (h, w, 3), in one Warp call now."""
+        full = Window(0, 0, *size)
+        samples = self.samples_per_pixel or supersample
         requests = [
-            self._request(model, _Pose.of(model, d), camera, size, supersample) for d in data
+            self._request(model, _Pose.of(model, d), camera, size, full, size, samples)
+            for d in data
         ]
         with self._cond:
             self._pending.extend(requests)
@@ -407,13 +461,33 @@ class BatchSession:
         model: mujoco.MjModel,
         pose: _Pose,
         camera: int,
+        canvas_size: tuple[int, int],
+        rect: Window,
         size: tuple[int, int],
-        supersample: int,
+        samples: int,
     ) -> _Request:
-        samples = self.samples_per_pixel or supersample
-        kind = _Kind(self._digest(model), int(camera), size, samples)
-        intrinsic = model.cam_intrinsic[camera].astype(np.float32)
-        return _Request(model, kind, pose, float(model.cam_fovy[camera]), intrinsic)
+        sensor = model.cam_sensorsize[camera]
+        if sensor[1] <= 0:
+            raise BatchError(
+                f"camera {camera} has no sensor size: the batch renderer casts from a camera's "
+                "intrinsics (MJCF sensorsize and focal or focalpixel)"
+            )
+        cast = size
+        if (rect.width, rect.height) != canvas_size:  # a window: on a rounded-up size
+            step = WINDOW_STEP_PX
+            cast = (-(-size[0] // step) * step, -(-size[1] // step) * step)
+        scale_x, scale_y = rect.width / size[0], rect.height / size[1]  # canvas px per px
+        corners = (
+            float(rect.x0),
+            float(rect.y0),
+            rect.x0 + cast[0] * scale_x,
+            rect.y0 + cast[1] * scale_y,
+        )
+        intrinsic = window_intrinsic(
+            model.cam_intrinsic[camera], sensor, canvas_size, corners, cast
+        )
+        kind = _Kind(self._digest(model), int(camera), cast, samples)
+        return _Request(model, kind, pose, float(model.cam_fovy[camera]), intrinsic, size)
 
     def _digest(self, model: mujoco.MjModel) -> str:
         known = self._digests.get(id(model))
@@ -467,17 +541,22 @@ class BatchEyeRenderer(render.EyeRenderer):
     def _draw(
         self, data: mujoco.MjData, index: int, rect: Window | None, binning: int = 1
     ) -> np.ndarray:
-        canvas = self._canvases[index]
-        image = self._session.draw(
-            self._mj_model, data, self._cam_ids[index], canvas.size, self._supersample
-        )
-        self.rendered_frames += 1.0  # the whole frame is cast, whatever is kept
+        """As the classic renderer: a window only its pixels' rays, a preview the camera at
+        1/b of the resolution (one ray a pixel)."""
+        width, height = self._canvases[index].size
+        samples = self._session.samples_per_pixel or self._supersample
         if binning > 1:
-            h, w = (image.shape[0] // binning) * binning, (image.shape[1] // binning) * binning
-            blocks = image[:h, :w].reshape(h // binning, binning, w // binning, binning, 3)
-            return np.clip(blocks.mean(axis=(1, 3)) + 0.5, 0, 255).astype(np.uint8)
-        if rect is not None:
-            return np.ascontiguousarray(image[rect.y0 : rect.y1, rect.x0 : rect.x1])
+            rect = Window(0, 0, width - width % binning, height - height % binning)
+            size, samples = (rect.width // binning, rect.height // binning), 1
+        elif rect is None:
+            rect = Window(0, 0, width, height)
+            size = (width, height)
+        else:
+            size = (rect.width, rect.height)
+        image = self._session.draw(
+            self._mj_model, data, self._cam_ids[index], (width, height), rect, size, samples
+        )
+        self.rendered_frames += (size[0] * size[1]) / (width * height)
         return image
 
     def close(self) -> None:

@@ -10,7 +10,14 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from headsim.sim.batch import BatchError, BatchRenderer, BatchSession, cuda_available
+from headsim.sim.batch import (
+    BatchError,
+    BatchRenderer,
+    BatchSession,
+    cuda_available,
+    window_intrinsic,
+)
+from headsim.sim.gl_window import Window
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import find_marker
@@ -176,3 +183,73 @@ def test_bad_sessions_name_what_is_allowed() -> None:
         BatchSession(samples_per_pixel=0)
     with pytest.raises(BatchError, match="device must be one of cpu, cuda, got 'gpu'"):
         BatchSession(device="gpu")
+
+
+def test_a_window_camera_covers_exactly_its_rectangle_of_the_canvas() -> None:
+    """Exact geometry: the whole canvas gives back the camera; a window's edges are the
+    canvas's pixel edges there (rays through the same points at unit depth)."""
+    intrinsic = np.array([0.0167, 0.0163, 0.0005, -0.0018])
+    sensor = np.array([0.01534, 0.01136])
+    canvas = (767, 568)
+    whole = window_intrinsic(intrinsic, sensor, canvas, (0.0, 0.0, 767.0, 568.0), canvas)
+    assert np.allclose(whole, intrinsic, rtol=1e-6, atol=1e-9)
+
+    def edges(k: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+        aspect = size[0] / size[1]
+        w, h = (
+            (sensor[0], sensor[0] / aspect)
+            if aspect > sensor[0] / sensor[1]
+            else (
+                sensor[1] * aspect,
+                sensor[1],
+            )
+        )
+        fx, fy, cx, cy = k
+        return np.array(
+            [-(w / 2 - cx) / fx, (w / 2 + cx) / fx, (h / 2 - cy) / fy, -(h / 2 + cy) / fy]
+        )
+
+    full = edges(intrinsic, canvas)
+    x0, y0, x1, y1 = 100.0, 40.0, 196.0, 72.0  # 96 x 32, another aspect than the sensor's
+    window = edges(
+        window_intrinsic(intrinsic, sensor, canvas, (x0, y0, x1, y1), (96, 32)), (96, 32)
+    )
+    expected = [
+        full[0] + (full[1] - full[0]) * x0 / 767,
+        full[0] + (full[1] - full[0]) * x1 / 767,
+        full[2] + (full[3] - full[2]) * y0 / 568,
+        full[2] + (full[3] - full[2]) * y1 / 568,
+    ]
+    assert np.allclose(window, expected, rtol=1e-5)
+
+
+@pytest.mark.parametrize("name", ["ideal", "paper"])
+def test_windows_and_previews_are_what_the_classic_renderer_takes(name: str) -> None:
+    """Only a window's rays are cast, on a rounded-up size; its marker lies where the
+    classic window puts it, and a binned preview finds the marker where the classic one does."""
+    with HeadSim(settings=preset(name)) as sim:
+        sim.move(eye=0.04)
+        full = find_marker(sim.render(1), "red").uv
+        assert full is not None
+        cam = sim.settings.cameras[0]
+        window = Window.around(full, 20.5, (cam.width, cam.height))
+        classic = find_marker(sim.render_window(1, window), "red").uv
+        preview = find_marker(sim.render_preview(1, 4), "red").uv
+        qpos = sim.data.qpos.copy()
+
+    def batch() -> tuple:
+        with HeadSim(settings=preset(name)) as head:
+            head.data.qpos[:] = qpos
+            head.move(eye=0.04)
+            return (
+                find_marker(head.render_window(1, window), "red").uv,
+                find_marker(head.render_preview(1, 4), "red").uv,
+                head.rendered_frames,
+            )
+
+    session = BatchSession()
+    ((win, prev, frames),) = session.run([batch])
+    assert win is not None and classic is not None and prev is not None and preview is not None
+    assert np.hypot(*np.subtract(win, classic)) <= CENTROID_TOLERANCE_PX
+    assert np.hypot(*np.subtract(prev, preview)) <= CENTROID_TOLERANCE_PX
+    assert frames < 0.2  # a 41 px window and a 1/16 preview: a small share of one frame
