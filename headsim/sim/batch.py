@@ -143,8 +143,15 @@ _SCENE_ARRAYS = (
     "light_cutoff",
     "light_exponent",
     "cam_projection",
-    "cam_sensorsize",
 )
+
+#: The sensor every Warp scene's cameras cast from (MuJoCo's ``cam_sensorsize``, which Warp
+#: holds per camera, not per world): each world's own sensor and intrinsics are expressed
+#: on it (:func:`window_intrinsic`), so heads of other sensors share a call.
+CAST_SENSOR = np.array([1.0, 1.0])
+#: The camera slot every world's image is cast in (the model's first camera): Warp renders
+#: only it; each world's own eye camera is put there.
+CAST_CAMERA = 0
 
 
 def _scene_digest(model: mujoco.MjModel) -> str:
@@ -202,10 +209,12 @@ def window_intrinsic(
     canvas_size: tuple[int, int],
     corners_px: tuple[float, float, float, float],
     size: tuple[int, int],
+    cast_sensor: np.ndarray | None = None,
 ) -> np.ndarray:
-    """The camera (fx, fy, cx, cy, m, MuJoCo's ``cam_intrinsic``) whose image of ``size``
-    px on the same sensor covers the canvas's rectangle ``corners_px`` (x0, y0, x1, y1, in
-    the canvas's pixels): the same rays as the canvas's pixels there, fewer to cast."""
+    """The camera (fx, fy, cx, cy, MuJoCo's ``cam_intrinsic``, in the units of the
+    sensor) whose image of ``size`` px on ``cast_sensor`` (default: the camera's own
+    ``sensor_m``) covers the canvas's rectangle ``corners_px`` (x0, y0, x1, y1, in the
+    canvas's pixels): the same rays as the canvas's pixels there, fewer to cast."""
     fx, fy, cx, cy = (float(v) for v in intrinsic_m)
     width, height = canvas_size
     sensor_w, sensor_h = _sensor_for(sensor_m, canvas_size)
@@ -216,7 +225,7 @@ def window_intrinsic(
     window_right = left + (right - left) * x1 / width
     window_top = top + (bottom - top) * y0 / height
     window_bottom = top + (bottom - top) * y1 / height
-    sensor_w, sensor_h = _sensor_for(sensor_m, size)
+    sensor_w, sensor_h = _sensor_for(sensor_m if cast_sensor is None else cast_sensor, size)
     fx_w = sensor_w / (window_right - window_left)
     fy_w = sensor_h / (window_top - window_bottom)
     cx_w = sensor_w / 2 + window_left * fx_w
@@ -224,17 +233,22 @@ def window_intrinsic(
     return np.array([fx_w, fy_w, cx_w, cy_w], np.float32)
 
 
-#: Windows are cast on sizes rounded up to this many pixels, so that heads whose windows
-#: differ a little share a Warp call; the extra pixels are cut off.
-WINDOW_STEP_PX = 32
+#: Windows are cast on sizes rounded up to a power of two, at least this many pixels, so
+#: that heads whose windows differ share a Warp call (and its kernel); the extra pixels
+#: are cut off.
+WINDOW_MIN_PX = 32
+
+
+def _cast_side(n: int) -> int:
+    return max(WINDOW_MIN_PX, 1 << (n - 1).bit_length())
 
 
 @dataclass(frozen=True)
 class _Kind:
-    """What worlds rendered together share: the scene, the camera, the image, the samples."""
+    """What worlds rendered together share: the scene, the image's size, the samples (each
+    world casts from its own camera, pose and intrinsics, in the scene's camera slot)."""
 
     digest: str
-    camera: int
     size: tuple[int, int]
     samples: int
 
@@ -244,6 +258,7 @@ class _Request:
     model: mujoco.MjModel
     kind: _Kind
     pose: _Pose
+    camera: int
     fovy: float
     intrinsic: np.ndarray
     keep: tuple[int, int]
@@ -275,9 +290,12 @@ class _Scene:
                 cam_res=[(width * kind.samples, height * kind.samples)],
                 render_rgb=True,
                 render_depth=False,
-                cam_active=[kind.camera],
+                cam_active=[CAST_CAMERA],
                 use_precomputed_rays=False,
                 deterministic=True,
+            )
+            self._m.cam_sensorsize = wp.array(
+                np.tile(CAST_SENSOR, (model.ncam, 1)).astype(np.float32), dtype=wp.vec2
             )
         self._fovy = np.tile(model.cam_fovy.astype(np.float32), (nworld, 1))
         self._intrinsic = np.tile(model.cam_intrinsic.astype(np.float32), (nworld, 1, 1))
@@ -291,15 +309,18 @@ class _Scene:
         def stacked(name: str) -> np.ndarray:
             return np.stack([getattr(r.pose, name) for r in rows]).astype(np.float32)
 
-        d, camera = self._d, self.kind.camera
-        for i, r in enumerate(rows):
-            self._fovy[i, camera] = r.fovy
-            self._intrinsic[i, camera] = r.intrinsic
+        d, slot = self._d, CAST_CAMERA
+        cam_xpos, cam_xmat = stacked("cam_xpos"), stacked("cam_xmat")
+        for i, r in enumerate(rows):  # each world's own camera, in the scene's one slot
+            cam_xpos[i, slot] = r.pose.cam_xpos[r.camera]
+            cam_xmat[i, slot] = r.pose.cam_xmat[r.camera]
+            self._fovy[i, slot] = r.fovy
+            self._intrinsic[i, slot] = r.intrinsic
         with wp.ScopedDevice(self._device):
             d.geom_xpos.assign(stacked("geom_xpos"))
             d.geom_xmat.assign(stacked("geom_xmat"))
-            d.cam_xpos.assign(stacked("cam_xpos"))
-            d.cam_xmat.assign(stacked("cam_xmat"))
+            d.cam_xpos.assign(cam_xpos)
+            d.cam_xmat.assign(cam_xmat)
             if d.light_xpos.shape[1]:
                 d.light_xpos.assign(stacked("light_xpos"))
                 d.light_xdir.assign(stacked("light_xdir"))
@@ -474,8 +495,7 @@ class BatchSession:
             )
         cast = size
         if (rect.width, rect.height) != canvas_size:  # a window: on a rounded-up size
-            step = WINDOW_STEP_PX
-            cast = (-(-size[0] // step) * step, -(-size[1] // step) * step)
+            cast = (_cast_side(size[0]), _cast_side(size[1]))
         scale_x, scale_y = rect.width / size[0], rect.height / size[1]  # canvas px per px
         corners = (
             float(rect.x0),
@@ -484,10 +504,11 @@ class BatchSession:
             rect.y0 + cast[1] * scale_y,
         )
         intrinsic = window_intrinsic(
-            model.cam_intrinsic[camera], sensor, canvas_size, corners, cast
+            model.cam_intrinsic[camera], sensor, canvas_size, corners, cast, CAST_SENSOR
         )
-        kind = _Kind(self._digest(model), int(camera), cast, samples)
-        return _Request(model, kind, pose, float(model.cam_fovy[camera]), intrinsic, size)
+        kind = _Kind(self._digest(model), cast, samples)
+        fovy = float(model.cam_fovy[camera])
+        return _Request(model, kind, pose, int(camera), fovy, intrinsic, size)
 
     def _digest(self, model: mujoco.MjModel) -> str:
         known = self._digests.get(id(model))
