@@ -4,6 +4,9 @@
 ``gymnasium.make("headsim/Fixate-v0")``.  In spawned worker processes
 (``gymnasium.make_vec(..., vectorization_mode="async",
 vector_kwargs={"context": "spawn"})``) the entry point imports this module.
+``gymnasium.make_vec(FIXATE_ID, num_envs=N, vectorization_mode="vector_entry_point")``
+makes :class:`headsim.envs.vector.FixateVectorEnv`: N heads rendered in batches by
+MuJoCo Warp (``headsim[batch]``).
 """
 
 from __future__ import annotations
@@ -16,6 +19,10 @@ except ImportError as err:  # pragma: no cover - depends on the install
 FIXATE_ID = "headsim/Fixate-v0"
 
 if FIXATE_ID not in gymnasium.registry:
-    gymnasium.register(id=FIXATE_ID, entry_point="headsim.envs.fixate:FixateEnv")
+    gymnasium.register(
+        id=FIXATE_ID,
+        entry_point="headsim.envs.fixate:FixateEnv",
+        vector_entry_point="headsim.envs.vector:FixateVectorEnv",
+    )
 
 __all__ = ["FIXATE_ID"]

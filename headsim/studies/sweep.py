@@ -223,6 +223,7 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
         else:
             result = run_scenario(scenario)
         calibrated = result.calibration is not None
+        acceptance = result.scenario.scene.acceptance
         ok = [r.measurement for r in result.records if r.measurement.ok]
         used = [
             r.measurement
@@ -241,6 +242,7 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
             mean_error_mm=float(np.mean(errors_mm)) if errors_mm else None,
             max_error_mm=float(np.max(errors_mm)) if errors_mm else None,
             renders=result.renders.overall.total,
+            targets_redrawn=acceptance.refused_total if acceptance is not None else 0,
             calibration_max_error_rad=float(
                 np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
             )

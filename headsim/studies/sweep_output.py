@@ -20,6 +20,7 @@ METRICS = (
     "mean_error_mm",
     "max_error_mm",
     "renders",
+    "targets_redrawn",
     "calibration_max_error_rad",
     "attempts",
 )
