@@ -64,6 +64,44 @@ def render_fidelity_presets() -> str:
     return table(("preset", "marker p50 / p95 px", "corner p50 / p95 px"), rows)
 
 
+#: Poses per preset of the batch renderer's centroid figures (``batch_render.py``: 16).
+BATCH_POSES = 16
+
+
+def batch_centroids() -> str:
+    """The batch renderer's marker centroid against the classic render's and the pinhole's,
+    per sub-pixel samples per axis, beside the classic renderer's own floor."""
+    from headsim.sim.settings import preset
+
+    br = benchmark("batch_render")
+    rows = []
+    for name in ("ideal", "paper"):
+        figures = br.agreement(preset(name), BATCH_POSES, 0, (1, 2, 4))
+
+        def cell(s: dict[str, float]) -> str:
+            return f"{s['median']:.3f} / {s['p95']:.3f} / {s['max']:.3f}"
+
+        rows.append((name, "classic (default)", "-", cell(figures["classic_to_truth_px"])))
+        for samples in (1, 2, 4):
+            f = figures[f"spp{samples}"]
+            rows.append(
+                (
+                    name,
+                    f"batch, {samples} x {samples}",
+                    cell(f["to_classic_px"]),
+                    cell(f["to_truth_px"]),
+                )
+            )
+    return (
+        f"{BATCH_POSES} seeded eye and neck poses x 2 eyes per preset, the red marker's centroid "
+        "(px, median / p95 / max):\n\n"
+        + table(
+            ("cameras", "renderer, samples per pixel", "to the classic render", "to the pinhole"),
+            rows,
+        )
+    )
+
+
 # --- relative positioning over all twelve areas -------------------------------------
 
 #: Objects per area (``relative_areas.py``: 20), and per area in the other seed and preset.

@@ -266,6 +266,7 @@ GENERATORS: dict[str, Generator] = {
     "render_fidelity_presets": Generator(
         servo.render_fidelity_presets, cheap=False, group="fidelity", seconds=20
     ),
+    "batch_centroids": Generator(servo.batch_centroids, cheap=False, seconds=60),
 }
 
 

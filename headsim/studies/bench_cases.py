@@ -80,6 +80,8 @@ CASES: dict[str, BenchCase] = {
         BenchCase("live_gaze", "figures", "live_gaze.py"),
         BenchCase("gym_env", "figures", "gym_env.py"),
         BenchCase("batch_render", "figures", "batch_render.py"),
+        BenchCase("batch_env", "figures", "batch_env.py"),
+        BenchCase("batch_sweep", "long", "batch_sweep.py"),
         BenchCase("render_fidelity", "long", "render_fidelity.py"),
         BenchCase("relative_areas", "long", "relative_areas.py"),
         BenchCase("reach_and_zoom", "long", "reach_and_zoom.py"),
