@@ -79,17 +79,12 @@ def sweep_command(args: argparse.Namespace) -> int:
         where = (
             f"Dask at {args.scheduler}" if args.scheduler else f"{args.workers} local process(es)"
         )
-        device = args.device or spec.batch.device
-        if args.device and spec.backend != "batch":
-            raise BadInput(
-                f"--device {args.device}: the sweep's backend is {spec.backend!r}; "
-                'allowed only with backend = "batch"'
-            )
-        if spec.backend == "batch":
-            samples = spec.batch.samples_per_pixel
+        batch = sweep.batch_options(spec, args.device)  # refused before it is announced
+        if batch is not None:
+            samples = batch.samples_per_pixel or "the head's"
             where += (
-                f", batch back-end: MuJoCo Warp on {device}, up to {spec.batch.worlds} heads "
-                f"per batch, sub-pixel samples per axis: {samples or 'the head' + chr(39) + 's'}"
+                f", batch back-end: MuJoCo Warp on {batch.device}, up to {batch.worlds} heads "
+                f"per batch, sub-pixel samples per axis: {samples}"
             )
         print(f"  running on {where}; log {Path(args.out) / 'jobs.jsonl'}", flush=True)
         with sigterm_interrupts():
@@ -117,14 +112,10 @@ def sweep_command(args: argparse.Namespace) -> int:
         f"{outcome.ran} jobs run ({outcome.skipped} already done) in {outcome.wall_s:.1f} s, "
         f"{rate:.1f} jobs/min; {len(outcome.failed)} failed"
     )
-    if outcome.rendered:
-        r = outcome.rendered
-        mean = r.get("images", 0) / r["calls"] if r.get("calls") else 0.0
-        print(
-            f"batch back-end: MuJoCo Warp on {device} rendered {int(r.get('images', 0))} "
-            f"images in {int(r.get('calls', 0))} calls (mean {mean:.1f}, largest "
-            f"{int(r.get('largest', 0))}), {r.get('render_s', 0.0):.1f} s rendering"
-        )
+    if batch is not None and outcome.rendered:
+        from headsim.sim.batch import BatchStats
+
+        print(f"batch back-end: {BatchStats.of(outcome.rendered).describe(batch.device)}")
     for kind, path in outcome.files.items():
         print(f"  {kind:18s} {path}")
     return 1 if outcome.failed else 0

@@ -356,6 +356,24 @@ class BatchStats:
     def mean_batch(self) -> float:
         return self.images / self.calls if self.calls else 0.0
 
+    @classmethod
+    def of(cls, totals: dict[str, float]) -> BatchStats:
+        """The stats of ``totals`` (a sweep's sums over its batches)."""
+        return cls(
+            calls=int(totals.get("calls", 0)),
+            images=int(totals.get("images", 0)),
+            largest=int(totals.get("largest", 0)),
+            render_s=float(totals.get("render_s", 0.0)),
+        )
+
+    def describe(self, device: str) -> str:
+        """What was rendered on ``device``, in words."""
+        return (
+            f"MuJoCo Warp on {device}: {self.images} images in {self.calls} batches "
+            f"(mean {self.mean_batch:.1f}, largest {self.largest}), "
+            f"{self.render_s:.1f} s rendering"
+        )
+
 
 class BatchSession:
     """N heads in lockstep, their images rendered together through MuJoCo Warp.
@@ -379,11 +397,7 @@ class BatchSession:
 
     def describe(self) -> str:
         """Which device ran and what it rendered, in words."""
-        s = self.stats
-        return (
-            f"MuJoCo Warp on {self.device}: {s.images} images in {s.calls} batches "
-            f"(mean {s.mean_batch:.1f}, largest {s.largest}), {s.render_s:.1f} s rendering"
-        )
+        return self.stats.describe(self.device)
 
     # -- lockstep --------------------------------------------------------------
     def run(self, calls: Sequence[Callable[[], T]]) -> list[T]:

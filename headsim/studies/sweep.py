@@ -40,7 +40,7 @@ import os
 import signal
 import time
 import traceback
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -104,17 +104,7 @@ def run_batch(batch: Batch, marker_dir: str | None, options: BatchOptions) -> di
         records = session.run([functools.partial(_run_job, job) for job in batch.jobs])
         for job_record in records:
             job_record["backend"] = "batch"
-        stats = session.stats
-        record.update(
-            status="ok",
-            records=records,
-            rendered={
-                "images": stats.images,
-                "calls": stats.calls,
-                "largest": stats.largest,
-                "render_s": stats.render_s,
-            },
-        )
+        record.update(status="ok", records=records, rendered=asdict(session.stats))
     except Exception as err:  # Warp failed: the batch's jobs are recorded as errors
         record.update(status="error", error=f"{type(err).__name__}: {err}")
     finally:
@@ -199,6 +189,24 @@ def _execute_batches(
         if again and stop_after is None:
             rounds.append((_batches(sorted(again, key=lambda j: j.index), 1, 1, 2), False))
     return finished
+
+
+def batch_options(spec: SweepSpec, device: str | None = None) -> BatchOptions | None:
+    """The batch back-end's options, with ``device`` in place of the file's where given,
+    once Warp and that device are known to run here; None on the classic back-end (which
+    takes no device)."""
+    if spec.backend != "batch":
+        if device is not None:
+            raise BadInput(
+                f"device {device!r}: the sweep's backend is {spec.backend!r}; "
+                'allowed only with backend = "batch"'
+            )
+        return None
+    from headsim.sim.batch import check_device
+
+    options = spec.batch if device is None else replace(spec.batch, device=device)
+    check_device(options.device)
+    return options
 
 
 def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
@@ -320,16 +328,12 @@ def run_sweep(
     ``recording``: record every job (:func:`run_job`; the classic back-end only).
     ``device``: the batch back-end's device instead of the file's ``batch.device``.
     """
-    options = spec.batch if device is None else replace(spec.batch, device=device)
-    if spec.backend == "batch":
-        from headsim.sim.batch import check_device
-
-        check_device(options.device)  # a missing extra or GPU is said before any job runs
-        if recording is not None:
-            raise BadInput(
-                'recording (--rrd, --connect) is not available with backend = "batch"; '
-                'allowed: backend = "classic"'
-            )
+    options = batch_options(spec, device)  # a missing extra or GPU is said before any job runs
+    if options is not None and recording is not None:
+        raise BadInput(
+            'recording (--rrd, --connect) is not available with backend = "batch"; '
+            'allowed: backend = "classic"'
+        )
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     log = out / "jobs.jsonl"
@@ -356,10 +360,10 @@ def run_sweep(
         if bar is not None:
             bar.update(note="" if record.get("status") == "ok" else "(this one failed)")
 
-    rendered: dict[str, float] | None = {} if spec.backend == "batch" else None
+    rendered: dict[str, float] = {}
 
     def run_all(make_executor: Any, markers: Path | None, pool_size: int) -> int:
-        if rendered is not None:
+        if options is not None:
             return _execute_batches(
                 remaining,
                 options,
@@ -395,7 +399,7 @@ def run_sweep(
         ran=ran,
         skipped=len(spec.jobs) - len(remaining),
         wall_s=wall,
-        rendered=rendered,
+        rendered=None if options is None else rendered,
     )
     if len(outcome.records) == len(spec.jobs):
         outcome.files = write_aggregate(spec, outcome.records, out)
