@@ -8,7 +8,7 @@ floor that anti-aliasing lowers).  Then images per second of each, as ratios
 measured in this run, for several batch sizes and two image sizes (the batch renderer
 at one ray per pixel, the classic at its default: 2 x 2 supersampling and 4x MSAA).
 
-    python benchmarks/batch_render.py [--poses 32] [--device cpu] [--json F]
+    python benchmarks/batch_render.py [--poses 16] [--device cpu] [--json F]
 """
 
 from __future__ import annotations

@@ -73,14 +73,13 @@ def batch_centroids() -> str:
     per sub-pixel samples per axis, beside the classic renderer's own floor."""
     from headsim.sim.settings import preset
 
+    def cell(s: dict[str, float]) -> str:
+        return f"{s['median']:.3f} / {s['p95']:.3f} / {s['max']:.3f}"
+
     br = benchmark("batch_render")
     rows = []
     for name in ("ideal", "paper"):
         figures = br.agreement(preset(name), BATCH_POSES, 0, (1, 2, 4))
-
-        def cell(s: dict[str, float]) -> str:
-            return f"{s['median']:.3f} / {s['p95']:.3f} / {s['max']:.3f}"
-
         rows.append((name, "classic (default)", "-", cell(figures["classic_to_truth_px"])))
         for samples in (1, 2, 4):
             f = figures[f"spp{samples}"]

@@ -12,15 +12,17 @@ call; the batch ends when the last one does.
 
 Each image is then finished exactly as the classic renderer finishes its own
 (:class:`~headsim.sim.render.EyeRenderer`): the lens by remap, the camera's noise from
-the same stream, the same counts.  A window is the full frame's crop, a preview its
-b x b area average.  Anti-aliasing: ``samples_per_pixel`` x ``samples_per_pixel``
-rays per pixel on a regular grid, averaged, by default the head's ``render.supersample``
-(the classic path's supersampling, without its MSAA).
+the same stream, the same counts.  A window casts only its own pixels' rays (a camera
+whose intrinsics cover just that rectangle, :func:`window_intrinsic`, on a size rounded
+up to a power of two), a preview one ray per binned pixel.  Anti-aliasing:
+``samples_per_pixel`` x ``samples_per_pixel`` rays per pixel on a regular grid, averaged,
+by default the head's ``render.supersample`` (the classic path's supersampling, without
+its MSAA).
 
-Worlds share one Warp call when they share the scene, the camera, the image size and the
-samples; their poses and their cameras' intrinsics (focal length, principal point) are
-each world's own, read from Warp's per-world camera parameters.  Other worlds are
-grouped by camera.
+Worlds share one Warp call when they share the scene, the cast size and the samples:
+each casts from its own eye's pose and intrinsics (focal length, principal point) in
+one camera slot, through Warp's per-world camera parameters, so heads of other cameras
+and lenses share a call.
 
 This module is the one adapter to ``mujoco_warp`` and ``warp`` (the ``batch`` extra:
 ``pip install 'headsim[batch]'``); they are imported only when a session is made.

@@ -26,9 +26,9 @@ images rendered together by MuJoCo Warp (``headsim[batch]``)::
     samples_per_pixel = 1            # Warp's sub-pixel samples per axis (default: the head's)
     device = "cpu"                   # or "cuda"
 
-  Jobs are appended to ``DIR/jobs.jsonl`` as they finish, so an
-interrupted sweep resumes where it stopped; a job that fails or crashes its
-process is retried once, then recorded as failed, and the rest go on.  At the
+Jobs are appended to ``DIR/jobs.jsonl`` as they finish, so an interrupted sweep
+resumes where it stopped; a job that fails or crashes its process is retried once,
+then recorded as failed, and the rest go on.  At the
 end ``DIR/aggregate.csv``, ``DIR/aggregate.json`` and a plot per swept field.
 """
 
