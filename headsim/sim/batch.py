@@ -31,11 +31,14 @@ Warp runs on the CPU by default, on a GPU with ``device="cuda"`` where it finds 
 
 from __future__ import annotations
 
+import contextlib
+import ctypes.util
 import hashlib
 import importlib
+import os
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, TypeVar
@@ -70,11 +73,40 @@ class _Warp:
     mjw: ModuleType
 
 
+@contextlib.contextmanager
+def _stderr_closed() -> Iterator[None]:
+    """Native writes to file descriptor 2 go to /dev/null while inside."""
+    saved = os.dup(2)
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+def _start_warp(wp: ModuleType) -> None:
+    """Start Warp's runtime; quietly where this machine has no CUDA driver at all.
+
+    Warp's native start-up prints "Could not find or load the NVIDIA CUDA driver"
+    with ``fprintf`` whenever ``libcuda`` is missing, which on a CPU-only machine
+    says nothing the user asked about.  Only then is its stderr closed, and only
+    around the start; with a driver present every message goes through.
+    """
+    if ctypes.util.find_library("cuda") is not None:
+        wp.init()
+        return
+    with _stderr_closed():
+        wp.init()
+
+
 def _warp() -> _Warp:
     try:
         wp = importlib.import_module("warp")
         # Warnings only (not each kernel module's load time), before mujoco_warp starts Warp.
         wp.config.log_level = wp.LOG_WARNING
+        _start_warp(wp)
         mjw = importlib.import_module("mujoco_warp")
     except ImportError as err:
         raise BatchError(

@@ -253,3 +253,19 @@ def test_windows_and_previews_are_what_the_classic_renderer_takes(name: str) -> 
     assert np.hypot(*np.subtract(win, classic)) <= CENTROID_TOLERANCE_PX
     assert np.hypot(*np.subtract(prev, preview)) <= CENTROID_TOLERANCE_PX
     assert frames < 0.2  # a 41 px window and a 1/16 preview: a small share of one frame
+
+
+def test_warp_starts_without_a_cuda_warning_on_a_machine_without_the_driver() -> None:
+    """Warp's native start-up complains about a missing libcuda; users here asked for no GPU."""
+    import ctypes.util
+    import subprocess
+    import sys
+
+    code = "from headsim.sim.batch import cuda_available; print(cuda_available())"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    if ctypes.util.find_library("cuda") is not None:
+        print("\nbatch: a CUDA driver is installed here; the quiet start-up did not run")
+        assert done.stdout.strip() in {"True", "False"}
+        return
+    assert done.stdout.strip() == "False"
+    assert "CUDA" not in done.stderr, done.stderr
