@@ -67,7 +67,6 @@ IMPERFECTION_KEYS = [
     ("[belief]\nbaseline_m = 0.149", lambda s: s.settings.believed.baseline_m, 0.149),
     ("[belief]\nneck_d1_m = 0.121", lambda s: s.settings.believed.neck_d1_m, 0.121),
     ("[belief]\nneck_a2_m = 0.089", lambda s: s.settings.believed.neck_a2_m, 0.089),
-    ("[belief]\nnodal_offset_m = [0.01, 0.02]", lambda s: s.settings.believed.nodal_offset_m, (0.01, 0.02)),
     ("[belief]\nside_offset_m = [0.001, -0.001]", lambda s: s.settings.believed.side_offset_m, (0.001, -0.001)),
     ("[experiment.calibration]\ndepth_noise_m = 0.002", lambda s: s.experiment.calibration.depth_noise_m, 0.002),
     ("[experiment.calibration]\nposition_noise_m = 0.001", lambda s: s.experiment.calibration.position_noise_m, 0.001),
