@@ -40,7 +40,6 @@ def run_command(args: argparse.Namespace) -> int:
     from headsim.run.serialise import results_payload
     from headsim.run.summary import summary_text
     from headsim.scenario.loading import load_scenario
-
     from headsim.scenario.tables import ScenarioError
 
     head = getattr(args, "head", None)

@@ -68,9 +68,9 @@ from headsim.live.paths import Static, Waypoints
 from headsim.sim.heads import HeadModel, shipped
 from headsim.sim.model import design, neck_of, on_head
 from headsim.sim.settings import (
+    BELIEF_KEYS,
     CAMERA_NUMBER_FIELDS,
     IDEAL_FOCAL_PX,
-    BELIEF_KEYS,
     CameraSettings,
     HeadBelief,
     HeadSettings,

@@ -264,7 +264,8 @@ def belief_text(scenario: Scenario) -> str:
         if key in values:
             groups.setdefault(source, []).append(values[key])
     return "belief: " + "; ".join(
-        f"{', '.join(parts)}: {_SOURCE_TEXT.get(source, source)}" for source, parts in groups.items()
+        f"{', '.join(parts)}: {_SOURCE_TEXT.get(source, source)}"
+        for source, parts in groups.items()
     )
 
 

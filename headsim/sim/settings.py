@@ -8,8 +8,8 @@ pixel (i, j) is at (i, j), so the geometric centre of a W x H image is
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, replace
 from collections.abc import Collection
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 from headsim.errors import BadInput
