@@ -196,3 +196,18 @@ def test_servo_windows_reach_the_servo_and_are_recorded_when_set(tmp_path: Path)
     off = load_scenario(path)
     assert servo_config(off).windows is False
     assert servo_record(off.experiment.servo)["windows"] is False
+
+
+@pytest.mark.parametrize(
+    ("text", "sources"),
+    [
+        ("", "design design design design design"),
+        ("[head]\nbaseline_m = 0.1512\n", "truth design design design design"),
+        ("[head]\nbaseline_m = 0.1512\n[belief]\nneck_d1_m = 0.121\n", "design file design design design"),
+        ('[head]\npreset = "realistic"\n', "preset preset preset preset preset"),
+        ('[head]\npreset = "realistic"\n[belief]\nside_offset_m = [0.001, 0.0]\n', "preset preset preset preset file"),
+    ],
+)  # fmt: skip
+def test_each_believed_quantity_says_where_it_came_from(tmp_path, text: str, sources: str) -> None:
+    scenario = load_scenario(write_scenario(tmp_path, MINIMAL + text))
+    assert " ".join(scenario.believed_from.values()) == sources
