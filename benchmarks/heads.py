@@ -253,10 +253,7 @@ def study(args: argparse.Namespace) -> list[dict[str, Any]]:
                         # Built and believed scaled alike: a head built to another design.
                         believed = settings.believed
                         doc["head"]["baseline_m"] = settings.baseline_m * scale
-                        doc["belief"] = {
-                            "baseline_m": believed.baseline_m * scale,
-                            "nodal_offset_m": list(believed.nodal_offset_m),
-                        }
+                        doc["belief"] = {"baseline_m": believed.baseline_m * scale}
                         value = believed.baseline_m * scale
                     else:
                         cameras = {"kx": camera.kx * scale, "ky": camera.ky * scale}

@@ -84,7 +84,8 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     run.add_argument(
         "--head",
         metavar="HEAD",
-        help="run on another shipped head: paper, independent_eyes (sets head.model)",
+        help="run on another head: paper, independent_eyes, icub or an MJCF file's path "
+        "(sets head.model)",
     )
     run.add_argument(
         "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"

@@ -40,9 +40,18 @@ def run_command(args: argparse.Namespace) -> int:
     from headsim.run.serialise import results_payload
     from headsim.run.summary import summary_text
     from headsim.scenario.loading import load_scenario
+    from headsim.scenario.tables import ScenarioError
 
-    overrides = None if getattr(args, "head", None) is None else {"head.model": args.head}
-    scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed, overrides=overrides)
+    head = getattr(args, "head", None)
+    if head is not None and Path(head).is_file():
+        head = str(Path(head).resolve())  # a flag's path is the shell's, not the file's
+    overrides = None if head is None else {"head.model": head}
+    try:
+        scenario = load_scenario(args.scenario, fast=args.fast, seed=args.seed, overrides=overrides)
+    except ScenarioError as err:
+        if overrides is None or err.field != "head.model":
+            raise
+        raise ScenarioError("--head", "", err.problem, err.allowed) from None
     target = recording_target(args)  # a bad --url or port is bad input (exit 2)
     raise_if_interrupted()  # an interrupt swallowed while loading: nothing written yet
     outputs = Outputs()
@@ -89,7 +98,7 @@ def run_command(args: argparse.Namespace) -> int:
         if recorder is not None and not target.serve:
             close_recorder(recorder, rrd)
         wall = time.perf_counter() - start
-        text = summary_text(result)
+        text = summary_text(result, getattr(args, "head", None))
         write_all(
             {
                 out / "results.json": results_payload(result),

@@ -19,8 +19,11 @@ encoders and the *believed* D-H lengths (``belief``; no truth) -- scored
 against the truth: minus its 3-D error over the marker's true distance from
 the true eyes' centre at rest, capped at 1 (-1 when there is no estimate).
 
-``belief``: the geometry the head believes it has (None: as built, the
-simulator's convention: the drawn ``baseline_m`` and the nominal neck).
+``belief``: the geometry the head believes it has (None: its design, the
+undrawn head's baseline and neck, so that a randomised ``baseline_m`` moves the
+truth and not the belief).  ``env.unwrapped.belief_sources``: where each
+believed quantity came from (``design`` or ``given``; results.json's
+``belief.sources``).
 
 Observation and ``info`` carry no truth except ``info["truth_world_m"]``:
 ``found`` and ``offsets_px`` (the marker's image offsets, px, NaN when not
@@ -65,6 +68,7 @@ from headsim.live.paths import Static, Waypoints
 from headsim.sim.heads import HeadModel, shipped
 from headsim.sim.model import design, neck_of, on_head
 from headsim.sim.settings import (
+    BELIEF_KEYS,
     CAMERA_NUMBER_FIELDS,
     IDEAL_FOCAL_PX,
     CameraSettings,
@@ -178,6 +182,10 @@ class FixateEnv(gymnasium.Env):
             on_head(HeadSettings(cameras=(camera, camera), belief=belief), head_model),
             cameras=(camera, camera),
         )
+        #: Where each believed quantity came from (:func:`belief_sources`).
+        self.belief_sources = dict.fromkeys(BELIEF_KEYS, "design" if belief is None else "given")
+        if belief is None:  # the design's, fixed: a drawn baseline_m is not believed
+            self.base_settings = replace(self.base_settings, belief=self.base_settings.believed)
         self.knowledge = HeadKnowledge()  # uncalibrated: the simulator's belief, no alpha_e
         self.defaults = {
             "depth_m": (0.5, 1.5),

@@ -168,6 +168,8 @@ class RunProgress:
 
     def notify(self, event: object, at: Stamp) -> None:
         if isinstance(event, PhaseStarted):
+            # Every fixation begun before a phase has ended (``at.step`` is the last one's).
+            self.counter.done = max(self.counter.done, at.step + 1)
             self.counter.phase(event.name)
         elif isinstance(event, FixationStarted):
             self.counter.update(at.step, event.label)

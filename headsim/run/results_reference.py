@@ -78,8 +78,13 @@ RESULTS_FIELDS: dict[str, str] = {
     "belief.baseline_m": "the believed baseline, m",
     "belief.neck_d1_m": "the believed neck d1, m",
     "belief.neck_a2_m": "the believed neck a2, m",
-    "belief.nodal_offset_m": "the believed nodal offset, m",
+    "belief.nodal_offset_m": "the believed nodal offset, m (recorded; no estimate uses it, "
+    "since it acts only through the goal column's angle off the optical axis)",
     "belief.side_offset_m": "the believed side offset, m",
+    "belief.sources": "where each believed quantity above came from: `design` (the head's "
+    "design), `preset` (the realistic preset's own belief), `file` (the scenario's "
+    "`[belief]`), `given` (a `HeadBelief` given in Python), or `truth` (equal to the true "
+    "head's, which the scenario changed in `[head]` and the belief followed)",
     "render_counts": "every image the simulator drew, each one a render",
     "render_counts.*": "one phase: `calibration`, `experiment` or `overall`",
     "render_counts.*.images": "full frames",

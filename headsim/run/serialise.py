@@ -179,7 +179,7 @@ def results_payload(result: RunResult) -> dict[str, Any]:
         "software": software_versions(),
         "settings": {**settings_record(s.settings), "settle_mode": s.settle_mode},
         # The truth above; what the head believes (and its estimators use) here.
-        "belief": asdict(s.settings.believed),
+        "belief": {**asdict(s.settings.believed), "sources": s.believed_from},
         "render_counts": result.renders.as_dict(),
         "rendered_frames": result.rendered_frames,
         "calibration": None

@@ -127,7 +127,9 @@ def _measurement_lines(result: RunResult) -> list[str]:
     tracking = any(r.time_s is not None for r in records)
     several = len({r.knowledge for r in records}) > 1
     headers = ["name", *(["t s"] if tracking else []), *(["head knew"] if several else [])]
-    headers += ["status", "depth m", "error mm", "% depth", "renders", "residual px"]
+    pairs = any(len(r.measurement.servo_residual_px) == 2 for r in records)
+    residual_header = "residual px (Ca1 Ca2)" if pairs else "residual px"
+    headers += ["status", "depth m", "error mm", "% depth", "renders", residual_header]
     rows = []
     for r in records:
         m = r.measurement
@@ -159,7 +161,7 @@ def _measurement_lines(result: RunResult) -> list[str]:
             f"<= {_cell(s.servo_residual_px_max, '.2f')} px"
         )
         if acceptance is not None and acceptance.drawn and s.count == acceptance.accepted:
-            lines.append(f"  head knew {label}: {_acceptance_text(s.ok, acceptance)}")
+            lines.append(f"    {_acceptance_text(s.ok, acceptance)}")
         if s.searched:
             scanned = (
                 f" ({s.scanned} scanned for where the head's pose did not show them: "
@@ -168,17 +170,20 @@ def _measurement_lines(result: RunResult) -> list[str]:
                 else ""
             )
             lines.append(
-                f"  head knew {label}: {s.searched} targets searched for again, "
+                f"    {s.searched} targets searched for again, "
                 f"{s.search_renders} renders of search{scanned}"
             )
         if s.failure_causes:
             causes = ", ".join(f"{n} {c}" for c, n in s.failure_causes.items())
-            lines.append(f"  head knew {label}: failures by cause: {causes}")
+            lines.append(f"    failures by cause: {causes}")
         bands = "; ".join(
-            f"{b.band}: {_cell(b.error_pct_of_depth_rms, '.3f')} % ({b.count})" for b in s.by_depth
+            f"{b.band}: {_cell(b.error_pct_of_depth_rms, '.3f')} % ({b.count})"
+            if b.count
+            else f"{b.band}: no targets"
+            for b in s.by_depth
         )
         lines.append(
-            f"    whole field, all {s.ok} targets: 3-D error RMS "
+            f"    {_targets_text(s.ok, s.count, acceptance)}: 3-D error RMS "
             f"{_cell(s.error_pct_of_depth_rms, '.3f')} % of depth; by depth: {bands}"
         )
         g = s.outside_start_view
@@ -189,6 +194,17 @@ def _measurement_lines(result: RunResult) -> list[str]:
                 f"{_cell(g.error_pct_of_depth_rms, '.3f')} % of depth"
             )
     return lines
+
+
+def _targets_text(ok: int, count: int, a: TargetAcceptance | None) -> str:
+    """Which targets the RMS is over: "the whole field" only for targets drawn over it."""
+    measured = f"all {ok} targets measured" if ok == count else f"the {ok} of {count} measured"
+    if a is None or not a.drawn:
+        return f"{measured} (placed by hand)"
+    drawn = a.accepted - a.listed
+    if not a.listed:
+        return f"whole field, {measured} (drawn over it)"
+    return f"{measured} ({a.listed} placed by hand, {drawn} drawn over the field)"
 
 
 def _acceptance_text(ok: int, a: TargetAcceptance) -> str:
@@ -221,13 +237,50 @@ def _head_text(scenario: Scenario) -> str:
     return "" if head.is_paper else f"{head.name} ({head.mapping.eyes} eyes), "
 
 
-def summary_text(result: RunResult) -> str:
-    """The table printed at the end of a run (figures of the paper beside ours for its head)."""
+#: How the summary names where a believed quantity came from (``belief.sources``).
+_SOURCE_TEXT = {
+    "design": "from the design",
+    "preset": "the preset's belief",
+    "file": "from [belief]",
+    "given": "given",
+    "truth": "equal to the truth (set in [head], no [belief])",
+}
+
+
+def belief_text(scenario: Scenario) -> str:
+    """ "belief: baseline 150 mm, neck d1 120 mm, a2 90 mm: from the design; ..." -- what the
+    estimators used and where each came from (the forward offsets, which none uses, left out)."""
+    b = scenario.settings.believed
+    values = {
+        "baseline_m": f"baseline {1e3 * b.baseline_m:g} mm",
+        "neck_d1_m": f"neck d1 {1e3 * b.neck_d1_m:g} mm",
+        "neck_a2_m": f"neck a2 {1e3 * b.neck_a2_m:g} mm",
+        "side_offset_m": "side offsets "
+        + "/".join(f"{1e3 * v:g}" for v in b.side_offset_m)
+        + " mm",
+    }
+    groups: dict[str, list[str]] = {}
+    for key, source in scenario.believed_from.items():
+        if key in values:
+            groups.setdefault(source, []).append(values[key])
+    return "belief: " + "; ".join(
+        f"{', '.join(parts)}: {_SOURCE_TEXT.get(source, source)}"
+        for source, parts in groups.items()
+    )
+
+
+def summary_text(result: RunResult, head_flag: str | None = None) -> str:
+    """The table printed at the end of a run (figures of the paper beside ours for its
+    head).  ``head_flag``: the head ``--head`` put in place of the file's (the file's
+    description, written for its own head, is then left out)."""
     s = result.scenario
     paper = s.paper_cameras
     e = result.experiment
+    variant = " (fast variant)" if s.fast else ""
     lines = [
-        f"{s.name}{' (fast variant)' if s.fast else ''}: {s.description}",
+        f"{s.name}{variant}: {s.description}"
+        if head_flag is None
+        else f"{s.name}{variant} with --head {head_flag} (the file describes its own head)",
         f"head: {_head_text(s)}{s.preset} preset; seed {s.seed}; procedure {s.experiment.procedure}; "
         f"{_renders_text(result.renders.overall)}"
         + (
@@ -236,6 +289,7 @@ def summary_text(result: RunResult) -> str:
             else ""
         )
         + ("; the paper's figures beside ours" if paper else ""),
+        belief_text(s),
         "",
     ]
     if result.calibration is not None:
@@ -256,4 +310,4 @@ def summary_text(result: RunResult) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["format_table", "summary_text"]
+__all__ = ["belief_text", "format_table", "summary_text"]

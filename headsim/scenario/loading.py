@@ -198,7 +198,7 @@ def _build(
     description = top.string("description")
     file_seed = top.integer("seed", 0, 0, 2**32 - 1)
     seed = file_seed if seed is None else seed
-    settings, preset_name, settle = read_head(top, ctx, path.parent)
+    settings, preset_name, settle, sources = read_head(top, ctx, path.parent)
     settings = replace(settings, seed=seed)
     experiment = read_experiment(top, ctx, preset_name)
     _check_head_fits(settings, experiment.procedure, ctx)
@@ -250,6 +250,7 @@ def _build(
         scene=scene,
         experiment=experiment,
         stored_calibration=stored,
+        belief_sources=sources,
     )
     _check_servo(ctx, scenario)
     check_reach(ctx, scenario)

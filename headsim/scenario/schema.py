@@ -38,6 +38,7 @@ from headsim.sim.settings import (
     HeadSettings,
     RenderFidelity,
     SettingsError,
+    belief_sources,
     preset,
 )
 
@@ -159,7 +160,11 @@ def _read_head_model(head: Table, ctx: Context, directory: Path) -> HeadModel:
     m = mapping_table
 
     def joint_name(key: str, default: Any = MISSING) -> Any:
-        return m.string(key, default)
+        kind = {"head_body": "body", "version": "actuator", "vergence": "actuator"}
+        what = f"the name of a {kind.get(key, 'joint')} in the head's MJCF file"
+        if default is not MISSING:
+            what += " (or leave it out)"
+        return m.string(key, default, what=what)
 
     cameras = m._get("cameras")
     if not (
@@ -212,8 +217,9 @@ def _designed(model: HeadModel, ctx: Context) -> None:
 
 def read_head(
     doc: Table, ctx: Context, directory: Path | None = None
-) -> tuple[HeadSettings, str, str]:
-    """``[head]`` with ``[cam1]``, ``[cam2]``: the head's settings, preset name, settle mode.
+) -> tuple[HeadSettings, str, str, dict[str, str]]:
+    """``[head]`` with ``[cam1]``, ``[cam2]``, ``[belief]``: the head's settings, preset
+    name, settle mode, and where each believed quantity came from (:func:`belief_sources`).
 
     On another head than the paper's, the lengths start from its design: a preset's
     departure from the paper's design is added to it."""
@@ -285,6 +291,7 @@ def read_head(
                 mount_roll_rad=roll[index],
             )
         )
+    belief_table = doc.table("belief")
     try:
         settings = HeadSettings(
             baseline_m=baseline,
@@ -294,13 +301,15 @@ def read_head(
             cameras=(cameras[0], cameras[1]),
             backlash_rad=backlash,
             count_error=count_error,
-            belief=_read_belief(doc.table("belief"), base),
+            belief=_read_belief(belief_table, base),
             render=RenderFidelity(offsamples=offsamples, supersample=supersample),
             head=head_model,
         )
     except SettingsError as err:  # pragma: no cover - the checks above are stricter
         raise ctx.error("head", str(err)) from err
-    return settings, preset_name, settle
+    given = () if belief_table is None else tuple(belief_table.data)
+    sources = belief_sources(settings, base, given=given, source="file")
+    return settings, preset_name, settle, sources
 
 
 def _read_belief(table: Table | None, base: HeadSettings) -> HeadBelief | None:
@@ -311,18 +320,27 @@ def _read_belief(table: Table | None, base: HeadSettings) -> HeadBelief | None:
     """
     if table is None:
         return base.belief
+    if "nodal_offset_m" in table.data:
+        # s = e cos t - n sin t (docs/equations.md): n acts only through the goal column's
+        # angle t off the optical axis, which takes the intrinsics the head does not know.
+        raise table.fail(
+            "nodal_offset_m",
+            "no estimate can use a believed forward offset (it acts only through the goal "
+            "column's angle off the optical axis, which needs the intrinsics)",
+            "leave it out: set the true [cam1]/[cam2] nodal_offset_m, and measure each line "
+            "of sight's offset with [experiment.calibration] lines_of_sight = true",
+        )
     nominal = base.believed
     baseline = table.number("baseline_m", nominal.baseline_m, 0.0, 1.0, lo_open=True, unit="m")
     d1 = table.number("neck_d1_m", nominal.neck_d1_m, 0.0, 2.0, unit="m")
     a2 = table.number("neck_a2_m", nominal.neck_a2_m, 0.0, 1.0, unit="m")
-    nodal = table.numbers("nodal_offset_m", 2, nominal.nodal_offset_m, -0.05, 0.1, unit="m")
     side = table.numbers("side_offset_m", 2, nominal.side_offset_m, -0.02, 0.02, unit="m")
     table.done()
     return HeadBelief(
         baseline_m=baseline,
         neck_d1_m=d1,
         neck_a2_m=a2,
-        nodal_offset_m=(nodal[0], nodal[1]),
+        nodal_offset_m=nominal.nodal_offset_m,
         side_offset_m=(side[0], side[1]),
     )
 

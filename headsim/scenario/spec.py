@@ -18,7 +18,7 @@ import numpy as np
 from headsim import paper
 from headsim.scenario import registry
 from headsim.sim import names
-from headsim.sim.settings import HeadSettings
+from headsim.sim.settings import HeadSettings, belief_sources
 
 if TYPE_CHECKING:
     from headsim.active.calibration_file import StoredCalibration
@@ -281,11 +281,23 @@ class Scenario:
     scene: SceneSpec
     experiment: ExperimentSpec
     stored_calibration: StoredCalibration | None = field(default=None, compare=False, repr=False)
+    #: Where each believed quantity came from (:func:`headsim.sim.settings.belief_sources`;
+    #: empty: not known, as for a scenario built in Python; :attr:`believed_from` fills it).
+    belief_sources: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def believed_from(self) -> dict[str, str]:
+        """Where each believed quantity came from: ``design``, ``preset``, ``file``,
+        ``given`` or ``truth`` (equal to the true head's, which the scenario changed)."""
+        return self.belief_sources or belief_sources(self.settings)
 
     @property
     def paper_cameras(self) -> bool:
-        """Whether the head is the paper's preset (its figures are shown beside ours)."""
-        return self.preset in ("paper", "realistic")
+        """Whether the head has the paper's cameras (its figures are shown beside ours): a
+        paper or realistic preset, on a head whose MJCF cameras are not its own."""
+        from headsim.sim.model import has_own_cameras
+
+        return self.preset in ("paper", "realistic") and not has_own_cameras(self.settings.head)
 
     @property
     def fixations(self) -> int:

@@ -235,9 +235,12 @@ class Table:
             )
         return value
 
-    def string(self, key: str, default: Any = MISSING, max_length: int = 200) -> str:
+    def string(
+        self, key: str, default: Any = MISSING, max_length: int = 200, what: str | None = None
+    ) -> str:
+        """A one-line string; ``what`` says what it names (an error's "allowed" text)."""
         value = self._get(key)
-        allowed = f"one line of text, at most {max_length} characters"
+        allowed = (what or "one line of text") + f", at most {max_length} characters"
         self._note(key, "string", allowed, default)
         if value is MISSING:
             if default is MISSING:

@@ -8,6 +8,7 @@ pixel (i, j) is at (i, j), so the geometric centre of a W x H image is
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
@@ -235,6 +236,47 @@ class HeadBelief:
                     lo <= value <= hi,
                     f"belief.{name} must be within [{lo:g}, {hi:g}] m, got {value}",
                 )
+
+
+#: The believed quantities, in :class:`HeadBelief`'s order.
+BELIEF_KEYS = ("baseline_m", "neck_d1_m", "neck_a2_m", "nodal_offset_m", "side_offset_m")
+#: Where a believed quantity came from (:func:`belief_sources`): the head's design; the
+#: preset's own belief; the scenario's ``[belief]``; a :class:`HeadBelief` given in Python;
+#: or the true head's value, which the scenario changed and the belief followed.
+BELIEF_SOURCES = ("design", "preset", "file", "given", "truth")
+_LENGTHS = ("baseline_m", "neck_d1_m", "neck_a2_m")
+
+
+def belief_sources(
+    settings: HeadSettings,
+    design: HeadSettings | None = None,
+    *,
+    given: Collection[str] = (),
+    source: str = "given",
+) -> dict[str, str]:
+    """Where each believed quantity of ``settings`` came from (:data:`BELIEF_SOURCES`).
+
+    ``design``: the head as its preset builds it before the scenario changes it
+    (None: only ``settings`` is known); ``given``: the keys that ``source``
+    ("file" or "given") set.  A quantity not given comes from the preset's own
+    belief when ``design`` has one; else, with no belief at all, it follows the
+    truth: "design" where the truth is the design's, "truth" where it is not.
+    """
+    out: dict[str, str] = {}
+    for key in BELIEF_KEYS:
+        if key in given:
+            out[key] = source
+        elif design is not None and design.belief is not None:
+            out[key] = "preset"
+        elif settings.belief is not None and design is None:
+            out[key] = source
+        elif settings.belief is not None or key not in _LENGTHS:
+            out[key] = "design"  # a [belief] table's missing keys, and the offsets: on axis
+        elif design is not None and getattr(settings, key) == getattr(design, key):
+            out[key] = "design"
+        else:
+            out[key] = "truth"
+    return out
 
 
 @dataclass(frozen=True)

@@ -61,7 +61,6 @@ _NOMINAL = {"head.baseline_m": 0.150, "head.neck_d1_m": 0.12, "head.neck_a2_m": 
 _FORWARD_OFF = {
     "cam1.nodal_offset_m": 0.0,
     "cam2.nodal_offset_m": 0.0,
-    "belief.nodal_offset_m": [0.0, 0.0],
 }
 _SIDE_OFF = {"cam1.side_offset_m": 0.0, "cam2.side_offset_m": 0.0}
 _COUNT_OFF = {"head.count_error": False}

@@ -262,3 +262,17 @@ def test_mjcf_mujoco_cannot_parse_is_one_line_from_the_real_command(
     assert "broken.xml" in lines[0] and "an MJCF file MuJoCo compiles" in lines[0]
     assert "XML_ERROR_MISMATCHED_ELEMENT" in lines[0] and "Line number=1" in lines[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_a_missing_mapping_key_says_what_it_names(
+    built: BuiltHead, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    mapping = built.toml.replace('neck_pitch = "nod"\n', "")
+    line = bad_run(
+        scenario(built.path.parent, "head.xml", mapping, name="no_pitch.toml"),
+        tmp_path,
+        capsys,
+        "head.mapping.neck_pitch: missing",
+    )
+    assert "allowed: the name of a joint in the head's MJCF file" in line
+    assert "one line of text" not in line

@@ -157,3 +157,20 @@ def test_position_reward_is_the_heads_estimate_with_its_belief_and_no_truth_is_o
         expected = -min(np.linalg.norm(info["estimate_world_m"] - truth) / distance, 1.0)
         assert reward == pytest.approx(expected, rel=1e-9)
     assert reward_a > -0.1 and reward_b < reward_a - 0.1  # 20 % too wide: ~20 % too far
+
+
+def test_a_randomised_baseline_moves_the_truth_and_not_the_belief() -> None:
+    """Unless given a belief, the head believes its design: a drawn baseline is not believed."""
+    env = gymnasium.make(ID, randomise={"baseline_m": (0.14, 0.16)})
+    env.reset(seed=3)
+    settings = env.unwrapped._settings
+    design = env.unwrapped.base_settings.baseline_m
+    assert settings.baseline_m != design and 0.14 <= settings.baseline_m <= 0.16
+    assert settings.believed.baseline_m == design
+    assert set(env.unwrapped.belief_sources.values()) == {"design"}
+    env.close()
+    told = gymnasium.make(ID, belief=HeadBelief(baseline_m=0.151))
+    assert set(told.unwrapped.belief_sources.values()) == {"given"}
+    told.reset(seed=3)
+    assert told.unwrapped._settings.believed.baseline_m == 0.151
+    told.close()

@@ -135,3 +135,42 @@ def test_the_package_run_stays_a_package_too() -> None:
 
     assert callable(headsim.run) and headsim.run.runner.run_scenario is not None
     assert headsim.HeadSim.__name__ == "HeadSim" and "load_scenario" in dir(headsim)
+
+
+def test_a_result_in_a_notebook_is_short_and_its_summary_is_summary_txt(
+    fast_run: RunResult, tmp_path: Path
+) -> None:
+    from headsim.run.accuracy import summarise
+
+    rms = summarise(fast_run.records).error_pct_of_depth_rms
+    n = len(fast_run.records)
+    assert repr(fast_run) == (
+        f"<RunResult quickstart (fast), seed 1, model2: {n} of {n} measured; "
+        f"3-D error RMS {rms:.3f} % of depth; ok>"
+    )
+    html = fast_run._repr_html_()
+    assert html.startswith("<table>") and html.endswith("</table>") and len(html) < 2000
+    assert f"<td style='text-align:left'>{rms:.3f}</td>" in html
+    assert "&gt;= 1 m" in html  # escaped
+    assert (
+        main(["--quiet", "run", "quickstart", "--fast", "--seed", "1", "--out", str(tmp_path)]) == 0
+    )
+    assert fast_run.summary() + "\n" == (tmp_path / "summary.txt").read_text()
+
+
+def test_plot_draws_each_measured_error_at_its_depth_under_agg(fast_run: RunResult) -> None:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = fast_run.plot()
+    assert isinstance(figure, Figure)
+    FigureCanvasAgg(figure).draw()  # renders without a display
+    (axes,) = figure.axes
+    ok = [row for row in fast_run.measurements if row.status == "ok"]
+    points = sorted(
+        (float(x), float(y))
+        for line in axes.get_lines()
+        for x, y in zip(*line.get_data(), strict=True)
+    )
+    assert points == sorted((row.depth_m, row.error_pct_of_depth) for row in ok)
+    assert axes.get_xlabel() == "true depth, m" and axes.get_ylabel() == "3-D error, % of depth"

@@ -12,6 +12,7 @@ from pathlib import Path
 from headsim.active.events import FixationStarted, PhaseStarted
 from headsim.run.events import Hub, RunFinished
 from headsim.run.progress import Counter, RunProgress, Status, time_left
+from headsim.scenario.loading import load_scenario
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 
@@ -53,7 +54,7 @@ def test_counter_prints_a_line_per_phase_and_at_most_one_per_interval_in_a_log()
     assert lines == [
         "headsim: calibration: 0/10 fixations, 0.0/s, time left unknown",
         "headsim: calibration: 5/10 fixations, 0.8/s, about 0:06 left",
-        "headsim: measurement: 5/10 fixations, 0.8/s, about 0:06 left",
+        "headsim: measurement: 6/10 fixations, 1.0/s, about 0:04 left",
         "headsim: finished: 10 fixations in 6.0 s",
     ]
     assert "\r" not in stream.getvalue()
@@ -134,6 +135,10 @@ def test_run_and_sweep_print_plain_lines_in_a_log_and_nothing_when_quiet(tmp_pat
     assert "\r" not in run.stderr
     phases = re.findall(r"^headsim: (\w+): (\d+)/(\d+) fixations", run.stderr, re.M)
     assert [p[0] for p in phases][:2] == ["calibration", "measurement"]
+    # The measurement starts once every calibration fixation has ended: all of them done.
+    calibration = load_scenario("quickstart", fast=True).experiment.calibration
+    assert calibration is not None
+    assert (phases[0][1], phases[1][1]) == ("0", str(calibration.targets))
     assert re.search(r"^headsim: finished: \d+ fixations in [\d.]+ s$", run.stderr, re.M)
 
     sweep = _cli("sweep", str(DATA / "sweep_grid.toml"), "--out", str(tmp_path / "sweep"))

@@ -67,11 +67,13 @@ def test_the_headline_gives_measured_of_accepted_and_of_drawn_and_the_edge_apart
     ok = len(records) - 1
     refused = ", ".join(f"{n} {code}" for code, n in a.refused.items())
     assert (
-        f"head knew calibrated: {ok} of {a.accepted} accepted targets measured, {ok} of "
+        f"    {ok} of {a.accepted} accepted targets measured, {ok} of "
         f"{a.drawn} drawn ({a.refused_total} draws refused by the reach check and drawn again: "
         f"{refused})"
     ) in text
     edge_ok = len(edge - {scenario.scene.targets[0].name})
+    assert text.count("head knew calibrated:") == 1
+    assert f"whole field, the {ok} of {len(records)} measured (drawn over it):" in text
     assert (
         "of them at the edge of the field (not seen whole by both cameras at the start pose): "
         f"{edge_ok} of {len(edge)} measured, 3-D error RMS 1.000 % of depth"

@@ -67,7 +67,6 @@ IMPERFECTION_KEYS = [
     ("[belief]\nbaseline_m = 0.149", lambda s: s.settings.believed.baseline_m, 0.149),
     ("[belief]\nneck_d1_m = 0.121", lambda s: s.settings.believed.neck_d1_m, 0.121),
     ("[belief]\nneck_a2_m = 0.089", lambda s: s.settings.believed.neck_a2_m, 0.089),
-    ("[belief]\nnodal_offset_m = [0.01, 0.02]", lambda s: s.settings.believed.nodal_offset_m, (0.01, 0.02)),
     ("[belief]\nside_offset_m = [0.001, -0.001]", lambda s: s.settings.believed.side_offset_m, (0.001, -0.001)),
     ("[experiment.calibration]\ndepth_noise_m = 0.002", lambda s: s.experiment.calibration.depth_noise_m, 0.002),
     ("[experiment.calibration]\nposition_noise_m = 0.001", lambda s: s.experiment.calibration.position_noise_m, 0.001),
@@ -197,3 +196,18 @@ def test_servo_windows_reach_the_servo_and_are_recorded_when_set(tmp_path: Path)
     off = load_scenario(path)
     assert servo_config(off).windows is False
     assert servo_record(off.experiment.servo)["windows"] is False
+
+
+@pytest.mark.parametrize(
+    ("text", "sources"),
+    [
+        ("", "design design design design design"),
+        ("[head]\nbaseline_m = 0.1512\n", "truth design design design design"),
+        ("[head]\nbaseline_m = 0.1512\n[belief]\nneck_d1_m = 0.121\n", "design file design design design"),
+        ('[head]\npreset = "realistic"\n', "preset preset preset preset preset"),
+        ('[head]\npreset = "realistic"\n[belief]\nside_offset_m = [0.001, 0.0]\n', "preset preset preset preset file"),
+    ],
+)  # fmt: skip
+def test_each_believed_quantity_says_where_it_came_from(tmp_path, text: str, sources: str) -> None:
+    scenario = load_scenario(write_scenario(tmp_path, MINIMAL + text))
+    assert " ".join(scenario.believed_from.values()) == sources

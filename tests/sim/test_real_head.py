@@ -352,7 +352,7 @@ def test_the_belief_differs_from_the_truth_only_where_the_scenario_says(tmp_path
     ("head", "field"),
     [
         ("[belief]\nbaseline_m = 2.0\n", "belief.baseline_m"),
-        ("[belief]\nnodal_offset_m = [0.5, 0.0]\n", "belief.nodal_offset_m[0]"),
+        ("[belief]\nnodal_offset_m = [0.02, 0.02]\n", "belief.nodal_offset_m"),
         ("[cam1]\nside_offset_m = 0.1\n", "cam1.side_offset_m"),
         ("[head]\nbacklash_rad = 1.0\n", "head.backlash_rad"),
         ("[head]\nrender_supersample = 0\n", "head.render_supersample"),

@@ -39,7 +39,6 @@ def test_uncorrected_offsets_cost_what_the_first_order_analysis_says() -> None:
     big = {"cam1.side_offset_m": 0.003, "cam2.side_offset_m": -0.003}
     off = {"cam1.side_offset_m": 0.0, "cam2.side_offset_m": 0.0}
     off |= {"cam1.nodal_offset_m": 0.0, "cam2.nodal_offset_m": 0.0}
-    off |= {"belief.nodal_offset_m": [0.0, 0.0]}
     no_fit = {"experiment.calibration.lines_of_sight": False}
     uncorrected = run_condition(BudgetCondition("big", "test", big | no_fit), fast=True, seed=0)
     without = run_condition(BudgetCondition("off", "test", off | no_fit), fast=True, seed=0)
