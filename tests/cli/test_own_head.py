@@ -262,3 +262,28 @@ def test_mjcf_mujoco_cannot_parse_is_one_line_from_the_real_command(
     assert "broken.xml" in lines[0] and "an MJCF file MuJoCo compiles" in lines[0]
     assert "XML_ERROR_MISMATCHED_ELEMENT" in lines[0] and "Line number=1" in lines[0]
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("camera", "size"),
+    [("", "1 x 1"), ('resolution="16 12" fovy="45"', "16 x 12")],
+    ids=["no_resolution", "too_small"],
+)
+def test_a_camera_without_a_resolution_is_refused_with_what_to_add(
+    built: BuiltHead, tmp_path: Path, capsys: pytest.CaptureFixture[str], camera: str, size: str
+) -> None:
+    # MuJoCo makes a camera without `resolution` 1 x 1 pixels, and takes sensorsize only
+    # with it: the head's cameras are given by field of view alone.
+    text = built.path.read_text().replace(
+        'resolution="480 360" sensorsize="0.0048 0.0036" focalpixel="420 420"', camera
+    )
+    assert text.count("<camera ") == 2 and 'resolution="480' not in text
+    (tmp_path / "small.xml").write_text(text)
+    line = bad_run(
+        scenario(tmp_path, "small.xml", built.toml, name="small.toml"),
+        tmp_path,
+        capsys,
+        "head.mapping.cameras[0]",
+    )
+    assert f"camera 'port_imager' is {size} pixels" in line
+    assert 'add resolution="WIDTH HEIGHT" to the camera' in line
