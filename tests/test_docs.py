@@ -148,3 +148,16 @@ def test_a_broken_link_fails_the_build(tmp_path: Path) -> None:
 
 def test_every_exit_code_has_its_meaning() -> None:
     assert list(EXIT_MEANINGS) == list(ExitCode)
+
+
+def test_the_screenshot_tool_refuses_without_chromium_and_writes_nothing(tmp_path: Path) -> None:
+    png = tmp_path / "recording.png"
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "tools" / "recording_screenshot.py"), "--out",
+         str(tmp_path / "out"), "--png", str(png), "--chromium", str(tmp_path / "no-chromium")],
+        cwd=tmp_path, capture_output=True, text=True, timeout=120, check=False,
+    )  # fmt: skip
+    assert done.returncode == 3, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Chromium is not installed" in lines[0], done.stderr
+    assert not png.exists() and not (tmp_path / "out").exists()
