@@ -15,9 +15,12 @@ import subprocess
 import sys
 import sysconfig
 import venv
+import zipfile
 from pathlib import Path
 
 import pytest
+
+from headsim import __version__
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -37,7 +40,7 @@ def _sources(tmp_path: Path) -> Path:
         shutil.copytree(
             REPO / folder, source / folder, ignore=shutil.ignore_patterns("__pycache__")
         )
-    for name in ("pyproject.toml", "README.md"):
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
         shutil.copy2(REPO / name, source / name)
     return source
 
@@ -69,6 +72,8 @@ def _run_elsewhere(tmp_path: Path, python: Path) -> list[Path]:
         cwd=elsewhere, env=env,
     ).stdout.split()  # fmt: skip
     headsim = str(python.parent / "headsim")
+    version = _run([headsim, "--version"], cwd=elsewhere, env=env)
+    assert version.stdout == f"headsim {__version__}\n", version.stdout
     listing = _run([headsim, "list"], cwd=elsewhere, env=env)
     assert "quickstart" in listing.stdout and "INVALID" not in listing.stdout
     _run([headsim, "run", "quickstart", "--quiet", "--out", "X"], cwd=elsewhere, env=env)
@@ -94,6 +99,16 @@ def test_pip_install_runs_the_quick_start_from_another_folder(tmp_path: Path) ->
     wheels = tmp_path / "wheels"
     _run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(wheels), str(source)])
     (wheel,) = wheels.glob("headsim-*.whl")
+    assert wheel.name.startswith(f"headsim-{__version__}-"), wheel.name
+    with zipfile.ZipFile(wheel) as archive:
+        info = f"headsim-{__version__}.dist-info"
+        license_text = archive.read(f"{info}/licenses/LICENSE").decode()
+        metadata = archive.read(f"{info}/METADATA").decode()
+    assert license_text == (REPO / "LICENSE").read_text()
+    assert "Apache License\n                           Version 2.0" in license_text
+    assert "License-Expression: Apache-2.0\n" in metadata
+    assert "License-File: LICENSE\n" in metadata
+    assert "Classifier: Intended Audience :: Science/Research\n" in metadata
     site, (module, models, scenarios) = _install_and_run(tmp_path, "--no-index", str(wheel))
     assert module.is_relative_to(site), module  # the wheel, not the checkout
     assert models == site / "headsim" / "models", models

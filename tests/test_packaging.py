@@ -13,11 +13,16 @@ import tomllib
 from fnmatch import fnmatch
 from pathlib import Path
 
+import pytest
+
+from headsim import __version__
+from headsim.cli import main
 from headsim.scenario.loading import SCENARIOS_DIR
 from headsim.sim.model import MODELS_DIR
 
 REPO = Path(__file__).resolve().parent.parent
-SETUPTOOLS = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]
+PYPROJECT = tomllib.loads((REPO / "pyproject.toml").read_text())
+SETUPTOOLS = PYPROJECT["tool"]["setuptools"]
 PACKAGES: list[str] = SETUPTOOLS["packages"]
 PACKAGE_DIR: dict[str, str] = SETUPTOOLS["package-dir"]
 #: The top-level data folders and the package each is installed as.
@@ -85,3 +90,28 @@ def test_the_installed_package_finds_the_checkouts_models_and_scenarios() -> Non
     assert SCENARIOS_DIR.resolve() == REPO / "scenarios"
     assert (MODELS_DIR / "head.xml").is_file()
     assert (SCENARIOS_DIR / "quickstart.toml").is_file()
+
+
+def test_the_license_file_and_the_metadata_ship_with_the_package() -> None:
+    project = PYPROJECT["project"]
+    assert project["license"] == "Apache-2.0"
+    assert project["license-files"] == ["LICENSE"]
+    text = (REPO / "LICENSE").read_text()
+    assert "Apache License" in text and "END OF TERMS AND CONDITIONS" in text
+    assert len(text.splitlines()) > 190  # the whole text, not a pointer to it
+    classifiers = project["classifiers"]
+    assert "Intended Audience :: Science/Research" in classifiers
+    # A license expression and a License :: classifier together are refused by setuptools.
+    assert not [c for c in classifiers if c.startswith("License ::")]
+    assert project["dynamic"] == ["version"]
+    assert SETUPTOOLS["dynamic"]["version"] == {"attr": "headsim.__version__"}
+
+
+def test_version_prints_the_package_version_and_exits_0(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    with pytest.raises(SystemExit) as done:  # argparse's exit, as for --help
+        main(["--version"])
+    assert done.value.code == 0
+    assert capsys.readouterr().out == f"headsim {__version__}\n"
+    assert __version__.count(".") == 2 and all(p.isdigit() for p in __version__.split("."))

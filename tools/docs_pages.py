@@ -9,20 +9,26 @@ site as a generated file (nothing generated is committed):
   :mod:`headsim.run.results_reference`;
 - ``reference/command-line.md``: every command's ``--help``, from the parser;
 - ``reference/exit-codes.md``: the exit-code contract (:mod:`headsim.errors`).
+
+and a page's ``<!-- generated:NAME -->`` is replaced by what ``GENERATED[NAME]`` makes:
+the package's version (the home page), the table of shipped scenarios (how to write one).
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import re
 from typing import Any
 
 from mkdocs.structure.files import File, Files
 
+from headsim import __version__
 from headsim.cli.parser import build_parser
 from headsim.errors import EXIT_MEANINGS
 from headsim.run.results_reference import EXPERIMENT_FIELDS, RESULTS_FIELDS
 from headsim.scenario.key_reference import accepted_keys
+from headsim.scenario.loading import load_scenario, scenario_files
 
 
 def _cell(text: str) -> str:
@@ -144,6 +150,33 @@ def exit_codes_page() -> str:
         "ends with one line `headsim: error: ...` on stderr and no Python traceback "
         "(`--debug` adds it).\n\n| code | name | meaning |\n|---|---|---|\n" + rows + "\n"
     )
+
+
+def scenarios_table() -> str:
+    """Every shipped scenario (scenarios/*.toml): its name, head, procedure and description."""
+    rows = ["| scenario | head | procedure | what |", "|---|---|---|---|"]
+    for path in scenario_files():
+        scenario = load_scenario(path)  # a shipped file that does not load fails the build
+        rows.append(
+            f"| `{path.stem}` | {scenario.settings.head.name} | "
+            f"`{scenario.experiment.procedure}` | {_cell(scenario.description)} |"
+        )
+    return "\n".join(rows)
+
+
+GENERATED = {"version": lambda: __version__, "scenarios": scenarios_table}
+MARKER = re.compile(r"<!-- generated:(?P<name>[\w-]+) -->")
+
+
+def on_page_markdown(markdown: str, page: Any, config: Any, files: Files) -> str:
+    """Each ``<!-- generated:NAME -->`` replaced by what it names."""
+
+    def one(match: re.Match[str]) -> str:
+        if match["name"] not in GENERATED:
+            raise ValueError(f"{page.file.src_uri}: unknown generated block {match[0]!r}")
+        return GENERATED[match["name"]]()
+
+    return MARKER.sub(one, markdown)
 
 
 PAGES = {

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 
+from headsim import __version__
 from headsim.cli.scenarios import calibrate_command, list_command, run_command
 from headsim.cli.snapshot import snapshot_command
 from headsim.cli.studies import bench_command, reproduce_command, study_command, sweep_command
@@ -48,6 +49,9 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         prog="headsim",
         description="MuJoCo testbed for vergence-based active stereo vision on humanoid heads.",
         epilog=EXIT_CODES_HELP,
+    )
+    parser.add_argument(
+        "--version", action="version", version=f"headsim {__version__}", help="print the version"
     )
     parser.add_argument(
         "--debug", action="store_true", help="show the Python traceback of an error (any position)"

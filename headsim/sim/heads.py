@@ -30,6 +30,8 @@ EYE_KINDS = ("coupled", "independent", "version_vergence")
 AXIS_TOLERANCE_RAD = 1e-3
 #: Largest offset of a neck axis from eq. (1)'s chain, m.
 NECK_TOLERANCE_M = 1e-6
+#: Smallest side of an eye camera's image, pixels.
+MIN_CAMERA_SIDE_PX = 32
 
 
 class HeadError(BadInput, ValueError):
@@ -300,6 +302,16 @@ def check_head(
                 key,
                 f"camera {name!r} is not on the body of {side} joint {getattr(mapping, side)!r}",
                 f"a camera on (or below) the body of the {side} joint",
+            )
+        width, height = (int(v) for v in model.cam_resolution[cam.id])
+        if min(width, height) < MIN_CAMERA_SIDE_PX:
+            # MuJoCo makes a camera without `resolution` 1 x 1 pixels.
+            raise HeadError(
+                key,
+                f"camera {name!r} is {width} x {height} pixels (MuJoCo's size for a camera "
+                "without resolution)",
+                f'add resolution="WIDTH HEIGHT" to the camera, at least {MIN_CAMERA_SIDE_PX} '
+                'pixels a side (resolution="640 480" takes the preset\'s cameras)',
             )
         cams.append(int(cam.id))
 

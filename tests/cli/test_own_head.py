@@ -276,3 +276,28 @@ def test_a_missing_mapping_key_says_what_it_names(
     )
     assert "allowed: the name of a joint in the head's MJCF file" in line
     assert "one line of text" not in line
+
+
+@pytest.mark.parametrize(
+    ("camera", "size"),
+    [("", "1 x 1"), ('resolution="16 12" fovy="45"', "16 x 12")],
+    ids=["no_resolution", "too_small"],
+)
+def test_a_camera_without_a_resolution_is_refused_with_what_to_add(
+    built: BuiltHead, tmp_path: Path, capsys: pytest.CaptureFixture[str], camera: str, size: str
+) -> None:
+    # MuJoCo makes a camera without `resolution` 1 x 1 pixels, and takes sensorsize only
+    # with it: the head's cameras are given by field of view alone.
+    text = built.path.read_text().replace(
+        'resolution="480 360" sensorsize="0.0048 0.0036" focalpixel="420 420"', camera
+    )
+    assert text.count("<camera ") == 2 and 'resolution="480' not in text
+    (tmp_path / "small.xml").write_text(text)
+    line = bad_run(
+        scenario(tmp_path, "small.xml", built.toml, name="small.toml"),
+        tmp_path,
+        capsys,
+        "head.mapping.cameras[0]",
+    )
+    assert f"camera 'port_imager' is {size} pixels" in line
+    assert 'add resolution="WIDTH HEIGHT" to the camera' in line

@@ -3,7 +3,9 @@
 The command line over :mod:`tests.run.viewer.browser` (serving, Chromium,
 the screenshot) and :mod:`tests.run.viewer.judge` (what each view shows):
 
-    python -m tests.run.viewer.check out/quickstart/recording.rrd --png docs/recording.png
+    python -m tests.run.viewer.check out/quickstart/recording.rrd --png viewer.png
+
+(docs/recording.png is made by tools/recording_screenshot.py, which runs the quick start first.)
 
 Exit status: 0 every view drew, 1 a view did not, 3 the viewer or Chromium
 could not be run.
