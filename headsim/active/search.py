@@ -208,16 +208,10 @@ def neck_scan_strides(servo: NeckServo, size_px: tuple[int, int]) -> tuple[float
     return max((yhi - ylo) / SCAN_DIVISIONS, 1.0), max((phi - plo) / SCAN_DIVISIONS, 1.0)
 
 
-def scan_neck_poses(servo: NeckServo, size_px: tuple[int, int]) -> list[tuple[int, int, int]]:
-    """(neck yaw, neck pitch, eye) steps a Model 1 scan looks from: the whole of the neck's
-    ranges, the eyes at 0, every pose once, at most :func:`neck_scan_strides` apart.
-
-    With a learnt Jacobian, nearest the start pose first (in strides).  With none
-    (the first target: no field of view known), coarse to fine: the grid's poses at
-    every 4th, every 2nd and every stride of 1/:data:`SCAN_DIVISIONS` of the range
-    (:data:`SCAN_LEVELS`), ordered by their distance from the start pose in their
-    own level's spacing, so that the coarse poses reach a far target in a few looks
-    while the fine ones cover a narrow view near the start."""
+def _neck_scan_grid(
+    servo: NeckServo, size_px: tuple[int, int]
+) -> list[tuple[tuple[int, int, int], tuple[float, float]]]:
+    """:func:`scan_neck_poses` in order, each with the (yaw, pitch) spacing of its level, steps."""
     (ylo, yhi), (plo, phi), _ = servo.step_ranges
     strides = neck_scan_strides(servo, size_px)
     levels = 1 if servo.jacobian is not None else SCAN_LEVELS
@@ -234,16 +228,34 @@ def scan_neck_poses(servo: NeckServo, size_px: tuple[int, int]) -> list[tuple[in
     order = sorted(
         ((i, j) for i in range(len(yaws)) for j in range(len(pitches))), key=lambda q: key(*q)
     )
-    return [(yaws[i], pitches[j], 0) for i, j in order]
+    out = []
+    for i, j in order:
+        spacing = 2 ** (levels - 1 - max(_level(i, levels), _level(j, levels)))
+        out.append(((yaws[i], pitches[j], 0), (spacing * strides[0], spacing * strides[1])))
+    return out
+
+
+def scan_neck_poses(servo: NeckServo, size_px: tuple[int, int]) -> list[tuple[int, int, int]]:
+    """(neck yaw, neck pitch, eye) steps a Model 1 scan looks from: the whole of the neck's
+    ranges, the eyes at 0, every pose once, at most :func:`neck_scan_strides` apart.
+
+    With a learnt Jacobian, nearest the start pose first (in strides).  With none
+    (the first target: no field of view known), coarse to fine: the grid's poses at
+    every 4th, every 2nd and every stride of 1/:data:`SCAN_DIVISIONS` of the range
+    (:data:`SCAN_LEVELS`), ordered by their distance from the start pose in their
+    own level's spacing, so that the coarse poses reach a far target in a few looks
+    while the fine ones cover a narrow view near the start."""
+    return [pose for pose, _ in _neck_scan_grid(servo, size_px)]
 
 
 def _refinement(
-    servo: NeckServo, pose: tuple[int, int, int], strides: tuple[float, float]
+    servo: NeckServo, pose: tuple[int, int, int], spacing: tuple[float, float]
 ) -> list[tuple[int, int, int]]:
-    """Neck poses half a scan stride around ``pose`` (within the ranges), nearest first:
-    where camera 1 sees the target and camera 2 not, both views overlap within a stride."""
+    """Neck poses half a grid spacing around ``pose`` (within the ranges), the four along
+    the axes first: where camera 1 sees the target and camera 2 not, the two views'
+    overlap is within a spacing of it."""
     (ylo, yhi), (plo, phi), _ = servo.step_ranges
-    dy, dp = (max(1, round(s / 2)) for s in strides)
+    dy, dp = (max(1, round(s / 2)) for s in spacing)
     around = [
         (pose[0] + i * dy, pose[1] + j * dp, pose[2])
         for i in (-1, 0, 1)
@@ -251,7 +263,7 @@ def _refinement(
         if (i, j) != (0, 0)
     ]
     inside = [q for q in around if ylo <= q[0] <= yhi and plo <= q[1] <= phi]
-    return sorted(inside, key=lambda q: (abs(q[0] - pose[0]) / dy + abs(q[1] - pose[1]) / dp, q))
+    return sorted(inside, key=lambda q: ((q[0] != pose[0]) + (q[1] != pose[1]), q))
 
 
 def scan_neck(servo: NeckServo, detector: Detector, max_poses: int | None = None) -> Scan:
@@ -260,24 +272,28 @@ def scan_neck(servo: NeckServo, detector: Detector, max_poses: int | None = None
 
     One binned preview of camera 1 per pose, and one of camera 2 where camera 1's
     shows it (a blob detector; else both full frames, :meth:`NeckServo.look_from`).
-    Where camera 1 alone sees it, the poses half a stride around come next
-    (:func:`_refinement`): the two views' overlap, narrower than a view, may fall
-    between the grid's poses.  At most ``max_poses`` (default: the whole grid and its
-    refinements), the pose the head is at skipped.  The head stays where it was found.
+    Where camera 1 alone sees it from a pose of the grid, the poses half that
+    pose's spacing around it come next (:func:`_refinement`; not refined again):
+    the two views' overlap, narrower than a view, may fall between the grid's
+    poses.  At most ``max_poses`` (default: the whole grid, at most
+    (:data:`SCAN_DIVISIONS` + 1)**2 poses before a gain is learnt, and 8 around
+    each pose refined), the pose the head is at skipped.  The head stays where it
+    was found.
     """
     sim = servo.sim
     binning = min(_binning(servo.looker, c, detector) for c in (1, 2))
     here = servo.steps()
-    strides = neck_scan_strides(servo, servo.looker.sizes[1])
-    queue = [q for q in scan_neck_poses(servo, servo.looker.sizes[1]) if q != here]
-    seen = {here}
+    queue: list[tuple[tuple[int, int, int], tuple[float, float] | None]] = [
+        (q, spacing) for q, spacing in _neck_scan_grid(servo, servo.looker.sizes[1]) if q != here
+    ]
+    looked = {here}
     resolution = sim.settings.encoder_resolution_rad
     tried = 0
     while queue and (max_poses is None or tried < max_poses):
-        pose = queue.pop(0)
-        if pose in seen:
+        pose, spacing = queue.pop(0)
+        if pose in looked:
             continue
-        seen.add(pose)
+        looked.add(pose)
         tried += 1
         if binning <= 1:
             if servo.look_from(pose, detector):
@@ -290,7 +306,9 @@ def scan_neck(servo: NeckServo, detector: Detector, max_poses: int | None = None
             continue
         if _shows(servo.looker, 2, detector, binning):
             return Scan(pose, None, tried)
-        queue[:0] = [q for q in _refinement(servo, pose, strides) if q not in seen]
+        if spacing is not None:
+            refined = [(q, None) for q in _refinement(servo, pose, spacing) if q not in looked]
+            queue[:0] = refined
     return Scan(None, None, tried)
 
 

@@ -14,6 +14,7 @@ from headsim.active.neck_servo import NeckServo
 from headsim.active.search import (
     SCAN_DIVISIONS,
     SCAN_STRIDE,
+    _refinement,
     neck_scan_strides,
     scan_neck_poses,
     search_poses,
@@ -63,6 +64,19 @@ def test_the_neck_scan_covers_both_whole_ranges_before_and_after_a_gain_is_learn
         _covered(poses, ((ylo, yhi), (plo, phi)), strides)
         d = [np.hypot(p[0] / strides[0], p[1] / strides[1]) for p in poses]
         assert d == sorted(d)  # nearest the start pose first
+
+
+def test_the_refinement_looks_half_a_spacing_around_a_pose_within_the_ranges() -> None:
+    with HeadSim("default", paper_head()) as sim:
+        servo = NeckServo(sim)
+        (_, yhi), (_, phi), _ = servo.step_ranges
+        around = _refinement(servo, (0, 0, 0), (800.0, 400.0))
+        assert set(around) == {
+            (i * 400, j * 200, 0) for i in (-1, 0, 1) for j in (-1, 0, 1) if (i, j) != (0, 0)
+        }
+        assert set(around[:4]) == {(400, 0, 0), (-400, 0, 0), (0, 200, 0), (0, -200, 0)}
+        corner = _refinement(servo, (yhi, phi, 0), (800.0, 400.0))
+    assert len(corner) == 3 and all(q[0] <= yhi and q[1] <= phi for q in corner)
 
 
 def test_camera_2s_search_reaches_the_end_of_the_eye_range() -> None:
