@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 
 from headsim.active.eye_servo import EyeServo
+from headsim.active.measurement import body_target
+from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.search import (
     SCAN_DIVISIONS,
@@ -26,7 +28,9 @@ from headsim.scenario.reach import ReachHead, model2_refusal
 from headsim.sim.settings import paper_head, realistic_head
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import DetectionStatus
-from headsim.vision.markers import find_marker
+from headsim.vision.markers import MarkerDetector, find_marker
+
+RED = body_target("marker_red", MarkerDetector("red"))
 
 
 def _covered(poses: list[tuple[int, int, int]], ranges, strides) -> None:
@@ -156,3 +160,19 @@ def test_model1_measures_every_target_when_the_hard_ones_come_first(tmp_path: Pa
     assert ms[0].scan_renders > 0 and ms[1].scan_renders > 0 and ms[2].scan_renders == 0
     assert max(m.scan_renders for m in ms) < 48
     assert all(m.scan_renders <= 2 * (SCAN_DIVISIONS + 1) ** 2 for m in ms)
+
+
+def test_model2_measures_a_close_lateral_target_camera_2_sees_only_near_the_eye_range_end() -> None:
+    # 0.15 m away, left of the midline: once Ca1 fixates it (eye 0.24 rad), Ca2 needs
+    # about 0.6 rad, less than a search stride from the eye range's end (0.7 rad).
+    settings = realistic_head()
+    p_head = np.array([-0.0277, -0.0120, 0.1545])
+    p_world = head_to_world(p_head, 0.0, 0.0, settings.neck_d1_m, settings.neck_a2_m)
+    assert model2_refusal(ReachHead.of(settings), p_world, "target", 0.004) is None
+    with HeadSim("default", settings) as sim:
+        sim.set_body_pose("marker_red", p_world)
+        m = measure_model2(sim, EyeServo(sim), RED)
+        high = EyeServo(sim).step_range[1]
+    assert m.ok, m.status_text
+    assert m.search_renders > 0  # Ca2 was searched for
+    assert round(m.details["gamma2_rad"] / settings.encoder_resolution_rad) == high
