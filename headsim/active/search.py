@@ -33,8 +33,11 @@ SCAN_STRIDE = 0.7
 #: covers any field of view wider than that (the eyes' 1.4 rad: 0.0875 rad, 5 degrees).
 SCAN_DIVISIONS = 16
 
-#: The most poses a scan looks from (it stops at the first that shows the target).
+#: The most poses an eye scan looks from (it stops at the first that shows the target).
 MAX_SCAN_POSES = 48
+
+#: Levels of a neck scan with no Jacobian learnt: its grid at 4, 2 and 1 stride(s).
+SCAN_LEVELS = 3
 
 
 @dataclass(frozen=True)
@@ -57,7 +60,8 @@ def search_poses(
 
     The poses where it last saw the target (most recent first), the start pose
     (eye 0), then a sweep out from the current pose in strides of 0.7 of the
-    field of view in steps (image width over the learnt gain), both ways.
+    field of view in steps (image width over the learnt gain), both ways, each
+    end of the range included where the sweep passes it.
     """
     low, high = servo.step_range
     current = servo.sim.eye_encoder_steps()
@@ -66,7 +70,8 @@ def search_poses(
     if gain:
         stride = max(1, int(0.7 * width_px / abs(gain)))
         for k in range(1, max_sweep + 1):
-            poses += [current + sign * k * stride for sign in (1, -1)]
+            # Clipped to the range: a view needing an end of it less than a stride away.
+            poses += [min(high, max(low, current + sign * k * stride)) for sign in (1, -1)]
     unique = []
     for p in poses:
         if low <= p <= high and p != current and p not in unique:
@@ -180,40 +185,116 @@ def scan_eyes(
     return Scan(None, None, len(poses))
 
 
-def scan_neck_poses(servo: NeckServo, size_px: tuple[int, int]) -> list[tuple[int, int, int]]:
-    """(neck yaw, neck pitch, eye) steps a Model 1 scan looks from, nearest the start pose
-    first (in strides): a grid over the neck's ranges with the eyes at 0, at most
-    :data:`SCAN_STRIDE` of a field of view apart (image width and height over the learnt
-    Jacobian's px per step), or 1/:data:`SCAN_DIVISIONS` of each range with none yet."""
+def _level(index: int, levels: int) -> int:
+    """The coarsest level of a coarse-to-fine grid (0: every 2**(levels - 1)-th point)
+    that grid point ``index`` belongs to."""
+    for level in range(levels - 1):
+        if index % 2 ** (levels - 1 - level) == 0:
+            return level
+    return levels - 1
+
+
+def neck_scan_strides(servo: NeckServo, size_px: tuple[int, int]) -> tuple[float, float]:
+    """(yaw, pitch) steps between a neck scan's poses: :data:`SCAN_STRIDE` of a field of
+    view (image width and height over the learnt Jacobian's px per step), or
+    1/:data:`SCAN_DIVISIONS` of each range with none learnt yet."""
     (ylo, yhi), (plo, phi), _ = servo.step_ranges
     jac = servo.jacobian
     width, height = size_px
     per_yaw = float(max(abs(jac[0, 0]), abs(jac[1, 0]))) if jac is not None else 0.0
     per_pitch = float(abs(jac[2, 1])) if jac is not None else 0.0
     if per_yaw > 0 and per_pitch > 0:
-        strides = (SCAN_STRIDE * width / per_yaw, SCAN_STRIDE * height / per_pitch)
-    else:
-        strides = ((yhi - ylo) / SCAN_DIVISIONS, (phi - plo) / SCAN_DIVISIONS)
-    grid = [(y, p, 0) for y in _grid(ylo, yhi, strides[0]) for p in _grid(plo, phi, strides[1])]
-    return sorted(grid, key=lambda q: (math.hypot(q[0] / strides[0], q[1] / strides[1]), q))
+        return SCAN_STRIDE * width / per_yaw, SCAN_STRIDE * height / per_pitch
+    return max((yhi - ylo) / SCAN_DIVISIONS, 1.0), max((phi - plo) / SCAN_DIVISIONS, 1.0)
 
 
-def scan_neck(servo: NeckServo, detector: Detector, max_poses: int = MAX_SCAN_POSES) -> Scan:
+def _neck_scan_grid(
+    servo: NeckServo, size_px: tuple[int, int]
+) -> list[tuple[tuple[int, int, int], tuple[float, float]]]:
+    """:func:`scan_neck_poses` in order, each with the (yaw, pitch) spacing of its level, steps."""
+    (ylo, yhi), (plo, phi), _ = servo.step_ranges
+    strides = neck_scan_strides(servo, size_px)
+    levels = 1 if servo.jacobian is not None else SCAN_LEVELS
+    yaws, pitches = _grid(ylo, yhi, strides[0]), _grid(plo, phi, strides[1])
+
+    def key(i: int, j: int) -> tuple[float, int, int, int]:
+        # Distance from the start pose in the strides of the pose's own level: each
+        # level reaches out as fast as its spacing allows, the levels interleaved.
+        level = max(_level(i, levels), _level(j, levels))
+        y, p = yaws[i], pitches[j]
+        spacing = 2 ** (levels - 1 - level)
+        return math.hypot(y / strides[0], p / strides[1]) / spacing, level, y, p
+
+    order = sorted(
+        ((i, j) for i in range(len(yaws)) for j in range(len(pitches))), key=lambda q: key(*q)
+    )
+    out = []
+    for i, j in order:
+        spacing = 2 ** (levels - 1 - max(_level(i, levels), _level(j, levels)))
+        out.append(((yaws[i], pitches[j], 0), (spacing * strides[0], spacing * strides[1])))
+    return out
+
+
+def scan_neck_poses(servo: NeckServo, size_px: tuple[int, int]) -> list[tuple[int, int, int]]:
+    """(neck yaw, neck pitch, eye) steps a Model 1 scan looks from: the whole of the neck's
+    ranges, the eyes at 0, every pose once, at most :func:`neck_scan_strides` apart.
+
+    With a learnt Jacobian, nearest the start pose first (in strides).  With none
+    (the first target: no field of view known), coarse to fine: the grid's poses at
+    every 4th, every 2nd and every stride of 1/:data:`SCAN_DIVISIONS` of the range
+    (:data:`SCAN_LEVELS`), ordered by their distance from the start pose in their
+    own level's spacing, so that the coarse poses reach a far target in a few looks
+    while the fine ones cover a narrow view near the start."""
+    return [pose for pose, _ in _neck_scan_grid(servo, size_px)]
+
+
+def _refinement(
+    servo: NeckServo, pose: tuple[int, int, int], spacing: tuple[float, float]
+) -> list[tuple[int, int, int]]:
+    """Neck poses half a grid spacing around ``pose`` (within the ranges), the four along
+    the axes first: where camera 1 sees the target and camera 2 not, the two views'
+    overlap is within a spacing of it."""
+    (ylo, yhi), (plo, phi), _ = servo.step_ranges
+    dy, dp = (max(1, round(s / 2)) for s in spacing)
+    around = [
+        (pose[0] + i * dy, pose[1] + j * dp, pose[2])
+        for i in (-1, 0, 1)
+        for j in (-1, 0, 1)
+        if (i, j) != (0, 0)
+    ]
+    inside = [q for q in around if ylo <= q[0] <= yhi and plo <= q[1] <= phi]
+    return sorted(inside, key=lambda q: ((q[0] != pose[0]) + (q[1] != pose[1]), q))
+
+
+def scan_neck(servo: NeckServo, detector: Detector, max_poses: int | None = None) -> Scan:
     """Move the neck (the eyes at 0) to each of :func:`scan_neck_poses` in turn until both
     cameras see the target (Model 1's servo needs both to start).
 
     One binned preview of camera 1 per pose, and one of camera 2 where camera 1's
-    shows it (a blob detector; else both full frames, :meth:`NeckServo.look_from`);
-    at most ``max_poses``, the pose the head is at skipped.  The head stays where
-    it was found.
+    shows it (a blob detector; else both full frames, :meth:`NeckServo.look_from`).
+    Where camera 1 alone sees it from a pose of the grid, the poses half that
+    pose's spacing around it come next (:func:`_refinement`; not refined again):
+    the two views' overlap, narrower than a view, may fall between the grid's
+    poses.  At most ``max_poses`` (default: the whole grid, at most
+    (:data:`SCAN_DIVISIONS` + 1)**2 poses before a gain is learnt, and 8 around
+    each pose refined), the pose the head is at skipped.  The head stays where it
+    was found.
     """
     sim = servo.sim
     binning = min(_binning(servo.looker, c, detector) for c in (1, 2))
     here = servo.steps()
-    poses = [q for q in scan_neck_poses(servo, servo.looker.sizes[1]) if q != here]
-    poses = poses[:max_poses]
+    queue: list[tuple[tuple[int, int, int], tuple[float, float] | None]] = [
+        (q, spacing) for q, spacing in _neck_scan_grid(servo, servo.looker.sizes[1]) if q != here
+    ]
+    looked = {here}
     resolution = sim.settings.encoder_resolution_rad
-    for tried, pose in enumerate(poses, start=1):
+    tried = 0
+    while queue and (max_poses is None or tried < max_poses):
+        pose, spacing = queue.pop(0)
+        if pose in looked:
+            continue
+        looked.add(pose)
+        tried += 1
         if binning <= 1:
             if servo.look_from(pose, detector):
                 return Scan(pose, None, tried)
@@ -221,11 +302,14 @@ def scan_neck(servo: NeckServo, detector: Detector, max_poses: int = MAX_SCAN_PO
         yaw, pitch, eye = (s * resolution for s in pose)
         sim.command(neck_yaw=yaw, neck_pitch=pitch, eye=eye)
         sim.settle()
-        if _shows(servo.looker, 1, detector, binning) and _shows(
-            servo.looker, 2, detector, binning
-        ):
+        if not _shows(servo.looker, 1, detector, binning):
+            continue
+        if _shows(servo.looker, 2, detector, binning):
             return Scan(pose, None, tried)
-    return Scan(None, None, len(poses))
+        if spacing is not None:
+            refined = [(q, None) for q in _refinement(servo, pose, spacing) if q not in looked]
+            queue[:0] = refined
+    return Scan(None, None, tried)
 
 
 def neck_search_poses(
@@ -298,11 +382,13 @@ def find_neck_view(
 __all__ = [
     "MAX_SCAN_POSES",
     "SCAN_DIVISIONS",
+    "SCAN_LEVELS",
     "SCAN_STRIDE",
     "Found",
     "Scan",
     "find_neck_view",
     "find_view",
+    "neck_scan_strides",
     "neck_search_poses",
     "scan_eye_poses",
     "scan_eyes",

@@ -77,9 +77,10 @@ class ReachHead:
     ) -> bool:
         """Whether a point projects into camera ``index``'s image at eye angle ``eye``.
 
-        With ``radius_m``, a ball of that radius around it images whole: its
-        centre's image is its apparent radius plus 2 px inside the border (what
-        the detector needs not to call it cut).
+        Seen from the camera's optical centre (off the yaw axis by the lens's offsets).
+        With ``radius_m``, a ball of that radius around it images whole: its rim's
+        image, through the lens, 2 px inside the border (what the detector needs
+        not to call it cut).
         """
         camera = self.settings.cameras[index]
         sign = names.EYE_CAMERAS[index].inward
@@ -89,12 +90,23 @@ class ReachHead:
         rotation = eye_rotation @ eye_from_camera_rotation(
             sign, camera.mount_yaw_rad, camera.mount_pitch_rad, camera.mount_roll_rad
         )
-        p = rotation.T @ (point_head - centre)
+        offset_cv = np.array([camera.side_offset_m, 0.0, camera.nodal_offset_m])
+        p = rotation.T @ (point_head - centre) - offset_cv
         if p[2] <= 0.01:
             return False
-        u, v = camera.pinhole().project(p)  # NaN beyond where the lens folds over
-        m = 2.0 + max(camera.kx, camera.ky) * radius_m / p[2] if radius_m > 0 else 0.0
-        return bool(m <= u <= camera.width - 1 - m and m <= v <= camera.height - 1 - m)
+        points = [p]
+        if radius_m > 0:  # the ball's rim across the line of sight, through the lens
+            sight = p / np.linalg.norm(p)
+            across = np.cross(sight, [1.0, 0.0, 0.0])
+            across /= np.linalg.norm(across)
+            for d in (across, np.cross(across, sight)):
+                points += [p + radius_m * d, p - radius_m * d]
+        uv = camera.pinhole().project(np.array(points))  # NaN beyond where the lens folds over
+        m = 2.0 if radius_m > 0 else 0.0
+        u, v = uv[:, 0], uv[:, 1]
+        return bool(
+            np.all((m <= u) & (u <= camera.width - 1 - m) & (m <= v) & (v <= camera.height - 1 - m))
+        )
 
     def model2_angles(self, p: np.ndarray) -> tuple[float, float]:
         """Encoder readings alpha1, alpha2 at which each camera fixates ``p`` (H), rad."""
