@@ -12,6 +12,7 @@ import functools
 import importlib.util
 import json
 import math
+import os
 import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -19,6 +20,14 @@ from types import ModuleType
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
+#: Set (to "1") by ``readme_figures.py --write`` for its processes: generators that draw a
+#: figure file (a PNG the pages show) draw it only then, not when checking.
+WRITE_ENV = "HEADSIM_FIGURES_WRITE"
+
+
+def writing() -> bool:
+    """Whether this run rewrites the blocks (and so the figure files beside them)."""
+    return os.environ.get(WRITE_ENV) == "1"
 
 
 def run_payload(

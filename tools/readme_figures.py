@@ -41,12 +41,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import figures_findings as findings
 import figures_live as live
 import figures_realistic as realistic
 import figures_servo as servo
 from figures_common import (
     ROOT,
     SEEDS,
+    WRITE_ENV,
     acceptance,
     bands,
     calibration_errors,
@@ -301,12 +303,19 @@ GENERATORS: dict[str, Generator] = {
     "stress": Generator(stress, cheap=False, ci=False, seconds=100),
     "layouts": Generator(realistic.layouts, cheap=False, group="forward", seconds=35),
     "budget": Generator(realistic.budget, cheap=False, ci=False, seconds=75),
-    "heads": Generator(servo.heads, cheap=False, ci=False, seconds=200),
+    "heads": Generator(servo.heads, cheap=False, ci=False, seconds=500),
     "render_fidelity": Generator(servo.render_fidelity, cheap=False, group="fidelity", seconds=30),
     "render_fidelity_presets": Generator(
         servo.render_fidelity_presets, cheap=False, group="fidelity", seconds=20
     ),
     "batch_centroids": Generator(servo.batch_centroids, cheap=False, seconds=60),
+    # docs/findings.md: the Tables V/VI experiment at full size over the seeds, shared.
+    "findings_figure": Generator(
+        findings.findings_figure, cheap=False, ci=False, group="findings", seconds=300
+    ),
+    "findings_xz": Generator(findings.findings_xz, cheap=False, ci=False, group="findings"),
+    "findings_y": Generator(findings.findings_y, cheap=False, ci=False, group="findings"),
+    "findings_zoom": Generator(findings.findings_zoom, cheap=False, ci=False, group="findings"),
 }
 
 
@@ -442,6 +451,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         for n, g in GENERATORS.items()
         if (g.cheap or not args.cheap) and (g.ci or g.cheap or not args.ci)
     ]
+    if args.write:
+        os.environ[WRITE_ENV] = "1"  # the generators' processes inherit it
     fresh, stale = check(names, present, args.root, args.jobs)
     if args.write:
         for page in {present[name][0] for name in fresh}:
