@@ -67,3 +67,32 @@ def test_figures_over_seeds_give_the_median_and_the_range() -> None:
     assert common.spread_pct([None]) == "-"
     assert common.seeds_label((0, 1, 2, 3, 4)) == "seeds 0-4"
     assert common.seeds_label((0, 2)) == "seeds 0, 2"
+
+
+def test_the_heads_table_over_seeds_gives_each_cell_as_median_range_and_targets() -> None:
+    heads = common.benchmark("heads")
+
+    def row(rms: float, near: float | None, count: int) -> dict:
+        return {
+            "head": "paper",
+            "procedure": "model2",
+            "count": count,
+            "ok": count,
+            "refused": {"occluded": 1},
+            "rms_pct": rms,
+            "0-0.6 m": (near, 0 if near is None else 2),
+            "0.6-1 m": (rms, count - 2),
+            ">= 1 m": (None, 0),
+            "renders_per_point": 10.0,
+            "failures": [],
+        }
+
+    text = heads.seeds_text(
+        [[row(0.2, 0.1, 5)], [row(0.4, None, 4)], [row(0.3, 0.3, 6)]], [0, 1, 2]
+    )
+    line = text.splitlines()[2]
+    assert "median over seeds 0-2" in text.splitlines()[0]
+    assert line.split()[2:4] == ["15", "3"]  # targets and refusals over the seeds
+    assert "0.300 (0.200-0.400) [15/15]" in line  # all: median, range, measured/targets
+    assert "0.200 (0.100-0.300) [4]" in line  # a band one seed lacks: two seeds' values
+    assert line.split()[-3:] == ["-", "[0]", "10.0"]  # a band no seed has; renders per point
