@@ -11,6 +11,7 @@ from headsim.studies.render_clock import CLOCK_RENDERS
 from headsim.studies.reproduce_experiments import (
     PAPER_ALPHA_E,
     PAPER_SIDE_MEAN_MM,
+    PAPER_SIDE_STD_MM,
     REALISTIC_BOARD_JOB,
     SCENARIO_JOBS,
     STUDY_JOB,
@@ -64,8 +65,33 @@ def main_figure(
         widths = [1e3 * w for w in e.get("widths_m", []) + e.get("heights_m", []) if w is not None]
         if widths:
             ax.hist(
-                widths, bins=15, color="tab:blue", alpha=0.8, label=f"ours, {len(widths)} sides"
+                widths,
+                bins=15,
+                color="tab:blue",
+                alpha=0.8,
+                label=f"paper preset, {len(widths)} sides",
             )
+        real = outcomes.get(REALISTIC_BOARD_JOB)
+        if real is not None and real.status != "error":
+            r = real.data["results"]["experiment"]
+            sides = [
+                1e3 * w for w in r.get("widths_m", []) + r.get("heights_m", []) if w is not None
+            ]
+            if sides:
+                ax.hist(
+                    sides,
+                    bins=15,
+                    color="tab:orange",
+                    alpha=0.6,
+                    label=f"realistic preset, {len(sides)} sides",
+                )
+        ax.axvspan(
+            PAPER_SIDE_MEAN_MM - PAPER_SIDE_STD_MM,
+            PAPER_SIDE_MEAN_MM + PAPER_SIDE_STD_MM,
+            color="grey",
+            alpha=0.15,
+            label="paper mean +- std",
+        )
         ax.axvline(PAPER_SIDE_MEAN_MM, color="grey", lw=2, label="paper mean 30.3")
         ax.axvline(TRUE_SIDE_MM, color="black", ls=":", label="true 30.0")
         ax.set_xlabel("side, mm")
