@@ -1,7 +1,7 @@
 """The figures the documentation quotes from runs, regenerated from today's code.
 
-Each block of figures, in README.md or a page under docs/ (most on docs/results.md),
-sits between two markers::
+Each block of figures, in README.md or a page under docs/ (most on docs/results.md and
+docs/findings.md), sits between two markers::
 
     <!-- figures:NAME -->
     ...text written by the generator NAME...
@@ -12,12 +12,13 @@ written by the generator of that name below (``figures_*.py`` beside this file),
 from fresh runs of today's code: scenarios through the runner, studies, the
 benchmark scripts' functions.  Every run is seeded, so a block is the same on
 every run on one machine (but a timed block's numbers, wall-time ratios, which the
-check leaves out); a name appears once over all pages.  Usage::
+check leaves out); a name appears once over all pages. A generator that draws a PNG
+for its page (``figures_findings.py``) draws it only with ``--write``.  Usage::
 
     python tools/readme_figures.py              # check every block; exit 1 naming each stale one
     python tools/readme_figures.py --cheap      # only the blocks that take seconds (a test runs these)
     python tools/readme_figures.py --ci         # all but the few of several minutes (CI runs these)
-    python tools/readme_figures.py --write      # rewrite the blocks in place
+    python tools/readme_figures.py --write      # rewrite the blocks in place (and the PNGs they show)
     python tools/readme_figures.py --only NAME  # one block (repeatable)
     python tools/readme_figures.py --jobs 1     # in this process only (default: 2 processes)
 
