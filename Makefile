@@ -30,7 +30,7 @@ test: setup
 regress: setup
 	$(BIN)/headsim bench
 
-# Every figure block of the documentation (docs/results.md) regenerated and checked (about 10 minutes; CI checks
+# Every figure block of the documentation (docs/results.md, docs/findings.md) regenerated and checked (about 20 minutes; CI checks
 # all but the longest): after an intended change, `python tools/readme_figures.py --write`.
 figures: setup
 	$(BIN)/python tools/readme_figures.py

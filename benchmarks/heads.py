@@ -17,7 +17,12 @@ depth band, and renders per point.
 The study (``--study``) runs Model 2 (and fixation) with the baseline and the focal
 length scaled about each head's own, and plots the whole field's RMS against each.
 
-    python benchmarks/heads.py [--fast] [--targets 20] [--seed 0] [--study] [--plot F] [--json F]
+    python benchmarks/heads.py [--fast] [--targets 20] [--seed 0] [--seeds 1] [--study] [--plot F]
+                               [--json F]
+
+With ``--seeds N`` the table is given over seeds ``--seed`` .. ``--seed + N - 1``: each
+cell the median of the seeds' RMS, their range and the targets behind it; the study
+runs at ``--seed`` alone.
 """
 
 from __future__ import annotations
@@ -237,6 +242,64 @@ def table_text(rows: list[dict[str, Any]], seed: int) -> str:
     return "\n".join(lines) + "\n"
 
 
+def seeds_table(args: argparse.Namespace, seeds: list[int]) -> list[list[dict[str, Any]]]:
+    """:func:`table` at each of ``seeds`` (each its own calibration balls, targets and noise)."""
+    return [table(argparse.Namespace(**{**vars(args), "seed": seed})) for seed in seeds]
+
+
+def _median(values: list[float]) -> float:
+    return float(np.median(values))
+
+
+def _spread(values: list[float | None]) -> str:
+    """'MEDIAN (MIN-MAX)' of the seeds' values; '-' when none has one."""
+    vs = [v for v in values if v is not None]
+    if not vs:
+        return "-"
+    if len(vs) == 1:
+        return f"{vs[0]:.3f} (1 seed)"
+    return f"{_median(vs):.3f} ({min(vs):.3f}-{max(vs):.3f})"
+
+
+def seeds_text(per_seed: list[list[dict[str, Any]]], seeds: list[int]) -> str:
+    """The table over seeds: each cell the median of the seeds' RMS (min-max), with the
+    targets behind it over all seeds."""
+    label = f"seeds {seeds[0]}-{seeds[-1]}" if len(seeds) > 1 else f"seed {seeds[0]}"
+    lines = [
+        f"3-D error RMS, % of depth: median over {label} (min-max over the seeds) [targets "
+        "over all seeds]; realistic heads after calibration, each seed its own balls and targets"
+    ]
+    width = 26
+    header = f"{'head':18} {'procedure':22} {'accepted':>8} {'refused':>8} {'all':>{width}}"
+    header += "".join(f" {label:>{width}}" for _, _, label in BANDS) + f" {'renders/pt':>10}"
+    lines.append(header)
+    for index, first in enumerate(per_seed[0]):
+        rows = [rs[index] for rs in per_seed]
+        refused = (
+            sum(sum(r["refused"].values()) for r in rows)
+            if all(isinstance(r.get("refused"), dict) for r in rows)
+            else "-"
+        )
+        ok, count = sum(r["ok"] for r in rows), sum(r["count"] for r in rows)
+        cells = [f"{_spread([r['rms_pct'] for r in rows])} [{ok}/{count}]"]
+        for _, _, band in BANDS:
+            cells.append(f"{_spread([r[band][0] for r in rows])} [{sum(r[band][1] for r in rows)}]")
+        rpp = [r["renders_per_point"] for r in rows if r["renders_per_point"] is not None]
+        shown = f"{_median(rpp):.1f}" if rpp else "-"
+        line = f"{first['head']:18} {first['procedure']:22} {count:>8} {refused!s:>8}"
+        line += "".join(f" {c:>{width}}" for c in cells) + f" {shown:>10}"
+        lines.append(line)
+        frame = [r["camera_frame_mean_pct"] for r in rows if r.get("camera_frame_mean_pct")]
+        if frame:
+            lines.append(
+                f"{'':18} {'  in camera 1 (truth-placed)':22} mean {_spread(frame)} % of depth"
+            )
+        failures = [f for r in rows for f in r["failures"]]
+        if failures:
+            lines.append(f"{'':18} failures: {'; '.join(failures)}")
+    return "\n".join(lines) + "\n"
+
+
 def study(args: argparse.Namespace) -> list[dict[str, Any]]:
     """Whole-field RMS with the baseline, then the focal length, scaled about each head's."""
     points = []
@@ -349,14 +412,23 @@ def main() -> None:
     parser.add_argument("--targets", type=int, default=None, help="random targets per run (20)")
     parser.add_argument("--balls", type=int, default=None, help="calibration balls (20)")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--seeds", type=int, default=1, help="the table over this many seeds from --seed (1)"
+    )
     parser.add_argument("--study", action="store_true", help="also the baseline/focal study")
     parser.add_argument("--plot", default=None, help="write the study's plot (PNG) here")
     parser.add_argument("--json", default=None, help="write every figure here")
     args = parser.parse_args()
     args.targets = args.targets or (4 if args.fast else 20)
     args.balls = args.balls or (12 if args.fast else 20)
-    figures: dict[str, Any] = {"table": table(args)}
-    print(table_text(figures["table"], args.seed), end="")
+    figures: dict[str, Any] = {}
+    if args.seeds > 1:
+        seeds = list(range(args.seed, args.seed + args.seeds))
+        figures["tables"] = seeds_table(args, seeds)
+        print(seeds_text(figures["tables"], seeds), end="")
+    else:
+        figures["table"] = table(args)
+        print(table_text(figures["table"], args.seed), end="")
     if args.study or args.plot:
         figures["study"] = study(args)
         print("\n" + study_text(figures["study"]), end="")

@@ -12,6 +12,7 @@ import functools
 import importlib.util
 import json
 import math
+import os
 import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -19,6 +20,14 @@ from types import ModuleType
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
+#: Set (to "1") by ``readme_figures.py --write`` for its processes: generators that draw a
+#: figure file (a PNG the pages show) draw it only then, not when checking.
+WRITE_ENV = "HEADSIM_FIGURES_WRITE"
+
+
+def writing() -> bool:
+    """Whether this run rewrites the blocks (and so the figure files beside them)."""
+    return os.environ.get(WRITE_ENV) == "1"
 
 
 def run_payload(
@@ -153,3 +162,33 @@ def table(header: Sequence[str], rows: Iterable[Sequence[str]]) -> str:
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(row) + " |" for row in rows]
     return "\n".join(lines) + "\n"
+
+
+# --- figures over seeds -------------------------------------------------------------
+
+#: The seeds every headline figure is given over: each seed draws its own calibration
+#: balls and targets, so the spread shows the calibration draw as well as the noise.
+SEEDS = tuple(range(5))
+
+
+def median(values: Sequence[float]) -> float:
+    """The median of ``values`` (the mean of the middle two for an even count)."""
+    vs = sorted(values)
+    mid = len(vs) // 2
+    return vs[mid] if len(vs) % 2 else 0.5 * (vs[mid - 1] + vs[mid])
+
+
+def spread_pct(values: Sequence[float | None], digits: int = 3) -> str:
+    """'MEDIAN % (MIN-MAX)' of per-seed values in %; '-' when no seed has one."""
+    vs = [v for v in values if v is not None and not math.isnan(v)]
+    if not vs:
+        return "-"
+    return f"{pct(median(vs), digits)} ({span(vs, digits)})"
+
+
+def seeds_label(seeds: Sequence[int] = SEEDS) -> str:
+    """'seeds 0-4' (or the list when they are not consecutive)."""
+    s = list(seeds)
+    if s == list(range(s[0], s[-1] + 1)) and len(s) > 1:
+        return f"seeds {s[0]}-{s[-1]}"
+    return "seeds " + ", ".join(map(str, s))

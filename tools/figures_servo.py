@@ -414,14 +414,22 @@ def reach_zoom_angles() -> str:
 
 
 def heads() -> str:
-    """benchmarks/heads.py's table and study (20 targets, 20 balls, seed 0)."""
+    """benchmarks/heads.py's table over seeds 0-4 and its study (20 targets, 20 balls,
+    the study at seed 0)."""
     import argparse
 
+    from figures_common import SEEDS
+
     bench = benchmark("heads")
-    args = argparse.Namespace(targets=20, balls=20, seed=0)
-    rows = bench.table(args)
+    args = argparse.Namespace(targets=20, balls=20, seed=SEEDS[0])
+    per_seed = bench.seeds_table(args, list(SEEDS))
     points = bench.study(args)
     return (
-        "`python benchmarks/heads.py --targets 20 --balls 20 --study --plot docs/heads-study.png`:\n\n"
-        "```\n" + bench.table_text(rows, args.seed) + "\n" + bench.study_text(points) + "```\n"
+        f"`python benchmarks/heads.py --targets 20 --balls 20 --seeds {len(SEEDS)} --study "
+        "--plot docs/heads-study.png` (the study at seed 0 alone):\n\n"
+        "```\n"
+        + bench.seeds_text(per_seed, list(SEEDS))
+        + "\n"
+        + bench.study_text(points)
+        + "```\n"
     )

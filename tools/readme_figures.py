@@ -1,7 +1,7 @@
 """The figures the documentation quotes from runs, regenerated from today's code.
 
-Each block of figures, in README.md or a page under docs/ (most on docs/results.md),
-sits between two markers::
+Each block of figures, in README.md or a page under docs/ (most on docs/results.md and
+docs/findings.md), sits between two markers::
 
     <!-- figures:NAME -->
     ...text written by the generator NAME...
@@ -12,12 +12,13 @@ written by the generator of that name below (``figures_*.py`` beside this file),
 from fresh runs of today's code: scenarios through the runner, studies, the
 benchmark scripts' functions.  Every run is seeded, so a block is the same on
 every run on one machine (but a timed block's numbers, wall-time ratios, which the
-check leaves out); a name appears once over all pages.  Usage::
+check leaves out); a name appears once over all pages. A generator that draws a PNG
+for its page (``figures_findings.py``) draws it only with ``--write``.  Usage::
 
     python tools/readme_figures.py              # check every block; exit 1 naming each stale one
     python tools/readme_figures.py --cheap      # only the blocks that take seconds (a test runs these)
     python tools/readme_figures.py --ci         # all but the few of several minutes (CI runs these)
-    python tools/readme_figures.py --write      # rewrite the blocks in place
+    python tools/readme_figures.py --write      # rewrite the blocks in place (and the PNGs they show)
     python tools/readme_figures.py --only NAME  # one block (repeatable)
     python tools/readme_figures.py --jobs 1     # in this process only (default: 2 processes)
 
@@ -41,17 +42,22 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import figures_findings as findings
 import figures_live as live
 import figures_realistic as realistic
 import figures_servo as servo
 from figures_common import (
     ROOT,
+    SEEDS,
+    WRITE_ENV,
     acceptance,
     bands,
     calibration_errors,
     effort,
     payload,
     pct,
+    seeds_label,
+    spread_pct,
     summary,
     table,
 )
@@ -68,14 +74,20 @@ _BLOCK = re.compile(
 
 
 def quickstart() -> str:
-    """``headsim run quickstart`` at seed 0: accuracy and what it drew."""
-    p = payload("quickstart")
+    """``headsim run quickstart`` at seed 0 (accuracy and what it drew), then over seeds."""
+    p = payload("quickstart", seed=0)
     s, e = summary(p), effort(p)
+    runs = [summary(payload("quickstart", seed=seed)) for seed in SEEDS]
+    per_seed = " / ".join(pct(r["error_pct_of_depth_rms"]) for r in runs)
     return (
         f"`headsim run quickstart` (seed 0): all {s['ok']} of {s['count']} markers measured, "
         f"3-D error RMS **{pct(s['error_pct_of_depth_rms'])} of depth** "
         f"(by depth band: {bands(s)}); {s['renders_per_point']:.1f} renders per marker. "
-        f"{_renders_line(e)}\n"
+        f"{_renders_line(e)} Over {seeds_label()} (`--seed N`; each seed draws its own "
+        f"calibration balls and random markers): 3-D error RMS median "
+        f"**{spread_pct([r['error_pct_of_depth_rms'] for r in runs])} of depth** (min-max "
+        f"over the {len(runs)} seeds), {sum(r['ok'] for r in runs)} of "
+        f"{sum(r['count'] for r in runs)} markers measured; per seed {per_seed}.\n"
     )
 
 
@@ -92,7 +104,7 @@ def _renders_line(e: dict[str, Any]) -> str:
 
 def realistic_field() -> str:
     """``headsim run realistic_field`` at seed 0: the whole field, effort, the calibration."""
-    p = payload("realistic_field")
+    p = payload("realistic_field", seed=0)
     s, e, a = summary(p), effort(p), acceptance(p)
     edge = s["outside_start_view"]
     refused = ", ".join(f"{n} {code}" for code, n in sorted(a["refused"].items())) or "none"
@@ -113,28 +125,59 @@ def realistic_field() -> str:
 PRESETS = ("ideal", "paper", "realistic")
 
 
+def _field_run(preset: str, seed: int) -> dict[str, Any]:
+    """``realistic_field`` at ``seed`` on ``preset`` (its own preset unchanged, so that the
+    run is shared with its block)."""
+    if preset == "realistic":
+        return payload("realistic_field", seed=seed)
+    return payload("realistic_field", seed=seed, **{"head.preset": preset})
+
+
 def accuracy_by_preset() -> str:
-    """``realistic_field`` at seed 0 on each preset: 3-D error RMS by depth band."""
-    rows = []
-    for preset in PRESETS:
-        # realistic_field's own preset runs unchanged, shared with its block.
-        p = (
-            payload("realistic_field")
-            if preset == "realistic"
-            else payload("realistic_field", **{"head.preset": preset})
-        )
-        s, a = summary(p), acceptance(p)
-        cells = [f"{pct(b['error_pct_of_depth_rms'])} ({b['count']})" for b in s["by_depth"]]
+    """``realistic_field`` over seeds on each preset: 3-D error RMS by depth band, the
+    median over seeds with its range, and the presets' order seed by seed."""
+    runs = {preset: [_field_run(preset, seed) for seed in SEEDS] for preset in PRESETS}
+    # A band no target of a seed fell in is left out of that seed's summary.
+    first = list(
+        dict.fromkeys(b["band"] for p in runs["realistic"] for b in summary(p)["by_depth"])
+    )
+    rows, overall = [], {}
+    for preset, payloads in runs.items():
+        sums, accept = [summary(p) for p in payloads], [acceptance(p) for p in payloads]
+        cells = []
+        for band in first:
+            entries = [b for s in sums for b in s["by_depth"] if b["band"] == band]
+            cells.append(
+                f"{spread_pct([b['error_pct_of_depth_rms'] for b in entries])}; "
+                f"{sum(b['count'] for b in entries)}"
+            )
+        overall[preset] = [s["error_pct_of_depth_rms"] for s in sums]
         rows.append(
             [
-                f"`{p['scenario']['preset']}`",
+                f"`{payloads[0]['scenario']['preset']}`",
                 *cells,
-                f"{pct(s['error_pct_of_depth_rms'])} ({s['count']})",
-                f"{s['ok']} / {a['drawn']}",
+                f"{spread_pct(overall[preset])}; {sum(s['count'] for s in sums)}",
+                f"{sum(s['ok'] for s in sums)} / {sum(a['drawn'] for a in accept)}",
             ]
         )
-    (first,) = {tuple(b["band"] for b in summary(payload("realistic_field"))["by_depth"])}
-    return table(("preset", *first, "all", "measured / drawn"), rows)
+    header = ("preset", *first, "all", "measured / drawn")
+    text = table(header, rows)
+    per_seed = "; ".join(
+        f"`{preset}` " + " / ".join(pct(v) for v in values) for preset, values in overall.items()
+    )
+    orders = []
+    for index, a in enumerate(PRESETS):
+        for b in PRESETS[index + 1 :]:
+            below = sum(
+                x is not None and y is not None and x < y
+                for x, y in zip(overall[a], overall[b], strict=True)
+            )
+            orders.append(f"`{a}` < `{b}` in {below} of {len(SEEDS)}")
+    return (
+        f"Median over {seeds_label()} of each seed's RMS (min-max over the seeds); targets "
+        f"over all seeds:\n\n{text}\nThe whole field's RMS seed by seed ({seeds_label()}): "
+        f"{per_seed}. Seeds where one preset's RMS is below another's: {'; '.join(orders)}.\n"
+    )
 
 
 def _calibration_line(p: dict[str, Any]) -> str:
@@ -236,7 +279,7 @@ class Generator:
 
 
 GENERATORS: dict[str, Generator] = {
-    "quickstart": Generator(quickstart, cheap=True, seconds=3),
+    "quickstart": Generator(quickstart, cheap=True, seconds=15),
     "reproduce": Generator(live.reproduce, cheap=False, seconds=45),
     "speed": Generator(live.speed, cheap=False, timed=True, seconds=15),
     "chessboard_windows": Generator(servo.chessboard_windows, cheap=False, seconds=7),
@@ -256,17 +299,24 @@ GENERATORS: dict[str, Generator] = {
     "forward_budget": Generator(realistic.forward_budget, cheap=True, group="forward", seconds=1),
     "realistic_field": Generator(realistic_field, cheap=False, group="realistic field", seconds=8),
     "accuracy_by_preset": Generator(
-        accuracy_by_preset, cheap=False, group="realistic field", seconds=30
+        accuracy_by_preset, cheap=False, ci=False, group="realistic field", seconds=150
     ),
     "stress": Generator(stress, cheap=False, ci=False, seconds=100),
     "layouts": Generator(realistic.layouts, cheap=False, group="forward", seconds=35),
     "budget": Generator(realistic.budget, cheap=False, ci=False, seconds=75),
-    "heads": Generator(servo.heads, cheap=False, ci=False, seconds=200),
+    "heads": Generator(servo.heads, cheap=False, ci=False, seconds=500),
     "render_fidelity": Generator(servo.render_fidelity, cheap=False, group="fidelity", seconds=30),
     "render_fidelity_presets": Generator(
         servo.render_fidelity_presets, cheap=False, group="fidelity", seconds=20
     ),
     "batch_centroids": Generator(servo.batch_centroids, cheap=False, seconds=60),
+    # docs/findings.md: the Tables V/VI experiment at full size over the seeds, shared.
+    "findings_figure": Generator(
+        findings.findings_figure, cheap=False, ci=False, group="findings", seconds=300
+    ),
+    "findings_xz": Generator(findings.findings_xz, cheap=False, ci=False, group="findings"),
+    "findings_y": Generator(findings.findings_y, cheap=False, ci=False, group="findings"),
+    "findings_zoom": Generator(findings.findings_zoom, cheap=False, ci=False, group="findings"),
 }
 
 
@@ -402,6 +452,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         for n, g in GENERATORS.items()
         if (g.cheap or not args.cheap) and (g.ci or g.cheap or not args.ci)
     ]
+    if args.write:
+        os.environ[WRITE_ENV] = "1"  # the generators' processes inherit it
     fresh, stale = check(names, present, args.root, args.jobs)
     if args.write:
         for page in {present[name][0] for name in fresh}:

@@ -21,3 +21,19 @@ def test_a_failing_job_says_why_and_leaves_the_pool_working(tmp_path: Path) -> N
                 job.result(timeout=300)
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def test_the_realistic_board_is_the_same_board_on_the_realistic_preset(tmp_path: Path) -> None:
+    from headsim.studies.reproduce_jobs import realistic_board_job
+    from headsim.studies.reproduce_rows import chessboard_rows
+
+    data = realistic_board_job(str(tmp_path), True, None)
+    results = data["results"]
+    assert results["scenario"]["preset"] == "realistic"
+    experiment = results["experiment"]
+    assert experiment["corners_measured"] == experiment["corners"] > 0
+    assert (tmp_path / "chessboard_realistic" / "results.json").is_file()
+    # Its rows stand beside the paper preset's, with the ratio to the paper's rig.
+    rows = {r.quantity: r for r in chessboard_rows({**data, "realistic": data})}
+    std = rows["square side, std, mm, realistic preset (real tolerances)"]
+    assert f"{1e3 * experiment['side_std_m']:.3f} (ours / paper's: " in std.ours

@@ -31,7 +31,17 @@ def test_a_failed_experiment_is_reported_beside_the_others(tmp_path: Path) -> No
     }
     text = report_text(_state(tmp_path, "failed"), outcomes, CALIBRATION, None)
     assert "**FAILED**: RuntimeError: GL context lost" in text
-    assert "| square side, mean, mm (true 30) | 30.3 | 30.030 |" in text
+    assert (
+        "| square side, mean, mm (true 30), paper preset (ideal mechanics) | 30.3 | 30.030 |"
+        in (text)
+    )
+    # The first line counts the rows: 2 directions, the board's 5 (its realistic preset not
+    # run: 2 rows without a figure, not reproduced) and the failed tracking (1).
+    assert text.splitlines()[0] == (
+        "# headsim reproduce: 5 of 8 rows reproduced, 3 not reproduced or failed, "
+        "0 without a paper figure to compare"
+    )
+    assert "(not run)." in text
     assert "hash `abababababab`" in text and "seed: 0" in text
     # Not yet run (an interrupted run): said so, the rest readable.
     interrupted = report_text(_state(tmp_path, "interrupted"), outcomes, CALIBRATION, None)
