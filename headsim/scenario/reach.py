@@ -4,7 +4,8 @@ A target is refused only where no pose the procedure may take fixates it:
 Model 2 (the neck still, as in the paper) needs it in front (z_h 0.1-10 m),
 each camera's fixation angle within the eye range, each camera seeing it
 whole where it fixates it, and nothing of the scene in either camera's line
-of sight; Model 1 needs the neck's and the eye's fixation angles within
+of sight (from its entrance pupil, at the start pose and where it fixates:
+:meth:`ReachHead.optical_centre`); Model 1 needs the neck's and the eye's fixation angles within
 their ranges, the same depth and lines of sight, and both cameras seeing it
 whole from some neck pose with the eyes at 0 (where its neck servo can
 start).  A target that the start pose does not show is not refused: the
