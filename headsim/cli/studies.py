@@ -107,6 +107,11 @@ def sweep_command(args: argparse.Namespace) -> int:
     finally:
         outputs.remove_empty_created()
     print(printable(summary_table(spec, outcome.records.values())))
+    for record in sorted(outcome.failed, key=lambda r: r["index"]):
+        reasons = [str(r) for r in record.get("failure_reasons") or [record.get("error", "")]]
+        more = f" (and {len(reasons) - 2} more in jobs.jsonl)" if len(reasons) > 2 else ""
+        why = "; ".join(reasons[:2]) + more
+        print(printable(f"  job {record['index']} {record.get('status', '?')}: {why}"))
     rate = 60 * outcome.ran / outcome.wall_s if outcome.wall_s > 0 else 0.0
     print(
         f"{outcome.ran} jobs run ({outcome.skipped} already done) in {outcome.wall_s:.1f} s, "

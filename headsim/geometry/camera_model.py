@@ -9,6 +9,7 @@ centre of a W x H image is ((W-1)/2, (H-1)/2).  Normalised coordinates are
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -80,7 +81,7 @@ class PinholeCamera:
         """True when k1 or k2 is non-zero."""
         return self.k1 != 0.0 or self.k2 != 0.0
 
-    @property
+    @functools.cached_property  # a root of a polynomial, asked for at every projection
     def fold_radius(self) -> float:
         """Normalised radius where ``r (1 + k1 r^2 + k2 r^4)`` stops increasing (inf if never)."""
         # Slope 1 + 3 k1 s + 5 k2 s^2 in s = r^2: its smallest positive root.

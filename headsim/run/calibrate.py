@@ -30,6 +30,7 @@ from headsim.active.placement import calibration_layout
 from headsim.estimators.result import Status
 from headsim.run.context import (
     PAPER,
+    PARKED_WORLD_M,
     servo_config,
     simulator,
     told,
@@ -52,6 +53,10 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
     near_far = spec.layout == "near_far"
     config, known = servo_config(scenario), told(scenario)
     with simulator(hub, "default", scenario) as sim:
+        # The ball alone in the scene, as on a bench: the markers where the scene's XML
+        # puts them stand among the ball's positions and would hide some of them.
+        for marker in names.MARKERS:
+            sim.set_body_pose(marker, np.array(PARKED_WORLD_M))
         try:
             depths_m = (
                 near_far_depths(spec.targets, spec.depth_m, spec.near_fraction)

@@ -344,7 +344,7 @@ DESCRIPTIONS: dict[str, str] = {
     "scene.random_targets.count": "Number of random targets.",
     "scene.random_targets.body": "The marker body of every random target.",
     **{f"scene.random_targets.{k}": v for k, v in _RANDOM_BOX.items()},
-    "scene.random_targets.within": "`box` refuses a drawn point out of reach; `reach` draws it again (counted).",
+    "scene.random_targets.within": "`box` refuses a drawn point out of reach and draws again one the scene hides; `reach` draws any refused point again (each redraw counted).",
     "scene.chessboard": "The chessboard (procedure `chessboard`); it faces the head.",
     "scene.chessboard.corners": 'Which inner corners are measured: `"all"` or an array of corner indices, row-major from the top-left.',
     **{

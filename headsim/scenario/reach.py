@@ -4,7 +4,8 @@ A target is refused only where no pose the procedure may take fixates it:
 Model 2 (the neck still, as in the paper) needs it in front (z_h 0.1-10 m),
 each camera's fixation angle within the eye range, each camera seeing it
 whole where it fixates it, and nothing of the scene in either camera's line
-of sight; Model 1 needs the neck's and the eye's fixation angles within
+of sight (from its entrance pupil, at the start pose and where it fixates:
+:meth:`ReachHead.optical_centre`); Model 1 needs the neck's and the eye's fixation angles within
 their ranges, the same depth and lines of sight, and both cameras seeing it
 whole from some neck pose with the eyes at 0 (where its neck servo can
 start).  A target that the start pose does not show is not refused: the
@@ -26,6 +27,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from headsim.geometry.camera_model import PinholeCamera
 from headsim.geometry.kinematics import eye_from_camera_rotation
 from headsim.scenario.occlusion import Occluder, hidden_by, scene_model, scene_occluders
 from headsim.scenario.spec import (
@@ -36,7 +38,34 @@ from headsim.sim import names
 from headsim.sim.forward import effective_directions
 from headsim.sim.heads import eye_motor_range
 from headsim.sim.model import head_names, neck_of
-from headsim.sim.settings import HeadSettings
+from headsim.sim.settings import CameraSettings, HeadSettings
+
+
+@lru_cache(maxsize=16)
+def _pinhole(camera: CameraSettings) -> PinholeCamera:
+    """A camera's lens, made once (the loader asks for it at every point it checks)."""
+    return camera.pinhole()
+
+
+@lru_cache(maxsize=16)
+def _mount_rotation(camera: CameraSettings, sign: float) -> np.ndarray:
+    """:func:`eye_from_camera_rotation` of a camera's mount, made once."""
+    return eye_from_camera_rotation(
+        sign, camera.mount_yaw_rad, camera.mount_pitch_rad, camera.mount_roll_rad
+    )
+
+
+def _project(lens: PinholeCamera, p: np.ndarray) -> tuple[float, float] | None:
+    """:meth:`PinholeCamera.project` of one point in floats (the loader asks at every
+    point); None beyond where the lens folds over (not imaged)."""
+    x, y = float(p[0] / p[2]), float(p[1] / p[2])
+    if lens.is_distorted:
+        r2 = x * x + y * y
+        if r2 >= lens.fold_radius**2:
+            return None
+        scale = 1.0 + lens.k1 * r2 + lens.k2 * r2 * r2
+        x, y = x * scale, y * scale
+    return lens.kx * x + lens.cx, lens.ky * y + lens.cy
 
 
 @dataclass(frozen=True)
@@ -87,9 +116,7 @@ class ReachHead:
         centre = np.array([sign * -self.settings.baseline_m / 2, 0.0, 0.0])
         c, s = math.cos(sign * eye), math.sin(sign * eye)
         eye_rotation = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-        rotation = eye_rotation @ eye_from_camera_rotation(
-            sign, camera.mount_yaw_rad, camera.mount_pitch_rad, camera.mount_roll_rad
-        )
+        rotation = eye_rotation @ _mount_rotation(camera, sign)
         offset_cv = np.array([camera.side_offset_m, 0.0, camera.nodal_offset_m])
         p = rotation.T @ (point_head - centre) - offset_cv
         if p[2] <= 0.01:
@@ -101,12 +128,16 @@ class ReachHead:
             across /= np.linalg.norm(across)
             for d in (across, np.cross(across, sight)):
                 points += [p + radius_m * d, p - radius_m * d]
-        uv = camera.pinhole().project(np.array(points))  # NaN beyond where the lens folds over
+        lens = _pinhole(camera)
         m = 2.0 if radius_m > 0 else 0.0
-        u, v = uv[:, 0], uv[:, 1]
-        return bool(
-            np.all((m <= u) & (u <= camera.width - 1 - m) & (m <= v) & (v <= camera.height - 1 - m))
-        )
+        for q in points:
+            uv = _project(lens, q)
+            if uv is None:
+                return False
+            u, v = uv
+            if not (m <= u <= camera.width - 1 - m and m <= v <= camera.height - 1 - m):
+                return False
+        return True
 
     def model2_angles(self, p: np.ndarray) -> tuple[float, float]:
         """Encoder readings alpha1, alpha2 at which each camera fixates ``p`` (H), rad."""
@@ -120,14 +151,38 @@ class ReachHead:
         s = self.settings
         return neck_of(s.head).world_to_head(point_world, yaw, pitch, s.neck_d1_m, s.neck_a2_m)
 
-    def eye_centres(self, yaw: float = 0.0, pitch: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-        """Each eye's centre (on its yaw axis) in W with the neck at (``yaw``, ``pitch``), m."""
-        s, half = self.settings, self.settings.baseline_m / 2
-        return tuple(  # type: ignore[return-value]
-            neck_of(s.head).head_to_world(
-                np.array([x, 0.0, 0.0]), yaw, pitch, s.neck_d1_m, s.neck_a2_m
-            )
-            for x in (-half, half)
+    def optical_centre(
+        self, index: int, eye: float = 0.0, yaw: float = 0.0, pitch: float = 0.0
+    ) -> np.ndarray:
+        """Camera ``index``'s true optical centre (its entrance pupil) in W, m, with its eye
+        at ``eye`` (rad, as the encoder reads) and the neck at (``yaw``, ``pitch``).
+
+        The true one, where the renderer draws from: the occlusion check asks what
+        the images will show, and placement may use the truth.  On a real head the
+        pupil sits ``nodal_offset_m`` ahead of the eye's yaw axis (20 mm on the
+        realistic preset) and turns with the eye: from the axis alone, a marker
+        that half hides another from the pupil passes.  The eye axis's tilt (mrad)
+        is left out: it moves the pupil by hundredths of a millimetre.
+        """
+        s = self.settings
+        centre_head = self.optical_centre_head(index, eye)
+        return neck_of(s.head).head_to_world(centre_head, yaw, pitch, s.neck_d1_m, s.neck_a2_m)
+
+    def optical_centre_head(self, index: int, eye: float = 0.0) -> np.ndarray:
+        """Camera ``index``'s true optical centre in H with its eye at ``eye``, rad, m."""
+        s, camera = self.settings, self.settings.cameras[index]
+        sign = names.EYE_CAMERAS[index].inward
+        # The mount's rotation applied to the offset, then the eye's about H's y.
+        offset = _mount_rotation(camera, sign) @ np.array(
+            [camera.side_offset_m, 0.0, camera.nodal_offset_m]
+        )
+        c, sn = math.cos(sign * eye), math.sin(sign * eye)
+        return np.array(
+            [
+                -sign * s.baseline_m / 2 + c * offset[0] + sn * offset[2],
+                offset[1],
+                -sn * offset[0] + c * offset[2],
+            ]
         )
 
     def in_start_view(self, point_world: np.ndarray, radius_m: float = 0.0) -> bool:
@@ -156,21 +211,37 @@ def _occlusion(
     what: str,
     radius_m: float,
     occluders: tuple[Occluder, ...],
-    yaw: float = 0.0,
-    pitch: float = 0.0,
+    poses: tuple[tuple[float, float, float], ...],
 ) -> Refusal | None:
-    """A refusal if the scene hides the point from either eye at neck pose (``yaw``, ``pitch``)."""
-    for index, eye in enumerate(head.eye_centres(yaw, pitch)):
-        # 2 px of the true lens beside the ball (placement: truth allowed)
-        margin = 2.0 / head.settings.cameras[index].kx
-        name = hidden_by(eye, p_world, radius_m, margin, occluders)
-        if name is not None:
-            return Refusal(
-                "occluded",
-                f"{what} at {fmt_point(head.to_head(p_world))} m in H is hidden from camera "
-                f"{index + 1} by {name}",
-                "targets that both cameras see with nothing of the scene in front of them",
-            )
+    """A refusal if the scene hides (any of) the point from either camera's optical centre
+    at any of ``poses`` (neck yaw, neck pitch, eye angle; rad) where that camera sees it.
+
+    The poses are where the procedure looks at the point: the start and the fixations.
+    A partly hidden marker's centroid is biased, and the detector calls it occluded.
+    """
+    s = head.settings
+    neck = neck_of(s.head)
+    for yaw, pitch in dict.fromkeys((yaw, pitch) for yaw, pitch, _ in poses):
+        at = [(index, eye) for y, p, eye in poses if (y, p) == (yaw, pitch) for index in (0, 1)]
+        centres = neck.head_to_world(
+            np.array([head.optical_centre_head(index, eye) for index, eye in at]),
+            yaw,
+            pitch,
+            s.neck_d1_m,
+            s.neck_a2_m,
+        )
+        for (index, eye), centre in zip(at, centres, strict=True):
+            # 2 px of the true lens beside the ball (placement: truth allowed)
+            margin = 2.0 / s.cameras[index].kx
+            name = hidden_by(centre, p_world, radius_m, margin, occluders)
+            # Hidden where the camera sees it (else there is nothing to hide).
+            if name is not None and head.in_view(head.to_head(p_world, yaw, pitch), index, eye):
+                return Refusal(
+                    "occluded",
+                    f"{what} at {fmt_point(head.to_head(p_world))} m in H is hidden from camera "
+                    f"{index + 1} by {name}",
+                    "targets that both cameras see with nothing of the scene in front of them",
+                )
     return None
 
 
@@ -262,7 +333,9 @@ def model2_refusal(
                 f"it fixates it (eye angle {alpha:.3f} rad): it lies above or below that view",
                 "targets that each camera sees whole at some eye angle with the neck still",
             )
-    return _occlusion(head, p_world, what, radius_m, occluders)
+    # The start pose, then each camera's fixation (the eyes move together on a coupled head).
+    poses = tuple((0.0, 0.0, eye) for eye in (0.0, *angles))
+    return _occlusion(head, p_world, what, radius_m, occluders, poses)
 
 
 def _model1_angles(head: ReachHead, p_world: np.ndarray) -> tuple[float, float, float]:
@@ -363,7 +436,9 @@ def model1_refusal(
                 "targets that both cameras see whole from some neck pose with the eyes at 0 "
                 "(Model 1 scans the neck; its servo converges the eyes once both see it)",
             )
-    return _occlusion(head, p_world, what, radius_m, occluders, yaw, pitch)
+    # The start pose, the neck facing it with the eyes at 0 (where the servo starts), fixated.
+    poses = ((0.0, 0.0, 0.0), (yaw, pitch, 0.0), (yaw, pitch, eye))
+    return _occlusion(head, p_world, what, radius_m, occluders, poses)
 
 
 @lru_cache(maxsize=8)

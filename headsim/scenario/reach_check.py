@@ -28,7 +28,7 @@ from headsim.scenario.spec import (
     Scenario,
     corner_count,
 )
-from headsim.scenario.tables import Context
+from headsim.scenario.tables import Context, TargetRefused
 from headsim.sim import names
 
 #: What a refused random target's message adds: how to keep the box and still run.
@@ -43,7 +43,9 @@ def _raise(ctx: Context, source: str, refusal: Refusal | None, *, drawn: bool = 
     drawn without ``within = "reach"``, whose message says how to have it drawn again."""
     if refusal is not None:
         allowed = f"{refusal.allowed}; {REDRAW_HINT}" if drawn else refusal.allowed
-        raise ctx.error(source, refusal.message, allowed)
+        raise TargetRefused(
+            ctx.source, ctx.field_name(source), refusal.message, allowed, refusal.code
+        )
 
 
 def _check_in_front(ctx: Context, source: str, p_head: np.ndarray, what: str) -> None:
@@ -113,12 +115,14 @@ def check_reach(ctx: Context, scenario: Scenario) -> None:
             at_start = head.in_view(p, 0) and head.in_view(p, 1)
             at_fixations = all(head.in_view(p, k, eye) for k in (0, 1) for eye in fixations)
             if not (at_start or at_fixations):
-                raise ctx.error(
-                    placement.source,
+                raise TargetRefused(
+                    ctx.source,
+                    ctx.field_name(placement.source),
                     f"{placement.name} at {fmt_point(p)} m in H is outside a camera's view at "
                     "the start pose and at the cross point's fixations",
                     "objects that both cameras see with neck and eyes at 0, or in all four "
                     "images at the cross point's fixations",
+                    "not_in_any_view",
                 )
     if scene.pursuit is not None:
         pursuit = scene.pursuit

@@ -80,6 +80,10 @@ def tuple3(p: np.ndarray) -> tuple[float, float, float]:
 
 #: Draws per random target before ``within = "reach"`` gives up on the box.
 MAX_DRAWS = 200
+#: What ``within = "box"`` draws again: a draw that the scene's other markers happen to
+#: hide (chance, not the box's fault: every seed must load).  Any other refusal says
+#: that the box reaches beyond the head, and the loader refuses the box for it.
+BOX_REDRAWN = frozenset({"occluded"})
 
 
 def _redraw_out_of_reach(
@@ -90,9 +94,12 @@ def _redraw_out_of_reach(
     points_world: np.ndarray,
     rng: np.random.Generator,
     occluders: tuple[Occluder, ...],
+    redrawn: frozenset[str] | None = None,
 ) -> tuple[np.ndarray, dict[str, int]]:
     """Points drawn again from the same box until the reach check accepts each (bounded),
-    and how many draws it refused, by reason code, most common first."""
+    and how many draws it refused, by reason code, most common first.  ``redrawn``: the
+    reason codes drawn again (None: all); a draw refused for another is kept as drawn,
+    for the loader's reach check to refuse."""
     head = ReachHead.of(settings)
     radius = body_radius(body)
     refused: dict[str, int] = {}
@@ -100,7 +107,7 @@ def _redraw_out_of_reach(
     for k in range(len(points_world)):
         for _ in range(MAX_DRAWS):
             refusal = target_refusal(head, procedure, points_world[k], "target", radius, occluders)
-            if refusal is None:
+            if refusal is None or (redrawn is not None and refusal.code not in redrawn):
                 break
             refused[refusal.code] = refused.get(refusal.code, 0) + 1
             points_world[k] = start_head_to_world(settings, random_points_head(table, 1, rng))[0]
@@ -119,7 +126,8 @@ def _read_targets(
 ) -> tuple[tuple[Placement, ...], TargetAcceptance]:
     """``[[scene.targets]]`` and ``[scene.random_targets]``: markers to measure, in turn,
     and how they were accepted (the loader's reach check refuses a listed one it cannot
-    fixate; ``within = "reach"`` draws a refused random one again, counted)."""
+    fixate; ``within = "reach"`` draws a refused random one again, ``"box"`` one that the
+    scene hides, each counted)."""
     bodies = tuple(MARKER_BODIES)
     targets = []
     for k, table in enumerate(scene.tables("targets")):
@@ -139,13 +147,19 @@ def _read_targets(
         within = random_table.choice("within", ("box", "reach"), "box")
         rng = np.random.default_rng([seed, STREAM_TARGETS])
         points = start_head_to_world(settings, random_points_head(random_table, count, rng))
-        if within == "reach":
-            # What can hide them: the scene as the listed targets leave it.
-            placed = {t.body: np.array(t.position_world_m) for t in targets}
-            occluders = scene_occluders(get(procedure).scene, placed, body)
-            points, refused = _redraw_out_of_reach(
-                random_table, settings, procedure, body, points, rng, occluders
-            )
+        # What can hide them: the scene as the listed targets leave it.
+        placed = {t.body: np.array(t.position_world_m) for t in targets}
+        occluders = scene_occluders(get(procedure).scene, placed, body)
+        points, refused = _redraw_out_of_reach(
+            random_table,
+            settings,
+            procedure,
+            body,
+            points,
+            rng,
+            occluders,
+            None if within == "reach" else BOX_REDRAWN,
+        )
         drawn = count + sum(refused.values())
         random_table.done()
         targets += [

@@ -32,6 +32,21 @@ class ScenarioError(BadInput, ValueError):
         super().__init__(where + message + (f" (allowed: {allowed})" if allowed else ""))
 
 
+class TargetRefused(ScenarioError):
+    """A scenario the reach check refuses: a target, corner, object or path point that the
+    head cannot fixate (``code``: the reason, :data:`headsim.scenario.spec.REFUSAL_REASONS`).
+
+    Bad input like any :class:`ScenarioError`; a sweep, whose file set the fields
+    right, records it as the failure of the one job whose values lead to it.
+    """
+
+    def __init__(
+        self, source: str, field_path: str, message: str, allowed: str | None, code: str
+    ) -> None:
+        super().__init__(source, field_path, message, allowed)
+        self.code = code
+
+
 def short_value(value: Any) -> str:
     """A value for a message: long integers and strings shortened."""
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**15:

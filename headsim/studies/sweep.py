@@ -28,7 +28,9 @@ images rendered together by MuJoCo Warp (``headsim[batch]``)::
 
 Jobs are appended to ``DIR/jobs.jsonl`` as they finish, so an interrupted sweep
 resumes where it stopped; a job that fails or crashes its process is retried once,
-then recorded as failed, and the rest go on.  At the
+then recorded as failed, and the rest go on.  A job whose scenario the reach check
+refuses (its values put a target out of the head's reach) is recorded as
+``refused`` with the reason, not retried.  At the
 end ``DIR/aggregate.csv``, ``DIR/aggregate.json`` and a plot per swept field.
 """
 
@@ -48,6 +50,7 @@ import numpy as np
 
 from headsim.errors import BadInput
 from headsim.run.progress import Counter
+from headsim.scenario.tables import TargetRefused
 from headsim.studies.jobs import dask_client, execute, local_pool
 from headsim.studies.sweep_output import write_aggregate
 from headsim.studies.sweep_spec import BatchOptions, Job, SweepSpec
@@ -256,6 +259,16 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
             )
             if result.calibration is not None and result.calibration.layout is not None
             else None,
+        )
+    except TargetRefused as err:  # this job's values: its failure, not the sweep file's
+        record.update(
+            status="refused",
+            failures=1,
+            failure_reasons=[f"scenario refused: {err.problem}"],
+            refusal=err.code,
+            error=str(err),
+            measurements_ok=0,
+            measurements=0,
         )
     except Exception as err:  # a job's error must not take the sweep down
         record.update(

@@ -81,9 +81,13 @@ def _values(source: str, key: str, value: Any) -> list[Any]:
 
 
 def load_sweep(path: str | Path) -> SweepSpec:
-    """Read and check a sweep file; every job's scenario is validated before anything runs."""
+    """Read and check a sweep file; every job's scenario is validated before anything runs.
+
+    A job whose scenario the reach check refuses (:class:`TargetRefused`: its values put a
+    target out of the head's reach) is kept: it fails when it runs, with that reason.
+    """
     from headsim.scenario.loading import load_scenario, resolve_path
-    from headsim.scenario.tables import ScenarioError
+    from headsim.scenario.tables import ScenarioError, TargetRefused
 
     path = Path(path)
     source = str(path)
@@ -135,6 +139,8 @@ def load_sweep(path: str | Path) -> SweepSpec:
         seed = params.get("seed")
         try:
             load_scenario(scenario_path, fast=fast, seed=seed, overrides=overrides)
+        except TargetRefused:
+            pass  # the file is right: this job's values put a target out of reach (its failure)
         except ScenarioError as err:
             raise SweepError(source, f"job {index} {params}", str(err)) from err
         jobs.append(Job(index, _job_id(scenario_path, fast, params), scenario_path, fast, params))

@@ -151,3 +151,67 @@ def test_a_batch_sweep_on_a_missing_device_is_refused_before_it_runs(
     assert not (out / "jobs.jsonl").exists()
     assert main(["sweep", str(grid), "--out", str(out), "--device", "cpu"]) == 2
     assert "allowed only with backend" in capsys.readouterr().err
+
+
+#: A target 0.3 m ahead: a 0.9 m baseline needs an eye angle beyond the eyes' range for it.
+NEAR_TARGET = """description = "one near marker; a wide baseline cannot fixate it"
+seed = 0
+
+[head]
+preset = "ideal"
+
+[experiment]
+procedure = "model2"
+
+[[scene.targets]]
+name = "near"
+position_head_m = [0.03, 0.01, 0.3]
+
+[fast]
+cam1.noise_std = 0.0
+"""
+
+
+def _refusing_sweep(tmp_path: Path, backend: str = "") -> Path:
+    (tmp_path / "near.toml").write_text(NEAR_TARGET)
+    path = tmp_path / f"refusing{backend}.toml"
+    path.write_text(
+        'description = "baseline: the second one puts the target out of reach"\n'
+        'scenario = "near.toml"\nfast = true\n'
+        + (f'backend = "{backend}"\n[batch]\nworlds = 2\n' if backend else "")
+        + '[grid]\n"head.baseline_m" = [0.15, 0.9]\n'
+    )
+    return path
+
+
+def test_a_job_its_scenario_refuses_is_that_jobs_failure_and_the_others_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    sweep = _refusing_sweep(tmp_path)
+    code = main(["sweep", str(sweep), "--out", str(out), "--workers", "1", "--no-progress"])
+    printed = capsys.readouterr()
+    assert code == 1, printed.err  # a job failed; the sweep file was fine (not 2)
+    records = {r["index"]: r for r in read_log(out / "jobs.jsonl").values()}
+    assert records[0]["status"] == "ok" and records[0]["measurements_ok"] == 1
+    refused = records[1]
+    assert (refused["status"], refused["refusal"], refused["attempts"]) == (
+        "refused",
+        "eye_range",
+        1,  # not retried: the same values are refused again
+    )
+    assert "needs an eye angle of" in refused["failure_reasons"][0]
+    assert [r["status"] for r in _rows(out / "aggregate.csv")] == ["ok", "refused"]
+    assert "job 1 refused: scenario refused: target at [0.030, 0.010, 0.300] m in H" in (
+        printed.out
+    )
+    assert "1 failed" in printed.out
+
+
+def test_a_refused_job_on_the_batch_back_end_is_its_failure_alone(tmp_path: Path) -> None:
+    outcome = run_sweep(
+        load_sweep(_refusing_sweep(tmp_path, "batch")), tmp_path / "out", progress=False
+    )
+    status = {r["index"]: (r["status"], r.get("refusal")) for r in outcome.records.values()}
+    assert status == {0: ("ok", None), 1: ("refused", "eye_range")}
+    assert len(outcome.failed) == 1
