@@ -91,6 +91,36 @@ def quickstart() -> str:
     )
 
 
+def quickstart_excerpt() -> str:
+    """The README's excerpt of what ``headsim run quickstart`` prints (seed 0), cut from
+    today's summary: its belief line, the calibration's first rows, the first markers and
+    the whole-field line."""
+    from headsim.run.runner import run_scenario
+    from headsim.run.summary import summary_text
+    from headsim.scenario.loading import load_scenario
+
+    lines = summary_text(run_scenario(load_scenario("quickstart", seed=0))).splitlines()
+
+    def after(prefix: str, count: int) -> list[str]:
+        start = next(i for i, line in enumerate(lines) if line.startswith(prefix))
+        return lines[start : start + count]
+
+    field = next(line for line in lines if "3-D error RMS" in line)
+    cut = field[: field.index("by depth:") + len("by depth:")] + " ..."
+    body = [
+        *after("belief:", 1),
+        "",
+        *after("Calibration of the initial directions", 4),
+        "  ...",
+        *after("Measurements (", 4),
+        "  ...",
+        cut,
+        "",
+        next(line for line in lines if line.startswith(("OK:", "FAILED"))),
+    ]
+    return "```text\n" + "\n".join(body) + "\n```\n"
+
+
 def _renders_line(e: dict[str, Any]) -> str:
     """Every image the run drew, by phase and by kind (each one a render)."""
     return (
@@ -280,6 +310,7 @@ class Generator:
 
 GENERATORS: dict[str, Generator] = {
     "quickstart": Generator(quickstart, cheap=True, seconds=15),
+    "quickstart_excerpt": Generator(quickstart_excerpt, cheap=True, seconds=3),
     "reproduce": Generator(live.reproduce, cheap=False, seconds=45),
     "speed": Generator(live.speed, cheap=False, timed=True, seconds=15),
     "chessboard_windows": Generator(servo.chessboard_windows, cheap=False, seconds=7),
