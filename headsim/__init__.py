@@ -22,7 +22,8 @@ __version__ = "0.1.0"
 
 if TYPE_CHECKING:
     from headsim.run.library import load_scenario
-    from headsim.run.outcomes import MeasurementRow, RunResult
+    from headsim.run.outcomes import MeasurementRow
+    from headsim.run.result import RunResult
     from headsim.scenario.spec import Scenario
     from headsim.scenario.tables import ScenarioError
     from headsim.sim.simulator import HeadSim
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
 #: Each lazily loaded name and the module that defines it.
 _LAZY = {
     "load_scenario": "headsim.run.library",
-    "RunResult": "headsim.run.outcomes",
+    "RunResult": "headsim.run.result",
     "MeasurementRow": "headsim.run.outcomes",
     "Scenario": "headsim.scenario.spec",
     "ScenarioError": "headsim.scenario.tables",

@@ -24,7 +24,7 @@ from headsim.sim.events import ImageKind, ImageTaken, RenderCounts
 
 if TYPE_CHECKING:
     from headsim.active.calibration_report import CalibrationReport
-    from headsim.run.outcomes import MeasurementRecord, RunResult
+    from headsim.run.outcomes import MeasurementRecord, RunOutcome
 
 
 @dataclass(frozen=True)
@@ -55,7 +55,7 @@ class CalibrationDone:
 class RunFinished:
     """The run is over."""
 
-    result: RunResult
+    result: RunOutcome
 
 
 class Subscriber(Protocol):

@@ -22,7 +22,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from headsim.run.outcomes import RunResult
+from headsim.run.result import RunResult
 from headsim.scenario.loading import load_scenario as _load_scenario
 from headsim.scenario.spec import Scenario
 from headsim.scenario.tables import ScenarioError

@@ -63,7 +63,7 @@ from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
-from headsim.run.outcomes import MeasurementRecord, RunResult
+from headsim.run.outcomes import MeasurementRecord, RunOutcome
 from headsim.run.recording_layout import (
     GREEN,
     GREY,
@@ -469,7 +469,7 @@ class Recorder:
         )
         self.flush()
 
-    def finished(self, result: RunResult) -> None:
+    def finished(self, result: RunOutcome) -> None:
         self._time()
         if result.experiment is not None:
             get(self.scenario.experiment.procedure).rows(result.experiment, self)

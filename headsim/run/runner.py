@@ -21,7 +21,8 @@ from headsim.active.calibration_report import CalibrationReport
 from headsim.run.calibrate import calibrate
 from headsim.run.context import told
 from headsim.run.events import CalibrationDone, Hub, RunFinished, Subscriber
-from headsim.run.outcomes import MeasurementRecord, RunRenders, RunResult
+from headsim.run.outcomes import MeasurementRecord, RunRenders
+from headsim.run.result import RunResult
 from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
 from headsim.sim.events import RenderCounts

@@ -22,7 +22,7 @@ import numpy as np
 import headsim
 from headsim.active.calibration_report import calibration_block
 from headsim.run.accuracy import MeasurementSummary, summaries
-from headsim.run.outcomes import MeasurementRecord, RunResult
+from headsim.run.outcomes import MeasurementRecord, RunOutcome
 from headsim.scenario.registry import get
 from headsim.scenario.spec import experiment_record
 from headsim.sim.settings import settings_record
@@ -157,7 +157,7 @@ def experiment_block(procedure: str, experiment: object | None) -> dict[str, Any
     }
 
 
-def results_payload(result: RunResult) -> dict[str, Any]:
+def results_payload(result: RunOutcome) -> dict[str, Any]:
     """The results.json document (plain data; :func:`headsim.files.write_json_atomic` writes it)."""
     s = result.scenario
     edge = () if s.scene.acceptance is None else s.scene.acceptance.outside_start_view

@@ -11,7 +11,7 @@ import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.run.accuracy import summaries
-from headsim.run.outcomes import RunResult
+from headsim.run.outcomes import RunOutcome
 from headsim.run.table import cell as _cell
 from headsim.run.table import format_table
 from headsim.run.table import mm as _mm
@@ -120,7 +120,7 @@ def _calibration_lines(report: CalibrationReport, paper: bool) -> list[str]:
     return out
 
 
-def _measurement_lines(result: RunResult) -> list[str]:
+def _measurement_lines(result: RunOutcome) -> list[str]:
     records = result.records
     if not records:
         return []
@@ -269,7 +269,7 @@ def belief_text(scenario: Scenario) -> str:
     )
 
 
-def summary_text(result: RunResult, head_flag: str | None = None) -> str:
+def summary_text(result: RunOutcome, head_flag: str | None = None) -> str:
     """The table printed at the end of a run (figures of the paper beside ours for its
     head).  ``head_flag``: the head ``--head`` put in place of the file's (the file's
     description, written for its own head, is then left out)."""

@@ -6,7 +6,7 @@ from collections.abc import Callable
 
 import pytest
 
-from headsim.run.outcomes import RunResult
+from headsim.run.result import RunResult
 from headsim.run.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 

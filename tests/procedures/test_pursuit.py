@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from headsim.procedures.pursuit import PursuitResult
-from headsim.run.outcomes import RunResult
+from headsim.run.result import RunResult
 from headsim.run.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 

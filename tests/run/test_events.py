@@ -13,7 +13,7 @@ from headsim.run.events import (
     RunFinished,
     Stamp,
 )
-from headsim.run.outcomes import RunResult
+from headsim.run.result import RunResult
 from headsim.run.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 from headsim.sim.events import ImageKind, ImageTaken

@@ -15,7 +15,8 @@ import pytest
 import headsim
 from headsim.cli import main
 from headsim.run.library import dotted_overrides
-from headsim.run.outcomes import MeasurementRow, RunResult
+from headsim.run.outcomes import MeasurementRow
+from headsim.run.result import RunResult
 
 
 def plain_python(code: str, cwd: Path) -> str:

@@ -8,7 +8,7 @@ import pytest
 
 from headsim.active.events import PhaseStarted
 from headsim.run.events import Stamp
-from headsim.run.outcomes import RunResult
+from headsim.run.result import RunResult
 from headsim.run.runner import run_scenario
 from headsim.run.serialise import results_payload
 from headsim.scenario.loading import load_scenario

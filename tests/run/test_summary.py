@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.estimators.result import Status
-from headsim.run.outcomes import RunRenders, RunResult
+from headsim.run.outcomes import RunRenders
+from headsim.run.result import RunResult
 from headsim.run.summary import format_table, summary_text
 from headsim.scenario.loading import load_scenario
 from headsim.sim.events import RenderCounts
