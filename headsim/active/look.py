@@ -72,16 +72,16 @@ class PatternFeature(Protocol):
 @runtime_checkable
 class FovealDetector(Protocol):
     """A detector that correlates a template on a foveal window
-    (:mod:`headsim.active.markerless`): it names the window it needs, around where the
-    looker expects its point (``expected_uv`` px; None: around its own last sight), and
-    is told where the image it is handed lies in the full frame; its detection is in
-    full-frame pixels.  Only that window is rendered."""
+    (:mod:`headsim.active.markerless`): it names the window it needs in ``camera``'s
+    image, around where the looker expects its point (``expected_uv`` px; None: around
+    its own last sight), and is told where the image it is handed lies in the full
+    frame; its detection is in full-frame pixels.  Only that window is rendered."""
 
     def search_window(
-        self, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
+        self, camera: int, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
     ) -> Window: ...
 
-    def locate(self, image: np.ndarray, origin_px: tuple[int, int]) -> Detection: ...
+    def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection: ...
 
     def __call__(self, image: np.ndarray) -> Detection: ...
 
@@ -467,13 +467,13 @@ class Looker:
             if seen is not None and seen.key == key and seen.neck == neck and gain is not None:
                 expected = (seen.uv[0] + gain * (steps - seen.steps), seen.uv[1])
         size = self.sizes[camera]
-        window = detector.search_window(size, expected)
+        window = detector.search_window(camera, size, expected)
         if (window.width, window.height) == size:
             image = self._take(camera)
         else:
             self.counts.window_renders += 1
             image = self._take(camera, window)
-        detection = detector.locate(image, (window.x0, window.y0))
+        detection = detector.locate(camera, image, (window.x0, window.y0))
         if self._report:
             self.sink.emit(Detected(camera, detection.status, detection.uv))
         if detection.found and detection.uv is not None:

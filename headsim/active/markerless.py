@@ -101,17 +101,18 @@ class TemplateTracker:
         return self.tracker.original
 
     def search_window(
-        self, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
+        self, camera: int, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
     ) -> Window:
         """The window the next look needs: the disc to search (around ``expected_uv``,
-        else the last sight) grown by the template's half-side and the fit's pixel."""
+        else the last sight) grown by the template's half-side and the fit's pixel.
+        ``camera``: the camera looking (this tracker follows one camera's fovea)."""
         if expected_uv is None:
             self._band = around(self.uv, self.reacquire_radius_px)
         else:
             self._band = around(expected_uv, self.search_radius_px)
         return _window(self._band.rect(image_size), self.config.half_px + 2, image_size)
 
-    def locate(self, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
+    def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
         """The tracked point in ``image`` (a window whose top-left is ``origin_px`` in
         the full frame), in full-frame pixels, searched where :meth:`search_window`
         said (else around the last sight)."""
@@ -126,8 +127,8 @@ class TemplateTracker:
     def __call__(self, image: np.ndarray) -> Detection:
         """On a whole frame: only the search window around the last sight is correlated."""
         size = (image.shape[1], image.shape[0])
-        window = self.search_window(size, None)
-        return self.locate(_crop(image, window), (window.x0, window.y0))
+        window = self.search_window(1, size, None)
+        return self.locate(1, _crop(image, window), (window.x0, window.y0))
 
 
 class CorrespondenceFinder:
@@ -164,7 +165,7 @@ class CorrespondenceFinder:
         return cls(cut_template(image1, uv1, config), band, config)
 
     def search_window(
-        self, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
+        self, camera: int, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
     ) -> Window:
         """The band's rectangle (or, with ``expected_uv`` inside the band, the disc of
         ``search_radius_px`` there), grown by the template's half-side and a pixel."""
@@ -177,7 +178,7 @@ class CorrespondenceFinder:
         self._next = band
         return _window(band.rect(image_size), self.config.half_px + 2, image_size)
 
-    def locate(self, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
+    def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
         """The corresponding point in ``image`` (a window whose top-left is
         ``origin_px``), full-frame pixels."""
         band = self._next or self.band()
@@ -189,8 +190,69 @@ class CorrespondenceFinder:
     def __call__(self, image: np.ndarray) -> Detection:
         """On a whole frame: only the band's rectangle is correlated."""
         size = (image.shape[1], image.shape[0])
-        window = self.search_window(size, None)
-        return self.locate(_crop(image, window), (window.x0, window.y0))
+        window = self.search_window(2, size, None)
+        return self.locate(2, _crop(image, window), (window.x0, window.y0))
 
 
-__all__ = ["CorrespondenceFinder", "TemplateTracker", "as_detection"]
+#: The head's belief, asked at camera 1's look: camera 1's point (u, v) px then ->
+#: the band camera 2 should search, evaluated at camera 2's look (the ray fixed in the
+#: head or world frame with the encoders of camera 1's look, projected into camera 2
+#: with the encoders of camera 2's; :func:`~headsim.vision.correspondence.epipolar_band`).
+BandFor = Callable[[tuple[float, float]], Callable[[], Band]]
+
+
+class MarkerlessPair:
+    """One target's detector for both cameras, for procedures that hand one detector
+    to the servos (Model 2, Model 1): camera 1 tracks the fovea clicked in its first
+    image (:class:`TemplateTracker`); camera 2 finds camera 1's latest foveal template
+    (cut at camera 1's last confident match, so at fixation once camera 1 fixates) in
+    the band ``band_for`` gives for camera 1's last point.  Model 2's images of the
+    camera that is not centred come from the same two: camera 2's at step 1 from the
+    correspondence, camera 1's at step 2 from the tracker.
+
+    Through the :class:`~headsim.active.look.Looker` (a
+    :class:`~headsim.active.look.FovealDetector`) only; called on an image alone it
+    cannot tell the camera and says LOST (a binned preview of a scan: the template is
+    at full scale)."""
+
+    def __init__(
+        self,
+        first_image1: np.ndarray,
+        click_uv: tuple[float, float],
+        band_for: BandFor,
+        config: MatchConfig | None = None,
+    ) -> None:
+        self.config = config or MatchConfig()
+        self.band_for = band_for
+        self.tracker = TemplateTracker(first_image1, click_uv, self.config)
+        self.finder = CorrespondenceFinder(
+            self.tracker.template, band_for(self.tracker.uv), self.config
+        )
+
+    def _camera2(self) -> CorrespondenceFinder:
+        self.finder.template = self.tracker.tracker.current
+        return self.finder
+
+    def search_window(
+        self, camera: int, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
+    ) -> Window:
+        """The window ``camera``'s next look needs (tracker's, or the band's)."""
+        if camera == 1:
+            return self.tracker.search_window(camera, image_size, expected_uv)
+        return self._camera2().search_window(camera, image_size, expected_uv)
+
+    def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
+        """``camera``'s point in ``image`` (top-left ``origin_px``), full-frame pixels."""
+        if camera == 1:
+            detection = self.tracker.locate(camera, image, origin_px)
+            if detection.found and detection.uv is not None:
+                self.finder.band = self.band_for(detection.uv)
+            return detection
+        return self._camera2().locate(camera, image, origin_px)
+
+    def __call__(self, image: np.ndarray) -> Detection:
+        """An image without its camera: nothing can be said (LOST, no score)."""
+        return Detection(DetectionStatus.LOST, None, 0.0)
+
+
+__all__ = ["BandFor", "CorrespondenceFinder", "MarkerlessPair", "TemplateTracker", "as_detection"]

@@ -203,6 +203,14 @@ def around(uv: tuple[float, float], radius_px: float) -> Band:
     return Band(((float(uv[0]), float(uv[1])),), float(radius_px))
 
 
+def row_band(v_px: float, image_width: int, tolerance_px: float) -> Band:
+    """The band along image row ``v_px`` across the whole width, +- ``tolerance_px``:
+    where a head that knows no focal length or eye angles looks for camera 1's point in
+    camera 2 (eyes on one tilt axis: epipolar lines near the rows; the tolerance holds
+    vergence, lens and reference-row differences)."""
+    return Band(((0.0, float(v_px)), (float(image_width - 1), float(v_px))), tolerance_px)
+
+
 def epipolar_band(
     project: Callable[[np.ndarray], np.ndarray],
     ray_cam1: np.ndarray,
@@ -409,4 +417,5 @@ __all__ = [
     "find",
     "grey_float",
     "predicted_sigma_px",
+    "row_band",
 ]

@@ -15,10 +15,12 @@ import pytest
 
 from headsim.active.eye_servo import EyeServo
 from headsim.active.look import foveal_detector
-from headsim.active.markerless import CorrespondenceFinder, TemplateTracker
+from headsim.active.markerless import CorrespondenceFinder, MarkerlessPair, TemplateTracker
+from headsim.active.measurement import Target, body_target
+from headsim.active.model2 import measure_model2
 from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.simulator import HeadSim
-from headsim.vision.correspondence import MatchConfig, epipolar_band
+from headsim.vision.correspondence import MatchConfig, epipolar_band, row_band
 from headsim.vision.detection import DetectionStatus
 from headsim.vision.markers import MarkerDetector
 
@@ -126,7 +128,7 @@ def test_the_tracker_follows_a_rendered_view_it_was_not_cut_from(views) -> None:
     point = cam1.position_world + ray * (-cam1.position_world[2] / ray[2])
     truth_uv2 = cam2.project(point)[0]
     tracker = TemplateTracker(image1, uv1, reacquire_radius_px=40.0)
-    window = tracker.search_window((WIDTH, HEIGHT), None)
+    window = tracker.search_window(1, (WIDTH, HEIGHT), None)
     assert window.width * window.height < 0.25 * WIDTH * HEIGHT
     detection = tracker(image2)
     assert detection.found and detection.uv is not None
@@ -187,3 +189,30 @@ def test_the_markerless_detectors_see_only_images_and_belief() -> None:
     for path in (SOURCE / "active" / "markerless.py", SOURCE / "vision" / "correspondence.py"):
         assert _reads_truth(path) == [], path
     assert _reads_truth(SOURCE / "active" / "look.py")  # the check can see a read (sim)
+
+
+def test_model2_measures_a_clicked_point_without_its_marker() -> None:
+    # The red marker clicked in camera 1's first image, then fixated by its template
+    # alone: camera 2 finds it along its row (a head that knows no focal length), each
+    # step's other camera by the same correspondence.  Same estimate as the marker's.
+    with HeadSim("default") as sim:
+        truth = sim.position("marker_red")
+        first = sim.render(1)
+        click = MarkerDetector("red")(first).uv
+        assert click is not None
+        width = sim.settings.cameras[1].width
+        v_shift = sim.settings.cameras[1].image_centre[1] - sim.settings.cameras[0].image_centre[1]
+
+        def band_for(uv1: tuple[float, float]):
+            return lambda: row_band(uv1[1] + v_shift, width, 6.0)
+
+        pair = MarkerlessPair(first, click, band_for, MatchConfig(half_px=15))
+        markerless = measure_model2(sim, EyeServo(sim), Target("clicked", pair, lambda s: truth))
+    with HeadSim("default") as sim:
+        marker = measure_model2(
+            sim, EyeServo(sim), body_target("marker_red", MarkerDetector("red"))
+        )
+    assert markerless.ok and marker.ok, markerless.detail
+    np.testing.assert_allclose(markerless.estimate_head_m, marker.estimate_head_m, atol=1e-4)
+    assert all(m.score > 0.9 for m in pair.finder.matches + pair.tracker.matches)
+    assert pair.finder.matches and pair.tracker.matches
