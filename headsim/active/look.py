@@ -73,12 +73,16 @@ class PatternFeature(Protocol):
 class FovealDetector(Protocol):
     """A detector that correlates a template on a foveal window
     (:mod:`headsim.active.markerless`): it names the window it needs in ``camera``'s
-    image, around where the looker expects its point (``expected_uv`` px; None: around
-    its own last sight), and is told where the image it is handed lies in the full
+    image, around where the looker expects its point (``expected_uv`` px, after an image
+    motion of ``motion_px``; None: around its own last sight), and is told where the image it is handed lies in the full
     frame; its detection is in full-frame pixels.  Only that window is rendered."""
 
     def search_window(
-        self, camera: int, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
+        self,
+        camera: int,
+        image_size: tuple[int, int],
+        expected_uv: tuple[float, float] | None,
+        motion_px: float = 0.0,
     ) -> Window: ...
 
     def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection: ...
@@ -458,16 +462,18 @@ class Looker:
         steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
         key: object = detector
         expected: tuple[float, float] | None = None
+        motion = 0.0
         if isinstance(hint, Around):
-            expected = hint.uv_px
+            expected, motion = hint.uv_px, hint.motion_px
         elif isinstance(hint, Since):
             key = detector if hint.key is None else hint.key
             seen = memory.sight.get(camera)
             gain = hint.gain_px_per_step
             if seen is not None and seen.key == key and seen.neck == neck and gain is not None:
-                expected = (seen.uv[0] + gain * (steps - seen.steps), seen.uv[1])
+                motion = gain * (steps - seen.steps)
+                expected = (seen.uv[0] + motion, seen.uv[1])
         size = self.sizes[camera]
-        window = detector.search_window(camera, size, expected)
+        window = detector.search_window(camera, size, expected, motion)
         if (window.width, window.height) == size:
             image = self._take(camera)
         else:

@@ -101,15 +101,21 @@ class TemplateTracker:
         return self.tracker.original
 
     def search_window(
-        self, camera: int, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
+        self,
+        camera: int,
+        image_size: tuple[int, int],
+        expected_uv: tuple[float, float] | None,
+        motion_px: float = 0.0,
     ) -> Window:
         """The window the next look needs: the disc to search (around ``expected_uv``,
-        else the last sight) grown by the template's half-side and the fit's pixel.
+        ``search_radius_px`` plus a quarter of the predicted ``motion_px``, as the
+        looker's blob windows; else the last sight's ``reacquire_radius_px``) grown by
+        the template's half-side and the fit's pixel.
         ``camera``: the camera looking (this tracker follows one camera's fovea)."""
         if expected_uv is None:
             self._band = around(self.uv, self.reacquire_radius_px)
         else:
-            self._band = around(expected_uv, self.search_radius_px)
+            self._band = around(expected_uv, self.search_radius_px + 0.25 * abs(motion_px))
         return _window(self._band.rect(image_size), self.config.half_px + 2, image_size)
 
     def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
@@ -165,13 +171,17 @@ class CorrespondenceFinder:
         return cls(cut_template(image1, uv1, config), band, config)
 
     def search_window(
-        self, camera: int, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
+        self,
+        camera: int,
+        image_size: tuple[int, int],
+        expected_uv: tuple[float, float] | None,
+        motion_px: float = 0.0,
     ) -> Window:
         """The band's rectangle (or, with ``expected_uv`` inside the band, the disc of
         ``search_radius_px`` there), grown by the template's half-side and a pixel."""
         band = self.band()
         if expected_uv is not None and self.matches and self.matches[-1].ok:
-            near = around(expected_uv, self.search_radius_px)
+            near = around(expected_uv, self.search_radius_px + 0.25 * abs(motion_px))
             inside = band.distance_px(np.array(expected_uv[0]), np.array(expected_uv[1]))
             if float(inside) <= band.tolerance_px:
                 band = Band(near.points_uv, near.tolerance_px)
@@ -234,12 +244,16 @@ class MarkerlessPair:
         return self.finder
 
     def search_window(
-        self, camera: int, image_size: tuple[int, int], expected_uv: tuple[float, float] | None
+        self,
+        camera: int,
+        image_size: tuple[int, int],
+        expected_uv: tuple[float, float] | None,
+        motion_px: float = 0.0,
     ) -> Window:
         """The window ``camera``'s next look needs (tracker's, or the band's)."""
         if camera == 1:
-            return self.tracker.search_window(camera, image_size, expected_uv)
-        return self._camera2().search_window(camera, image_size, expected_uv)
+            return self.tracker.search_window(camera, image_size, expected_uv, motion_px)
+        return self._camera2().search_window(camera, image_size, expected_uv, motion_px)
 
     def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
         """``camera``'s point in ``image`` (top-left ``origin_px``), full-frame pixels."""

@@ -262,7 +262,7 @@ def _refined(
     """The sub-pixel peak near whole pixel (x, y) of ``ncc`` (the NCC of ``patch`` over
     ``region``) and its NCC: the quadratic's peak, then the region resampled (Lanczos) so
     that the peak falls on a whole pixel and the quadratic fitted again, until the step
-    is below 0.002 px.  One quadratic fit is biased towards the whole pixel where the
+    is below 0.005 px.  One quadratic fit is biased towards the whole pixel where the
     texture has energy near the Nyquist limit (its peak is sharp); at the peak
     resampled onto a whole pixel the fit is symmetric, so the bias vanishes."""
     sx, sy = _subpixel(ncc, x, y)
@@ -280,7 +280,7 @@ def _refined(
         sx, sy, score = sx + dx, sy + dy, float(local[1, 1])
         if abs(sx) > 1.0 or abs(sy) > 1.0:  # ran off: keep the whole pixel's fit
             return (*_subpixel(ncc, x, y), float(ncc[y, x]))
-        if math.hypot(dx, dy) < 0.002:
+        if math.hypot(dx, dy) < 0.005:
             break
     return sx, sy, score
 
@@ -317,11 +317,10 @@ def find(
     and second-best local maxima are picked inside the band; the best is refined by a
     quadratic fit.  A best peak on the map's rim (the target may lie beyond) is LOST.
     """
-    grey = grey_float(image)
     ox, oy = origin_px
     h = template.half_px
     du, dv = template.offset_px
-    height, width = grey.shape
+    height, width = image.shape[:2]
     # Reference-point candidates, in the image's pixels: the band, one more pixel each
     # side for the quadratic fit.
     rect = band.rect((width + ox, height + oy))
@@ -332,7 +331,7 @@ def find(
     y0 = max(rect[1] - oy - 1 - h, 0)
     x1 = min(rect[2] - ox + 1 + h, width)
     y1 = min(rect[3] - oy + 1 + h, height)
-    region = grey[y0:y1, x0:x1]
+    region = grey_float(image[y0:y1, x0:x1])  # only the searched pixels are converted
     if region.shape[0] < 2 * h + 3 or region.shape[1] < 2 * h + 3:
         return empty
     ncc = cv2.matchTemplate(region, template.patch, cv2.TM_CCOEFF_NORMED)

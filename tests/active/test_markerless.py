@@ -17,7 +17,9 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.look import foveal_detector
 from headsim.active.markerless import CorrespondenceFinder, MarkerlessPair, TemplateTracker
 from headsim.active.measurement import Target, body_target
+from headsim.active.model1 import measure_model1
 from headsim.active.model2 import measure_model2
+from headsim.active.neck_servo import NeckServo
 from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import MatchConfig, epipolar_band, row_band
@@ -216,3 +218,25 @@ def test_model2_measures_a_clicked_point_without_its_marker() -> None:
     np.testing.assert_allclose(markerless.estimate_head_m, marker.estimate_head_m, atol=1e-4)
     assert all(m.score > 0.9 for m in pair.finder.matches + pair.tracker.matches)
     assert pair.finder.matches and pair.tracker.matches
+
+
+def test_model1_fixates_a_clicked_point_with_neck_and_eyes_without_its_marker() -> None:
+    # The neck servo's looks (its own predictions) through the same pair.
+    with HeadSim("default") as sim:
+        truth = sim.position("marker_red")
+        first = sim.render(1)
+        click = MarkerDetector("red")(first).uv
+        assert click is not None
+        width = sim.settings.cameras[1].width
+        pair = MarkerlessPair(
+            first, click, lambda uv1: lambda: row_band(uv1[1], width, 6.0), MatchConfig(half_px=15)
+        )
+        markerless = measure_model1(sim, NeckServo(sim), Target("clicked", pair, lambda s: truth))
+    with HeadSim("default") as sim:
+        marker = measure_model1(
+            sim, NeckServo(sim), body_target("marker_red", MarkerDetector("red"))
+        )
+    assert markerless.ok and marker.ok, markerless.detail
+    np.testing.assert_allclose(markerless.estimate_head_m, marker.estimate_head_m, atol=1e-4)
+    assert len(pair.tracker.matches) > 2 and len(pair.finder.matches) > 2
+    assert all(m.ok for m in pair.finder.matches + pair.tracker.matches)
