@@ -221,7 +221,7 @@ def row_band(v_px: float, image_width: int, tolerance_px: float) -> Band:
 def epipolar_band(
     project: Callable[[np.ndarray], np.ndarray],
     ray_cam1: np.ndarray,
-    depths_m: Sequence[float],
+    depths_m: Sequence[float] | np.ndarray,
     tolerance_px: float,
 ) -> Band:
     """The band the believed geometry predicts for camera 1's ray in camera 2: the

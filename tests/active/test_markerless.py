@@ -80,10 +80,16 @@ class Pinhole:
                          self.centre[1] - self.focal_px * cam[:, 1] / depth], axis=1)  # fmt: skip
 
 
-@pytest.fixture(scope="module")
-def views(tmp_path_factory: pytest.TempPathFactory):
-    folder = tmp_path_factory.mktemp("textured_plane")
-    _pink_png(folder / "pink.png")
+def _grating_png(path: Path, size: int = 256) -> None:
+    """Stripes of 8 texels across u on weaker rows of 11 (a 2-D repetitive texture)."""
+    v, u = np.mgrid[0:size, 0:size].astype(np.float64)
+    grey = 128 + 70 * np.sin(2 * np.pi * u / 8) + 30 * np.sin(2 * np.pi * v / 11)
+    grey = np.clip(grey, 0, 255).astype(np.uint8)
+    cv2.imwrite(str(path), cv2.merge([grey, grey, grey]))
+
+
+def _render(folder: Path, texture) -> tuple[list[np.ndarray], Pinhole, Pinhole]:
+    texture(folder / "pink.png")
     (folder / "scene.xml").write_text(SCENE)
     model = mujoco.MjModel.from_xml_path(str(folder / "scene.xml"))
     data = mujoco.MjData(model)
@@ -96,6 +102,21 @@ def views(tmp_path_factory: pytest.TempPathFactory):
     return images, Pinhole(data, 0), Pinhole(data, 1)
 
 
+@pytest.fixture(scope="module")
+def views(tmp_path_factory: pytest.TempPathFactory):
+    return _render(tmp_path_factory.mktemp("textured_plane"), _pink_png)
+
+
+def _belief_band(cam1: Pinhole, cam2: Pinhole, uv1: tuple[float, float]):
+    """The believed geometry (here exact): camera 1's ray, 0.2 to 3 m, into camera 2."""
+    ray_cam1 = cam1.world_from_cam.T @ cam1.ray_world(uv1)
+
+    def project(points_cam1: np.ndarray) -> np.ndarray:
+        return cam2.project(cam1.position_world + points_cam1 @ cam1.world_from_cam.T)
+
+    return lambda: epipolar_band(project, ray_cam1, np.geomspace(0.2, 3.0, 8), 2.0)
+
+
 def test_correspondence_finds_the_same_3d_point_in_camera_2_within_03_px(views) -> None:
     (image1, image2), cam1, cam2 = views
     assert image1.std() > 20  # the texture is there
@@ -105,20 +126,28 @@ def test_correspondence_finds_the_same_3d_point_in_camera_2_within_03_px(views) 
         point = cam1.position_world + ray * (-cam1.position_world[2] / ray[2])  # on z = 0
         truth_uv2 = cam2.project(point)[0]
 
-        # The believed geometry (here exact): camera 1's ray, 0.2 to 3 m, into camera 2.
-        def band(uv1=uv1):
-            ray_cam1 = cam1.world_from_cam.T @ cam1.ray_world(uv1)
-            to_world = lambda p: cam1.position_world + p @ cam1.world_from_cam.T  # noqa: E731
-            depths = np.geomspace(0.2, 3.0, 8)
-            return epipolar_band(lambda p: cam2.project(to_world(p)), ray_cam1, depths, 2.0)
-
+        band = _belief_band(cam1, cam2, uv1)
         finder = CorrespondenceFinder.from_view(image1, uv1, band)
         detection = finder(image2)
         assert detection.status is DetectionStatus.FOUND, finder.matches[-1]
-        assert detection.score is not None and detection.score > 0.9
+        assert detection.uv is not None and detection.score is not None
+        assert detection.score > 0.9
         errors.append(math.dist(detection.uv, truth_uv2))
     assert np.median(errors) < 0.1
     assert max(errors) < 0.3, errors
+
+
+def test_a_rendered_grating_is_ambiguous_along_the_band(tmp_path: Path) -> None:
+    # The other eye's classic trap: along the epipolar band every stripe matches.
+    (image1, image2), cam1, cam2 = _render(tmp_path, _grating_png)
+    finder = CorrespondenceFinder.from_view(
+        image1, (160.0, 120.0), _belief_band(cam1, cam2, (160.0, 120.0))
+    )
+    detection = finder(image2)
+    assert detection.status is DetectionStatus.AMBIGUOUS
+    assert detection.uv is None and detection.score is not None and detection.score > 0.9
+    assert detection.ambiguity is not None and detection.ambiguity > 0.9
+    assert finder.matches[-1].uv is not None  # where it would have gone: kept
 
 
 def test_the_tracker_follows_a_rendered_view_it_was_not_cut_from(views) -> None:

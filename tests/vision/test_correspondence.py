@@ -38,7 +38,7 @@ def pink(size: int, seed: int, contrast_grey: float = 40.0) -> np.ndarray:
 
 def shifted(image: np.ndarray, du: float, dv: float) -> np.ndarray:
     """``image`` moved by (du, dv) px: the content at (u, v) goes to (u + du, v + dv)."""
-    move = np.float32([[1, 0, du], [0, 1, dv]])
+    move = np.array([[1.0, 0.0, du], [0.0, 1.0, dv]], dtype=np.float32)
     size = (image.shape[1], image.shape[0])
     return cv2.warpAffine(
         image.astype(np.float32), move, size, flags=cv2.INTER_CUBIC,
