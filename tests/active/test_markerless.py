@@ -175,6 +175,7 @@ def test_the_eye_servo_fixates_a_clicked_point_through_foveal_windows() -> None:
         assert click is not None
         tracker = TemplateTracker(first, click, MatchConfig(half_px=15))
         assert foveal_detector(tracker) is tracker
+        assert foveal_detector(MarkerDetector("red")) is None  # blobs keep their looks
         kinds: list[ImageKind] = []
 
         class Kinds:
