@@ -18,6 +18,8 @@ class FailureCause(enum.Enum):
     LOST = "lost"  # nothing of the target in the camera's image
     CUT = "cut"  # the target runs off the image border
     OCCLUDED = "occluded"  # partly hidden
+    LOW_TEXTURE = "low texture"  # the fovea's template too plain to track (markerless)
+    AMBIGUOUS = "ambiguous"  # the match had a rival nearly as good (markerless)
     JOINT_LIMIT = "joint limit"  # the fixation needs a joint beyond its range
     ITERATION_LIMIT = "iteration limit"  # the servo's bound on moves
     ESTIMATOR = "estimator"  # the estimator flagged the point invalid
@@ -27,6 +29,8 @@ _FROM_DETECTION = {
     DetectionStatus.LOST: FailureCause.LOST,
     DetectionStatus.CUT: FailureCause.CUT,
     DetectionStatus.OCCLUDED: FailureCause.OCCLUDED,
+    DetectionStatus.LOW_TEXTURE: FailureCause.LOW_TEXTURE,
+    DetectionStatus.AMBIGUOUS: FailureCause.AMBIGUOUS,
 }
 
 

@@ -9,8 +9,9 @@ looked for again in a preview, then in the same instant's full frame.  Never fro
 truth, nor from whether the scene changed: detections, gains, encoders.
 
 The servos call :meth:`Looker.look` with a :data:`Hint`; nothing else here renders.
-What a detector can do is declared by the protocols :class:`BlobDetector` and
-:class:`PatternFeature`; a detector that declares neither always sees whole frames.
+What a detector can do is declared by the protocols :class:`BlobDetector`,
+:class:`PatternFeature` and :class:`FovealDetector`; a detector that declares none
+always sees whole frames.
 """
 
 from __future__ import annotations
@@ -66,6 +67,32 @@ class PatternFeature(Protocol):
         ...
 
     def __call__(self, image: np.ndarray) -> Detection: ...
+
+
+@runtime_checkable
+class FovealDetector(Protocol):
+    """A detector that correlates a template on a foveal window
+    (:mod:`headsim.active.markerless`): it names the window it needs in ``camera``'s
+    image, around where the looker expects its point (``expected_uv`` px, after an image
+    motion of ``motion_px``; None: around its own last sight), and is told where the image it is handed lies in the full
+    frame; its detection is in full-frame pixels.  Only that window is rendered."""
+
+    def search_window(
+        self,
+        camera: int,
+        image_size: tuple[int, int],
+        expected_uv: tuple[float, float] | None,
+        motion_px: float = 0.0,
+    ) -> Window: ...
+
+    def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection: ...
+
+    def __call__(self, image: np.ndarray) -> Detection: ...
+
+
+def foveal_detector(detector: object) -> FovealDetector | None:
+    """``detector`` as a :class:`FovealDetector`, or None where it is not one."""
+    return detector if isinstance(detector, FovealDetector) else None
 
 
 def finds_blob(detector: object) -> bool:
@@ -303,6 +330,9 @@ class Looker:
     def look(self, camera: int, detector: Detector, hint: Hint) -> Detection:
         """``detector``'s answer on ``camera``'s next image, from as few pixels as the full
         frame's answer needs (see each :data:`Hint`)."""
+        foveal = foveal_detector(detector)
+        if foveal is not None and not isinstance(hint, Glance):
+            return self._foveal(camera, foveal, hint)
         if isinstance(hint, Since):
             return self._since(camera, detector, hint)
         if isinstance(hint, Glance):
@@ -421,6 +451,44 @@ class Looker:
             return None, False
         return self._in_window(camera, report(window), window, retake=True), True
 
+    # -- a foveal detector's look: only the window it names ---------------------------
+    def _foveal(self, camera: int, detector: FovealDetector, hint: Hint) -> Detection:
+        """Render the window ``detector`` names around where the hint puts its point (the
+        neck servo's prediction; the eye servo's last sight moved by the gain times the
+        eye steps since, with the neck unchanged; else the detector's own last sight)
+        and locate it there.  A miss is the detector's answer: no whole frame follows
+        (correlation stays foveal inside the loop)."""
+        sim, memory = self.sim, self._memory
+        steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
+        key: object = detector
+        expected: tuple[float, float] | None = None
+        motion = 0.0
+        if isinstance(hint, Around):
+            expected, motion = hint.uv_px, hint.motion_px
+        elif isinstance(hint, Since):
+            key = detector if hint.key is None else hint.key
+            seen = memory.sight.get(camera)
+            gain = hint.gain_px_per_step
+            if seen is not None and seen.key == key and seen.neck == neck and gain is not None:
+                motion = gain * (steps - seen.steps)
+                expected = (seen.uv[0] + motion, seen.uv[1])
+        size = self.sizes[camera]
+        window = detector.search_window(camera, size, expected, motion)
+        if (window.width, window.height) == size:
+            image = self._take(camera)
+        else:
+            self.counts.window_renders += 1
+            image = self._take(camera, window)
+        detection = detector.locate(camera, image, (window.x0, window.y0))
+        if self._report:
+            self.sink.emit(Detected(camera, detection.status, detection.uv))
+        if detection.found and detection.uv is not None:
+            memory.sight[camera] = Sight(key, steps, neck, detection.uv, detection.area_px)
+            memory.extent[camera] = None
+        else:
+            memory.sight.pop(camera, None)
+        return detection
+
     # -- the eye servo's look: predicted from the last sight -------------------------
     def _since(self, camera: int, detector: Detector, hint: Since) -> Detection:
         """With windows on, and when this camera last saw the same target (``key``,
@@ -520,6 +588,7 @@ __all__ = [
     "Anew",
     "Around",
     "BlobDetector",
+    "FovealDetector",
     "Glance",
     "Hint",
     "LookCounts",
@@ -530,6 +599,7 @@ __all__ = [
     "Whole",
     "expected_window",
     "finds_blob",
+    "foveal_detector",
     "look_once",
     "pattern_feature",
     "pattern_window",

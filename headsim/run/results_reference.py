@@ -135,7 +135,7 @@ RESULTS_FIELDS: dict[str, str] = {
     "measurements[].status": '`"ok"`, or why it failed (`"Ca2 at step 1: target lost (and at '
     '12 eye angles searched)"`, ...)',
     "measurements[].failure": "`null`, or the cause: `cause` (`lost`, `cut`, `occluded`, "
-    "`joint limit`, `iteration limit`, `estimator`), `stage` (`step 1`, `step 2`, `fixation`, "
+    "`low texture`, `ambiguous`, `joint limit`, `iteration limit`, `estimator`), `stage` (`step 1`, `step 2`, `fixation`, "
     "`estimate`), `camera` (1, 2 or `null`), `detail`",
     "measurements[].knowledge": 'what the head knew: `"none"` or `"calibrated"`',
     "measurements[].step": "its step in the recording",

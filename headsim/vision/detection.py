@@ -35,6 +35,8 @@ class DetectionStatus(enum.Enum):
     LOST = "lost"  # nothing of the target in the image
     CUT = "cut"  # the target runs off the image border: its position would be biased
     OCCLUDED = "occluded"  # the target is partly hidden: its position would be biased
+    LOW_TEXTURE = "low texture"  # a template too plain to place itself (markerless)
+    AMBIGUOUS = "ambiguous"  # a second match nearly as good as the best (markerless)
 
 
 @dataclass(frozen=True)
@@ -49,6 +51,9 @@ class Detection:
     where that detection found every feature of the pattern, (u, v) px in the
     same pixels as ``uv``, and ``pattern_scale_px`` the pattern's spacing (a
     chessboard's square); None and 0 otherwise (a feature found alone).
+    ``score`` and ``ambiguity``: a correlation match's peak NCC and second-best / best
+    peak ratio, given whatever the status (:mod:`headsim.vision.correspondence`);
+    None for a detector that does not correlate.
     """
 
     status: DetectionStatus
@@ -57,6 +62,8 @@ class Detection:
     extent_px: tuple[float, float, float, float] | None = None
     pattern_uv: tuple[tuple[float, float], ...] | None = None
     pattern_scale_px: float = 0.0
+    score: float | None = None
+    ambiguity: float | None = None
 
     def moved(self, du: float, dv: float) -> Detection:
         """This detection in pixels offset by (du, dv) (a window's in the full frame's)."""

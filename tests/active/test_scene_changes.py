@@ -193,7 +193,8 @@ def test_nothing_the_head_runs_reads_the_simulators_placements() -> None:
     # sim.placements counts the bodies the simulator moved: the truth of "the scene
     # changed", for recording only.  The servos, the live head and the envs decide
     # from their images.
-    files = [p for part in ("active", "live", "envs") for p in (SOURCE / part).rglob("*.py")]
+    parts = ("active", "live", "envs", "vision")  # vision: the markerless correspondence too
+    files = [p for part in parts for p in (SOURCE / part).rglob("*.py")]
     assert len(files) > 20
     assert [str(p.relative_to(SOURCE)) for p in files if _reads_placements(p)] == []
     assert _reads_placements(SOURCE / "sim" / "simulator.py")  # the check can see a read
