@@ -47,6 +47,7 @@ rewrites it).
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -78,7 +79,14 @@ from headsim.run.recording_layout import (
     recording_id,
     scenario_markdown,
 )
-from headsim.run.rerun_cli import RecordingTarget
+from headsim.run.rerun_cli import (
+    VIEWER_WAIT_S,
+    RecordingTarget,
+    ViewerUnreachable,
+    check_viewer,
+    viewer_stream_closed,
+    viewer_stream_opened,
+)
 from headsim.run.summary import summary_text
 from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
@@ -98,6 +106,9 @@ MAX_KEPT_ROWS = 500
 FLUSH_TICK = timedelta(seconds=1)
 #: Distance from the image plane to the optical centre of a drawn frustum, m.
 FRUSTUM_DEPTH_M = 0.08
+#: A flush to a viewer waits in slices this long, so that Ctrl-C and SIGTERM (handled by
+#: Python between them, never inside Rerun's wait) end the run at once.
+FLUSH_SLICE_S = 0.25
 
 
 class Recorder:
@@ -125,6 +136,10 @@ class Recorder:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         self.scenario = scenario
         self.jpeg_quality = int(jpeg_quality)
+        if target.connect_url is not None:
+            check_viewer(target.connect_url)  # before Rerun's stream, which would wait for ever
+        #: Whether the viewer stopped answering: the stream is then not flushed again.
+        self._viewer_lost = False
         self.rec = rr.RecordingStream(
             APP_ID,
             recording_id=recording or recording_id(scenario),
@@ -144,6 +159,8 @@ class Recorder:
             sinks.append(rr.FileSink(self.path))
         if sinks:
             self.rec.set_sinks(*sinks, default_blueprint=layout)  # each sink gets the layout
+            if target.connect_url is not None:
+                viewer_stream_opened()
         elif self.path is not None:
             self.rec.save(self.path, default_blueprint=layout)
         if target.serve:
@@ -638,17 +655,48 @@ class Recorder:
         """Everything logged so far written (or streamed)."""
         self._send_kept_rows()
         self._wait()
-        self.rec.flush()
+        if self.target.connect_url is None:
+            self.rec.flush()
+        else:
+            self._flush_to_viewer(self.target.connect_url)
+
+    def _flush_to_viewer(self, url: str) -> None:
+        """Flush a stream with a viewer in it within :data:`VIEWER_WAIT_S`, in slices;
+        :class:`ViewerUnreachable` if the viewer does not take it (a viewer that is gone
+        makes Rerun's own flush wait for ever)."""
+        deadline = time.monotonic() + VIEWER_WAIT_S
+        while True:
+            try:
+                self.rec.flush(timeout_sec=FLUSH_SLICE_S)
+                return
+            except RuntimeError as err:
+                text = str(err).lower()
+                # Rerun's words for "not yet": a timed-out wait, a viewer not (yet) connected.
+                if "timed out" not in text and "unable to connect" not in text:
+                    raise
+                if time.monotonic() >= deadline:
+                    self._viewer_lost = True
+                    raise ViewerUnreachable(url, VIEWER_WAIT_S, lost=True) from None
 
     def close(self) -> None:
         """Flush and write the footer; the file is complete after this."""
         if not self.closed:
             self.closed = True
+            flushed = False
             try:
-                self.flush()
+                if not self._viewer_lost:
+                    self.flush()
+                    flushed = True
             finally:
                 self._background.shutdown(wait=True, cancel_futures=False)
-                self.rec.disconnect()
+                if flushed or self.target.connect_url is None:
+                    self.rec.disconnect()
+                    if self.target.connect_url is not None:
+                        viewer_stream_closed()
+                # Else the stream is left as it is: with a viewer that does not take the data
+                # (or after an interrupted flush), disconnecting, even finishing only the file
+                # sink, waits for ever.  The file, if any, is then without footer (readable);
+                # the command line leaves without waiting for the stream.
 
     def __enter__(self) -> Recorder:
         return self
