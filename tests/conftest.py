@@ -15,11 +15,12 @@ listed there is ``render``.
 from __future__ import annotations
 
 import signal
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
+from shipped_runs import ShippedRun, run_shipped
 
 import headsim
 import headsim.cli
@@ -98,6 +99,21 @@ def _no_render_in_the_fast_tier(request: pytest.FixtureRequest) -> Iterator[None
         patch.setattr(mujoco, "GLContext", refuse)
         patch.setattr(render, "_acquire", refuse)
         yield
+
+
+@pytest.fixture(scope="session")
+def shipped_fast_run(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str], ShippedRun]:
+    """Run a shipped scenario's fast variant through the command line once per session; later
+    calls return the same run.  The runner's tests check the command's files and output,
+    the procedures' tests the typed result: one run serves both."""
+    runs: dict[str, ShippedRun] = {}
+
+    def run(name: str) -> ShippedRun:
+        if name not in runs:
+            runs[name] = run_shipped(name, tmp_path_factory.mktemp(name))
+        return runs[name]
+
+    return run
 
 
 @pytest.fixture

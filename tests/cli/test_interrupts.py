@@ -15,6 +15,7 @@ from headsim.cli.interrupts import process_signals, sigterm_interrupts
 from headsim.errors import clear_interrupted, interrupt_handler, interrupted
 
 ROOT = Path(__file__).resolve().parents[2]
+TESTS = str(ROOT / "tests")
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
@@ -101,7 +102,8 @@ def _interrupted_suite(tmp_path: Path, *plugins: str) -> tuple[int, str, bool]:
     process = subprocess.Popen(
         [sys.executable, "-m", "pytest", "-q", *config, *options, str(probe)],
         cwd=ROOT,
-        env={**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")},
+        # The suite's conftest as a plugin (the probe lies outside tests/), its helpers on the path.
+        env={**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl"), "PYTHONPATH": TESTS},
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
         text=True,
@@ -121,7 +123,7 @@ def _interrupted_suite(tmp_path: Path, *plugins: str) -> tuple[int, str, bool]:
 
 
 def test_ctrl_c_stops_the_suite_not_only_the_command_it_drives(tmp_path: Path) -> None:
-    code, output, next_ran = _interrupted_suite(tmp_path, "tests.conftest")
+    code, output, next_ran = _interrupted_suite(tmp_path, "conftest")
     assert code == pytest.ExitCode.INTERRUPTED, output  # 2
     assert "KeyboardInterrupt" in output and not next_ran, output
 
@@ -129,5 +131,4 @@ def test_ctrl_c_stops_the_suite_not_only_the_command_it_drives(tmp_path: Path) -
 def test_without_the_suites_setting_the_command_swallows_ctrl_c(tmp_path: Path) -> None:
     """The premise: main() alone turns Ctrl-C into 130 and the suite would run on."""
     code, output, next_ran = _interrupted_suite(tmp_path)
-    assert code == pytest.ExitCode.TESTS_FAILED or next_ran, output
-    assert next_ran, output
+    assert next_ran and code != pytest.ExitCode.INTERRUPTED, output
