@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 #: What ``headsim run`` without --rrd/--connect/--serve imports: the command line, the runner,
 #: every procedure (the registry imports them all) and every shipped scenario, loaded.
 UNRECORDED_RUN_IMPORTS = """
@@ -36,10 +38,12 @@ def loaded_rerun(code: str, cwd: Path) -> list[str]:
     return ast.literal_eval(done.stdout.strip().splitlines()[-1])
 
 
+@pytest.mark.fast
 def test_import_headsim_does_not_import_rerun(tmp_path: Path) -> None:
     assert loaded_rerun("import headsim", tmp_path) == []
 
 
+@pytest.mark.fast
 def test_an_unrecorded_runs_imports_and_scenarios_do_not_import_rerun(tmp_path: Path) -> None:
     assert loaded_rerun(UNRECORDED_RUN_IMPORTS, tmp_path) == []
     # The check can fail: the recorder's module brings Rerun with it.
