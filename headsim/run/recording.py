@@ -47,7 +47,6 @@ rewrites it).
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -80,10 +79,10 @@ from headsim.run.recording_layout import (
     scenario_markdown,
 )
 from headsim.run.rerun_cli import (
-    VIEWER_WAIT_S,
     RecordingTarget,
     ViewerUnreachable,
     check_viewer,
+    flush_to_viewer,
     viewer_stream_closed,
     viewer_stream_opened,
 )
@@ -106,9 +105,6 @@ MAX_KEPT_ROWS = 500
 FLUSH_TICK = timedelta(seconds=1)
 #: Distance from the image plane to the optical centre of a drawn frustum, m.
 FRUSTUM_DEPTH_M = 0.08
-#: A flush to a viewer waits in slices this long, so that Ctrl-C and SIGTERM (handled by
-#: Python between them, never inside Rerun's wait) end the run at once.
-FLUSH_SLICE_S = 0.25
 
 
 class Recorder:
@@ -657,26 +653,12 @@ class Recorder:
         self._wait()
         if self.target.connect_url is None:
             self.rec.flush()
-        else:
-            self._flush_to_viewer(self.target.connect_url)
-
-    def _flush_to_viewer(self, url: str) -> None:
-        """Flush a stream with a viewer in it within :data:`VIEWER_WAIT_S`, in slices;
-        :class:`ViewerUnreachable` if the viewer does not take it (a viewer that is gone
-        makes Rerun's own flush wait for ever)."""
-        deadline = time.monotonic() + VIEWER_WAIT_S
-        while True:
-            try:
-                self.rec.flush(timeout_sec=FLUSH_SLICE_S)
-                return
-            except RuntimeError as err:
-                text = str(err).lower()
-                # Rerun's words for "not yet": a timed-out wait, a viewer not (yet) connected.
-                if "timed out" not in text and "unable to connect" not in text:
-                    raise
-                if time.monotonic() >= deadline:
-                    self._viewer_lost = True
-                    raise ViewerUnreachable(url, VIEWER_WAIT_S, lost=True) from None
+            return
+        try:
+            flush_to_viewer(self.rec, self.target.connect_url)
+        except ViewerUnreachable:
+            self._viewer_lost = True
+            raise
 
     def close(self) -> None:
         """Flush and write the footer; the file is complete after this."""

@@ -20,6 +20,7 @@ import time
 import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from headsim.errors import BadInput, EnvironmentProblem
 
@@ -31,6 +32,9 @@ DEFAULT_URL = f"rerun+http://127.0.0.1:{DEFAULT_GRPC_PORT}/proxy"
 #: How long ``--connect`` waits for its viewer (to accept the connection, then each flush)
 #: before the run gives up with exit 3: Rerun's own stream would wait for ever.
 VIEWER_WAIT_S = 5.0
+#: A flush to a viewer waits in slices this long, so that Ctrl-C and SIGTERM (handled by
+#: Python between them, never inside Rerun's wait) end the run at once.
+FLUSH_SLICE_S = 0.25
 
 
 class RecordingArgumentError(BadInput, ValueError):
@@ -75,6 +79,24 @@ def check_viewer(url: str, wait_s: float = VIEWER_WAIT_S) -> None:
             if left <= 0:
                 raise ViewerUnreachable(url, wait_s) from None
             time.sleep(min(0.2, max(left, 0.0)))
+
+
+def flush_to_viewer(rec: Any, url: str, wait_s: float = VIEWER_WAIT_S) -> None:
+    """Flush ``rec`` (a ``rerun.RecordingStream`` with a viewer among its sinks) within
+    ``wait_s``, in slices; :class:`ViewerUnreachable` if the viewer does not take it (Rerun's
+    own flush waits for ever on a viewer that is gone or does not answer)."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            rec.flush(timeout_sec=FLUSH_SLICE_S)
+            return
+        except RuntimeError as err:
+            text = str(err).lower()
+            # Rerun's words for "not yet": a timed-out wait, a viewer not (yet) connected.
+            if "timed out" not in text and "unable to connect" not in text:
+                raise
+            if time.monotonic() >= deadline:
+                raise ViewerUnreachable(url, wait_s, lost=True) from None
 
 
 class _ViewerStreams:
@@ -236,6 +258,7 @@ __all__ = [
     "ViewerUnreachable",
     "add_recording_arguments",
     "check_viewer",
+    "flush_to_viewer",
     "job_target",
     "recording_target",
     "viewer_stream_closed",
