@@ -22,8 +22,7 @@ import numpy as np
 import pytest
 from shipped_runs import ShippedRun, run_shipped
 
-import headsim
-import headsim.cli
+import headsim.cli  # headsim sets MUJOCO_GL before anything imports mujoco
 
 # The suite tests Ctrl-C. A suite started as a background job (`pytest &` in a script)
 # inherits SIGINT ignored, and so would every command it starts: undo that here, so
