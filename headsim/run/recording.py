@@ -61,6 +61,7 @@ import rerun as rr
 from headsim.active.calibration_report import CalibrationReport
 from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
+from headsim.errors import interrupted
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
 from headsim.run.outcomes import MeasurementRecord, RunResult
@@ -79,6 +80,8 @@ from headsim.run.recording_layout import (
     scenario_markdown,
 )
 from headsim.run.rerun_cli import (
+    INTERRUPTED_VIEWER_WAIT_S,
+    VIEWER_WAIT_S,
     RecordingTarget,
     ViewerUnreachable,
     check_viewer,
@@ -647,15 +650,15 @@ class Recorder:
         for future in pending:
             future.result()
 
-    def flush(self) -> None:
-        """Everything logged so far written (or streamed)."""
+    def flush(self, viewer_wait_s: float = VIEWER_WAIT_S) -> None:
+        """Everything logged so far written (or streamed: within ``viewer_wait_s``)."""
         self._send_kept_rows()
         self._wait()
         if self.target.connect_url is None:
             self.rec.flush()
             return
         try:
-            flush_to_viewer(self.rec, self.target.connect_url)
+            flush_to_viewer(self.rec, self.target.connect_url, viewer_wait_s)
         except ViewerUnreachable:
             self._viewer_lost = True
             raise
@@ -667,7 +670,8 @@ class Recorder:
             flushed = False
             try:
                 if not self._viewer_lost:
-                    self.flush()
+                    # After Ctrl-C or SIGTERM a viewer gets a moment, not the full wait.
+                    self.flush(INTERRUPTED_VIEWER_WAIT_S if interrupted() else VIEWER_WAIT_S)
                     flushed = True
             finally:
                 self._background.shutdown(wait=True, cancel_futures=False)

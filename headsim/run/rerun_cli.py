@@ -32,6 +32,8 @@ DEFAULT_URL = f"rerun+http://127.0.0.1:{DEFAULT_GRPC_PORT}/proxy"
 #: How long ``--connect`` waits for its viewer (to accept the connection, then each flush)
 #: before the run gives up with exit 3: Rerun's own stream would wait for ever.
 VIEWER_WAIT_S = 5.0
+#: The same when the run was interrupted (Ctrl-C, SIGTERM) and the recording is closed.
+INTERRUPTED_VIEWER_WAIT_S = 0.5
 #: A flush to a viewer waits in slices this long, so that Ctrl-C and SIGTERM (handled by
 #: Python between them, never inside Rerun's wait) end the run at once.
 FLUSH_SLICE_S = 0.25
@@ -252,6 +254,7 @@ def recording_target(args: argparse.Namespace, *, per_job: bool = False) -> Reco
 
 __all__ = [
     "DEFAULT_URL",
+    "INTERRUPTED_VIEWER_WAIT_S",
     "VIEWER_WAIT_S",
     "RecordingArgumentError",
     "RecordingTarget",

@@ -57,9 +57,7 @@ def test_connect_with_no_viewer_is_exit_3_and_one_line_within_seconds(
     assert not out.exists()
 
 
-def test_a_viewer_that_never_answers_is_exit_3_not_a_hang(
-    tmp_path: Path, silent_port: int
-) -> None:
+def test_a_viewer_that_never_answers_is_exit_3_not_a_hang(tmp_path: Path, silent_port: int) -> None:
     out = tmp_path / "out"
     result = headsim(
         "run", "quickstart", "--fast", "--out", str(out), "--connect", "--url",
@@ -73,7 +71,7 @@ def test_a_viewer_that_never_answers_is_exit_3_not_a_hang(
 def test_a_signal_while_streaming_to_a_silent_viewer_ends_the_run_with_130(
     tmp_path: Path, silent_port: int, sig: signal.Signals
 ) -> None:
-    """SIGINT (Ctrl-C) and SIGTERM alike: exit 130, promptly, even with the stream stuck."""
+    """SIGINT (Ctrl-C) and SIGTERM alike: exit 130 within a second or so, the stream stuck."""
     out = tmp_path / "out"
     command = [*CLI, "run", "quickstart", "--fast", "--out", str(out), "--connect"]
     process = subprocess.Popen(
@@ -98,5 +96,5 @@ def test_a_signal_while_streaming_to_a_silent_viewer_ends_the_run_with_130(
             process.kill()
     assert process.returncode == 130, stderr
     assert "Traceback" not in stderr and "interrupted" in stderr
-    assert took_s < VIEWER_WAIT_S + 10, took_s
+    assert took_s < VIEWER_WAIT_S, took_s  # the stuck stream is not waited for in full
     assert not (out / "results.json").exists()
