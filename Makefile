@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 export MUJOCO_GL ?= egl
 
-.PHONY: setup demo test regress bench figures docs clean
+.PHONY: setup demo test test-fast test-render test-e2e regress bench figures docs clean
 
 $(BIN)/headsim: pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -25,6 +25,18 @@ test: setup
 	$(BIN)/ruff format --check headsim tests benchmarks tools
 	$(BIN)/mypy
 	$(BIN)/python -m pytest -q
+
+# The suite's tiers (pytest markers, assigned in tests/conftest.py; README "Tests" gives
+# their times): fast (pure math, estimators, scenario checks; under a minute), render
+# (components with real MuJoCo renders), e2e (the command line, procedures, studies, docs).
+test-fast: setup
+	$(BIN)/python -m pytest -q -m fast
+
+test-render: setup
+	$(BIN)/python -m pytest -q -m render
+
+test-e2e: setup
+	$(BIN)/python -m pytest -q -m e2e
 
 # The regression suite CI runs after the tests: exits 1 on a regression.
 regress: setup

@@ -28,6 +28,10 @@ from headsim.errors import ExitCode
 RENDER_FREE_COMMANDS = frozenset({"list"})
 #: Options every command takes, anywhere on the command line.
 GLOBAL_FLAGS = ("--debug", "--quiet")
+#: Whether :func:`main` called with ``argv`` (in-process) raises KeyboardInterrupt after an
+#: interrupted command instead of returning 130: for callers that Ctrl-C must stop too (the
+#: test suite sets it, so that Ctrl-C stops the suite, not just the command under test).
+RAISE_INTERRUPTS = False
 
 
 def _command(argv: Sequence[str]) -> str | None:
@@ -50,7 +54,8 @@ def _main(argv: list[str], *, debug: bool, quiet: bool) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """The ``headsim`` entry point: runs a command and returns its exit code (0, 1, 2, 3, 130)."""
+    """The ``headsim`` entry point: runs a command and returns its exit code (0, 1, 2, 3, 130;
+    see :data:`RAISE_INTERRUPTS`)."""
     try:
         given = list(sys.argv[1:] if argv is None else argv)
         debug = "--debug" in given
@@ -66,6 +71,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:  # before the command's own guard, or as it is taken down
         print("headsim: interrupted", file=sys.stderr)
         code = int(ExitCode.INTERRUPTED)
+    if argv is not None and code == ExitCode.INTERRUPTED and RAISE_INTERRUPTS:
+        raise KeyboardInterrupt  # the command cleaned up; now its caller stops too
     if argv is None and code == ExitCode.INTERRUPTED:
         # CPython ends a process by SIGINT at exit (status -2, not 130) once a
         # KeyboardInterrupt passed through an extension's PyRun_* call (pybind11's exec
@@ -74,4 +81,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         import ctypes
 
         ctypes.pythonapi.PyRun_SimpleString(b"pass")
+    rerun_cli = sys.modules.get("headsim.run.rerun_cli")
+    if argv is None and rerun_cli is not None and rerun_cli.viewer_streams_left_open():
+        # Rerun's gRPC client, left with a viewer that does not answer, blocks the
+        # interpreter's exit for ever, signals included: leave without it (all written).
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
     return code

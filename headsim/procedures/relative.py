@@ -8,7 +8,6 @@ from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
-import rerun as rr
 
 from headsim.active.events import FixationStarted, MeasurementDone, PhaseStarted
 from headsim.active.eye_servo import EyeServo
@@ -30,7 +29,6 @@ from headsim.run.context import (
 )
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
-from headsim.run.recording_layout import GREEN, ORANGE, RED
 from headsim.run.table import cell, format_table
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import (
@@ -153,6 +151,10 @@ class RelativeResult:
 
     def log_rows(self, log: Recorder) -> None:
         """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
+        import rerun as rr  # only when recording: Rerun costs a third of a second to import
+
+        from headsim.run.recording_layout import GREEN, ORANGE, RED
+
         baseline = log.scenario.settings.baseline_m
         s = log.scenario.settings
         strips, labels = [], []

@@ -45,7 +45,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import rerun as rr
 
 from headsim.active.chessboard import look_for_board
 from headsim.active.events import PhaseStarted
@@ -55,7 +54,6 @@ from headsim.geometry.transforms import frame_deviation
 from headsim.run.context import simulator
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
-from headsim.run.recording_layout import GREEN
 from headsim.run.table import cell, format_table, mm
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
@@ -212,6 +210,10 @@ def triangulated_line(targets: tuple[StereoTarget, ...]) -> str:
 
 def log_estimates(log: Recorder, targets: tuple[StereoTarget, ...]) -> None:
     """Each triangulated target's estimate in W."""
+    import rerun as rr  # only when recording: Rerun costs a third of a second to import
+
+    from headsim.run.recording_layout import GREEN
+
     seen = [t for t in targets if t.ok]
     if seen:
         log.rec.log(

@@ -10,7 +10,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import rerun as rr
 
 from headsim.active.events import PhaseStarted
 from headsim.active.measurement import HeadKnowledge
@@ -24,7 +23,6 @@ from headsim.active.principal import (
 from headsim.run.context import simulator
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
-from headsim.run.recording_layout import GREEN
 from headsim.run.table import format_table
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.spec import CalibrationSpec, Scenario
@@ -90,6 +88,10 @@ class ZoomFixedPoints:
 
     def log_rows(self, log: Recorder) -> None:
         """Each camera's fixed point in its image."""
+        import rerun as rr  # only when recording: Rerun costs a third of a second to import
+
+        from headsim.run.recording_layout import GREEN
+
         for cam, uv in zip(names.CAMERAS, self.run.principal_px, strict=True):
             log.rec.log(
                 f"/world/head/{cam}/zoom_fixed_point", rr.Points2D([uv], radii=4.0, colors=[GREEN])

@@ -61,6 +61,7 @@ import rerun as rr
 from headsim.active.calibration_report import CalibrationReport
 from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
+from headsim.errors import interrupted
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
 from headsim.run.outcomes import MeasurementRecord, RunOutcome
@@ -78,7 +79,16 @@ from headsim.run.recording_layout import (
     recording_id,
     scenario_markdown,
 )
-from headsim.run.rerun_cli import RecordingTarget
+from headsim.run.rerun_cli import (
+    INTERRUPTED_VIEWER_WAIT_S,
+    VIEWER_WAIT_S,
+    RecordingTarget,
+    ViewerUnreachable,
+    check_viewer,
+    flush_to_viewer,
+    viewer_stream_closed,
+    viewer_stream_opened,
+)
 from headsim.run.summary import summary_text
 from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
@@ -125,6 +135,10 @@ class Recorder:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         self.scenario = scenario
         self.jpeg_quality = int(jpeg_quality)
+        if target.connect_url is not None:
+            check_viewer(target.connect_url)  # before Rerun's stream, which would wait for ever
+        #: Whether the viewer stopped answering: the stream is then not flushed again.
+        self._viewer_lost = False
         self.rec = rr.RecordingStream(
             APP_ID,
             recording_id=recording or recording_id(scenario),
@@ -144,6 +158,8 @@ class Recorder:
             sinks.append(rr.FileSink(self.path))
         if sinks:
             self.rec.set_sinks(*sinks, default_blueprint=layout)  # each sink gets the layout
+            if target.connect_url is not None:
+                viewer_stream_opened()
         elif self.path is not None:
             self.rec.save(self.path, default_blueprint=layout)
         if target.serve:
@@ -634,21 +650,39 @@ class Recorder:
         for future in pending:
             future.result()
 
-    def flush(self) -> None:
-        """Everything logged so far written (or streamed)."""
+    def flush(self, viewer_wait_s: float = VIEWER_WAIT_S) -> None:
+        """Everything logged so far written (or streamed: within ``viewer_wait_s``)."""
         self._send_kept_rows()
         self._wait()
-        self.rec.flush()
+        if self.target.connect_url is None:
+            self.rec.flush()
+            return
+        try:
+            flush_to_viewer(self.rec, self.target.connect_url, viewer_wait_s)
+        except ViewerUnreachable:
+            self._viewer_lost = True
+            raise
 
     def close(self) -> None:
         """Flush and write the footer; the file is complete after this."""
         if not self.closed:
             self.closed = True
+            flushed = False
             try:
-                self.flush()
+                if not self._viewer_lost:
+                    # After Ctrl-C or SIGTERM a viewer gets a moment, not the full wait.
+                    self.flush(INTERRUPTED_VIEWER_WAIT_S if interrupted() else VIEWER_WAIT_S)
+                    flushed = True
             finally:
                 self._background.shutdown(wait=True, cancel_futures=False)
-                self.rec.disconnect()
+                if flushed or self.target.connect_url is None:
+                    self.rec.disconnect()
+                    if self.target.connect_url is not None:
+                        viewer_stream_closed()
+                # Else the stream is left as it is: with a viewer that does not take the data
+                # (or after an interrupted flush), disconnecting, even finishing only the file
+                # sink, waits for ever.  The file, if any, is then without footer (readable);
+                # the command line leaves without waiting for the stream.
 
     def __enter__(self) -> Recorder:
         return self

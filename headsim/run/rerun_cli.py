@@ -15,17 +15,28 @@ module imports no Rerun, so that ``headsim --help`` stays fast.
 from __future__ import annotations
 
 import argparse
+import socket
+import time
 import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from headsim.errors import BadInput
+from headsim.errors import BadInput, EnvironmentProblem
 
 #: Rerun's default ports: the gRPC server and the web viewer.
 DEFAULT_GRPC_PORT = 9876
 DEFAULT_WEB_PORT = 9090
 #: Where ``--connect`` streams without ``--url`` (a viewer started with ``rerun``).
 DEFAULT_URL = f"rerun+http://127.0.0.1:{DEFAULT_GRPC_PORT}/proxy"
+#: How long ``--connect`` waits for its viewer (to accept the connection, then each flush)
+#: before the run gives up with exit 3: Rerun's own stream would wait for ever.
+VIEWER_WAIT_S = 5.0
+#: The same when the run was interrupted (Ctrl-C, SIGTERM) and the recording is closed.
+INTERRUPTED_VIEWER_WAIT_S = 0.5
+#: A flush to a viewer waits in slices this long, so that Ctrl-C and SIGTERM (handled by
+#: Python between them, never inside Rerun's wait) end the run at once.
+FLUSH_SLICE_S = 0.25
 
 
 class RecordingArgumentError(BadInput, ValueError):
@@ -34,6 +45,82 @@ class RecordingArgumentError(BadInput, ValueError):
     def __init__(self, field: str, message: str, allowed: str) -> None:
         super().__init__(f"{field}: {message} (allowed: {allowed})")
         self.field, self.message, self.allowed = field, message, allowed
+
+
+class ViewerUnreachable(EnvironmentProblem):
+    """No Rerun viewer answered at ``--connect``'s address in time (exit 3)."""
+
+    def __init__(self, url: str, wait_s: float, *, lost: bool = False) -> None:
+        where = urllib.parse.urlparse(url).netloc or url
+        if lost:
+            message = f"the Rerun viewer at {where} did not take the recording within {wait_s:g} s"
+        else:
+            message = f"no Rerun viewer answered at {where} within {wait_s:g} s"
+        super().__init__(f"{message}: start one with `rerun`, or use --rrd FILE")
+        self.url, self.wait_s = url, wait_s
+
+
+def check_viewer(url: str, wait_s: float = VIEWER_WAIT_S) -> None:
+    """:class:`ViewerUnreachable` unless something accepts a connection at ``url``'s host and
+    port within ``wait_s`` (tried again every 0.2 s: a viewer may be starting).
+
+    Rerun's gRPC sink offers no such check: with nobody listening it retries for ever and its
+    flush blocks (also Ctrl-C).  A URL without a port is left to :class:`Recorder`'s bounded
+    flushes.
+    """
+    parsed = urllib.parse.urlparse(url)
+    if parsed.hostname is None or parsed.port is None:
+        return
+    deadline = time.monotonic() + wait_s
+    while True:
+        left = deadline - time.monotonic()
+        try:
+            with socket.create_connection((parsed.hostname, parsed.port), timeout=max(left, 0.1)):
+                return
+        except OSError:
+            if left <= 0:
+                raise ViewerUnreachable(url, wait_s) from None
+            time.sleep(min(0.2, max(left, 0.0)))
+
+
+def flush_to_viewer(rec: Any, url: str, wait_s: float = VIEWER_WAIT_S) -> None:
+    """Flush ``rec`` (a ``rerun.RecordingStream`` with a viewer among its sinks) within
+    ``wait_s``, in slices; :class:`ViewerUnreachable` if the viewer does not take it (Rerun's
+    own flush waits for ever on a viewer that is gone or does not answer)."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        try:
+            rec.flush(timeout_sec=FLUSH_SLICE_S)
+            return
+        except RuntimeError as err:
+            text = str(err).lower()
+            # Rerun's words for "not yet": a timed-out wait, a viewer not (yet) connected.
+            if "timed out" not in text and "unable to connect" not in text:
+                raise
+            if time.monotonic() >= deadline:
+                raise ViewerUnreachable(url, wait_s, lost=True) from None
+
+
+class _ViewerStreams:
+    """Streams to a viewer (``--connect``) opened in this process and not closed cleanly."""
+
+    open = 0
+
+
+def viewer_stream_opened() -> None:
+    """Note a stream to a viewer opened (:class:`headsim.run.recording.Recorder`)."""
+    _ViewerStreams.open += 1
+
+
+def viewer_stream_closed() -> None:
+    """Note a stream to a viewer closed cleanly (it disconnected)."""
+    _ViewerStreams.open -= 1
+
+
+def viewer_streams_left_open() -> bool:
+    """Whether a stream to a viewer was left open: Rerun's gRPC client then blocks the
+    interpreter's exit, signals included, while its viewer does not answer."""
+    return _ViewerStreams.open > 0
 
 
 def job_target(target: RecordingTarget, job_id: str) -> RecordingTarget:
@@ -167,9 +254,17 @@ def recording_target(args: argparse.Namespace, *, per_job: bool = False) -> Reco
 
 __all__ = [
     "DEFAULT_URL",
+    "INTERRUPTED_VIEWER_WAIT_S",
+    "VIEWER_WAIT_S",
     "RecordingArgumentError",
     "RecordingTarget",
+    "ViewerUnreachable",
     "add_recording_arguments",
+    "check_viewer",
+    "flush_to_viewer",
     "job_target",
     "recording_target",
+    "viewer_stream_closed",
+    "viewer_stream_opened",
+    "viewer_streams_left_open",
 ]

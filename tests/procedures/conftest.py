@@ -1,24 +1,17 @@
-"""One run per scenario (its fast variant) for the procedure tests of a module, typed as the runner returns it."""
+"""The procedure tests read the typed result of each scenario's fast variant, run once for the
+whole suite (``shipped_fast_run`` in tests/conftest.py, shared with the runner's tests)."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
 import pytest
+from shipped_runs import ShippedRun
 
 from headsim.run.result import RunResult
-from headsim.run.runner import run_scenario
-from headsim.scenario.loading import load_scenario
 
 
-@pytest.fixture(scope="module")
-def fast_run() -> Callable[[str], RunResult]:
-    """Run a scenario's fast variant once per test module; later calls return the same result."""
-    runs: dict[str, RunResult] = {}
-
-    def run(name: str) -> RunResult:
-        if name not in runs:
-            runs[name] = run_scenario(load_scenario(name, fast=True))
-        return runs[name]
-
-    return run
+@pytest.fixture
+def fast_run(shipped_fast_run: Callable[[str], ShippedRun]) -> Callable[[str], RunResult]:
+    """A shipped scenario's fast variant, as the runner returned it (one run per session)."""
+    return lambda name: shipped_fast_run(name).result

@@ -5,9 +5,11 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from shipped_runs import ShippedRun
 
 from headsim.cli import main
 from headsim.run.results_reference import (
@@ -77,11 +79,12 @@ def _check_schema(results: dict, scenario_name: str) -> None:
 
 @pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
 def test_every_scenario_runs_in_its_fast_variant(
-    path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    path: Path, shipped_fast_run: Callable[[str], ShippedRun]
 ) -> None:
-    code, out = _run([path.stem, "--fast", "--out", str(tmp_path)], capsys)
+    run = shipped_fast_run(path.stem)  # the run the procedures' tests read too
+    code, out, directory = run.code, run.out, run.directory
     assert code == 0, out
-    results = json.loads((tmp_path / "results.json").read_text())
+    results = json.loads((directory / "results.json").read_text())
     _check_schema(results, path.stem)
     # Every key the run wrote has a meaning; every meaning of its procedure names a key it wrote.
     assert undocumented(results) == []
@@ -90,8 +93,8 @@ def test_every_scenario_runs_in_its_fast_variant(
     assert held - {"experiment.procedure"} == {
         f"experiment.{k}" for k in EXPERIMENT_FIELDS[procedure] if k not in FAILED_ONLY
     }
-    assert (tmp_path / "summary.txt").read_text().strip() in out
-    assert json.loads((tmp_path / "timing.json").read_text())["wall_s"] > 0
+    assert (directory / "summary.txt").read_text().strip() in out
+    assert json.loads((directory / "timing.json").read_text())["wall_s"] > 0
     scenario = load_scenario(path, fast=True)
     calibration = results["calibration"]
     if scenario.experiment.calibration is not None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
@@ -15,6 +16,7 @@ from headsim.sim.simulator import HeadSim
 from headsim.vision.crosses import find_cross_point
 
 
+@pytest.mark.render
 def test_objects_placed_in_the_magnitude_areas_are_classified_by_both_tests() -> None:
     wanted = [1, 2, 3, 4, 7, 8]  # the areas random layouts almost never reach
     with HeadSim("blocks", paper_head()) as sim:
@@ -86,6 +88,7 @@ def test_placed_objects_never_touch_in_any_image_so_each_centroid_is_unbiased() 
     assert closest > 5.0
 
 
+@pytest.mark.render
 def test_a_ball_partly_hidden_by_another_counts_as_not_seen_not_as_a_biased_area() -> None:
     with HeadSim("blocks", paper_head()) as sim:
         ref_head = np.array([0.01, 0.0, 0.8])

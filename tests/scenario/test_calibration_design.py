@@ -65,6 +65,7 @@ def test_the_fit_states_and_reaches_the_designs_limit() -> None:
     assert 0.6 * near_far < scatter < 1.4 * near_far  # 20 seeds: the scatter matches it
 
 
+@pytest.mark.render
 def test_a_rendered_near_far_calibration_fixates_every_ball() -> None:
     near_far = {"experiment.calibration.layout": "near_far"}
     scenario = load_scenario("realistic_field", fast=True, overrides=near_far)

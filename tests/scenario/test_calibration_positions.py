@@ -40,6 +40,7 @@ def test_targets_other_than_the_positions_count_is_refused() -> None:
         scenario_from_document(_doc({"positions_world_m": positions, "targets": 5}), "bad")
 
 
+@pytest.mark.render
 def test_given_positions_calibrate_as_the_same_positions_drawn() -> None:
     drawn = run_scenario(scenario_from_document(_doc({"targets": 6}), "drawn"))
     assert drawn.calibration is not None and drawn.calibration.layout is not None
@@ -54,6 +55,7 @@ def test_given_positions_calibrate_as_the_same_positions_drawn() -> None:
     assert given.calibration.alpha_e_rad == drawn.calibration.alpha_e_rad
 
 
+@pytest.mark.render
 def test_the_reported_truth_is_the_goal_columns_own() -> None:
     """With the servo on other columns than the image centres, the report's truth is the
     effective direction through those columns: fitted minus truth is the reported error,

@@ -39,6 +39,7 @@ def test_calibration_reaches_the_reprojection_and_focal_length_bounds(calibrated
     assert rotation < 5e-3 and translation < 1e-3
 
 
+@pytest.mark.render
 def test_too_few_views_is_a_clear_error() -> None:
     with HeadSim("chessboard", ideal_head()) as sim:
         views = chessboard_views(sim, 3, np.random.default_rng(0))

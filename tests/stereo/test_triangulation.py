@@ -15,6 +15,7 @@ from .conftest import PRESETS
 from .helpers import calibration_from_truth
 
 
+@pytest.mark.render
 def test_stereo_error_at_a_known_depth_is_below_half_a_percent(calibrated) -> None:
     name, _, calib = calibrated
     settings = PRESETS[name]()
@@ -30,6 +31,7 @@ def test_stereo_error_at_a_known_depth_is_below_half_a_percent(calibrated) -> No
             assert abs(measured.error_m[2]) < 0.005 * p_head[2]
 
 
+@pytest.mark.render
 def test_a_target_that_is_not_seen_is_a_clear_error(calibrated) -> None:
     _, _, calib = calibrated
     with HeadSim("default", ideal_head()) as sim:

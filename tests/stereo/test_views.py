@@ -35,6 +35,7 @@ def test_a_board_pose_that_cannot_be_seen_is_a_clear_error() -> None:
         sample_board_pose(sim, np.random.default_rng(0), (0.1, 0.12), max_attempts=50)
 
 
+@pytest.mark.render
 def test_same_seed_gives_the_same_views() -> None:
     settings = dataclasses.replace(ideal_head(), seed=1)
     results = []
