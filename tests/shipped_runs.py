@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
-from headsim.run.outcomes import RunResult
+from headsim.run.result import RunResult
 
 
 @dataclass(frozen=True)
