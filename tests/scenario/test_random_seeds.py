@@ -39,6 +39,8 @@ def test_the_shipped_scenarios_with_random_targets_are_found() -> None:
     assert "quickstart" in RANDOM and len(RANDOM) >= 5, RANDOM
 
 
+# 200 seeds of six scenarios: about 35 s of loading, too long for the fast tier.
+@pytest.mark.e2e
 @pytest.mark.parametrize("name", RANDOM)
 def test_every_seed_loads_and_its_redraws_are_counted_by_cause(name: str) -> None:
     redrawn: Counter[str] = Counter()

@@ -5,6 +5,7 @@ calls the rendered half disc occluded rather than placing a biased centroid."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from headsim.scenario.occlusion import hidden_by
 from headsim.scenario.reach import ReachHead, body_radius, model2_refusal, scene_occluders
@@ -60,6 +61,7 @@ def test_a_partial_occlusion_the_yaw_axis_missed_is_refused_from_the_pupil() -> 
     assert model2_refusal(head, target, "target", radius, occluders) is None
 
 
+@pytest.mark.render
 def test_the_rendered_half_disc_is_occluded_and_the_whole_one_found() -> None:
     head, target, blocker, _ = _layout()
     _, _, clear, _ = _layout(0.03)
