@@ -13,10 +13,9 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
 
-from headsim.sim import names
+from headsim.scenario.surface_targets import cast
 from headsim.sim.simulator import CameraId, HeadSim
 
 
@@ -96,25 +95,6 @@ def ray_direction_world(sim: HeadSim, camera: CameraId, goal_uv: Sequence[float]
     return _unit(world_from_cam[:3, :3] @ np.array([xy[0], xy[1], 1.0]))
 
 
-#: The geom groups a cast ray may hit: all but the head's own (``names.HEAD_VISUAL_GROUP``).
-SCENE_GROUPS = np.array([g != names.HEAD_VISUAL_GROUP for g in range(6)], dtype=np.uint8)
-
-
-def cast(
-    model: mujoco.MjModel, data: mujoco.MjData, origin_world_m: np.ndarray, direction: np.ndarray
-) -> tuple[np.ndarray | None, float, int]:
-    """The first scene geom (not the head's) along a ray: (point in W or None, distance
-    along the unit ``direction``, geom id or -1)."""
-    direction = _unit(direction)
-    geom = np.array([-1], dtype=np.int32)
-    distance = mujoco.mj_ray(
-        model, data, np.asarray(origin_world_m, dtype=float), direction, SCENE_GROUPS, 1, -1, geom
-    )
-    if geom[0] < 0 or distance < 0:
-        return None, math.inf, -1
-    return np.asarray(origin_world_m) + distance * direction, float(distance), int(geom[0])
-
-
 def landing(sim: HeadSim, camera: CameraId, goal_uv: Sequence[float]) -> Landing:
     """Where ``camera``'s ray through ``goal_uv`` (the servo's goal pixel), at the camera's
     true pose now, meets the scene."""
@@ -167,12 +147,10 @@ def fixation_truth(
 
 
 __all__ = [
-    "SCENE_GROUPS",
     "FixationError",
     "FixationTruth",
     "Landing",
     "angle_deg",
-    "cast",
     "fixation_error",
     "fixation_truth",
     "landing",

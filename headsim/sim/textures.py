@@ -83,15 +83,24 @@ def texture_grey(spec: TextureSpec) -> np.ndarray:
         angle = rng.uniform(0, 2 * np.pi)
         ramp = np.cos(angle) * cols + np.sin(angle) * rows
         ramp = (ramp - ramp.min()) / max(float(np.ptp(ramp)), 1e-12) - 0.5
-        # A gentle ramp and faint fine noise: 2 % of the contrast.
-        faint = 0.02 * rng.standard_normal((n, n))
+        # A gentle ramp and faint fine noise, about one grey level of 255: no more
+        # than a camera's own noise.
+        faint = 0.005 * rng.standard_normal((n, n))
         return np.clip(0.5 + spec.contrast * (0.25 * ramp + faint), 0.0, 1.0)
-    wave = grating(n, spec.period_px, spec.orientation_rad, 0.0)
-    square = np.sign(wave)
+    square = _square(n, spec.period_px, spec.orientation_rad)
     if spec.checks:
-        square = square * np.sign(grating(n, spec.period_px, spec.orientation_rad + np.pi / 2, 0.0))
-    square[square == 0] = 1.0
+        square = square * _square(n, spec.period_px, spec.orientation_rad + np.pi / 2)
     return 0.5 + 0.5 * spec.contrast * square
+
+
+def _square(size_px: int, period_px: float, orientation_rad: float) -> np.ndarray:
+    """(N, N) square wave of +-1: +1 over the first half of each period along the
+    direction (cos o, sin o) in (column, row) pixels."""
+    rows, cols = np.mgrid[0:size_px, 0:size_px].astype(float)
+    along = cols * np.cos(orientation_rad) + rows * np.sin(orientation_rad)
+    # A hair over: a pixel on a half-period edge (up to rounding) starts the next half.
+    half = np.floor(2.0 * along / period_px + 1e-9)
+    return np.where(half % 2 == 0, 1.0, -1.0)
 
 
 def to_rgb(grey: np.ndarray, tint: tuple[float, float, float] = (1.0, 1.0, 1.0)) -> np.ndarray:
