@@ -14,6 +14,7 @@ Positions in W, m; ``size_m`` as MuJoCo's geom sizes (half-lengths, radii).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -130,14 +131,20 @@ class RoomSpec:
         )  # fmt: skip
 
 
+@functools.lru_cache(maxsize=128)
+def texture_bytes(texture: TextureSpec) -> bytes:
+    """``texture``'s tinted 8-bit RGB pixels, row by row (made once per spec: every
+    simulator of a run builds the same room)."""
+    return to_rgb(texture_grey(texture), tint_of(texture.seed)).tobytes()
+
+
 def _texture(spec: mujoco.MjSpec, name: str, obj: SceneObject) -> str:
     """Add ``obj``'s texture and material to ``spec``; the material's name."""
-    rgb = to_rgb(texture_grey(obj.texture), tint_of(obj.texture.seed))
     n = obj.texture.size_px
     plane = obj.shape == "plane"
     kind = mujoco.mjtTexture.mjTEXTURE_2D if plane else mujoco.mjtTexture.mjTEXTURE_CUBE
     texture = spec.add_texture(name=f"{name}_texture", type=kind, width=n, height=n, nchannel=3)
-    texture.data = rgb.tobytes()
+    texture.data = texture_bytes(obj.texture)
     material = spec.add_material(name=f"{name}_material")
     material.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = texture.name
     material.specular = 0.0

@@ -5,6 +5,7 @@ without changing it.  Real rendering."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import cv2
 import mujoco
@@ -131,3 +132,11 @@ def test_the_light_settings_reach_the_model_and_the_image() -> None:
     with HeadSim("default", settings, room=shadows) as s:
         assert bool(s.model.light(names.KEY_LIGHT).castshadow)
         assert int(s.model.vis.quality.shadowsize) > 0
+        # The same room's textures without shadows were drawn first: the shadowed one
+        # still gets a context with a shadow map (the pool keys on it), and its panel
+        # casts a shadow on the table below it.
+        s.move(neck_pitch=-0.4)
+        with HeadSim("default", settings, room=replace(shadows, light=LightSettings())) as flat:
+            flat.move(neck_pitch=-0.4)
+            darker = flat.render(1).astype(float).mean() - s.render(1).astype(float).mean()
+        assert darker > 0.5
