@@ -379,7 +379,7 @@ DESCRIPTIONS: dict[str, str] = {
     "scene.room.light.ambient": "Ambient light everywhere, 0-1.",
     "scene.room.light.shadows": "Whether the key light casts shadows (a shadow map: dearer renders).",
     "scene.room.objects": "Textured objects placed in the room.",
-    "scene.room.objects[].name": "The object's name, unique (default `object_N`; `clutter_` and `room_` are reserved).",
+    "scene.room.objects[].name": "The object's name, unique (default `item_N`; `clutter_`, `room_` and the scenes' bodies are reserved).",
     "scene.room.objects[].shape": "`box`, `cylinder`, `sphere` or `plane`.",
     "scene.room.objects[].size_m": "MuJoCo's sizes, m: a box's half-lengths, a cylinder's radius and half-height (then 0), a sphere's radius (then 0, 0), a plane's half-sides (then 0).",
     "scene.room.objects[].pos_world_m": "The object's centre in W, m.",

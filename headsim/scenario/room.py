@@ -9,14 +9,16 @@ box, cylinder or sphere 3-8 cm in half-size, resting on the table at a depth in
 
 from __future__ import annotations
 
+import functools
 import math
 from contextvars import ContextVar
 
 import numpy as np
 
-from headsim.scenario.occlusion import Occluder
+from headsim.scenario.occlusion import Occluder, scene_model
 from headsim.scenario.spec import MAX_DEPTH_M
 from headsim.scenario.tables import Table
+from headsim.sim import names
 from headsim.sim.textured_scene import SHAPES, LightSettings, RoomSpec, SceneObject
 from headsim.sim.textures import TEXTURE_KINDS, TextureSpec
 
@@ -61,7 +63,7 @@ def draw_clutter(
 
 def _object(table: Table, k: int, seed: int) -> SceneObject:
     """One ``[[scene.room.objects]]`` entry."""
-    name = table.string("name", f"object_{k + 1}", 60)
+    name = table.string("name", f"item_{k + 1}", 60)
     shape = table.choice("shape", tuple(SHAPES))
     size = table.numbers("size_m", 3, None, 0.0, 5.0, unit="m")
     if size is None or min(size[: {"sphere": 1, "cylinder": 2}.get(shape, 2)]) <= 0.0:
@@ -85,6 +87,17 @@ def _object(table: Table, k: int, seed: int) -> SceneObject:
     table.done()
     full = (size[0], size[1], 1.0 if shape == "plane" else size[2])
     return SceneObject(name, shape, full, (pos[0], pos[1], pos[2]), texture, yaw, pitch, tile)
+
+
+@functools.cache
+def scene_names() -> frozenset[str]:
+    """Every body and geom name of the shipped scenes (an object may not take one)."""
+    taken: set[str] = set()
+    for scene in names.SCENES:
+        model = scene_model(scene)
+        taken.update(model.body(b).name for b in range(model.nbody))
+        taken.update(model.geom(g).name for g in range(model.ngeom))
+    return frozenset(taken)
 
 
 def read_room(scene: Table, seed: int) -> RoomSpec | None:
@@ -114,13 +127,16 @@ def read_room(scene: Table, seed: int) -> RoomSpec | None:
         light_table.done()
     objects = tuple(_object(t, k, seed) for k, t in enumerate(table.tables("objects", 100)))
     table.done()
-    names = [o.name for o in objects]
-    for name in names:
-        if names.count(name) > 1 or name.startswith(("clutter_", "room_")):
+    given = [o.name for o in objects]
+    taken = scene_names()
+    for k, name in enumerate(given):
+        if given.count(name) > 1 or name.startswith(("clutter_", "room_")) or name in taken:
             raise scene.ctx.error(
-                f"{table.path}.objects", f"object name {name!r} is used twice or reserved",
-                "unique names, not starting with clutter_ or room_",
-            )  # fmt: skip
+                f"{table.path}.objects[{k}].name",
+                f"{name!r} is used twice, reserved or a name of the scene",
+                "unique names, not starting with clutter_ or room_, not a body of the scenes "
+                "(markers, chessboard, object_1..6)",
+            )
     room = RoomSpec(seed=seed, surface=surface, light=light)
     rng = np.random.default_rng([seed, STREAM_ROOM])
     clutter = draw_clutter(room, count, (near, far), rng)

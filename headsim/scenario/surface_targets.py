@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+from numpy.typing import ArrayLike
 
 from headsim.scenario.reach import ReachHead, target_refusal
 from headsim.sim import names
@@ -98,7 +99,7 @@ def _triple(p: np.ndarray) -> tuple[float, float, float]:
     return (float(p[0]), float(p[1]), float(p[2]))
 
 
-def point_world(sim: HeadSim, body: str, point_body_m: Sequence[float]) -> np.ndarray:
+def point_world(sim: HeadSim, body: str, point_body_m: ArrayLike) -> np.ndarray:
     """Where a point given in ``body``'s frame truly is now, W, m."""
     b = sim.data.body(body)
     return np.asarray(b.xpos + b.xmat.reshape(3, 3) @ np.asarray(point_body_m, dtype=float))
@@ -118,7 +119,7 @@ def _scene_geoms(model: mujoco.MjModel) -> list[int]:
     ]
 
 
-def surface_of(sim: HeadSim, point_world_m: Sequence[float]) -> tuple[int, float]:
+def surface_of(sim: HeadSim, point_world_m: ArrayLike) -> tuple[int, float]:
     """The scene geom whose surface is nearest a world point, and the distance, m."""
     p = np.asarray(point_world_m, dtype=float)
     best, best_d = -1, math.inf
@@ -130,7 +131,7 @@ def surface_of(sim: HeadSim, point_world_m: Sequence[float]) -> tuple[int, float
     return best, best_d
 
 
-def on_object(sim: HeadSim, name: str, body: str, point_body_m: Sequence[float]) -> SurfaceTarget:
+def on_object(sim: HeadSim, name: str, body: str, point_body_m: ArrayLike) -> SurfaceTarget:
     """A target at ``point_body_m`` on ``body``, checked to lie on its surface."""
     if mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_BODY, body) < 0:
         raise NotOnSurface(f"{name}: no object named {body!r} in the scene")
@@ -146,7 +147,7 @@ def on_object(sim: HeadSim, name: str, body: str, point_body_m: Sequence[float])
     return SurfaceTarget(name, body, _triple(np.asarray(point_body_m, dtype=float)), _triple(p))
 
 
-def on_surface(sim: HeadSim, name: str, point_world_m: Sequence[float]) -> SurfaceTarget:
+def on_surface(sim: HeadSim, name: str, point_world_m: ArrayLike) -> SurfaceTarget:
     """A target at a world point, checked to lie within :data:`ON_SURFACE_M` of a surface."""
     p = np.asarray(point_world_m, dtype=float)
     geom, distance = surface_of(sim, p)
@@ -166,7 +167,7 @@ def camera_centre(sim: HeadSim, camera: int) -> np.ndarray:
     return sim.world_from_camera(camera)[:3, 3].copy()
 
 
-def visible(sim: HeadSim, camera: int, point_world_m: Sequence[float]) -> bool:
+def visible(sim: HeadSim, camera: int, point_world_m: ArrayLike) -> bool:
     """Whether camera ``camera``'s (1, 2) line of sight to the point, from its true centre
     now, first meets the scene at the point (within :data:`ON_SURFACE_M`)."""
     p = np.asarray(point_world_m, dtype=float)
@@ -188,7 +189,7 @@ class Click:
 
 def click(
     sim: HeadSim,
-    point_world_m: Sequence[float],
+    point_world_m: ArrayLike,
     rng: np.random.Generator,
     error_px: float = CLICK_ERROR_PX,
 ) -> Click:

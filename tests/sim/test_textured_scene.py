@@ -140,3 +140,25 @@ def test_the_light_settings_reach_the_model_and_the_image() -> None:
             flat.move(neck_pitch=-0.4)
             darker = flat.render(1).astype(float).mean() - s.render(1).astype(float).mean()
         assert darker > 0.5
+
+
+def test_every_surface_of_the_room_faces_into_it() -> None:
+    """Rays from the head out to each side meet that side's surface (MuJoCo meets, and
+    draws, a plane from its front only)."""
+    from headsim.scenario.surface_targets import cast
+
+    room = RoomSpec()
+    with HeadSim("default", HeadSettings(), room=room) as sim:
+        origin = sim.world_from_head()[:3, 3]
+        expected = {
+            (0.0, 1.0, 0.0): (names.ROOM_WALLS[0], 1, room.back_wall_y_m),
+            (-1.0, 0.0, 0.0): (names.ROOM_WALLS[1], 0, -room.side_wall_x_m),
+            (1.0, 0.0, 0.0): (names.ROOM_WALLS[2], 0, room.side_wall_x_m),
+            (0.0, 0.0, 1.0): (names.ROOM_CEILING, 2, room.ceiling_z_m),
+            (0.0, -0.5, -1.0): (names.ROOM_FLOOR, 2, room.floor_z_m),
+            (0.0, 1.0, -0.3): (names.ROOM_TABLE, 2, room.table_top_z_m),
+        }
+        for direction, (name, axis, value) in expected.items():
+            point, _, geom = cast(sim.model, sim.data, origin, np.array(direction))
+            assert geom >= 0 and sim.model.geom(geom).name == name, direction
+            assert point is not None and point[axis] == pytest.approx(value, abs=1e-9)
