@@ -4,6 +4,7 @@ goal rays cast into a real model against the analytic intersection."""
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -57,7 +58,7 @@ def test_fixation_error_is_an_angle_and_a_distance_from_the_target() -> None:
 
 
 @pytest.fixture(scope="module")
-def sim() -> HeadSim:
+def sim() -> Iterator[HeadSim]:
     """The ideal head facing a large textured panel at y = PANEL_Y_M (its normal -y)."""
     panel = SceneObject(
         "panel", "plane", (1.5, 1.0, 1.0), (0.0, PANEL_Y_M, 0.2), TextureSpec("pink", seed=1),

@@ -5,6 +5,7 @@ targets on the surfaces the start pose sees.  A real model; exact geometry."""
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import mujoco
 import numpy as np
@@ -59,7 +60,7 @@ PANEL = SceneObject(
 
 
 @pytest.fixture(scope="module")
-def sim() -> HeadSim:
+def sim() -> Iterator[HeadSim]:
     with HeadSim("default", HeadSettings(), room=RoomSpec(objects=(BOX, PANEL))) as s:
         yield s
 
