@@ -64,7 +64,7 @@ def test_a_textured_plane_shows_its_texture_upright_and_at_scale() -> None:
     expected = cv2.remap(grey.astype(np.float32), map_x, map_y, cv2.INTER_LINEAR)
     inside = (np.abs(x) < half - 0.01) & (np.abs(y) < half - 0.01)
     r = np.corrcoef(image[inside], expected[inside])[0, 1]
-    assert r > 0.95
+    assert r > 0.99  # 0.9998 here
     # The same texture flipped left-right or upside down does not match.
     for flipped in (expected[:, ::-1], expected[::-1, :]):
         assert np.corrcoef(image[inside], flipped[inside])[0, 1] < 0.3
