@@ -92,7 +92,6 @@ HEAD_VISUAL_GROUP = 3
 TABLE_PLANE = "floor"
 KEY_LIGHT = "key_light"
 ROOM_FLOOR = "room_floor"
-ROOM_CEILING = "room_ceiling"
 ROOM_WALLS = ("room_wall_back", "room_wall_left", "room_wall_right")
 ROOM_TABLE = "room_table"
 #: Geom group of the room's surfaces and objects (drawn by the eye cameras).

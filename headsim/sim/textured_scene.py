@@ -76,9 +76,9 @@ class SceneObject:
 
 @dataclass(frozen=True)
 class RoomSpec:
-    """A room around the head: a floor at ``floor_z_m`` (W's z), a ceiling at
-    ``ceiling_z_m``, a back wall at ``back_wall_y_m``, side walls at +-``side_wall_x_m``
-    (a wall 1 m behind the head is left open), a table whose top is at
+    """A room around the head: a floor at ``floor_z_m`` (W's z), walls up to
+    ``wall_top_z_m``, a back wall at ``back_wall_y_m``, side walls at +-``side_wall_x_m``
+    (open behind the head, where the floor and side walls end 1 m back), a table whose top is at
     ``table_top_z_m`` spanning ``table_x_m`` and ``table_y_m`` (each a (min, max)), each
     with a texture of ``surface`` kind from the seed; ``objects`` on it; ``light``."""
 
@@ -87,7 +87,7 @@ class RoomSpec:
     floor_z_m: float = -1.1
     back_wall_y_m: float = 3.0
     side_wall_x_m: float = 2.0
-    ceiling_z_m: float = 1.6
+    wall_top_z_m: float = 2.0
     table_top_z_m: float = -0.35
     table_x_m: tuple[float, float] = (-0.9, 0.9)
     table_y_m: tuple[float, float] = (0.15, 2.1)
@@ -95,12 +95,13 @@ class RoomSpec:
     light: LightSettings = field(default_factory=LightSettings)
 
     def surfaces(self) -> tuple[SceneObject, ...]:
-        """The floor, the walls, the ceiling and the table, as textured objects; each plane
-        faces into the room (MuJoCo draws a plane, and ``mj_ray`` meets it, from the front)."""
+        """The floor, the walls and the table, as textured objects; each plane faces into
+        the room (MuJoCo draws a plane, and ``mj_ray`` meets it, from the front).  No
+        ceiling: it would shadow the whole room from the key light."""
         x0, x1 = self.table_x_m
         y0, y1 = self.table_y_m
-        half_height = (self.ceiling_z_m - self.floor_z_m) / 2
-        mid_z = (self.ceiling_z_m + self.floor_z_m) / 2
+        half_height = (self.wall_top_z_m - self.floor_z_m) / 2
+        mid_z = (self.wall_top_z_m + self.floor_z_m) / 2
         depth = self.back_wall_y_m - (-1.0)
         mid_y = (self.back_wall_y_m - 1.0) / 2
 
@@ -125,10 +126,6 @@ class RoomSpec:
             SceneObject(
                 names.ROOM_WALLS[2], "plane", (depth / 2, half_height, 1.0),
                 (self.side_wall_x_m, mid_y, mid_z), tex(4), yaw_rad=-p, pitch_rad=p, tile_m=1.0,
-            ),
-            SceneObject(
-                names.ROOM_CEILING, "plane", (self.side_wall_x_m, depth / 2, 1.0),
-                (0.0, mid_y, self.ceiling_z_m), tex(6), pitch_rad=math.pi, tile_m=1.0,
             ),
             SceneObject(
                 names.ROOM_TABLE, "box", ((x1 - x0) / 2, (y1 - y0) / 2, thick),
