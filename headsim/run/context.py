@@ -43,7 +43,13 @@ def model2_config(scenario: Scenario) -> Model2Config:
 def simulator(hub: Hub, scene: str, scenario: Scenario) -> HeadSim:
     """The scenario's simulator in ``scene``, reporting to ``hub`` (so do its servos and
     the procedures working with it)."""
-    return HeadSim(scene, scenario.settings, settle_mode=scenario.settle_mode, sink=hub)
+    return HeadSim(
+        scene,
+        scenario.settings,
+        settle_mode=scenario.settle_mode,
+        sink=hub,
+        room=scenario.scene.room,
+    )
 
 
 def told(scenario: Scenario) -> HeadKnowledge:

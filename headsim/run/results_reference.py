@@ -38,6 +38,9 @@ RESULTS_FIELDS: dict[str, str] = {
     "scenario.scene.parked": "the bodies parked out of sight",
     "scenario.scene.moving": "the moving target's path, or `null`",
     "scenario.scene.pursuit": "the live pursuit's target and path, or `null`",
+    "scenario.scene.room": "the textured room (`[scene.room]`): its seed, surface texture, "
+    "table and walls, every object (clutter drawn from the seed included) and the light; "
+    "`null`: none",
     "scenario.scene.acceptance": "how the targets came to be measured (`null`: a procedure "
     "without targets)",
     "scenario.scene.acceptance.within": "`[scene.random_targets] within` (`box` or `reach`; "

@@ -9,6 +9,7 @@ scenario's seed, one stream per use (``STREAM_*``).
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -24,6 +25,7 @@ from headsim.scenario.reach import (
     target_refusal,
 )
 from headsim.scenario.registry import get
+from headsim.scenario.room import ROOM_OCCLUDERS, read_room, room_occluders
 
 if TYPE_CHECKING:
     from headsim.scenario.registry import SceneReader
@@ -149,7 +151,7 @@ def _read_targets(
         points = start_head_to_world(settings, random_points_head(random_table, count, rng))
         # What can hide them: the scene as the listed targets leave it.
         placed = {t.body: np.array(t.position_world_m) for t in targets}
-        occluders = scene_occluders(get(procedure).scene, placed, body)
+        occluders = scene_occluders(get(procedure).scene, placed, body) + ROOM_OCCLUDERS.get()
         points, refused = _redraw_out_of_reach(
             random_table,
             settings,
@@ -205,10 +207,16 @@ def read_scene(
     """``[scene]``: what the procedure measures, and where it is."""
     found = get(procedure)
     table = doc.table("scene") or Table({}, "scene", ctx)
-    read = found.read_scene
-    spec = SceneSpec(scene=found.scene) if read is None else read(table, ctx, settings, seed)
+    room = read_room(table, seed)
+    # The room's surfaces and clutter can hide the procedure's targets.
+    token = ROOM_OCCLUDERS.set(() if room is None else room_occluders(room))
+    try:
+        read = found.read_scene
+        spec = SceneSpec(scene=found.scene) if read is None else read(table, ctx, settings, seed)
+    finally:
+        ROOM_OCCLUDERS.reset(token)
     table.done()
-    return spec
+    return spec if room is None else replace(spec, room=room)
 
 
 def targets_reader(procedure: str, *, required: bool) -> SceneReader:

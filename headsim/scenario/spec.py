@@ -19,6 +19,7 @@ from headsim import paper
 from headsim.scenario import registry
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, belief_sources
+from headsim.sim.textured_scene import RoomSpec
 
 if TYPE_CHECKING:
     from headsim.active.calibration_file import StoredCalibration
@@ -260,6 +261,8 @@ class SceneSpec:
     pursuit: PursuitSpec | None = None  # for the pursuit procedure
     #: how the targets were drawn and accepted (None: a procedure without targets)
     acceptance: TargetAcceptance | None = None
+    #: the textured room put into every scene of the run (``[scene.room]``; None: none)
+    room: RoomSpec | None = None
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,7 @@ from headsim.sim.heads import (
 )
 from headsim.sim.optics import DistortionCanvas, distortion_canvas
 from headsim.sim.settings import MAX_IMAGE_SIDE, CameraSettings, HeadSettings, SettingsError
+from headsim.sim.textured_scene import RoomSpec, add_room
 
 #: Sensor pixel pitch used to express pixel intrinsics in MuJoCo's length units, m.
 PIXEL_PITCH_M = 1e-5
@@ -224,10 +225,17 @@ def apply_settings(
     return canvases[0], canvases[1]
 
 
-def build_model(scene: str | Path = "default", settings: HeadSettings | None = None) -> BuiltModel:
-    """Load ``scene``, apply ``settings`` (default: ideal head) and compile."""
+def build_model(
+    scene: str | Path = "default",
+    settings: HeadSettings | None = None,
+    room: RoomSpec | None = None,
+) -> BuiltModel:
+    """Load ``scene``, put ``room`` in it (:mod:`headsim.sim.textured_scene`; None: the
+    scene as it is), apply ``settings`` (default: ideal head) and compile."""
     settings = settings or HeadSettings()
     spec = load_spec(scene, settings.head)
+    if room is not None:
+        add_room(spec, room)
     canvases = apply_settings(spec, settings)
     return BuiltModel(
         model=spec.compile(), spec=spec, canvases=canvases, names=head_names(settings.head)

@@ -86,3 +86,13 @@ HEAD_MODEL = "head.xml"
 
 # Geom group holding the head's own visual geoms; the eye cameras never draw it.
 HEAD_VISUAL_GROUP = 3
+
+# The textured room (headsim.sim.textured_scene): the base scene's table plane and key
+# light, which the room replaces, and the room's own surfaces.
+TABLE_PLANE = "floor"
+KEY_LIGHT = "key_light"
+ROOM_FLOOR = "room_floor"
+ROOM_WALLS = ("room_wall_back", "room_wall_left", "room_wall_right")
+ROOM_TABLE = "room_table"
+#: Geom group of the room's surfaces and objects (drawn by the eye cameras).
+ROOM_GROUP = 0

@@ -60,6 +60,8 @@ def context_key(scene: str, model: mujoco.MjModel) -> tuple[str, str]:
     canvas asked of it."""
     digest = hashlib.sha1()
     digest.update(f"offsamples={int(model.vis.quality.offsamples)}".encode())
+    # The shadow map's buffer is made with the context: a model with shadows needs its own.
+    digest.update(f"shadowsize={int(model.vis.quality.shadowsize)}".encode())
     for name in _CONTEXT_ARRAYS:
         array = getattr(model, name, None)
         if array is not None:

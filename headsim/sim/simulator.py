@@ -41,6 +41,7 @@ from headsim.sim.model import CV_FROM_MJCAM, HEAD_PREFIX, BuiltModel, build_mode
 from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
 from headsim.sim.render import Window, context_key, make_eye_renderer
 from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
+from headsim.sim.textured_scene import RoomSpec
 
 #: A camera: 1 or 2 (the paper's Ca1, Ca2), its MJCF name "cam1"/"cam2", or a names.Camera.
 CameraId = int | str | names.Camera
@@ -57,7 +58,9 @@ class HeadSim:
         settle_tolerance_rad: float = 1e-6,
         max_settle_steps: int = 5000,
         sink: EventSink | None = None,
+        room: RoomSpec | None = None,
     ) -> None:
+        """``room``: a textured room put into ``scene`` (:mod:`headsim.sim.textured_scene`)."""
         if settle_mode not in ("kinematic", "physics"):
             raise SettingsError(
                 f"settle_mode must be 'kinematic' or 'physics', got {settle_mode!r}"
@@ -69,7 +72,7 @@ class HeadSim:
         #: Where this simulator reports every image it takes (and the servos and
         #: procedures working with it report theirs, unless given another sink).
         self.sink: EventSink = NO_EVENTS if sink is None else sink
-        self.built: BuiltModel = build_model(scene, self.settings)
+        self.built: BuiltModel = build_model(scene, self.settings, room)
         self.model = self.built.model
         self.data = mujoco.MjData(self.model)
         #: The head's names as compiled into the scene (:mod:`headsim.sim.heads`).
@@ -501,10 +504,12 @@ def for_settings(
     scene: str | Path = "default",
     settle_mode: str = "kinematic",
     sink: EventSink | None = None,
+    room: RoomSpec | None = None,
 ) -> HeadSim:
-    """The simulator for ``settings`` in ``scene``: the one builder that code outside the
-    simulator, the procedures, the runner and the tests goes through."""
-    return HeadSim(scene, settings, settle_mode=settle_mode, sink=sink)
+    """The simulator for ``settings`` in ``scene`` (with ``room`` in it, if given): the one
+    builder that code outside the simulator, the procedures, the runner and the tests
+    goes through."""
+    return HeadSim(scene, settings, settle_mode=settle_mode, sink=sink, room=room)
 
 
 def start_views(

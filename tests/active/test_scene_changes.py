@@ -198,3 +198,28 @@ def test_nothing_the_head_runs_reads_the_simulators_placements() -> None:
     assert len(files) > 20
     assert [str(p.relative_to(SOURCE)) for p in files if _reads_placements(p)] == []
     assert _reads_placements(SOURCE / "sim" / "simulator.py")  # the check can see a read
+
+
+#: Modules that read the scene's truth (where a surface target is, where the eyes
+#: landed), for placing, scoring and recording: what the head runs never imports them.
+TRUTH_MODULES = ("headsim.run.landing", "headsim.scenario.surface_targets")
+
+
+def _imports(path: Path) -> set[str]:
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            found.add(node.module)
+            found.update(f"{node.module}.{alias.name}" for alias in node.names)
+        elif isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+    return found
+
+
+def test_no_servo_tracker_or_correspondence_imports_the_scene_truth() -> None:
+    files = [p for part in ("active", "vision", "live") for p in (SOURCE / part).rglob("*.py")]
+    assert len(files) > 20
+    readers = [str(p.relative_to(SOURCE)) for p in files if _imports(p).intersection(TRUTH_MODULES)]
+    assert readers == []
+    # The check can see an import: the scorer's own module imports the placing one.
+    assert TRUTH_MODULES[1] in _imports(SOURCE / "run" / "landing.py")
