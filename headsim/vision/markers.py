@@ -114,6 +114,14 @@ MAX_ASYMMETRY = 0.06
 MIN_SHAPE_AREA_PX = 6.0
 #: The Gaussian that softens a blob before it is turned, px.
 _SOFTEN_PX = 0.7
+#: ... and a hard-edged one (rendered without anti-aliasing, ``RenderFidelity(0, 1)``:
+#: no pixel partly covered), whose staircase edges alone reach 0.14 at 0.7 px: at
+#: 1.3 px whole ones stay under 0.053 (80 poses at 0.4-1.6 m), while half a marker
+#: hidden still reads 0.2 from about 35 px^2 up.
+_SOFTEN_HARD_EDGE_PX = 1.3
+#: A blob whose partly covered pixels (weights 0.1-0.9) are fewer than this share of
+#: its pixels has hard edges: anti-aliased renders give 0.19-0.75, aliased ones 0.
+_HARD_EDGE_SHARE = 0.1
 
 
 def asymmetry(weights: np.ndarray, u: float, v: float) -> float:
@@ -125,12 +133,16 @@ def asymmetry(weights: np.ndarray, u: float, v: float) -> float:
     model's resampling, and symmetric about its centre however blurred; a marker
     partly hidden is a disc with a piece missing, which is not.  Both copies are
     softened by a Gaussian (linear interpolation of a sharp edge is itself
-    uneven) and moved half-way each, so that both are interpolated alike.
+    uneven; more where the render has no anti-aliasing, whose staircase edges are
+    uneven too) and moved half-way each, so that both are interpolated alike.
     """
     h, w = weights.shape
-    pad = 3  # room for the softening and the moves: the blob stays inside
+    inked = weights[weights > 0.02]
+    partial = float(np.mean((inked > 0.1) & (inked < 0.9))) if inked.size else 0.0
+    soften = _SOFTEN_HARD_EDGE_PX if partial < _HARD_EDGE_SHARE else _SOFTEN_PX
+    pad = 4  # room for the softening and the moves: the blob stays inside
     padded = np.pad(weights.astype(np.float32), pad)
-    a = cv2.GaussianBlur(padded, (0, 0), _SOFTEN_PX, borderType=cv2.BORDER_CONSTANT)
+    a = cv2.GaussianBlur(padded, (0, 0), soften, borderType=cv2.BORDER_CONSTANT)
     b = np.ascontiguousarray(a[::-1, ::-1])
     du, dv = (w - 1) / 2 - u, (h - 1) / 2 - v  # moves the centroid to the middle
     size = (w + 2 * pad, h + 2 * pad)

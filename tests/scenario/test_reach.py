@@ -198,7 +198,7 @@ def test_other_scenes_check_their_own_things(tmp_path: Path) -> None:
         )
     with pytest.raises(
         ScenarioError,
-        match=r"scene.targets: unknown key \(allowed: blocks, objects, random_objects\)",
+        match=r"scene.targets: unknown key \(allowed: room, blocks, objects, random_objects\)",
     ):
         load_scenario(
             write_scenario(tmp_path, blocks + "[[scene.targets]]\nposition_head_m = [0, 0, 1]\n")
