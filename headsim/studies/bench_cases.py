@@ -82,6 +82,7 @@ CASES: dict[str, BenchCase] = {
         BenchCase("batch_render", "figures", "batch_render.py"),
         BenchCase("batch_env", "figures", "batch_env.py"),
         BenchCase("scene_cost", "figures", "scene_cost.py"),
+        BenchCase("search_cases", "long", "search_cases.py"),
         BenchCase("batch_sweep", "long", "batch_sweep.py"),
         BenchCase("render_fidelity", "long", "render_fidelity.py"),
         BenchCase("relative_areas", "long", "relative_areas.py"),
