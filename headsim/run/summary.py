@@ -11,7 +11,7 @@ import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.run.accuracy import summaries
-from headsim.run.outcomes import RunOutcome
+from headsim.run.outcomes import RunOutcome, SurfaceDraw, fixation_stats
 from headsim.run.table import cell as _cell
 from headsim.run.table import format_table
 from headsim.run.table import mm as _mm
@@ -193,6 +193,31 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
                 f"start pose): {g.ok} of {g.count} measured, 3-D error RMS "
                 f"{_cell(g.error_pct_of_depth_rms, '.3f')} % of depth"
             )
+    return lines + _markerless_lines(result)
+
+
+def _markerless_lines(result: RunOutcome) -> list[str]:
+    """Markerless targets: how they were drawn, and where the eyes truly landed."""
+    stats = fixation_stats(result.records)
+    if not stats.count:
+        return []
+    lines = []
+    surface = getattr(result.experiment, "surface", None)
+    if isinstance(surface, SurfaceDraw):
+        refused = ", ".join(f"{n} {c}" for c, n in surface.refused.items()) or "none"
+        lines.append(
+            f"  markerless targets: {surface.asked} asked on the room's surfaces, "
+            f"{surface.drawn} draws (refused and drawn again: {refused})"
+        )
+    ok = sum(1 for r in result.records if r.fixation is not None and r.measurement.ok)
+    causes = ", ".join(f"{n} {c}" for c, n in stats.failure_causes.items()) or "none"
+    lines.append(
+        f"  markerless fixations (truth: where each eye's goal ray landed): vergence error "
+        f"median {_cell(stats.vergence_error_deg_median, '.4f')} deg, RMS "
+        f"{_cell(stats.vergence_error_deg_rms, '.4f')} deg; false fixations "
+        f"{stats.false_fixations} of {ok} ok (eye 1 landed > max(1 % of depth, 5 mm) off); "
+        f"failures by cause: {causes}"
+    )
     return lines
 
 
