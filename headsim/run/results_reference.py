@@ -232,6 +232,9 @@ _SURFACE: dict[str, str] = {
     "surface_targets.vergence_error_deg_rms": "their RMS, degrees",
 }
 
+#: ``experiment`` keys written only with markerless targets (``[scene.room] targets``).
+MARKERLESS_ONLY = frozenset(_SURFACE)
+
 EXPERIMENT_FIELDS: dict[str, dict[str, str]] = {
     "model2": _SURFACE,
     "model1": _SURFACE,
@@ -402,4 +405,11 @@ def documented_paths(results: Mapping[str, Any]) -> set[str]:
     return {documented for _, documented in _pairs(results) if documented is not None}
 
 
-__all__ = ["EXPERIMENT_FIELDS", "FAILED_ONLY", "RESULTS_FIELDS", "documented_paths", "undocumented"]
+__all__ = [
+    "EXPERIMENT_FIELDS",
+    "FAILED_ONLY",
+    "MARKERLESS_ONLY",
+    "RESULTS_FIELDS",
+    "documented_paths",
+    "undocumented",
+]

@@ -153,6 +153,7 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
     lines += format_table(headers, rows)
     acceptance = result.scenario.scene.acceptance
     edge = () if acceptance is None else acceptance.outside_start_view
+    markerless = any(r.fixation is not None for r in records)
     for label, s in summaries(records, edge).items():
         lines.append(
             f"  head knew {label}: {s.ok} of {s.count} ok; error mean {_mm(s.error_m_mean)} mm "
@@ -183,7 +184,7 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
             for b in s.by_depth
         )
         lines.append(
-            f"    {_targets_text(s.ok, s.count, acceptance)}: 3-D error RMS "
+            f"    {_targets_text(s.ok, s.count, acceptance, markerless)}: 3-D error RMS "
             f"{_cell(s.error_pct_of_depth_rms, '.3f')} % of depth; by depth: {bands}"
         )
         g = s.outside_start_view
@@ -221,9 +222,11 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
     return lines
 
 
-def _targets_text(ok: int, count: int, a: TargetAcceptance | None) -> str:
+def _targets_text(ok: int, count: int, a: TargetAcceptance | None, markerless: bool = False) -> str:
     """Which targets the RMS is over: "the whole field" only for targets drawn over it."""
     measured = f"all {ok} targets measured" if ok == count else f"the {ok} of {count} measured"
+    if markerless:
+        return f"whole field, {measured} (points of the room's surfaces drawn over it)"
     if a is None or not a.drawn:
         return f"{measured} (placed by hand)"
     drawn = a.accepted - a.listed

@@ -48,7 +48,7 @@ from headsim.scenario.spec import (
 )
 from headsim.scenario.surface_targets import Click, SurfaceTarget, click, draw_targets, point_world
 from headsim.sim.simulator import HeadSim
-from headsim.vision.correspondence import Band, MatchConfig, row_band
+from headsim.vision.correspondence import Band, Match, MatchConfig, row_band
 from headsim.vision.detection import Detection
 
 
@@ -126,9 +126,10 @@ def score_fixation(
     depth_m: float,
     ok: bool,
     told: Click,
-    pair: MarkerlessPair,
+    match: Match | None,
 ) -> FixationScore:
-    """A :class:`FixationScore` from the logged landings (an eye missing: NaN)."""
+    """A :class:`FixationScore` from the logged landings (an eye missing: NaN) and camera
+    2's last correspondence ``match``."""
     one, two = landings.get(1), landings.get(2)
     errors = [
         (math.nan, math.nan)
@@ -144,7 +145,6 @@ def score_fixation(
     limit = false_fixation_limit_m(depth_m)
     off = errors[0][1]
     false = ok and (math.isnan(off) or off > limit)
-    match = pair.finder.matches[-1] if pair.finder.matches else None
 
     def point(x: Landing | None) -> tuple[float, ...] | None:
         return None if x is None or x.point_world_m is None else tuple(map(float, x.point_world_m))
@@ -223,7 +223,8 @@ def measure_surface_targets(
             m = measure(sim, shared, target, knowledge)
             where = point_world(sim, placed.body, placed.point_body_m)
             depth = float(sim.transform_points(where, "world", "head")[0][2])
-            score = score_fixation(log.landings, where, depth, m.ok, told, pair)
+            match = pair.finder.matches[-1] if pair.finder.matches else None
+            score = score_fixation(log.landings, where, depth, m.ok, told, match)
             records.append(record_measurement(hub, m, label, step, fixation=score))
     return records, replace(drawn, stats=fixation_stats(records))
 
