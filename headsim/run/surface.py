@@ -98,11 +98,20 @@ class ScoredEyeServo(EyeServo):
 
 class ScoredNeckServo(NeckServo):
     """The neck servo, unchanged, with both cameras' landings logged where it converged
-    (goal pixels: each camera's goal column on the goal row)."""
+    (goal pixels: each camera's goal column on the row its last image there showed the
+    target; the goal row where that image is not the final pose's)."""
 
     def __init__(self, sim: HeadSim, config: ServoConfig, log: LandingLog) -> None:
         super().__init__(sim, config)
         self.log = log
+        #: The rows each camera saw the target on, by encoder steps, in the current run.
+        self._rows: dict[tuple[int, tuple[int, ...]], float] = {}
+
+    def _look(self, camera: int, detector: Detector) -> Detection:
+        seen = super()._look(camera, detector)
+        if seen.found and seen.uv is not None:
+            self._rows[(camera, tuple(int(x) for x in self._steps()))] = seen.uv[1]
+        return seen
 
     def run(
         self,
@@ -110,13 +119,16 @@ class ScoredNeckServo(NeckServo):
         goals: tuple[float, float, float] | None = None,
         key: object = None,
     ) -> NeckServoResult:
+        self._rows = {}
         result = super().run(detector, goals, key)
         if result.converged:
             if goals is None:
                 (u10, v10), (u20, v20) = (self.sim.camera_settings(c).image_centre for c in (1, 2))
                 goals = (u10, u20, (v10 + v20) / 2)
-            self.log.landed(1, (goals[0], goals[2]))
-            self.log.landed(2, (goals[1], goals[2]))
+            steps = tuple(int(x) for x in result.steps)
+            for camera in (1, 2):
+                row = self._rows.get((camera, steps), goals[2])
+                self.log.landed(camera, (goals[camera - 1], row))
         return result
 
 
