@@ -36,8 +36,8 @@ class FixationScore:
     point; ``error_deg``/``error_m``: each eye's ray against the intended target, and its
     landed point's distance from it; ``landed``: the objects hit ("" none);
     ``click_error_px``: |clicked - true| of the click the head was told; ``match_score``,
-    ``match_ambiguity``, ``match_status``: camera 2's last correspondence (None: none
-    made); ``false_fixation``: the measurement is ok but eye 1 landed more than
+    ``match_ambiguity``, ``match_status``: camera 2's last confident correspondence (else
+    its last; None: none made); ``false_fixation``: the measurement is ok but eye 1 landed more than
     ``false_fixation_limit_m`` from the target (or on nothing).  NaN where an eye did not
     converge.
     """

@@ -174,7 +174,8 @@ RESULTS_FIELDS: dict[str, str] = {
     "measurements[].fixation.landed_world_m": "each eye's landed point in W, m (`null`: none)",
     "measurements[].fixation.click_error_px": "|clicked - true| of the click in camera 1's "
     "image the head was told, px",
-    "measurements[].fixation.match_score": "camera 2's last correspondence: peak NCC",
+    "measurements[].fixation.match_score": "camera 2's last confident correspondence (else its "
+    "last): peak NCC",
     "measurements[].fixation.match_ambiguity": "its second-best peak over the best",
     "measurements[].fixation.match_status": "its status (`ok`, `low texture`, `ambiguous`, "
     "`occluded`, `lost`)",

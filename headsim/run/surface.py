@@ -235,7 +235,10 @@ def measure_surface_targets(
             m = measure(sim, shared, target, knowledge)
             where = point_world(sim, placed.body, placed.point_body_m)
             depth = float(sim.transform_points(where, "world", "head")[0][2])
-            match = pair.finder.matches[-1] if pair.finder.matches else None
+            # The correspondence the measurement used: camera 2's last confident match
+            # (else its last one, whatever it said).
+            used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
+            match = used[-1] if used else None
             score = score_fixation(log.landings, where, depth, m.ok, told, match)
             records.append(record_measurement(hub, m, label, step, fixation=score))
     return records, replace(drawn, stats=fixation_stats(records))
