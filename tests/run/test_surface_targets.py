@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -14,12 +15,14 @@ import pytest
 from headsim.cli import main
 from headsim.run.landing import Landing
 from headsim.run.outcomes import FALSE_FIXATION_MIN_M
+from headsim.run.runner import run_scenario
 from headsim.run.surface import false_fixation_limit_m, score_fixation
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.surface_targets import Click
 from headsim.scenario.tables import ScenarioError
 from headsim.vision.correspondence import Match, MatchStatus
 
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 TARGET = np.array([0.0, 1.0, 0.0])  # 1 m in front of eye 1, W
 EYE1 = np.array([-0.075, 0.0, 0.0])
 EYE2 = np.array([0.075, 0.0, 0.0])
@@ -113,3 +116,26 @@ def test_natural_field_fast_measures_clicked_points_and_writes_where_the_eyes_la
         assert m["error_pct_of_depth"] < 5.0
     assert drawn["false_fixations"] == sum(m["fixation"]["false_fixation"] for m in ok)
     assert "markerless fixations" in out and "false fixations" in out
+
+
+def test_model1_lands_both_eyes_on_the_clicked_point_where_it_measures_it() -> None:
+    # natural_field with the neck (Model 1), its fast calibration (the reference rows the
+    # band needs): each eye's landing is taken on the row its own image showed the point
+    # at the fixation's pose.
+    with (SCENARIOS / "natural_field.toml").open("rb") as handle:
+        doc = tomllib.load(handle)
+    doc["experiment"]["procedure"] = "model1"
+    doc["experiment"]["calibration"]["targets"] = 8
+    doc["scene"]["room"]["targets"] = 4
+    doc.pop("fast")
+    result = run_scenario(scenario_from_document(doc, "natural_field_model1"))
+    assert len(result.records) == 4
+    ok = [r for r in result.records if r.measurement.ok]
+    assert ok, result.failures
+    for record in ok:
+        f = record.fixation
+        assert f is not None and all(f.landed)
+        # Both eyes near one point: the goal row alone (their mean) put each 4-9 degrees off
+        # on this head, whose reference rows lie 110 px apart.
+        assert f.vergence_error_deg < 1.0, f
+        assert max(f.error_deg) < 1.0, f
