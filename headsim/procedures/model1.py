@@ -11,8 +11,8 @@ from headsim.active.neck_servo import NeckServo
 from headsim.procedures.each_target import measure_each_target
 from headsim.run.context import servo_config
 from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.surface import ScoredNeckServo, SurfaceDraw, measure_surface_targets
+from headsim.run.outcomes import MeasurementRecord, SurfaceDraw
+from headsim.run.surface import measure_surface_targets
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
@@ -54,7 +54,7 @@ def run_model1(
             hub,
             knowledge,
             label,
-            lambda sim, log: ScoredNeckServo(sim, servo_config(scenario), log),
+            lambda sim: NeckServo(sim, servo_config(scenario)),
             measure,
         )
         return scored, Model1Result(drawn)

@@ -11,8 +11,8 @@ from headsim.active.model2 import measure_model2
 from headsim.procedures.each_target import measure_each_target
 from headsim.run.context import model2_config, servo_config
 from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.surface import ScoredEyeServo, SurfaceDraw, measure_surface_targets
+from headsim.run.outcomes import MeasurementRecord, SurfaceDraw
+from headsim.run.surface import measure_surface_targets
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option, near_midline_options
@@ -52,7 +52,7 @@ def run_model2(
             hub,
             knowledge,
             label,
-            lambda sim, log: ScoredEyeServo(sim, servo_config(scenario), log),
+            lambda sim: EyeServo(sim, servo_config(scenario)),
             measure,
         )
         return scored, Model2Result(drawn)

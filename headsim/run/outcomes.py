@@ -30,16 +30,17 @@ from headsim.sim.events import RenderCounts
 class FixationScore:
     """Where a markerless target's fixation truly landed, scored (truth: never told the head).
 
-    Each eye's goal ray at its true pose where its servo converged (Model 2: camera 1 at
-    step 1, camera 2 at step 2; Model 1: both at the neck's fixation) cast into the scene.
+    Each eye's goal ray (its goal column, on the row its image showed the target) at its
+    true pose where its servo left it fixated (Model 2: camera 1 at step 1, camera 2 at
+    step 2; Model 1: both at the neck's fixation), cast into the scene.
     ``vergence_error_deg``: eye 2's goal ray against the direction to eye 1's landed
     point; ``error_deg``/``error_m``: each eye's ray against the intended target, and its
     landed point's distance from it; ``landed``: the objects hit ("" none);
     ``click_error_px``: |clicked - true| of the click the head was told; ``match_score``,
     ``match_ambiguity``, ``match_status``: camera 2's last confident correspondence (else
-    its last; None: none made); ``false_fixation``: the measurement is ok but eye 1 landed more than
-    ``false_fixation_limit_m`` from the target (or on nothing).  NaN where an eye did not
-    converge.
+    its last; None: none made); ``false_fixation``: the measurement is ok but eye 1
+    landed more than ``false_fixation_limit_m`` from the target (or on nothing).  NaN (no
+    landing) when the measurement failed.
     """
 
     vergence_error_deg: float

@@ -165,7 +165,7 @@ RESULTS_FIELDS: dict[str, str] = {
     "2: camera 1 at step 1, camera 2 at step 2; Model 1: both at the fixation), cast into the "
     "scene; truth, never told the head",
     "measurements[].fixation.vergence_error_deg": "angle between eye 2's goal ray and the "
-    "direction from eye 2 to the point eye 1 landed on, degrees (`null`: an eye did not converge)",
+    "direction from eye 2 to the point eye 1 landed on, degrees (`null`: the measurement failed)",
     "measurements[].fixation.error_deg": "each eye's goal ray against the direction to the "
     "intended target, degrees",
     "measurements[].fixation.error_m": "each eye's landed point's distance from the intended "

@@ -22,14 +22,11 @@ from typing import TypeVar
 
 import numpy as np
 
-from headsim.active.events import PhaseStarted
-from headsim.active.eye_servo import EyeServo
+from headsim.active.events import Detected, PhaseStarted
 from headsim.active.markerless import MarkerlessPair
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
-from headsim.active.neck_servo import NeckServo
-from headsim.active.servo_types import Detector, NeckServoResult, ServoConfig, ServoResult
 from headsim.run.context import PARKED_WORLD_M, record_measurement, simulator
-from headsim.run.events import Hub
+from headsim.run.events import Hub, Stamp
 from headsim.run.landing import Landing, fixation_error, landing, vergence_error_deg
 from headsim.run.outcomes import (
     FALSE_FIXATION_FRACTION,
@@ -49,7 +46,6 @@ from headsim.scenario.spec import (
 from headsim.scenario.surface_targets import Click, SurfaceTarget, click, draw_targets, point_world
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import Band, Match, MatchConfig, row_band
-from headsim.vision.detection import Detection
 
 
 def false_fixation_limit_m(depth_m: float) -> float:
@@ -58,78 +54,62 @@ def false_fixation_limit_m(depth_m: float) -> float:
 
 
 class LandingLog:
-    """Each camera's first converged fixation of the current target: its goal ray at the
-    camera's true pose then, cast into the scene (truth, for scoring)."""
+    """A run subscriber (truth, for scoring): at each look that found the target, that
+    camera's goal ray (its goal column ``goal_u``, on the row the look saw the target) at
+    the camera's true pose then, cast into the scene, kept with the encoder readings of
+    that pose.  The servos are not touched: they report their looks as events."""
 
-    def __init__(self, sim: HeadSim) -> None:
+    def __init__(self, sim: HeadSim, goal_u: tuple[float, float]) -> None:
         self.sim = sim
-        self.landings: dict[int, Landing] = {}
+        self.goal_u = goal_u
+        self.looks: list[tuple[int, tuple[int, ...], Landing]] = []
 
     def clear(self) -> None:
-        self.landings = {}
+        self.looks = []
 
-    def landed(self, camera: int, goal_uv: tuple[float, float]) -> None:
-        if camera not in self.landings:
-            self.landings[camera] = landing(self.sim, camera, goal_uv)
+    def encoders(self) -> tuple[int, ...]:
+        """Every motor's encoder reading now, whole steps, in ``sim.motors`` order."""
+        return tuple(self.sim.encoder_steps(motor) for motor in self.sim.motors)
 
+    def notify(self, event: object, at: Stamp) -> None:
+        if isinstance(event, Detected) and event.uv_px is not None:
+            goal = (self.goal_u[event.camera - 1], event.uv_px[1])
+            self.looks.append(
+                (event.camera, self.encoders(), landing(self.sim, event.camera, goal))
+            )
 
-class ScoredEyeServo(EyeServo):
-    """The eye servo, unchanged, with each converged run's landing logged (Model 2: step
-    1's camera 1, step 2's camera 2); the goal pixel is the goal column on the row the
-    image shows the target."""
+    def last(self, camera: int, where: Callable[[tuple[int, ...]], bool]) -> Landing | None:
+        """``camera``'s last landing at a pose whose encoders satisfy ``where``."""
+        for seen, encoders, landed in reversed(self.looks):
+            if seen == camera and where(encoders):
+                return landed
+        return None
 
-    def __init__(self, sim: HeadSim, config: ServoConfig, log: LandingLog) -> None:
-        super().__init__(sim, config)
-        self.log = log
+    def fixations(self, m: Measurement) -> dict[int, Landing]:
+        """Each camera's landing where its servo left it fixated: Model 2's camera 1 at step
+        1's eye encoder, camera 2 at step 2's; Model 1's both at the final pose."""
+        out: dict[int, Landing] = {}
+        if not m.ok:
+            return out
+        if m.method.value == "model2":
+            eye = self.sim.motors.index("eye")
+            resolution = self.sim.settings.encoder_resolution_rad
+            for camera, key in ((1, "step1_encoder_rad"), (2, "step2_encoder_rad")):
+                steps = round(m.details[key] / resolution)
 
-    def run(
-        self,
-        camera: int,
-        detector: Detector,
-        goal_u: float | None = None,
-        first: Detection | None = None,
-    ) -> ServoResult:
-        result = super().run(camera, detector, goal_u, first)
-        if result.converged and result.uv is not None:
-            goal = self.sim.camera_settings(camera).image_centre[0] if goal_u is None else goal_u
-            self.log.landed(camera, (goal, result.uv[1]))
-        return result
+                def at_step(encoders: tuple[int, ...], steps: int = steps) -> bool:
+                    return encoders[eye] == steps
 
-
-class ScoredNeckServo(NeckServo):
-    """The neck servo, unchanged, with both cameras' landings logged where it converged
-    (goal pixels: each camera's goal column on the row its last image there showed the
-    target; the goal row where that image is not the final pose's)."""
-
-    def __init__(self, sim: HeadSim, config: ServoConfig, log: LandingLog) -> None:
-        super().__init__(sim, config)
-        self.log = log
-        #: The rows each camera saw the target on, by encoder steps, in the current run.
-        self._rows: dict[tuple[int, tuple[int, ...]], float] = {}
-
-    def _look(self, camera: int, detector: Detector) -> Detection:
-        seen = super()._look(camera, detector)
-        if seen.found and seen.uv is not None:
-            self._rows[(camera, tuple(int(x) for x in self._steps()))] = seen.uv[1]
-        return seen
-
-    def run(
-        self,
-        detector: Detector,
-        goals: tuple[float, float, float] | None = None,
-        key: object = None,
-    ) -> NeckServoResult:
-        self._rows = {}
-        result = super().run(detector, goals, key)
-        if result.converged:
-            if goals is None:
-                (u10, v10), (u20, v20) = (self.sim.camera_settings(c).image_centre for c in (1, 2))
-                goals = (u10, u20, (v10 + v20) / 2)
-            steps = tuple(int(x) for x in result.steps)
-            for camera in (1, 2):
-                row = self._rows.get((camera, steps), goals[2])
-                self.log.landed(camera, (goals[camera - 1], row))
-        return result
+                found = self.last(camera, at_step)
+                if found is not None:
+                    out[camera] = found
+            return out
+        now = self.encoders()
+        for camera in (1, 2):
+            found = self.last(camera, lambda e: e == now)
+            if found is not None:
+                out[camera] = found
+        return out
 
 
 def score_fixation(
@@ -205,12 +185,12 @@ def measure_surface_targets(
     hub: Hub,
     knowledge: HeadKnowledge,
     label: str,
-    servo: Callable[[HeadSim, LandingLog], S],
+    servo: Callable[[HeadSim], S],
     measure: Callable[[HeadSim, S, Target, HeadKnowledge], Measurement],
 ) -> tuple[list[MeasurementRecord], SurfaceDraw]:
     """Each of ``[scene.room] targets`` measured in turn from the start pose: drawn, clicked
-    in camera 1's image there, measured with ``measure`` through one shared ``servo``
-    (built with the landing log), its fixation scored."""
+    in camera 1's image there, measured with ``measure`` through one shared ``servo``, its
+    fixation scored from the looks the run reported (:class:`LandingLog`)."""
     spec = scenario.scene.surface_targets
     assert spec is not None
     records: list[MeasurementRecord] = []
@@ -220,27 +200,33 @@ def measure_surface_targets(
         drawn = _draw(sim, spec, scenario.seed)
         truth = {t.name: np.array(t.point_world_m) for t in drawn.targets}
         hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
-        log = LandingLog(sim)
-        shared = servo(sim, log)
-        clicks = np.random.default_rng([scenario.seed, STREAM_CLICKS])
-        band_for = row_band_for(knowledge, sim, spec.band_px)
-        for placed in drawn.targets:
-            step = hub.begin(placed.name)
-            _start_pose(sim)
-            first = sim.render(1)
-            told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
-            pair = MarkerlessPair(first, told.clicked_uv, band_for)
-            target = Target(placed.name, pair, _truth(placed))
-            log.clear()
-            m = measure(sim, shared, target, knowledge)
-            where = point_world(sim, placed.body, placed.point_body_m)
-            depth = float(sim.transform_points(where, "world", "head")[0][2])
-            # The correspondence the measurement used: camera 2's last confident match
-            # (else its last one, whatever it said).
-            used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
-            match = used[-1] if used else None
-            score = score_fixation(log.landings, where, depth, m.ok, told, match)
-            records.append(record_measurement(hub, m, label, step, fixation=score))
+        goal_u = (knowledge.reference(sim, 1)[0], knowledge.reference(sim, 2)[0])
+        log = LandingLog(sim, goal_u)
+        hub.subscribers.append(log)
+        try:
+            shared = servo(sim)
+            clicks = np.random.default_rng([scenario.seed, STREAM_CLICKS])
+            band_for = row_band_for(knowledge, sim, spec.band_px)
+            for placed in drawn.targets:
+                step = hub.begin(placed.name)
+                _start_pose(sim)
+                first = sim.render(1)
+                told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
+                pair = MarkerlessPair(first, told.clicked_uv, band_for)
+                target = Target(placed.name, pair, _truth(placed))
+                log.clear()
+                m = measure(sim, shared, target, knowledge)
+                landings = log.fixations(m)
+                where = point_world(sim, placed.body, placed.point_body_m)
+                depth = float(sim.transform_points(where, "world", "head")[0][2])
+                # The correspondence the measurement used: camera 2's last confident match
+                # (else its last one, whatever it said).
+                used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
+                match = used[-1] if used else None
+                score = score_fixation(landings, where, depth, m.ok, told, match)
+                records.append(record_measurement(hub, m, label, step, fixation=score))
+        finally:
+            hub.subscribers.remove(log)
     return records, replace(drawn, stats=fixation_stats(records))
 
 
@@ -270,8 +256,6 @@ def fixation_scores(records: Sequence[MeasurementRecord]) -> list[FixationScore]
 
 __all__ = [
     "LandingLog",
-    "ScoredEyeServo",
-    "ScoredNeckServo",
     "false_fixation_limit_m",
     "fixation_scores",
     "measure_surface_targets",
