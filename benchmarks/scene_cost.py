@@ -62,7 +62,8 @@ def main() -> None:
     for _ in range(args.runs):
         for name in per_target:
             result = run_scenario(load_scenario(name, fast=True))
-            assert result.ok, result.failures
+            # A markerless target may fail honestly (its cause counted); its time counts too.
+            assert result.records and (result.ok or name == "natural_field"), result.failures
             per_target[name].append(result.timing_s["experiment"] / len(result.records))
     runs = {name: statistics.median(values) for name, values in per_target.items()}
     ratio = runs["natural_field"] / runs["quickstart"]

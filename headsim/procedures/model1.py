@@ -5,27 +5,36 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from headsim.active.measurement import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
 from headsim.procedures.each_target import measure_each_target
 from headsim.run.context import servo_config
 from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
+from headsim.run.outcomes import MeasurementRecord, SurfaceDraw
+from headsim.run.surface import measure_surface_targets
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
+from headsim.sim.simulator import HeadSim
 
 
 @dataclass(frozen=True)
 class Model1Result:
-    """Model 1 on each target: nothing beyond its measurements."""
+    """Model 1 on each target; ``surface``: how the markerless targets were
+    drawn (None: marker targets)."""
+
+    surface: SurfaceDraw | None = None
 
     def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: none."""
-        return {}
+        """results.json's ``experiment`` fields: ``surface_targets`` with markerless ones."""
+        return {} if self.surface is None else {"surface_targets": self.surface.block()}
+
+    def failures(self) -> tuple[str, ...]:
+        """Markerless targets that could not be drawn."""
+        return () if self.surface is None or not self.surface.failure else (self.surface.failure,)
 
 
 def run_model1(
@@ -33,13 +42,29 @@ def run_model1(
 ) -> tuple[list[MeasurementRecord], Model1Result]:
     """Model 1 on each target in turn, one neck servo for all."""
     interpolate = scenario.experiment.interpolate
+
+    def measure(
+        sim: HeadSim, servo: NeckServo, target: Target, known: HeadKnowledge
+    ) -> Measurement:
+        return measure_model1(sim, servo, target, known, interpolate)
+
+    if scenario.scene.surface_targets is not None:
+        scored, drawn = measure_surface_targets(
+            scenario,
+            hub,
+            knowledge,
+            label,
+            lambda sim: NeckServo(sim, servo_config(scenario)),
+            measure,
+        )
+        return scored, Model1Result(drawn)
     records = measure_each_target(
         scenario,
         hub,
         knowledge,
         [(knowledge, label)],
         lambda sim: NeckServo(sim, servo_config(scenario)),
-        lambda sim, servo, target, known: measure_model1(sim, servo, target, known, interpolate),
+        measure,
     )
     return records, Model1Result()
 
@@ -55,6 +80,7 @@ MODEL1 = register(
         "default",
         run_model1,
         fields=Model1Result.block,
+        failures=Model1Result.failures,
         options=read_options,
         read_scene=targets_reader("model1", required=True),
         needs=frozenset({"neck_yaw"}),

@@ -6,26 +6,35 @@ from dataclasses import dataclass
 from typing import Any
 
 from headsim.active.eye_servo import EyeServo
-from headsim.active.measurement import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model2 import measure_model2
 from headsim.procedures.each_target import measure_each_target
 from headsim.run.context import model2_config, servo_config
 from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
+from headsim.run.outcomes import MeasurementRecord, SurfaceDraw
+from headsim.run.surface import measure_surface_targets
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
+from headsim.sim.simulator import HeadSim
 
 
 @dataclass(frozen=True)
 class Model2Result:
-    """Model 2 on each target: nothing beyond its measurements."""
+    """Model 2 on each target; ``surface``: how the markerless targets were
+    drawn (None: marker targets)."""
+
+    surface: SurfaceDraw | None = None
 
     def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: none."""
-        return {}
+        """results.json's ``experiment`` fields: ``surface_targets`` with markerless ones."""
+        return {} if self.surface is None else {"surface_targets": self.surface.block()}
+
+    def failures(self) -> tuple[str, ...]:
+        """Markerless targets that could not be drawn."""
+        return () if self.surface is None or not self.surface.failure else (self.surface.failure,)
 
 
 def run_model2(
@@ -33,13 +42,27 @@ def run_model2(
 ) -> tuple[list[MeasurementRecord], Model2Result]:
     """Model 2 on each target in turn, one eye servo for all."""
     config = model2_config(scenario)
+
+    def measure(sim: HeadSim, servo: EyeServo, target: Target, known: HeadKnowledge) -> Measurement:
+        return measure_model2(sim, servo, target, known, config)
+
+    if scenario.scene.surface_targets is not None:
+        scored, drawn = measure_surface_targets(
+            scenario,
+            hub,
+            knowledge,
+            label,
+            lambda sim: EyeServo(sim, servo_config(scenario)),
+            measure,
+        )
+        return scored, Model2Result(drawn)
     records = measure_each_target(
         scenario,
         hub,
         knowledge,
         [(knowledge, label)],
         lambda sim: EyeServo(sim, servo_config(scenario)),
-        lambda sim, servo, target, known: measure_model2(sim, servo, target, known, config),
+        measure,
     )
     return records, Model2Result()
 
@@ -55,6 +78,7 @@ MODEL2 = register(
         "default",
         run_model2,
         fields=Model2Result.block,
+        failures=Model2Result.failures,
         options=read_options,
         read_scene=targets_reader("model2", required=True),
     )

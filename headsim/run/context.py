@@ -12,7 +12,7 @@ from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import Model2Config
 from headsim.active.servo_types import ServoConfig
 from headsim.run.events import Hub, MeasurementRecorded
-from headsim.run.outcomes import MeasurementRecord
+from headsim.run.outcomes import FixationScore, MeasurementRecord
 from headsim.scenario.spec import Scenario
 from headsim.sim.simulator import HeadSim
 
@@ -59,9 +59,14 @@ def told(scenario: Scenario) -> HeadKnowledge:
 
 
 def record_measurement(
-    hub: Hub, m: Measurement, knowledge: str, step: int, time_s: float | None = None
+    hub: Hub,
+    m: Measurement,
+    knowledge: str,
+    step: int,
+    time_s: float | None = None,
+    fixation: FixationScore | None = None,
 ) -> MeasurementRecord:
-    record = MeasurementRecord(m, knowledge, step, time_s)
+    record = MeasurementRecord(m, knowledge, step, time_s, fixation)
     hub.emit(MeasurementRecorded(record))
     return record
 

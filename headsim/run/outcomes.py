@@ -10,6 +10,8 @@ in the names: m, rad, px; positions in W unless named otherwise.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -18,19 +20,127 @@ import numpy as np
 from headsim.active.calibration_report import CalibrationReport
 from headsim.active.measurement import Measurement
 from headsim.scenario.spec import Scenario
+from headsim.scenario.surface_targets import SurfaceTarget
 from headsim.sim.events import RenderCounts
 
 # -- the run ----------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
+class FixationScore:
+    """Where a markerless target's fixation truly landed, scored (truth: never told the head).
+
+    Each eye's goal ray (its goal column, on the row its image showed the target) at its
+    true pose where its servo left it fixated (Model 2: camera 1 at step 1, camera 2 at
+    step 2; Model 1: both at the neck's fixation), cast into the scene.
+    ``vergence_error_deg``: eye 2's goal ray against the direction to eye 1's landed
+    point; ``error_deg``/``error_m``: each eye's ray against the intended target, and its
+    landed point's distance from it; ``landed``: the objects hit ("" none);
+    ``click_error_px``: |clicked - true| of the click the head was told; ``match_score``,
+    ``match_ambiguity``, ``match_status``: camera 2's last confident correspondence (else
+    its last; None: none made); ``false_fixation``: the measurement is ok but eye 1
+    landed more than ``false_fixation_limit_m`` from the target (or on nothing).  NaN (no
+    landing) when the measurement failed.
+    """
+
+    vergence_error_deg: float
+    error_deg: tuple[float, float]
+    error_m: tuple[float, float]
+    landed: tuple[str, str]
+    landed_world_m: tuple[tuple[float, ...] | None, tuple[float, ...] | None]
+    click_error_px: float
+    match_score: float | None
+    match_ambiguity: float | None
+    match_status: str | None
+    false_fixation: bool
+    false_fixation_limit_m: float
+
+
+#: A fixation is false beyond this fraction of the target's depth ...
+FALSE_FIXATION_FRACTION = 0.01
+#: ... or this distance, m, whichever is larger.
+FALSE_FIXATION_MIN_M = 0.005
+
+
+@dataclass(frozen=True)
 class MeasurementRecord:
-    """A measurement with what the head knew (``"none"``, ``"calibrated"``), its step and time."""
+    """A measurement with what the head knew (``"none"``, ``"calibrated"``), its step and
+    time; ``fixation``: a markerless target's landing truth (None: a marker's)."""
 
     measurement: Measurement
     knowledge: str
     step: int
     time_s: float | None = None
+    fixation: FixationScore | None = None
+
+
+@dataclass(frozen=True)
+class FixationStats:
+    """The fixations of markerless targets in short: vergence error median and RMS over
+    those where both eyes converged (degrees; NaN: none), false fixations, and the
+    measurements that failed, by cause."""
+
+    count: int
+    vergence_error_deg_median: float
+    vergence_error_deg_rms: float
+    false_fixations: int
+    failure_causes: dict[str, int]
+
+
+def fixation_stats(records: Sequence[MeasurementRecord]) -> FixationStats:
+    """:class:`FixationStats` of the records with a fixation score."""
+    scored = [r for r in records if r.fixation is not None]
+    vergence = np.array(
+        [r.fixation.vergence_error_deg for r in scored if r.fixation is not None], dtype=float
+    )
+    vergence = vergence[np.isfinite(vergence)]
+    causes: dict[str, int] = {}
+    for r in scored:
+        failure = r.measurement.failure
+        if failure is not None:
+            causes[failure.cause.value] = causes.get(failure.cause.value, 0) + 1
+    return FixationStats(
+        count=len(scored),
+        vergence_error_deg_median=float(np.median(vergence)) if vergence.size else math.nan,
+        vergence_error_deg_rms=float(np.sqrt(np.mean(vergence**2))) if vergence.size else math.nan,
+        false_fixations=sum(
+            1 for r in scored if r.fixation is not None and r.fixation.false_fixation
+        ),
+        failure_causes=dict(sorted(causes.items(), key=lambda kv: (-kv[1], kv[0]))),
+    )
+
+
+@dataclass(frozen=True)
+class SurfaceDraw:
+    """How the markerless targets were drawn: ``asked`` targets, ``drawn`` draws in all,
+    the ``refused`` ones by cause (each drawn again), and the ``targets`` placed;
+    ``stats``: how they were fixated (None until measured); ``failure``: why none could
+    be drawn ("" when they were)."""
+
+    asked: int
+    drawn: int
+    refused: dict[str, int]
+    targets: tuple[SurfaceTarget, ...]
+    stats: FixationStats | None = None
+    failure: str = ""
+
+    def block(self) -> dict[str, Any]:
+        """results.json's ``experiment.surface_targets``."""
+        stats = self.stats
+        return {
+            "asked": self.asked,
+            "drawn": self.drawn,
+            "refused": dict(self.refused),
+            "false_fixation_limit": f"max({FALSE_FIXATION_FRACTION:g} x depth, "
+            f"{FALSE_FIXATION_MIN_M:g} m)",
+            "targets": [
+                {"name": t.name, "body": t.body, "point_world_m": list(t.point_world_m)}
+                for t in self.targets
+            ],
+            "false_fixations": None if stats is None else stats.false_fixations,
+            "vergence_error_deg_median": None if stats is None else stats.vergence_error_deg_median,
+            "vergence_error_deg_rms": None if stats is None else stats.vergence_error_deg_rms,
+        }
 
 
 Vector3 = tuple[float, float, float]
@@ -187,9 +297,15 @@ class RunOutcome:
 
 
 __all__ = [
+    "FALSE_FIXATION_FRACTION",
+    "FALSE_FIXATION_MIN_M",
+    "FixationScore",
+    "FixationStats",
     "MeasurementRecord",
     "MeasurementRow",
     "RunOutcome",
     "RunRenders",
+    "SurfaceDraw",
+    "fixation_stats",
     "measurement_table",
 ]

@@ -41,6 +41,8 @@ RESULTS_FIELDS: dict[str, str] = {
     "scenario.scene.room": "the textured room (`[scene.room]`): its seed, surface texture, "
     "table and walls, every object (clutter drawn from the seed included) and the light; "
     "`null`: none",
+    "scenario.scene.surface_targets": "`[scene.room] targets` and its keys (`count`, "
+    "`depth_m`, `lateral`, `vertical`, `click_error_px`, `band_px`); `null`: none",
     "scenario.scene.acceptance": "how the targets came to be measured (`null`: a procedure "
     "without targets)",
     "scenario.scene.acceptance.within": "`[scene.random_targets] within` (`box` or `reach`; "
@@ -158,6 +160,29 @@ RESULTS_FIELDS: dict[str, str] = {
     "ranges for a target the head's pose did not show",
     "measurements[].servo_residual_px": "each servo's final image offset from its goal, px",
     "measurements[].details": "angles and pixels used (`alpha1_rad`, `u11_px`, ...)",
+    "measurements[].fixation": "a markerless target's landing truth (`[scene.room] targets`; "
+    "`null`: a marker's): each eye's goal ray at its true pose where its servo converged (Model "
+    "2: camera 1 at step 1, camera 2 at step 2; Model 1: both at the fixation), cast into the "
+    "scene; truth, never told the head",
+    "measurements[].fixation.vergence_error_deg": "angle between eye 2's goal ray and the "
+    "direction from eye 2 to the point eye 1 landed on, degrees (`null`: the measurement failed)",
+    "measurements[].fixation.error_deg": "each eye's goal ray against the direction to the "
+    "intended target, degrees",
+    "measurements[].fixation.error_m": "each eye's landed point's distance from the intended "
+    "target, m",
+    "measurements[].fixation.landed": 'the object each eye\'s ray hit (`""`: none or not converged)',
+    "measurements[].fixation.landed_world_m": "each eye's landed point in W, m (`null`: none)",
+    "measurements[].fixation.click_error_px": "|clicked - true| of the click in camera 1's "
+    "image the head was told, px",
+    "measurements[].fixation.match_score": "camera 2's last confident correspondence (else its "
+    "last): peak NCC",
+    "measurements[].fixation.match_ambiguity": "its second-best peak over the best",
+    "measurements[].fixation.match_status": "its status (`ok`, `low texture`, `ambiguous`, "
+    "`occluded`, `lost`)",
+    "measurements[].fixation.false_fixation": "the measurement is ok but eye 1 landed farther "
+    "than `false_fixation_limit_m` from the target (or on nothing)",
+    "measurements[].fixation.false_fixation_limit_m": "that distance: 1 % of the target's depth, "
+    "at least 5 mm",
     "summary": "the measurements' statistics, per knowledge",
     "summary.*": 'one knowledge (`"none"`, `"calibrated"`)',
     "summary.*.count": "measurements",
@@ -194,9 +219,26 @@ _NONE: dict[str, str] = {}
 #: ``experiment`` keys a procedure writes only when it failed.
 FAILED_ONLY = frozenset({"reason"})
 
+#: Model 2's and Model 1's keys with markerless targets (none with markers).
+_SURFACE: dict[str, str] = {
+    "surface_targets": "how the markerless targets were drawn and how they landed",
+    "surface_targets.asked": "targets asked for (`[scene.room] targets`)",
+    "surface_targets.drawn": "draws made, refused ones included",
+    "surface_targets.refused": "draws refused and drawn again, by cause (`no_surface`, `depth`, "
+    "`occluded`, `start_view`, `reach`)",
+    "surface_targets.false_fixation_limit": "the rule of a false fixation",
+    "surface_targets.targets": "each target: `name`, the `body` it lies on, `point_world_m`",
+    "surface_targets.false_fixations": "measurements ok whose eye 1 landed off the target",
+    "surface_targets.vergence_error_deg_median": "median vergence error of the fixations, degrees",
+    "surface_targets.vergence_error_deg_rms": "their RMS, degrees",
+}
+
+#: ``experiment`` keys written only with markerless targets (``[scene.room] targets``).
+MARKERLESS_ONLY = frozenset(_SURFACE)
+
 EXPERIMENT_FIELDS: dict[str, dict[str, str]] = {
-    "model2": _NONE,
-    "model1": _NONE,
+    "model2": _SURFACE,
+    "model1": _SURFACE,
     "fixation": _NONE,
     "calibration": {
         "check_targets": "each check target, before and after the calibration",
@@ -364,4 +406,11 @@ def documented_paths(results: Mapping[str, Any]) -> set[str]:
     return {documented for _, documented in _pairs(results) if documented is not None}
 
 
-__all__ = ["EXPERIMENT_FIELDS", "FAILED_ONLY", "RESULTS_FIELDS", "documented_paths", "undocumented"]
+__all__ = [
+    "EXPERIMENT_FIELDS",
+    "FAILED_ONLY",
+    "MARKERLESS_ONLY",
+    "RESULTS_FIELDS",
+    "documented_paths",
+    "undocumented",
+]

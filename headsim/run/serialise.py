@@ -22,7 +22,7 @@ import numpy as np
 import headsim
 from headsim.active.calibration_report import calibration_block
 from headsim.run.accuracy import MeasurementSummary, summaries
-from headsim.run.outcomes import MeasurementRecord, RunOutcome
+from headsim.run.outcomes import FixationScore, MeasurementRecord, RunOutcome
 from headsim.scenario.registry import get
 from headsim.scenario.spec import experiment_record
 from headsim.sim.settings import settings_record
@@ -69,6 +69,7 @@ MEASUREMENT_KEYS = (
     "scan_renders",
     "servo_residual_px",
     "details",
+    "fixation",
 )
 
 
@@ -117,6 +118,24 @@ def measurement_entry(record: MeasurementRecord) -> dict[str, Any]:
         "scan_renders": m.scan_renders,
         "servo_residual_px": list(m.servo_residual_px),
         "details": dict(m.details),
+        "fixation": None if record.fixation is None else fixation_entry(record.fixation),
+    }
+
+
+def fixation_entry(f: FixationScore) -> dict[str, Any]:
+    """A markerless target's landing truth as results.json holds it (NaN becomes null)."""
+    return {
+        "vergence_error_deg": f.vergence_error_deg,
+        "error_deg": list(f.error_deg),
+        "error_m": list(f.error_m),
+        "landed": list(f.landed),
+        "landed_world_m": [None if p is None else list(p) for p in f.landed_world_m],
+        "click_error_px": f.click_error_px,
+        "match_score": f.match_score,
+        "match_ambiguity": f.match_ambiguity,
+        "match_status": f.match_status,
+        "false_fixation": f.false_fixation,
+        "false_fixation_limit_m": f.false_fixation_limit_m,
     }
 
 
@@ -199,6 +218,7 @@ __all__ = [
     "RESULTS_SCHEMA",
     "calibration_block",
     "experiment_block",
+    "fixation_entry",
     "measurement_entry",
     "results_payload",
     "software_versions",

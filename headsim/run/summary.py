@@ -11,7 +11,7 @@ import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.run.accuracy import summaries
-from headsim.run.outcomes import RunOutcome
+from headsim.run.outcomes import RunOutcome, SurfaceDraw, fixation_stats
 from headsim.run.table import cell as _cell
 from headsim.run.table import format_table
 from headsim.run.table import mm as _mm
@@ -153,6 +153,7 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
     lines += format_table(headers, rows)
     acceptance = result.scenario.scene.acceptance
     edge = () if acceptance is None else acceptance.outside_start_view
+    markerless = any(r.fixation is not None for r in records)
     for label, s in summaries(records, edge).items():
         lines.append(
             f"  head knew {label}: {s.ok} of {s.count} ok; error mean {_mm(s.error_m_mean)} mm "
@@ -183,7 +184,7 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
             for b in s.by_depth
         )
         lines.append(
-            f"    {_targets_text(s.ok, s.count, acceptance)}: 3-D error RMS "
+            f"    {_targets_text(s.ok, s.count, acceptance, markerless)}: 3-D error RMS "
             f"{_cell(s.error_pct_of_depth_rms, '.3f')} % of depth; by depth: {bands}"
         )
         g = s.outside_start_view
@@ -193,12 +194,39 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
                 f"start pose): {g.ok} of {g.count} measured, 3-D error RMS "
                 f"{_cell(g.error_pct_of_depth_rms, '.3f')} % of depth"
             )
+    return lines + _markerless_lines(result)
+
+
+def _markerless_lines(result: RunOutcome) -> list[str]:
+    """Markerless targets: how they were drawn, and where the eyes truly landed."""
+    stats = fixation_stats(result.records)
+    if not stats.count:
+        return []
+    lines = []
+    surface = getattr(result.experiment, "surface", None)
+    if isinstance(surface, SurfaceDraw):
+        refused = ", ".join(f"{n} {c}" for c, n in surface.refused.items()) or "none"
+        lines.append(
+            f"  markerless targets: {surface.asked} asked on the room's surfaces, "
+            f"{surface.drawn} draws (refused and drawn again: {refused})"
+        )
+    ok = sum(1 for r in result.records if r.fixation is not None and r.measurement.ok)
+    causes = ", ".join(f"{n} {c}" for c, n in stats.failure_causes.items()) or "none"
+    lines.append(
+        f"  markerless fixations (truth: where each eye's goal ray landed): vergence error "
+        f"median {_cell(stats.vergence_error_deg_median, '.4f')} deg, RMS "
+        f"{_cell(stats.vergence_error_deg_rms, '.4f')} deg; false fixations "
+        f"{stats.false_fixations} of {ok} ok (eye 1 landed > max(1 % of depth, 5 mm) off); "
+        f"failures by cause: {causes}"
+    )
     return lines
 
 
-def _targets_text(ok: int, count: int, a: TargetAcceptance | None) -> str:
+def _targets_text(ok: int, count: int, a: TargetAcceptance | None, markerless: bool = False) -> str:
     """Which targets the RMS is over: "the whole field" only for targets drawn over it."""
     measured = f"all {ok} targets measured" if ok == count else f"the {ok} of {count} measured"
+    if markerless:
+        return f"whole field, {measured} (points of the room's surfaces drawn over it)"
     if a is None or not a.drawn:
         return f"{measured} (placed by hand)"
     drawn = a.accepted - a.listed

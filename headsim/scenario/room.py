@@ -12,11 +12,12 @@ from __future__ import annotations
 import functools
 import math
 from contextvars import ContextVar
+from dataclasses import replace
 
 import numpy as np
 
 from headsim.scenario.occlusion import Occluder, scene_model
-from headsim.scenario.spec import MAX_DEPTH_M
+from headsim.scenario.spec import MAX_DEPTH_M, SurfaceTargetsSpec
 from headsim.scenario.tables import Table
 from headsim.sim import names
 from headsim.sim.textured_scene import SHAPES, LightSettings, RoomSpec, SceneObject
@@ -27,6 +28,10 @@ STREAM_ROOM = 6
 
 #: Thinnest half-size, m, below which a box counts as a plane for occlusion (a table top).
 THIN_M = 0.03
+
+#: Whether the room has markerless targets, while the scene's marker targets are read
+#: (then a procedure that requires targets needs no marker ones).
+ROOM_HAS_TARGETS: ContextVar[bool] = ContextVar("room_has_targets", default=False)
 
 #: What can hide a target besides the scene's own geoms, while a room's targets are read.
 ROOM_OCCLUDERS: ContextVar[tuple[Occluder, ...]] = ContextVar("room_occluders", default=())
@@ -100,12 +105,36 @@ def scene_names() -> frozenset[str]:
     return frozenset(taken)
 
 
-def read_room(scene: Table, seed: int) -> RoomSpec | None:
-    """``[scene.room]``, its ``light`` and ``objects``; None without it."""
+def _surface_targets(table: Table) -> SurfaceTargetsSpec | None:
+    """``[scene.room]``'s markerless targets (``targets`` and its ``targets_*`` keys,
+    ``click_error_px``, ``band_px``); None when ``targets`` is 0 or absent."""
+    count = table.integer("targets", 0, 0, 200)
+    near, far = table.numbers("targets_depth_m", 2, (0.3, 2.0), 0.2, MAX_DEPTH_M, unit="m")
+    if near >= far:
+        raise table.fail(
+            "targets_depth_m", f"[{near:g}, {far:g}] is empty", "[near, far], near < far"
+        )
+    lateral = table.number("targets_lateral", 0.25, 0.0, 1.0, lo_open=True)
+    vertical = table.number("targets_vertical", 0.1, 0.0, 1.0, lo_open=True)
+    click_px = table.number("click_error_px", 0.5, 0.0, 20.0, unit="px")
+    band_px = table.number("band_px", 10.0, 1.0, 100.0, unit="px")
+    if count == 0:
+        return None
+    return SurfaceTargetsSpec(count, (near, far), lateral, vertical, click_px, band_px)
+
+
+def read_room(scene: Table, seed: int) -> tuple[RoomSpec | None, SurfaceTargetsSpec | None]:
+    """``[scene.room]``, its ``light`` and ``objects``, and its markerless targets;
+    (None, None) without it."""
     table = scene.table("room")
     if table is None:
-        return None
+        return None, None
+    targets = _surface_targets(table)
     surface = table.choice("surface", TEXTURE_KINDS, "pink")
+    floor, top = RoomSpec.floor_z_m, RoomSpec.wall_top_z_m
+    table_z = table.number(
+        "table_top_z_m", RoomSpec.table_top_z_m, floor, top, lo_open=True, hi_open=True, unit="m"
+    )
     count = table.integer("clutter", 8, 0, 40)
     near, far = table.numbers("clutter_depth_m", 2, (0.3, 2.0), 0.2, 2.1, unit="m")
     if near >= far:
@@ -137,10 +166,10 @@ def read_room(scene: Table, seed: int) -> RoomSpec | None:
                 "unique names, not starting with clutter_ or room_, not a body of the scenes "
                 "(markers, chessboard, object_1..6)",
             )
-    room = RoomSpec(seed=seed, surface=surface, light=light)
+    room = RoomSpec(seed=seed, surface=surface, light=light, table_top_z_m=table_z)
     rng = np.random.default_rng([seed, STREAM_ROOM])
     clutter = draw_clutter(room, count, (near, far), rng)
-    return RoomSpec(seed=seed, surface=surface, light=light, objects=objects + clutter)
+    return replace(room, objects=objects + clutter), targets
 
 
 def room_occluders(room: RoomSpec) -> tuple[Occluder, ...]:
@@ -174,4 +203,11 @@ def room_occluders(room: RoomSpec) -> tuple[Occluder, ...]:
     return tuple(out)
 
 
-__all__ = ["ROOM_OCCLUDERS", "STREAM_ROOM", "draw_clutter", "read_room", "room_occluders"]
+__all__ = [
+    "ROOM_HAS_TARGETS",
+    "ROOM_OCCLUDERS",
+    "STREAM_ROOM",
+    "draw_clutter",
+    "read_room",
+    "room_occluders",
+]

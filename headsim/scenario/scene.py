@@ -25,7 +25,7 @@ from headsim.scenario.reach import (
     target_refusal,
 )
 from headsim.scenario.registry import get
-from headsim.scenario.room import ROOM_OCCLUDERS, read_room, room_occluders
+from headsim.scenario.room import ROOM_HAS_TARGETS, ROOM_OCCLUDERS, read_room, room_occluders
 
 if TYPE_CHECKING:
     from headsim.scenario.registry import SceneReader
@@ -168,7 +168,7 @@ def _read_targets(
             Placement(f"random_{k + 1}", body, tuple3(p), f"{random_table.path} (target {k + 1})")
             for k, p in enumerate(points)
         ]
-    if required and not targets:
+    if required and not targets and not ROOM_HAS_TARGETS.get():
         raise scene.fail(
             "targets", "no target to measure", "[[scene.targets]] entries or [scene.random_targets]"
         )
@@ -201,22 +201,34 @@ def default_position(scene: str, body: str) -> np.ndarray:
     return np.array(model.body(body).pos, dtype=float)
 
 
+#: The procedures that measure ``[scene.room] targets`` (one servo, target by target).
+SURFACE_TARGET_PROCEDURES = ("model2", "model1")
+
+
 def read_scene(
     doc: Table, ctx: Context, procedure: str, settings: HeadSettings, seed: int
 ) -> SceneSpec:
     """``[scene]``: what the procedure measures, and where it is."""
     found = get(procedure)
     table = doc.table("scene") or Table({}, "scene", ctx)
-    room = read_room(table, seed)
+    room, surface_targets = read_room(table, seed)
+    if surface_targets is not None and procedure not in SURFACE_TARGET_PROCEDURES:
+        raise ctx.error(
+            "scene.room.targets",
+            f"markerless targets are not measured by the {procedure} procedure",
+            f"procedure = {' or '.join(SURFACE_TARGET_PROCEDURES)}, or targets = 0",
+        )
     # The room's surfaces and clutter can hide the procedure's targets.
     token = ROOM_OCCLUDERS.set(() if room is None else room_occluders(room))
+    has_targets = ROOM_HAS_TARGETS.set(surface_targets is not None)
     try:
         read = found.read_scene
         spec = SceneSpec(scene=found.scene) if read is None else read(table, ctx, settings, seed)
     finally:
         ROOM_OCCLUDERS.reset(token)
+        ROOM_HAS_TARGETS.reset(has_targets)
     table.done()
-    return spec if room is None else replace(spec, room=room)
+    return spec if room is None else replace(spec, room=room, surface_targets=surface_targets)
 
 
 def targets_reader(procedure: str, *, required: bool) -> SceneReader:

@@ -50,6 +50,8 @@ MAX_DEPTH_M = 10.0
 
 #: Independent random streams drawn from the scenario seed.
 STREAM_CALIBRATION, STREAM_TARGETS, STREAM_OBJECTS, STREAM_MOVING, STREAM_DEPTH_NOISE = range(1, 6)
+#: The seed's streams of the room's surface targets and of their clicks (after the room's 6).
+STREAM_SURFACE_TARGETS, STREAM_CLICKS = 7, 8
 
 
 @dataclass(frozen=True)
@@ -243,6 +245,23 @@ class TargetAcceptance:
 
 
 @dataclass(frozen=True)
+class SurfaceTargetsSpec:
+    """``[scene.room] targets``: ``count`` markerless targets, points on the room's
+    surfaces drawn at run time from the seed (the surfaces the start pose shows both
+    cameras, ``depth_m`` deep in H, within ``lateral`` |x/z| and ``vertical`` |y/z|).
+    The head is told each only by a click in camera 1's image, ``click_error_px`` its
+    standard deviation per axis; camera 2 searches camera 1's row of the point
+    +- ``band_px`` (a head that knows no focal length)."""
+
+    count: int
+    depth_m: tuple[float, float] = (0.3, 2.0)
+    lateral: float = 0.25
+    vertical: float = 0.1
+    click_error_px: float = 0.5
+    band_px: float = 10.0
+
+
+@dataclass(frozen=True)
 class SceneSpec:
     """What is where: ``scene`` is the MJCF scene; ``targets`` to measure (or check
     targets after a calibration); ``chessboard``/``blocks`` the board's top-left inner
@@ -263,6 +282,8 @@ class SceneSpec:
     acceptance: TargetAcceptance | None = None
     #: the textured room put into every scene of the run (``[scene.room]``; None: none)
     room: RoomSpec | None = None
+    #: markerless targets on the room's surfaces (``[scene.room] targets``; None: none)
+    surface_targets: SurfaceTargetsSpec | None = None
 
 
 @dataclass(frozen=True)

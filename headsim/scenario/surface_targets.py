@@ -213,18 +213,25 @@ class DrawnTargets:
     refused: dict[str, int]
 
 
-def _in_image(sim: HeadSim, camera: int, p: np.ndarray) -> bool:
+def _in_image(sim: HeadSim, camera: int, p: np.ndarray, margin_px: float = 0.0) -> bool:
+    """Whether the point projects into ``camera``'s image at least ``margin_px`` inside."""
     cam = sim.camera_settings(camera)
     if sim.transform_points(p, "world", names.CAMERAS[camera - 1])[0][2] <= 0:
         return False
     u, v = sim.project(p[None, :], camera)[0]
-    return bool(0.0 <= u <= cam.width - 1 and 0.0 <= v <= cam.height - 1)
+    m = margin_px
+    return bool(m <= u <= cam.width - 1 - m and m <= v <= cam.height - 1 - m)
 
 
 def surface_refusal(
-    sim: HeadSim, p: np.ndarray | None, depth_m: tuple[float, float], head: ReachHead | None
+    sim: HeadSim,
+    p: np.ndarray | None,
+    depth_m: tuple[float, float],
+    head: ReachHead | None,
+    margin_px: float = 0.0,
 ) -> str | None:
-    """Why a point met on a surface is no target (:data:`SURFACE_REFUSALS`), or None."""
+    """Why a point met on a surface is no target (:data:`SURFACE_REFUSALS`), or None;
+    ``margin_px``: how far inside camera 1's start image it must be (a template's room)."""
     if p is None:
         return "no_surface"
     depth = float(sim.transform_points(p, "world", "head")[0][2])
@@ -232,7 +239,7 @@ def surface_refusal(
         return "depth"
     if not (visible(sim, 1, p) and visible(sim, 2, p)):
         return "occluded"
-    if not _in_image(sim, 1, p):
+    if not _in_image(sim, 1, p, margin_px):
         return "start_view"
     if head is not None and target_refusal(head, "model2", p) is not None:
         return "reach"
@@ -247,11 +254,13 @@ def draw_targets(
     lateral: float = 0.25,
     vertical: float = 0.1,
     max_draws: int = 200,
+    margin_px: float = 0.0,
 ) -> DrawnTargets:
     """``count`` targets on the surfaces the head sees at its pose now (call it at the
     start pose): a direction in H with |x/z| <= ``lateral`` and |y/z| <= ``vertical``
     from the midpoint of the two cameras, cast into the scene; a point met is kept when
-    :func:`surface_refusal` finds nothing wrong, else drawn again (counted by cause)."""
+    :func:`surface_refusal` finds nothing wrong (``margin_px`` inside camera 1's image),
+    else drawn again (counted by cause)."""
     origin = (camera_centre(sim, 1) + camera_centre(sim, 2)) / 2
     world_from_head = sim.world_from_head()[:3, :3]
     head = ReachHead.of(sim.settings)
@@ -266,7 +275,7 @@ def draw_targets(
         drawn += 1
         x, y = rng.uniform(-lateral, lateral), rng.uniform(-vertical, vertical)
         hit, _, _ = cast(sim.model, sim.data, origin, world_from_head @ np.array([x, y, 1.0]))
-        reason = surface_refusal(sim, hit, depth_m, head)
+        reason = surface_refusal(sim, hit, depth_m, head, margin_px)
         if reason is not None:
             refused[reason] = refused.get(reason, 0) + 1
             continue

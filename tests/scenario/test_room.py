@@ -28,7 +28,14 @@ def test_natural_field_has_its_room_and_clutter_from_the_seed() -> None:
     assert room is not None and room.surface == "pink" and not room.light.shadows
     listed = [o for o in room.objects if not o.name.startswith("clutter_")]
     clutter = [o for o in room.objects if o.name.startswith("clutter_")]
-    assert [o.name for o in listed] == ["panel_grating", "box_low"] and len(clutter) == 12
+    assert [o.name for o in listed] == [
+        "poster",
+        "box_low",
+        "books",
+        "mug",
+        "cereal_box",
+        "ball",
+    ] and len(clutter) == 12
     for obj in clutter:
         half_height = (
             obj.size_m[0] if obj.shape == "sphere" else obj.size_m[2 if obj.shape == "box" else 1]
@@ -39,7 +46,7 @@ def test_natural_field_has_its_room_and_clutter_from_the_seed() -> None:
     again = load_scenario("natural_field", fast=True).scene.room
     assert again == room
     other = load_scenario("natural_field", fast=True, seed=1).scene.room
-    assert other is not None and other.objects[2:] != room.objects[2:]
+    assert other is not None and other.objects[6:] != room.objects[6:]
 
 
 @pytest.mark.parametrize(
@@ -71,6 +78,12 @@ def test_natural_field_has_its_room_and_clutter_from_the_seed() -> None:
             "not a body of the scenes",
         ),
         ({"lamp": 1}, "scene.room.lamp", "unknown key"),
+        ({"targets": 201}, "scene.room.targets", "from 0 to 200"),
+        ({"targets": 2, "targets_depth_m": [1.5, 0.5]}, "scene.room.targets_depth_m", "near < far"),
+        ({"targets": 2, "targets_lateral": 0}, "scene.room.targets_lateral", "> 0"),
+        ({"targets": 2, "band_px": 0.5}, "scene.room.band_px", ">= 1"),
+        ({"targets": 2, "click_error_px": -1}, "scene.room.click_error_px", ">= 0"),
+        ({"table_top_z_m": 3.0}, "scene.room.table_top_z_m", "< 2"),
     ],
 )
 def test_a_bad_room_value_is_refused_naming_its_key(room: dict, field: str, allowed: str) -> None:
