@@ -24,11 +24,14 @@ DEPTH_BANDS_M = ((0.0, 0.6), (0.6, 1.0), (1.0, math.inf))
 
 @dataclass(frozen=True)
 class DepthBand:
-    """One depth band: its name (e.g. "0.6-1 m"), the targets in it, and their RMS error, %."""
+    """One depth band: its name (e.g. "0.6-1 m"), the targets measured in it (``count``)
+    and their RMS error, %; ``asked``: every target whose true depth lies in it, failed
+    ones included."""
 
     band: str
     count: int
     error_pct_of_depth_rms: float
+    asked: int = 0
 
 
 @dataclass(frozen=True)
@@ -108,7 +111,12 @@ def summarise(
         failure_causes=_cause_counts([r.measurement.failure for r in records]),
         error_pct_of_depth_rms=_rms_pct(pct),
         by_depth=tuple(
-            DepthBand(_band_name(lo, hi), int(np.sum(sel)), _rms_pct(pct[sel]))
+            DepthBand(
+                _band_name(lo, hi),
+                int(np.sum(sel)),
+                _rms_pct(pct[sel]),
+                sum(lo <= r.measurement.depth_m < hi for r in records),
+            )
             for lo, hi in DEPTH_BANDS_M
             for sel in [np.array([lo <= m.depth_m < hi for m in ok], dtype=bool)]
         ),

@@ -201,6 +201,7 @@ RESULTS_FIELDS: dict[str, str] = {
     "summary.*.by_depth": "per depth band 0-0.6, 0.6-1, >= 1 m",
     "summary.*.by_depth[].band": "the band",
     "summary.*.by_depth[].count": "measurements in it",
+    "summary.*.by_depth[].asked": "targets whose true depth lies in it, the failed ones included",
     "summary.*.by_depth[].error_pct_of_depth_rms": "their RMS error, % of depth",
     "summary.*.scanned": "measurements that scanned for a target the start pose did not show",
     "summary.*.scan_renders": "their scan renders",

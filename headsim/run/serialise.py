@@ -156,7 +156,12 @@ def summary_entry(s: MeasurementSummary) -> dict[str, Any]:
         "failure_causes": dict(s.failure_causes),
         "error_pct_of_depth_rms": s.error_pct_of_depth_rms,
         "by_depth": [
-            {"band": b.band, "count": b.count, "error_pct_of_depth_rms": b.error_pct_of_depth_rms}
+            {
+                "band": b.band,
+                "count": b.count,
+                "asked": b.asked,
+                "error_pct_of_depth_rms": b.error_pct_of_depth_rms,
+            }
             for b in s.by_depth
         ],
         "scanned": s.scanned,

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
-from headsim.run.accuracy import summaries
+from headsim.run.accuracy import DepthBand, summaries
 from headsim.run.outcomes import RunOutcome, SurfaceDraw, fixation_stats
 from headsim.run.table import cell as _cell
 from headsim.run.table import format_table
@@ -177,12 +177,7 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
         if s.failure_causes:
             causes = ", ".join(f"{n} {c}" for c, n in s.failure_causes.items())
             lines.append(f"    failures by cause: {causes}")
-        bands = "; ".join(
-            f"{b.band}: {_cell(b.error_pct_of_depth_rms, '.3f')} % ({b.count})"
-            if b.count
-            else f"{b.band}: no targets"
-            for b in s.by_depth
-        )
+        bands = "; ".join(band_text(b) for b in s.by_depth)
         lines.append(
             f"    {_targets_text(s.ok, s.count, acceptance, markerless)}: 3-D error RMS "
             f"{_cell(s.error_pct_of_depth_rms, '.3f')} % of depth; by depth: {bands}"
@@ -295,6 +290,17 @@ def belief_text(scenario: Scenario) -> str:
         f"{', '.join(parts)}: {_SOURCE_TEXT.get(source, source)}"
         for source, parts in groups.items()
     )
+
+
+def band_text(b: DepthBand) -> str:
+    """One depth band's figure: its RMS over the targets measured in it, how many of
+    those asked there were measured (when not all), or that it held no target."""
+    if not b.asked:
+        return f"{b.band}: no targets"
+    if not b.count:
+        return f"{b.band}: 0 of {b.asked} measured"
+    of = f" of {b.asked} measured" if b.count < b.asked else ""
+    return f"{b.band}: {_cell(b.error_pct_of_depth_rms, '.3f')} % ({b.count}{of})"
 
 
 def summary_text(result: RunOutcome, head_flag: str | None = None) -> str:

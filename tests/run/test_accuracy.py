@@ -7,6 +7,7 @@ import pytest
 
 from headsim.run.accuracy import DEPTH_BANDS_M, summaries, summarise
 from headsim.run.outcomes import MeasurementRecord
+from headsim.run.summary import band_text
 
 from .helpers import LOST, measurement
 
@@ -36,3 +37,19 @@ def test_every_depth_counts_in_exactly_one_band() -> None:
     pct = np.array([0.1 / d for d in depths])
     assert s.error_pct_of_depth_rms == pytest.approx(float(np.sqrt(np.mean(pct**2))))
     assert s.servo_residual_px_max == 0.5 and s.renders_per_point == 7.0
+
+
+def test_a_band_whose_targets_all_failed_says_so_and_is_not_called_empty() -> None:
+    records = [
+        MeasurementRecord(measurement(0.0, 0.5, LOST), "calibrated", 0),
+        MeasurementRecord(measurement(0.0, 0.55, LOST), "calibrated", 1),
+        MeasurementRecord(measurement(0.004, 0.8), "calibrated", 2),
+        MeasurementRecord(measurement(0.0, 0.9, LOST), "calibrated", 3),
+    ]
+    near, middle, far = summarise(records).by_depth
+    assert (near.count, near.asked) == (0, 2)
+    assert (middle.count, middle.asked) == (1, 2)
+    assert (far.count, far.asked) == (0, 0)
+    assert band_text(near) == "0-0.6 m: 0 of 2 measured"
+    assert band_text(middle) == "0.6-1 m: 0.500 % (1 of 2 measured)"
+    assert band_text(far) == ">= 1 m: no targets"
