@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from headsim.run.accuracy import summarise
 from headsim.run.outcomes import RunOutcome
-from headsim.run.summary import band_text, summary_text
+from headsim.run.summary import band_figure, summary_text
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -50,7 +50,7 @@ class RunResult(RunOutcome):
             stats = summarise(self.records)
             rms = stats.error_pct_of_depth_rms
             rows.append(("3-D error RMS, % of depth", f"{rms:.3f}" if math.isfinite(rms) else "-"))
-            rows += [(f"  {b.band}", band_text(b).split(": ", 1)[1]) for b in stats.by_depth]
+            rows += [(f"  {b.band}", band_figure(b)) for b in stats.by_depth]
         cells = "".join(
             f"<tr><th style='text-align:left'>{html.escape(k)}</th>"
             f"<td style='text-align:left'>{html.escape(v)}</td></tr>"

@@ -292,15 +292,20 @@ def belief_text(scenario: Scenario) -> str:
     )
 
 
-def band_text(b: DepthBand) -> str:
+def band_figure(b: DepthBand) -> str:
     """One depth band's figure: its RMS over the targets measured in it, how many of
     those asked there were measured (when not all), or that it held no target."""
     if not b.asked:
-        return f"{b.band}: no targets"
+        return "no targets"
     if not b.count:
-        return f"{b.band}: 0 of {b.asked} measured"
+        return f"0 of {b.asked} measured"
     of = f" of {b.asked} measured" if b.count < b.asked else ""
-    return f"{b.band}: {_cell(b.error_pct_of_depth_rms, '.3f')} % ({b.count}{of})"
+    return f"{_cell(b.error_pct_of_depth_rms, '.3f')} % ({b.count}{of})"
+
+
+def band_text(b: DepthBand) -> str:
+    """The band's name and :func:`band_figure`."""
+    return f"{b.band}: {band_figure(b)}"
 
 
 def summary_text(result: RunOutcome, head_flag: str | None = None) -> str:

@@ -113,12 +113,10 @@ class ReachHead:
         """
         camera = self.settings.cameras[index]
         sign = names.EYE_CAMERAS[index].inward
-        centre = np.array([sign * -self.settings.baseline_m / 2, 0.0, 0.0])
         c, s = math.cos(sign * eye), math.sin(sign * eye)
         eye_rotation = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
         rotation = eye_rotation @ _mount_rotation(camera, sign)
-        offset_cv = np.array([camera.side_offset_m, 0.0, camera.nodal_offset_m])
-        p = rotation.T @ (point_head - centre) - offset_cv
+        p = rotation.T @ (point_head - self.optical_centre_head(index, eye))
         if p[2] <= 0.01:
             return False
         points = [p]
