@@ -36,7 +36,11 @@ class FixationScore:
     ``vergence_error_deg``: eye 2's goal ray against the direction to eye 1's landed
     point; ``error_deg``/``error_m``: each eye's ray against the intended target, and its
     landed point's distance from it; ``landed``: the objects hit ("" none);
-    ``click_error_px``: |clicked - true| of the click the head was told; ``match_score``,
+    ``click_error_px``: |clicked - true| of the click the head was told;
+    ``image_error_px``: each eye's look at its fixation, |where its image said the clicked
+    point is - where that surface point truly was| (eye 1: the tracker's drift; eye 2: the
+    correspondence error; the click's own error apart); ``match_sigma_px``: the spread the matched template's texture allows at the
+    image noise (Cramer-Rao, one axis: the theory's correspondence noise); ``match_score``,
     ``match_ambiguity``, ``match_status``: camera 2's last confident correspondence (else
     its last; None: none made); ``false_fixation``: the measurement is ok but eye 1
     landed more than ``false_fixation_limit_m`` from the target (or on nothing).  NaN (no
@@ -49,6 +53,8 @@ class FixationScore:
     landed: tuple[str, str]
     landed_world_m: tuple[tuple[float, ...] | None, tuple[float, ...] | None]
     click_error_px: float
+    image_error_px: tuple[float, float]
+    match_sigma_px: float | None
     match_score: float | None
     match_ambiguity: float | None
     match_status: str | None

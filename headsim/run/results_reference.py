@@ -174,6 +174,12 @@ RESULTS_FIELDS: dict[str, str] = {
     "measurements[].fixation.landed_world_m": "each eye's landed point in W, m (`null`: none)",
     "measurements[].fixation.click_error_px": "|clicked - true| of the click in camera 1's "
     "image the head was told, px",
+    "measurements[].fixation.image_error_px": "each eye's look at its fixation: |where its "
+    "image said the clicked surface point is - its true projection|, px (eye 1: the tracker's "
+    "drift; eye 2: the correspondence error; the click's error apart)",
+    "measurements[].fixation.match_sigma_px": "the location spread the matched template's "
+    "texture allows at the image noise (Cramer-Rao, one axis), px: the theory's correspondence "
+    "noise",
     "measurements[].fixation.match_score": "camera 2's last confident correspondence (else its "
     "last): peak NCC",
     "measurements[].fixation.match_ambiguity": "its second-best peak over the best",

@@ -131,6 +131,8 @@ def fixation_entry(f: FixationScore) -> dict[str, Any]:
         "landed": list(f.landed),
         "landed_world_m": [None if p is None else list(p) for p in f.landed_world_m],
         "click_error_px": f.click_error_px,
+        "image_error_px": list(f.image_error_px),
+        "match_sigma_px": f.match_sigma_px,
         "match_score": f.match_score,
         "match_ambiguity": f.match_ambiguity,
         "match_status": f.match_status,

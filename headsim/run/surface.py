@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TypeVar
 
 import numpy as np
@@ -53,19 +53,41 @@ def false_fixation_limit_m(depth_m: float) -> float:
     return max(FALSE_FIXATION_FRACTION * depth_m, FALSE_FIXATION_MIN_M)
 
 
+@dataclass(frozen=True)
+class Look:
+    """One look that found the target, as :class:`LandingLog` keeps it: the ``camera``,
+    every motor's ``encoders`` then, the goal ray's ``landing``, where the look saw the
+    target ``seen_uv`` and where it truly was in that image ``true_uv`` (px; None: no
+    target set)."""
+
+    camera: int
+    encoders: tuple[int, ...]
+    landing: Landing
+    seen_uv: tuple[float, float]
+    true_uv: tuple[float, float] | None
+
+    @property
+    def error_px(self) -> float:
+        """|seen - true|, px (NaN without a true position)."""
+        return math.nan if self.true_uv is None else math.dist(self.seen_uv, self.true_uv)
+
+
 class LandingLog:
     """A run subscriber (truth, for scoring): at each look that found the target, that
     camera's goal ray (its goal column ``goal_u``, on the row the look saw the target) at
     the camera's true pose then, cast into the scene, kept with the encoder readings of
-    that pose.  The servos are not touched: they report their looks as events."""
+    that pose and the target's true pixel in that image (``target``: its true position
+    now, set per target).  The servos are not touched: they report their looks as events."""
 
     def __init__(self, sim: HeadSim, goal_u: tuple[float, float]) -> None:
         self.sim = sim
         self.goal_u = goal_u
-        self.looks: list[tuple[int, tuple[int, ...], Landing]] = []
+        self.looks: list[Look] = []
+        self.target: Callable[[], np.ndarray] | None = None
 
-    def clear(self) -> None:
+    def clear(self, target: Callable[[], np.ndarray] | None = None) -> None:
         self.looks = []
+        self.target = target
 
     def encoders(self) -> tuple[int, ...]:
         """Every motor's encoder reading now, whole steps, in ``sim.motors`` order."""
@@ -74,21 +96,32 @@ class LandingLog:
     def notify(self, event: object, at: Stamp) -> None:
         if isinstance(event, Detected) and event.uv_px is not None:
             goal = (self.goal_u[event.camera - 1], event.uv_px[1])
+            true_uv = None
+            if self.target is not None:
+                u, v = self.sim.project(self.target()[None, :], event.camera)[0]
+                true_uv = (float(u), float(v))
+            seen = (float(event.uv_px[0]), float(event.uv_px[1]))
             self.looks.append(
-                (event.camera, self.encoders(), landing(self.sim, event.camera, goal))
+                Look(
+                    event.camera,
+                    self.encoders(),
+                    landing(self.sim, event.camera, goal),
+                    seen,
+                    true_uv,
+                )
             )
 
-    def last(self, camera: int, where: Callable[[tuple[int, ...]], bool]) -> Landing | None:
-        """``camera``'s last landing at a pose whose encoders satisfy ``where``."""
-        for seen, encoders, landed in reversed(self.looks):
-            if seen == camera and where(encoders):
-                return landed
+    def last(self, camera: int, where: Callable[[tuple[int, ...]], bool]) -> Look | None:
+        """``camera``'s last look at a pose whose encoders satisfy ``where``."""
+        for look in reversed(self.looks):
+            if look.camera == camera and where(look.encoders):
+                return look
         return None
 
-    def fixations(self, m: Measurement) -> dict[int, Landing]:
-        """Each camera's landing where its servo left it fixated: Model 2's camera 1 at step
+    def fixations(self, m: Measurement) -> dict[int, Look]:
+        """Each camera's look where its servo left it fixated: Model 2's camera 1 at step
         1's eye encoder, camera 2 at step 2's; Model 1's both at the final pose."""
-        out: dict[int, Landing] = {}
+        out: dict[int, Look] = {}
         if not m.ok:
             return out
         if m.method.value == "model2":
@@ -113,16 +146,17 @@ class LandingLog:
 
 
 def score_fixation(
-    landings: dict[int, Landing],
+    looks: dict[int, Look],
     target_world_m: np.ndarray,
     depth_m: float,
     ok: bool,
     told: Click,
     match: Match | None,
 ) -> FixationScore:
-    """A :class:`FixationScore` from the logged landings (an eye missing: NaN) and camera
-    2's last correspondence ``match``."""
-    one, two = landings.get(1), landings.get(2)
+    """A :class:`FixationScore` from the logged looks at the fixation (an eye missing:
+    NaN) and camera 2's last correspondence ``match``."""
+    one, two = (None if (x := looks.get(c)) is None else x.landing for c in (1, 2))
+    look_px = [math.nan if (x := looks.get(c)) is None else x.error_px for c in (1, 2)]
     errors = [
         (math.nan, math.nan)
         if x is None
@@ -148,6 +182,8 @@ def score_fixation(
         landed=("" if one is None else one.body, "" if two is None else two.body),
         landed_world_m=(point(one), point(two)),
         click_error_px=math.dist(told.clicked_uv, told.true_uv),
+        image_error_px=(look_px[0], look_px[1]),
+        match_sigma_px=None if match is None else float(match.template_sigma_px),
         match_score=None if match is None else float(match.score),
         match_ambiguity=None if match is None else float(match.ambiguity),
         match_status=None if match is None else match.status.value,
@@ -213,8 +249,8 @@ def measure_surface_targets(
                 first = sim.render(1)
                 told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
                 pair = MarkerlessPair(first, told.clicked_uv, band_for)
-                target = Target(placed.name, pair, _truth(placed))
-                log.clear()
+                target = Target(placed.name, pair, _true_point(placed))
+                log.clear(_clicked_point(sim, told, placed))
                 m = measure(sim, shared, target, knowledge)
                 landings = log.fixations(m)
                 where = point_world(sim, placed.body, placed.point_body_m)
@@ -230,7 +266,20 @@ def measure_surface_targets(
     return records, replace(drawn, stats=fixation_stats(records))
 
 
-def _truth(placed: SurfaceTarget) -> Callable[[HeadSim], np.ndarray]:
+def _clicked_point(sim: HeadSim, told: Click, placed: SurfaceTarget) -> Callable[[], np.ndarray]:
+    """Where the surface point under the click truly is now (call at the start pose): the
+    point both eyes' templates hold, so that an eye's image error is its tracker's drift
+    or its correspondence's error, apart from the click's.  The target itself when the
+    click's ray meets nothing."""
+    hit = landing(sim, 1, told.clicked_uv)
+    if hit.point_world_m is None or not hit.body:
+        return lambda: point_world(sim, placed.body, placed.point_body_m)
+    body = sim.data.body(hit.body)
+    local = body.xmat.reshape(3, 3).T @ (hit.point_world_m - body.xpos)
+    return lambda: point_world(sim, hit.body, local)
+
+
+def _true_point(placed: SurfaceTarget) -> Callable[[HeadSim], np.ndarray]:
     return lambda sim: point_world(sim, placed.body, placed.point_body_m)
 
 
@@ -256,6 +305,7 @@ def fixation_scores(records: Sequence[MeasurementRecord]) -> list[FixationScore]
 
 __all__ = [
     "LandingLog",
+    "Look",
     "false_fixation_limit_m",
     "fixation_scores",
     "measure_surface_targets",

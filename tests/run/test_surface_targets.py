@@ -16,7 +16,7 @@ from headsim.cli import main
 from headsim.run.landing import Landing
 from headsim.run.outcomes import FALSE_FIXATION_MIN_M
 from headsim.run.runner import run_scenario
-from headsim.run.surface import false_fixation_limit_m, score_fixation
+from headsim.run.surface import Look, false_fixation_limit_m, score_fixation
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.surface_targets import Click
 from headsim.scenario.tables import ScenarioError
@@ -38,6 +38,11 @@ def _landing(camera: int, origin: np.ndarray, point: np.ndarray | None, body: st
     return Landing(camera, (320.0, 240.0), origin, direction, point, distance, body, body)
 
 
+def _look(landing: Landing, seen_uv: tuple[float, float] = (320.0, 240.0)) -> Look:
+    """A look at the fixation that saw the target at ``seen_uv``; truly at (320, 240)."""
+    return Look(landing.camera, (0, 0, 0), landing, seen_uv, (320.0, 240.0))
+
+
 def test_the_limit_is_one_percent_of_depth_but_at_least_5_mm() -> None:
     assert false_fixation_limit_m(0.3) == FALSE_FIXATION_MIN_M == 0.005
     assert false_fixation_limit_m(2.0) == pytest.approx(0.02)
@@ -48,8 +53,11 @@ def test_an_ok_fixation_landed_beyond_the_limit_is_false(off_m: float, false: bo
     # Eye 1 landed ``off_m`` beside the target on a wall at 1 m (limit: 1 % of 1 m);
     # eye 2 looks exactly at eye 1's point: no vergence error, yet a false fixation.
     landed = TARGET + np.array([off_m, 0.0, 0.0])
-    landings = {1: _landing(1, EYE1, landed, "wall"), 2: _landing(2, EYE2, landed, "wall")}
-    score = score_fixation(landings, TARGET, 1.0, True, CLICK, MATCH)
+    looks = {
+        1: _look(_landing(1, EYE1, landed, "wall")),
+        2: _look(_landing(2, EYE2, landed, "wall"), (323.0, 244.0)),
+    }
+    score = score_fixation(looks, TARGET, 1.0, True, CLICK, MATCH)
     assert score.false_fixation is false
     assert score.false_fixation_limit_m == pytest.approx(0.01)
     assert score.error_m[0] == pytest.approx(off_m, rel=1e-9)
@@ -57,6 +65,9 @@ def test_an_ok_fixation_landed_beyond_the_limit_is_false(off_m: float, false: bo
     assert score.error_deg[0] > 0 and score.landed == ("wall", "wall")
     assert score.click_error_px == pytest.approx(0.5)
     assert (score.match_score, score.match_ambiguity, score.match_status) == (0.97, 0.4, "ok")
+    # Eye 2's image put the target 3 px right and 4 px down of where it truly was.
+    assert score.image_error_px == (0.0, pytest.approx(5.0))
+    assert score.match_sigma_px == 0.01
 
 
 def test_vergence_error_is_eye_2_off_eye_1s_point_and_a_failure_is_no_false_fixation() -> None:
@@ -67,15 +78,16 @@ def test_vergence_error_is_eye_2_off_eye_1s_point_and_a_failure_is_no_false_fixa
     c, s = math.cos(turn), math.sin(turn)
     aimed = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ to_point
     two = _landing(2, EYE2, EYE2 + aimed, "wall")
-    score = score_fixation({1: one, 2: two}, TARGET, 1.0, True, CLICK, MATCH)
+    score = score_fixation({1: _look(one), 2: _look(two)}, TARGET, 1.0, True, CLICK, MATCH)
     assert score.vergence_error_deg == pytest.approx(0.5, rel=1e-9)
     assert not score.false_fixation  # eye 1 is on the target
     # An ok measurement whose eye 1 met nothing is false; a failed one is a failure.
     nothing = _landing(1, EYE1, None, "")
-    assert score_fixation({1: nothing}, TARGET, 1.0, True, CLICK, None).false_fixation
-    failed = score_fixation({1: nothing}, TARGET, 1.0, False, CLICK, None)
+    assert score_fixation({1: _look(nothing)}, TARGET, 1.0, True, CLICK, None).false_fixation
+    failed = score_fixation({1: _look(nothing)}, TARGET, 1.0, False, CLICK, None)
     assert not failed.false_fixation and math.isnan(failed.vergence_error_deg)
     assert failed.match_score is None and math.isnan(failed.error_m[1])
+    assert math.isnan(failed.image_error_px[1])
 
 
 def _doc(procedure: str, room: dict) -> dict:
