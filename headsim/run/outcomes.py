@@ -42,7 +42,7 @@ class FixationScore:
     correspondence error; the click's own error apart); ``match_sigma_px``: the spread the matched template's texture allows at the
     image noise (Cramer-Rao, one axis: the theory's correspondence noise); ``match_score``,
     ``match_ambiguity``, ``match_status``: camera 2's last confident correspondence (else
-    its last; None: none made); ``false_fixation``: the measurement is ok but eye 1
+    its last; None: none made); ``false_fixation``: the measurement is ok but an eye
     landed more than ``false_fixation_limit_m`` from the target (or on nothing).  NaN (no
     landing) when the measurement failed.
     """

@@ -185,7 +185,7 @@ RESULTS_FIELDS: dict[str, str] = {
     "measurements[].fixation.match_ambiguity": "its second-best peak over the best",
     "measurements[].fixation.match_status": "its status (`ok`, `low texture`, `ambiguous`, "
     "`occluded`, `lost`)",
-    "measurements[].fixation.false_fixation": "the measurement is ok but eye 1 landed farther "
+    "measurements[].fixation.false_fixation": "the measurement is ok but an eye landed farther "
     "than `false_fixation_limit_m` from the target (or on nothing)",
     "measurements[].fixation.false_fixation_limit_m": "that distance: 1 % of the target's depth, "
     "at least 5 mm",
@@ -235,7 +235,7 @@ _SURFACE: dict[str, str] = {
     "`occluded`, `start_view`, `reach`)",
     "surface_targets.false_fixation_limit": "the rule of a false fixation",
     "surface_targets.targets": "each target: `name`, the `body` it lies on, `point_world_m`",
-    "surface_targets.false_fixations": "measurements ok whose eye 1 landed off the target",
+    "surface_targets.false_fixations": "measurements ok with an eye landed off the target",
     "surface_targets.vergence_error_deg_median": "median vergence error of the fixations, degrees",
     "surface_targets.vergence_error_deg_rms": "their RMS, degrees",
 }

@@ -211,7 +211,7 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
         f"  markerless fixations (truth: where each eye's goal ray landed): vergence error "
         f"median {_cell(stats.vergence_error_deg_median, '.4f')} deg, RMS "
         f"{_cell(stats.vergence_error_deg_rms, '.4f')} deg; false fixations "
-        f"{stats.false_fixations} of {ok} ok (eye 1 landed > max(1 % of depth, 5 mm) off); "
+        f"{stats.false_fixations} of {ok} ok (an eye landed > max(1 % of depth, 5 mm) off); "
         f"failures by cause: {causes}"
     )
     return lines

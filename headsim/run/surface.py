@@ -8,9 +8,10 @@ camera 1's row of the point +- ``band_px`` in camera 2, from the believed refere
 rows (a head that knows no focal length).  The truth (the drawn point, the click's true
 projection, the landings) is for placing, the click and scoring only.
 
-A fixation is **false** when the measurement says ok but eye 1's goal ray landed more
-than :func:`false_fixation_limit_m` (1 % of the target's depth, at least 5 mm) from the
-intended target, or on nothing: a confident wrong correspondence, counted, not hidden.
+A fixation is **false** when the measurement says ok but either eye's goal ray landed
+more than :func:`false_fixation_limit_m` (1 % of the target's depth, at least 5 mm) from
+the intended target, or on nothing: a tracker that slid off (eye 1) or a confident wrong
+correspondence (eye 2), counted, not hidden.
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ from headsim.vision.correspondence import Band, Match, MatchConfig, row_band
 
 
 def false_fixation_limit_m(depth_m: float) -> float:
-    """How far eye 1's landed point may lie from the target before the fixation is false, m."""
+    """How far an eye's landed point may lie from the target before the fixation is false, m."""
     return max(FALSE_FIXATION_FRACTION * depth_m, FALSE_FIXATION_MIN_M)
 
 
@@ -169,8 +170,11 @@ def score_fixation(
     if one is not None and two is not None and one.point_world_m is not None:
         vergence = vergence_error_deg(two.origin_world_m, two.direction_world, one.point_world_m)
     limit = false_fixation_limit_m(depth_m)
-    off = errors[0][1]
-    false = ok and (math.isnan(off) or off > limit)
+    # An eye whose ray met nothing is off; an eye without a look at the fixation is unknown.
+    false = ok and any(
+        x is not None and (math.isnan(off) or off > limit)
+        for x, (_, off) in zip((one, two), errors, strict=True)
+    )
 
     def point(x: Landing | None) -> tuple[float, ...] | None:
         return None if x is None or x.point_world_m is None else tuple(map(float, x.point_world_m))

@@ -90,6 +90,19 @@ def test_vergence_error_is_eye_2_off_eye_1s_point_and_a_failure_is_no_false_fixa
     assert math.isnan(failed.image_error_px[1])
 
 
+def test_eye_2_on_the_wall_behind_is_a_false_fixation_though_eye_1_is_on_the_target() -> None:
+    # A confident wrong correspondence: eye 1 on the target, eye 2's ray on a wall 0.8 m
+    # beyond it.  An eye with no look at the fixation is unknown, not false.
+    one = _landing(1, EYE1, TARGET, "box")
+    wall = EYE2 + 1.8 * (TARGET + np.array([0.02, 0.0, 0.0]) - EYE2)
+    two = _landing(2, EYE2, wall, "wall")
+    score = score_fixation({1: _look(one), 2: _look(two)}, TARGET, 1.0, True, CLICK, MATCH)
+    assert score.false_fixation and score.error_m[1] > 0.5
+    assert score.landed == ("box", "wall") and score.vergence_error_deg > 0.5
+    alone = score_fixation({1: _look(one)}, TARGET, 1.0, True, CLICK, MATCH)
+    assert not alone.false_fixation
+
+
 def _doc(procedure: str, room: dict) -> dict:
     return {"description": "d", "experiment": {"procedure": procedure}, "scene": {"room": room}}
 
