@@ -23,6 +23,7 @@ __all__ = [
     "rel_dx_model2",
     "rel_dy_model2",
     "rel_dy_model2_simplified",
+    "rel_dz_correspondence",
     "rel_dz_model1",
     "rel_dz_model1_small_angle",
     "rel_dz_model2",
@@ -61,6 +62,14 @@ def rel_dz_model2_small_angle(
     return np.asarray(rel_dD) - (np.asarray(da1) + np.asarray(da2)) / (
         np.asarray(a1) + np.asarray(a2)
     )
+
+
+def rel_dz_correspondence(
+    a1: ArrayLike, a2: ArrayLike, du2_px: ArrayLike, f2_px: ArrayLike
+) -> np.ndarray:
+    """docs/equations.md (M5): dz/z from a correspondence error ``du2_px`` in camera 2
+    (eye 2 turned by du2 / f2), eq. (17) with dD = da1 = 0."""
+    return rel_dz_model2(a1, a2, 0.0, 0.0, np.asarray(du2_px, float) / np.asarray(f2_px, float))
 
 
 def rel_dx_model2(

@@ -14,6 +14,7 @@ from headsim.estimators import (
     rel_dx_model2,
     rel_dy_model2,
     rel_dy_model2_simplified,
+    rel_dz_correspondence,
     rel_dz_model1,
     rel_dz_model1_small_angle,
     rel_dz_model2,
@@ -73,6 +74,17 @@ def test_model2_depth_and_x_formulas_are_the_derivative_of_eqs_4_5():
     assert np.all(
         np.abs(gap[small]) <= 0.05 * (np.abs(da1) + np.abs(da2))[small] / (a1 + a2)[small]
     )
+
+
+def test_correspondence_error_in_depth_is_eye_2_turned_by_du_over_f():
+    # (M5): a target straight ahead at z; camera 2's match du px off turns eye 2 by
+    # du / f.  Exact: the depth where eye 1's ray meets eye 2's turned ray.
+    z, f, du = 1.0, 840.0, 0.1
+    a = math.atan(D / (2.0 * z))
+    exact = D / (math.tan(a) + math.tan(a + du / f)) / z - 1.0
+    rel = float(rel_dz_correspondence(a, a, du, f))
+    assert rel == pytest.approx(exact, rel=2e-3)
+    assert abs(rel) == pytest.approx(z * du / (D * f), rel=1e-2)  # ~ z du / (D f)
 
 
 def test_model2_y_formula_is_the_derivative_of_eqs_9_to_11():
