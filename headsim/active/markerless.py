@@ -71,8 +71,9 @@ def _crop(image: np.ndarray, window: Window) -> np.ndarray:
 
 
 class TemplateTracker:
-    """Camera 1's detector: the fovea around the click in camera 1's first image,
-    tracked (:class:`~headsim.vision.correspondence.Tracker`, drift-controlled).
+    """Camera 1's detector: the fovea around the click in camera 1's first image (or a
+    window of it whose top-left is ``origin_px``), tracked
+    (:class:`~headsim.vision.correspondence.Tracker`, drift-controlled).
 
     ``search_radius_px``: how far from the predicted point a look searches, when the
     looker predicts it (the eye steps since the last sight times the gain);
@@ -86,9 +87,11 @@ class TemplateTracker:
         config: MatchConfig | None = None,
         search_radius_px: float = 12.0,
         reacquire_radius_px: float = 48.0,
+        origin_px: tuple[int, int] = (0, 0),
     ) -> None:
         self.config = config or MatchConfig()
-        self.tracker = Tracker(cut_template(first_image, click_uv, self.config), self.config)
+        template = cut_template(first_image, click_uv, self.config, origin_px)
+        self.tracker = Tracker(template, self.config)
         self.uv = (float(click_uv[0]), float(click_uv[1]))
         self.search_radius_px = search_radius_px
         self.reacquire_radius_px = reacquire_radius_px
@@ -214,7 +217,7 @@ BandFor = Callable[[tuple[float, float]], Callable[[], Band]]
 class MarkerlessPair:
     """One target's detector for both cameras, for procedures that hand one detector
     to the servos (Model 2, Model 1): camera 1 tracks the fovea clicked in its first
-    image (:class:`TemplateTracker`); camera 2 finds camera 1's latest foveal template
+    image (:class:`TemplateTracker`; a window of it at ``origin_px`` will do); camera 2 finds camera 1's latest foveal template
     (cut at camera 1's last confident match, so at fixation once camera 1 fixates) in
     the band ``band_for`` gives for camera 1's last point.  Model 2's images of the
     camera that is not centred come from the same two: camera 2's at step 1 from the
@@ -231,10 +234,11 @@ class MarkerlessPair:
         click_uv: tuple[float, float],
         band_for: BandFor,
         config: MatchConfig | None = None,
+        origin_px: tuple[int, int] = (0, 0),
     ) -> None:
         self.config = config or MatchConfig()
         self.band_for = band_for
-        self.tracker = TemplateTracker(first_image1, click_uv, self.config)
+        self.tracker = TemplateTracker(first_image1, click_uv, self.config, origin_px=origin_px)
         self.finder = CorrespondenceFinder(
             self.tracker.template, band_for(self.tracker.uv), self.config
         )

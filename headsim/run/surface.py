@@ -45,6 +45,7 @@ from headsim.scenario.spec import (
     SurfaceTargetsSpec,
 )
 from headsim.scenario.surface_targets import Click, SurfaceTarget, click, draw_targets, point_world
+from headsim.sim.render import Window
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import Band, Match, MatchConfig, row_band
 
@@ -250,9 +251,13 @@ def measure_surface_targets(
             for placed in drawn.targets:
                 step = hub.begin(placed.name)
                 _start_pose(sim)
-                first = sim.render(1)
                 told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
-                pair = MarkerlessPair(first, told.clicked_uv, band_for)
+                # The first image: the head needs only the fovea around the click (the
+                # full frame's crop, at a window's cost).
+                fovea = _fovea(sim, told.clicked_uv)
+                first = sim.render_window(1, fovea)
+                origin = (fovea.x0, fovea.y0)
+                pair = MarkerlessPair(first, told.clicked_uv, band_for, origin_px=origin)
                 target = Target(placed.name, pair, _true_point(placed))
                 log.clear(_clicked_point(sim, told, placed))
                 m = measure(sim, shared, target, knowledge)
@@ -268,6 +273,12 @@ def measure_surface_targets(
         finally:
             hub.subscribers.remove(log)
     return records, replace(drawn, stats=fixation_stats(records))
+
+
+def _fovea(sim: HeadSim, uv: tuple[float, float]) -> Window:
+    """Camera 1's window that holds the template around ``uv`` (inside the image)."""
+    cam = sim.camera_settings(1)
+    return Window.around(uv, MatchConfig().half_px + 2, (cam.width, cam.height))
 
 
 def _clicked_point(sim: HeadSim, told: Click, placed: SurfaceTarget) -> Callable[[], np.ndarray]:

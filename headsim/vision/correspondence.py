@@ -144,13 +144,19 @@ def predicted_sigma_px(patch: np.ndarray, noise_grey: float) -> float:
     return math.sqrt(2.0 * noise_grey**2 / (patch[inner].size * signal))
 
 
-def cut_template(image: np.ndarray, uv: tuple[float, float], config: MatchConfig) -> Template:
+def cut_template(
+    image: np.ndarray,
+    uv: tuple[float, float],
+    config: MatchConfig,
+    origin_px: tuple[int, int] = (0, 0),
+) -> Template:
     """The foveal template of ``image`` around ``uv`` px (whole pixels, no resampling:
-    the fraction is kept as ``offset_px``).  Raises ValueError where the patch would
-    leave the image."""
+    the fraction is kept as ``offset_px``); ``image`` may be a window whose top-left is
+    ``origin_px`` in the full frame (``uv`` is full-frame).  Raises ValueError where the
+    patch would leave the image."""
     grey = grey_float(image)
     h = config.half_px
-    c, r = round(uv[0]), round(uv[1])
+    c, r = round(uv[0]) - origin_px[0], round(uv[1]) - origin_px[1]
     if not (h <= c < grey.shape[1] - h and h <= r < grey.shape[0] - h):
         raise ValueError(
             f"uv {uv} is within {h} px of the image border: no {2 * h + 1} px template there"
@@ -159,7 +165,7 @@ def cut_template(image: np.ndarray, uv: tuple[float, float], config: MatchConfig
     return Template(
         patch=patch,
         uv=(float(uv[0]), float(uv[1])),
-        offset_px=(float(uv[0] - c), float(uv[1] - r)),
+        offset_px=(float(uv[0] - round(uv[0])), float(uv[1] - round(uv[1]))),
         sigma_px=predicted_sigma_px(patch, config.noise_grey),
         contrast_grey=float(patch.std()),
     )
@@ -402,14 +408,10 @@ class Tracker:
         match = find(self.original, image, band, self.config, origin_px)
         if match.ok and match.uv is not None:
             if match.score >= self.refresh_score:
-                local = (match.uv[0] - origin_px[0], match.uv[1] - origin_px[1])
                 try:
-                    cut = cut_template(image, local, self.config)
+                    self.current = cut_template(image, match.uv, self.config, origin_px)
                 except ValueError:  # too near the image's edge: keep the last copy
                     return match
-                self.current = Template(
-                    cut.patch, match.uv, cut.offset_px, cut.sigma_px, cut.contrast_grey
-                )
                 self.refreshes += 1
             return match
         if self.current is self.original:
