@@ -34,7 +34,9 @@ def test_plane_env_passes_gymnasiums_checker_and_observations_are_the_images() -
     obs, info = env.reset(seed=1)
     assert obs in env.observation_space
     assert obs["cam1"].shape == obs["cam2"].shape == (48, 64, 3)
-    assert env.observation_space["cam1"].shape == (48, 64, 3)
+    space = env.observation_space
+    assert isinstance(space, gymnasium.spaces.Dict)
+    assert space["cam1"].shape == space["cam2"].shape == (48, 64, 3)
     # Textured, not blank: the plane fills both images.
     assert min(float(obs[c].std()) for c in ("cam1", "cam2")) > 5.0
     assert {"vergence_error_deg", "depth_m", "texture_seed", "truth_world_m"} <= set(info)
