@@ -149,7 +149,25 @@ def test_bad_options_name_the_field_and_what_is_allowed() -> None:
         FixateEnv(scene="textured_plane", reward="offsets")
     with pytest.raises(SettingsError, match=r"reward for scene 'marker'.*'vergence'"):
         FixateEnv(reward="vergence")
-    with pytest.raises(SettingsError, match=r"plane_depth_m must lie within \[0.1, 2.5\]"):
+    with pytest.raises(SettingsError, match=r"plane_depth_m must lie within \[0.1, 5.0\]"):
         FixateEnv(scene="textured_plane", randomise={"plane_depth_m": (0.05, 1.0)})
     with pytest.raises(SettingsError, match="scene: the vectorised env has the marker scene only"):
         FixateVectorEnv(1, scene="textured_plane")
+
+
+def test_position_reward_scores_the_heads_estimate_of_the_verged_point() -> None:
+    """Verged by the image policy, the head's Model 1 estimate (encoders and belief) lies
+    within a few percent of the plane point eye 1 looks at."""
+    env = FixateEnv(scene="textured_plane", reward="position", max_steps=20)
+    policy = VergencePolicy(env.action_space, env.period_s)
+    obs, _ = env.reset(seed=1)
+    reward = env.step(np.zeros(3, np.float32))[1]
+    assert reward == -1.0  # eyes parallel: no estimate
+    for _ in range(20):
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        if terminated or truncated:
+            break
+    assert terminated
+    assert -0.05 < reward <= 0.0
+    assert info["estimate_world_m"] is not None
+    env.close()
