@@ -23,7 +23,14 @@ import numpy as np
 from gymnasium import spaces
 
 from headsim.envs.fixate import MOTOR_SPEED_LIMITS_RAD_S
-from headsim.vision.correspondence import MatchConfig, cut_template, find, row_band
+from headsim.vision.correspondence import (
+    Match,
+    MatchConfig,
+    MatchStatus,
+    cut_template,
+    find,
+    row_band,
+)
 from headsim.vision.markers import find_marker
 
 #: Probe size per joint, rad.
@@ -120,6 +127,8 @@ class ServoPolicy:
 
 #: The eye motor's index in the action.
 EYE = 2
+#: The vergence search's step per frame before a first match, rad.
+SEARCH_RAD = 0.05
 
 
 class VergencePolicy:
@@ -128,7 +137,10 @@ class VergencePolicy:
     ``match``: the fovea's template and its thresholds (default: a 31 px template, the
     correspondence's thresholds); ``row_tolerance_px``: how far off camera 2's centre row
     the match may lie.  ``action_scale_rad_s`` as :class:`ServoPolicy`'s.  No action
-    while the match is not OK (low texture, ambiguous, lost).
+    while the match is not OK (low texture, ambiguous, lost), except before the episode's
+    first match: LOST, it turns the eyes in by :data:`SEARCH_RAD` a frame
+    (``converge_sign``: the eye command's sign that does so, + on the paper's head), for
+    a plane so near that camera 1's fovea lies beyond camera 2's searchable row.
     """
 
     def __init__(
@@ -138,6 +150,7 @@ class VergencePolicy:
         action_scale_rad_s: np.ndarray | None = None,
         match: MatchConfig | None = None,
         row_tolerance_px: float = 3.0,
+        converge_sign: float = 1.0,
     ) -> None:
         self.action_space = action_space
         self.action_scale_rad_s = (
@@ -149,41 +162,56 @@ class VergencePolicy:
         self.match = match or MatchConfig(half_px=15)
         self.row_tolerance_px = row_tolerance_px
         self.gain_px_per_rad: float | None = None  # d(disparity) / d(eye encoder)
+        self.converge_sign = float(converge_sign)
         self._last: tuple[float, float] | None = None  # (eye encoder, disparity)
+        self._matched = False  # this episode
 
     def reset(self) -> None:
-        """A new episode: forget the last frame, keep the gain."""
+        """A new episode: forget the last frame and match, keep the gain."""
         self._last = None
+        self._matched = False
 
-    def disparity_px(self, observation: dict[str, np.ndarray]) -> float | None:
-        """Where camera 1's fovea lies in camera 2, from camera 2's centre column, px
-        (None: no OK match)."""
+    def fovea_match(self, observation: dict[str, np.ndarray]) -> Match:
+        """Camera 1's fovea found along camera 2's centre row."""
         cam1, cam2 = observation["cam1"], observation["cam2"]
         height, width = cam1.shape[:2]
         centre = ((width - 1) / 2, (height - 1) / 2)
         template = cut_template(cam1, centre, self.match)
         band = row_band(centre[1], cam2.shape[1], self.row_tolerance_px)
-        found = find(template, cam2, band, self.match)
+        return find(template, cam2, band, self.match)
+
+    def disparity_px(self, observation: dict[str, np.ndarray]) -> float | None:
+        """Where camera 1's fovea lies in camera 2, from camera 2's centre column, px
+        (None: no OK match)."""
+        found = self.fovea_match(observation)
         if not found.ok or found.uv is None:
             return None
-        return float(found.uv[0] - (cam2.shape[1] - 1) / 2)
+        return float(found.uv[0] - (observation["cam2"].shape[1] - 1) / 2)
 
     def __call__(self, observation: dict[str, np.ndarray]) -> np.ndarray:
         eye = float(np.asarray(observation["encoders"], float)[EYE])
-        disparity = self.disparity_px(observation)
-        if disparity is None:
+        found = self.fovea_match(observation)
+        speeds = np.zeros(3)
+        if not found.ok or found.uv is None:
             self._last = None
-            return np.zeros(3, np.float32)
+            if found.status is MatchStatus.LOST and not self._matched:
+                # Not in camera 2's view yet: a plane nearer than its row reaches.
+                speeds[EYE] = self.converge_sign * SEARCH_RAD / self.period_s
+            return self._action(speeds)
+        self._matched = True
+        disparity = float(found.uv[0] - (observation["cam2"].shape[1] - 1) / 2)
         last, self._last = self._last, (eye, disparity)
         if last is not None and abs(eye - last[0]) >= MIN_SECANT_RAD:
             # Broyden's update in one dimension: the secant of the last move.
             self.gain_px_per_rad = (disparity - last[1]) / (eye - last[0])
-        speeds = np.zeros(3)
         if self.gain_px_per_rad is None or abs(self.gain_px_per_rad) < 1e-6:
             speeds[EYE] = PROBE_RAD / self.period_s  # probe: the gain from the next frame
         else:
             speeds[EYE] = -disparity / self.gain_px_per_rad / self.period_s
-        action = speeds / self.action_scale_rad_s
+        return self._action(speeds)
+
+    def _action(self, speeds_rad_s: np.ndarray) -> np.ndarray:
+        action = speeds_rad_s / self.action_scale_rad_s
         return np.clip(action, self.action_space.low, self.action_space.high).astype(np.float32)
 
 

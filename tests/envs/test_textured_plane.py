@@ -18,6 +18,7 @@ from headsim.envs.policies import VergencePolicy
 from headsim.envs.vector import FixateVectorEnv
 from headsim.sim.render import release_renderers
 from headsim.sim.settings import SettingsError
+from headsim.vision.correspondence import MatchStatus
 
 ID = headsim.envs.FIXATE_ID
 SMALL: dict[str, Any] = {"scene": "textured_plane", "width": 64, "height": 48}
@@ -170,4 +171,21 @@ def test_position_reward_scores_the_heads_estimate_of_the_verged_point() -> None
     assert terminated
     assert -0.05 < reward <= 0.0
     assert info["estimate_world_m"] is not None
+    env.close()
+
+
+def test_vergence_policy_searches_inward_for_a_plane_nearer_than_its_row_reaches() -> None:
+    """At 0.3 m camera 1's fovea lies about 58 px left of camera 2's centre, beyond the
+    31 px template's reach in a 128 px row: LOST, so the policy turns the eyes in first."""
+    env = FixateEnv(scene="textured_plane", randomise={"plane_depth_m": (0.3, 0.3)})
+    policy = VergencePolicy(env.action_space, env.period_s)
+    obs, info = env.reset(seed=0)
+    policy.reset()
+    assert policy.fovea_match(obs).status is MatchStatus.LOST
+    assert policy(obs)[2] > 0.0
+    for _ in range(10):
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        if terminated or truncated:
+            break
+    assert terminated, f"error {info['vergence_error_deg']:.2f} deg"
     env.close()
