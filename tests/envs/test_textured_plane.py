@@ -189,3 +189,15 @@ def test_vergence_policy_searches_inward_for_a_plane_nearer_than_its_row_reaches
             break
     assert terminated, f"error {info['vergence_error_deg']:.2f} deg"
     env.close()
+
+
+def test_set_texture_refuses_an_unknown_texture_or_another_size() -> None:
+    env = FixateEnv(**SMALL)
+    env.reset(seed=0)
+    sim = env._sim
+    assert sim is not None
+    with pytest.raises(SettingsError, match="no texture 'nope' in this scene"):
+        sim.set_texture("nope", np.zeros((8, 8, 3), np.uint8))
+    with pytest.raises(SettingsError, match=r"texture 'gym_plane_texture' takes \(128, 128, 3\)"):
+        sim.set_texture("gym_plane_texture", np.zeros((64, 64, 3), np.uint8))
+    env.close()
