@@ -3,8 +3,10 @@ Gymnasium's checker, the image-based vergence policy, bad options."""
 
 from __future__ import annotations
 
+import ast
 import math
 import warnings
+from pathlib import Path
 from typing import Any
 
 import gymnasium
@@ -13,6 +15,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import headsim.envs
+import headsim.envs.policies
 from headsim.envs.fixate import FixateEnv, plane_texture_px
 from headsim.envs.policies import VergencePolicy
 from headsim.envs.vector import FixateVectorEnv
@@ -201,3 +204,16 @@ def test_set_texture_refuses_an_unknown_texture_or_another_size() -> None:
     with pytest.raises(SettingsError, match=r"texture 'gym_plane_texture' takes \(128, 128, 3\)"):
         sim.set_texture("gym_plane_texture", np.zeros((64, 64, 3), np.uint8))
     env.close()
+
+
+def test_the_policies_never_import_the_scene_truth() -> None:
+    """The vergence error is the env's teacher signal; a policy sees only observations."""
+    source = Path(headsim.envs.policies.__file__).read_text(encoding="utf-8")
+    modules = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            modules.add(node.module)
+        elif isinstance(node, ast.Import):
+            modules.update(alias.name for alias in node.names)
+    assert "headsim.vision.correspondence" in modules  # the check sees its imports
+    assert not modules & {"headsim.run.landing", "headsim.scenario.surface_targets", "mujoco"}
