@@ -8,6 +8,11 @@ servo policy probes its Jacobian in its first episode (3 extra steps) and
 keeps it, so the figure is given with and without that first episode.  Also
 checks the API: gymnasium's check_env, two same-seed resets, 2 spawned workers.
 
+The textured plane (``scene="textured_plane"``): its step time over the marker
+scene's (zero actions, interleaved blocks in this process, resets excluded), and
+the image-based vergence policy's share of pink-noise episodes within tolerance
+(1 px at eye 2's focal length) in 10 steps.
+
     python benchmarks/gym_env.py [--episodes 100] [--json out.json]
 """
 
@@ -21,7 +26,8 @@ import numpy as np
 from gymnasium.utils.env_checker import check_env
 
 import headsim.envs
-from headsim.envs.policies import RandomPolicy, ServoPolicy
+from headsim.envs.fixate import FixateEnv
+from headsim.envs.policies import RandomPolicy, ServoPolicy, VergencePolicy
 from headsim.files import write_json_atomic
 
 ID = headsim.envs.FIXATE_ID
@@ -65,6 +71,28 @@ def step_over_render_ratio(
             sim.render(2)
         render_s += time.perf_counter() - start
     return step_s / render_s, blocks * size / render_s
+
+
+def plane_over_marker_step(blocks: int = 6, size: int = 50) -> tuple[float, float, float]:
+    """The textured plane's env step time over the marker scene's: zero actions, 128 x 96,
+    blocks interleaved, each step timed alone (no resets).  Returns (ratio, marker ms,
+    plane ms) per step."""
+    envs = [FixateEnv(max_steps=10**6), FixateEnv(scene="textured_plane", max_steps=10**6)]
+    zero = np.zeros(3, np.float32)
+    totals = [0.0, 0.0]
+    for env in envs:
+        env.reset(seed=0)
+        env.step(zero)  # the renderer made, the texture uploaded
+    for _ in range(blocks):
+        for index, env in enumerate(envs):
+            for _ in range(size):
+                start = time.perf_counter()
+                env.step(zero)
+                totals[index] += time.perf_counter() - start
+    for env in envs:
+        env.close()
+    marker_ms, plane_ms = (1000 * t / (blocks * size) for t in totals)
+    return plane_ms / marker_ms, marker_ms, plane_ms
 
 
 def episodes(env: gymnasium.Env, policy: object, count: int, limit: int = 10) -> list[int | None]:
@@ -124,6 +152,16 @@ def main() -> None:
         np.mean([n is not None for n in random_lengths])
     )
     env.close()
+    ratio, marker_ms, plane_ms = plane_over_marker_step()
+    results["plane_step_over_marker_step"] = ratio
+    results["marker_step_ms"] = marker_ms
+    results["plane_step_ms"] = plane_ms
+    plane = FixateEnv(scene="textured_plane")
+    verging = episodes(plane, VergencePolicy(plane.action_space, plane.period_s), args.episodes)
+    verged = [n for n in verging if n is not None]
+    results["vergence_policy_within_tolerance_in_10_steps_pct"] = 100 * len(verged) / len(verging)
+    results["vergence_policy_mean_steps"] = float(np.mean(verged)) if verged else float("nan")
+    plane.close()
     for key, value in results.items():
         print(f"{key:<48} {value:10.2f}")
     if args.json:

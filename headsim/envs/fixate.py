@@ -1,4 +1,5 @@
-"""``headsim/Fixate-v0``: bring a marker onto both cameras' goal columns with neck and eyes.
+"""``headsim/Fixate-v0``: bring a marker onto both cameras' goal columns with neck and eyes,
+or verge on a textured plane.
 
 Observation (``Dict``): ``cam1``, ``cam2`` -- both cameras' RGB images
 (default 128 x 96); ``encoders`` -- (neck yaw, neck pitch, eye motor), rad.
@@ -44,6 +45,28 @@ within ``tolerance_px`` of the goals in both images; truncated after
 
 The target is a red ball (``target_radius_m``, default 20 mm: the scenes' 4 mm
 markers are a third of a pixel across at 1.5 m in a 128 x 96 image).
+
+``scene="textured_plane"``: no marker, no room: before a plain background stands a
+fronto-parallel plane (a thin box facing W's -y, no shadows), centred straight ahead of
+the eyes' centre at rest at a depth ``plane_depth_m`` drawn per episode (default 0.3 to
+2 m; ``randomise`` may set it within 0.1..5 m), with a ``texture`` drawn from the
+episode's seed (:mod:`headsim.sim.textures`: default ``pink`` 1/f noise, or
+``grating``, ``low``, ``repetitive``; the texture's defaults otherwise).  The plane
+spans +-45 degrees seen from the eyes at rest, whatever its depth, and one texture
+covers it, about one texel per pixel (:func:`plane_texture_px`): only disparity tells
+its depth, not the texture's scale.  The target is where eye 1's optical axis (its
+goal pixel) meets the scene (``mujoco.mj_ray``, truth).  ``info``:
+``vergence_error_deg``, the angle between eye 2's goal ray and the direction from eye 2
+to that point (:func:`headsim.run.landing.vergence_error_deg`; NaN when eye 1's ray
+hits nothing), ``depth_m`` (the plane's), ``texture_seed``, and ``truth_world_m`` (that
+target); no ``found`` or ``offsets_px``.  Reward ``"vergence"`` (the default there):
+minus the vergence error over the camera's half horizontal field of view, capped at 1
+(-1 when NaN), as the offsets are shares of half the image: the teacher signal of
+active efficient coding, truth that no policy may read; ``"position"`` scores the
+Model 1 estimate against that target.  Terminated when the vergence error is within
+the angle ``tolerance_px`` subtends at eye 2's focal length.  The vectorised env has
+no plane scene.
+
 ``multisamples`` is MuJoCo's off-screen multisampling: 0 by default here,
 because 4 (the at-rest procedures' setting, edges to a quarter pixel) made a
 128 x 96 render about 5 times slower on the CPU renderer (6.5 against 1.3 ms
@@ -65,6 +88,7 @@ from headsim.active.measurement import HeadKnowledge, to_world
 from headsim.estimators.model1 import model1
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, Frame, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
+from headsim.run.landing import landing, vergence_error_deg
 from headsim.sim.heads import HeadModel, shipped
 from headsim.sim.model import design, neck_of, on_head
 from headsim.sim.settings import (
@@ -77,6 +101,8 @@ from headsim.sim.settings import (
     SettingsError,
 )
 from headsim.sim.simulator import HeadSim, for_settings
+from headsim.sim.textured_scene import LightSettings, RoomSpec, SceneObject
+from headsim.sim.textures import TEXTURE_KINDS, TextureSpec, texture_grey, tint_of, to_rgb
 from headsim.vision.markers import find_marker
 
 
@@ -102,7 +128,22 @@ TARGET_COLOUR = "red"
 CAMERA_FIELDS = CAMERA_NUMBER_FIELDS  # their order fixes the random draws
 HEAD_FIELDS = ("baseline_m",)
 TARGET_FIELDS = ("depth_m", "bearing_rad", "speed_m_s")
-REWARDS = ("offsets", "position")
+PLANE_FIELDS = ("plane_depth_m",)
+#: What the eyes look at: a marker ball, or a textured plane filling the view.
+SCENES = ("marker", "textured_plane")
+REWARDS = ("offsets", "position", "vergence")
+#: The rewards each scene offers; the first is its default.
+SCENE_REWARDS = {"marker": ("offsets", "position"), "textured_plane": ("vergence", "position")}
+#: The plane's body, geom and texture (``<name>_texture``).
+PLANE_NAME = "gym_plane"
+#: The plane's half-size seen from the eyes' centre at rest, deg.
+PLANE_HALF_ANGLE_DEG = 45.0
+#: Half the plane's thickness (a thin box), m.
+PLANE_HALF_THICKNESS_M = 0.005
+#: The plane's nearest and farthest depths, m: at 5 m the eyes' vergence is under 2 degrees.
+PLANE_DEPTH_LIMITS_M = (0.1, 5.0)
+#: The key light shines along the view (the room's default, from above, left the plane dim).
+PLANE_LIGHT = LightSettings(direction_world=(0.0, 1.0, -0.3), diffuse=0.7, ambient=0.3)
 #: What an action is: the share of each motor's speed limit, or rad/s.
 ACTION_SPACES = ("normalised", "physical")
 #: The motors' speed limits, rad/s, in the action's order: neck yaw, neck pitch, eye.
@@ -112,7 +153,7 @@ MOTOR_SPEED_LIMITS_RAD_S = np.array(
 
 
 def _check_ranges(randomise: dict[str, Any]) -> dict[str, tuple[float, float]]:
-    allowed = (*CAMERA_FIELDS, *HEAD_FIELDS, *TARGET_FIELDS)
+    allowed = (*CAMERA_FIELDS, *HEAD_FIELDS, *TARGET_FIELDS, *PLANE_FIELDS)
     ranges = {}
     for name, bounds in randomise.items():
         if name not in allowed:
@@ -122,8 +163,20 @@ def _check_ranges(randomise: dict[str, Any]) -> dict[str, tuple[float, float]]:
             raise SettingsError(
                 f"randomise.{name} must be (low, high) with low <= high, got {bounds!r}"
             )
+        low, high = PLANE_DEPTH_LIMITS_M
+        if name == "plane_depth_m" and not (low <= lo and hi <= high):
+            raise SettingsError(
+                f"randomise.plane_depth_m must lie within [{low}, {high}] m, got {bounds!r}"
+            )
         ranges[name] = (lo, hi)
     return ranges
+
+
+def plane_texture_px(focal_px: float) -> int:
+    """The plane texture's side: the power of two (64..2048) that gives at least one texel
+    per pixel at the plane's centre seen straight on with focal length ``focal_px``."""
+    need = 2.0 * math.tan(math.radians(PLANE_HALF_ANGLE_DEG)) * focal_px
+    return int(min(max(2 ** math.ceil(math.log2(need)), 64), 2048))
 
 
 class FixateEnv(gymnasium.Env):
@@ -138,7 +191,7 @@ class FixateEnv(gymnasium.Env):
         frame_rate_hz: float = 30.0,
         latency_frames: int = 0,
         max_steps: int = 50,
-        reward: str = "offsets",
+        reward: str | None = None,
         tolerance_px: float = 1.0,
         randomise: dict[str, Any] | None = None,
         target_radius_m: float = 0.02,
@@ -147,13 +200,26 @@ class FixateEnv(gymnasium.Env):
         belief: HeadBelief | None = None,
         action_space: str = "normalised",
         head: str | HeadModel = "paper",
+        scene: str = "marker",
+        texture: str = "pink",
     ) -> None:
+        if scene not in SCENES:
+            raise SettingsError(f"scene must be one of {', '.join(SCENES)}, got {scene!r}")
+        if texture not in TEXTURE_KINDS:
+            raise SettingsError(
+                f"texture must be one of {', '.join(TEXTURE_KINDS)}, got {texture!r}"
+            )
+        if reward is None:
+            reward = SCENE_REWARDS[scene][0]
         if action_space not in ACTION_SPACES:
             raise SettingsError(
                 f"action_space must be one of {', '.join(ACTION_SPACES)}, got {action_space!r}"
             )
-        if reward not in REWARDS:
-            raise SettingsError(f"reward must be one of {', '.join(REWARDS)}, got {reward!r}")
+        if reward not in SCENE_REWARDS[scene]:
+            raise SettingsError(
+                f"reward for scene {scene!r} must be one of {', '.join(SCENE_REWARDS[scene])}, "
+                f"got {reward!r}"
+            )
         if render_mode not in (None, "rgb_array"):
             raise SettingsError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         if not (isinstance(max_steps, int) and max_steps >= 1):
@@ -170,6 +236,8 @@ class FixateEnv(gymnasium.Env):
         self.multisamples = multisamples
         self.render_mode = render_mode
         self.reward_kind = reward
+        self.scene = scene
+        self.texture = texture
         self.max_steps = max_steps
         self.tolerance_px = float(tolerance_px)
         self.live_config = LiveConfig(frame_rate_hz=frame_rate_hz, latency_frames=latency_frames)
@@ -191,7 +259,24 @@ class FixateEnv(gymnasium.Env):
             "depth_m": (0.5, 1.5),
             "bearing_rad": (-0.15, 0.15),
             "speed_m_s": (0.0, 0.0),
+            "plane_depth_m": (0.3, 2.0),
         }
+        self._room: RoomSpec | None = None
+        if scene == "textured_plane":
+            # A thin box, not a MuJoCo plane: an OpenGL context builds a plane's grid once,
+            # at its size then, while a box is scaled at every render (_place_plane sizes it).
+            # Its face toward the head carries the whole texture, whatever its size.
+            plane = SceneObject(
+                PLANE_NAME,
+                "box",
+                (1.0, PLANE_HALF_THICKNESS_M, 1.0),
+                (0.0, 1.0, 0.0),
+                TextureSpec(texture, size_px=plane_texture_px(focal)),
+            )
+            # No room around it: behind a plane that fills the view it doubled a render's
+            # cost (2.9 against 5.7 ms a stereo pair at 128 x 96, one run).
+            self._room = RoomSpec(objects=(plane,), light=PLANE_LIGHT, plain=True)
+        self._plane: dict[str, Any] = {}
         self.randomise = _check_ranges(randomise or {})
         image = spaces.Box(0, 255, (height, width, 3), np.uint8)
         low = -_encoder_bounds(head_model)
@@ -244,10 +329,20 @@ class FixateEnv(gymnasium.Env):
         if self._sim is None or settings != self._settings:
             if self._sim is not None:
                 self._sim.close()
-            self._sim, self._settings = for_settings(settings), settings
+            if self._room is None:
+                self._sim = for_settings(settings)
+            else:
+                self._sim = for_settings(settings, scene="base", room=self._room)
+            self._settings = settings
             self._prepare_model(self._sim)
         sim = self._sim
         sim.reset()
+        if self._room is not None:
+            self._place_plane(sim, self._draw(ranges, "plane_depth_m"))
+            self._live = LiveHead(sim, self.live_config)
+            self._steps = 0
+            self._frame = self._live.capture()
+            return self._observation(), self._info(self._measure())
         depth = self._draw(ranges, "depth_m")
         azimuth, elevation = self._draw(ranges, "bearing_rad"), self._draw(ranges, "bearing_rad")
         start = _head_at_home(settings) + depth * np.array(
@@ -292,8 +387,12 @@ class FixateEnv(gymnasium.Env):
         self._frame = self._live.capture()
         self._steps += 1
         measured = self._measure()
-        offsets, found = measured["offsets_px"], measured["found"]
-        terminated = bool(found and np.all(np.abs(offsets) <= self.tolerance_px))
+        if self._room is None:
+            offsets, found = measured["offsets_px"], measured["found"]
+            terminated = bool(found and np.all(np.abs(offsets) <= self.tolerance_px))
+        else:
+            error = measured["vergence_error_deg"]
+            terminated = bool(error <= self._angle_deg(self.tolerance_px))  # False when NaN
         truncated = bool(not terminated and self._steps >= self.max_steps)
         return (
             self._observation(),
@@ -305,11 +404,34 @@ class FixateEnv(gymnasium.Env):
 
     def _prepare_model(self, sim: HeadSim) -> None:
         """This env's own model: its target's size and the renderer's multisampling."""
-        geom = sim.model.geom(TARGET_BODY)
-        sim.model.geom_size[geom.id, 0] = self.target_radius_m
-        sim.model.geom_rbound[geom.id] = self.target_radius_m
+        if self._room is None:
+            geom = sim.model.geom(TARGET_BODY)
+            sim.model.geom_size[geom.id, 0] = self.target_radius_m
+            sim.model.geom_rbound[geom.id] = self.target_radius_m
         # Read when the renderer is made, at the first render (after this).
         sim.model.vis.quality.offsamples = self.multisamples
+
+    def _place_plane(self, sim: HeadSim, depth_m: float) -> None:
+        """The episode's plane: ``depth_m`` straight ahead of the eyes' centre at rest,
+        spanning +-:data:`PLANE_HALF_ANGLE_DEG`, with a texture from the episode's seed."""
+        seed = int(self.np_random.integers(0, 2**31 - 1))
+        texture_id = sim.model.texture(f"{PLANE_NAME}_texture").id
+        spec = TextureSpec(self.texture, seed=seed, size_px=int(sim.model.tex_width[texture_id]))
+        sim.set_texture(f"{PLANE_NAME}_texture", to_rgb(texture_grey(spec), tint_of(seed)))
+        eyes = (sim.world_from_camera(1)[:3, 3] + sim.world_from_camera(2)[:3, 3]) / 2
+        half = depth_m * math.tan(math.radians(PLANE_HALF_ANGLE_DEG))
+        front = np.array([0.0, depth_m + PLANE_HALF_THICKNESS_M, 0.0])
+        sim.model.body_pos[sim.model.body(PLANE_NAME).id] = eyes + front
+        geom = sim.model.geom(PLANE_NAME).id
+        sim.model.geom_size[geom] = (half, PLANE_HALF_THICKNESS_M, half)
+        sim.model.geom_rbound[geom] = math.sqrt(2 * half**2 + PLANE_HALF_THICKNESS_M**2)
+        mujoco.mj_forward(sim.model, sim.data)
+        self._plane = {"depth_m": depth_m, "texture_seed": seed}
+
+    def _angle_deg(self, pixels: float) -> float:
+        """``pixels`` from eye 2's image centre seen as an angle, deg."""
+        assert self._settings is not None
+        return math.degrees(math.atan(pixels / self._settings.cameras[1].kx))
 
     # -- measurements ------------------------------------------------------------
     def _goals(self) -> np.ndarray:
@@ -319,13 +441,42 @@ class FixateEnv(gymnasium.Env):
 
     def _measure(self) -> dict[str, Any]:
         assert self._frame is not None
+        if self._room is not None:
+            return self._measure_plane()
         seen = [find_marker(image, TARGET_COLOUR) for image in self._frame.images]
         found = all(s.found and s.uv is not None for s in seen)
         offsets = np.full(3, np.nan)
         if found:
             (u1, v1), (u2, v2) = seen[0].uv, seen[1].uv  # type: ignore[misc]
             offsets = np.array([u1, u2, (v1 + v2) / 2]) - self._goals()
-        return {"found": found, "offsets_px": offsets, "estimate_world_m": self._estimate()}
+        return {
+            "found": found,
+            "offsets_px": offsets,
+            "estimate_world_m": self._estimate(),
+            "truth_world_m": self._frame.truth_target_world_m,
+        }
+
+    def _measure_plane(self) -> dict[str, Any]:
+        """Truth, for the reward and info only: where eye 1's goal ray meets the scene and
+        eye 2's vergence error on it."""
+        assert self._sim is not None
+        goal1, goal2 = self._goals_uv()
+        one, two = landing(self._sim, 1, goal1), landing(self._sim, 2, goal2)
+        error = (
+            math.nan
+            if one.point_world_m is None
+            else vergence_error_deg(two.origin_world_m, two.direction_world, one.point_world_m)
+        )
+        return {
+            "vergence_error_deg": error,
+            "estimate_world_m": self._estimate(),
+            "truth_world_m": one.point_world_m,
+        }
+
+    def _goals_uv(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        assert self._settings is not None
+        one, two = (c.image_centre for c in self._settings.cameras)
+        return (float(one[0]), float(one[1])), (float(two[0]), float(two[1]))
 
     def _estimate(self) -> np.ndarray | None:
         """The head's Model 1 estimate from the encoders and its belief (W, m), as if fixated."""
@@ -350,8 +501,14 @@ class FixateEnv(gymnasium.Env):
             cam = self._settings.cameras[0]
             scale = np.array([cam.width / 2, cam.width / 2, cam.height / 2])
             return -float(np.mean(np.minimum(np.abs(measured["offsets_px"]) / scale, 1.0)))
+        if self.reward_kind == "vergence":
+            error = measured["vergence_error_deg"]
+            if math.isnan(error):
+                return -1.0
+            half_view_deg = self._angle_deg(self._settings.cameras[1].width / 2)
+            return -min(error / half_view_deg, 1.0)
         # Scoring only: the truth judges the head's estimate, it never enters it.
-        estimate, truth = measured["estimate_world_m"], self._frame.truth_target_world_m
+        estimate, truth = measured["estimate_world_m"], measured["truth_world_m"]
         if truth is None or estimate is None:
             return -1.0
         s = self._settings
@@ -368,11 +525,15 @@ class FixateEnv(gymnasium.Env):
 
     def _info(self, measured: dict[str, Any]) -> dict[str, Any]:
         assert self._frame is not None
-        truth = self._frame.truth_target_world_m
+        truth = measured["truth_world_m"]
         estimate = measured["estimate_world_m"]
+        info: dict[str, Any] = (
+            {"found": measured["found"], "offsets_px": measured["offsets_px"]}
+            if self._room is None
+            else {"vergence_error_deg": measured["vergence_error_deg"], **self._plane}
+        )
         return {
-            "found": measured["found"],
-            "offsets_px": measured["offsets_px"],
+            **info,
             "estimate_world_m": None if estimate is None else estimate.copy(),
             "time_s": self._frame.time_s,
             "truth_world_m": None if truth is None else truth.copy(),  # truth: scoring only
@@ -390,4 +551,11 @@ class FixateEnv(gymnasium.Env):
             self._sim = None
 
 
-__all__ = ["ACTION_SPACES", "MOTOR_SPEED_LIMITS_RAD_S", "FixateEnv"]
+__all__ = [
+    "ACTION_SPACES",
+    "MOTOR_SPEED_LIMITS_RAD_S",
+    "SCENES",
+    "SCENE_REWARDS",
+    "FixateEnv",
+    "plane_texture_px",
+]

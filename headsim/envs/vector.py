@@ -56,6 +56,11 @@ class FixateVectorEnv(VectorEnv):
     ) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
             raise SettingsError(f"num_envs must be a whole number >= 1, got {num_envs!r}")
+        if env_kwargs.get("scene", "marker") != "marker":
+            raise SettingsError(
+                "scene: the vectorised env has the marker scene only (its batch renderer "
+                "keeps the textures it was made with); use FixateEnv for 'textured_plane'"
+            )
         self.session = BatchSession(device, samples_per_pixel)
         self.envs = [FixateEnv(**env_kwargs) for _ in range(num_envs)]
         spec = gymnasium.registry.get(FIXATE_ID)

@@ -23,6 +23,7 @@ one render and is counted, with its pixels in full-frame equivalents.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import math
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
@@ -45,6 +46,11 @@ POOL_SIZE = 4
 _POOL: OrderedDict[Hashable, mujoco.Renderer] = OrderedDict()
 #: Renderers created in this process (the pool's misses), for the bench and tests.
 created = 0
+#: Which version of a changed texture each pooled context holds, by (context key, texture
+#: id): contexts are shared, so an eye renderer whose model's texture changed uploads it
+#: again before drawing whenever another model's version was drawn there last.
+_UPLOADED: dict[tuple[Hashable, int], int] = {}
+_versions = itertools.count(1)
 
 
 #: What an OpenGL context holds of a model (uploaded once): meshes, textures, height
@@ -98,6 +104,10 @@ def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
             model.vis.global_.offwidth, model.vis.global_.offheight = saved
         check_renderer(renderer)
         created += 1
+        for uploaded in [k for k in _UPLOADED if k[0] == key]:
+            del _UPLOADED[
+                uploaded
+            ]  # a new context holds the textures of the model it was made with
     _POOL[key] = renderer
     while len(_POOL) > POOL_SIZE:
         _, oldest = _POOL.popitem(last=False)
@@ -110,6 +120,7 @@ def release_renderers() -> None:
     while _POOL:
         _, renderer = _POOL.popitem()
         renderer.close()
+    _UPLOADED.clear()
 
 
 class EyeRenderer:
@@ -154,10 +165,21 @@ class EyeRenderer:
         self.render_count = 0
         #: Pixels rendered, in full frames of the camera that rendered them.
         self.rendered_frames = 0.0
+        #: The version of each texture changed in the model since it was built, by texture id.
+        self._textures: dict[int, int] = {}
+
+    def texture_changed(self, texture_id: int) -> None:
+        """The model's ``tex_data`` of ``texture_id`` changed: upload it before the next image."""
+        self._textures[texture_id] = next(_versions)
 
     def _renderer(self) -> mujoco.Renderer:
         renderer = _acquire(self._key, self._mj_model)
         use_model(renderer, self._mj_model)  # the same assets; this model's cameras and bodies
+        for texture_id, version in self._textures.items():
+            if _UPLOADED.get((self._key, texture_id)) != version:
+                make_current(renderer)
+                mujoco.mjr_uploadTexture(self._mj_model, mjr_context(renderer), texture_id)
+                _UPLOADED[(self._key, texture_id)] = version
         return renderer
 
     def _draw(

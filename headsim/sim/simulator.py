@@ -423,6 +423,25 @@ class HeadSim:
             self.data.mocap_quat[mocap_id] = quat_world
         mujoco.mj_forward(self.model, self.data)
 
+    def set_texture(self, name: str, rgb: np.ndarray) -> None:
+        """Replace texture ``name``'s pixels with ``rgb`` ((height, width, 3) uint8, its size);
+        the next images show it."""
+        texture_id = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_TEXTURE, name)
+        if texture_id < 0:
+            raise SettingsError(f"no texture {name!r} in this scene")
+        shape = (
+            int(self.model.tex_height[texture_id]),
+            int(self.model.tex_width[texture_id]),
+            int(self.model.tex_nchannel[texture_id]),
+        )
+        if rgb.shape != shape or rgb.dtype != np.uint8:
+            raise SettingsError(
+                f"texture {name!r} takes {shape} uint8, got {rgb.shape} {rgb.dtype}"
+            )
+        start = int(self.model.tex_adr[texture_id])
+        self.model.tex_data[start : start + rgb.size] = rgb.reshape(-1)
+        self._renderer.texture_changed(texture_id)
+
     def camera_matrix(self, camera: CameraId) -> np.ndarray:
         """True intrinsic matrix K of a camera's output image, px."""
         return camera_matrix(self.camera_settings(camera))

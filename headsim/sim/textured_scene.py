@@ -80,7 +80,9 @@ class RoomSpec:
     ``wall_top_z_m``, a back wall at ``back_wall_y_m``, side walls at +-``side_wall_x_m``
     (open behind the head, where the floor and side walls end 1 m back), a table whose top is at
     ``table_top_z_m`` spanning ``table_x_m`` and ``table_y_m`` (each a (min, max)), each
-    with a texture of ``surface`` kind from the seed; ``objects`` on it; ``light``."""
+    with a texture of ``surface`` kind from the seed; ``objects`` on it; ``light``.
+    ``plain``: no floor, walls or table, only the objects before MuJoCo's plain background
+    (a scene that fills the view with its objects renders fastest so)."""
 
     seed: int = 0
     surface: str = "pink"
@@ -93,11 +95,14 @@ class RoomSpec:
     table_y_m: tuple[float, float] = (0.15, 2.1)
     objects: tuple[SceneObject, ...] = ()
     light: LightSettings = field(default_factory=LightSettings)
+    plain: bool = False
 
     def surfaces(self) -> tuple[SceneObject, ...]:
         """The floor, the walls and the table, as textured objects; each plane faces into
         the room (MuJoCo draws a plane, and ``mj_ray`` meets it, from the front).  No
-        ceiling: it would shadow the whole room from the key light."""
+        ceiling: it would shadow the whole room from the key light.  None when ``plain``."""
+        if self.plain:
+            return ()
         x0, x1 = self.table_x_m
         y0, y1 = self.table_y_m
         half_height = (self.wall_top_z_m - self.floor_z_m) / 2

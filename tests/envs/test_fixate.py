@@ -93,7 +93,9 @@ def test_position_reward_is_small_when_fixated() -> None:
 def test_bad_options_name_the_field() -> None:
     with pytest.raises(SettingsError, match="unknown field 'focal'"):
         gymnasium.make(ID, randomise={"focal": (1, 2)})
-    with pytest.raises(SettingsError, match="reward must be one of offsets, position"):
+    with pytest.raises(
+        SettingsError, match="reward for scene 'marker' must be one of offsets, position"
+    ):
         gymnasium.make(ID, reward="distance")
     with pytest.raises(SettingsError, match="action_space must be one of normalised, physical"):
         gymnasium.make(ID, action_space="rad/s")
