@@ -212,7 +212,7 @@ def measure_surface_targets(
                 _start_pose(sim)
                 first = sim.render(1)
                 told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
-                pair = MarkerlessPair(first, told.clicked_uv, band_for)
+                pair = MarkerlessPair(first, told.clicked_uv, band_for, sink=hub)
                 target = Target(placed.name, pair, _truth(placed))
                 log.clear()
                 m = measure(sim, shared, target, knowledge)
