@@ -112,7 +112,11 @@ class RoomRecording:
         for cam, colour in zip(names.CAMERAS, EYE_COLOURS, strict=True):
             # Each eye's colour; its ambiguity darker, as a cross.
             dark = tuple(c // 2 for c in colour)
-            for key, shade, marker in (("score", colour, "circle"), ("ambiguity", dark, "cross")):
+            shapes = rr.components.MarkerShape
+            for key, shade, marker in (
+                ("score", colour, shapes.Circle),
+                ("ambiguity", dark, shapes.Cross),
+            ):
                 self.rec.log(
                     f"/correlation/{cam}/{key}",
                     rr.SeriesPoints(
