@@ -72,7 +72,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"recording_screenshot: error: {err}", file=sys.stderr)
         return 3
     shot = args.out / "viewer.png"
-    cv2.imwrite(str(shot), cv2.cvtColor(image, cv2.COLOR_RGB2BGR))
+    # Lossless, compressed harder than OpenCV's default: the page ships with the docs.
+    cv2.imwrite(str(shot), cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_PNG_COMPRESSION, 9])
     room = results.get("scenario", {}).get("scene", {}).get("room") is not None
     verdict = judge_room(image) if room else judge(image)
     for name, figure in verdict.figures.items():
