@@ -7,6 +7,7 @@ scores and status, the rays to where each eye landed; and the textured meshes' g
 from __future__ import annotations
 
 import json
+import re
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -227,3 +228,19 @@ def test_a_crop_off_the_image_is_black_there() -> None:
     assert out.shape == (3, 3, 3)
     assert np.array_equal(out[:2, 1:], image[3:5, 0:2])
     assert not out[:, 0].any() and not out[2].any()
+
+
+def test_every_entity_of_the_room_recording_is_documented(room_run: tuple[Path, dict]) -> None:
+    rrd, _ = room_run
+    page = (Path(__file__).resolve().parents[2] / "docs" / "how-to" / "record.md").read_text()
+    table = page[page.index("| entity | type | what |") :].split("\n\n")[0]
+    documented = set()
+    for cell in re.findall(r"^\| ([^|]+) \|", table, re.M):
+        paths = re.findall(r"`([^`]+)`", cell)
+        for p in paths:  # "..." continues the first path's parent
+            documented.add(paths[0].rsplit("/", 2)[0] + p[3:] if p.startswith("...") else p)
+    entities = {c.entity_path for c in RrdReader(rrd).stream()}
+    room = {e for e in entities if e.startswith(("/fovea", "/correlation", "/world/landing"))}
+    assert len(room) == 14  # 5 correlation, 6 foveal, 3 landing
+    others = {e for e in entities if not e.startswith(("/__", "/world/model/"))}
+    assert others <= documented, others - documented
