@@ -8,6 +8,8 @@ The vocabulary of a run, in the order a fixation sees them:
 - :class:`headsim.sim.events.ImageTaken`: the simulator took an image (full,
   retake, window or preview), reported by the simulator itself;
 - :class:`Detected`: a servo looked for its target in the image just taken;
+- :class:`Matched`: a markerless detector correlated its template there (before
+  its :class:`Detected`);
 - :class:`ServoStep`: a servo moved its motors and looked again;
 - :class:`MeasurementDone`: a procedure finished measuring one target;
 - :class:`CalibrationPosition`: the calibration finished one of its positions;
@@ -27,6 +29,7 @@ import numpy as np
 
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.sim.simulator import HeadSim
+from headsim.vision.correspondence import Match, Template
 from headsim.vision.detection import DetectionStatus
 
 
@@ -60,6 +63,18 @@ class Detected:
     camera: int
     status: DetectionStatus
     uv_px: tuple[float, float] | None
+
+
+@dataclass(frozen=True)
+class Matched:
+    """A markerless detector (:mod:`headsim.active.markerless`) correlated ``template``
+    in the image camera 1 or 2 just took: the ``match`` (full-frame pixels, score,
+    ambiguity, status), whatever its status.  Camera 1's template is the fovea cut at
+    the click; camera 2's, camera 1's latest (what it looks for)."""
+
+    camera: int
+    match: Match
+    template: Template
 
 
 class ServoKind(enum.Enum):
@@ -101,6 +116,7 @@ __all__ = [
     "CalibrationPosition",
     "Detected",
     "FixationStarted",
+    "Matched",
     "MeasurementDone",
     "PhaseStarted",
     "ServoKind",

@@ -10,6 +10,8 @@ the same window out of it, so correlation stays foveal there too.
 
 Every match is kept (``matches``) with its score and ambiguity, and the detection
 carries them, also when the match is refused: a confident wrong match stays visible.
+A :class:`MarkerlessPair` given a sink reports each match with its template
+(:class:`~headsim.active.events.Matched`: for the recording).
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from headsim.active.events import Matched
+from headsim.sim.events import EventSink, NoEvents
 from headsim.sim.render import Window
 from headsim.vision.correspondence import (
     Band,
@@ -226,7 +230,7 @@ class MarkerlessPair:
     Through the :class:`~headsim.active.look.Looker` (a
     :class:`~headsim.active.look.FovealDetector`) only; called on an image alone it
     cannot tell the camera and says LOST (a binned preview of a scan: the template is
-    at full scale)."""
+    at full scale).  ``sink``: where each match is reported (:class:`Matched`)."""
 
     def __init__(
         self,
@@ -235,9 +239,11 @@ class MarkerlessPair:
         band_for: BandFor,
         config: MatchConfig | None = None,
         origin_px: tuple[int, int] = (0, 0),
+        sink: EventSink | None = None,
     ) -> None:
         self.config = config or MatchConfig()
         self.band_for = band_for
+        self.sink = sink or NoEvents()
         self.tracker = TemplateTracker(first_image1, click_uv, self.config, origin_px=origin_px)
         self.finder = CorrespondenceFinder(
             self.tracker.template, band_for(self.tracker.uv), self.config
@@ -263,10 +269,14 @@ class MarkerlessPair:
         """``camera``'s point in ``image`` (top-left ``origin_px``), full-frame pixels."""
         if camera == 1:
             detection = self.tracker.locate(camera, image, origin_px)
+            self.sink.emit(Matched(1, self.tracker.matches[-1], self.tracker.template))
             if detection.found and detection.uv is not None:
                 self.finder.band = self.band_for(detection.uv)
             return detection
-        return self._camera2().locate(camera, image, origin_px)
+        finder = self._camera2()
+        detection = finder.locate(camera, image, origin_px)
+        self.sink.emit(Matched(2, finder.matches[-1], finder.template))
+        return detection
 
     def __call__(self, image: np.ndarray) -> Detection:
         """An image without its camera: nothing can be said (LOST, no score)."""

@@ -25,6 +25,8 @@ and the geom has a material, then the material's ``rgba`` times the mean
 colour of its texture.  Body poses are ``Transform3D`` world_from_body at
 ``ROOT/<body>`` (a flat list under ``ROOT``, one entity per body), logged
 by :class:`BodyPoses` whenever a body moved since it was last logged.
+With ``textured=True`` a textured plane, box, cylinder or sphere (a room's) is a
+Mesh3D that carries its texture instead (:mod:`headsim.run.mjcf_textures`).
 """
 
 from __future__ import annotations
@@ -35,6 +37,8 @@ from typing import Any
 import mujoco
 import numpy as np
 import rerun as rr
+
+from headsim.run.mjcf_textures import TEXTURED_KINDS, textured_mesh
 
 #: Entity path under which the model's bodies are logged.
 ROOT = "/world/model"
@@ -220,7 +224,12 @@ def _xyzw(quat_wxyz: np.ndarray) -> list[float]:
 
 
 def log_model_geometry(
-    rec: rr.RecordingStream, model: mujoco.MjModel, root: str = ROOT, *, static: bool = True
+    rec: rr.RecordingStream,
+    model: mujoco.MjModel,
+    root: str = ROOT,
+    *,
+    static: bool = True,
+    textured: bool = False,
 ) -> ModelGeometry:
     """Log every visible geom of ``model`` once under its body's entity path.
 
@@ -228,7 +237,9 @@ def log_model_geometry(
     (``ROOT/<body>/boxes``, ``.../ellipsoids``, ``.../cylinders``,
     ``.../capsules``; hover shows each geom's name); a mesh or height field is
     a Mesh3D at ``ROOT/<body>/<geom>`` with its Transform3D body_from_geom.
-    ``static=False`` logs them at the stream's current time instead.
+    ``static=False`` logs them at the stream's current time instead.  ``textured``: a
+    plane, box, cylinder or sphere with an RGB texture is a Mesh3D carrying it
+    (:mod:`headsim.run.mjcf_textures`) at ``ROOT/<body>/<geom>``, as a mesh is.
     """
     logged: list[LoggedGeom] = []
     invisible: list[str] = []
@@ -239,6 +250,12 @@ def log_model_geometry(
         kind = _shape_kind(model, geom_id)
         if geom_rgba(model, geom_id)[3] <= 0.0:
             invisible.append(name)
+        elif (
+            textured and kind in TEXTURED_KINDS and _log_textured(rec, model, geom_id, root, static)
+        ):
+            body_id = int(model.geom_bodyid[geom_id])
+            path = f"{body_path(model, body_id, root)}/{rr.escape_entity_path_part(name)}"
+            logged.append(LoggedGeom(path, name, body_name(model, body_id), kind, "Mesh3D"))
         elif kind in _BATCHED:
             batches.setdefault((int(model.geom_bodyid[geom_id]), _BATCHED[kind]), []).append(
                 geom_id
@@ -267,6 +284,28 @@ def log_model_geometry(
             for g, n in zip(geoms, names, strict=True)
         ]
     return ModelGeometry(tuple(logged), tuple(invisible), tuple(skipped))
+
+
+def _log_textured(
+    rec: rr.RecordingStream, model: mujoco.MjModel, geom_id: int, root: str, static: bool
+) -> bool:
+    """Log the geom as a textured Mesh3D with its body_from_geom; False if it has no texture."""
+    material = int(model.geom_matid[geom_id])
+    rgba = model.mat_rgba[material] if material >= 0 else model.geom_rgba[geom_id]
+    mesh = textured_mesh(model, geom_id, np.asarray(rgba, dtype=float))
+    if mesh is None:
+        return False
+    body = body_path(model, int(model.geom_bodyid[geom_id]), root)
+    rec.log(
+        f"{body}/{rr.escape_entity_path_part(geom_name(model, geom_id))}",
+        rr.Transform3D(
+            translation=model.geom_pos[geom_id],
+            quaternion=rr.Quaternion(xyzw=_xyzw(model.geom_quat[geom_id])),
+        ),
+        mesh,
+        static=static,
+    )
+    return True
 
 
 _ENTITY = {

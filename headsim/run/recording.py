@@ -79,6 +79,7 @@ from headsim.run.recording_layout import (
     recording_id,
     scenario_markdown,
 )
+from headsim.run.recording_room import RoomRecording
 from headsim.run.rerun_cli import (
     INTERRUPTED_VIEWER_WAIT_S,
     VIEWER_WAIT_S,
@@ -199,6 +200,12 @@ class Recorder:
         self._background = ThreadPoolExecutor(1, thread_name_prefix="headsim-recording")
         self._pending: list[Future[None]] = []
         self._log_static()
+        #: A room run's foveas, matches and landings (:mod:`headsim.run.recording_room`).
+        self.room = (
+            RoomRecording(self.rec, self._later, self.jpeg_quality)
+            if scenario.scene.room is not None
+            else None
+        )
 
     # -- the subscriber -----------------------------------------------------------
     def notify(self, event: object, at: Stamp) -> None:
@@ -212,7 +219,10 @@ class Recorder:
             self.step(at.step, event.label)
         elif isinstance(event, ImageTaken) and event.kind is not ImageKind.PREVIEW:
             assert self.sim is not None
-            self.rendered(self.sim, event.camera, self._frame_image(event), at.frame)
+            image = self._frame_image(event)
+            self.rendered(self.sim, event.camera, image, at.frame)
+            if self.room is not None:
+                self.room.image(event.camera, image, at.frame, self.current_step)
         elif isinstance(event, Detected):
             assert self.sim is not None
             status = event.status.value
@@ -225,6 +235,8 @@ class Recorder:
             self.calibrated(event.report)
         elif isinstance(event, RunFinished):
             self.finished(event.result)
+        if self.room is not None:  # after the recorder: at the time it set
+            self.room.notify(event, at)
 
     def _frame_image(self, event: ImageTaken) -> np.ndarray:
         """The image as shown: a window in a full-size frame, around it the camera's last
@@ -577,7 +589,9 @@ class Recorder:
             self.rec.log(mjcf_rerun.ROOT, rr.Clear(recursive=True))
         self._scene_key = key
         self.geometry.append(
-            mjcf_rerun.log_model_geometry(self.rec, model, static=self._static_geometry)
+            mjcf_rerun.log_model_geometry(
+                self.rec, model, static=self._static_geometry, textured=self.room is not None
+            )
         )
         self._body_poses = mjcf_rerun.BodyPoses(model)
 

@@ -14,6 +14,10 @@ from headsim.run import mjcf_rerun
 from headsim.scenario.spec import Scenario
 from headsim.sim.model import neck_of
 
+#: Half the side of a recorded fovea, px (:mod:`headsim.run.recording_room`; the
+#: template's half side is 20: the fovea is twice its size).
+FOVEA_HALF_PX = 40
+
 GREEN = (40, 220, 90)
 
 RED = (235, 60, 50)
@@ -77,6 +81,8 @@ def _placements(scenario: Scenario | None) -> list[tuple[float, float, float]]:
     points += [p.position_world_m for p in (scene.chessboard, scene.blocks) if p is not None]
     if scene.moving is not None:
         points += list(scene.moving.waypoints_world_m)
+    if scene.room is not None:  # the objects on the table (the surface targets are drawn later)
+        points += [o.pos_world_m for o in scene.room.objects]
     return points
 
 
@@ -84,8 +90,10 @@ def blueprint(scenario: Scenario | None = None) -> rrb.Blueprint:
     """The default layout: 3-D view, both camera images, servo and joint traces, results.
 
     Every text document has a view of its own (tabs), so that no view is
-    asked to show more than one document.
+    asked to show more than one document.  A room run has its own (:func:`room_blueprint`).
     """
+    if scenario is not None and scenario.scene.room is not None:
+        return room_blueprint(scenario)
     return rrb.Blueprint(
         rrb.Horizontal(
             rrb.Spatial3DView(
@@ -106,6 +114,64 @@ def blueprint(scenario: Scenario | None = None) -> rrb.Blueprint:
                 ),
                 rrb.Tabs(*text_views(), active_tab=2),
                 row_shares=[3, 2, 2],
+            ),
+            column_shares=[2, 3],
+        ),
+        rrb.TimePanel(timeline="frame", state="collapsed"),
+        collapse_panels=True,
+    )
+
+
+def room_blueprint(scenario: Scenario) -> rrb.Blueprint:
+    """A room run's layout (:mod:`headsim.run.recording_room`): the textured room in 3-D
+    with the landing rays; both cameras; each eye's fovea beside camera 1's template and
+    camera 2's matched patch; the match scores, the match status and the servo error;
+    the joints, the measurements and the documents in tabs."""
+
+    side = 2 * FOVEA_HALF_PX + 1
+    # The foveal views keep the crop's bounds: a match box outside it does not zoom out.
+    bounds = rrb.VisualBounds2D(x_range=[-0.5, side - 0.5], y_range=[-0.5, side - 0.5])
+
+    def fovea(cam: str, name: str) -> rrb.Spatial2DView:
+        origin = f"/fovea/{cam}"
+        return rrb.Spatial2DView(
+            origin=origin,
+            contents=[f"{origin}/image", f"{origin}/match"],
+            name=name,
+            visual_bounds=bounds,
+        )
+
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Spatial3DView(
+                origin="/world",
+                name="room, head and where the eyes landed (W)",
+                eye_controls=eye_controls(scenario),
+                defaults=mjcf_rerun.view_defaults(),
+            ),
+            rrb.Vertical(
+                rrb.Horizontal(
+                    rrb.Spatial2DView(origin="/world/head/cam1", name="camera 1"),
+                    rrb.Spatial2DView(origin="/world/head/cam2", name="camera 2"),
+                ),
+                rrb.Horizontal(
+                    fovea("cam1", "fovea 1"),
+                    rrb.Spatial2DView(origin="/fovea/cam1/template", name="template 1"),
+                    fovea("cam2", "fovea 2"),
+                    rrb.Spatial2DView(origin="/fovea/cam2/patch", name="found in 2"),
+                ),
+                rrb.Horizontal(
+                    rrb.TimeSeriesView(origin="/correlation", name="match score, ambiguity"),
+                    rrb.TextLogView(origin="/correlation/status", name="match status"),
+                    rrb.TimeSeriesView(origin="/servo", name="servo error, px"),
+                ),
+                rrb.Tabs(
+                    *text_views(),
+                    rrb.TimeSeriesView(origin="/measurements", name="measurements"),
+                    rrb.TimeSeriesView(origin="/joints", name="joint encoders, rad"),
+                    active_tab=2,
+                ),
+                row_shares=[3, 2, 2, 2],
             ),
             column_shares=[2, 3],
         ),
@@ -199,6 +265,7 @@ __all__ = [
     "calibration_markdown",
     "eye_controls",
     "recording_id",
+    "room_blueprint",
     "scenario_markdown",
     "text_views",
 ]

@@ -257,7 +257,7 @@ def measure_surface_targets(
                 fovea = _fovea(sim, told.clicked_uv)
                 first = sim.render_window(1, fovea)
                 origin = (fovea.x0, fovea.y0)
-                pair = MarkerlessPair(first, told.clicked_uv, band_for, origin_px=origin)
+                pair = MarkerlessPair(first, told.clicked_uv, band_for, origin_px=origin, sink=hub)
                 target = Target(placed.name, pair, _true_point(placed))
                 log.clear(_clicked_point(sim, told, placed))
                 m = measure(sim, shared, target, knowledge)

@@ -13,7 +13,7 @@ import cv2
 import numpy as np
 import pytest
 
-from tests.run.viewer.judge import WINDOW, judge, view_regions
+from tests.run.viewer.judge import WINDOW, judge, judge_room, room_view_regions, view_regions
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 
@@ -85,3 +85,26 @@ def test_the_judge_sees_an_error_panel_and_empty_views() -> None:
     # A blank page is not a drawn viewer either.
     blank = np.full((*WINDOW[::-1], 3), 255, np.uint8)
     assert len(judge(blank).problems) >= 8
+
+
+ROOM_SHOT = Path(__file__).resolve().parents[2] / "docs" / "recording-room.png"
+
+
+def test_the_room_judge_passes_the_room_screenshot_and_fails_a_blanked_fovea() -> None:
+    image = cv2.cvtColor(cv2.imread(str(ROOM_SHOT)), cv2.COLOR_BGR2RGB)
+    assert judge_room(image).ok, judge_room(image).problems
+    for view in ("fovea 1", "fovea 2", "template 1", "patch 2"):
+        blank = image.copy()
+        x0, y0, x1, y1 = room_view_regions()[view]
+        blank[y0:y1, x0:x1] = 255  # the empty view's background
+        problems = judge_room(blank).problems
+        assert problems and all(view in p for p in problems), (view, problems)
+
+
+def test_the_room_judge_fails_a_room_drawn_in_flat_colours() -> None:
+    image = cv2.cvtColor(cv2.imread(str(ROOM_SHOT)), cv2.COLOR_BGR2RGB)
+    x0, y0, x1, y1 = room_view_regions()["3d"]
+    # Each texture replaced by its mean colour: a coarse blur keeps the shapes, not the detail.
+    image[y0:y1, x0:x1] = cv2.blur(image[y0:y1, x0:x1], (25, 25))
+    problems = judge_room(image).problems
+    assert len(problems) == 1 and "textures" in problems[0], problems

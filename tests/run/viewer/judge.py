@@ -144,3 +144,67 @@ def judge(image: np.ndarray) -> ViewJudgement:
         "no results text",
     )
     return ViewJudgement(figures, tuple(problems))
+
+
+def room_view_regions(size: tuple[int, int] = WINDOW) -> dict[str, Region]:
+    """Each view's drawing area in a screenshot of
+    :func:`headsim.run.recording_layout.room_blueprint`: columns 2:3; right column rows
+    3:2:2:2 (cameras; the four foveal views; plots and the status; tabs)."""
+    width, height = size
+    top, bottom = TOP_BAR_PX, height - TIME_PANEL_PX
+    split = width * 2 // 5
+    row = (bottom - top) / 9.0
+    rows = (top, top + 3 * row, top + 5 * row)
+    quarter = (width - split) / 4.0
+    boxes: dict[str, tuple[float, float, float, float]] = {
+        "3d": (0, top, split, bottom),
+        "camera 1": (split, rows[0], split + (width - split) / 2, rows[1]),
+        "camera 2": (split + (width - split) / 2, rows[0], width, rows[1]),
+    }
+    for k, name in enumerate(("fovea 1", "template 1", "fovea 2", "patch 2")):
+        boxes[name] = (split + k * quarter, rows[1], split + (k + 1) * quarter, rows[2])
+    return {
+        name: (
+            int(x0) + _MARGIN_PX,
+            int(y0) + VIEW_TITLE_PX,
+            int(x1) - _MARGIN_PX,
+            int(y1) - _MARGIN_PX,
+        )
+        for name, (x0, y0, x1, y1) in boxes.items()
+    }
+
+
+def judge_room(image: np.ndarray) -> ViewJudgement:
+    """Judge a screenshot of a room run's layout by pixel statistics per view.
+
+    - no error panel anywhere;
+    - 3-D: the textured room (fine grey-level detail: the mean absolute difference of
+      neighbouring pixels, which a flat-coloured room lacks);
+    - each camera and each foveal view (foveas, template, matched patch): an image with
+      contrast, not the empty view's background.
+    """
+    figures: dict[str, float] = {}
+    problems: list[str] = []
+
+    def need(name: str, value: float, minimum: float, what: str) -> None:
+        figures[name] = round(float(value), 5)
+        if value < minimum:
+            problems.append(f"{what}: {name} = {value:.4g} < {minimum:g}")
+
+    error_px = int(_near(image, ERROR_PANEL_RGB, 3).sum())
+    figures["error_panel_px"] = error_px
+    if error_px > 500:
+        problems.append(f"an error panel is shown ({error_px} px of its background)")
+    regions = room_view_regions((image.shape[1], image.shape[0]))
+    for name, (x0, y0, x1, y1) in regions.items():
+        view = image[y0:y1, x0:x1].astype(np.int16)
+        key = name.replace(" ", "_")
+        if name == "3d":
+            grey = view.mean(axis=2)
+            detail = np.abs(np.diff(grey, axis=1)).mean()
+            need("3d_texture_detail", detail, 2.0, "the room's textures are not drawn")
+            continue
+        need(f"{key}_contrast", view.std(), 8.0, f"{name} shows no image")
+        background = np.mean(view.min(axis=2) > 235)
+        need(f"{key}_not_background", 1.0 - background, 0.3, f"{name} is empty")
+    return ViewJudgement(figures, tuple(problems))
