@@ -228,10 +228,23 @@ _SURFACE: dict[str, str] = {
     "surface_targets.refused": "draws refused and drawn again, by cause (`no_surface`, `depth`, "
     "`occluded`, `start_view`, `reach`)",
     "surface_targets.false_fixation_limit": "the rule of a false fixation",
-    "surface_targets.targets": "each target: `name`, the `body` it lies on, `point_world_m`",
+    "surface_targets.targets": "each target: `name`, the `body` it lies on, `point_world_m`, "
+    "its `texture_class` (`rich`, `low`, `repetitive`, `occluded`: from truth at placement)",
     "surface_targets.false_fixations": "measurements ok whose eye 1 landed off the target",
     "surface_targets.vergence_error_deg_median": "median vergence error of the fixations, degrees",
     "surface_targets.vergence_error_deg_rms": "their RMS, degrees",
+    "surface_targets.by_texture": "per texture class (`rich`: pink noise, `low`, `repetitive`: "
+    "gratings, stripes, checks; `occluded`: part of either camera's template window hidden "
+    "from the other at the start pose), always all four",
+    "surface_targets.by_texture[].texture_class": "the class",
+    "surface_targets.by_texture[].asked": "targets placed in it, the failed ones included",
+    "surface_targets.by_texture[].measured": "those measured (ok)",
+    "surface_targets.by_texture[].error_pct_of_depth_rms": "their 3-D error RMS, % of depth",
+    "surface_targets.by_texture[].vergence_error_deg_median": "median vergence error, degrees",
+    "surface_targets.by_texture[].vergence_error_deg_rms": "its RMS, degrees",
+    "surface_targets.by_texture[].false_fixations": "measurements ok whose eye 1 landed off",
+    "surface_targets.by_texture[].failure_causes": "failures by cause",
+    "surface_targets.by_texture[].renders_per_point": "renders per target asked",
 }
 
 #: ``experiment`` keys written only with markerless targets (``[scene.room] targets``).

@@ -11,7 +11,7 @@ import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.run.accuracy import DepthBand, summaries
-from headsim.run.outcomes import RunOutcome, SurfaceDraw, fixation_stats
+from headsim.run.outcomes import RunOutcome, SurfaceDraw, TextureClassStats, fixation_stats
 from headsim.run.table import cell as _cell
 from headsim.run.table import format_table
 from headsim.run.table import mm as _mm
@@ -214,7 +214,33 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
         f"{stats.false_fixations} of {ok} ok (eye 1 landed > max(1 % of depth, 5 mm) off); "
         f"failures by cause: {causes}"
     )
+    if isinstance(surface, SurfaceDraw) and surface.by_texture:
+        lines.append(
+            "  by texture class (truth at placement; occluded: part of a template hidden):"
+        )
+        lines += [f"    {texture_text(c)}" for c in surface.by_texture]
     return lines
+
+
+def texture_text(c: TextureClassStats) -> str:
+    """One texture class's line, with the same figures as the whole: measured of asked,
+    3-D RMS, vergence error, false fixations, failures by cause, renders per point."""
+    if not c.asked:
+        return f"{c.texture_class}: no targets"
+    f = c.fixation
+    causes = ", ".join(f"{n} {k}" for k, n in f.failure_causes.items()) or "none"
+    if not c.measured:
+        return (
+            f"{c.texture_class}: 0 of {c.asked} measured; failures by cause: {causes}; "
+            f"{_cell(c.renders_per_point, '.1f')} renders per point"
+        )
+    return (
+        f"{c.texture_class}: {c.measured} of {c.asked} measured, 3-D RMS "
+        f"{_cell(c.error_pct_of_depth_rms, '.3f')} % of depth; vergence error median "
+        f"{_cell(f.vergence_error_deg_median, '.4f')} deg, RMS "
+        f"{_cell(f.vergence_error_deg_rms, '.4f')} deg; false fixations {f.false_fixations}; "
+        f"failures by cause: {causes}; {_cell(c.renders_per_point, '.1f')} renders per point"
+    )
 
 
 def _targets_text(ok: int, count: int, a: TargetAcceptance | None, markerless: bool = False) -> str:
@@ -349,4 +375,4 @@ def summary_text(result: RunOutcome, head_flag: str | None = None) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["belief_text", "format_table", "summary_text"]
+__all__ = ["belief_text", "format_table", "summary_text", "texture_text"]

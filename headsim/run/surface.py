@@ -34,8 +34,10 @@ from headsim.run.outcomes import (
     FixationScore,
     MeasurementRecord,
     SurfaceDraw,
+    by_texture,
     fixation_stats,
 )
+from headsim.run.texture_class import TEXTURE_CLASSES, texture_class, texture_kinds
 from headsim.scenario.spec import (
     MARKER_BODIES,
     STREAM_CLICKS,
@@ -197,7 +199,7 @@ def measure_surface_targets(
     with simulator(hub, "default", scenario) as sim:
         for body in MARKER_BODIES:  # markers play no part: out of every view
             sim.set_body_pose(body, np.array(PARKED_WORLD_M))
-        drawn = _draw(sim, spec, scenario.seed)
+        drawn = _classed(sim, scenario, _draw(sim, spec, scenario.seed))
         truth = {t.name: np.array(t.point_world_m) for t in drawn.targets}
         hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         goal_u = (knowledge.reference(sim, 1)[0], knowledge.reference(sim, 2)[0])
@@ -227,7 +229,29 @@ def measure_surface_targets(
                 records.append(record_measurement(hub, m, label, step, fixation=score))
         finally:
             hub.subscribers.remove(log)
-    return records, replace(drawn, stats=fixation_stats(records))
+    classes = {t.name: t.texture_class for t in drawn.targets}
+    return records, replace(
+        drawn,
+        stats=fixation_stats(records),
+        by_texture=by_texture(records, classes, TEXTURE_CLASSES),
+    )
+
+
+def _classed(sim: HeadSim, scenario: Scenario, drawn: SurfaceDraw) -> SurfaceDraw:
+    """``drawn`` with each target's texture class (:mod:`headsim.run.texture_class`),
+    decided at the start pose (truth, for the by-texture table)."""
+    room = scenario.scene.room
+    kinds = {} if room is None else texture_kinds(room)
+    half = MatchConfig().half_px
+    return replace(
+        drawn,
+        targets=tuple(
+            replace(
+                t, texture_class=texture_class(sim, kinds, t.body, np.array(t.point_world_m), half)
+            )
+            for t in drawn.targets
+        ),
+    )
 
 
 def _truth(placed: SurfaceTarget) -> Callable[[HeadSim], np.ndarray]:

@@ -87,12 +87,14 @@ def surface_distance_m(geom_type: int, size: Sequence[float], point_geom_m: np.n
 @dataclass(frozen=True)
 class SurfaceTarget:
     """A target point on a surface: the ``body`` (and geom) it lies on, the point in the
-    body's frame ``point_body_m`` and in W ``point_world_m`` (m), as placed."""
+    body's frame ``point_body_m`` and in W ``point_world_m`` (m), as placed;
+    ``texture_class`` for the by-texture table ("": not yet classed)."""
 
     name: str
     body: str
     point_body_m: tuple[float, float, float]
     point_world_m: tuple[float, float, float]
+    texture_class: str = ""
 
 
 def _triple(p: np.ndarray) -> tuple[float, float, float]:
