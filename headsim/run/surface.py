@@ -45,7 +45,18 @@ from headsim.scenario.spec import (
     Scenario,
     SurfaceTargetsSpec,
 )
-from headsim.scenario.surface_targets import Click, SurfaceTarget, click, draw_targets, point_world
+from headsim.scenario.surface_targets import (
+    Click,
+    NotOnSurface,
+    SurfaceTarget,
+    click,
+    draw_targets,
+    in_image,
+    on_object,
+    on_surface,
+    point_world,
+    visible,
+)
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import Band, Match, MatchConfig, row_band
 
@@ -259,18 +270,42 @@ def _truth(placed: SurfaceTarget) -> Callable[[HeadSim], np.ndarray]:
 
 
 def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int) -> SurfaceDraw:
-    """The targets drawn at the start pose; none, with the failure, when the surfaces in
-    view offer too few (a room and a field that do not meet)."""
-    rng = np.random.default_rng([seed, STREAM_SURFACE_TARGETS])
+    """The listed targets, then those drawn at the start pose; none drawn, with the failure,
+    when the surfaces in view offer too few (a room and a field that do not meet); none at
+    all when a listed one is not on its surface or not in camera 1's start image (the click)."""
+    asked = spec.count + len(spec.listed)
     # Room for camera 1's template around the click, wherever the click error puts it.
     margin = MatchConfig().half_px + 2 + 4 * spec.click_error_px
+    listed = []
+    for t in spec.listed:
+        try:
+            placed = (
+                on_surface(sim, t.name, t.point_m)
+                if t.body is None
+                else on_object(sim, t.name, t.body, t.point_m)
+            )
+        except NotOnSurface as error:
+            return SurfaceDraw(asked, 0, {}, (), failure=f"listed markerless target {error}")
+        if not (
+            visible(sim, 1, np.array(placed.point_world_m))
+            and in_image(sim, 1, np.array(placed.point_world_m), margin)
+        ):
+            return SurfaceDraw(
+                asked, 0, {}, (),
+                failure=f"listed markerless target {t.name}: camera 1's start image does not "
+                f"show it {margin:g} px inside (a click needs it)",
+            )  # fmt: skip
+        listed.append(placed)
+    if not spec.count:
+        return SurfaceDraw(asked, 0, {}, tuple(listed))
+    rng = np.random.default_rng([seed, STREAM_SURFACE_TARGETS])
     try:
         found = draw_targets(
             sim, spec.count, rng, spec.depth_m, spec.lateral, spec.vertical, margin_px=margin
         )
     except ValueError as error:
-        return SurfaceDraw(spec.count, 0, {}, (), failure=f"markerless targets: {error}")
-    return SurfaceDraw(spec.count, found.drawn, found.refused, found.targets)
+        return SurfaceDraw(asked, 0, {}, tuple(listed), failure=f"markerless targets: {error}")
+    return SurfaceDraw(asked, found.drawn, found.refused, (*listed, *found.targets))
 
 
 def fixation_scores(records: Sequence[MeasurementRecord]) -> list[FixationScore]:
