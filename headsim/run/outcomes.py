@@ -177,12 +177,15 @@ class SurfaceDraw:
     stats: FixationStats | None = None
     failure: str = ""
     by_texture: tuple[TextureClassStats, ...] = ()
+    #: of ``asked``, those listed (``[[scene.room.targets]]``, first in ``targets``)
+    listed: int = 0
 
     def block(self) -> dict[str, Any]:
         """results.json's ``experiment.surface_targets``."""
         stats = self.stats
         return {
             "asked": self.asked,
+            "listed": self.listed,
             "drawn": self.drawn,
             "refused": dict(self.refused),
             "false_fixation_limit": f"max({FALSE_FIXATION_FRACTION:g} x depth, "

@@ -224,6 +224,7 @@ FAILED_ONLY = frozenset({"reason"})
 _SURFACE: dict[str, str] = {
     "surface_targets": "how the markerless targets were drawn and how they landed",
     "surface_targets.asked": "targets asked for (`[scene.room] targets`)",
+    "surface_targets.listed": "of them, those listed (`[[scene.room.targets]]`), measured first",
     "surface_targets.drawn": "draws made, refused ones included",
     "surface_targets.refused": "draws refused and drawn again, by cause (`no_surface`, `depth`, "
     "`occluded`, `start_view`, `reach`)",

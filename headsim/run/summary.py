@@ -154,6 +154,9 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
     acceptance = result.scenario.scene.acceptance
     edge = () if acceptance is None else acceptance.outside_start_view
     markerless = any(r.fixation is not None for r in records)
+    surface = getattr(result.experiment, "surface", None)
+    if isinstance(surface, SurfaceDraw) and surface.listed == surface.asked:
+        markerless = False  # listed points only: not the whole field
     for label, s in summaries(records, edge).items():
         lines.append(
             f"  head knew {label}: {s.ok} of {s.count} ok; error mean {_mm(s.error_m_mean)} mm "
@@ -201,9 +204,10 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
     surface = getattr(result.experiment, "surface", None)
     if isinstance(surface, SurfaceDraw):
         refused = ", ".join(f"{n} {c}" for c, n in surface.refused.items()) or "none"
+        listed = f"{surface.listed} listed, " if surface.listed else ""
         lines.append(
-            f"  markerless targets: {surface.asked} asked on the room's surfaces, "
-            f"{surface.drawn} draws (refused and drawn again: {refused})"
+            f"  markerless targets: {surface.asked} asked on the room's surfaces ({listed}"
+            f"{surface.drawn} draws, refused and drawn again: {refused})"
         )
     ok = sum(1 for r in result.records if r.fixation is not None and r.measurement.ok)
     causes = ", ".join(f"{n} {c}" for c, n in stats.failure_causes.items()) or "none"

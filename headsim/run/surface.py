@@ -297,15 +297,19 @@ def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int) -> SurfaceDraw:
             )  # fmt: skip
         listed.append(placed)
     if not spec.count:
-        return SurfaceDraw(asked, 0, {}, tuple(listed))
+        return SurfaceDraw(asked, 0, {}, tuple(listed), listed=len(listed))
     rng = np.random.default_rng([seed, STREAM_SURFACE_TARGETS])
     try:
         found = draw_targets(
             sim, spec.count, rng, spec.depth_m, spec.lateral, spec.vertical, margin_px=margin
         )
     except ValueError as error:
-        return SurfaceDraw(asked, 0, {}, tuple(listed), failure=f"markerless targets: {error}")
-    return SurfaceDraw(asked, found.drawn, found.refused, (*listed, *found.targets))
+        return SurfaceDraw(
+            asked, 0, {}, tuple(listed), failure=f"markerless targets: {error}", listed=len(listed)
+        )
+    return SurfaceDraw(
+        asked, found.drawn, found.refused, (*listed, *found.targets), listed=len(listed)
+    )
 
 
 def fixation_scores(records: Sequence[MeasurementRecord]) -> list[FixationScore]:
