@@ -179,6 +179,8 @@ class SurfaceDraw:
     by_texture: tuple[TextureClassStats, ...] = ()
     #: of ``asked``, those listed (``[[scene.room.targets]]``, first in ``targets``)
     listed: int = 0
+    #: how each was measured: ``surface`` (by correlation) or ``markers`` (the twin)
+    measured_as: str = "surface"
 
     def block(self) -> dict[str, Any]:
         """results.json's ``experiment.surface_targets``."""
@@ -186,6 +188,7 @@ class SurfaceDraw:
         return {
             "asked": self.asked,
             "listed": self.listed,
+            "measured_as": self.measured_as,
             "drawn": self.drawn,
             "refused": dict(self.refused),
             "false_fixation_limit": f"max({FALSE_FIXATION_FRACTION:g} x depth, "

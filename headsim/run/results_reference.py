@@ -42,7 +42,8 @@ RESULTS_FIELDS: dict[str, str] = {
     "table and walls, every object (clutter drawn from the seed included) and the light; "
     "`null`: none",
     "scenario.scene.surface_targets": "`[scene.room] targets` and its keys (`count`, "
-    "`depth_m`, `lateral`, `vertical`, `click_error_px`, `band_px`); `null`: none",
+    "`depth_m`, `lateral`, `vertical`, `click_error_px`, `band_px`, `listed`, `targets_as`); "
+    "`null`: none",
     "scenario.scene.acceptance": "how the targets came to be measured (`null`: a procedure "
     "without targets)",
     "scenario.scene.acceptance.within": "`[scene.random_targets] within` (`box` or `reach`; "
@@ -225,6 +226,8 @@ _SURFACE: dict[str, str] = {
     "surface_targets": "how the markerless targets were drawn and how they landed",
     "surface_targets.asked": "targets asked for (`[scene.room] targets`)",
     "surface_targets.listed": "of them, those listed (`[[scene.room.targets]]`), measured first",
+    "surface_targets.measured_as": "`surface` (by correlation) or `markers` (a marker put at "
+    "each point: the marker twin, `[scene.room] targets_as`)",
     "surface_targets.drawn": "draws made, refused ones included",
     "surface_targets.refused": "draws refused and drawn again, by cause (`no_surface`, `depth`, "
     "`occluded`, `start_view`, `reach`)",

@@ -205,14 +205,22 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
     if isinstance(surface, SurfaceDraw):
         refused = ", ".join(f"{n} {c}" for c, n in surface.refused.items()) or "none"
         listed = f"{surface.listed} listed, " if surface.listed else ""
+        what = "markerless targets" if surface.measured_as == "surface" else "points"
         lines.append(
-            f"  markerless targets: {surface.asked} asked on the room's surfaces ({listed}"
+            f"  {what}: {surface.asked} asked on the room's surfaces ({listed}"
             f"{surface.drawn} draws, refused and drawn again: {refused})"
         )
     ok = sum(1 for r in result.records if r.fixation is not None and r.measurement.ok)
     causes = ", ".join(f"{n} {c}" for c, n in stats.failure_causes.items()) or "none"
+    twin = isinstance(surface, SurfaceDraw) and surface.measured_as == "markers"
+    if twin:
+        lines.append(
+            "  each measured with a marker put there (5 mm out along the normal), not by "
+            "correlation; scored against the marker's centre"
+        )
     lines.append(
-        f"  markerless fixations (truth: where each eye's goal ray landed): vergence error "
+        f"  {'marker' if twin else 'markerless'} fixations (truth: where each eye's goal ray "
+        f"landed): vergence error "
         f"median {_cell(stats.vergence_error_deg_median, '.4f')} deg, RMS "
         f"{_cell(stats.vergence_error_deg_rms, '.4f')} deg; false fixations "
         f"{stats.false_fixations} of {ok} ok (eye 1 landed > max(1 % of depth, 5 mm) off); "

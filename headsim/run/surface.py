@@ -37,6 +37,7 @@ from headsim.run.outcomes import (
     by_texture,
     fixation_stats,
 )
+from headsim.run.targets import marker_target
 from headsim.run.texture_class import TEXTURE_CLASSES, texture_class, texture_kinds
 from headsim.scenario.spec import (
     MARKER_BODIES,
@@ -55,10 +56,17 @@ from headsim.scenario.surface_targets import (
     on_object,
     on_surface,
     point_world,
+    surface_normal,
     visible,
 )
+from headsim.sim import names
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import Band, Match, MatchConfig, row_band
+
+#: The marker the twin puts at each point (the default scene's; 4 mm in radius) ...
+TWIN_MARKER = names.MARKERS[0]
+#: ... its centre this far out from the surface along the normal, m: 1 mm clear of it.
+MARKER_OFFSET_M = 0.005
 
 
 def false_fixation_limit_m(depth_m: float) -> float:
@@ -130,11 +138,12 @@ def score_fixation(
     target_world_m: np.ndarray,
     depth_m: float,
     ok: bool,
-    told: Click,
+    told: Click | None,
     match: Match | None,
 ) -> FixationScore:
-    """A :class:`FixationScore` from the logged landings (an eye missing: NaN) and camera
-    2's last correspondence ``match``."""
+    """A :class:`FixationScore` from the logged landings (an eye missing: NaN), the click
+    the head was ``told`` (None: a marker, no click; its error NaN) and camera 2's last
+    correspondence ``match``."""
     one, two = landings.get(1), landings.get(2)
     errors = [
         (math.nan, math.nan)
@@ -160,7 +169,7 @@ def score_fixation(
         error_m=(errors[0][1], errors[1][1]),
         landed=("" if one is None else one.body, "" if two is None else two.body),
         landed_world_m=(point(one), point(two)),
-        click_error_px=math.dist(told.clicked_uv, told.true_uv),
+        click_error_px=math.nan if told is None else math.dist(told.clicked_uv, told.true_uv),
         match_score=None if match is None else float(match.score),
         match_ambiguity=None if match is None else float(match.ambiguity),
         match_status=None if match is None else match.status.value,
@@ -201,9 +210,12 @@ def measure_surface_targets(
     servo: Callable[[HeadSim], S],
     measure: Callable[[HeadSim, S, Target, HeadKnowledge], Measurement],
 ) -> tuple[list[MeasurementRecord], SurfaceDraw]:
-    """Each of ``[scene.room] targets`` measured in turn from the start pose: drawn, clicked
-    in camera 1's image there, measured with ``measure`` through one shared ``servo``, its
-    fixation scored from the looks the run reported (:class:`LandingLog`)."""
+    """Each of ``[scene.room] targets`` measured in turn from the start pose: listed or
+    drawn, clicked in camera 1's image there, measured with ``measure`` through one shared
+    ``servo``, its fixation scored from the looks the run reported (:class:`LandingLog`).
+    With ``targets_as = "markers"`` (the marker twin) each is instead the ordinary marker
+    target: :data:`TWIN_MARKER` put :data:`MARKER_OFFSET_M` out from the point along the
+    surface's normal, found by its colour, scored against the marker's centre."""
     spec = scenario.scene.surface_targets
     assert spec is not None
     records: list[MeasurementRecord] = []
@@ -211,7 +223,16 @@ def measure_surface_targets(
         for body in MARKER_BODIES:  # markers play no part: out of every view
             sim.set_body_pose(body, np.array(PARKED_WORLD_M))
         drawn = _classed(sim, scenario, _draw(sim, spec, scenario.seed))
-        truth = {t.name: np.array(t.point_world_m) for t in drawn.targets}
+        markers_at = [
+            np.array(t.point_world_m) + MARKER_OFFSET_M * surface_normal(sim, t.point_world_m)
+            if spec.targets_as == "markers"
+            else None
+            for t in drawn.targets
+        ]
+        truth = {
+            t.name: np.array(t.point_world_m) if at is None else at
+            for t, at in zip(drawn.targets, markers_at, strict=True)
+        }
         hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         goal_u = (knowledge.reference(sim, 1)[0], knowledge.reference(sim, 2)[0])
         log = LandingLog(sim, goal_u)
@@ -220,29 +241,37 @@ def measure_surface_targets(
             shared = servo(sim)
             clicks = np.random.default_rng([scenario.seed, STREAM_CLICKS])
             band_for = row_band_for(knowledge, sim, spec.band_px)
-            for placed in drawn.targets:
+            for placed, marker_at in zip(drawn.targets, markers_at, strict=True):
                 step = hub.begin(placed.name)
                 _start_pose(sim)
-                first = sim.render(1)
-                told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
-                pair = MarkerlessPair(first, told.clicked_uv, band_for)
-                target = Target(placed.name, pair, _truth(placed))
                 log.clear()
-                m = measure(sim, shared, target, knowledge)
+                if marker_at is not None:
+                    # The twin: the ordinary marker target, detected by its colour.
+                    sim.set_body_pose(TWIN_MARKER, marker_at)
+                    m = measure(sim, shared, marker_target(placed.name, TWIN_MARKER), knowledge)
+                    where = sim.position(TWIN_MARKER)
+                    told, match = None, None
+                else:
+                    first = sim.render(1)
+                    told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
+                    pair = MarkerlessPair(first, told.clicked_uv, band_for)
+                    m = measure(sim, shared, Target(placed.name, pair, _truth(placed)), knowledge)
+                    where = point_world(sim, placed.body, placed.point_body_m)
+                    # The correspondence the measurement used: camera 2's last confident
+                    # match (else its last one, whatever it said).
+                    used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
+                    match = used[-1] if used else None
                 landings = log.fixations(m)
-                where = point_world(sim, placed.body, placed.point_body_m)
                 depth = float(sim.transform_points(where, "world", "head")[0][2])
-                # The correspondence the measurement used: camera 2's last confident match
-                # (else its last one, whatever it said).
-                used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
-                match = used[-1] if used else None
                 score = score_fixation(landings, where, depth, m.ok, told, match)
                 records.append(record_measurement(hub, m, label, step, fixation=score))
+            sim.set_body_pose(TWIN_MARKER, np.array(PARKED_WORLD_M))
         finally:
             hub.subscribers.remove(log)
     classes = {t.name: t.texture_class for t in drawn.targets}
     return records, replace(
         drawn,
+        measured_as=spec.targets_as,
         stats=fixation_stats(records),
         by_texture=by_texture(records, classes, TEXTURE_CLASSES),
     )
@@ -318,6 +347,8 @@ def fixation_scores(records: Sequence[MeasurementRecord]) -> list[FixationScore]
 
 
 __all__ = [
+    "MARKER_OFFSET_M",
+    "TWIN_MARKER",
     "LandingLog",
     "false_fixation_limit_m",
     "fixation_scores",

@@ -395,6 +395,7 @@ DESCRIPTIONS: dict[str, str] = {
     "scene.room.targets_lateral": "Largest |x_h / z_h| of a markerless target's draw direction (0.25: the shared field).",
     "scene.room.targets_vertical": "Largest |y_h / z_h| of a markerless target's draw direction.",
     "scene.room.click_error_px": "Standard deviation of the click that tells the head a markerless target, px per axis.",
+    "scene.room.targets_as": "`surface`: each target by correlation; `markers`: an emissive marker put 5 mm out along the surface's normal, found by its colour (the marker twin).",
     "scene.room.band_px": "Half-height of the band along camera 1's row in which camera 2 searches the clicked point, px (the head knows no focal length).",
     "scene.room.light": "The key light and the ambient level.",
     "scene.room.light.direction_world": "Direction the key light shines along, in W (normalised).",

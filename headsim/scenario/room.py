@@ -18,7 +18,7 @@ import mujoco
 import numpy as np
 
 from headsim.scenario.occlusion import Occluder, scene_model
-from headsim.scenario.spec import MAX_DEPTH_M, ListedSurfaceTarget, SurfaceTargetsSpec
+from headsim.scenario.spec import MAX_DEPTH_M, TARGETS_AS, ListedSurfaceTarget, SurfaceTargetsSpec
 from headsim.scenario.surface_targets import NotOnSurface, on_object, on_surface
 from headsim.scenario.tables import Table
 from headsim.sim import names
@@ -151,9 +151,12 @@ def _surface_targets(table: Table) -> SurfaceTargetsSpec | None:
     vertical = table.number("targets_vertical", 0.1, 0.0, 1.0, lo_open=True)
     click_px = table.number("click_error_px", 0.5, 0.0, 20.0, unit="px")
     band_px = table.number("band_px", 10.0, 1.0, 100.0, unit="px")
+    targets_as = table.choice("targets_as", TARGETS_AS, "surface")
     if count == 0 and not listed:
         return None
-    return SurfaceTargetsSpec(count, (near, far), lateral, vertical, click_px, band_px, listed)
+    return SurfaceTargetsSpec(
+        count, (near, far), lateral, vertical, click_px, band_px, listed, targets_as
+    )
 
 
 @dataclass(frozen=True)

@@ -277,6 +277,8 @@ class SurfaceTargetsSpec:
     band_px: float = 10.0
     #: ``[[scene.room.targets]]``, measured first, in file order
     listed: tuple[ListedSurfaceTarget, ...] = ()
+    #: how each is measured (:data:`TARGETS_AS`): by correlation, or by a marker put there
+    targets_as: str = "surface"
 
 
 @dataclass(frozen=True)

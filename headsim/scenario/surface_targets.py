@@ -144,6 +144,35 @@ def surface_of(sim: SceneState, point_world_m: ArrayLike) -> tuple[int, float]:
     return best, best_d
 
 
+def surface_normal(sim: SceneState, point_world_m: ArrayLike) -> np.ndarray:
+    """The outward unit normal, in W, of the scene surface nearest a point on it (a plane's
+    front, a sphere's radius, a box's face, a cylinder's side or cap)."""
+    p = np.asarray(point_world_m, dtype=float)
+    geom, _ = surface_of(sim, p)
+    if geom < 0:
+        raise NotOnSurface("no surface in the scene")
+    rotation = sim.data.geom_xmat[geom].reshape(3, 3)
+    local = rotation.T @ (p - sim.data.geom_xpos[geom])
+    size = sim.model.geom_size[geom]
+    kind = int(sim.model.geom_type[geom])
+    if kind == mujoco.mjtGeom.mjGEOM_PLANE:
+        normal = np.array([0.0, 0.0, 1.0])
+    elif kind == mujoco.mjtGeom.mjGEOM_SPHERE:
+        normal = local
+    elif kind == mujoco.mjtGeom.mjGEOM_BOX:
+        axis = int(np.argmax(np.abs(local) - size[:3]))
+        normal = np.zeros(3)
+        normal[axis] = 1.0 if local[axis] >= 0 else -1.0
+    else:  # a cylinder: its side or a cap, whichever the point lies on
+        radial = math.hypot(local[0], local[1])
+        if abs(local[2]) - size[1] > radial - size[0]:
+            normal = np.array([0.0, 0.0, 1.0 if local[2] >= 0 else -1.0])
+        else:
+            normal = np.array([local[0], local[1], 0.0])
+    world = rotation @ normal
+    return np.asarray(world / float(np.linalg.norm(world)))
+
+
 def on_object(sim: SceneState, name: str, body: str, point_body_m: ArrayLike) -> SurfaceTarget:
     """A target at ``point_body_m`` on ``body``, checked to lie on its surface."""
     if mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_BODY, body) < 0:
@@ -315,6 +344,7 @@ __all__ = [
     "on_surface",
     "point_world",
     "surface_distance_m",
+    "surface_normal",
     "surface_of",
     "surface_refusal",
     "visible",

@@ -8,7 +8,13 @@ from typing import Any
 
 import pytest
 
-from headsim.scenario.loading import read_toml, resolve_path, scenario_from_document, set_field
+from headsim.scenario.loading import (
+    load_scenario,
+    read_toml,
+    resolve_path,
+    scenario_from_document,
+    set_field,
+)
 from headsim.scenario.spec import Scenario
 from headsim.scenario.tables import ScenarioError
 
@@ -69,3 +75,11 @@ def test_a_bad_listed_target_is_a_one_line_error_naming_its_field(
 def test_a_name_used_twice_is_refused() -> None:
     with pytest.raises(ScenarioError, match=r"targets\[1\]\.name: 'on_poster' is used twice"):
         _load([ON_POSTER, ON_POSTER])
+
+
+def test_targets_as_is_surface_or_markers() -> None:
+    doc = set_field(read_toml(PATH), "scene.room.targets_as", "stickers")
+    with pytest.raises(ScenarioError, match=r"scene\.room\.targets_as: unknown value"):
+        scenario_from_document(doc, "natural_field", directory=PATH.parent)
+    spec = load_scenario("natural_field_markers", fast=True).scene.surface_targets
+    assert spec is not None and spec.targets_as == "markers"
