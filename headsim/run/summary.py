@@ -216,7 +216,9 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
     if twin:
         lines.append(
             "  each measured with a marker put there (5 mm out along the normal), not by "
-            "correlation; scored against the marker's centre"
+            "correlation; scored against the marker's centre.  Its vergence error includes the "
+            "marker's own parallax: eye 1's ray lands on the 4 mm sphere's front, about "
+            "radius x vergence angle off eye 2's line (0.14 deg at 0.5 m)"
         )
     lines.append(
         f"  {'marker' if twin else 'markerless'} fixations (truth: where each eye's goal ray "
