@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
+from headsim.scenario.loading import SCENARIOS_DIR as SCENARIOS
 from headsim.scenario.loading import load_scenario
 
 #: Each scenario and the texture class its designed targets (all but the control) take.
@@ -48,3 +49,21 @@ def test_a_failure_scenario_counts_every_target_by_class_and_cause(
     assert sum(c["measured"] for c in table.values()) == len(ok)
     assert block["false_fixations"] == sum(m["fixation"]["false_fixation"] for m in ok)
     assert code == (1 if failed else 0)
+
+
+def test_a_listed_target_camera_1_cannot_see_fails_the_run_saying_so(tmp_path: Path) -> None:
+    # Behind the bottle for camera 1 (its strip of the poster), so no click can name it.
+    text = (SCENARIOS / "occluded_clutter.toml").read_text()
+    extra = (
+        '\n[[scene.room.targets]]\nname = "behind_for_camera_1"\npoint_world_m = [0.06, 1.3, 0.2]\n'
+    )
+    path = tmp_path / "hidden.toml"
+    path.write_text(text.replace("\n[fast]", extra + "\n[fast]"))
+    code = main(["run", str(path), "--fast", "--out", str(tmp_path / "out"), "--no-progress"])
+    assert code == 1
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert results["measurements"] == []
+    assert any(
+        "behind_for_camera_1: camera 1's start image does not show it" in f
+        for f in results["failures"]
+    )
