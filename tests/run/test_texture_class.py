@@ -45,7 +45,7 @@ def _post(sim: HeadSim) -> SceneObject:
         "post",
         "sphere",
         (0.5 * clearance, 0.0, 0.0),
-        tuple(map(float, centre)),
+        (float(centre[0]), float(centre[1]), float(centre[2])),
         TextureSpec("pink"),
     )
 
