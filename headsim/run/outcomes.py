@@ -117,6 +117,59 @@ def fixation_stats(records: Sequence[MeasurementRecord]) -> FixationStats:
 
 
 @dataclass(frozen=True)
+class TextureClassStats:
+    """The markerless targets of one texture class (``rich``, ``low``, ``repetitive``,
+    ``occluded``): ``asked`` (every one placed in it), ``measured`` (ok), their 3-D error
+    RMS in % of depth (NaN: none measured), ``fixation`` (vergence, false fixations,
+    failures by cause) and renders per point (NaN: none asked)."""
+
+    texture_class: str
+    asked: int
+    measured: int
+    error_pct_of_depth_rms: float
+    fixation: FixationStats
+    renders_per_point: float
+
+    def entry(self) -> dict[str, Any]:
+        """results.json's ``by_texture[]``."""
+        return {
+            "texture_class": self.texture_class,
+            "asked": self.asked,
+            "measured": self.measured,
+            "error_pct_of_depth_rms": self.error_pct_of_depth_rms,
+            "vergence_error_deg_median": self.fixation.vergence_error_deg_median,
+            "vergence_error_deg_rms": self.fixation.vergence_error_deg_rms,
+            "false_fixations": self.fixation.false_fixations,
+            "failure_causes": dict(self.fixation.failure_causes),
+            "renders_per_point": self.renders_per_point,
+        }
+
+
+def by_texture(
+    records: Sequence[MeasurementRecord], classes: dict[str, str], order: Sequence[str]
+) -> tuple[TextureClassStats, ...]:
+    """:class:`TextureClassStats` of each class in ``order``, the records split by the class
+    ``classes`` gives each target's name (a record of a name it lacks is left out)."""
+    out = []
+    for name in order:
+        group = [r for r in records if classes.get(r.measurement.name) == name]
+        pct = np.array([r.measurement.error_pct_of_depth for r in group if r.measurement.ok])
+        out.append(
+            TextureClassStats(
+                texture_class=name,
+                asked=len(group),
+                measured=int(pct.size),
+                error_pct_of_depth_rms=float(np.sqrt(np.mean(pct**2))) if pct.size else math.nan,
+                fixation=fixation_stats(group),
+                renders_per_point=float(np.mean([r.measurement.renders for r in group]))
+                if group
+                else math.nan,
+            )
+        )
+    return tuple(out)
+
+
+@dataclass(frozen=True)
 class SurfaceDraw:
     """How the markerless targets were drawn: ``asked`` targets, ``drawn`` draws in all,
     the ``refused`` ones by cause (each drawn again), and the ``targets`` placed;
@@ -129,23 +182,36 @@ class SurfaceDraw:
     targets: tuple[SurfaceTarget, ...]
     stats: FixationStats | None = None
     failure: str = ""
+    by_texture: tuple[TextureClassStats, ...] = ()
+    #: of ``asked``, those listed (``[[scene.room.targets]]``, first in ``targets``)
+    listed: int = 0
+    #: how each was measured: ``surface`` (by correlation) or ``markers`` (the twin)
+    measured_as: str = "surface"
 
     def block(self) -> dict[str, Any]:
         """results.json's ``experiment.surface_targets``."""
         stats = self.stats
         return {
             "asked": self.asked,
+            "listed": self.listed,
+            "measured_as": self.measured_as,
             "drawn": self.drawn,
             "refused": dict(self.refused),
             "false_fixation_limit": f"max({FALSE_FIXATION_FRACTION:g} x depth, "
             f"{FALSE_FIXATION_MIN_M:g} m)",
             "targets": [
-                {"name": t.name, "body": t.body, "point_world_m": list(t.point_world_m)}
+                {
+                    "name": t.name,
+                    "body": t.body,
+                    "point_world_m": list(t.point_world_m),
+                    "texture_class": t.texture_class,
+                }
                 for t in self.targets
             ],
             "false_fixations": None if stats is None else stats.false_fixations,
             "vergence_error_deg_median": None if stats is None else stats.vergence_error_deg_median,
             "vergence_error_deg_rms": None if stats is None else stats.vergence_error_deg_rms,
+            "by_texture": [c.entry() for c in self.by_texture],
         }
 
 
@@ -312,6 +378,8 @@ __all__ = [
     "RunOutcome",
     "RunRenders",
     "SurfaceDraw",
+    "TextureClassStats",
+    "by_texture",
     "fixation_stats",
     "measurement_table",
 ]

@@ -11,7 +11,7 @@ import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.run.accuracy import DepthBand, summaries
-from headsim.run.outcomes import RunOutcome, SurfaceDraw, fixation_stats
+from headsim.run.outcomes import RunOutcome, SurfaceDraw, TextureClassStats, fixation_stats
 from headsim.run.table import cell as _cell
 from headsim.run.table import format_table
 from headsim.run.table import mm as _mm
@@ -154,6 +154,9 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
     acceptance = result.scenario.scene.acceptance
     edge = () if acceptance is None else acceptance.outside_start_view
     markerless = any(r.fixation is not None for r in records)
+    surface = getattr(result.experiment, "surface", None)
+    if isinstance(surface, SurfaceDraw) and surface.listed == surface.asked:
+        markerless = False  # listed points only: not the whole field
     for label, s in summaries(records, edge).items():
         lines.append(
             f"  head knew {label}: {s.ok} of {s.count} ok; error mean {_mm(s.error_m_mean)} mm "
@@ -201,20 +204,57 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
     surface = getattr(result.experiment, "surface", None)
     if isinstance(surface, SurfaceDraw):
         refused = ", ".join(f"{n} {c}" for c, n in surface.refused.items()) or "none"
+        listed = f"{surface.listed} listed, " if surface.listed else ""
+        what = "markerless targets" if surface.measured_as == "surface" else "points"
         lines.append(
-            f"  markerless targets: {surface.asked} asked on the room's surfaces, "
-            f"{surface.drawn} draws (refused and drawn again: {refused})"
+            f"  {what}: {surface.asked} asked on the room's surfaces ({listed}"
+            f"{surface.drawn} draws, refused and drawn again: {refused})"
         )
     ok = sum(1 for r in result.records if r.fixation is not None and r.measurement.ok)
     causes = ", ".join(f"{n} {c}" for c, n in stats.failure_causes.items()) or "none"
+    twin = isinstance(surface, SurfaceDraw) and surface.measured_as == "markers"
+    if twin:
+        lines.append(
+            "  each measured with a marker put there (5 mm out along the normal), not by "
+            "correlation; scored against the marker's centre.  Its vergence error includes the "
+            "marker's own parallax: eye 1's ray lands on the 4 mm sphere's front, about "
+            "radius x vergence angle off eye 2's line (0.14 deg at 0.5 m)"
+        )
     lines.append(
-        f"  markerless fixations (truth: where each eye's goal ray landed): vergence error "
+        f"  {'marker' if twin else 'markerless'} fixations (truth: where each eye's goal ray "
+        f"landed): vergence error "
         f"median {_cell(stats.vergence_error_deg_median, '.4f')} deg, RMS "
         f"{_cell(stats.vergence_error_deg_rms, '.4f')} deg; false fixations "
         f"{stats.false_fixations} of {ok} ok (an eye landed > max(1 % of depth, 5 mm) off); "
         f"failures by cause: {causes}"
     )
+    if isinstance(surface, SurfaceDraw) and surface.by_texture:
+        lines.append(
+            "  by texture class (truth at placement; occluded: part of a template hidden):"
+        )
+        lines += [f"    {texture_text(c)}" for c in surface.by_texture]
     return lines
+
+
+def texture_text(c: TextureClassStats) -> str:
+    """One texture class's line, with the same figures as the whole: measured of asked,
+    3-D RMS, vergence error, false fixations, failures by cause, renders per point."""
+    if not c.asked:
+        return f"{c.texture_class}: no targets"
+    f = c.fixation
+    causes = ", ".join(f"{n} {k}" for k, n in f.failure_causes.items()) or "none"
+    if not c.measured:
+        return (
+            f"{c.texture_class}: 0 of {c.asked} measured; failures by cause: {causes}; "
+            f"{_cell(c.renders_per_point, '.1f')} renders per point"
+        )
+    return (
+        f"{c.texture_class}: {c.measured} of {c.asked} measured, 3-D RMS "
+        f"{_cell(c.error_pct_of_depth_rms, '.3f')} % of depth; vergence error median "
+        f"{_cell(f.vergence_error_deg_median, '.4f')} deg, RMS "
+        f"{_cell(f.vergence_error_deg_rms, '.4f')} deg; false fixations {f.false_fixations}; "
+        f"failures by cause: {causes}; {_cell(c.renders_per_point, '.1f')} renders per point"
+    )
 
 
 def _targets_text(ok: int, count: int, a: TargetAcceptance | None, markerless: bool = False) -> str:
@@ -349,4 +389,4 @@ def summary_text(result: RunOutcome, head_flag: str | None = None) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["belief_text", "format_table", "summary_text"]
+__all__ = ["belief_text", "format_table", "summary_text", "texture_text"]

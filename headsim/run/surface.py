@@ -35,8 +35,11 @@ from headsim.run.outcomes import (
     FixationScore,
     MeasurementRecord,
     SurfaceDraw,
+    by_texture,
     fixation_stats,
 )
+from headsim.run.targets import marker_target
+from headsim.run.texture_class import TEXTURE_CLASSES, texture_class, texture_kinds
 from headsim.scenario.spec import (
     MARKER_BODIES,
     STREAM_CLICKS,
@@ -44,10 +47,28 @@ from headsim.scenario.spec import (
     Scenario,
     SurfaceTargetsSpec,
 )
-from headsim.scenario.surface_targets import Click, SurfaceTarget, click, draw_targets, point_world
+from headsim.scenario.surface_targets import (
+    Click,
+    NotOnSurface,
+    SurfaceTarget,
+    click,
+    draw_targets,
+    in_image,
+    on_object,
+    on_surface,
+    point_world,
+    surface_normal,
+    visible,
+)
+from headsim.sim import names
 from headsim.sim.render import Window
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import Band, Match, MatchConfig, row_band
+
+#: The marker the twin puts at each point (the default scene's; 4 mm in radius) ...
+TWIN_MARKER = names.MARKERS[0]
+#: ... its centre this far out from the surface along the normal, m: 1 mm clear of it.
+MARKER_OFFSET_M = 0.005
 
 
 def false_fixation_limit_m(depth_m: float) -> float:
@@ -152,11 +173,12 @@ def score_fixation(
     target_world_m: np.ndarray,
     depth_m: float,
     ok: bool,
-    told: Click,
+    told: Click | None,
     match: Match | None,
 ) -> FixationScore:
     """A :class:`FixationScore` from the logged looks at the fixation (an eye missing:
-    NaN) and camera 2's last correspondence ``match``."""
+    NaN), the click the head was ``told`` (None: a marker, no click; its error NaN) and
+    camera 2's last correspondence ``match``."""
     one, two = (None if (x := looks.get(c)) is None else x.landing for c in (1, 2))
     look_px = [math.nan if (x := looks.get(c)) is None else x.error_px for c in (1, 2)]
     errors = [
@@ -186,7 +208,7 @@ def score_fixation(
         error_m=(errors[0][1], errors[1][1]),
         landed=("" if one is None else one.body, "" if two is None else two.body),
         landed_world_m=(point(one), point(two)),
-        click_error_px=math.dist(told.clicked_uv, told.true_uv),
+        click_error_px=math.nan if told is None else math.dist(told.clicked_uv, told.true_uv),
         image_error_px=(look_px[0], look_px[1]),
         match_sigma_px=None if match is None else float(match.template_sigma_px),
         match_score=None if match is None else float(match.score),
@@ -229,17 +251,29 @@ def measure_surface_targets(
     servo: Callable[[HeadSim], S],
     measure: Callable[[HeadSim, S, Target, HeadKnowledge], Measurement],
 ) -> tuple[list[MeasurementRecord], SurfaceDraw]:
-    """Each of ``[scene.room] targets`` measured in turn from the start pose: drawn, clicked
-    in camera 1's image there, measured with ``measure`` through one shared ``servo``, its
-    fixation scored from the looks the run reported (:class:`LandingLog`)."""
+    """Each of ``[scene.room] targets`` measured in turn from the start pose: listed or
+    drawn, clicked in camera 1's image there, measured with ``measure`` through one shared
+    ``servo``, its fixation scored from the looks the run reported (:class:`LandingLog`).
+    With ``targets_as = "markers"`` (the marker twin) each is instead the ordinary marker
+    target: :data:`TWIN_MARKER` put :data:`MARKER_OFFSET_M` out from the point along the
+    surface's normal, found by its colour, scored against the marker's centre."""
     spec = scenario.scene.surface_targets
     assert spec is not None
     records: list[MeasurementRecord] = []
     with simulator(hub, "default", scenario) as sim:
         for body in MARKER_BODIES:  # markers play no part: out of every view
             sim.set_body_pose(body, np.array(PARKED_WORLD_M))
-        drawn = _draw(sim, spec, scenario.seed)
-        truth = {t.name: np.array(t.point_world_m) for t in drawn.targets}
+        drawn = _classed(sim, scenario, _draw(sim, spec, scenario.seed))
+        markers_at = [
+            np.array(t.point_world_m) + MARKER_OFFSET_M * surface_normal(sim, t.point_world_m)
+            if spec.targets_as == "markers"
+            else None
+            for t in drawn.targets
+        ]
+        truth = {
+            t.name: np.array(t.point_world_m) if at is None else at
+            for t, at in zip(drawn.targets, markers_at, strict=True)
+        }
         hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         goal_u = (knowledge.reference(sim, 1)[0], knowledge.reference(sim, 2)[0])
         log = LandingLog(sim, goal_u)
@@ -248,31 +282,66 @@ def measure_surface_targets(
             shared = servo(sim)
             clicks = np.random.default_rng([scenario.seed, STREAM_CLICKS])
             band_for = row_band_for(knowledge, sim, spec.band_px)
-            for placed in drawn.targets:
+            for placed, marker_at in zip(drawn.targets, markers_at, strict=True):
                 step = hub.begin(placed.name)
                 _start_pose(sim)
-                told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
-                # The first image: the head needs only the fovea around the click (the
-                # full frame's crop, at a window's cost).
-                fovea = _fovea(sim, told.clicked_uv)
-                first = sim.render_window(1, fovea)
-                origin = (fovea.x0, fovea.y0)
-                pair = MarkerlessPair(first, told.clicked_uv, band_for, origin_px=origin, sink=hub)
-                target = Target(placed.name, pair, _true_point(placed))
-                log.clear(_clicked_point(sim, told, placed))
-                m = measure(sim, shared, target, knowledge)
+                log.clear()
+                if marker_at is not None:
+                    # The twin: the ordinary marker target, detected by its colour.
+                    sim.set_body_pose(TWIN_MARKER, marker_at)
+                    m = measure(sim, shared, marker_target(placed.name, TWIN_MARKER), knowledge)
+                    where = sim.position(TWIN_MARKER)
+                    told, match = None, None
+                else:
+                    told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
+                    # The first image: the head needs only the fovea around the click (the
+                    # full frame's crop, at a window's cost).
+                    fovea = _fovea(sim, told.clicked_uv)
+                    first = sim.render_window(1, fovea)
+                    origin = (fovea.x0, fovea.y0)
+                    pair = MarkerlessPair(
+                        first, told.clicked_uv, band_for, origin_px=origin, sink=hub
+                    )
+                    log.clear(_clicked_point(sim, told, placed))
+                    m = measure(
+                        sim, shared, Target(placed.name, pair, _true_point(placed)), knowledge
+                    )
+                    where = point_world(sim, placed.body, placed.point_body_m)
+                    # The correspondence the measurement used: camera 2's last confident
+                    # match (else its last one, whatever it said).
+                    used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
+                    match = used[-1] if used else None
                 landings = log.fixations(m)
-                where = point_world(sim, placed.body, placed.point_body_m)
                 depth = float(sim.transform_points(where, "world", "head")[0][2])
-                # The correspondence the measurement used: camera 2's last confident match
-                # (else its last one, whatever it said).
-                used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
-                match = used[-1] if used else None
                 score = score_fixation(landings, where, depth, m.ok, told, match)
                 records.append(record_measurement(hub, m, label, step, fixation=score))
+            sim.set_body_pose(TWIN_MARKER, np.array(PARKED_WORLD_M))
         finally:
             hub.subscribers.remove(log)
-    return records, replace(drawn, stats=fixation_stats(records))
+    classes = {t.name: t.texture_class for t in drawn.targets}
+    return records, replace(
+        drawn,
+        measured_as=spec.targets_as,
+        stats=fixation_stats(records),
+        by_texture=by_texture(records, classes, TEXTURE_CLASSES),
+    )
+
+
+def _classed(sim: HeadSim, scenario: Scenario, drawn: SurfaceDraw) -> SurfaceDraw:
+    """``drawn`` with each target's texture class (:mod:`headsim.run.texture_class`),
+    decided at the start pose (truth, for the by-texture table)."""
+    room = scenario.scene.room
+    kinds = {} if room is None else texture_kinds(room)
+    half = MatchConfig().half_px
+    return replace(
+        drawn,
+        targets=tuple(
+            replace(
+                t, texture_class=texture_class(sim, kinds, t.body, np.array(t.point_world_m), half)
+            )
+            for t in drawn.targets
+        ),
+    )
 
 
 def _fovea(sim: HeadSim, uv: tuple[float, float]) -> Window:
@@ -299,18 +368,46 @@ def _true_point(placed: SurfaceTarget) -> Callable[[HeadSim], np.ndarray]:
 
 
 def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int) -> SurfaceDraw:
-    """The targets drawn at the start pose; none, with the failure, when the surfaces in
-    view offer too few (a room and a field that do not meet)."""
-    rng = np.random.default_rng([seed, STREAM_SURFACE_TARGETS])
+    """The listed targets, then those drawn at the start pose; none drawn, with the failure,
+    when the surfaces in view offer too few (a room and a field that do not meet); none at
+    all when a listed one is not on its surface or not in camera 1's start image (the click)."""
+    asked = spec.count + len(spec.listed)
     # Room for camera 1's template around the click, wherever the click error puts it.
     margin = MatchConfig().half_px + 2 + 4 * spec.click_error_px
+    listed = []
+    for t in spec.listed:
+        try:
+            placed = (
+                on_surface(sim, t.name, t.point_m)
+                if t.body is None
+                else on_object(sim, t.name, t.body, t.point_m)
+            )
+        except NotOnSurface as error:
+            return SurfaceDraw(asked, 0, {}, (), failure=f"listed markerless target {error}")
+        if not (
+            visible(sim, 1, np.array(placed.point_world_m))
+            and in_image(sim, 1, np.array(placed.point_world_m), margin)
+        ):
+            return SurfaceDraw(
+                asked, 0, {}, (),
+                failure=f"listed markerless target {t.name}: camera 1's start image does not "
+                f"show it {margin:g} px inside (a click needs it)",
+            )  # fmt: skip
+        listed.append(placed)
+    if not spec.count:
+        return SurfaceDraw(asked, 0, {}, tuple(listed), listed=len(listed))
+    rng = np.random.default_rng([seed, STREAM_SURFACE_TARGETS])
     try:
         found = draw_targets(
             sim, spec.count, rng, spec.depth_m, spec.lateral, spec.vertical, margin_px=margin
         )
     except ValueError as error:
-        return SurfaceDraw(spec.count, 0, {}, (), failure=f"markerless targets: {error}")
-    return SurfaceDraw(spec.count, found.drawn, found.refused, found.targets)
+        return SurfaceDraw(
+            asked, 0, {}, tuple(listed), failure=f"markerless targets: {error}", listed=len(listed)
+        )
+    return SurfaceDraw(
+        asked, found.drawn, found.refused, (*listed, *found.targets), listed=len(listed)
+    )
 
 
 def fixation_scores(records: Sequence[MeasurementRecord]) -> list[FixationScore]:
@@ -319,6 +416,8 @@ def fixation_scores(records: Sequence[MeasurementRecord]) -> list[FixationScore]
 
 
 __all__ = [
+    "MARKER_OFFSET_M",
+    "TWIN_MARKER",
     "LandingLog",
     "Look",
     "false_fixation_limit_m",

@@ -79,6 +79,18 @@ VARIANTS: tuple[tuple[str, Edit], ...] = (
         ),
     ),
     ("chessboard", _edits(("belief", {}))),  # the paper's preset: other belief defaults
+    (  # listed markerless targets: on an object, and a world point on a surface
+        "natural_field",
+        _edits(
+            (
+                "scene.room.targets",
+                [
+                    {"name": "poster_centre", "object": "poster", "point_object_m": [0, 0, 0]},
+                    {"name": "poster_too", "point_world_m": [-0.35, 1.6, 0.1]},
+                ],
+            ),
+        ),
+    ),
     (
         "relative_positioning",
         _edits(("scene.objects", None), ("scene.random_objects", {"count": 3})),
@@ -374,11 +386,16 @@ DESCRIPTIONS: dict[str, str] = {
     "scene.room.table_top_z_m": "Height of the table top in W's z, m (the eyes are about 0.2 m up; default -0.35); the clutter rests on it.",
     "scene.room.clutter": "Objects drawn from the seed (box, cylinder or sphere, 3-8 cm half-size, a texture class each), resting on the table.",
     "scene.room.clutter_depth_m": "Range of W's y (depth in front of the head) of the clutter's centres, m.",
-    "scene.room.targets": "Markerless targets (`model2`, `model1`): points on the room's surfaces drawn from the seed where the start pose shows both cameras; the head is told each only by a click in camera 1's image (0: none).",
+    "scene.room.targets": "Markerless targets (`model2`, `model1`; told by a click in camera 1's image): a count drawn from the seed where the start pose shows both cameras (0: none), or a list.",
+    "scene.room.targets[].name": "The listed target's name, unique (`surface_` is reserved for drawn ones). Listed targets are measured in file order.",
+    "scene.room.targets[].object": "The room object the point lies on (an objects entry, `clutter_N`, `room_floor`, `room_table`, `room_wall_*`).",
+    "scene.room.targets[].point_object_m": "The point in the object's frame, m; must lie within 1 mm of its surface.",
+    "scene.room.targets[].point_world_m": "Without `object`: the point in W, m; must lie within 1 mm of a surface of the room.",
     "scene.room.targets_depth_m": "Depth range in H of the markerless targets, m (a draw outside is drawn again, counted).",
     "scene.room.targets_lateral": "Largest |x_h / z_h| of a markerless target's draw direction (0.25: the shared field).",
     "scene.room.targets_vertical": "Largest |y_h / z_h| of a markerless target's draw direction.",
     "scene.room.click_error_px": "Standard deviation of the click that tells the head a markerless target, px per axis.",
+    "scene.room.targets_as": "`surface`: each target by correlation; `markers`: an emissive marker put 5 mm out along the surface's normal, found by its colour (the marker twin).",
     "scene.room.band_px": "Half-height of the band along camera 1's row in which camera 2 searches the clicked point, px (the head knows no focal length).",
     "scene.room.light": "The key light and the ambient level.",
     "scene.room.light.direction_world": "Direction the key light shines along, in W (normalised).",

@@ -12,12 +12,14 @@ from __future__ import annotations
 import functools
 import math
 from contextvars import ContextVar
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
+import mujoco
 import numpy as np
 
 from headsim.scenario.occlusion import Occluder, scene_model
-from headsim.scenario.spec import MAX_DEPTH_M, SurfaceTargetsSpec
+from headsim.scenario.spec import MAX_DEPTH_M, TARGETS_AS, ListedSurfaceTarget, SurfaceTargetsSpec
+from headsim.scenario.surface_targets import NotOnSurface, on_object, on_surface
 from headsim.scenario.tables import Table
 from headsim.sim import names
 from headsim.sim.textured_scene import SHAPES, LightSettings, RoomSpec, SceneObject
@@ -105,10 +107,41 @@ def scene_names() -> frozenset[str]:
     return frozenset(taken)
 
 
+def _listed(entry: Table) -> ListedSurfaceTarget:
+    """One ``[[scene.room.targets]]`` entry (its point checked later, with the room)."""
+    name = entry.string("name", what="the target's name", max_length=60)
+    body = entry.string("object", None, 60, what="the name of an object of the room")
+    in_object = entry.numbers("point_object_m", 3, None, -MAX_DEPTH_M, MAX_DEPTH_M, unit="m")
+    in_world = entry.numbers("point_world_m", 3, None, -MAX_DEPTH_M, MAX_DEPTH_M, unit="m")
+    entry.done()
+    if body is not None and (in_object is None or in_world is not None):
+        raise entry.fail(
+            "point_object_m",
+            "missing" if in_object is None else "given with point_world_m",
+            "with object: point_object_m = [x, y, z] in the object's frame, m (no point_world_m)",
+        )
+    if body is None and (in_world is None or in_object is not None):
+        raise entry.fail(
+            "point_world_m",
+            "missing" if in_world is None else "given with point_object_m but no object",
+            "point_world_m = [x, y, z] on a surface, m; or object and point_object_m",
+        )
+    point = in_object if body is not None else in_world
+    assert point is not None
+    return ListedSurfaceTarget(name, body, (point[0], point[1], point[2]))
+
+
 def _surface_targets(table: Table) -> SurfaceTargetsSpec | None:
-    """``[scene.room]``'s markerless targets (``targets`` and its ``targets_*`` keys,
-    ``click_error_px``, ``band_px``); None when ``targets`` is 0 or absent."""
-    count = table.integer("targets", 0, 0, 200)
+    """``[scene.room]``'s markerless targets (``targets``: a count drawn from the seed, or
+    ``[[scene.room.targets]]`` listed; its ``targets_*`` keys, ``click_error_px``,
+    ``band_px``); None when there are none."""
+    listed: tuple[ListedSurfaceTarget, ...] = ()
+    if isinstance(table.data.get("targets"), list):
+        # TOML gives a key one type: listed targets leave no count to draw.
+        listed = tuple(_listed(t) for t in table.tables("targets", 200))
+        count = 0
+    else:
+        count = table.integer("targets", 0, 0, 200)
     near, far = table.numbers("targets_depth_m", 2, (0.3, 2.0), 0.2, MAX_DEPTH_M, unit="m")
     if near >= far:
         raise table.fail(
@@ -118,9 +151,73 @@ def _surface_targets(table: Table) -> SurfaceTargetsSpec | None:
     vertical = table.number("targets_vertical", 0.1, 0.0, 1.0, lo_open=True)
     click_px = table.number("click_error_px", 0.5, 0.0, 20.0, unit="px")
     band_px = table.number("band_px", 10.0, 1.0, 100.0, unit="px")
-    if count == 0:
+    targets_as = table.choice("targets_as", TARGETS_AS, "surface")
+    if count == 0 and not listed:
         return None
-    return SurfaceTargetsSpec(count, (near, far), lateral, vertical, click_px, band_px)
+    return SurfaceTargetsSpec(
+        count, (near, far), lateral, vertical, click_px, band_px, listed, targets_as
+    )
+
+
+@dataclass(frozen=True)
+class RoomGeometry:
+    """The room's surfaces and objects alone, compiled, at rest (no head, no textures): for
+    checking that a listed target lies on a surface when the scenario is read."""
+
+    model: mujoco.MjModel
+    data: mujoco.MjData
+
+    @classmethod
+    def of(cls, room: RoomSpec) -> RoomGeometry:
+        spec = mujoco.MjSpec()
+        for obj in (*room.surfaces(), *room.objects):
+            quat = np.zeros(4)
+            mujoco.mju_mat2Quat(quat, np.ascontiguousarray(obj.world_from_object).reshape(9))
+            body = spec.worldbody.add_body(
+                name=obj.name, pos=list(obj.pos_world_m), quat=list(quat)
+            )
+            body.add_geom(
+                name=obj.name, type=SHAPES[obj.shape], size=list(obj.size_m), group=names.ROOM_GROUP
+            )
+        model = spec.compile()
+        data = mujoco.MjData(model)
+        mujoco.mj_kinematics(model, data)
+        return cls(model, data)
+
+
+def check_listed(scene: Table, room: RoomSpec, listed: tuple[ListedSurfaceTarget, ...]) -> None:
+    """Each listed target's name unique and its point on its object's surface (or, a world
+    point, on some surface), else a one-line error naming the entry's field."""
+    if not listed:
+        return
+    geometry = RoomGeometry.of(room)
+    bodies = [obj.name for obj in (*room.surfaces(), *room.objects)]
+    path = f"{scene.field('room')}.targets"
+    seen: list[str] = []
+    for k, t in enumerate(listed):
+        if t.name in seen or t.name.startswith("surface_"):
+            raise scene.ctx.error(
+                f"{path}[{k}].name",
+                f"{t.name!r} is used twice or reserved",
+                "unique names, not starting with surface_ (the drawn targets' names)",
+            )
+        seen.append(t.name)
+        if t.body is not None and t.body not in bodies:
+            raise scene.ctx.error(
+                f"{path}[{k}].object",
+                f"no object named {t.body!r} in the room",
+                "an object of [[scene.room.objects]], clutter_N, room_floor, room_table, "
+                + ", ".join(names.ROOM_WALLS),
+            )
+        try:
+            if t.body is not None:
+                on_object(geometry, t.name, t.body, t.point_m)
+            else:
+                on_surface(geometry, t.name, t.point_m)
+        except NotOnSurface as error:
+            key = "point_object_m" if t.body is not None else "point_world_m"
+            # The message says what is allowed (within ON_SURFACE_M).
+            raise scene.ctx.error(f"{path}[{k}].{key}", str(error)) from None
 
 
 def read_room(scene: Table, seed: int) -> tuple[RoomSpec | None, SurfaceTargetsSpec | None]:
@@ -169,7 +266,10 @@ def read_room(scene: Table, seed: int) -> tuple[RoomSpec | None, SurfaceTargetsS
     room = RoomSpec(seed=seed, surface=surface, light=light, table_top_z_m=table_z)
     rng = np.random.default_rng([seed, STREAM_ROOM])
     clutter = draw_clutter(room, count, (near, far), rng)
-    return replace(room, objects=objects + clutter), targets
+    room = replace(room, objects=objects + clutter)
+    if targets is not None:
+        check_listed(scene, room, targets.listed)
+    return room, targets
 
 
 def room_occluders(room: RoomSpec) -> tuple[Occluder, ...]:
@@ -207,6 +307,8 @@ __all__ = [
     "ROOM_HAS_TARGETS",
     "ROOM_OCCLUDERS",
     "STREAM_ROOM",
+    "RoomGeometry",
+    "check_listed",
     "draw_clutter",
     "read_room",
     "room_occluders",

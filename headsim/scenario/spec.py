@@ -245,6 +245,22 @@ class TargetAcceptance:
 
 
 @dataclass(frozen=True)
+class ListedSurfaceTarget:
+    """``[[scene.room.targets]]``: a named point on the room's surfaces, on ``body`` at
+    ``point_m`` in its frame, or (``body`` None) at the world point ``point_m``, m; checked
+    to lie on the surface when read."""
+
+    name: str
+    body: str | None
+    point_m: tuple[float, float, float]
+
+
+#: How a room's markerless targets are measured (``[scene.room] targets_as``): as points of
+#: the surfaces (by correlation), or each by an emissive marker put there (the twin).
+TARGETS_AS = ("surface", "markers")
+
+
+@dataclass(frozen=True)
 class SurfaceTargetsSpec:
     """``[scene.room] targets``: ``count`` markerless targets, points on the room's
     surfaces drawn at run time from the seed (the surfaces the start pose shows both
@@ -259,6 +275,10 @@ class SurfaceTargetsSpec:
     vertical: float = 0.1
     click_error_px: float = 0.5
     band_px: float = 10.0
+    #: ``[[scene.room.targets]]``, measured first, in file order
+    listed: tuple[ListedSurfaceTarget, ...] = ()
+    #: how each is measured (:data:`TARGETS_AS`): by correlation, or by a marker put there
+    targets_as: str = "surface"
 
 
 @dataclass(frozen=True)

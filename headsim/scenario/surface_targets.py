@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 import mujoco
 import numpy as np
@@ -37,6 +38,16 @@ CLICK_ERROR_PX = 0.5
 SURFACE_REFUSALS = ("no_surface", "depth", "occluded", "start_view", "reach")
 #: The geom groups a cast ray may hit: all but the head's own.
 SCENE_GROUPS = np.array([g != names.HEAD_VISUAL_GROUP for g in range(6)], dtype=np.uint8)
+
+
+class SceneState(Protocol):
+    """A compiled scene at a state: a :class:`HeadSim`, or a room's model alone."""
+
+    @property
+    def model(self) -> mujoco.MjModel: ...
+
+    @property
+    def data(self) -> mujoco.MjData: ...
 
 
 class NotOnSurface(ValueError):
@@ -87,19 +98,21 @@ def surface_distance_m(geom_type: int, size: Sequence[float], point_geom_m: np.n
 @dataclass(frozen=True)
 class SurfaceTarget:
     """A target point on a surface: the ``body`` (and geom) it lies on, the point in the
-    body's frame ``point_body_m`` and in W ``point_world_m`` (m), as placed."""
+    body's frame ``point_body_m`` and in W ``point_world_m`` (m), as placed;
+    ``texture_class`` for the by-texture table ("": not yet classed)."""
 
     name: str
     body: str
     point_body_m: tuple[float, float, float]
     point_world_m: tuple[float, float, float]
+    texture_class: str = ""
 
 
 def _triple(p: np.ndarray) -> tuple[float, float, float]:
     return (float(p[0]), float(p[1]), float(p[2]))
 
 
-def point_world(sim: HeadSim, body: str, point_body_m: ArrayLike) -> np.ndarray:
+def point_world(sim: SceneState, body: str, point_body_m: ArrayLike) -> np.ndarray:
     """Where a point given in ``body``'s frame truly is now, W, m."""
     b = sim.data.body(body)
     return np.asarray(b.xpos + b.xmat.reshape(3, 3) @ np.asarray(point_body_m, dtype=float))
@@ -119,7 +132,7 @@ def _scene_geoms(model: mujoco.MjModel) -> list[int]:
     ]
 
 
-def surface_of(sim: HeadSim, point_world_m: ArrayLike) -> tuple[int, float]:
+def surface_of(sim: SceneState, point_world_m: ArrayLike) -> tuple[int, float]:
     """The scene geom whose surface is nearest a world point, and the distance, m."""
     p = np.asarray(point_world_m, dtype=float)
     best, best_d = -1, math.inf
@@ -131,7 +144,36 @@ def surface_of(sim: HeadSim, point_world_m: ArrayLike) -> tuple[int, float]:
     return best, best_d
 
 
-def on_object(sim: HeadSim, name: str, body: str, point_body_m: ArrayLike) -> SurfaceTarget:
+def surface_normal(sim: SceneState, point_world_m: ArrayLike) -> np.ndarray:
+    """The outward unit normal, in W, of the scene surface nearest a point on it (a plane's
+    front, a sphere's radius, a box's face, a cylinder's side or cap)."""
+    p = np.asarray(point_world_m, dtype=float)
+    geom, _ = surface_of(sim, p)
+    if geom < 0:
+        raise NotOnSurface("no surface in the scene")
+    rotation = sim.data.geom_xmat[geom].reshape(3, 3)
+    local = rotation.T @ (p - sim.data.geom_xpos[geom])
+    size = sim.model.geom_size[geom]
+    kind = int(sim.model.geom_type[geom])
+    if kind == mujoco.mjtGeom.mjGEOM_PLANE:
+        normal = np.array([0.0, 0.0, 1.0])
+    elif kind == mujoco.mjtGeom.mjGEOM_SPHERE:
+        normal = local
+    elif kind == mujoco.mjtGeom.mjGEOM_BOX:
+        axis = int(np.argmax(np.abs(local) - size[:3]))
+        normal = np.zeros(3)
+        normal[axis] = 1.0 if local[axis] >= 0 else -1.0
+    else:  # a cylinder: its side or a cap, whichever the point lies on
+        radial = math.hypot(local[0], local[1])
+        if abs(local[2]) - size[1] > radial - size[0]:
+            normal = np.array([0.0, 0.0, 1.0 if local[2] >= 0 else -1.0])
+        else:
+            normal = np.array([local[0], local[1], 0.0])
+    world = rotation @ normal
+    return np.asarray(world / float(np.linalg.norm(world)))
+
+
+def on_object(sim: SceneState, name: str, body: str, point_body_m: ArrayLike) -> SurfaceTarget:
     """A target at ``point_body_m`` on ``body``, checked to lie on its surface."""
     if mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_BODY, body) < 0:
         raise NotOnSurface(f"{name}: no object named {body!r} in the scene")
@@ -147,7 +189,7 @@ def on_object(sim: HeadSim, name: str, body: str, point_body_m: ArrayLike) -> Su
     return SurfaceTarget(name, body, _triple(np.asarray(point_body_m, dtype=float)), _triple(p))
 
 
-def on_surface(sim: HeadSim, name: str, point_world_m: ArrayLike) -> SurfaceTarget:
+def on_surface(sim: SceneState, name: str, point_world_m: ArrayLike) -> SurfaceTarget:
     """A target at a world point, checked to lie within :data:`ON_SURFACE_M` of a surface."""
     p = np.asarray(point_world_m, dtype=float)
     geom, distance = surface_of(sim, p)
@@ -213,7 +255,7 @@ class DrawnTargets:
     refused: dict[str, int]
 
 
-def _in_image(sim: HeadSim, camera: int, p: np.ndarray, margin_px: float = 0.0) -> bool:
+def in_image(sim: HeadSim, camera: int, p: np.ndarray, margin_px: float = 0.0) -> bool:
     """Whether the point projects into ``camera``'s image at least ``margin_px`` inside."""
     cam = sim.camera_settings(camera)
     if sim.transform_points(p, "world", names.CAMERAS[camera - 1])[0][2] <= 0:
@@ -239,7 +281,7 @@ def surface_refusal(
         return "depth"
     if not (visible(sim, 1, p) and visible(sim, 2, p)):
         return "occluded"
-    if not _in_image(sim, 1, p, margin_px):
+    if not in_image(sim, 1, p, margin_px):
         return "start_view"
     if head is not None and target_refusal(head, "model2", p) is not None:
         return "reach"
@@ -291,15 +333,18 @@ __all__ = [
     "Click",
     "DrawnTargets",
     "NotOnSurface",
+    "SceneState",
     "SurfaceTarget",
     "camera_centre",
     "cast",
     "click",
     "draw_targets",
+    "in_image",
     "on_object",
     "on_surface",
     "point_world",
     "surface_distance_m",
+    "surface_normal",
     "surface_of",
     "surface_refusal",
     "visible",
