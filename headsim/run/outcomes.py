@@ -44,7 +44,10 @@ class FixationScore:
     ``match_ambiguity``, ``match_status``: camera 2's last confident correspondence (else
     its last; None: none made); ``false_fixation``: the measurement is ok but an eye
     landed more than ``false_fixation_limit_m`` from the target (or on nothing).  NaN (no
-    landing) when the measurement failed.
+    landing) when the measurement failed.  ``match_error_px``: camera 2's last confident
+    look's image error, whatever the measurement's outcome (NaN: none); ``wrong_match``:
+    that error is more than the false-fixation limit seen from camera 2 (a confident
+    match on the wrong point, counted also where the measurement then failed).
     """
 
     vergence_error_deg: float
@@ -60,6 +63,8 @@ class FixationScore:
     match_status: str | None
     false_fixation: bool
     false_fixation_limit_m: float
+    match_error_px: float = math.nan
+    wrong_match: bool = False
 
 
 #: A fixation is false beyond this fraction of the target's depth ...
@@ -83,7 +88,8 @@ class MeasurementRecord:
 @dataclass(frozen=True)
 class FixationStats:
     """The fixations of markerless targets in short: vergence error median and RMS over
-    those where both eyes converged (degrees; NaN: none), false fixations, and the
+    those where both eyes converged (degrees; NaN: none), false fixations, confident
+    wrong matches (all, and those in measurements that then failed), and the
     measurements that failed, by cause."""
 
     count: int
@@ -91,6 +97,8 @@ class FixationStats:
     vergence_error_deg_rms: float
     false_fixations: int
     failure_causes: dict[str, int]
+    wrong_matches: int = 0
+    wrong_matches_failed: int = 0
 
 
 def fixation_stats(records: Sequence[MeasurementRecord]) -> FixationStats:
@@ -113,6 +121,12 @@ def fixation_stats(records: Sequence[MeasurementRecord]) -> FixationStats:
             1 for r in scored if r.fixation is not None and r.fixation.false_fixation
         ),
         failure_causes=dict(sorted(causes.items(), key=lambda kv: (-kv[1], kv[0]))),
+        wrong_matches=sum(1 for r in scored if r.fixation is not None and r.fixation.wrong_match),
+        wrong_matches_failed=sum(
+            1
+            for r in scored
+            if r.fixation is not None and r.fixation.wrong_match and not r.measurement.ok
+        ),
     )
 
 
@@ -140,6 +154,7 @@ class TextureClassStats:
             "vergence_error_deg_median": self.fixation.vergence_error_deg_median,
             "vergence_error_deg_rms": self.fixation.vergence_error_deg_rms,
             "false_fixations": self.fixation.false_fixations,
+            "wrong_matches": self.fixation.wrong_matches,
             "failure_causes": dict(self.fixation.failure_causes),
             "renders_per_point": self.renders_per_point,
         }
@@ -209,6 +224,8 @@ class SurfaceDraw:
                 for t in self.targets
             ],
             "false_fixations": None if stats is None else stats.false_fixations,
+            "wrong_matches": None if stats is None else stats.wrong_matches,
+            "wrong_matches_failed": None if stats is None else stats.wrong_matches_failed,
             "vergence_error_deg_median": None if stats is None else stats.vergence_error_deg_median,
             "vergence_error_deg_rms": None if stats is None else stats.vergence_error_deg_rms,
             "by_texture": [c.entry() for c in self.by_texture],

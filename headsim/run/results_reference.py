@@ -181,6 +181,12 @@ RESULTS_FIELDS: dict[str, str] = {
     "measurements[].fixation.match_sigma_px": "the location spread the matched template's "
     "texture allows at the image noise (Cramer-Rao, one axis), px: the theory's correspondence "
     "noise",
+    "measurements[].fixation.match_error_px": "camera 2's last confident look: |where its "
+    "match put the clicked point - its true projection|, px, whatever the measurement's "
+    "outcome (`null`: no confident match)",
+    "measurements[].fixation.wrong_match": "that error exceeds the false-fixation limit seen "
+    "from camera 2 (`false_fixation_limit_m` / depth x camera 2's focal length): a confident "
+    "match on the wrong point, counted also where the measurement then failed",
     "measurements[].fixation.match_score": "camera 2's last confident correspondence (else its "
     "last): peak NCC",
     "measurements[].fixation.match_ambiguity": "its second-best peak over the best",
@@ -241,6 +247,10 @@ _SURFACE: dict[str, str] = {
     "surface_targets.targets": "each target: `name`, the `body` it lies on, `point_world_m`, "
     "its `texture_class` (`rich`, `low`, `repetitive`, `occluded`: from truth at placement)",
     "surface_targets.false_fixations": "measurements ok with an eye landed off the target",
+    "surface_targets.wrong_matches": "targets whose camera 2 made a confident match on the "
+    "wrong point (`wrong_match`)",
+    "surface_targets.wrong_matches_failed": "of those, the ones whose measurement then failed "
+    "(not false fixations: counted here, not hidden)",
     "surface_targets.vergence_error_deg_median": "median vergence error of the fixations, degrees",
     "surface_targets.vergence_error_deg_rms": "their RMS, degrees",
     "surface_targets.by_texture": "per texture class (`rich`: pink noise, `low`, `repetitive`: "
@@ -253,6 +263,7 @@ _SURFACE: dict[str, str] = {
     "surface_targets.by_texture[].vergence_error_deg_median": "median vergence error, degrees",
     "surface_targets.by_texture[].vergence_error_deg_rms": "its RMS, degrees",
     "surface_targets.by_texture[].false_fixations": "measurements ok with an eye landed off",
+    "surface_targets.by_texture[].wrong_matches": "confident matches on the wrong point",
     "surface_targets.by_texture[].failure_causes": "failures by cause",
     "surface_targets.by_texture[].renders_per_point": "renders per target asked",
 }

@@ -138,6 +138,8 @@ def fixation_entry(f: FixationScore) -> dict[str, Any]:
         "match_status": f.match_status,
         "false_fixation": f.false_fixation,
         "false_fixation_limit_m": f.false_fixation_limit_m,
+        "match_error_px": f.match_error_px,
+        "wrong_match": f.wrong_match,
     }
 
 

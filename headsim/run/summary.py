@@ -216,9 +216,8 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
     if twin:
         lines.append(
             "  each measured with a marker put there (5 mm out along the normal), not by "
-            "correlation; scored against the marker's centre.  Its vergence error includes the "
-            "marker's own parallax: eye 1's ray lands on the 4 mm sphere's front, about "
-            "radius x vergence angle off eye 2's line (0.14 deg at 0.5 m)"
+            "correlation; scored against the marker's centre: each eye's fixated point is "
+            "its ray's point nearest the centre (the ray meets the sphere's front)"
         )
     lines.append(
         f"  {'marker' if twin else 'markerless'} fixations (truth: where each eye's goal ray "
@@ -226,6 +225,8 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
         f"median {_cell(stats.vergence_error_deg_median, '.4f')} deg, RMS "
         f"{_cell(stats.vergence_error_deg_rms, '.4f')} deg; false fixations "
         f"{stats.false_fixations} of {ok} ok (an eye landed > max(1 % of depth, 5 mm) off); "
+        f"confident matches on a wrong point {stats.wrong_matches} "
+        f"({stats.wrong_matches_failed} of them in failed measurements); "
         f"failures by cause: {causes}"
     )
     if isinstance(surface, SurfaceDraw) and surface.by_texture:

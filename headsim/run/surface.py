@@ -175,10 +175,14 @@ def score_fixation(
     ok: bool,
     told: Click | None,
     match: Match | None,
+    last_match: Look | None = None,
+    focal2_px: float = math.nan,
 ) -> FixationScore:
     """A :class:`FixationScore` from the logged looks at the fixation (an eye missing:
     NaN), the click the head was ``told`` (None: a marker, no click; its error NaN) and
-    camera 2's last correspondence ``match``."""
+    camera 2's last correspondence ``match``; ``last_match``: camera 2's last confident look
+    whatever the outcome, judged wrong beyond the false-fixation limit seen from camera 2
+    at ``focal2_px`` (truth's focal length: scoring only)."""
     one, two = (None if (x := looks.get(c)) is None else x.landing for c in (1, 2))
     look_px = [math.nan if (x := looks.get(c)) is None else x.error_px for c in (1, 2)]
     errors = [
@@ -193,6 +197,7 @@ def score_fixation(
     if one is not None and two is not None and one.point_world_m is not None:
         vergence = vergence_error_deg(two.origin_world_m, two.direction_world, one.point_world_m)
     limit = false_fixation_limit_m(depth_m)
+    match_px = math.nan if last_match is None else last_match.error_px
     # An eye whose ray met nothing is off; an eye without a look at the fixation is unknown.
     false = ok and any(
         x is not None and (math.isnan(off) or off > limit)
@@ -216,6 +221,8 @@ def score_fixation(
         match_status=None if match is None else match.status.value,
         false_fixation=bool(false),
         false_fixation_limit_m=limit,
+        match_error_px=match_px,
+        wrong_match=bool(match_px > limit / depth_m * focal2_px),
     )
 
 
@@ -311,9 +318,13 @@ def measure_surface_targets(
                     # match (else its last one, whatever it said).
                     used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
                     match = used[-1] if used else None
-                landings = log.fixations(m)
+                looks = log.fixations(m)
+                if marker_at is not None:
+                    looks = {c: _nearest(x, where) for c, x in looks.items()}
                 depth = float(sim.transform_points(where, "world", "head")[0][2])
-                score = score_fixation(landings, where, depth, m.ok, told, match)
+                last = log.last(2, lambda encoders: True)
+                focal2 = sim.camera_settings(2).kx
+                score = score_fixation(looks, where, depth, m.ok, told, match, last, focal2)
                 records.append(record_measurement(hub, m, label, step, fixation=score))
             sim.set_body_pose(TWIN_MARKER, np.array(PARKED_WORLD_M))
         finally:
@@ -342,6 +353,16 @@ def _classed(sim: HeadSim, scenario: Scenario, drawn: SurfaceDraw) -> SurfaceDra
             for t in drawn.targets
         ),
     )
+
+
+def _nearest(look: Look, centre_world_m: np.ndarray) -> Look:
+    """``look`` with its landed point moved to the point of its ray nearest a marker's
+    centre: the point the eye fixates (its ray meets the sphere's front, about radius x
+    the vergence angle off the other eye's line)."""
+    ray = look.landing
+    along = float(ray.direction_world @ (centre_world_m - ray.origin_world_m))
+    point = ray.origin_world_m + along * ray.direction_world
+    return replace(look, landing=replace(ray, point_world_m=point, distance_m=along))
 
 
 def _fovea(sim: HeadSim, uv: tuple[float, float]) -> Window:

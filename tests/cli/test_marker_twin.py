@@ -36,7 +36,10 @@ def test_the_twin_measures_natural_fields_points_with_a_marker_at_each(tmp_path:
         assert float(off @ -np.asarray(point["point_world_m"])) > 0
         if m["status"] == "ok":
             assert m["fixation"]["landed"][0] == TWIN_MARKER
-            assert np.isfinite(m["fixation"]["vergence_error_deg"])
+            # Each eye's fixated point is its ray's nearest to the centre, not the sphere's
+            # front (whose parallax alone is 0.14 deg at 0.5 m): the eyes meet there.
+            assert max(m["fixation"]["error_m"]) < 1e-3
+            assert m["fixation"]["vergence_error_deg"] < 0.05
     # The markerless run's truth is the point itself.
     for point, m in zip(points, markerless["measurements"], strict=True):
         np.testing.assert_allclose(m["truth_world_m"], point["point_world_m"], atol=1e-9)

@@ -103,6 +103,22 @@ def test_eye_2_on_the_wall_behind_is_a_false_fixation_though_eye_1_is_on_the_tar
     assert not alone.false_fixation
 
 
+def test_a_confident_match_far_off_is_wrong_though_the_measurement_failed() -> None:
+    # Camera 2's last confident look put the clicked point 20 px from where it truly was;
+    # at 1 m the limit, 10 mm, is 8.4 px at 840 px focal length.  The measurement failed
+    # after it: no false fixation, but a wrong match, counted.
+    nothing = _landing(1, EYE1, None, "")
+    far = Look(2, (0, 0, 0), _landing(2, EYE2, TARGET, "wall"), (340.0, 240.0), (320.0, 240.0))
+    near = Look(2, (0, 0, 0), _landing(2, EYE2, TARGET, "wall"), (324.0, 240.0), (320.0, 240.0))
+    wrong = score_fixation({1: _look(nothing)}, TARGET, 1.0, False, CLICK, MATCH, far, 840.0)
+    assert wrong.wrong_match and not wrong.false_fixation
+    assert wrong.match_error_px == pytest.approx(20.0)
+    right = score_fixation({}, TARGET, 1.0, False, CLICK, MATCH, near, 840.0)
+    assert not right.wrong_match and right.match_error_px == pytest.approx(4.0)
+    unknown = score_fixation({}, TARGET, 1.0, False, CLICK, MATCH)
+    assert not unknown.wrong_match and math.isnan(unknown.match_error_px)
+
+
 def _doc(procedure: str, room: dict) -> dict:
     return {"description": "d", "experiment": {"procedure": procedure}, "scene": {"room": room}}
 
