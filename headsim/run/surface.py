@@ -87,7 +87,8 @@ class LandingLog:
 
     def fixations(self, m: Measurement) -> dict[int, Landing]:
         """Each camera's landing where its servo left it fixated: Model 2's camera 1 at step
-        1's eye encoder, camera 2 at step 2's; Model 1's both at the final pose."""
+        1's eye encoder, camera 2 at step 2's; Model 1's both at the final pose; the
+        one-step fixation's each at its own eye motor's and the neck's final encoders."""
         out: dict[int, Landing] = {}
         if not m.ok:
             return out
@@ -105,8 +106,28 @@ class LandingLog:
                     out[camera] = found
             return out
         now = self.encoders()
+        if m.method.value == "fixation":
+            # Each eye's own motor: camera c's view depends on the neck and its eye alone,
+            # so its last look at the final pose may precede the other eye's last step.
+            return self._per_eye(now)
         for camera in (1, 2):
             found = self.last(camera, lambda e: e == now)
+            if found is not None:
+                out[camera] = found
+        return out
+
+    def _per_eye(self, now: tuple[int, ...]) -> dict[int, Landing]:
+        """Each camera's last landing with the neck and that camera's eye motor (camera
+        1: ``eye``, camera 2: ``eye2``) at their encoders ``now``."""
+        motors = self.sim.motors
+        out: dict[int, Landing] = {}
+        for camera, eye in ((1, "eye"), (2, "eye2")):
+            kept = [k for k, name in enumerate(motors) if name.startswith("neck") or name == eye]
+
+            def same(encoders: tuple[int, ...], kept: list[int] = kept) -> bool:
+                return all(encoders[k] == now[k] for k in kept)
+
+            found = self.last(camera, same)
             if found is not None:
                 out[camera] = found
         return out
@@ -187,17 +208,21 @@ def measure_surface_targets(
     label: str,
     servo: Callable[[HeadSim], S],
     measure: Callable[[HeadSim, S, Target, HeadKnowledge], Measurement],
+    both_views: bool = False,
 ) -> tuple[list[MeasurementRecord], SurfaceDraw]:
     """Each of ``[scene.room] targets`` measured in turn from the start pose: drawn, clicked
     in camera 1's image there, measured with ``measure`` through one shared ``servo``, its
-    fixation scored from the looks the run reported (:class:`LandingLog`)."""
+    fixation scored from the looks the run reported (:class:`LandingLog`).
+    ``both_views``: draw only points that camera 2's start image also shows with a
+    template's room (a servo whose first look is with both cameras: Model 1, the
+    one-step fixation); else camera 2 need only see them."""
     spec = scenario.scene.surface_targets
     assert spec is not None
     records: list[MeasurementRecord] = []
     with simulator(hub, "default", scenario) as sim:
         for body in MARKER_BODIES:  # markers play no part: out of every view
             sim.set_body_pose(body, np.array(PARKED_WORLD_M))
-        drawn = _draw(sim, spec, scenario.seed)
+        drawn = _draw(sim, spec, scenario.seed, both_views)
         truth = {t.name: np.array(t.point_world_m) for t in drawn.targets}
         hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         goal_u = (knowledge.reference(sim, 1)[0], knowledge.reference(sim, 2)[0])
@@ -214,11 +239,15 @@ def measure_surface_targets(
                 told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
                 pair = MarkerlessPair(first, told.clicked_uv, band_for)
                 target = Target(placed.name, pair, _truth(placed))
+                # Depth at the start pose (a failure leaves the head wherever it gave up).
+                where = point_world(sim, placed.body, placed.point_body_m)
+                truth_head = sim.transform_points(where, "world", "head")[0]
+                depth = float(truth_head[2])
                 log.clear()
                 m = measure(sim, shared, target, knowledge)
+                if not m.ok:
+                    m = replace(m, truth_head_m=truth_head)
                 landings = log.fixations(m)
-                where = point_world(sim, placed.body, placed.point_body_m)
-                depth = float(sim.transform_points(where, "world", "head")[0][2])
                 # The correspondence the measurement used: camera 2's last confident match
                 # (else its last one, whatever it said).
                 used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
@@ -234,15 +263,23 @@ def _truth(placed: SurfaceTarget) -> Callable[[HeadSim], np.ndarray]:
     return lambda sim: point_world(sim, placed.body, placed.point_body_m)
 
 
-def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int) -> SurfaceDraw:
-    """The targets drawn at the start pose; none, with the failure, when the surfaces in
-    view offer too few (a room and a field that do not meet)."""
+def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int, both_views: bool) -> SurfaceDraw:
+    """The targets drawn at the start pose (``both_views``: inside camera 2's image with
+    the same margin as camera 1's); none, with the failure, when the surfaces in view
+    offer too few (a room and a field that do not meet)."""
     rng = np.random.default_rng([seed, STREAM_SURFACE_TARGETS])
     # Room for camera 1's template around the click, wherever the click error puts it.
     margin = MatchConfig().half_px + 2 + 4 * spec.click_error_px
     try:
         found = draw_targets(
-            sim, spec.count, rng, spec.depth_m, spec.lateral, spec.vertical, margin_px=margin
+            sim,
+            spec.count,
+            rng,
+            spec.depth_m,
+            spec.lateral,
+            spec.vertical,
+            margin_px=margin,
+            margin2_px=margin if both_views else None,
         )
     except ValueError as error:
         return SurfaceDraw(spec.count, 0, {}, (), failure=f"markerless targets: {error}")

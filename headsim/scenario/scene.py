@@ -202,7 +202,7 @@ def default_position(scene: str, body: str) -> np.ndarray:
 
 
 #: The procedures that measure ``[scene.room] targets`` (one servo, target by target).
-SURFACE_TARGET_PROCEDURES = ("model2", "model1")
+SURFACE_TARGET_PROCEDURES = ("model2", "model1", "fixation")
 
 
 def read_scene(
