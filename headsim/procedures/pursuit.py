@@ -43,7 +43,7 @@ from headsim.scenario.pursuit import PursuitSpec, describe
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import read_pursuit_scene
 from headsim.scenario.spec import MARKER_BODIES, STREAM_CLICKS, Scenario
-from headsim.scenario.surface_targets import camera_centre, cast, click
+from headsim.scenario.surface_targets import Click, camera_centre, cast, click
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import MatchConfig
@@ -228,22 +228,31 @@ def run_pursuit(
             return [], PursuitResult(
                 described, failures=(f"{spec.name}: never present in the run",)
             )
+        told: Click | None = None
         if textured:
             for body in MARKER_BODIES:  # markers play no part: out of every view
                 sim.set_body_pose(body, np.array(PARKED_WORLD_M))
             live.advance_to(first)
-            pair, offset, failure = _clicked_object(sim, spec, knowledge, scenario.seed)
-            if pair is None:
+            told, offset = _click_object(sim, spec, scenario.seed)
+            if told is None:
                 sink.emit(PhaseStarted("measurement", sim, knowledge, {}))
+                failure = "not in camera 1's first image (hidden or out of view)"
                 return [], PursuitResult(described, failures=(f"{spec.name}: {failure}",))
-            detector: Detector = pair
             live.point_offset_m = offset
         else:
-            detector = marker_target(spec.name, spec.body).detector
             live.advance_to(first)
         truth = live.target_truth(first)
         assert truth is not None
         sink.emit(PhaseStarted("measurement", sim, knowledge, {spec.name: truth}))
+        detector: Detector = (
+            marker_target(spec.name, spec.body).detector
+            if told is None
+            # Camera 1's first image, clicked: camera 1 tracks that fovea, camera 2
+            # finds it by correlation along the believed row.
+            else MarkerlessPair(
+                sim.render(1), told.clicked_uv, row_band_for(knowledge, sim, spec.band_px)
+            )
+        )
         # Whole frames, no windows or previews: the acquisition as it has always run (a
         # markerless pair still correlates only its foveal window).
         estimator = acquire(live, NeckServo(sim, ServoConfig(windows=False)), detector, knowledge)
@@ -270,30 +279,25 @@ def run_pursuit(
     )
 
 
-def _clicked_object(
-    sim: HeadSim, spec: PursuitSpec, knowledge: HeadKnowledge, seed: int
-) -> tuple[MarkerlessPair | None, np.ndarray, str]:
-    """The user's click on the room object ``spec.body`` in camera 1's first image, as
-    a markerless pair (camera 1 tracks the clicked fovea, camera 2 finds it by
-    correlation along the believed row), and the clicked surface point's offset from
-    the object's centre (truth, for scoring).  The point: where camera 1's line of
-    sight to the object's centre first meets the object (else None and why)."""
+def _click_object(sim: HeadSim, spec: PursuitSpec, seed: int) -> tuple[Click | None, np.ndarray]:
+    """The user's click on the room object ``spec.body`` in camera 1's image now, and the
+    clicked surface point's offset from the object's centre (truth, for placing the click
+    and scoring).  The point: where camera 1's line of sight to the object's centre first
+    meets the object; None where that is another object, or too near the image's edge
+    for a template."""
     centre = sim.data.xpos[sim.model.body(spec.body).id].copy()
     origin = camera_centre(sim, 1)
     hit, _, geom = cast(sim.model, sim.data, origin, centre - origin)
     none = np.zeros(3)
     if hit is None or sim.model.body(int(sim.model.geom_bodyid[geom])).name != spec.body:
-        return None, none, "not in camera 1's first image (hidden or out of view)"
+        return None, none
     told = click(sim, hit, np.random.default_rng([seed, STREAM_CLICKS]), spec.click_error_px)
     size = sim.camera_settings(1)
     half = MatchConfig().half_px + 2
     u, v = told.clicked_uv
     if not (half <= u <= size.width - 1 - half and half <= v <= size.height - 1 - half):
-        return None, none, "not in camera 1's first image (hidden or out of view)"
-    pair = MarkerlessPair(
-        sim.render(1), told.clicked_uv, row_band_for(knowledge, sim, spec.band_px)
-    )
-    return pair, hit - centre, ""
+        return None, none
+    return told, hit - centre
 
 
 def _fixations(scenario: Scenario) -> int:

@@ -268,5 +268,5 @@ def test_the_tracker_and_the_correspondence_see_only_images() -> None:
         assert _scene_reads(tree) == set(), module
     assert _scene_reads(_function(SOURCE / "live" / "gaze.py", "detect")) == set()
     # The check can see a read: the textured pursuit's click, truth for placing it.
-    clicked = _function(SOURCE / "procedures" / "pursuit.py", "_clicked_object")
+    clicked = _function(SOURCE / "procedures" / "pursuit.py", "_click_object")
     assert {"sim", "data", "xpos"} <= _scene_reads(clicked)

@@ -7,11 +7,13 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
 from shipped_runs import ShippedRun
 
+from headsim.cli import main
 from headsim.live.head import LiveHead
 from headsim.procedures.pursuit import PursuitResult
 from headsim.run.runner import run_scenario
@@ -123,3 +125,15 @@ def test_pursuit_keeps_the_textured_box_and_measures_it_from_images_alone() -> N
     assert shifted.per_frame is not None and shifted.figures is not None
     assert shifted.per_frame["estimate_world_m"] == frames["estimate_world_m"]
     assert shifted.figures.position_rms_m > 0.04
+
+
+def test_the_textured_pursuit_records(tmp_path: Path) -> None:
+    # The recording needs the phase (the truth's scene) before the click's first image.
+    rrd = tmp_path / "run.rrd"
+    argv = ["run", "pursuit_textured", "--fast", "--out", str(tmp_path), "--no-progress"]
+    assert main([*argv, "--rrd", str(rrd)]) == 0
+    assert rrd.stat().st_size > 100_000
+    experiment = json.loads((tmp_path / "results.json").read_text())["experiment"]
+    assert (
+        experiment["frames_lost"] == 0 and len(experiment["per_frame"]["vergence_error_deg"]) == 16
+    )
