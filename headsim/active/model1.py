@@ -8,6 +8,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from headsim.active.failure import neck_failure
+from headsim.active.look import foveal_detector
 from headsim.active.measurement import (
     HeadKnowledge,
     Measurement,
@@ -43,7 +44,8 @@ def measure_model1(
     renders per point).  Where the start pose does not show it to both
     cameras, the neck scans its ranges with the eyes at 0
     (:func:`headsim.active.search.scan_neck`, counted in ``scan_renders``)
-    and the servo fixates from where both see it.
+    and the servo fixates from where both see it; not for a foveal (markerless)
+    detector, which a scan's whole frames cannot serve.
     """
     knowledge = knowledge or HeadKnowledge()
     start = sim.render_count
@@ -71,8 +73,16 @@ def measure_model1(
             sim.command(neck_yaw=0.0, neck_pitch=0.0, eye=0.0)
             sim.settle()
             result = servo.run(target.detector, goals=goals)
-        if found is None and result.outcome is ServoOutcome.TARGET_LOST and not result.iterations:
-            # Not in both views from the start pose either: scan the neck's ranges.
+        scannable = foveal_detector(target.detector) is None
+        if (
+            scannable
+            and found is None
+            and result.outcome is ServoOutcome.TARGET_LOST
+            and not result.iterations
+        ):
+            # Not in both views from the start pose either: scan the neck's ranges.  (A
+            # markerless target, clicked in camera 1's start image, is correlated in
+            # foveal windows only: a scan's previews and whole frames cannot show it.)
             before = sim.render_count
             scanned = scan_neck(servo, target.detector)
             scan = sim.render_count - before

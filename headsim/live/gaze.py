@@ -1,7 +1,7 @@
 """Gaze behaviours on the live head: saccades, smooth pursuit, a position estimate every frame.
 
 Measurement path (no ground truth): :mod:`headsim.live.estimator` turns each
-frame's marker centroids and encoders into the *fixation angles* ``q*`` and
+frame's marker centroids (or a markerless pair's tracked and corresponded points) and encoders into the *fixation angles* ``q*`` and
 a position estimate.
 
 Smooth pursuit drives the motors towards ``q*``; with the constant-velocity
@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from headsim.active.look import foveal_detector
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import Detector
@@ -28,6 +29,7 @@ from headsim.live.estimator import GazeEstimator
 from headsim.live.head import Frame, LiveHead
 from headsim.live.motors import MotorDriver, bang_bang_duration, min_jerk_duration
 from headsim.sim.model import neck_of
+from headsim.vision.detection import Detection
 
 
 class GazeMode(enum.Enum):
@@ -169,6 +171,19 @@ class PursuitRun:
         return float(np.sqrt(np.mean(np.square(errors)))) if errors else math.nan
 
 
+def detect(detector: Detector, camera: int, image: np.ndarray) -> Detection:
+    """``detector``'s answer on ``camera``'s whole ``image``; a foveal detector (a
+    markerless pair) is told the camera and handed only the window it names (around
+    its last sight, or its band), so correlation stays foveal."""
+    foveal = foveal_detector(detector)
+    if foveal is None:
+        return detector(image)
+    height, width = image.shape[:2]
+    window = foveal.search_window(camera, (width, height), None)
+    crop = image[window.y0 : window.y1, window.x0 : window.x1]
+    return foveal.locate(camera, crop, (window.x0, window.y0))
+
+
 def _saccade_duration(move_rad: np.ndarray, live: LiveHead, profile: SaccadeProfile) -> float:
     limits = live.motors.motors
     fn = min_jerk_duration if profile is SaccadeProfile.MIN_JERK else bang_bang_duration
@@ -222,7 +237,7 @@ def pursue(
         if live.time_s >= duration_s:
             break
         frame: Frame = live.capture()
-        seen = [detector(image) for image in frame.images]
+        seen = [detect(detector, camera, image) for camera, image in enumerate(frame.images, 1)]
         uv = (seen[0].uv if seen[0].found else None, seen[1].uv if seen[1].found else None)
         if uv[0] is None or uv[1] is None:
             records.append(

@@ -12,7 +12,8 @@ output would latch them.  A command sent after frame ``k`` takes effect
 Joints move only through the motors (:mod:`headsim.live.motors`), so an image
 taken while the eyes move sees them where the physics put them, and each
 encoder reads its joint to the count (no backlash on the live head).  The target
-is a mocap body moved along its path at every physics step.
+is a mocap body (a marker, or a room's textured object) moved along its path at every
+physics step.
 """
 
 from __future__ import annotations
@@ -122,8 +123,12 @@ class LiveHead:
         target_body: str | None = None,
         path: Path | None = None,
         visibility: Visibility | None = None,
+        point_offset_m: np.ndarray | None = None,
     ) -> None:
+        """``point_offset_m``: the scored point's offset from the moved body's centre, W, m
+        (a textured object's clicked surface point; the path moves the centre)."""
         self.sim = sim
+        self.point_offset_m = None if point_offset_m is None else np.asarray(point_offset_m)
         self.config = config or LiveConfig()
         self.dt = float(sim.model.opt.timestep)
         limits = (self.config.neck_limits, self.config.neck_limits, self.config.eye_limits)
@@ -156,16 +161,19 @@ class LiveHead:
         return round(time_s / self.dt)
 
     def target_truth(self, time_s: float) -> np.ndarray | None:
-        """Where the target is at ``time_s`` (world, m), None when it is not present."""
+        """Where the target (its point ``point_offset_m`` from the body's centre) is at
+        ``time_s`` (world, m), None when it is not present."""
         if self.path is None or not self.visibility.visible(time_s):
             return None
-        return self.path.position(time_s)
+        centre = self.path.position(time_s)
+        return centre if self.point_offset_m is None else centre + self.point_offset_m
 
     def _place_target(self) -> None:
         if self._mocap < 0 or self.path is None:
             return
-        truth = self.target_truth(self.time_s)
-        self.sim.data.mocap_pos[self._mocap] = PARKED_WORLD_M if truth is None else truth
+        present = self.visibility.visible(self.time_s)
+        centre = self.path.position(self.time_s) if present else PARKED_WORLD_M
+        self.sim.data.mocap_pos[self._mocap] = centre
 
     def advance_to(self, time_s: float) -> None:
         """Step the physics, motors and target until ``time_s`` (rounded to a physics step)."""

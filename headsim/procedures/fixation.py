@@ -1,5 +1,7 @@
-"""One-step fixation with independent eyes on each of the scenario's targets: the
-baseline that the paper's one-motor design gives up."""
+"""One-step fixation with independent eyes on each of the scenario's targets (markers,
+or ``[scene.room] targets``: clicked points of the textured surfaces, camera 1 tracking
+its fovea and camera 2 finding it by correlation): the baseline that the paper's
+one-motor design gives up."""
 
 from __future__ import annotations
 
@@ -7,25 +9,35 @@ from dataclasses import dataclass
 from typing import Any
 
 from headsim.active.fixation import fixation_servo, measure_fixation
-from headsim.active.measurement import HeadKnowledge
+from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.active.neck_servo import NeckServo
 from headsim.procedures.each_target import measure_each_target
 from headsim.run.context import servo_config
 from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
+from headsim.run.outcomes import MeasurementRecord, SurfaceDraw
+from headsim.run.surface import measure_surface_targets
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
+from headsim.sim.simulator import HeadSim
 
 
 @dataclass(frozen=True)
 class FixationResult:
-    """One-step fixation on each target: nothing beyond its measurements."""
+    """One-step fixation on each target; ``surface``: how the markerless targets were
+    drawn (None: marker targets)."""
+
+    surface: SurfaceDraw | None = None
 
     def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: none."""
-        return {}
+        """results.json's ``experiment`` fields: ``surface_targets`` with markerless ones."""
+        return {} if self.surface is None else {"surface_targets": self.surface.block()}
+
+    def failures(self) -> tuple[str, ...]:
+        """Markerless targets that could not be drawn."""
+        return () if self.surface is None or not self.surface.failure else (self.surface.failure,)
 
 
 def run_fixation(
@@ -33,14 +45,22 @@ def run_fixation(
 ) -> tuple[list[MeasurementRecord], FixationResult]:
     """Each target in turn, one servo of both eyes and the neck pitch for all."""
     interpolate = scenario.experiment.interpolate
-    records = measure_each_target(
-        scenario,
-        hub,
-        knowledge,
-        [(knowledge, label)],
-        lambda sim: fixation_servo(sim, config=servo_config(scenario)),
-        lambda sim, servo, target, known: measure_fixation(sim, servo, target, known, interpolate),
-    )
+
+    def measure(
+        sim: HeadSim, servo: NeckServo, target: Target, known: HeadKnowledge
+    ) -> Measurement:
+        return measure_fixation(sim, servo, target, known, interpolate)
+
+    def servo(sim: HeadSim) -> NeckServo:
+        return fixation_servo(sim, config=servo_config(scenario))
+
+    if scenario.scene.surface_targets is not None:
+        # The servo's first look is with both cameras: points both start images show.
+        scored, drawn = measure_surface_targets(
+            scenario, hub, knowledge, label, servo, measure, both_views=True
+        )
+        return scored, FixationResult(drawn)
+    records = measure_each_target(scenario, hub, knowledge, [(knowledge, label)], servo, measure)
     return records, FixationResult()
 
 
@@ -55,6 +75,7 @@ FIXATION = register(
         "default",
         run_fixation,
         fields=FixationResult.block,
+        failures=FixationResult.failures,
         options=read_options,
         read_scene=targets_reader("fixation", required=True),
         needs=frozenset({"independent_eyes"}),

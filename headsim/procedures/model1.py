@@ -56,6 +56,7 @@ def run_model1(
             label,
             lambda sim: NeckServo(sim, servo_config(scenario)),
             measure,
+            both_views=True,  # the neck servo's first look is with both cameras
         )
         return scored, Model1Result(drawn)
     records = measure_each_target(

@@ -1,5 +1,11 @@
 """The ``pursuit`` scenario procedure: acquire at rest, then pursue on the live head.
 
+The target is a marker, or a textured object of ``[scene.room]`` (a mocap body moved
+along the path): the user clicks it once in camera 1's first image, then camera 1
+tracks its fovea and camera 2 finds it by correlation each frame
+(:class:`~headsim.active.markerless.MarkerlessPair`); its truth is the clicked surface
+point carried with the object.
+
 The head first fixates the target at rest with the paper's Model 1 servo (the
 scenario's servo settings), at the first instant the target is present; the
 servo's image Jacobian then serves the live gaze controller
@@ -16,25 +22,31 @@ its record a ``PursuitFrame`` event.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from headsim.active.events import FixationStarted, PhaseStarted
+from headsim.active.markerless import MarkerlessPair
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
-from headsim.active.servo_types import ServoConfig
+from headsim.active.servo_types import Detector, ServoConfig
 from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
+from headsim.run.context import PARKED_WORLD_M
+from headsim.run.landing import landing, vergence_error_deg
 from headsim.run.outcomes import MeasurementRecord
+from headsim.run.surface import row_band_for
 from headsim.run.targets import marker_target
 from headsim.scenario.pursuit import PursuitSpec, describe
 from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import read_pursuit_scene
-from headsim.scenario.spec import Scenario
+from headsim.scenario.spec import MARKER_BODIES, STREAM_CLICKS, Scenario
+from headsim.scenario.surface_targets import Click, camera_centre, cast, click
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
+from headsim.vision.correspondence import MatchConfig
 
 
 @dataclass(frozen=True)
@@ -42,7 +54,9 @@ class PursuitFigures:
     """The figures that score a live pursuit, over the frames on which the target was present.
 
     Times in s, offsets in px, position errors in W, m; NaN where undefined.
-    ``ended``: why the loop ended.
+    ``ended``: why the loop ended.  ``vergence_error_*_deg``: over the frames that found
+    the target, the angle between eye 2's goal ray and the direction to where eye 1's
+    goal ray truly landed (truth: each eye's true pose at the frame).
     """
 
     frames: int
@@ -58,6 +72,8 @@ class PursuitFigures:
     position_rms_pct_of_depth: float
     position_max_m: float
     ended: str
+    vergence_error_median_deg: float = math.nan
+    vergence_error_rms_deg: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -102,6 +118,8 @@ class PursuitResult:
             f"position error RMS along the path {f('position_rms_m', 1000)} mm = {f('position_rms_pct_of_depth')} % of "
             f"distance (max {f('position_max_m', 1000)} mm); pursuit lag {f('lag_s', 1000, '.1f')} ms; "
             f"image offset RMS {f('offset_rms_px')} px; time to fixation {f('time_to_fixation_s', 1000, '.0f')} ms",
+            f"vergence error (truth: where the eyes' goal rays landed) median "
+            f"{f('vergence_error_median_deg', 1, '.3f')} deg, RMS {f('vergence_error_rms_deg', 1, '.3f')} deg",
         ]
 
     def ok_line(self, measured: int) -> str:
@@ -113,9 +131,17 @@ class PursuitResult:
         return self.failures
 
 
-def figures(run: PursuitRun, spec: PursuitSpec) -> PursuitFigures:
-    """The figures that score a pursuit run (all frames on which the target was present)."""
+def figures(
+    run: PursuitRun, spec: PursuitSpec, vergence_deg: list[float] | None = None
+) -> PursuitFigures:
+    """The figures that score a pursuit run (all frames on which the target was present);
+    ``vergence_deg``: each frame's vergence error (NaN: eye 1's ray met nothing)."""
     errors = run.errors_m
+    found = [
+        v
+        for v, r in zip(vergence_deg or [], run.records, strict=False)
+        if r.found and math.isfinite(v)
+    ]
     start = spec.visibility.windows[0][0] if spec.visibility.windows else 0.0
     return PursuitFigures(
         frames=len(run.records),
@@ -131,10 +157,21 @@ def figures(run: PursuitRun, spec: PursuitSpec) -> PursuitFigures:
         position_rms_pct_of_depth=run.rms_error_pct_of_depth(),
         position_max_m=float(errors.max()) if errors.size else math.nan,
         ended=run.ended,
+        vergence_error_median_deg=float(np.median(found)) if found else math.nan,
+        vergence_error_rms_deg=float(np.sqrt(np.mean(np.square(found)))) if found else math.nan,
     )
 
 
-def _per_frame(records: tuple[FrameRecord, ...]) -> dict[str, Any]:
+def _vergence_deg(sim: HeadSim, goals: tuple[tuple[float, float], ...]) -> float:
+    """The vergence error now, degrees (truth, for scoring): eye 2's goal ray against the
+    direction to where eye 1's landed; NaN when eye 1's met nothing."""
+    one, two = landing(sim, 1, goals[0]), landing(sim, 2, goals[1])
+    if one.point_world_m is None:
+        return math.nan
+    return vergence_error_deg(two.origin_world_m, two.direction_world, one.point_world_m)
+
+
+def _per_frame(records: tuple[FrameRecord, ...], vergence_deg: list[float]) -> dict[str, Any]:
     def vec(values: list[np.ndarray | None]) -> list[Any]:
         return [None if v is None else np.asarray(v).tolist() for v in values]
 
@@ -151,6 +188,7 @@ def _per_frame(records: tuple[FrameRecord, ...]) -> dict[str, Any]:
             for r in records
         ],
         "encoders_rad": vec([r.encoders_rad for r in records]),
+        "vergence_error_deg": [v if math.isfinite(v) else None for v in vergence_deg],
     }
 
 
@@ -163,8 +201,18 @@ def run_pursuit(
     """
     spec = scenario.scene.pursuit
     assert spec is not None  # the reader sets it for this procedure
-    target = marker_target(spec.name, spec.body)
-    with HeadSim("default", scenario.settings, settle_mode=scenario.settle_mode, sink=sink) as sim:
+    room, textured = scenario.scene.room, spec.body not in MARKER_BODIES
+    if textured:  # a room object, moved as a mocap body
+        assert room is not None  # the reader offers a room's objects only
+        room = replace(
+            room,
+            objects=tuple(
+                replace(o, movable=True) if o.name == spec.body else o for o in room.objects
+            ),
+        )
+    with HeadSim(
+        "default", scenario.settings, settle_mode=scenario.settle_mode, sink=sink, room=room
+    ) as sim:
         live = LiveHead(sim, spec.live, spec.body, spec.path, spec.visibility)
         first = next(
             (
@@ -174,33 +222,82 @@ def run_pursuit(
             ),
             None,
         )
-        truth = {} if first is None else {spec.name: spec.path.position(first)}
-        sink.emit(PhaseStarted("measurement", sim, knowledge, truth))
         described = describe(spec)
         if first is None:
+            sink.emit(PhaseStarted("measurement", sim, knowledge, {}))
             return [], PursuitResult(
                 described, failures=(f"{spec.name}: never present in the run",)
             )
-        live.advance_to(first)
-        # Whole frames, no windows or previews: the acquisition as it has always run.
-        estimator = acquire(
-            live, NeckServo(sim, ServoConfig(windows=False)), target.detector, knowledge
+        told: Click | None = None
+        if textured:
+            for body in MARKER_BODIES:  # markers play no part: out of every view
+                sim.set_body_pose(body, np.array(PARKED_WORLD_M))
+            live.advance_to(first)
+            told, offset = _click_object(sim, spec, scenario.seed)
+            if told is None:
+                sink.emit(PhaseStarted("measurement", sim, knowledge, {}))
+                failure = "not in camera 1's first image (hidden or out of view)"
+                return [], PursuitResult(described, failures=(f"{spec.name}: {failure}",))
+            live.point_offset_m = offset
+        else:
+            live.advance_to(first)
+        truth = live.target_truth(first)
+        assert truth is not None
+        sink.emit(PhaseStarted("measurement", sim, knowledge, {spec.name: truth}))
+        detector: Detector = (
+            marker_target(spec.name, spec.body).detector
+            if told is None
+            # Camera 1's first image, clicked: camera 1 tracks that fovea, camera 2
+            # finds it by correlation along the believed row.
+            else MarkerlessPair(
+                sim.render(1), told.clicked_uv, row_band_for(knowledge, sim, spec.band_px)
+            )
         )
+        # Whole frames, no windows or previews: the acquisition as it has always run (a
+        # markerless pair still correlates only its foveal window).
+        estimator = acquire(live, NeckServo(sim, ServoConfig(windows=False)), detector, knowledge)
         if estimator is None:
             return [], PursuitResult(described, failures=(f"{spec.name}: not acquired at rest",))
 
+        # The servo's goal pixels: each camera's goal column on the mean goal row.
+        (u1, v1), (u2, v2) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+        goals = ((u1, (v1 + v2) / 2), (u2, (v1 + v2) / 2))
+        vergence: list[float] = []
+
         def on_frame(record: FrameRecord) -> None:
+            vergence.append(_vergence_deg(sim, goals))  # the pose the frame was taken at
             sink.emit(FixationStarted(f"{spec.name} t={record.time_s:.3f}s"))  # a step per frame
             sink.emit(PursuitFrame(record))
 
-        run = pursue(live, target.detector, estimator, spec.duration_s, spec.gaze, on_frame)
+        run = pursue(live, detector, estimator, spec.duration_s, spec.gaze, on_frame)
     return [], PursuitResult(
         described,
-        figures=figures(run, spec),
-        per_frame=_per_frame(run.records),
+        figures=figures(run, spec, vergence),
+        per_frame=_per_frame(run.records, vergence),
         failures=(f"{spec.name}: lost {run.losses} times",) if run.losses else (),
         run=run,
     )
+
+
+def _click_object(sim: HeadSim, spec: PursuitSpec, seed: int) -> tuple[Click | None, np.ndarray]:
+    """The user's click on the room object ``spec.body`` in camera 1's image now, and the
+    clicked surface point's offset from the object's centre (truth, for placing the click
+    and scoring).  The point: where camera 1's line of sight to the object's centre first
+    meets the object; None where that is another object, or too near the image's edge
+    for a template."""
+    centre = sim.data.xpos[sim.model.body(spec.body).id].copy()
+    origin = camera_centre(sim, 1)
+    hit, _, geom = cast(sim.model, sim.data, origin, centre - origin)
+    none = np.zeros(3)
+    if hit is None or sim.model.body(int(sim.model.geom_bodyid[geom])).name != spec.body:
+        return None, none
+    told = click(sim, hit, np.random.default_rng([seed, STREAM_CLICKS]), spec.click_error_px)
+    size = sim.camera_settings(1)
+    half = MatchConfig().half_px + 2
+    u, v = told.clicked_uv
+    if not (half <= u <= size.width - 1 - half and half <= v <= size.height - 1 - half):
+        return None, none
+    return told, hit - centre
 
 
 def _fixations(scenario: Scenario) -> int:

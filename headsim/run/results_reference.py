@@ -385,8 +385,11 @@ EXPERIMENT_FIELDS: dict[str, dict[str, str]] = {
         "position_rms_pct_of_depth": "the same, % of depth",
         "position_max_m": "largest position error, m",
         "ended": "why the loop ended",
+        "vergence_error_median_deg": "median vergence error over the frames that found the "
+        "target (eye 2's goal ray against where eye 1's truly landed), deg",
+        "vergence_error_rms_deg": "the same, RMS, deg",
         "per_frame": "each frame: `time_s`, `found`, `offsets_px`, `encoders_rad`, "
-        "`estimate_world_m`, `truth_world_m`, `error_m`",
+        "`estimate_world_m`, `truth_world_m`, `error_m`, `vergence_error_deg`",
     },
 }
 

@@ -143,7 +143,8 @@ class LandingLog:
 
     def fixations(self, m: Measurement) -> dict[int, Look]:
         """Each camera's look where its servo left it fixated: Model 2's camera 1 at step
-        1's eye encoder, camera 2 at step 2's; Model 1's both at the final pose."""
+        1's eye encoder, camera 2 at step 2's; Model 1's both at the final pose; the
+        one-step fixation's each at its own eye motor's and the neck's final encoders."""
         out: dict[int, Look] = {}
         if not m.ok:
             return out
@@ -161,8 +162,28 @@ class LandingLog:
                     out[camera] = found
             return out
         now = self.encoders()
+        if m.method.value == "fixation":
+            # Each eye's own motor: camera c's view depends on the neck and its eye alone,
+            # so its last look at the final pose may precede the other eye's last step.
+            return self._per_eye(now)
         for camera in (1, 2):
             found = self.last(camera, lambda e: e == now)
+            if found is not None:
+                out[camera] = found
+        return out
+
+    def _per_eye(self, now: tuple[int, ...]) -> dict[int, Look]:
+        """Each camera's last look with the neck and that camera's eye motor (camera
+        1: ``eye``, camera 2: ``eye2``) at their encoders ``now``."""
+        motors = self.sim.motors
+        out: dict[int, Look] = {}
+        for camera, eye in ((1, "eye"), (2, "eye2")):
+            kept = [k for k, name in enumerate(motors) if name.startswith("neck") or name == eye]
+
+            def same(encoders: tuple[int, ...], kept: list[int] = kept) -> bool:
+                return all(encoders[k] == now[k] for k in kept)
+
+            found = self.last(camera, same)
             if found is not None:
                 out[camera] = found
         return out
@@ -257,20 +278,24 @@ def measure_surface_targets(
     label: str,
     servo: Callable[[HeadSim], S],
     measure: Callable[[HeadSim, S, Target, HeadKnowledge], Measurement],
+    both_views: bool = False,
 ) -> tuple[list[MeasurementRecord], SurfaceDraw]:
     """Each of ``[scene.room] targets`` measured in turn from the start pose: listed or
     drawn, clicked in camera 1's image there, measured with ``measure`` through one shared
     ``servo``, its fixation scored from the looks the run reported (:class:`LandingLog`).
     With ``targets_as = "markers"`` (the marker twin) each is instead the ordinary marker
     target: :data:`TWIN_MARKER` put :data:`MARKER_OFFSET_M` out from the point along the
-    surface's normal, found by its colour, scored against the marker's centre."""
+    surface's normal, found by its colour, scored against the marker's centre.
+    ``both_views``: only points that camera 2's start image also shows with a template's
+    room (a servo whose first look is with both cameras: Model 1, the one-step fixation);
+    else camera 2 need only see them."""
     spec = scenario.scene.surface_targets
     assert spec is not None
     records: list[MeasurementRecord] = []
     with simulator(hub, "default", scenario) as sim:
         for body in MARKER_BODIES:  # markers play no part: out of every view
             sim.set_body_pose(body, np.array(PARKED_WORLD_M))
-        drawn = _classed(sim, scenario, _draw(sim, spec, scenario.seed))
+        drawn = _classed(sim, scenario, _draw(sim, spec, scenario.seed, both_views))
         markers_at = [
             np.array(t.point_world_m) + MARKER_OFFSET_M * surface_normal(sim, t.point_world_m)
             if spec.targets_as == "markers"
@@ -293,12 +318,13 @@ def measure_surface_targets(
                 step = hub.begin(placed.name)
                 _start_pose(sim)
                 log.clear()
+                pair: MarkerlessPair | None = None
                 if marker_at is not None:
                     # The twin: the ordinary marker target, detected by its colour.
                     sim.set_body_pose(TWIN_MARKER, marker_at)
-                    m = measure(sim, shared, marker_target(placed.name, TWIN_MARKER), knowledge)
+                    target = marker_target(placed.name, TWIN_MARKER)
                     where = sim.position(TWIN_MARKER)
-                    told, match = None, None
+                    told = None
                 else:
                     told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
                     # The first image: the head needs only the fovea around the click (the
@@ -310,10 +336,16 @@ def measure_surface_targets(
                         first, told.clicked_uv, band_for, origin_px=origin, sink=hub
                     )
                     log.clear(_clicked_point(sim, told, placed))
-                    m = measure(
-                        sim, shared, Target(placed.name, pair, _true_point(placed)), knowledge
-                    )
+                    target = Target(placed.name, pair, _true_point(placed))
                     where = point_world(sim, placed.body, placed.point_body_m)
+                # Depth at the start pose (a failure leaves the head wherever it gave up).
+                truth_head = sim.transform_points(where, "world", "head")[0]
+                depth = float(truth_head[2])
+                m = measure(sim, shared, target, knowledge)
+                if not m.ok:
+                    m = replace(m, truth_head_m=truth_head)
+                match = None
+                if pair is not None:
                     # The correspondence the measurement used: camera 2's last confident
                     # match (else its last one, whatever it said).
                     used = [x for x in pair.finder.matches if x.ok] or pair.finder.matches
@@ -321,7 +353,6 @@ def measure_surface_targets(
                 looks = log.fixations(m)
                 if marker_at is not None:
                     looks = {c: _nearest(x, where) for c, x in looks.items()}
-                depth = float(sim.transform_points(where, "world", "head")[0][2])
                 last = log.last(2, lambda encoders: True)
                 focal2 = sim.camera_settings(2).kx
                 score = score_fixation(looks, where, depth, m.ok, told, match, last, focal2)
@@ -388,10 +419,11 @@ def _true_point(placed: SurfaceTarget) -> Callable[[HeadSim], np.ndarray]:
     return lambda sim: point_world(sim, placed.body, placed.point_body_m)
 
 
-def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int) -> SurfaceDraw:
+def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int, both_views: bool) -> SurfaceDraw:
     """The listed targets, then those drawn at the start pose; none drawn, with the failure,
     when the surfaces in view offer too few (a room and a field that do not meet); none at
-    all when a listed one is not on its surface or not in camera 1's start image (the click)."""
+    all when a listed one is not on its surface or not in camera 1's start image (the click),
+    or, ``both_views``, not in camera 2's with the same margin."""
     asked = spec.count + len(spec.listed)
     # Room for camera 1's template around the click, wherever the click error puts it.
     margin = MatchConfig().half_px + 2 + 4 * spec.click_error_px
@@ -405,14 +437,14 @@ def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int) -> SurfaceDraw:
             )
         except NotOnSurface as error:
             return SurfaceDraw(asked, 0, {}, (), failure=f"listed markerless target {error}")
-        if not (
-            visible(sim, 1, np.array(placed.point_world_m))
-            and in_image(sim, 1, np.array(placed.point_world_m), margin)
-        ):
+        point = np.array(placed.point_world_m)
+        cameras = (1, 2) if both_views else (1,)
+        if not all(visible(sim, c, point) and in_image(sim, c, point, margin) for c in cameras):
             return SurfaceDraw(
                 asked, 0, {}, (),
-                failure=f"listed markerless target {t.name}: camera 1's start image does not "
-                f"show it {margin:g} px inside (a click needs it)",
+                failure=f"listed markerless target {t.name}: camera "
+                f"{' or '.join(map(str, cameras))}'s start image does not show it {margin:g} px "
+                "inside (a click and the first look need it)",
             )  # fmt: skip
         listed.append(placed)
     if not spec.count:
@@ -420,7 +452,14 @@ def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int) -> SurfaceDraw:
     rng = np.random.default_rng([seed, STREAM_SURFACE_TARGETS])
     try:
         found = draw_targets(
-            sim, spec.count, rng, spec.depth_m, spec.lateral, spec.vertical, margin_px=margin
+            sim,
+            spec.count,
+            rng,
+            spec.depth_m,
+            spec.lateral,
+            spec.vertical,
+            margin_px=margin,
+            margin2_px=margin if both_views else None,
         )
     except ValueError as error:
         return SurfaceDraw(

@@ -1,6 +1,9 @@
 """The ``pursuit`` procedure's scenario settings: ``[scene.pursuit]`` and its sub-tables.
 
-``[scene.pursuit]``: ``body`` (a marker of the default scene), ``duration_s``;
+``[scene.pursuit]``: ``body`` (a marker of the default scene, or an object of
+``[scene.room]``: clicked once in camera 1's first image, then tracked without markers,
+``click_error_px`` per axis, camera 2 searching camera 1's row +- ``band_px``),
+``duration_s``;
 ``[scene.pursuit.path]``: ``kind`` and that kind's fields (world frame, m, s):
 
 - ``waypoints``: ``points_world_m`` (>= 2 points), ``speeds_m_s`` (one per leg);
@@ -60,6 +63,10 @@ class PursuitSpec:
     duration_s: float
     live: LiveConfig
     gaze: GazeConfig
+    #: A room object's pursuit: the click's error per axis, px, and the rows +- camera
+    #: 2 searches, px (unused for a marker).
+    click_error_px: float = 0.5
+    band_px: float = 10.0
 
     def sample_times(self, step_s: float = 0.05) -> np.ndarray:
         """Times at which the path is checked and drawn, s."""
@@ -161,6 +168,8 @@ def read_pursuit(scene: Table, seed: int, bodies: tuple[str, ...]) -> PursuitSpe
     name = table.string("name", "pursuit target", 60)
     body = table.choice("body", bodies, bodies[0])
     duration = table.number("duration_s", 3.0, 0.0, 600.0, lo_open=True, unit="s")
+    click_error = table.number("click_error_px", 0.5, 0.0, 20.0, unit="px")
+    band = table.number("band_px", 10.0, 0.0, 100.0, lo_open=True, unit="px")
     path_table = table.table("path")
     if path_table is None:
         raise table.fail("path", "missing", "a [scene.pursuit.path] table with a kind")
@@ -168,7 +177,7 @@ def read_pursuit(scene: Table, seed: int, bodies: tuple[str, ...]) -> PursuitSpe
     live = _live(table.table("live"))
     gaze = _gaze(table.table("gaze"))
     table.done()
-    return PursuitSpec(name, body, path, kind, visibility, duration, live, gaze)
+    return PursuitSpec(name, body, path, kind, visibility, duration, live, gaze, click_error, band)
 
 
 def _live(table: Table | None) -> LiveConfig:

@@ -9,6 +9,7 @@ scenario's seed, one stream per use (``STREAM_*``).
 
 from __future__ import annotations
 
+from contextvars import ContextVar
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
@@ -201,8 +202,11 @@ def default_position(scene: str, body: str) -> np.ndarray:
     return np.array(model.body(body).pos, dtype=float)
 
 
+#: The names of the room's objects while ``[scene]`` is read (a pursuit may move one).
+ROOM_OBJECTS: ContextVar[tuple[str, ...]] = ContextVar("room_objects", default=())
+
 #: The procedures that measure ``[scene.room] targets`` (one servo, target by target).
-SURFACE_TARGET_PROCEDURES = ("model2", "model1")
+SURFACE_TARGET_PROCEDURES = ("model2", "model1", "fixation")
 
 
 def read_scene(
@@ -221,12 +225,14 @@ def read_scene(
     # The room's surfaces and clutter can hide the procedure's targets.
     token = ROOM_OCCLUDERS.set(() if room is None else room_occluders(room))
     has_targets = ROOM_HAS_TARGETS.set(surface_targets is not None)
+    objects = ROOM_OBJECTS.set(() if room is None else tuple(o.name for o in room.objects))
     try:
         read = found.read_scene
         spec = SceneSpec(scene=found.scene) if read is None else read(table, ctx, settings, seed)
     finally:
         ROOM_OCCLUDERS.reset(token)
         ROOM_HAS_TARGETS.reset(has_targets)
+        ROOM_OBJECTS.reset(objects)
     table.done()
     return spec if room is None else replace(spec, room=room, surface_targets=surface_targets)
 
@@ -245,8 +251,10 @@ def targets_reader(procedure: str, *, required: bool) -> SceneReader:
 
 
 def read_pursuit_scene(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
-    """``[scene.pursuit]`` in the default scene."""
-    return SceneSpec(scene="default", pursuit=read_pursuit(table, seed, tuple(MARKER_BODIES)))
+    """``[scene.pursuit]`` in the default scene: its ``body`` a marker or an object of
+    ``[scene.room]`` (tracked markerlessly from a click)."""
+    bodies = (*MARKER_BODIES, *ROOM_OBJECTS.get())
+    return SceneSpec(scene="default", pursuit=read_pursuit(table, seed, bodies))
 
 
 def finite_number(table: Table, key: str, value: Any) -> float:

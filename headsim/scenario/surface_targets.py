@@ -271,9 +271,11 @@ def surface_refusal(
     depth_m: tuple[float, float],
     head: ReachHead | None,
     margin_px: float = 0.0,
+    margin2_px: float | None = None,
 ) -> str | None:
     """Why a point met on a surface is no target (:data:`SURFACE_REFUSALS`), or None;
-    ``margin_px``: how far inside camera 1's start image it must be (a template's room)."""
+    ``margin_px``: how far inside camera 1's start image it must be (a template's room);
+    ``margin2_px``: how far inside camera 2's (None: camera 2 need only see it)."""
     if p is None:
         return "no_surface"
     depth = float(sim.transform_points(p, "world", "head")[0][2])
@@ -282,6 +284,8 @@ def surface_refusal(
     if not (visible(sim, 1, p) and visible(sim, 2, p)):
         return "occluded"
     if not in_image(sim, 1, p, margin_px):
+        return "start_view"
+    if margin2_px is not None and not in_image(sim, 2, p, margin2_px):
         return "start_view"
     if head is not None and target_refusal(head, "model2", p) is not None:
         return "reach"
@@ -297,12 +301,13 @@ def draw_targets(
     vertical: float = 0.1,
     max_draws: int = 200,
     margin_px: float = 0.0,
+    margin2_px: float | None = None,
 ) -> DrawnTargets:
     """``count`` targets on the surfaces the head sees at its pose now (call it at the
     start pose): a direction in H with |x/z| <= ``lateral`` and |y/z| <= ``vertical``
     from the midpoint of the two cameras, cast into the scene; a point met is kept when
-    :func:`surface_refusal` finds nothing wrong (``margin_px`` inside camera 1's image),
-    else drawn again (counted by cause)."""
+    :func:`surface_refusal` finds nothing wrong (``margin_px`` inside camera 1's image,
+    ``margin2_px`` inside camera 2's unless None), else drawn again (counted by cause)."""
     origin = (camera_centre(sim, 1) + camera_centre(sim, 2)) / 2
     world_from_head = sim.world_from_head()[:3, :3]
     head = ReachHead.of(sim.settings)
@@ -317,7 +322,7 @@ def draw_targets(
         drawn += 1
         x, y = rng.uniform(-lateral, lateral), rng.uniform(-vertical, vertical)
         hit, _, _ = cast(sim.model, sim.data, origin, world_from_head @ np.array([x, y, 1.0]))
-        reason = surface_refusal(sim, hit, depth_m, head, margin_px)
+        reason = surface_refusal(sim, hit, depth_m, head, margin_px, margin2_px)
         if reason is not None:
             refused[reason] = refused.get(reason, 0) + 1
             continue

@@ -53,7 +53,8 @@ class SceneObject:
     half-lengths, a cylinder's radius and half-height, a sphere's radius, a plane's
     half-sides), its centre ``pos_world_m``, ``yaw_rad`` about W's z, and an extra
     ``pitch_rad`` about its own x (a plane stood up: pi/2 faces -y, toward the head);
-    ``texture`` and ``tile_m``, the side of one texture tile on a plane, m."""
+    ``texture`` and ``tile_m``, the side of one texture tile on a plane, m; ``movable``:
+    on a mocap body (the live head moves it along a path), else a static one."""
 
     name: str
     shape: str
@@ -63,6 +64,7 @@ class SceneObject:
     yaw_rad: float = 0.0
     pitch_rad: float = 0.0
     tile_m: float = 0.5
+    movable: bool = False
 
     @property
     def world_from_object(self) -> np.ndarray:
@@ -167,7 +169,8 @@ def _texture(spec: mujoco.MjSpec, name: str, obj: SceneObject) -> str:
 
 
 def add_object(spec: mujoco.MjSpec, obj: SceneObject) -> None:
-    """Add ``obj`` to ``spec`` on a static body of its name (geom and body named alike)."""
+    """Add ``obj`` to ``spec`` on a body of its name (geom and body named alike; a mocap
+    body when ``obj.movable``)."""
     if obj.shape not in SHAPES:
         raise ValueError(f"unknown shape {obj.shape!r}; allowed: {', '.join(SHAPES)}")
     if obj.texture.kind not in TEXTURE_KINDS:
@@ -175,7 +178,9 @@ def add_object(spec: mujoco.MjSpec, obj: SceneObject) -> None:
     material = _texture(spec, obj.name, obj)
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(obj.world_from_object).reshape(9))
-    body = spec.worldbody.add_body(name=obj.name, pos=list(obj.pos_world_m), quat=list(quat))
+    body = spec.worldbody.add_body(
+        name=obj.name, pos=list(obj.pos_world_m), quat=list(quat), mocap=obj.movable
+    )
     body.add_geom(
         name=obj.name,
         type=SHAPES[obj.shape],

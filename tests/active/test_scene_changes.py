@@ -223,3 +223,50 @@ def test_no_servo_tracker_or_correspondence_imports_the_scene_truth() -> None:
     assert readers == []
     # The check can see an import: the scorer's own module imports the placing one.
     assert TRUTH_MODULES[1] in _imports(SOURCE / "run" / "landing.py")
+
+
+#: Where a scene's state is read: the simulator (its model, data, bodies' poses) and the
+#: live head's scoring truth (the target's path point, the scored point's offset).
+SCENE_STATE = frozenset(
+    {
+        "sim",
+        "data",
+        "model",
+        "mocap_pos",
+        "xpos",
+        "placements",
+        "target_truth",
+        "point_offset_m",
+        "truth_target_world_m",
+        "true_joints",
+    }
+)
+
+
+def _scene_reads(node: ast.AST) -> set[str]:
+    """The names and attributes of :data:`SCENE_STATE` that ``node`` reads."""
+    found = set()
+    for sub in ast.walk(node):
+        if isinstance(sub, ast.Attribute) and sub.attr in SCENE_STATE:
+            found.add(sub.attr)
+        elif isinstance(sub, ast.Name) and sub.id in SCENE_STATE:
+            found.add(sub.id)
+    return found
+
+
+def _function(path: Path, name: str) -> ast.AST:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return next(n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) and n.name == name)
+
+
+def test_the_tracker_and_the_correspondence_see_only_images() -> None:
+    # The markerless pair (camera 1's tracker, camera 2's correspondence) and the live
+    # pursuit's per-camera detection take images, pixels and the belief's band: no
+    # simulator, no pose of a body, no scoring truth.
+    for module in ("active/markerless.py", "vision/correspondence.py"):
+        tree = ast.parse((SOURCE / module).read_text(encoding="utf-8"))
+        assert _scene_reads(tree) == set(), module
+    assert _scene_reads(_function(SOURCE / "live" / "gaze.py", "detect")) == set()
+    # The check can see a read: the textured pursuit's click, truth for placing it.
+    clicked = _function(SOURCE / "procedures" / "pursuit.py", "_click_object")
+    assert {"sim", "data", "xpos"} <= _scene_reads(clicked)

@@ -91,9 +91,10 @@ def test_the_summary_gives_millimetres_and_milliseconds_and_n_a_for_no_figure() 
     result = PursuitResult(
         pursuit={"path_kind": "sinusoid", "duration_s": 2.0, "predictor": True}, figures=figures
     )
-    first, second, third = result.summary_lines()
+    first, second, third, fourth = result.summary_lines()
     assert first.startswith("pursuit: sinusoid path for 2.0 s;") and "predictor on" in first
     assert second.startswith("frames 60 (target present 58), lost 2")
     assert "RMS along the path 1.20 mm" in third and "(max n/a mm)" in third
     assert "pursuit lag 33.3 ms" in third and "time to fixation n/a ms" in third
+    assert fourth.startswith("vergence error") and "median n/a deg, RMS n/a deg" in fourth
     assert PursuitResult(pursuit={}).summary_lines() == []

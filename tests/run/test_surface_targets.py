@@ -132,7 +132,7 @@ def test_surface_targets_need_no_markers_and_a_procedure_that_measures_them() ->
         scenario_from_document(_doc("model2", {"clutter": 0, "targets": 0}), "s")
     with pytest.raises(ScenarioError, match=r"scene\.room\.targets") as caught:
         scenario_from_document(_doc("stereo", {"targets": 2}), "s")
-    assert "model2 or model1" in str(caught.value) and "\n" not in str(caught.value)
+    assert "model2 or model1 or fixation" in str(caught.value) and "\n" not in str(caught.value)
 
 
 def test_natural_field_fast_measures_clicked_points_and_writes_where_the_eyes_landed(
