@@ -9,7 +9,17 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
-from figures_common import SEEDS, effort, num, payload, seeds_label, spread_pct, summary, table
+from figures_common import (
+    ROOT,
+    SEEDS,
+    effort,
+    num,
+    payload,
+    seeds_label,
+    spread_pct,
+    summary,
+    table,
+)
 
 from headsim.estimators.errors import rel_dz_correspondence
 
@@ -26,10 +36,18 @@ def _runs(scenario: str) -> tuple[dict[str, Any], ...]:
 
 
 def _targets(runs: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Every markerless target asked for over the runs, each a measurement with its seed."""
+    """Every markerless target asked for over the runs, each a measurement with its seed
+    and its texture class."""
     out = []
-    for seed, p in zip(SEEDS, runs, strict=True):
-        out += [{**m, "seed": seed} for m in p["measurements"] if m.get("fixation") is not None]
+    for seed, p in enumerate(runs):
+        classes = {
+            t["name"]: t["texture_class"] for t in p["experiment"]["surface_targets"]["targets"]
+        }
+        out += [
+            {**m, "seed": seed, "texture_class": classes[m["name"]]}
+            for m in p["measurements"]
+            if m.get("fixation") is not None
+        ]
     return out
 
 
@@ -70,7 +88,8 @@ def _row(targets: Sequence[dict[str, Any]], renders_per_point: float | None) -> 
         num(_rms(pct)),
         *by_band,
         f"{num(float(np.median(vergence)) if vergence else math.nan, 4)} / {num(_rms(vergence), 4)}",
-        f"{sum(1 for m in ok if m['fixation']['false_fixation'])} of {len(ok)}",
+        f"{sum(1 for m in ok if m['fixation']['false_fixation'])} of {len(ok)}; "
+        f"{sum(1 for m in targets if m['fixation'].get('wrong_match'))}",
         failures or "none",
         "-" if renders_per_point is None else f"{renders_per_point:.1f}",
     ]
@@ -82,7 +101,7 @@ HEADER = (
     "3-D RMS %",
     *(f"{b} RMS % (measured/asked)" for b in BANDS),
     "vergence error median / RMS, deg",
-    "false fixations",
+    "false fixations of ok; wrong matches of all",
     "failures by cause",
     "renders per point",
 )
@@ -135,7 +154,7 @@ def natural_field() -> str:
     ]
     classes: dict[str, list[dict[str, Any]]] = {c: [] for c in TEXTURES}
     for m in targets:
-        classes.setdefault(m["fixation"]["texture_class"], []).append(m)
+        classes.setdefault(m["texture_class"], []).append(m)
     by_texture = [[f"`{c}`", *_row(ms, None)] for c, ms in classes.items()]
     theory = _theory(targets, field[0]["settings"])
     twin_depth = _theory_depth(marked)
@@ -167,4 +186,101 @@ def _theory_depth(targets: Sequence[dict[str, Any]]) -> float:
     )
 
 
-GENERATORS: dict[str, Callable[[], str]] = {"natural_field": natural_field}
+#: The room's procedures beside their marker equivalents: (label, scenario, overrides).
+PROCEDURES = (
+    ("Model 2 (`natural_field`)", "natural_field", {}),
+    ("Model 1 (`natural_field_model1`)", "natural_field_model1", {}),
+    (
+        "one-step fixation, independent eyes (`natural_field_fixation`)",
+        "natural_field_fixation",
+        {},
+    ),
+)
+#: The failure modes' scenarios (listed targets on chosen surfaces, each with a control).
+FAILURE_MODES = ("low_texture", "repetitive_texture", "occluded_clutter")
+
+
+def room_procedures() -> str:
+    """Model 2, Model 1 and the one-step fixation on the room, and the textured pursuit
+    beside a marker on the same path."""
+    rows = []
+    for label, scenario, overrides in PROCEDURES:
+        runs = tuple(payload(scenario, seed=seed, **overrides) for seed in SEEDS)
+        rows.append([label, *_row(_targets(runs), _renders(runs))])
+    marker_eyes = [payload("independent_eyes", seed=seed) for seed in SEEDS]
+    eyes = [m for p in marker_eyes for m in p["measurements"]]
+    eyes_ok = [m["error_pct_of_depth"] for m in eyes if m["status"] == "ok"]
+    pursuit = []
+    for body in ("crate", "marker_red"):
+        e = [_pursuit(body, seed) for seed in SEEDS]
+        pursuit.append(
+            (
+                "textured box, markerless" if body == "crate" else "a marker on the same path",
+                " / ".join(f"{1e3 * x['position_rms_m']:.2f}" for x in e),
+                " / ".join(f"{x['position_rms_pct_of_depth']:.2f}" for x in e),
+                f"{min(x['frames_present'] for x in e)}-{max(x['frames_present'] for x in e)} of "
+                f"{e[0]['frames']}",
+                " / ".join(num(x["vergence_error_median_deg"], 4) for x in e),
+            )
+        )
+    return (
+        f"The room of `natural_field` (realistic head), {seeds_label()}, every target asked "
+        "counted:\n\n"
+        + table(HEADER, rows)
+        + f"\nThe same independent-eyes head on markers (`independent_eyes`, its own targets): "
+        f"{len(eyes_ok)} of {len(eyes)} measured, 3-D RMS {num(_rms(eyes_ok))} %.\n\n"
+        "`pursuit_textured` (ideal head, 3 s at 0.3 m/s about 1 m away), seed by seed:\n\n"
+        + table(
+            (
+                "",
+                "position RMS, mm",
+                "% of distance",
+                "frames with the target",
+                "vergence error median, deg",
+            ),
+            pursuit,
+        )
+    )
+
+
+@functools.cache
+def _pursuit(body: str, seed: int) -> dict[str, Any]:
+    """``pursuit_textured``'s experiment at ``seed``, pursuing ``body``: its crate, or a
+    marker on the same path (the crate then taken out of the room)."""
+    import tomllib
+
+    from headsim.run.runner import run_scenario
+    from headsim.run.serialise import results_payload
+    from headsim.scenario.loading import scenario_from_document
+
+    doc = tomllib.loads((ROOT / "scenarios" / "pursuit_textured.toml").read_text())
+    if body != "crate":
+        room = doc["scene"]["room"]
+        room["objects"] = [o for o in room["objects"] if o["name"] != "crate"]
+        doc["scene"]["pursuit"]["body"] = body
+        for key in ("click_error_px", "band_px"):
+            doc["scene"]["pursuit"].pop(key)
+    scenario = scenario_from_document(doc, "pursuit_textured", seed=seed)
+    return dict(results_payload(run_scenario(scenario))["experiment"])
+
+
+def failure_modes() -> str:
+    """The failure modes' scenarios: each class's targets over the seeds, every one counted."""
+    rows = []
+    for scenario in FAILURE_MODES:
+        targets = _targets(tuple(payload(scenario, seed=seed) for seed in SEEDS))
+        for cls in TEXTURES:
+            group = [m for m in targets if m["texture_class"] == cls]
+            if group:
+                rows.append([f"`{scenario}`: `{cls}`", *_row(group, None)[:-1]])
+    return (
+        f"{seeds_label()}, listed targets on chosen surfaces (the textured control in each "
+        "file is the `rich` row):\n\n" + table(HEADER[:-1], rows)
+    )
+
+
+GENERATORS: dict[str, Callable[[], str]] = {
+    "natural_field": natural_field,
+    "room_procedures": room_procedures,
+    "failure_modes": failure_modes,
+}

@@ -45,6 +45,7 @@ from typing import Any
 import figures_findings as findings
 import figures_live as live
 import figures_realistic as realistic
+import figures_scenes as scenes
 import figures_servo as servo
 from figures_common import (
     ROOT,
@@ -341,6 +342,16 @@ GENERATORS: dict[str, Generator] = {
         servo.render_fidelity_presets, cheap=False, group="fidelity", seconds=20
     ),
     "batch_centroids": Generator(servo.batch_centroids, cheap=False, seconds=60),
+    # docs/results.md's real scenes: the room's runs over the seeds.
+    "natural_field": Generator(
+        scenes.natural_field, cheap=False, ci=False, group="scenes", seconds=120
+    ),
+    "room_procedures": Generator(
+        scenes.room_procedures, cheap=False, ci=False, group="scenes", seconds=200
+    ),
+    "failure_modes": Generator(
+        scenes.failure_modes, cheap=False, ci=False, group="scenes", seconds=100
+    ),
     # docs/findings.md: the Tables V/VI experiment at full size over the seeds, shared.
     "findings_figure": Generator(
         findings.findings_figure, cheap=False, ci=False, group="findings", seconds=300

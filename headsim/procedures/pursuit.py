@@ -55,8 +55,9 @@ class PursuitFigures:
 
     Times in s, offsets in px, position errors in W, m; NaN where undefined.
     ``ended``: why the loop ended.  ``vergence_error_*_deg``: over the frames that found
-    the target, the angle between eye 2's goal ray and the direction to where eye 1's
-    goal ray truly landed (truth: each eye's true pose at the frame).
+    the target, the angle between eye 2's goal ray and the direction to the point eye 1
+    fixates: where its goal ray truly landed on a surface, or for a marker the ray's point
+    nearest the marker's centre (truth: each eye's true pose at the frame).
     """
 
     frames: int
@@ -162,13 +163,22 @@ def figures(
     )
 
 
-def _vergence_deg(sim: HeadSim, goals: tuple[tuple[float, float], ...]) -> float:
+def _vergence_deg(
+    sim: HeadSim, goals: tuple[tuple[float, float], ...], marker_world_m: np.ndarray | None
+) -> float:
     """The vergence error now, degrees (truth, for scoring): eye 2's goal ray against the
-    direction to where eye 1's landed; NaN when eye 1's met nothing."""
+    direction to the point eye 1 fixates: where its ray landed on a surface, or, for a
+    marker (``marker_world_m``, its centre), its ray's point nearest the centre (a 4 mm
+    sphere's front, or the wall behind when the ray passes beside it, is not what the eyes
+    converge on); NaN when eye 1's met nothing."""
     one, two = landing(sim, 1, goals[0]), landing(sim, 2, goals[1])
-    if one.point_world_m is None:
+    fixated = one.point_world_m
+    if marker_world_m is not None:
+        along = float(one.direction_world @ (marker_world_m - one.origin_world_m))
+        fixated = one.origin_world_m + along * one.direction_world
+    if fixated is None:
         return math.nan
-    return vergence_error_deg(two.origin_world_m, two.direction_world, one.point_world_m)
+    return vergence_error_deg(two.origin_world_m, two.direction_world, fixated)
 
 
 def _per_frame(records: tuple[FrameRecord, ...], vergence_deg: list[float]) -> dict[str, Any]:
@@ -265,7 +275,9 @@ def run_pursuit(
         vergence: list[float] = []
 
         def on_frame(record: FrameRecord) -> None:
-            vergence.append(_vergence_deg(sim, goals))  # the pose the frame was taken at
+            # At the pose the frame was taken at; a marker's centre is what the eyes fixate.
+            centre = record.truth_world_m if told is None else None
+            vergence.append(_vergence_deg(sim, goals, centre))
             sink.emit(FixationStarted(f"{spec.name} t={record.time_s:.3f}s"))  # a step per frame
             sink.emit(PursuitFrame(record))
 

@@ -137,7 +137,7 @@ RESULTS_FIELDS: dict[str, str] = {
     "measurements": "one entry per measurement, in order",
     "measurements[].name": "the target (`corner_i_j` for chessboard corners, `blocks` for the "
     "cross point)",
-    "measurements[].method": "`model2` or `model1`",
+    "measurements[].method": "`model2`, `model1` or `fixation`",
     "measurements[].status": '`"ok"`, or why it failed (`"Ca2 at step 1: target lost (and at '
     '12 eye angles searched)"`, ...)',
     "measurements[].failure": "`null`, or the cause: `cause` (`lost`, `cut`, `occluded`, "
@@ -274,7 +274,7 @@ MARKERLESS_ONLY = frozenset(_SURFACE)
 EXPERIMENT_FIELDS: dict[str, dict[str, str]] = {
     "model2": _SURFACE,
     "model1": _SURFACE,
-    "fixation": _NONE,
+    "fixation": _SURFACE,
     "calibration": {
         "check_targets": "each check target, before and after the calibration",
         "check_targets[].name": "the target",
