@@ -16,7 +16,9 @@ The mapping follows MuJoCo's where it matters and approximates it elsewhere:
   side faces;
 - a cylinder's side shows it four times around and once over its height, each cap once;
   a sphere's four times around and twice from pole to pole (MuJoCo projects the cube map,
-  which these approximate: the viewer's picture, not the camera's).
+  which these approximate: the viewer's picture, not the camera's);
+- a mesh takes its own texture coordinates, each face's moved by whole tiles to start
+  at 0 (the viewer does not wrap them; a face wider than a tile is clamped).
 
 Pure geometry apart from reading the model; positions in the geom's frame, m.
 """
@@ -37,7 +39,7 @@ MAX_TEXTURE_PX = 128
 AROUND = 32
 BANDS = 16
 #: The shapes drawn textured.
-TEXTURED_KINDS = ("plane", "box", "cylinder", "sphere")
+TEXTURED_KINDS = ("plane", "box", "cylinder", "sphere", "mesh")
 
 Mesh = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]  # positions, normals, uv, triangles
 
@@ -216,6 +218,28 @@ def sphere_mesh(radius_m: float, around: int = AROUND, bands: int = BANDS) -> Me
     return _quads(corners, normals, uv)
 
 
+def mesh_mesh(model: mujoco.MjModel, geom_id: int) -> Mesh:
+    """A mesh geom with its own texture coordinates, each face its own three vertices."""
+    mesh = int(model.geom_dataid[geom_id])
+    v0, f0 = int(model.mesh_vertadr[mesh]), int(model.mesh_faceadr[mesh])
+    nf = int(model.mesh_facenum[mesh])
+    faces = np.asarray(model.mesh_face[f0 : f0 + nf], dtype=int)
+    corners = np.asarray(model.mesh_vert, dtype=float)[v0 + faces]  # F x 3 x 3
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    t0 = int(model.mesh_texcoordadr[mesh])
+    uv = np.asarray(model.mesh_texcoord, dtype=float)[
+        t0 + np.asarray(model.mesh_facetexcoord[f0 : f0 + nf], dtype=int)
+    ]
+    uv -= np.floor(uv.min(axis=1, keepdims=True))
+    return (
+        corners.reshape(-1, 3).astype(np.float32),
+        np.repeat(normals, 3, axis=0).astype(np.float32),
+        uv.reshape(-1, 2).astype(np.float32),
+        np.arange(3 * nf, dtype=np.uint32).reshape(-1, 3),
+    )
+
+
 def textured_mesh(model: mujoco.MjModel, geom_id: int, rgba: np.ndarray) -> rr.Mesh3D | None:
     """The geom as a textured Mesh3D in its own frame, None when it has no RGB texture or
     its shape is not one of :data:`TEXTURED_KINDS`.  ``rgba``: the colour it multiplies
@@ -237,6 +261,8 @@ def textured_mesh(model: mujoco.MjModel, geom_id: int, rgba: np.ndarray) -> rr.M
         shape = cylinder_mesh(size[0], size[1])
     elif kind == "sphere":
         shape = sphere_mesh(size[0])
+    elif kind == "mesh":
+        shape = mesh_mesh(model, geom_id)
     else:
         return None
     positions, normals, uv, triangles = shape
@@ -258,6 +284,7 @@ __all__ = [
     "TEXTURED_KINDS",
     "box_mesh",
     "cylinder_mesh",
+    "mesh_mesh",
     "plane_mesh",
     "sphere_mesh",
     "texture_id",

@@ -22,7 +22,14 @@ from headsim.scenario.spec import MAX_DEPTH_M, TARGETS_AS, ListedSurfaceTarget, 
 from headsim.scenario.surface_targets import NotOnSurface, on_object, on_surface
 from headsim.scenario.tables import Table
 from headsim.sim import names
-from headsim.sim.textured_scene import SHAPES, LightSettings, RoomSpec, SceneObject
+from headsim.sim.textured_scene import (
+    SHAPES,
+    LightSettings,
+    RoomSpec,
+    SceneObject,
+    Vec3,
+    add_shape,
+)
 from headsim.sim.textures import TEXTURE_KINDS, TextureSpec
 
 #: The seed's stream for the room's clutter and textures (after ``spec.STREAM_*``).
@@ -68,12 +75,67 @@ def draw_clutter(
     return tuple(out)
 
 
+#: A mesh object's largest vertex count and coordinate (object frame), m.
+MAX_MESH_VERTICES, MAX_MESH_M = 1000, 2.0
+
+
+def _mesh(table: Table) -> tuple[tuple[Vec3, ...], tuple[tuple[int, int, int], ...]]:
+    """A ``mesh`` object's ``vertices_m`` and ``faces``, checked: every index a vertex, no
+    face without area."""
+    allowed = f"4 to {MAX_MESH_VERTICES} points [x, y, z] in the object's frame, m"
+    raw = table.data.get("vertices_m")
+    table.has("vertices_m")
+    if not isinstance(raw, list) or not 4 <= len(raw) <= MAX_MESH_VERTICES:
+        raise table.fail(
+            "vertices_m", "missing" if raw is None else "wrong length or type", allowed
+        )
+    vertices = []
+    for i, p in enumerate(raw):
+        if not (isinstance(p, list) and len(p) == 3):
+            raise table.fail(f"vertices_m[{i}]", "must be [x, y, z]", allowed)
+        x, y, z = (
+            table._check_number(
+                f"vertices_m[{i}]", c, -MAX_MESH_M, MAX_MESH_M, False, False, allowed
+            )
+            for c in p
+        )
+        vertices.append((x, y, z))
+    count = len(vertices)
+    allowed = (
+        f"triangles [i, j, k] of vertex indices 0-{count - 1}, counter-clockwise seen from "
+        "outside, at least 4, each with an area"
+    )
+    raw = table.data.get("faces")
+    table.has("faces")
+    if not isinstance(raw, list) or not 4 <= len(raw) <= 4 * MAX_MESH_VERTICES:
+        raise table.fail("faces", "missing" if raw is None else "wrong length or type", allowed)
+    faces = []
+    points = np.asarray(vertices)
+    for i, f in enumerate(raw):
+        ok = isinstance(f, list) and len(f) == 3
+        ok = ok and all(isinstance(j, int) and not isinstance(j, bool) for j in f)
+        if not ok or not all(0 <= j < count for j in f):
+            raise table.fail(f"faces[{i}]", "must be three vertex indices", allowed)
+        a, b, c = points[f[0]], points[f[1]], points[f[2]]
+        if float(np.linalg.norm(np.cross(b - a, c - a))) < 1e-10:
+            raise table.fail(f"faces[{i}]", "has no area", allowed)
+        faces.append((f[0], f[1], f[2]))
+    return tuple(vertices), tuple(faces)
+
+
 def _object(table: Table, k: int, seed: int) -> SceneObject:
     """One ``[[scene.room.objects]]`` entry."""
     name = table.string("name", f"item_{k + 1}", 60)
     shape = table.choice("shape", tuple(SHAPES))
-    size = table.numbers("size_m", 3, None, 0.0, 5.0, unit="m")
-    if size is None or min(size[: {"sphere": 1, "cylinder": 2}.get(shape, 2)]) <= 0.0:
+    if shape == "mesh":
+        vertices, faces = _mesh(table)
+        size: tuple[float, ...] | None = (0.0, 0.0, 0.0)
+    else:
+        vertices, faces = (), ()
+        size = table.numbers("size_m", 3, None, 0.0, 5.0, unit="m")
+    if size is None or (
+        shape != "mesh" and min(size[: {"sphere": 1, "cylinder": 2}.get(shape, 2)]) <= 0.0
+    ):
         raise table.fail(
             "size_m",
             "missing or not positive" if size is None else "a size that is not positive",
@@ -93,7 +155,10 @@ def _object(table: Table, k: int, seed: int) -> SceneObject:
     tile = table.number("tile_m", 0.5, 0.0, 10.0, lo_open=True, unit="m")
     table.done()
     full = (size[0], size[1], 1.0 if shape == "plane" else size[2])
-    return SceneObject(name, shape, full, (pos[0], pos[1], pos[2]), texture, yaw, pitch, tile)
+    return SceneObject(
+        name, shape, full, (pos[0], pos[1], pos[2]), texture, yaw, pitch, tile,
+        vertices_m=vertices, faces=faces,
+    )  # fmt: skip
 
 
 @functools.cache
@@ -171,14 +236,7 @@ class RoomGeometry:
     def of(cls, room: RoomSpec) -> RoomGeometry:
         spec = mujoco.MjSpec()
         for obj in (*room.surfaces(), *room.objects):
-            quat = np.zeros(4)
-            mujoco.mju_mat2Quat(quat, np.ascontiguousarray(obj.world_from_object).reshape(9))
-            body = spec.worldbody.add_body(
-                name=obj.name, pos=list(obj.pos_world_m), quat=list(quat)
-            )
-            body.add_geom(
-                name=obj.name, type=SHAPES[obj.shape], size=list(obj.size_m), group=names.ROOM_GROUP
-            )
+            add_shape(spec, replace(obj, movable=False))
         model = spec.compile()
         data = mujoco.MjData(model)
         mujoco.mj_kinematics(model, data)
@@ -295,6 +353,7 @@ def room_occluders(room: RoomSpec) -> tuple[Occluder, ...]:
             "box": float(np.linalg.norm(size)),
             "cylinder": math.hypot(size[0], size[1]),
             "sphere": float(size[0]),
+            "mesh": max((float(np.linalg.norm(v)) for v in obj.vertices_m), default=0.0),
         }[obj.shape]
         out.append(
             Occluder(obj.name, obj.name, False, centre, radius, rotation[:, 2].copy(),

@@ -76,9 +76,39 @@ def _box_distance(q: np.ndarray) -> float:
     return abs(outside + inside)
 
 
+def triangle_distance_m(point_m: np.ndarray, triangles_m: np.ndarray) -> float:
+    """Distance of a point from the nearest of triangles (T, 3, 3), m (one frame)."""
+    p = np.asarray(point_m, dtype=float)
+    a, b, c = (np.asarray(triangles_m, dtype=float)[:, k] for k in range(3))
+    ab, ac, ap = b - a, c - a, p - a
+    n = np.cross(ab, ac)
+    area2 = np.einsum("ij,ij->i", n, n)
+    # Barycentric coordinates of the projection into each triangle's plane.
+    w_c = np.einsum("ij,ij->i", np.cross(ab, ap), n) / area2
+    w_b = np.einsum("ij,ij->i", np.cross(ap, ac), n) / area2
+    inside = (w_b >= 0) & (w_c >= 0) & (w_b + w_c <= 1)
+    plane = np.abs(np.einsum("ij,ij->i", ap, n)) / np.sqrt(area2)
+    best = float(plane[inside].min()) if inside.any() else math.inf
+    for s, e in ((a, b), (b, c), (c, a)):  # else the nearest point lies on an edge
+        d = e - s
+        t = np.clip(np.einsum("ij,ij->i", p - s, d) / np.einsum("ij,ij->i", d, d), 0.0, 1.0)
+        best = min(best, float(np.linalg.norm(s + t[:, None] * d - p, axis=1).min()))
+    return best
+
+
+def mesh_triangles_m(model: mujoco.MjModel, geom: int) -> np.ndarray:
+    """A mesh geom's triangles (T, 3, 3) in the geom's frame, m (MuJoCo's processed mesh)."""
+    mesh = int(model.geom_dataid[geom])
+    v0, nv = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+    f0, nf = int(model.mesh_faceadr[mesh]), int(model.mesh_facenum[mesh])
+    vertices = np.asarray(model.mesh_vert[v0 : v0 + nv], dtype=float)
+    return vertices[np.asarray(model.mesh_face[f0 : f0 + nf], dtype=int)]
+
+
 def surface_distance_m(geom_type: int, size: Sequence[float], point_geom_m: np.ndarray) -> float:
     """Distance of a point, in a geom's frame, from its surface, m: a plane (a bounded
-    rectangle; size 0: unbounded), sphere, box or cylinder (MuJoCo's sizes)."""
+    rectangle; size 0: unbounded), sphere, box or cylinder (MuJoCo's sizes); a mesh's is
+    :func:`triangle_distance_m` over :func:`mesh_triangles_m`."""
     p = np.asarray(point_geom_m, dtype=float)
     if geom_type == mujoco.mjtGeom.mjGEOM_PLANE:
         a, b = size[0], size[1]
@@ -124,6 +154,7 @@ def _scene_geoms(model: mujoco.MjModel) -> list[int]:
         mujoco.mjtGeom.mjGEOM_SPHERE,
         mujoco.mjtGeom.mjGEOM_BOX,
         mujoco.mjtGeom.mjGEOM_CYLINDER,
+        mujoco.mjtGeom.mjGEOM_MESH,
     )
     return [
         g
@@ -138,7 +169,10 @@ def surface_of(sim: SceneState, point_world_m: ArrayLike) -> tuple[int, float]:
     best, best_d = -1, math.inf
     for g in _scene_geoms(sim.model):
         local = sim.data.geom_xmat[g].reshape(3, 3).T @ (p - sim.data.geom_xpos[g])
-        d = surface_distance_m(int(sim.model.geom_type[g]), sim.model.geom_size[g], local)
+        if int(sim.model.geom_type[g]) == mujoco.mjtGeom.mjGEOM_MESH:
+            d = triangle_distance_m(local, mesh_triangles_m(sim.model, g))
+        else:
+            d = surface_distance_m(int(sim.model.geom_type[g]), sim.model.geom_size[g], local)
         if d < best_d:
             best, best_d = g, d
     return best, best_d
@@ -146,7 +180,8 @@ def surface_of(sim: SceneState, point_world_m: ArrayLike) -> tuple[int, float]:
 
 def surface_normal(sim: SceneState, point_world_m: ArrayLike) -> np.ndarray:
     """The outward unit normal, in W, of the scene surface nearest a point on it (a plane's
-    front, a sphere's radius, a box's face, a cylinder's side or cap)."""
+    front, a sphere's radius, a box's face, a cylinder's side or cap, a mesh's nearest
+    face)."""
     p = np.asarray(point_world_m, dtype=float)
     geom, _ = surface_of(sim, p)
     if geom < 0:
@@ -159,6 +194,11 @@ def surface_normal(sim: SceneState, point_world_m: ArrayLike) -> np.ndarray:
         normal = np.array([0.0, 0.0, 1.0])
     elif kind == mujoco.mjtGeom.mjGEOM_SPHERE:
         normal = local
+    elif kind == mujoco.mjtGeom.mjGEOM_MESH:
+        triangles = mesh_triangles_m(sim.model, geom)
+        nearest = int(np.argmin([triangle_distance_m(local, t[None]) for t in triangles]))
+        a, b, c = triangles[nearest]
+        normal = np.cross(b - a, c - a)
     elif kind == mujoco.mjtGeom.mjGEOM_BOX:
         axis = int(np.argmax(np.abs(local) - size[:3]))
         normal = np.zeros(3)
@@ -345,6 +385,7 @@ __all__ = [
     "click",
     "draw_targets",
     "in_image",
+    "mesh_triangles_m",
     "on_object",
     "on_surface",
     "point_world",
@@ -352,5 +393,6 @@ __all__ = [
     "surface_normal",
     "surface_of",
     "surface_refusal",
+    "triangle_distance_m",
     "visible",
 ]

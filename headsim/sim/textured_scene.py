@@ -30,6 +30,7 @@ SHAPES = {
     "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
     "plane": mujoco.mjtGeom.mjGEOM_PLANE,
+    "mesh": mujoco.mjtGeom.mjGEOM_MESH,
 }
 
 Vec3 = tuple[float, float, float]
@@ -53,8 +54,11 @@ class SceneObject:
     half-lengths, a cylinder's radius and half-height, a sphere's radius, a plane's
     half-sides), its centre ``pos_world_m``, ``yaw_rad`` about W's z, and an extra
     ``pitch_rad`` about its own x (a plane stood up: pi/2 faces -y, toward the head);
-    ``texture`` and ``tile_m``, the side of one texture tile on a plane, m; ``movable``:
-    on a mocap body (the live head moves it along a path), else a static one."""
+    ``texture`` and ``tile_m``, the side of one texture tile on a plane or a mesh, m;
+    ``movable``: on a mocap body (the live head moves it along a path), else a static one.
+    A ``mesh``: ``vertices_m`` in the object's frame and triangular ``faces`` (vertex
+    indices, counter-clockwise seen from outside); each face is textured by projecting
+    it onto the object-frame plane it faces most, one tile per ``tile_m``."""
 
     name: str
     shape: str
@@ -65,6 +69,8 @@ class SceneObject:
     pitch_rad: float = 0.0
     tile_m: float = 0.5
     movable: bool = False
+    vertices_m: tuple[Vec3, ...] = ()
+    faces: tuple[tuple[int, int, int], ...] = ()
 
     @property
     def world_from_object(self) -> np.ndarray:
@@ -148,11 +154,29 @@ def texture_bytes(texture: TextureSpec) -> bytes:
     return to_rgb(texture_grey(texture), tint_of(texture.seed)).tobytes()
 
 
+def mesh_texcoords(
+    vertices_m: np.ndarray, faces: np.ndarray, tile_m: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per face corner texture coordinates of a mesh, (3 F, 2), and their indices per face,
+    (F, 3): each face projected onto the object-frame plane its normal is nearest (x-y,
+    y-z or z-x), one texture tile per ``tile_m`` metres."""
+    corners = np.asarray(vertices_m, dtype=float)[np.asarray(faces, dtype=int)]  # F x 3 x 3
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    axis = np.argmax(np.abs(normals), axis=1)
+    # The two other axes, in the order that keeps each projection right-handed.
+    across = np.array([[1, 2], [2, 0], [0, 1]])[axis]
+    u = np.take_along_axis(corners, across[:, None, 0:1].repeat(3, axis=1), axis=2)[..., 0]
+    v = np.take_along_axis(corners, across[:, None, 1:2].repeat(3, axis=1), axis=2)[..., 0]
+    uv = np.stack([u, v], axis=-1).reshape(-1, 2) / tile_m
+    return uv, np.arange(uv.shape[0]).reshape(-1, 3)
+
+
 def _texture(spec: mujoco.MjSpec, name: str, obj: SceneObject) -> str:
     """Add ``obj``'s texture and material to ``spec``; the material's name."""
     n = obj.texture.size_px
     plane = obj.shape == "plane"
-    kind = mujoco.mjtTexture.mjTEXTURE_2D if plane else mujoco.mjtTexture.mjTEXTURE_CUBE
+    flat = plane or obj.shape == "mesh"  # its own texture coordinates: a 2-D texture
+    kind = mujoco.mjtTexture.mjTEXTURE_2D if flat else mujoco.mjtTexture.mjTEXTURE_CUBE
     texture = spec.add_texture(name=f"{name}_texture", type=kind, width=n, height=n, nchannel=3)
     texture.data = texture_bytes(obj.texture)
     material = spec.add_material(name=f"{name}_material")
@@ -170,21 +194,39 @@ def _texture(spec: mujoco.MjSpec, name: str, obj: SceneObject) -> str:
 
 def add_object(spec: mujoco.MjSpec, obj: SceneObject) -> None:
     """Add ``obj`` to ``spec`` on a body of its name (geom and body named alike; a mocap
-    body when ``obj.movable``)."""
-    if obj.shape not in SHAPES:
-        raise ValueError(f"unknown shape {obj.shape!r}; allowed: {', '.join(SHAPES)}")
+    body when ``obj.movable``), with its texture."""
     if obj.texture.kind not in TEXTURE_KINDS:
         raise ValueError(f"unknown texture {obj.texture.kind!r}")
-    material = _texture(spec, obj.name, obj)
+    add_shape(spec, obj, _texture(spec, obj.name, obj))
+
+
+def add_shape(spec: mujoco.MjSpec, obj: SceneObject, material: str = "") -> None:
+    """Add ``obj``'s body and geom (and a mesh's mesh) to ``spec``, with ``material`` (""
+    none: the geometry alone, as the reach check's occlusion model takes it)."""
+    if obj.shape not in SHAPES:
+        raise ValueError(f"unknown shape {obj.shape!r}; allowed: {', '.join(SHAPES)}")
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(obj.world_from_object).reshape(9))
     body = spec.worldbody.add_body(
         name=obj.name, pos=list(obj.pos_world_m), quat=list(quat), mocap=obj.movable
     )
+    mesh = ""
+    if obj.shape == "mesh":
+        vertices = np.asarray(obj.vertices_m, dtype=float)
+        faces = np.asarray(obj.faces, dtype=int)
+        uv, uv_faces = mesh_texcoords(vertices, faces, obj.tile_m)
+        added = spec.add_mesh(name=f"{obj.name}_mesh")
+        added.uservert = vertices.reshape(-1).tolist()
+        added.userface = faces.reshape(-1).tolist()
+        added.usertexcoord = uv.reshape(-1).tolist()
+        added.userfacetexcoord = uv_faces.reshape(-1).tolist()
+        added.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL  # open meshes too
+        mesh = f"{obj.name}_mesh"
     body.add_geom(
         name=obj.name,
         type=SHAPES[obj.shape],
         size=list(obj.size_m),
+        meshname=mesh,
         material=material,
         contype=0,
         conaffinity=0,
@@ -225,4 +267,13 @@ def add_room(spec: mujoco.MjSpec, room: RoomSpec) -> None:
         spec.stat.extent = 4.0
 
 
-__all__ = ["SHAPES", "LightSettings", "RoomSpec", "SceneObject", "add_object", "add_room"]
+__all__ = [
+    "SHAPES",
+    "LightSettings",
+    "RoomSpec",
+    "SceneObject",
+    "add_object",
+    "add_room",
+    "add_shape",
+    "mesh_texcoords",
+]

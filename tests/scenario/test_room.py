@@ -35,6 +35,7 @@ def test_natural_field_has_its_room_and_clutter_from_the_seed() -> None:
         "mug",
         "cereal_box",
         "ball",
+        "book_stand",
     ] and len(clutter) == 12
     for obj in clutter:
         half_height = (
