@@ -196,9 +196,14 @@ _CAMERA_FIELDS = frozenset(f.name for f in fields(CameraSettings))
 
 def camera_values(values: dict[str, float]) -> dict[str, Any]:
     """Imperfection settings by name as :class:`CameraSettings` arguments: its fields,
-    and the rest as ``extra``."""
+    and the rest as ``extra`` (those at their declared default left out, so that a
+    camera's record is the same whatever else is registered)."""
     own = {k: v for k, v in values.items() if k in _CAMERA_FIELDS}
-    extra = tuple((k, v) for k, v in values.items() if k not in _CAMERA_FIELDS)
+    extra = tuple(
+        (k, v)
+        for k, v in values.items()
+        if k not in _CAMERA_FIELDS and v != imperfections.setting(k).default
+    )
     return {**own, "extra": extra} if extra else own
 
 
