@@ -142,16 +142,15 @@ class CameraSettings:
                     0 <= value <= size - 1,
                     f"principal point {name} = {value} px lies outside the image [0, {size - 1}]",
                 )
-        own = {f.name for f in fields(self)}
-        names = {name for name, _ in self.extra}
+        declared = {s.name for s in imperfections.all_settings()} - _CAMERA_FIELDS
+        names = [name for name, _ in self.extra]
         _check(
-            all(isinstance(n, str) and n not in own for n in names)
-            and len(names) == len(self.extra),
-            f"camera extra must be (name, value) pairs of settings not among its fields, "
-            f"got {self.extra!r}",
+            all(name in declared for name in names) and len(set(names)) == len(names),
+            f"camera extra must be (name, value) pairs of registered imperfection settings "
+            f"other than its fields ({', '.join(sorted(declared)) or 'none'}), got {self.extra!r}",
         )
-        for declared in imperfections.all_settings():
-            problem = declared.check(self.value(declared.name))
+        for setting in imperfections.all_settings():
+            problem = setting.check(self.value(setting.name))
             _check(problem is None, str(problem))
         for name in ("mount_yaw_rad", "mount_pitch_rad", "mount_roll_rad"):
             _check(

@@ -166,8 +166,9 @@ def test_an_imperfections_setting_is_a_scenario_key_with_its_range_and_meaning(
 def test_settings_outside_their_declared_range_are_refused_in_python(ramp: RowRamp) -> None:
     with pytest.raises(ValueError, match=r"row_ramp_grey must be within \[0, 100\] grey levels"):
         CameraSettings(**camera_values({RAMP.name: -1.0}))
-    with pytest.raises(ValueError, match="not among its fields"):
-        CameraSettings(extra=(("noise_std", 1.0),))
+    for extra in ((("noise_std", 1.0),), (("row_ramp_grey", 1.0),) * 2, (("unknown", 1.0),)):
+        with pytest.raises(ValueError, match="registered imperfection settings other than"):
+            CameraSettings(extra=extra)
 
 
 def test_a_taken_name_is_refused() -> None:
