@@ -18,7 +18,7 @@ import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.files import write_json_atomic
-from headsim.sim.optics import GaussianNoise
+from headsim.sim.imperfections.noise import GaussianNoise
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +31,7 @@ from headsim.active.calibration_report import (
 from headsim.active.measurement import HeadKnowledge
 from headsim.files import to_jsonable, write_json_atomic
 from headsim.sim.events import RenderCounts
-from headsim.sim.settings import HeadSettings
+from headsim.sim.settings import HeadSettings, settings_record
 
 FORMAT = "headsim-calibration/1"
 #: Settings that do not change the head a calibration holds for.
@@ -54,8 +54,8 @@ def head_fields(settings: HeadSettings) -> dict[str, Any]:
         else:
             flat[prefix[:-1]] = to_jsonable(value)
 
-    raw = asdict(settings)
-    raw.pop("head")
+    raw = settings_record(settings)  # the cameras' ``extra`` left out while empty
+    raw.pop("head", None)
     if not settings.head.is_paper:  # the paper's head is the one every older file was for
         raw["head_model"] = settings.head.name
     cameras = raw.pop("cameras")

@@ -22,6 +22,7 @@ from headsim.scenario.loading import (
     set_field,
 )
 from headsim.scenario.tables import KeyUse, collecting_keys
+from headsim.sim import imperfections
 from headsim.sim.model import MODELS_DIR
 
 
@@ -235,9 +236,15 @@ def _fold(uses: dict[str, KeyUse], seen: dict[str, KeyUse]) -> None:
 def accepted_keys() -> list[Key]:
     """Every accepted key with its meaning (KeyError-free: a key without a line gets "")."""
     return [
-        Key(u.path, u.kind, u.allowed, u.default, DESCRIPTIONS.get(u.path, ""))
+        Key(u.path, u.kind, u.allowed, u.default, DESCRIPTIONS.get(u.path) or _meaning(u.path))
         for u in collect_uses().values()
     ]
+
+
+def _meaning(path: str) -> str:
+    """A camera's imperfection setting's declared meaning (one registered after import)."""
+    table, _, name = path.partition(".")
+    return imperfections.meanings().get(name, "") if table in ("cam1", "cam2") else ""
 
 
 _CAMERA = {
@@ -249,9 +256,7 @@ _CAMERA = {
     "ky": "Focal length along the image's v axis, px.",
     "cx": "Principal point's column, px (pixel centres at integer coordinates).",
     "cy": "Principal point's row, px.",
-    "k1": "First radial distortion coefficient (OpenCV's).",
-    "k2": "Second radial distortion coefficient (OpenCV's).",
-    "noise_std": "Gaussian image noise, grey levels (seeded by `seed`).",
+    **imperfections.meanings(),  # declared with each image imperfection
     "nodal_offset_m": "Optical centre in front of the eye's yaw axis, m (lenses: 0.01-0.03).",
     "side_offset_m": "Optical centre along the camera's x from the yaw axis, m (mounting: up to 0.002).",
     "eye_axis_tilt_rad": "The eye's yaw axis leaning forward, rad (machining: a few mrad).",

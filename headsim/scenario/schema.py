@@ -27,7 +27,7 @@ from headsim.scenario.spec import (
     ServoSpec,
 )
 from headsim.scenario.tables import MISSING, Context, Table, describe_value, short_value
-from headsim.sim import heads, names
+from headsim.sim import heads, imperfections, names
 from headsim.sim.heads import HeadModel
 from headsim.sim.model import design, has_own_cameras, on_head
 from headsim.sim.optics import centre_ray_yaw
@@ -39,6 +39,7 @@ from headsim.sim.settings import (
     RenderFidelity,
     SettingsError,
     belief_sources,
+    camera_values,
     preset,
 )
 
@@ -74,9 +75,11 @@ def _read_camera(
     cy_default = base.cy if base.cy is not None and base.cy <= height - 1 else None
     cx = table.number("cx", cx_default, 0.0, width - 1.0, unit="px (inside the image)")
     cy = table.number("cy", cy_default, 0.0, height - 1.0, unit="px (inside the image)")
-    k1 = table.number("k1", base.k1, -1.0, 1.0)
-    k2 = table.number("k2", base.k2, -1.0, 1.0)
-    noise = table.number("noise_std", base.noise_std, 0.0, 50.0, unit="grey levels")
+    # Every image imperfection's settings, with their declared ranges.
+    image_settings = {
+        s.name: table.number(s.name, base.value(s.name), s.lo, s.hi, unit=s.unit)
+        for s in imperfections.all_settings()
+    }
     nodal = table.number("nodal_offset_m", base.nodal_offset_m, -0.05, 0.1, unit="m")
     side = table.number("side_offset_m", base.side_offset_m, -0.02, 0.02, unit="m")
     tilt = table.number("eye_axis_tilt_rad", base.eye_axis_tilt_rad, -0.1, 0.1, unit="rad")
@@ -88,12 +91,10 @@ def _read_camera(
         ky=ky,
         cx=cx,
         cy=cy,
-        k1=k1,
-        k2=k2,
-        noise_std=noise,
         nodal_offset_m=nodal,
         side_offset_m=side,
         eye_axis_tilt_rad=tilt,
+        **camera_values(image_settings),
     )
     problem = _lens_problem(camera)
     if problem is not None:

@@ -11,8 +11,9 @@ all are ray-cast in one Warp call per kind of world.  A head that converges ends
 call; the batch ends when the last one does.
 
 Each image is then finished exactly as the classic renderer finishes its own
-(:class:`~headsim.sim.render.EyeRenderer`): the lens by remap, the camera's noise from
-the same stream, the same counts.  A window casts only its own pixels' rays (a camera
+(:class:`~headsim.sim.render.EyeRenderer`): every registered imperfection
+(:func:`headsim.sim.imperfections.finish`: the lens by remap, the camera's noise from
+the same stream), the same counts.  A window casts only its own pixels' rays (a camera
 whose intrinsics cover just that rectangle, :func:`window_intrinsic`, on a size rounded
 up to a power of two), a preview one ray per binned pixel.  Anti-aliasing:
 ``samples_per_pixel`` x ``samples_per_pixel`` rays per pixel on a regular grid, averaged,
@@ -48,9 +49,8 @@ import mujoco
 import numpy as np
 
 from headsim.errors import BadInput
-from headsim.sim import render
+from headsim.sim import imperfections, render
 from headsim.sim.gl_window import Window
-from headsim.sim.optics import GaussianNoise, apply_canvas
 from headsim.sim.simulator import HeadSim
 
 #: The devices a batch session runs on.
@@ -657,7 +657,11 @@ class BatchRenderer:
         self.model: mujoco.MjModel = sim.model
         self._cameras = [int(self.model.camera(name).id) for name in sim.names.cameras]
         self._canvases = sim.built.canvases
-        self._noise = tuple(GaussianNoise.of(c.noise_std) for c in sim.settings.cameras)
+        self._stages = tuple(
+            imperfections.prepare(camera, canvas)
+            for camera, canvas in zip(sim.settings.cameras, self._canvases, strict=True)
+        )
+        self._sizes = tuple((c.width, c.height) for c in sim.settings.cameras)
         self._seed = sim.settings.seed if seed is None else seed
         self._frame = 0
 
@@ -694,9 +698,10 @@ class BatchRenderer:
         return out
 
     def _finish(self, image: np.ndarray, camera: int, world: int) -> np.ndarray:
-        image = apply_canvas(image, self._canvases[camera])
-        key: Any = (self._seed, BATCH_STREAM, world, camera)
-        return self._noise[camera].apply(image, key, self._frame)
+        shot = imperfections.Shot(
+            (self._seed, BATCH_STREAM, world, camera), self._frame, self._sizes[camera]
+        )
+        return imperfections.finish(lambda _: image, self._stages[camera], shot)
 
 
 __all__ = [

@@ -28,7 +28,7 @@ from headsim.sim.heads import (
     HeadModel,
     check_head,
 )
-from headsim.sim.optics import DistortionCanvas, distortion_canvas
+from headsim.sim.imperfections.distortion import DistortionCanvas, distortion_canvas
 from headsim.sim.settings import MAX_IMAGE_SIDE, CameraSettings, HeadSettings, SettingsError
 from headsim.sim.textured_scene import RoomSpec, add_room
 

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-import math
 from collections import OrderedDict
 from collections.abc import Callable, Hashable
 from contextvars import ContextVar
@@ -34,11 +33,11 @@ import cv2
 import mujoco
 import numpy as np
 
-from headsim.sim import names
+from headsim.sim import imperfections, names
 from headsim.sim.backend import INSTALL_HINT, RenderBackendError, check_backend
 from headsim.sim.gl_window import Window, draw_window
+from headsim.sim.imperfections.distortion import DistortionCanvas
 from headsim.sim.mujoco_renderer import check_renderer, make_current, mjr_context, use_model
-from headsim.sim.optics import DistortionCanvas, GaussianNoise, apply_canvas
 from headsim.sim.settings import CameraSettings
 
 #: Renderers kept per process (one per head and scene); the least recently used goes first.
@@ -152,10 +151,13 @@ class EyeRenderer:
         self._own = key is None
         self._option = mujoco.MjvOption()
         self._option.geomgroup[names.HEAD_VISUAL_GROUP] = 0
-        # One noise stream per camera: image k of camera i gets the noise drawn
-        # from (seed, i, k), whatever else was rendered.
+        # One image stream per camera: image k of camera i gets the imperfections
+        # (its noise) drawn from (seed, i, k), whatever else was rendered.
         self._seed = seed
-        self._noise = tuple(GaussianNoise.of(camera.noise_std) for camera in cameras)
+        self._stages = tuple(
+            imperfections.prepare(camera, canvas)
+            for camera, canvas in zip(cameras, canvases, strict=True)
+        )
         self._taken = [0, 0]
         self._previews = [0, 0]
         self._cam_ids = [
@@ -266,14 +268,15 @@ class EyeRenderer:
             raise ValueError(
                 f"binning {binning} must divide the {camera.width}x{camera.height} image"
             )
-        image = apply_canvas(
-            self._draw(data, index, None, binning=binning),
-            binned_canvas(self._canvases[index], binning, (camera.width, camera.height)),
-        )
         self.render_count += 1
         frame = self._previews[index]
         self._previews[index] += 1
-        return self._noise[index].apply(image, (self._seed, index, PREVIEW_STREAM), frame)
+        shot = imperfections.Shot(
+            (self._seed, index, PREVIEW_STREAM), frame, (camera.width, camera.height), binning
+        )
+        return imperfections.finish(
+            lambda rect: self._draw(data, index, rect, binning=binning), self._stages[index], shot
+        )
 
     def render(self, data: mujoco.MjData, index: int, retake: bool = False) -> np.ndarray:
         """Render camera ``index`` (0 = Ca1, 1 = Ca2) from ``data``: (H, W, 3) uint8.
@@ -281,8 +284,7 @@ class EyeRenderer:
         ``retake``: the whole of the image just taken as a window (the same
         instant: the same noise); it is still a render and is counted.
         """
-        image = apply_canvas(self._draw(data, index, None), self._canvases[index])
-        return self._add_noise(image, index, None, retake)
+        return self._finish(data, index, None, retake)
 
     def render_window(
         self, data: mujoco.MjData, index: int, window: Window, retake: bool = False
@@ -292,7 +294,7 @@ class EyeRenderer:
         ``retake``: a window of the image just taken (the same instant: the same noise);
         it is still a render and is counted.
         """
-        camera, canvas = self._cameras[index], self._canvases[index]
+        camera = self._cameras[index]
         if not (
             0 <= window.x0 < window.x1 <= camera.width
             and 0 <= window.y0 < window.y1 <= camera.height
@@ -300,31 +302,12 @@ class EyeRenderer:
             raise ValueError(
                 f"window {window} is not inside the {camera.width}x{camera.height} image"
             )
-        if canvas.identity:
-            image = self._draw(data, index, window)
-        else:
-            assert canvas.map_x is not None and canvas.map_y is not None
-            map_x = canvas.map_x[window.y0 : window.y1, window.x0 : window.x1]
-            map_y = canvas.map_y[window.y0 : window.y1, window.x0 : window.x1]
-            source = _canvas_region(map_x, map_y, canvas.size)
-            if source is None:  # nothing of the canvas is seen through this window
-                image = np.zeros((window.height, window.width, 3), dtype=np.uint8)
-            else:
-                region = self._draw(data, index, source)
-                # Shifting float32 maps by whole pixels is exact: the same samples.
-                shifted = DistortionCanvas(
-                    size=(source.width, source.height),
-                    principal=canvas.principal,
-                    map_x=np.where(map_x >= 0, map_x - np.float32(source.x0), np.float32(-1)),
-                    map_y=np.where(map_y >= 0, map_y - np.float32(source.y0), np.float32(-1)),
-                    valid_fraction=canvas.valid_fraction,
-                )
-                image = apply_canvas(region, shifted)
-        return self._add_noise(image, index, window, retake)
+        return self._finish(data, index, window, retake)
 
-    def _add_noise(
-        self, image: np.ndarray, index: int, window: Window | None, retake: bool = False
+    def _finish(
+        self, data: mujoco.MjData, index: int, window: Window | None, retake: bool
     ) -> np.ndarray:
+        """Image or ``window`` of camera ``index``: drawn, then every imperfection applied."""
         self.render_count += 1
         if retake and self._taken[index] > 0:
             frame = self._taken[index] - 1
@@ -332,8 +315,10 @@ class EyeRenderer:
             frame = self._taken[index]
             self._taken[index] += 1
         camera = self._cameras[index]
-        crop = None if window is None else (window.x0, window.y0, camera.width, camera.height)
-        return self._noise[index].apply(image, (self._seed, index), frame, crop=crop)
+        shot = imperfections.Shot((self._seed, index), frame, (camera.width, camera.height))
+        return imperfections.finish(
+            lambda rect: self._draw(data, index, rect), self._stages[index], shot, window
+        )
 
     def close(self) -> None:
         """Give the OpenGL context back to the pool (closed if it was this renderer's own)."""
@@ -358,67 +343,3 @@ def make_eye_renderer(*args: Any, **kwargs: Any) -> EyeRenderer:
 
 #: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.
 PREVIEW_STREAM = 1_000_003
-
-
-#: Binned canvases by (id of the canvas, binning), with the canvas kept alive.
-_BINNED: dict[tuple[int, int], tuple[DistortionCanvas, DistortionCanvas]] = {}
-
-
-def binned_canvas(
-    canvas: DistortionCanvas, binning: int, image_size: tuple[int, int]
-) -> DistortionCanvas:
-    """``canvas`` for images binned ``binning`` x ``binning`` from a canvas binned alike
-    (made once per canvas and binning).
-
-    The remap tables' b x b blocks are averaged (the block centre's sample of a
-    smooth map) and moved to the binned canvas's pixels; a block with any pixel
-    without source has none.
-    """
-    key = (id(canvas), binning)
-    if key not in _BINNED:
-        _BINNED[key] = (canvas, _binned_canvas(canvas, binning, image_size))
-    return _BINNED[key][1]
-
-
-def _binned_canvas(
-    canvas: DistortionCanvas, binning: int, image_size: tuple[int, int]
-) -> DistortionCanvas:
-    width, height = image_size
-    size = (width // binning, height // binning)
-    width_b = (canvas.size[0] - canvas.size[0] % binning) // binning
-    height_b = (canvas.size[1] - canvas.size[1] % binning) // binning
-    if canvas.map_x is None or canvas.map_y is None:
-        return DistortionCanvas((width_b, height_b), canvas.principal, None, None, 1.0)
-    offset = (binning - 1) / 2.0
-    invalid = (
-        cv2.resize((canvas.map_x < 0).astype(np.float32), size, interpolation=cv2.INTER_AREA) > 0
-    )
-    map_x = (cv2.resize(canvas.map_x, size, interpolation=cv2.INTER_AREA) - offset) / binning
-    map_y = (cv2.resize(canvas.map_y, size, interpolation=cv2.INTER_AREA) - offset) / binning
-    invalid |= (map_x < 0) | (map_x > width_b - 1) | (map_y < 0) | (map_y > height_b - 1)
-    map_x[invalid] = -1.0
-    map_y[invalid] = -1.0
-    map_x, map_y = map_x.astype(np.float32), map_y.astype(np.float32)
-    map_x.flags.writeable = map_y.flags.writeable = False
-    return DistortionCanvas(
-        size=(width_b, height_b),
-        principal=canvas.principal,
-        map_x=map_x,
-        map_y=map_y,
-        valid_fraction=float(1.0 - invalid.mean()),
-    )
-
-
-def _canvas_region(
-    map_x: np.ndarray, map_y: np.ndarray, canvas_size: tuple[int, int]
-) -> Window | None:
-    """The canvas rectangle that bilinear sampling at (map_x, map_y) reads (None: no valid source)."""
-    valid = map_x >= 0
-    if not valid.any():
-        return None
-    xs, ys = map_x[valid], map_y[valid]
-    x0 = max(math.floor(float(xs.min())) - 1, 0)
-    y0 = max(math.floor(float(ys.min())) - 1, 0)
-    x1 = min(math.floor(float(xs.max())) + 3, canvas_size[0])
-    y1 = min(math.floor(float(ys.max())) + 3, canvas_size[1])
-    return Window(x0, y0, x1 - x0, y1 - y0)

@@ -9,14 +9,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
 from headsim.errors import BadInput
 from headsim.geometry.camera_model import PinholeCamera, image_centre
 from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import BASELINE_M, ENCODER_RESOLUTION_RAD, INITIAL_DIRECTIONS_RAD, INTRINSICS
+from headsim.sim import imperfections
 from headsim.sim.heads import PAPER, HeadModel
+from headsim.sim.imperfections.distortion import K1, K2
+from headsim.sim.imperfections.noise import NOISE_STD
 from headsim.sim.tolerances import REALISTIC_BUDGET
 
 #: Largest image side the off-screen buffer is allowed to grow to, px.
@@ -67,7 +70,10 @@ class CameraSettings:
     coefficients on normalised coordinates.  ``mount_yaw_rad`` is the paper's
     alpha_e (the eye's initial direction, positive inward like the eye angle);
     ``mount_pitch_rad``/``mount_roll_rad`` tilt the camera on its eye (0 in the
-    paper).  ``noise_std`` is Gaussian image noise in 8-bit grey levels.
+    paper).  The image imperfections' settings (``k1``, ``k2``, ``noise_std`` and
+    those of any other registered imperfection, kept in ``extra``) are declared,
+    with their ranges and meanings, in their modules (:mod:`headsim.sim.imperfections`);
+    :meth:`value` reads any of them.
 
     Beyond the paper (issue 10, a real head): ``nodal_offset_m`` puts the
     optical centre that far in front of the eye's yaw axis, along the optical
@@ -85,15 +91,18 @@ class CameraSettings:
     ky: float = IDEAL_FOCAL_PX
     cx: float | None = None
     cy: float | None = None
-    k1: float = 0.0
-    k2: float = 0.0
+    k1: float = K1.default
+    k2: float = K2.default
     mount_yaw_rad: float = 0.0
     mount_pitch_rad: float = 0.0
     mount_roll_rad: float = 0.0
-    noise_std: float = 0.0
+    noise_std: float = NOISE_STD.default
     nodal_offset_m: float = 0.0
     side_offset_m: float = 0.0
     eye_axis_tilt_rad: float = 0.0
+    #: Settings of imperfections registered beyond the fields above, as (name, value)
+    #: pairs (left out of the records while empty; see :func:`settings_record`).
+    extra: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("width", "height"):
@@ -133,12 +142,31 @@ class CameraSettings:
                     0 <= value <= size - 1,
                     f"principal point {name} = {value} px lies outside the image [0, {size - 1}]",
                 )
-        _check(self.noise_std >= 0, f"noise_std must be >= 0, got {self.noise_std}")
+        declared = {s.name for s in imperfections.all_settings()} - _CAMERA_FIELDS
+        names = [name for name, _ in self.extra]
+        _check(
+            all(name in declared for name in names) and len(set(names)) == len(names),
+            f"camera extra must be (name, value) pairs of registered imperfection settings "
+            f"other than its fields ({', '.join(sorted(declared)) or 'none'}), got {self.extra!r}",
+        )
+        for setting in imperfections.all_settings():
+            problem = setting.check(self.value(setting.name))
+            _check(problem is None, str(problem))
         for name in ("mount_yaw_rad", "mount_pitch_rad", "mount_roll_rad"):
             _check(
                 abs(getattr(self, name)) < 0.5,
                 f"{name} must be within (-0.5, 0.5) rad, got {getattr(self, name)}",
             )
+
+    def value(self, name: str) -> float:
+        """The value of imperfection setting ``name``: its field, its ``extra`` entry, or
+        its declared default."""
+        if name in _CAMERA_FIELDS:
+            return float(getattr(self, name))
+        for key, value in self.extra:
+            if key == name:
+                return value
+        return imperfections.setting(name).default
 
     @property
     def principal(self) -> tuple[float, float]:
@@ -160,6 +188,22 @@ class CameraSettings:
         """The same camera with both focal lengths scaled by ``factor``."""
         _check(factor > 0, f"zoom factor must be > 0, got {factor}")
         return replace(self, kx=self.kx * factor, ky=self.ky * factor)
+
+
+_CAMERA_FIELDS = frozenset(f.name for f in fields(CameraSettings))
+
+
+def camera_values(values: dict[str, float]) -> dict[str, Any]:
+    """Imperfection settings by name as :class:`CameraSettings` arguments: its fields,
+    and the rest as ``extra`` (those at their declared default left out, so that a
+    camera's record is the same whatever else is registered)."""
+    own = {k: v for k, v in values.items() if k in _CAMERA_FIELDS}
+    extra = tuple(
+        (k, v)
+        for k, v in values.items()
+        if k not in _CAMERA_FIELDS and v != imperfections.setting(k).default
+    )
+    return {**own, "extra": extra} if extra else own
 
 
 @dataclass(frozen=True)
@@ -370,6 +414,9 @@ def settings_record(settings: HeadSettings) -> dict[str, Any]:
     """The settings as results.json and snapshots record them: the head model only when
     it is not the paper's (whose records predate the choice of head)."""
     record = asdict(settings)
+    for camera in record["cameras"]:
+        if not camera["extra"]:
+            del camera["extra"]  # the layout of every record made before imperfection modules
     head = record.pop("head")
     if not settings.head.is_paper:
         record["head"] = {**head, "path": str(settings.head.path)}

@@ -8,7 +8,7 @@ from statistics import NormalDist
 import numpy as np
 import pytest
 
-from headsim.sim.optics import GaussianNoise
+from headsim.sim.imperfections.noise import GaussianNoise
 
 GREY = np.full((480, 640, 3), 128, dtype=np.uint8)
 

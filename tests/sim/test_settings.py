@@ -22,7 +22,7 @@ from headsim.sim.simulator import HeadSim
         (lambda: CameraSettings(height=0), "height must be a positive integer"),
         (lambda: CameraSettings(kx=-5.0), "focal length kx must be > 0"),
         (lambda: CameraSettings(cx=700.0), "principal point cx = 700.0 px lies outside the image"),
-        (lambda: CameraSettings(noise_std=-1.0), "noise_std must be >= 0"),
+        (lambda: CameraSettings(noise_std=-1.0), r"noise_std must be within \[0, 50\] grey levels"),
         (lambda: HeadSettings(encoder_resolution_rad=0.0), "encoder_resolution_rad must be > 0"),
         (lambda: HeadSettings(cameras=(CameraSettings(),)), "cameras must be a pair"),
         (lambda: preset("fisheye"), "unknown preset 'fisheye'; allowed: ideal, paper"),
