@@ -14,11 +14,10 @@ The names below load on first use, so ``import headsim`` stays cheap.
 from typing import TYPE_CHECKING, Any
 
 from headsim.sim.backend import choose_default_backend
+from headsim.version import __version__
 
 # MuJoCo picks its OpenGL backend when first imported: choose before that.
 choose_default_backend()
-
-__version__ = "0.1.0"
 
 if TYPE_CHECKING:
     from headsim.run.library import load_scenario
