@@ -20,7 +20,9 @@ from headsim.version import __version__
 choose_default_backend()
 
 if TYPE_CHECKING:
-    from headsim.run.library import load_scenario
+    # At run time ``headsim.run`` is the callable package (headsim/run/__init__.py); a
+    # type checker sees the function, so ``headsim.run(...)`` type-checks.
+    from headsim.run.library import load_scenario, run
     from headsim.run.outcomes import MeasurementRow
     from headsim.run.result import RunResult
     from headsim.scenario.spec import Scenario
