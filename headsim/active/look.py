@@ -160,7 +160,7 @@ Hint = Since | Around | Anew | Whole | Glance
 class Sight:
     """A camera's last detection the next window is predicted from: what the head saw
     (``key``'s target at ``uv_px``, full-frame pixels, of ``area_px``, px^2) and where
-    its encoders stood (the eye motors' ``eye_steps``, the neck's ``neck_rad``)."""
+    its encoders stood (the eye motor's ``eye_steps``, the neck's (yaw, pitch) ``neck_rad``)."""
 
     key: object
     eye_steps: int
