@@ -159,6 +159,9 @@ def main() -> int:
         for f, words_ in PROCEDURE_RECIPE
         if " ".join(words_.split()) in recipe
     ]
+    gone = [f for f, words_ in PROCEDURE_RECIPE if " ".join(words_.split()) not in recipe]
+    if gone:  # the recipe was rewritten: PROCEDURE_RECIPE must be read from it again
+        print("steps of PROCEDURE_RECIPE no longer in CONTRIBUTING.md:", ", ".join(gone))
     registered = procedures(root)
     lists = naming_all(index, registered, skip="headsim/procedures/")
     print(f"\nregistered procedures: {len(registered)}")
