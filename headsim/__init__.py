@@ -14,14 +14,15 @@ The names below load on first use, so ``import headsim`` stays cheap.
 from typing import TYPE_CHECKING, Any
 
 from headsim.sim.backend import choose_default_backend
+from headsim.version import __version__
 
 # MuJoCo picks its OpenGL backend when first imported: choose before that.
 choose_default_backend()
 
-__version__ = "0.1.0"
-
 if TYPE_CHECKING:
-    from headsim.run.library import load_scenario
+    # At run time ``headsim.run`` is the callable package (headsim/run/__init__.py); a
+    # type checker sees the function, so ``headsim.run(...)`` type-checks.
+    from headsim.run.library import load_scenario, run
     from headsim.run.outcomes import MeasurementRow
     from headsim.run.result import RunResult
     from headsim.scenario.spec import Scenario

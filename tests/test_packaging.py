@@ -9,13 +9,14 @@ data that covers every file in them.
 
 from __future__ import annotations
 
+import ast
 import tomllib
 from fnmatch import fnmatch
 from pathlib import Path
 
 import pytest
 
-from headsim import __version__
+from headsim import __version__, version
 from headsim.cli import main
 from headsim.scenario.loading import SCENARIOS_DIR
 from headsim.sim.model import MODELS_DIR
@@ -104,7 +105,7 @@ def test_the_license_file_and_the_metadata_ship_with_the_package() -> None:
     # A license expression and a License :: classifier together are refused by setuptools.
     assert not [c for c in classifiers if c.startswith("License ::")]
     assert project["dynamic"] == ["version"]
-    assert SETUPTOOLS["dynamic"]["version"] == {"attr": "headsim.__version__"}
+    assert SETUPTOOLS["dynamic"]["version"] == {"attr": "headsim.version.__version__"}
 
 
 def test_version_prints_the_package_version_and_exits_0(
@@ -115,3 +116,29 @@ def test_version_prints_the_package_version_and_exits_0(
     assert done.value.code == 0
     assert capsys.readouterr().out == f"headsim {__version__}\n"
     assert __version__.count(".") == 2 and all(p.isdigit() for p in __version__.split("."))
+
+
+def test_no_module_of_the_package_imports_the_package_root_for_a_name() -> None:
+    """The version has one home below every layer (headsim/version.py): a module that
+    took it, or anything else, from ``headsim`` itself would import the lazy top-level
+    API (and the whole package above it) from below."""
+    package = REPO / "headsim"
+    found = []
+    for path in sorted(package.rglob("*.py")):
+        if path == package / "__init__.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                found += [
+                    f"{path.relative_to(REPO)}: import {a.name}"
+                    for a in node.names
+                    if a.name == "headsim"
+                ]
+            elif isinstance(node, ast.ImportFrom) and node.module == "headsim" and node.level == 0:
+                found += [
+                    f"{path.relative_to(REPO)}: from headsim import {a.name}"
+                    for a in node.names
+                    if not (package / a.name).is_dir() and not (package / f"{a.name}.py").is_file()
+                ]
+    assert found == [], found
+    assert version.__version__ == __version__

@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 LAYERS = (
+    "version",
     "errors",
     "files",
     "paper",

@@ -73,15 +73,17 @@ class PatternFeature(Protocol):
 class FovealDetector(Protocol):
     """A detector that correlates a template on a foveal window
     (:mod:`headsim.active.markerless`): it names the window it needs in ``camera``'s
-    image, around where the looker expects its point (``expected_uv`` px, after an image
-    motion of ``motion_px``; None: around its own last sight), and is told where the image it is handed lies in the full
-    frame; its detection is in full-frame pixels.  Only that window is rendered."""
+    image of ``image_size_px`` (width, height), around where the looker expects its
+    point (``expected_uv_px``, full-frame pixels, after an image motion of
+    ``motion_px``; None: around its own last sight), and is told where the image it is
+    handed lies in the full frame; its detection is in full-frame pixels.  Only that
+    window is rendered."""
 
     def search_window(
         self,
         camera: int,
-        image_size: tuple[int, int],
-        expected_uv: tuple[float, float] | None,
+        image_size_px: tuple[int, int],
+        expected_uv_px: tuple[float, float] | None,
         motion_px: float = 0.0,
     ) -> Window: ...
 
@@ -120,7 +122,8 @@ class Since:
 @dataclass(frozen=True)
 class Around:
     """The neck servo's hint: its own prediction of the blob ``key`` found: at
-    ``uv_px``, of ``area_px``, after an image motion of ``motion_px``."""
+    ``uv_px`` (full-frame pixels), of ``area_px`` (px^2), after an image motion of
+    ``motion_px``."""
 
     key: object
     uv_px: tuple[float, float]
@@ -156,12 +159,13 @@ Hint = Since | Around | Anew | Whole | Glance
 @dataclass(frozen=True)
 class Sight:
     """A camera's last detection the next window is predicted from: what the head saw
-    and did (``key``, eye steps, neck encoders rad, uv px, area px^2)."""
+    (``key``'s target at ``uv_px``, full-frame pixels, of ``area_px``, px^2) and where
+    its encoders stood (the eye motor's ``eye_steps``, the neck's (yaw, pitch) ``neck_rad``)."""
 
     key: object
-    steps: int
-    neck: tuple[float, float]
-    uv: tuple[float, float]
+    eye_steps: int
+    neck_rad: tuple[float, float]
+    uv_px: tuple[float, float]
     area_px: float
 
 
@@ -174,18 +178,19 @@ def unbinned_px(binned_px: tuple[float, ...] | np.ndarray, binning: int) -> np.n
 
 # -- where a window goes (pure) ------------------------------------------------------
 def pattern_window(
-    image_size: tuple[int, int],
-    expected_uv: tuple[float, float],
+    image_size_px: tuple[int, int],
+    expected_uv_px: tuple[float, float],
     extent_px: Extent,
     motion_px: float,
     margin_px: float,
 ) -> Window | None:
-    """The window to look for a pattern of ``extent_px`` around ``expected_uv`` after an
-    image motion of ``motion_px``: the extent plus the margin and a quarter of the motion
-    on every side.  None where it would be barely cheaper than the frame."""
-    width, height = image_size
+    """The window to look for a pattern of ``extent_px`` around ``expected_uv_px`` (full
+    frame) after an image motion of ``motion_px``: the extent plus the margin and a
+    quarter of the motion on every side.  None where it would be barely cheaper than the
+    frame."""
+    width, height = image_size_px
     grow = margin_px + 0.25 * abs(motion_px)
-    u, v = expected_uv
+    u, v = expected_uv_px
     left, top, right, bottom = extent_px
     x0 = max(math.floor(u + left - grow), 0)
     y0 = max(math.floor(v + top - grow), 0)
@@ -197,18 +202,18 @@ def pattern_window(
 
 
 def expected_window(
-    image_size: tuple[int, int],
-    expected_uv: tuple[float, float],
+    image_size_px: tuple[int, int],
+    expected_uv_px: tuple[float, float],
     area_px: float,
     motion_px: float,
     margin_px: float,
 ) -> Window | None:
-    """The window to look for a blob of ``area_px`` expected at ``expected_uv`` after an
-    image motion of ``motion_px``: half-side 3 blob radii + margin + a quarter of the
-    motion.  None where it would be barely cheaper than the frame."""
+    """The window to look for a blob of ``area_px`` expected at ``expected_uv_px`` (full
+    frame) after an image motion of ``motion_px``: half-side 3 blob radii + margin + a
+    quarter of the motion.  None where it would be barely cheaper than the frame."""
     half = 3.0 * math.sqrt(area_px / math.pi) + margin_px + 0.25 * abs(motion_px)
-    window = Window.around(expected_uv, half, image_size)
-    if window.width * window.height >= 0.5 * image_size[0] * image_size[1]:
+    window = Window.around(expected_uv_px, half, image_size_px)
+    if window.width * window.height >= 0.5 * image_size_px[0] * image_size_px[1]:
         return None
     return window
 
@@ -216,7 +221,7 @@ def expected_window(
 def stands_for_frame(
     seen: Detection,
     window: Window,
-    image_size: tuple[int, int],
+    image_size_px: tuple[int, int],
     expected_area_px: float | None = None,
 ) -> Detection | None:
     """``seen`` (detected in ``window``) in full-frame pixels if the full frame would give
@@ -235,8 +240,8 @@ def stands_for_frame(
         expected_area_px / AREA_CHANGE <= seen.area_px <= AREA_CHANGE * expected_area_px
     ):
         return None
-    u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0
-    width, height = image_size
+    u, v = seen.uv[0] + window.x0, seen.uv[1] + window.y0  # in the full frame
+    width, height = image_size_px
     if seen.extent_px is not None:
         left, top, right, bottom = seen.extent_px
         if (
@@ -264,10 +269,10 @@ def reporting(
 
     def detect(image: np.ndarray) -> Detection:
         detection = detector(image)
-        uv = detection.uv if detection.found else None
-        if uv is not None and window is not None:  # in the full frame's pixels
-            uv = (uv[0] + window.x0, uv[1] + window.y0)
-        sink.emit(Detected(camera, detection.status, uv))
+        uv_px = detection.uv if detection.found else None
+        if uv_px is not None and window is not None:  # in the full frame's pixels
+            uv_px = (uv_px[0] + window.x0, uv_px[1] + window.y0)
+        sink.emit(Detected(camera, detection.status, uv_px))
         return detection
 
     return detect
@@ -302,7 +307,7 @@ class _Memory:
     """Per camera: the last sight, and the extent of the pattern last seen (None: a blob)."""
 
     sight: dict[int, Sight] = field(default_factory=dict)
-    extent: dict[int, Extent | None] = field(default_factory=dict)
+    extent_px: dict[int, Extent | None] = field(default_factory=dict)
 
 
 class Looker:
@@ -323,7 +328,7 @@ class Looker:
         self.counts = LookCounts()
         self._memory = _Memory()
         #: Each camera's image size (width, height) px, by camera (1, 2).
-        self.sizes = {
+        self.image_sizes_px = {
             n: (camera.width, camera.height) for n, camera in enumerate(sim.settings.cameras, 1)
         }
 
@@ -340,7 +345,7 @@ class Looker:
         cfg = self.config
         if isinstance(hint, Around) and cfg.windows and finds_blob(hint.key):
             window = expected_window(
-                self.sizes[camera], hint.uv_px, hint.area_px, hint.motion_px,
+                self.image_sizes_px[camera], hint.uv_px, hint.area_px, hint.motion_px,
                 cfg.window_margin_px,
             )  # fmt: skip
             if window is not None:
@@ -368,19 +373,19 @@ class Looker:
         detector: Detector,
         key: object,
         window: Window,
-        guessed: float | None = None,
+        guessed_area_px: float | None = None,
     ) -> Detection:
         """Detect in a rendered window; a miss costs the same instant's whole frame, or,
-        for a window ``guessed`` from a blob of that area seen before, first a preview
-        and the window it places."""
+        for a window guessed from a blob of ``guessed_area_px`` seen before, first a
+        preview and the window it places."""
         self.counts.window_renders += 1
         detection = self._in_window(
-            camera, self._reported(detector, camera, window), window, guessed
+            camera, self._reported(detector, camera, window), window, guessed_area_px
         )
         if detection is not None:
             return detection
         self.counts.window_misses += 1
-        if guessed is not None and self.config.preview_binning > 1:
+        if guessed_area_px is not None and self.config.preview_binning > 1:
             self.counts.previews += 1
             report = partial(reporting, detector, self.sink, camera)
             detection, rendered = self._look_again(camera, key, report)
@@ -414,7 +419,7 @@ class Looker:
         """Render ``window`` and detect there: the detection in full-frame pixels, or None
         (a miss, :func:`stands_for_frame`).  ``retake``: of the instant just taken."""
         seen = detector(self._take(camera, window, retake=retake))
-        return stands_for_frame(seen, window, self.sizes[camera], expected_area_px)
+        return stands_for_frame(seen, window, self.image_sizes_px[camera], expected_area_px)
 
     def _preview_window(self, camera: int, detector: object, binning: int = 0) -> Window | None:
         """Render a preview of ``camera``'s whole view binned b x b (``binning``, default
@@ -427,16 +432,18 @@ class Looker:
         seen = detector(self._take(camera, binning=b))
         if not isinstance(seen, Detection) or not seen.found or seen.uv is None:
             return None
-        # Its position is good to about b px.
+        # Its position in the full frame is good to about b px.
         u, v = unbinned_px(seen.uv, b)
-        uv = (float(u), float(v))
-        size = self.sizes[camera]
+        uv_px = (float(u), float(v))
+        size_px = self.image_sizes_px[camera]
         if seen.extent_px is not None:  # a pattern: its box, from the feature
             left, top, right, bottom = (b * e for e in seen.extent_px)
             return pattern_window(
-                size, uv, (left, top, right, bottom), 4.0 * b, config.window_margin_px
+                size_px, uv_px, (left, top, right, bottom), 4.0 * b, config.window_margin_px
             )
-        return expected_window(size, uv, b * b * seen.area_px, 4.0 * b, config.window_margin_px)
+        return expected_window(
+            size_px, uv_px, b * b * seen.area_px, 4.0 * b, config.window_margin_px
+        )
 
     def _look_again(
         self, camera: int, detector: object, report: Callable[[Window], Detector]
@@ -459,22 +466,27 @@ class Looker:
         and locate it there.  A miss is the detector's answer: no whole frame follows
         (correlation stays foveal inside the loop)."""
         sim, memory = self.sim, self._memory
-        steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
+        eye_steps, neck_rad = sim.eye_encoder_steps(), sim.neck_encoders()
         key: object = detector
-        expected: tuple[float, float] | None = None
-        motion = 0.0
+        expected_uv_px: tuple[float, float] | None = None
+        motion_px = 0.0
         if isinstance(hint, Around):
-            expected, motion = hint.uv_px, hint.motion_px
+            expected_uv_px, motion_px = hint.uv_px, hint.motion_px
         elif isinstance(hint, Since):
             key = detector if hint.key is None else hint.key
             seen = memory.sight.get(camera)
-            gain = hint.gain_px_per_step
-            if seen is not None and seen.key == key and seen.neck == neck and gain is not None:
-                motion = gain * (steps - seen.steps)
-                expected = (seen.uv[0] + motion, seen.uv[1])
-        size = self.sizes[camera]
-        window = detector.search_window(camera, size, expected, motion)
-        if (window.width, window.height) == size:
+            gain_px_per_step = hint.gain_px_per_step
+            if (
+                seen is not None
+                and seen.key == key
+                and seen.neck_rad == neck_rad
+                and gain_px_per_step is not None
+            ):
+                motion_px = gain_px_per_step * (eye_steps - seen.eye_steps)
+                expected_uv_px = (seen.uv_px[0] + motion_px, seen.uv_px[1])
+        size_px = self.image_sizes_px[camera]
+        window = detector.search_window(camera, size_px, expected_uv_px, motion_px)
+        if (window.width, window.height) == size_px:
             image = self._take(camera)
         else:
             self.counts.window_renders += 1
@@ -483,8 +495,8 @@ class Looker:
         if self._report:
             self.sink.emit(Detected(camera, detection.status, detection.uv))
         if detection.found and detection.uv is not None:
-            memory.sight[camera] = Sight(key, steps, neck, detection.uv, detection.area_px)
-            memory.extent[camera] = None
+            memory.sight[camera] = Sight(key, eye_steps, neck_rad, detection.uv, detection.area_px)
+            memory.extent_px[camera] = None
         else:
             memory.sight.pop(camera, None)
         return detection
@@ -501,30 +513,30 @@ class Looker:
         ``preview=False`` renders the full frame instead (a search's look)."""
         key = detector if hint.key is None else hint.key
         sim, cfg, counts = self.sim, self.config, self.counts
-        steps, neck = sim.eye_encoder_steps(), sim.neck_encoders()
+        eye_steps, neck_rad = sim.eye_encoder_steps(), sim.neck_encoders()
         feature = pattern_feature(key)
         if feature is not None:  # a pattern's features share their windows
             key = feature.window_key
         window = None
         if feature is not None or finds_blob(key):
-            window = self._window(camera, key, steps, neck, hint.gain_px_per_step)
+            window = self._window(camera, key, eye_steps, neck_rad, hint.gain_px_per_step)
         # A blob's window placed from the last sight of it: a guess the image confirms.
-        guessed = (
+        guessed_area_px = (
             self._memory.sight[camera].area_px if window is not None and feature is None else None
         )
         if hint.preview and window is None and feature is None and finds_blob(key):
-            window = self._blob_preview(camera, key, neck)
+            window = self._blob_preview(camera, key, neck_rad)
         detection = None
         if window is not None:
             counts.window_renders += 1
             detection = self._in_window(
-                camera, reporting(detector, self.sink, camera, window), window, guessed
+                camera, reporting(detector, self.sink, camera, window), window, guessed_area_px
             )
             if detection is None:
                 counts.window_misses += 1
             if (
                 detection is None
-                and guessed is not None
+                and guessed_area_px is not None
                 and hint.preview
                 and cfg.preview_binning > 1
             ):
@@ -541,19 +553,21 @@ class Looker:
         memory = self._memory
         # Only detections with a centroid and an area predict a window.
         if isinstance(detection, Detection) and detection.found and detection.uv is not None:
-            memory.sight[camera] = Sight(key, steps, neck, detection.uv, detection.area_px)
-            memory.extent[camera] = detection.extent_px
+            memory.sight[camera] = Sight(key, eye_steps, neck_rad, detection.uv, detection.area_px)
+            memory.extent_px[camera] = detection.extent_px
         else:
             memory.sight.pop(camera, None)
         return detection
 
-    def _blob_preview(self, camera: int, key: object, neck: tuple[float, float]) -> Window | None:
+    def _blob_preview(
+        self, camera: int, key: object, neck_rad: tuple[float, float]
+    ) -> Window | None:
         """A preview's window for ``key``'s blob where no sight predicts where it is (a
         new target, or the neck moved since)."""
         seen = self._memory.sight.get(camera)
         if not self.config.windows or self.config.preview_binning <= 1:
             return None
-        if seen is not None and seen.key == key and seen.neck == neck:
+        if seen is not None and seen.key == key and seen.neck_rad == neck_rad:
             return None
         self.counts.previews += 1
         return self._preview_window(camera, key)
@@ -562,25 +576,26 @@ class Looker:
         self,
         camera: int,
         key: object,
-        steps: int,
-        neck: tuple[float, float],
-        gain: float | None,
+        eye_steps: int,
+        neck_rad: tuple[float, float],
+        gain_px_per_step: float | None,
     ) -> Window | None:
         """Where to look for ``key``'s target in ``camera`` (None: the full frame): around
         where the last sight puts it, the whole pattern's box for a pattern."""
         cfg, memory = self.config, self._memory
         seen = memory.sight.get(camera)
-        if not cfg.windows or seen is None or gain is None:
+        if not cfg.windows or seen is None or gain_px_per_step is None:
             return None
-        if seen.key != key or seen.neck != neck:
+        if seen.key != key or seen.neck_rad != neck_rad:
             return None
-        size = self.sizes[camera]
-        motion = gain * (steps - seen.steps)
-        expected, margin = (seen.uv[0] + motion, seen.uv[1]), cfg.window_margin_px
-        extent = memory.extent.get(camera)
-        if extent is not None:  # a pattern: the whole of it
-            return pattern_window(size, expected, extent, motion, margin)
-        return expected_window(size, expected, seen.area_px, motion, margin)
+        size_px = self.image_sizes_px[camera]
+        motion_px = gain_px_per_step * (eye_steps - seen.eye_steps)
+        expected_uv_px = (seen.uv_px[0] + motion_px, seen.uv_px[1])
+        margin_px = cfg.window_margin_px
+        extent_px = memory.extent_px.get(camera)
+        if extent_px is not None:  # a pattern: the whole of it
+            return pattern_window(size_px, expected_uv_px, extent_px, motion_px, margin_px)
+        return expected_window(size_px, expected_uv_px, seen.area_px, motion_px, margin_px)
 
 
 __all__ = [

@@ -110,20 +110,20 @@ class TemplateTracker:
     def search_window(
         self,
         camera: int,
-        image_size: tuple[int, int],
-        expected_uv: tuple[float, float] | None,
+        image_size_px: tuple[int, int],
+        expected_uv_px: tuple[float, float] | None,
         motion_px: float = 0.0,
     ) -> Window:
-        """The window the next look needs: the disc to search (around ``expected_uv``,
+        """The window the next look needs: the disc to search (around ``expected_uv_px``,
         ``search_radius_px`` plus a quarter of the predicted ``motion_px``, as the
         looker's blob windows; else the last sight's ``reacquire_radius_px``) grown by
         the template's half-side and the fit's pixel.
         ``camera``: the camera looking (this tracker follows one camera's fovea)."""
-        if expected_uv is None:
+        if expected_uv_px is None:
             self._band = around(self.uv, self.reacquire_radius_px)
         else:
-            self._band = around(expected_uv, self.search_radius_px + 0.25 * abs(motion_px))
-        return _window(self._band.rect(image_size), self.config.half_px + 2, image_size)
+            self._band = around(expected_uv_px, self.search_radius_px + 0.25 * abs(motion_px))
+        return _window(self._band.rect(image_size_px), self.config.half_px + 2, image_size_px)
 
     def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
         """The tracked point in ``image`` (a window whose top-left is ``origin_px`` in
@@ -180,20 +180,20 @@ class CorrespondenceFinder:
     def search_window(
         self,
         camera: int,
-        image_size: tuple[int, int],
-        expected_uv: tuple[float, float] | None,
+        image_size_px: tuple[int, int],
+        expected_uv_px: tuple[float, float] | None,
         motion_px: float = 0.0,
     ) -> Window:
-        """The band's rectangle (or, with ``expected_uv`` inside the band, the disc of
+        """The band's rectangle (or, with ``expected_uv_px`` inside the band, the disc of
         ``search_radius_px`` there), grown by the template's half-side and a pixel."""
         band = self.band()
-        if expected_uv is not None and self.matches and self.matches[-1].ok:
-            near = around(expected_uv, self.search_radius_px + 0.25 * abs(motion_px))
-            inside = band.distance_px(np.array(expected_uv[0]), np.array(expected_uv[1]))
+        if expected_uv_px is not None and self.matches and self.matches[-1].ok:
+            near = around(expected_uv_px, self.search_radius_px + 0.25 * abs(motion_px))
+            inside = band.distance_px(np.array(expected_uv_px[0]), np.array(expected_uv_px[1]))
             if float(inside) <= band.tolerance_px:
                 band = Band(near.points_uv, near.tolerance_px)
         self._next = band
-        return _window(band.rect(image_size), self.config.half_px + 2, image_size)
+        return _window(band.rect(image_size_px), self.config.half_px + 2, image_size_px)
 
     def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
         """The corresponding point in ``image`` (a window whose top-left is
@@ -256,14 +256,14 @@ class MarkerlessPair:
     def search_window(
         self,
         camera: int,
-        image_size: tuple[int, int],
-        expected_uv: tuple[float, float] | None,
+        image_size_px: tuple[int, int],
+        expected_uv_px: tuple[float, float] | None,
         motion_px: float = 0.0,
     ) -> Window:
         """The window ``camera``'s next look needs (tracker's, or the band's)."""
         if camera == 1:
-            return self.tracker.search_window(camera, image_size, expected_uv, motion_px)
-        return self._camera2().search_window(camera, image_size, expected_uv, motion_px)
+            return self.tracker.search_window(camera, image_size_px, expected_uv_px, motion_px)
+        return self._camera2().search_window(camera, image_size_px, expected_uv_px, motion_px)
 
     def locate(self, camera: int, image: np.ndarray, origin_px: tuple[int, int]) -> Detection:
         """``camera``'s point in ``image`` (top-left ``origin_px``), full-frame pixels."""

@@ -93,7 +93,7 @@ def find_view(
     most ``max_poses``.  None: not found (the caller names the failure).
     """
     sim = servo.sim
-    width = servo.looker.sizes[camera][0]
+    width = servo.looker.image_sizes_px[camera][0]
     poses = search_poses(servo, camera, remembered, width)[:max_poses]
     for tried, steps in enumerate(poses, start=1):
         sim.command_eye_steps(steps)
@@ -144,7 +144,7 @@ def _binning(looker: Looker, camera: int, detector: Detector) -> int:
     """The preview binning a scan looks with (1: full frames): the servo's, for a blob
     detector, where it divides the image."""
     b = looker.config.preview_binning if looker.config.windows else 1
-    width, height = looker.sizes[camera]
+    width, height = looker.image_sizes_px[camera]
     if b <= 1 or not finds_blob(detector) or width % b or height % b:
         return 1
     return b
@@ -169,7 +169,7 @@ def scan_eyes(
     """
     sim = servo.sim
     binning = _binning(servo.looker, camera, detector)
-    poses = scan_eye_poses(servo, camera, servo.looker.sizes[camera][0])
+    poses = scan_eye_poses(servo, camera, servo.looker.image_sizes_px[camera][0])
     current = sim.eye_encoder_steps()
     poses = [p for p in poses if p != current][:max_poses]
     for tried, steps in enumerate(poses, start=1):
@@ -284,7 +284,9 @@ def scan_neck(servo: NeckServo, detector: Detector, max_poses: int | None = None
     binning = min(_binning(servo.looker, c, detector) for c in (1, 2))
     here = servo.steps()
     queue: list[tuple[tuple[int, int, int], tuple[float, float] | None]] = [
-        (q, spacing) for q, spacing in _neck_scan_grid(servo, servo.looker.sizes[1]) if q != here
+        (q, spacing)
+        for q, spacing in _neck_scan_grid(servo, servo.looker.image_sizes_px[1])
+        if q != here
     ]
     looked = {here}
     resolution = sim.settings.encoder_resolution_rad
@@ -372,7 +374,7 @@ def find_neck_view(
     ``max_poses``.  Returns the pose and the number of poses tried, or None
     (the caller names the failure).
     """
-    poses = neck_search_poses(servo, last, servo.looker.sizes[1])[:max_poses]
+    poses = neck_search_poses(servo, last, servo.looker.image_sizes_px[1])[:max_poses]
     for tried, pose in enumerate(poses, start=1):
         if servo.look_from(pose, detector):
             return pose, tried

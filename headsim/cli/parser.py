@@ -1,8 +1,8 @@
 """The ``headsim`` command line's arguments: every command, its options and its help.
 
-Imports only the standard library, :mod:`headsim.errors` and the command
-modules at the top (they load their work inside), so that ``--help`` stays
-fast; :func:`build_parser` reads the scene names when called, and a given preset is
+Imports only the standard library, :mod:`headsim.errors`, :mod:`headsim.version`
+and the command modules at the top (they load their work inside), so that
+``--help`` stays fast; :func:`build_parser` reads the scene names when called, and a given preset is
 checked against the settings' list only then.
 """
 
@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import argparse
 
-from headsim import __version__
 from headsim.cli.scenarios import calibrate_command, list_command, run_command
 from headsim.cli.snapshot import snapshot_command
 from headsim.cli.studies import bench_command, reproduce_command, study_command, sweep_command
 from headsim.errors import (
     EXIT_CODES_HELP,
 )
+from headsim.version import __version__
 
 
 def positive_int(text: str) -> int:

@@ -19,13 +19,13 @@ import cv2
 import mujoco
 import numpy as np
 
-import headsim
 from headsim.active.calibration_report import calibration_block
 from headsim.run.accuracy import MeasurementSummary, summaries
 from headsim.run.outcomes import FixationScore, MeasurementRecord, RunOutcome
 from headsim.scenario.registry import get
 from headsim.scenario.spec import experiment_record
 from headsim.sim.settings import settings_record
+from headsim.version import __version__
 
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
 RESULTS_SCHEMA = "headsim.results/2"
@@ -83,7 +83,7 @@ def software_versions() -> dict[str, str]:
             return "not installed"
 
     return {
-        "headsim": headsim.__version__,
+        "headsim": __version__,
         "python": platform.python_version(),
         "mujoco": mujoco.__version__,
         "numpy": np.__version__,

@@ -9,11 +9,11 @@ import cv2
 import mujoco
 import numpy as np
 
-import headsim
 from headsim.files import write_json_atomic, write_png_atomic
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, settings_record
 from headsim.sim.simulator import HeadSim
+from headsim.version import __version__
 
 
 def movable_bodies(sim: HeadSim) -> list[str]:
@@ -111,7 +111,7 @@ def take_snapshot(
         }
         written["overview"] = write_png_atomic(out / "overview.png", overview(images, truth))
         payload = {
-            "headsim_version": headsim.__version__,
+            "headsim_version": __version__,
             "mujoco_version": mujoco.__version__,
             "scene": str(scene),
             "settings": settings_record(sim.settings),

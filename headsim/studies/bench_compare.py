@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-import headsim
+from headsim.version import __version__
 
 BENCH_DIR = Path(__file__).resolve().parents[2] / "benchmarks"
 BASELINE = BENCH_DIR / "baseline.json"
@@ -84,7 +84,7 @@ def environment() -> dict[str, str]:
     import mujoco
 
     return {
-        "headsim": headsim.__version__,
+        "headsim": __version__,
         "mujoco": mujoco.__version__,
         "numpy": np.__version__,
         "python": platform.python_version(),

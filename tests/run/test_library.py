@@ -175,3 +175,17 @@ def test_plot_draws_each_measured_error_at_its_depth_under_agg(fast_run: RunResu
     )
     assert points == sorted((row.depth_m, row.error_pct_of_depth) for row in ok)
     assert axes.get_xlabel() == "true depth, m" and axes.get_ylabel() == "3-D error, % of depth"
+
+
+def test_a_type_checker_sees_headsim_run_as_the_function(tmp_path: Path) -> None:
+    """mypy on a user's script: ``headsim.run(...)`` is a call returning a RunResult, not
+    "Module not callable" (the package headsim.run is callable only at run time)."""
+    from mypy import api
+
+    script = tmp_path / "user.py"
+    script.write_text('import headsim\n\nreveal_type(headsim.run("quickstart", fast=True))\n')
+    out, err, status = api.run(
+        [str(script), "--cache-dir", str(tmp_path / "cache"), "--follow-imports", "silent"]
+    )
+    assert status == 0 and "Module not callable" not in out, out + err
+    assert 'Revealed type is "headsim.run.result.RunResult"' in out, out

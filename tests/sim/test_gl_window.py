@@ -264,8 +264,8 @@ def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
     rng = np.random.default_rng(9)
     points = random_targets_head(rng, 3, (0.5, 1.0), vertical=(-0.1, 0.1))
 
-    def far_away(image_size, expected_uv, area_px, motion_px, margin_px):  # type: ignore[no-untyped-def]
-        return Window(0, 0, 24, 24) if expected_uv[0] > 100 else Window(600, 440, 24, 24)
+    def far_away(image_size_px, expected_uv_px, area_px, motion_px, margin_px):  # type: ignore[no-untyped-def]
+        return Window(0, 0, 24, 24) if expected_uv_px[0] > 100 else Window(600, 440, 24, 24)
 
     runs = {}
     for windows in (False, True):
