@@ -62,6 +62,7 @@ from headsim.active.calibration_report import CalibrationReport
 from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
 from headsim.errors import interrupted
+from headsim.procedures.contract import get
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
 from headsim.run.outcomes import MeasurementRecord, RunOutcome
@@ -91,7 +92,6 @@ from headsim.run.rerun_cli import (
     viewer_stream_opened,
 )
 from headsim.run.summary import summary_text
-from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.events import ImageKind, ImageTaken

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from headsim.geometry.sampling import sample_points_head
+from headsim.procedures.contract import get
 from headsim.scenario.pursuit import read_pursuit
 from headsim.scenario.reach import (
     Occluder,
@@ -25,11 +26,10 @@ from headsim.scenario.reach import (
     scene_occluders,
     target_refusal,
 )
-from headsim.scenario.registry import get
 from headsim.scenario.room import ROOM_HAS_TARGETS, ROOM_OCCLUDERS, read_room, room_occluders
 
 if TYPE_CHECKING:
-    from headsim.scenario.registry import SceneReader
+    from headsim.procedures.contract import SceneReader
 from headsim.scenario.schema import depth_range
 from headsim.scenario.spec import (
     MARKER_BODIES,
@@ -43,6 +43,19 @@ from headsim.scenario.tables import MISSING, Context, Table
 from headsim.sim import names
 from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadSettings
+
+#: What the keys of a position (:func:`read_position`) mean.
+POSITION_KEYS: dict[str, str] = {
+    "position_head_m": "Position in H at the start pose (neck and eyes at 0), m; or `position_world_m`.",
+    "position_world_m": "Position in W, m; or `position_head_m`.",
+}
+
+#: What the keys of a random box (``[scene.random_*]``) mean.
+RANDOM_BOX_KEYS: dict[str, str] = {
+    "depth_m": "Depth range z_h of the drawn points in H, m.",
+    "lateral": "Largest |x_h / z_h| of a drawn point (half the horizontal field, as a ratio).",
+    "vertical": "Largest |y_h / z_h| of a drawn point.",
+}
 
 
 def read_position(table: Table, settings: HeadSettings, default: Any = MISSING) -> np.ndarray:

@@ -15,7 +15,7 @@ import pytest
 import rerun as rr
 from rerun.chunk import RrdReader
 
-from headsim import procedures
+from headsim.procedures import contract as procedures
 from headsim.active.measurement import HeadKnowledge
 from headsim.cli import main
 from headsim.run.context import simulator

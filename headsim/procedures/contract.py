@@ -1,20 +1,21 @@
-"""The registry of procedures: each scenario's ``[experiment] procedure`` names one.
+"""The procedure contract and its registry: each scenario's ``[experiment] procedure`` names one.
 
 A :class:`Procedure` is what the generic code (the scenario reader, the runner,
-results.json, the summary, the recording) needs of a procedure, and nothing of
-its result's type: the result is handed back to the procedure's own functions.
-The scenario reader asks it for the procedure's ``[experiment]`` options and
-``[scene]`` tables, and the progress bar for its number of fixations.
-The built-in procedures register themselves in :mod:`headsim.procedures`, which
-:func:`get` loads by name the first time a procedure is looked up (a plugin
-load: this layer never imports the procedures, which sit above the runner).
+results.json, the summary, the recording, the two reference pages) needs of a
+procedure, and nothing of its result's type: the result is handed back to the
+procedure's own functions.  It also declares what its keys mean: its
+results.json ``experiment`` keys (``results``) and its own scenario keys
+(``keys``), from which the reference pages are made.  Each module of
+:mod:`headsim.procedures` registers its procedure; importing the package (which
+:func:`get` and :func:`names` do on first use) finds every module in it.
 """
 
 from __future__ import annotations
 
 import importlib
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+import pkgutil
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -29,8 +30,15 @@ if TYPE_CHECKING:
     #: ``read_scene(scene_table, ctx, settings, seed)``: the procedure's part of ``[scene]``.
     SceneReader = Callable[[Table, Context, HeadSettings, int], SceneSpec]
 
-#: The module whose import registers the built-in procedures.
+#: The package whose modules are the built-in procedures.
 BUILT_IN = "headsim.procedures"
+
+
+def discover() -> None:
+    """Import every module of :data:`BUILT_IN` (each registers its procedure)."""
+    package = importlib.import_module(BUILT_IN)
+    for found in pkgutil.iter_modules(package.__path__):
+        importlib.import_module(BUILT_IN + "." + found.name)
 
 
 def _no_lines(result: Any, paper: bool) -> list[str]:
@@ -89,6 +97,9 @@ class Procedure:
     read_scene: SceneReader | None = None
     fixations: Callable[[Scenario], int] = _each_target
     needs: frozenset[str] = frozenset()
+    results: Mapping[str, str] = field(default_factory=dict)
+    keys: Mapping[str, str] = field(default_factory=dict)
+    rank: int = 100
 
 
 #: Every registered procedure, by name.
@@ -104,20 +115,34 @@ def register(procedure: Procedure) -> Procedure:
     return procedure
 
 
+def procedures() -> tuple[Procedure, ...]:
+    """Every procedure, by rank, then by name."""
+    discover()
+    return tuple(sorted(REGISTRY.values(), key=lambda p: (p.rank, p.name)))
+
+
 def names() -> tuple[str, ...]:
-    """The names of every procedure, the built-in ones first."""
-    importlib.import_module(BUILT_IN)
-    return tuple(REGISTRY)
+    """The names of every procedure, by rank, then by name."""
+    return tuple(p.name for p in procedures())
 
 
 def get(name: str) -> Procedure:
     """The procedure named ``name``."""
     if name not in REGISTRY:
-        importlib.import_module(BUILT_IN)
+        discover()
     try:
         return REGISTRY[name]
     except KeyError:
-        raise KeyError(f"no procedure named {name!r}; known: {', '.join(REGISTRY)}") from None
+        raise KeyError(f"no procedure named {name!r}; known: {', '.join(names())}") from None
 
 
-__all__ = ["BUILT_IN", "REGISTRY", "Procedure", "get", "names", "register"]
+__all__ = [
+    "BUILT_IN",
+    "REGISTRY",
+    "Procedure",
+    "discover",
+    "get",
+    "names",
+    "procedures",
+    "register",
+]
