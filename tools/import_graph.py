@@ -2,8 +2,8 @@
 
     python tools/import_graph.py [REPO_ROOT]
 
-The layers, low to high, are LAYERS (a module's layer is its package under
-headsim/, or its own name for a top-level module). An import from a module to a
+The layers, low to high, are LAYERS (a module's layer is the longest entry that
+its dotted path under headsim/ starts with: its package, or a module named there). An import from a module to a
 higher layer is upward. Every import counts: inside functions, in a
 TYPE_CHECKING block (a type a module names is a dependency), and a load by
 ``importlib.import_module`` of a literal ``"headsim..."`` name or of a
@@ -29,6 +29,9 @@ LAYERS = (
     "stereo",
     "active",
     "live",
+    # The procedure contract: the interface the scenario reader and the runner call and the
+    # procedures implement, so below both (it names none of their types).
+    "procedures.contract",
     "scenario",
     "run",
     "procedures",
@@ -144,8 +147,12 @@ def circles(edges: dict[str, set[str]]) -> list[list[str]]:
 
 
 def layer(name: str) -> int:
-    parts = name.split(".")
-    return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else -1
+    """The index of the longest entry of LAYERS that ``name`` (after ``headsim.``) starts with."""
+    parts = name.split(".")[1:]
+    for end in range(len(parts), 0, -1):
+        if ".".join(parts[:end]) in LAYERS:
+            return LAYERS.index(".".join(parts[:end]))
+    return -1
 
 
 def main() -> int:

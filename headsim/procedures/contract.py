@@ -5,40 +5,50 @@ results.json, the summary, the recording, the two reference pages) needs of a
 procedure, and nothing of its result's type: the result is handed back to the
 procedure's own functions.  It also declares what its keys mean: its
 results.json ``experiment`` keys (``results``) and its own scenario keys
-(``keys``), from which the reference pages are made.  Each module of
-:mod:`headsim.procedures` registers its procedure; importing the package (which
-:func:`get` and :func:`names` do on first use) finds every module in it.
+(``keys``), from which the reference pages are made.
+
+This module is the interface the generic layers call and the procedures
+implement, so it sits below them (``tools/import_graph.py``'s LAYERS: below
+``scenario``): it names none of their types (the arguments it passes on are
+``Any`` here; each procedure's own functions are typed) and loads no procedure.
+Each module of :mod:`headsim.procedures` registers its procedure when imported;
+the package root hands :func:`on_first_lookup` the function that imports them
+all, which :func:`get` and :func:`names` call once, on first use.
 """
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from headsim.active.measurement import HeadKnowledge
-    from headsim.run.events import Hub
-    from headsim.run.outcomes import MeasurementRecord
-    from headsim.run.recording import Recorder
-    from headsim.scenario.spec import CalibrationSpec, Scenario, SceneSpec
-    from headsim.scenario.tables import Context, Table
     from headsim.sim.settings import HeadSettings
 
-    #: ``read_scene(scene_table, ctx, settings, seed)``: the procedure's part of ``[scene]``.
-    SceneReader = Callable[[Table, Context, HeadSettings, int], SceneSpec]
+#: ``read_scene(scene_table, ctx, settings, seed) -> SceneSpec``: the procedure's part of
+#: ``[scene]`` (``headsim.scenario.scene.SceneReader``, typed there).
+SceneReader = Callable[[Any, Any, "HeadSettings", int], Any]
 
-#: The package whose modules are the built-in procedures.
-BUILT_IN = "headsim.procedures"
+#: What :func:`discover` calls: each imports a package of procedures.
+_LOADERS: list[Callable[[], object]] = []
+_loaded = False
+
+
+def on_first_lookup(load: Callable[[], object]) -> None:
+    """Have the first lookup call ``load`` (it imports procedure modules, which register)."""
+    global _loaded
+    _LOADERS.append(load)
+    _loaded = False
 
 
 def discover() -> None:
-    """Import every module of :data:`BUILT_IN` (each registers its procedure)."""
-    package = importlib.import_module(BUILT_IN)
-    for found in pkgutil.iter_modules(package.__path__):
-        importlib.import_module(BUILT_IN + "." + found.name)
+    """Import every package of procedures handed to :func:`on_first_lookup`, once."""
+    global _loaded
+    if not _loaded:
+        _loaded = True
+        for load in tuple(_LOADERS):
+            load()
 
 
 def _no_lines(result: Any, paper: bool) -> list[str]:
@@ -49,15 +59,15 @@ def _no_failures(result: Any) -> tuple[str, ...]:
     return ()
 
 
-def _no_rows(result: Any, log: Recorder) -> None:
+def _no_rows(result: Any, log: Any) -> None:
     return None
 
 
-def _no_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+def _no_options(table: Any, calibration: Any) -> dict[str, Any]:
     return {}
 
 
-def _each_target(scenario: Scenario) -> int:
+def _each_target(scenario: Any) -> int:
     return len(scenario.scene.targets)
 
 
@@ -87,15 +97,15 @@ class Procedure:
 
     name: str
     scene: str
-    run: Callable[[Scenario, Hub, HeadKnowledge, str], tuple[Sequence[MeasurementRecord], Any]]
+    run: Callable[[Any, Any, HeadKnowledge, str], tuple[Sequence[Any], Any]]
     fields: Callable[[Any], dict[str, Any]]
     summary: Callable[[Any, bool], list[str]] = _no_lines
     ok_line: Callable[[Any, int], str] = _measured_line
     failures: Callable[[Any], tuple[str, ...]] = _no_failures
-    rows: Callable[[Any, Recorder], None] = _no_rows
-    options: Callable[[Table, CalibrationSpec | None], dict[str, Any]] = _no_options
+    rows: Callable[[Any, Any], None] = _no_rows
+    options: Callable[[Any, Any], dict[str, Any]] = _no_options
     read_scene: SceneReader | None = None
-    fixations: Callable[[Scenario], int] = _each_target
+    fixations: Callable[[Any], int] = _each_target
     needs: frozenset[str] = frozenset()
     results: Mapping[str, str] = field(default_factory=dict)
     keys: Mapping[str, str] = field(default_factory=dict)
@@ -137,7 +147,6 @@ def get(name: str) -> Procedure:
 
 
 __all__ = [
-    "BUILT_IN",
     "REGISTRY",
     "Procedure",
     "discover",

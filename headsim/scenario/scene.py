@@ -9,9 +9,10 @@ scenario's seed, one stream per use (``STREAM_*``).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from contextvars import ContextVar
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -27,9 +28,6 @@ from headsim.scenario.reach import (
     target_refusal,
 )
 from headsim.scenario.room import ROOM_HAS_TARGETS, ROOM_OCCLUDERS, read_room, room_occluders
-
-if TYPE_CHECKING:
-    from headsim.procedures.contract import SceneReader
 from headsim.scenario.schema import depth_range
 from headsim.scenario.spec import (
     MARKER_BODIES,
@@ -248,6 +246,10 @@ def read_scene(
         ROOM_OBJECTS.reset(objects)
     table.done()
     return spec if room is None else replace(spec, room=room, surface_targets=surface_targets)
+
+
+#: ``read_scene(scene_table, ctx, settings, seed)``: a procedure's part of ``[scene]``.
+SceneReader = Callable[[Table, Context, HeadSettings, int], SceneSpec]
 
 
 def targets_reader(procedure: str, *, required: bool) -> SceneReader:
