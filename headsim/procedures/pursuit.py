@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -47,6 +47,9 @@ from headsim.scenario.surface_targets import Click, camera_centre, cast, click
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import MatchConfig
+
+if TYPE_CHECKING:
+    from headsim.run.recording import Recorder
 
 
 @dataclass(frozen=True)
@@ -318,6 +321,25 @@ def _fixations(scenario: Scenario) -> int:
     return math.ceil(pursuit.duration_s * pursuit.live.frame_rate_hz)  # one per camera frame
 
 
+def log_path(result: PursuitResult, log: Recorder) -> None:
+    """The target's path where it is visible, drawn once (static) in the recording."""
+    import rerun as rr  # only when recording: Rerun costs a third of a second to import
+
+    from headsim.run.recording_layout import GREY
+
+    spec = log.scenario.scene.pursuit
+    if spec is None:
+        return
+    times = spec.sample_times(0.02)
+    path = [spec.path.position(float(t)) for t in times if spec.visibility.visible(float(t))]
+    if len(path) > 1:
+        log.rec.log(
+            "/world/pursuit/path",
+            rr.LineStrips3D([np.array(path)], colors=[GREY], labels=["path"]),
+            static=True,
+        )
+
+
 #: What its results.json ``experiment`` keys mean (beside ``procedure``).
 RESULTS: dict[str, str] = {
     "pursuit": "the pursuit spec as run (`path_kind`, `duration_s`, `frame_rate_hz`, "
@@ -395,6 +417,7 @@ PURSUIT = register(
         summary=PursuitResult.summary_lines,
         ok_line=PursuitResult.ok_line,
         failures=PursuitResult.failure_lines,
+        rows=log_path,
         read_scene=read_pursuit_scene,
         fixations=_fixations,
         results=RESULTS,
