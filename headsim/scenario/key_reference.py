@@ -241,11 +241,23 @@ def descriptions() -> dict[str, str]:
 
 
 def accepted_keys() -> list[Key]:
-    """Every accepted key with its meaning (KeyError-free: a key without a line gets "")."""
+    """Every accepted key with its meaning (KeyError-free: a key without a line gets "").
+
+    A key a procedure declares that no shipped scenario or variant reaches (one registered
+    from outside the package) is listed with its meaning alone, after the others."""
     meanings = descriptions()
+    uses = collect_uses()
     return [
-        Key(u.path, u.kind, u.allowed, u.default, meanings.get(u.path, ""))
-        for u in collect_uses().values()
+        *(
+            Key(u.path, u.kind, u.allowed, u.default, meanings.get(u.path, ""))
+            for u in uses.values()
+        ),
+        *(
+            Key(path, "", "", "", text)
+            for p in procedures()
+            for path, text in p.keys.items()
+            if path not in uses
+        ),
     ]
 
 
