@@ -93,6 +93,16 @@ class Procedure:
     set) and checks them against the calibration before it; ``read_scene`` reads its
     ``[scene]`` tables (None: it takes none); ``fixations(scenario)`` is how many
     fixations it makes after the calibration (for the progress bar).
+
+    What its keys mean: ``results`` its results.json ``experiment`` keys beside
+    ``procedure`` (paths relative to ``experiment``: ``a.b``, ``a[].b``, ``a.*``, as in
+    :mod:`headsim.run.results_reference`), ``keys`` the scenario keys only it reads
+    (full paths: ``experiment.NAME.key``, ``scene.NAME.key``; the shared ones are in
+    :mod:`headsim.scenario.key_reference`); both reference pages are made from them.
+    ``rank`` orders the procedures in a scenario's error and the references (lower
+    first, then by name).  ``reach`` is the reach check its targets take (``"model2"``:
+    each eye fixates from the start pose; ``"model1"``: the neck turns too);
+    ``markerless`` whether it measures ``[scene.room] targets``.
     """
 
     name: str
@@ -110,6 +120,8 @@ class Procedure:
     results: Mapping[str, str] = field(default_factory=dict)
     keys: Mapping[str, str] = field(default_factory=dict)
     rank: int = 100
+    reach: str = "model2"
+    markerless: bool = False
 
 
 #: Every registered procedure, by name.

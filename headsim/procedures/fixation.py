@@ -80,6 +80,7 @@ FIXATION = register(
         read_scene=targets_reader("fixation", required=True),
         needs=frozenset({"independent_eyes"}),
         results=SURFACE_FIELDS,
+        markerless=True,
         rank=95,
     )
 )

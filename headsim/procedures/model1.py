@@ -86,6 +86,8 @@ MODEL1 = register(
         read_scene=targets_reader("model1", required=True),
         needs=frozenset({"neck_yaw"}),
         results=SURFACE_FIELDS,
+        markerless=True,
+        reach="model1",
         rank=20,
     )
 )

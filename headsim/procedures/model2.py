@@ -82,6 +82,7 @@ MODEL2 = register(
         options=read_options,
         read_scene=targets_reader("model2", required=True),
         results=SURFACE_FIELDS,
+        markerless=True,
         rank=10,
     )
 )

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from headsim.geometry.sampling import sample_points_head
-from headsim.procedures.contract import get
+from headsim.procedures.contract import get, procedures
 from headsim.scenario.pursuit import read_pursuit
 from headsim.scenario.reach import (
     Occluder,
@@ -120,7 +120,9 @@ def _redraw_out_of_reach(
     points_world = np.array(points_world)
     for k in range(len(points_world)):
         for _ in range(MAX_DRAWS):
-            refusal = target_refusal(head, procedure, points_world[k], "target", radius, occluders)
+            refusal = target_refusal(
+                head, get(procedure).reach, points_world[k], "target", radius, occluders
+            )
             if refusal is None or (redrawn is not None and refusal.code not in redrawn):
                 break
             refused[refusal.code] = refused.get(refusal.code, 0) + 1
@@ -216,9 +218,6 @@ def default_position(scene: str, body: str) -> np.ndarray:
 #: The names of the room's objects while ``[scene]`` is read (a pursuit may move one).
 ROOM_OBJECTS: ContextVar[tuple[str, ...]] = ContextVar("room_objects", default=())
 
-#: The procedures that measure ``[scene.room] targets`` (one servo, target by target).
-SURFACE_TARGET_PROCEDURES = ("model2", "model1", "fixation")
-
 
 def read_scene(
     doc: Table, ctx: Context, procedure: str, settings: HeadSettings, seed: int
@@ -227,11 +226,12 @@ def read_scene(
     found = get(procedure)
     table = doc.table("scene") or Table({}, "scene", ctx)
     room, surface_targets = read_room(table, seed)
-    if surface_targets is not None and procedure not in SURFACE_TARGET_PROCEDURES:
+    if surface_targets is not None and not found.markerless:
+        measuring = [p.name for p in procedures() if p.markerless]
         raise ctx.error(
             "scene.room.targets",
             f"markerless targets are not measured by the {procedure} procedure",
-            f"procedure = {' or '.join(SURFACE_TARGET_PROCEDURES)}, or targets = 0",
+            f"procedure = {' or '.join(measuring)}, or targets = 0",
         )
     # The room's surfaces and clutter can hide the procedure's targets.
     token = ROOM_OCCLUDERS.set(() if room is None else room_occluders(room))
