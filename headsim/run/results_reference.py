@@ -5,9 +5,10 @@ table, ``a[].b`` a key of each entry of a list, ``a.*`` each key of a table
 whose keys are data (a knowledge, a phase).  A path listed without any of its
 children is described as a whole (its keys are not listed one by one).
 :func:`experiment_fields` gives each procedure's ``experiment`` keys the same
-way, relative to ``experiment``, from its declaration (``Procedure.results``).  :func:`undocumented` and
-:func:`documented_paths` compare a real results.json with both; the
-documentation hook (``tools/docs_pages.py``) writes the page from them.
+way, relative to ``experiment``, from its declaration (``Procedure.results``).
+:func:`undocumented` and :func:`documented_paths` compare a real results.json
+with both; the documentation hook (``tools/docs_pages.py``) writes the page
+from them.
 """
 
 from __future__ import annotations
@@ -232,7 +233,6 @@ RESULTS_FIELDS: dict[str, str] = {
 
 #: ``experiment`` keys a procedure writes only when it failed.
 FAILED_ONLY = frozenset({"reason"})
-
 
 #: ``experiment`` keys written only with markerless targets (``[scene.room] targets``).
 MARKERLESS_ONLY = frozenset(SURFACE_FIELDS)
