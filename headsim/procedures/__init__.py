@@ -16,6 +16,8 @@ from __future__ import annotations
 import importlib
 import pkgutil
 
+from headsim.procedures.contract import REGISTRY, Procedure, get, names, register
+
 #: This package, whose every module is a procedure (or a helper of some).
 PACKAGE = "headsim.procedures"
 
@@ -26,4 +28,4 @@ def discover() -> None:
         importlib.import_module(PACKAGE + "." + found.name)
 
 
-__all__ = ["discover"]
+__all__ = ["REGISTRY", "Procedure", "discover", "get", "names", "register"]

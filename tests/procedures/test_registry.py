@@ -17,9 +17,9 @@ import pytest
 import rerun as rr
 from rerun.chunk import RrdReader
 
+from headsim import procedures
 from headsim.active.measurement import HeadKnowledge
 from headsim.cli import main
-from headsim.procedures import contract as procedures
 from headsim.run.context import simulator
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
