@@ -11,13 +11,24 @@ From Python (``docs/python.md``)::
 The names below load on first use, so ``import headsim`` stays cheap.
 """
 
+import importlib
 from typing import TYPE_CHECKING, Any
 
+from headsim.procedures import contract as _contract
 from headsim.sim.backend import choose_default_backend
 from headsim.version import __version__
 
 # MuJoCo picks its OpenGL backend when first imported: choose before that.
 choose_default_backend()
+
+
+def _built_in_procedures() -> None:
+    importlib.import_module("headsim.procedures").discover()
+
+
+# The generic layers look procedures up by name and never import them: the first lookup
+# imports the built-in ones (headsim.procedures.contract).
+_contract.on_first_lookup(_built_in_procedures)
 
 if TYPE_CHECKING:
     # At run time ``headsim.run`` is the callable package (headsim/run/__init__.py); a
@@ -52,8 +63,6 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    import importlib
-
     if name == "run":  # the package headsim.run, which is callable (headsim.run.library.run)
         return importlib.import_module("headsim.run")
     if name in _LAZY:

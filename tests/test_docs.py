@@ -14,7 +14,7 @@ import yaml
 
 from headsim import __version__
 from headsim.errors import EXIT_MEANINGS, ExitCode
-from headsim.scenario.key_reference import DESCRIPTIONS
+from headsim.scenario.key_reference import descriptions
 from headsim.scenario.loading import scenario_files
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,7 +48,7 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_the_site_builds_strictly_with_every_generated_page(site: Path) -> None:
     keys = (site / "reference" / "scenario-keys.html").read_text()
-    for path in DESCRIPTIONS:
+    for path in descriptions():
         assert f"<code>{path}</code>" in keys, path
     cli = (site / "reference" / "command-line.html").read_text()
     assert "headsim run" in cli and "--rrd" in cli

@@ -20,3 +20,36 @@ def test_no_circle_no_upward_import_no_module_over_800_lines() -> None:
     assert "circles: 0" in result.stdout, result.stdout
     assert "upward imports" in result.stdout and "): 0" in result.stdout, result.stdout
     assert result.returncode == 0, result.stdout
+
+
+def _check(root: Path) -> str:
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "tools" / "import_graph.py"), str(root)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    return result.stdout
+
+
+def test_a_circle_through_type_checking_or_importlib_is_counted(tmp_path: Path) -> None:
+    package = tmp_path / "headsim"
+    (package / "scenario").mkdir(parents=True)
+    (package / "run").mkdir()
+    (package / "plugins").mkdir()
+    for folder in (package, package / "scenario", package / "run", package / "plugins"):
+        (folder / "__init__.py").write_text("")
+    (package / "scenario" / "spec.py").write_text(
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from headsim.run.hub import Hub\n"
+    )
+    (package / "run" / "hub.py").write_text("from headsim.scenario.spec import Spec\n")
+    (package / "run" / "look.py").write_text(
+        'import importlib\nPLUGINS = "headsim.plugins"\n\n\ndef load(name):\n'
+        '    importlib.import_module(PLUGINS + "." + name)\n'
+    )
+    (package / "plugins" / "one.py").write_text("from headsim.run.look import load\n")
+    out = _check(tmp_path)
+    assert "circles: 2" in out, out
+    assert "headsim.run.hub <-> headsim.scenario.spec" in out, out
+    assert "headsim.plugins.one <-> headsim.run.look" in out, out
+    assert "headsim.scenario.spec -> headsim.run.hub" in out, out  # upward, under TYPE_CHECKING

@@ -26,7 +26,7 @@ from mkdocs.structure.files import File, Files
 from headsim import __version__
 from headsim.cli.parser import build_parser
 from headsim.errors import EXIT_MEANINGS
-from headsim.run.results_reference import EXPERIMENT_FIELDS, RESULTS_FIELDS
+from headsim.run.results_reference import RESULTS_FIELDS, experiment_fields
 from headsim.scenario.key_reference import accepted_keys
 from headsim.scenario.loading import load_scenario, scenario_files
 
@@ -42,7 +42,7 @@ def scenario_keys_page() -> str:
         "Every key the scenario loader accepts, made at build time by running the real "
         "readers over every shipped scenario (and variants that take their other branches): "
         "the type, what is allowed and the default are the readers' own, the meaning is "
-        "`headsim.scenario.key_reference.DESCRIPTIONS`. Lengths m, angles rad, pixels as "
+        "`headsim.scenario.key_reference.descriptions()` (the shared keys' and each procedure's own `keys`). Lengths m, angles rad, pixels as "
         "OpenCV's; `[]` stands for any entry of an array of tables. *required* means "
         "the file must give it where its table is read; a default that other keys set "
         "(a preset, the image size) says so. How to write a file: "
@@ -104,9 +104,9 @@ def results_json_page() -> str:
     out = [_RESULTS_INTRO, *_field_tables(RESULTS_FIELDS, "Top level")]
     out.append(
         "\n## `experiment` by procedure\n\nBeside `procedure`, each procedure's own keys "
-        "(its result's fields; `headsim.run.results_reference.EXPERIMENT_FIELDS`)."
+        "(its result's fields; the `results` its module declares in its `Procedure`)."
     )
-    for procedure, fields in EXPERIMENT_FIELDS.items():
+    for procedure, fields in experiment_fields().items():
         out.append(f"\n### `{procedure}`\n")
         if not fields:
             out.append("No keys beyond its measurements.")

@@ -2,10 +2,13 @@
 
     python tools/import_graph.py [REPO_ROOT]
 
-The layers, low to high, are LAYERS (a module's layer is its package under
-headsim/, or its own name for a top-level module). An import from a module to a
-higher layer is upward. Imports inside functions count; a TYPE_CHECKING block
-does not. Exit status 1 when there is a circle, an upward import or a module
+The layers, low to high, are LAYERS (a module's layer is the longest entry that
+its dotted path under headsim/ starts with: its package, or a module named there). An import from a module to a
+higher layer is upward. Every import counts: inside functions, in a
+TYPE_CHECKING block (a type a module names is a dependency), and a load by
+``importlib.import_module`` of a literal ``"headsim..."`` name or of a
+module-level constant holding one (``PACKAGE + "." + name``: every module of
+PACKAGE, the way a discovery loads them). Exit status 1 when there is a circle, an upward import or a module
 over MAX_LINES lines.
 """
 
@@ -27,6 +30,9 @@ LAYERS = (
     "stereo",
     "active",
     "live",
+    # The procedure contract: the interface the scenario reader and the runner call and the
+    # procedures implement, so below both (it names none of their types).
+    "procedures.contract",
     "scenario",
     "run",
     "procedures",
@@ -43,21 +49,46 @@ def module_name(root: Path, path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
+def _constants(tree: ast.AST) -> dict[str, str]:
+    """Module-level names bound to a string literal (``BUILT_IN = "headsim.x"``)."""
+    found: dict[str, str] = {}
+    for node in getattr(tree, "body", []):
+        value = node.value if isinstance(node, (ast.Assign, ast.AnnAssign)) else None
+        if isinstance(value, ast.Constant) and isinstance(value.value, str):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            found.update((t.id, value.value) for t in targets if isinstance(t, ast.Name))
+    return found
+
+
+def _loaded(call: ast.Call, constants: dict[str, str]) -> str | None:
+    """The module an ``importlib.import_module(...)`` call loads, where the source names it."""
+    func = call.func
+    name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")
+    if name != "import_module" or not call.args:
+        return None
+    arg = call.args[0]
+    if isinstance(arg, ast.BinOp) and isinstance(arg.op, ast.Add):
+        # PACKAGE + "." + name: a discovery that may load every module of PACKAGE.
+        while isinstance(arg, ast.BinOp):
+            arg = arg.left
+        prefix = _loaded(ast.Call(func=call.func, args=[arg], keywords=[]), constants)
+        return None if prefix is None else f"{prefix}.*"
+    if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
+        return arg.value
+    return constants.get(arg.id) if isinstance(arg, ast.Name) else None
+
+
 def imports(tree: ast.AST) -> list[str]:
-    """Every headsim module or name imported outside TYPE_CHECKING blocks."""
+    """Every headsim module or name imported, TYPE_CHECKING blocks and importlib loads included."""
     found: list[str] = []
-
-    def visit(node: ast.AST) -> None:
-        for child in ast.iter_child_nodes(node):
-            if isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test):
-                continue
-            if isinstance(child, ast.ImportFrom) and child.level == 0 and child.module:
-                found.extend(f"{child.module}.{alias.name}" for alias in child.names)
-            elif isinstance(child, ast.Import):
-                found.extend(alias.name for alias in child.names)
-            visit(child)
-
-    visit(tree)
+    constants = _constants(tree)
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            found.extend(f"{node.module}.{alias.name}" for alias in node.names)
+        elif isinstance(node, ast.Import):
+            found.extend(alias.name for alias in node.names)
+        elif isinstance(node, ast.Call) and (loaded := _loaded(node, constants)):
+            found.append(loaded)
     return [name for name in found if name.startswith("headsim")]
 
 
@@ -65,8 +96,12 @@ def graph(root: Path) -> tuple[dict[str, set[str]], dict[str, int]]:
     paths = {module_name(root, p): p for p in (root / "headsim").rglob("*.py")}
     edges: dict[str, set[str]] = {}
     for name, path in paths.items():
-        targets = set()
+        targets: set[str] = set()
         for imported in imports(ast.parse(path.read_text())):
+            if imported.endswith(".*"):
+                package = imported[:-1]
+                targets.update(m for m in paths if m.startswith(package) and m != name)
+                continue
             while imported not in paths and "." in imported:
                 imported = imported.rsplit(".", 1)[0]
             if imported in paths and imported != name:
@@ -113,8 +148,12 @@ def circles(edges: dict[str, set[str]]) -> list[list[str]]:
 
 
 def layer(name: str) -> int:
-    parts = name.split(".")
-    return LAYERS.index(parts[1]) if len(parts) > 1 and parts[1] in LAYERS else -1
+    """The index of the longest entry of LAYERS that ``name`` (after ``headsim.``) starts with."""
+    parts = name.split(".")[1:]
+    for end in range(len(parts), 0, -1):
+        if ".".join(parts[:end]) in LAYERS:
+            return LAYERS.index(".".join(parts[:end]))
+    return -1
 
 
 def main() -> int:

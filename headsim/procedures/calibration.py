@@ -11,12 +11,12 @@ import numpy as np
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import measure_model2
+from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.run.context import model2_config, servo_config, told
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import format_table, mm
-from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import CalibrationSpec, Scenario
@@ -96,6 +96,16 @@ def _fixations(scenario: Scenario) -> int:
     return 2 * len(scenario.scene.targets)  # each check target before and after
 
 
+#: What its results.json ``experiment`` keys mean (beside ``procedure``).
+RESULTS: dict[str, str] = {
+    "check_targets": "each check target, before and after the calibration",
+    "check_targets[].name": "the target",
+    "check_targets[].error_m_uncalibrated": "its 3-D error with what the head was told, m "
+    "(NaN: failed)",
+    "check_targets[].error_m_calibrated": "its 3-D error calibrated, m (NaN: failed)",
+}
+
+
 CALIBRATION = register(
     Procedure(
         "calibration",
@@ -106,6 +116,8 @@ CALIBRATION = register(
         options=read_options,
         read_scene=targets_reader("calibration", required=False),
         fixations=_fixations,
+        results=RESULTS,
+        rank=30,
     )
 )
 

@@ -13,6 +13,7 @@ from headsim.active.events import FixationStarted, MeasurementDone, PhaseStarted
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import Model2Config, measure_model2
+from headsim.procedures.contract import Procedure, register
 from headsim.run.context import (
     PAPER,
     model2_config,
@@ -23,8 +24,7 @@ from headsim.run.context import (
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import format_table, mm
-from headsim.scenario.registry import Procedure, register
-from headsim.scenario.scene import default_position, read_position, tuple3
+from headsim.scenario.scene import POSITION_KEYS, default_position, read_position, tuple3
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import (
     CHESSBOARD_PATTERN,
@@ -294,6 +294,38 @@ def _fixations(scenario: Scenario) -> int:
     return len(scenario.scene.corners or range(corner_count()))
 
 
+#: What its results.json ``experiment`` keys mean (beside ``procedure``).
+RESULTS: dict[str, str] = {
+    "pattern": "inner corners (columns, rows)",
+    "square_m": "the squares' side, m",
+    "corners": "inner corners",
+    "corners_measured": "corners measured",
+    "widths_m": "each square's measured width, m",
+    "heights_m": "each square's measured height, m",
+    "true_widths_m": "their true widths, m",
+    "true_heights_m": "their true heights, m",
+    "width_mean_m": "mean width, m",
+    "width_std_m": "its std, m",
+    "height_mean_m": "mean height, m",
+    "height_std_m": "its std, m",
+    "side_mean_m": "mean of all sides, m",
+    "side_std_m": "its std, m",
+    "paper": "Tables III/IV's square side",
+    "paper.side_mean_m": "the paper's mean side, m (0.0303)",
+    "paper.side_std_m": "the paper's std, m (0.000677)",
+}
+
+#: What the scenario keys only it reads mean.
+KEYS: dict[str, str] = {
+    "scene.chessboard": "The chessboard (procedure `chessboard`); it faces the head.",
+    "scene.chessboard.corners": 'Which inner corners are measured: `"all"` or an array of corner indices, row-major from the top-left.',
+    **{
+        f"scene.chessboard.{k}": "Top-left inner corner: " + v[0].lower() + v[1:]
+        for k, v in POSITION_KEYS.items()
+    },
+}
+
+
 CHESSBOARD = register(
     Procedure(
         "chessboard",
@@ -304,6 +336,9 @@ CHESSBOARD = register(
         options=read_options,
         read_scene=read_chessboard,
         fixations=_fixations,
+        results=RESULTS,
+        keys=KEYS,
+        rank=50,
     )
 )
 

@@ -8,12 +8,12 @@ from typing import Any
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
+from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.run.context import servo_config
 from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord, SurfaceDraw
+from headsim.run.outcomes import SURFACE_FIELDS, MeasurementRecord, SurfaceDraw
 from headsim.run.surface import measure_surface_targets
-from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
 from headsim.scenario.spec import CalibrationSpec, Scenario
@@ -85,6 +85,10 @@ MODEL1 = register(
         options=read_options,
         read_scene=targets_reader("model1", required=True),
         needs=frozenset({"neck_yaw"}),
+        results=SURFACE_FIELDS,
+        markerless=True,
+        reach="model1",
+        rank=20,
     )
 )
 

@@ -8,12 +8,12 @@ from typing import Any
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model2 import measure_model2
+from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.run.context import model2_config, servo_config
 from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord, SurfaceDraw
+from headsim.run.outcomes import SURFACE_FIELDS, MeasurementRecord, SurfaceDraw
 from headsim.run.surface import measure_surface_targets
-from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import CalibrationSpec, Scenario
@@ -81,6 +81,9 @@ MODEL2 = register(
         failures=Model2Result.failures,
         options=read_options,
         read_scene=targets_reader("model2", required=True),
+        results=SURFACE_FIELDS,
+        markerless=True,
+        rank=10,
     )
 )
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -34,19 +34,22 @@ from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import Detector, ServoConfig
 from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
+from headsim.procedures.contract import Procedure, register
 from headsim.run.context import PARKED_WORLD_M
 from headsim.run.landing import landing, vergence_error_deg
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.surface import row_band_for
 from headsim.run.targets import marker_target
 from headsim.scenario.pursuit import PursuitSpec, describe
-from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import read_pursuit_scene
 from headsim.scenario.spec import MARKER_BODIES, STREAM_CLICKS, Scenario
 from headsim.scenario.surface_targets import Click, camera_centre, cast, click
 from headsim.sim.events import EventSink
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import MatchConfig
+
+if TYPE_CHECKING:
+    from headsim.run.recording import Recorder
 
 
 @dataclass(frozen=True)
@@ -318,6 +321,93 @@ def _fixations(scenario: Scenario) -> int:
     return math.ceil(pursuit.duration_s * pursuit.live.frame_rate_hz)  # one per camera frame
 
 
+def log_path(result: PursuitResult, log: Recorder) -> None:
+    """The target's path where it is visible, drawn once (static) in the recording."""
+    import rerun as rr  # only when recording: Rerun costs a third of a second to import
+
+    from headsim.run.recording_layout import GREY
+
+    spec = log.scenario.scene.pursuit
+    if spec is None:
+        return
+    times = spec.sample_times(0.02)
+    path = [spec.path.position(float(t)) for t in times if spec.visibility.visible(float(t))]
+    if len(path) > 1:
+        log.rec.log(
+            "/world/pursuit/path",
+            rr.LineStrips3D([np.array(path)], colors=[GREY], labels=["path"]),
+            static=True,
+        )
+
+
+#: What its results.json ``experiment`` keys mean (beside ``procedure``).
+RESULTS: dict[str, str] = {
+    "pursuit": "the pursuit spec as run (`path_kind`, `duration_s`, `frame_rate_hz`, "
+    "`latency_frames`, `exposure_s`, `blur_subframes`, `mode`, `predictor`, `saccade`, ...)",
+    "frames": "frames run",
+    "frames_present": "frames on which the target was present",
+    "frames_lost": "frames the target was lost",
+    "losses": "times it was lost",
+    "reacquisitions": "times it was found again",
+    "saccades": "saccades made",
+    "time_to_fixation_s": "time to the first fixation, s",
+    "lag_s": "the gaze's lag behind the target, s",
+    "offset_rms_px": "RMS image offset from the goal, px",
+    "position_rms_m": "RMS position error in W along the path, m",
+    "position_rms_pct_of_depth": "the same, % of depth",
+    "position_max_m": "largest position error, m",
+    "ended": "why the loop ended",
+    "vergence_error_median_deg": "median vergence error over the frames that found the "
+    "target (eye 2's goal ray against where eye 1's truly landed), deg",
+    "vergence_error_rms_deg": "the same, RMS, deg",
+    "per_frame": "each frame: `time_s`, `found`, `offsets_px`, `encoders_rad`, "
+    "`estimate_world_m`, `truth_world_m`, `error_m`, `vergence_error_deg`",
+}
+
+_PURSUIT = "scene.pursuit"
+#: What the scenario keys only it reads mean.
+KEYS: dict[str, str] = {
+    _PURSUIT: "The live head pursuing a moving marker (procedure `pursuit`).",
+    f"{_PURSUIT}.name": "The pursued target's name.",
+    f"{_PURSUIT}.body": "What moves: a marker body, or a `[[scene.room.objects]]` name (clicked once, then tracked without markers).",
+    f"{_PURSUIT}.duration_s": "Length of the pursuit, s.",
+    f"{_PURSUIT}.click_error_px": "A room object's pursuit: the user's click in camera 1's first image, error per axis, px.",
+    f"{_PURSUIT}.band_px": "A room object's pursuit: half-height of the band along camera 1's row in which camera 2 searches, px.",
+    f"{_PURSUIT}.path": "How the target moves.",
+    f"{_PURSUIT}.path.kind": "The kind of path; each kind takes its own keys below.",
+    f"{_PURSUIT}.path.points_world_m": "`waypoints`: the points [[x, y, z], ...] in W, m.",
+    f"{_PURSUIT}.path.speeds_m_s": "`waypoints`: the speed along each leg, m/s.",
+    f"{_PURSUIT}.path.centre_world_m": "`sinusoid`: the centre in W, m.",
+    f"{_PURSUIT}.path.amplitude_m": "`sinusoid`: the amplitude along x, y, z of W, m.",
+    f"{_PURSUIT}.path.frequency_hz": "`sinusoid`: the frequency, Hz.",
+    f"{_PURSUIT}.path.phase_rad": "`sinusoid`: the phase along x, y, z, rad.",
+    f"{_PURSUIT}.path.start_world_m": "`random_walk`, `throw`, `jump`: the start in W, m.",
+    f"{_PURSUIT}.path.max_speed_m_s": "`random_walk`: the largest speed, m/s.",
+    f"{_PURSUIT}.path.box_half_m": "`random_walk`: half the box it stays in, along x, y, z, m.",
+    f"{_PURSUIT}.path.seed": "`random_walk`: the walk's seed; default the scenario's `seed`.",
+    f"{_PURSUIT}.path.end_world_m": "`jump`: where the target is from `time_s` on, in W, m.",
+    f"{_PURSUIT}.path.time_s": "`jump`: when the target jumps from the start to the end, s.",
+    f"{_PURSUIT}.path.velocity_m_s": "`throw`: the initial velocity in W, m/s (then gravity).",
+    f"{_PURSUIT}.path.point_world_m": "`static`: the point in W, m.",
+    f"{_PURSUIT}.path.windows_s": "When the target is visible: [[appear_s, disappear_s], ...]; default always.",
+    f"{_PURSUIT}.live": "The live head's camera and motors.",
+    f"{_PURSUIT}.live.frame_rate_hz": "Camera frame rate, Hz.",
+    f"{_PURSUIT}.live.exposure_s": "Exposure time, s (> 0 with `blur_subframes` > 1: motion blur).",
+    f"{_PURSUIT}.live.blur_subframes": "Renders averaged per frame for motion blur.",
+    f"{_PURSUIT}.live.latency_frames": "Frames between an image and the command it causes.",
+    f"{_PURSUIT}.live.eye_max_speed": "Eye motor's speed limit, rad/s.",
+    f"{_PURSUIT}.live.eye_max_accel": "Eye motor's acceleration limit, rad/s^2.",
+    f"{_PURSUIT}.live.neck_max_speed": "Neck motors' speed limit, rad/s.",
+    f"{_PURSUIT}.live.neck_max_accel": "Neck motors' acceleration limit, rad/s^2.",
+    f"{_PURSUIT}.gaze": "The gaze behaviour.",
+    f"{_PURSUIT}.gaze.mode": "Model 1 with the neck, or the eyes alone.",
+    f"{_PURSUIT}.gaze.predictor": "A constant-velocity predictor against the latency.",
+    f"{_PURSUIT}.gaze.saccade": "Saccade profile: minimum jerk or bang-bang.",
+    f"{_PURSUIT}.gaze.saccade_threshold_rad": "A fixation correction larger than this starts a saccade, rad.",
+    f"{_PURSUIT}.gaze.fixation_tolerance_px": "Image error within which the target counts as fixated, px.",
+}
+
+
 PURSUIT = register(
     Procedure(
         "pursuit",
@@ -327,8 +417,12 @@ PURSUIT = register(
         summary=PursuitResult.summary_lines,
         ok_line=PursuitResult.ok_line,
         failures=PursuitResult.failure_lines,
+        rows=log_path,
         read_scene=read_pursuit_scene,
         fixations=_fixations,
+        results=RESULTS,
+        keys=KEYS,
+        rank=70,
     )
 )
 

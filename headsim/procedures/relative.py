@@ -20,6 +20,7 @@ from headsim.estimators.areas import (
     areas_from_pixels,
     compare_areas,
 )
+from headsim.procedures.contract import Procedure, register
 from headsim.run.context import (
     PAPER,
     PARKED_WORLD_M,
@@ -30,8 +31,9 @@ from headsim.run.context import (
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import cell, format_table
-from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import (
+    POSITION_KEYS,
+    RANDOM_BOX_KEYS,
     default_position,
     random_points_head,
     read_position,
@@ -436,6 +438,50 @@ def read_blocks(table: Table, ctx: Context, settings: HeadSettings, seed: int) -
     )
 
 
+#: What its results.json ``experiment`` keys mean (beside ``procedure``).
+RESULTS: dict[str, str] = {
+    "alpha1_rad": "the first fixation's encoder reading, rad",
+    "alpha2_rad": "the second fixation's encoder reading, rad",
+    "objects": "each object",
+    "objects[].name": "its body",
+    "objects[].colour": "its colour",
+    "objects[].area": "its measured area S1..S12 (0: none)",
+    "objects[].true_area": "its true area",
+    "objects[].agree": "whether they agree",
+    "objects[].margin_px": "the area test's margin for it, px (NaN: not compared)",
+    "objects[].gain_area": "its area by the gain-normalised test",
+    "objects[].gain_agree": "whether that agrees with the truth",
+    "objects[].columns_px": "u11, u12, u21, u22, px",
+    "objects[].position_head_m": "its true position in H, m",
+    "missing": "objects not seen in all four images",
+    "agree": "objects whose area agrees",
+    "disagree_outside_margin": "disagreements outside the margin (`null`: no threshold)",
+    "gain_agree": "agreements by the gain-normalised test",
+    "gain_disagree_outside_margin": "its disagreements outside the margin",
+    "margin_threshold_px": "the margin, px (`null`: none)",
+    "renders": "renders of both fixations",
+    "paper": "Sec. VI-C's `alpha1_rad`, `alpha2_rad` and `objects`",
+    "paper.alpha1_rad": "the paper's first fixation angle, rad",
+    "paper.alpha2_rad": "the paper's second fixation angle, rad",
+    "paper.objects": "the paper's number of objects",
+}
+
+#: What the scenario keys only it reads mean.
+KEYS: dict[str, str] = {
+    "scene.blocks": "The blocks' cross point (procedure `relative_positioning`).",
+    **{
+        f"scene.blocks.{k}": "Cross point: " + v[0].lower() + v[1:]
+        for k, v in POSITION_KEYS.items()
+    },
+    "scene.objects": "Objects measured relative to the cross point, each seen by both cameras at the start pose or in all four images at the cross point's fixations; those not listed are parked out of view.",
+    "scene.objects[].body": "The object body (`object_1`..`object_6`).",
+    **{f"scene.objects[].{k}": v for k, v in POSITION_KEYS.items()},
+    "scene.random_objects": "Objects at random positions instead of `[[scene.objects]]`, drawn from the seed.",
+    "scene.random_objects.count": "Number of objects placed.",
+    **{f"scene.random_objects.{k}": v for k, v in RANDOM_BOX_KEYS.items()},
+}
+
+
 RELATIVE_POSITIONING = register(
     Procedure(
         "relative_positioning",
@@ -447,6 +493,9 @@ RELATIVE_POSITIONING = register(
         rows=RelativeResult.log_rows,
         read_scene=read_blocks,
         fixations=lambda scenario: 1,  # the cross point's
+        results=RESULTS,
+        keys=KEYS,
+        rank=60,
     )
 )
 

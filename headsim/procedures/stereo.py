@@ -51,11 +51,11 @@ from headsim.active.events import PhaseStarted
 from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge
 from headsim.geometry.transforms import frame_deviation
+from headsim.procedures.contract import Procedure, register
 from headsim.run.context import simulator
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import cell, format_table, mm
-from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.spec import WHEN_GIVEN, CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
@@ -622,6 +622,45 @@ def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str,
     return {"block": StereoSpec(views, (low, high), tilt, refine, board_seed, board_look)}
 
 
+#: What its results.json ``experiment`` keys mean (beside ``procedure``).
+RESULTS: dict[str, str] = {
+    "poses": "board poses rendered",
+    "views": "board views kept (the whole board found in both images)",
+    "renders": "renders of the board views",
+    "corner_rms_px": "detected corners against their true projections, RMS, px",
+    "corner_max_px": "the same, largest, px",
+    "cameras": "each camera's parameters (`fx`, `fy`, `cx`, `cy`, `k1`, `k2`): `truth`, `mono` (calibrateCamera) and `stereo` (stereoCalibrate)",
+    "stereo_rms_px": "stereoCalibrate's reprojection RMS, px",
+    "baseline_m": "the calibrated baseline, |t|, m",
+    "true_baseline_m": "the true baseline, m",
+    "t_m": "camera 2 from camera 1: the calibrated translation, m",
+    "true_t_m": "the true translation, m",
+    "r": "the calibrated rotation (3 x 3)",
+    "true_r": "the true rotation (3 x 3)",
+    "rotation_error_rad": "angle between the calibrated and the true rotation, rad",
+    "max_rms_px": "the larger camera's reprojection RMS, px (acceptance: <= 0.2)",
+    "max_abs_focal_error_pct": "the largest focal-length error against the truth, % (acceptance: <= 0.5)",
+    "passed": "both acceptance figures met",
+    "head_frames": "each way of placing camera 1 in H (`label`, `rotation_error_rad`, `translation_error_m`, `max_error_m`, `max_error_pct_depth`, `mean_error_pct_depth`)",
+    "targets": "each target (`name`, `status`, `truth_head_m`, `estimate_head_m`, `estimate_world_m`, `uv1_px`, `uv2_px`), m, px",
+    "reason": "why the pair was not calibrated (only then, beside `poses`)",
+}
+
+#: What the scenario keys only it reads mean.
+KEYS: dict[str, str] = {
+    "experiment.stereo": "The calibrated stereo baseline (procedure `stereo`): Zhang's calibration from chessboard views, then each target triangulated at eye angle 0.",
+    "experiment.stereo.views": "Chessboard poses rendered for the calibration (at least 5 must show the whole board).",
+    "experiment.stereo.distance_m": "The board centre's distance from camera 1, [low, high], m.",
+    "experiment.stereo.max_tilt_rad": "The board's largest tilt about its x and y axes, rad.",
+    "experiment.stereo.refine_intrinsics": "stereoCalibrate refines each camera's K, k1, k2 (false: keeps each camera's own calibration).",
+    "experiment.stereo.board_seed": "The board poses' seed (default: the scenario's seed), so that a study can calibrate with the poses it drew before.",
+    "experiment.stereo.board_look": "How each camera finds the board: `full_frame`, or `windowed` (a binned preview, then a window on the board: the same corners).",
+    "experiment.stereo.from": "A stored stereo calibration file (`headsim.stereo.calibration_file`) to triangulate with instead of calibrating (no board keys then).",
+    "experiment.stereo.look": "With `from`: each camera's look for a target, the full frame or `once` (a binned preview, then a window where it shows the target).",
+    "experiment.stereo.pattern": "The board's inner corners, [columns, rows]: the chessboard scene's board, [8, 6].",
+}
+
+
 STEREO = register(
     Procedure(
         "stereo",
@@ -636,6 +675,9 @@ STEREO = register(
         rows=lambda result, log: result.log_rows(log),
         options=read_options,
         read_scene=targets_reader("stereo", required=False),
+        results=RESULTS,
+        keys=KEYS,
+        rank=80,
     )
 )
 

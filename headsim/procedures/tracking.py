@@ -12,6 +12,7 @@ from headsim.active.events import FixationStarted, MeasurementDone, PhaseStarted
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
+from headsim.procedures.contract import Procedure, register
 from headsim.run.context import (
     record_measurement,
     servo_config,
@@ -21,8 +22,8 @@ from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import cell, mm
 from headsim.run.targets import marker_target
-from headsim.scenario.registry import Procedure, register
 from headsim.scenario.scene import (
+    RANDOM_BOX_KEYS,
     finite_number,
     random_points_head,
     start_head_to_world,
@@ -210,6 +211,30 @@ def _fixations(scenario: Scenario) -> int:
     return scenario.scene.moving.steps if scenario.scene.moving else 0
 
 
+#: What its results.json ``experiment`` keys mean (beside ``procedure``).
+RESULTS: dict[str, str] = {
+    "times_s": "each fixation's time, s",
+    "waypoints_world_m": "the path's waypoints in W, m",
+    "errors_world_m": "each fixation's error in W, m",
+    "renders_first": "renders of the first fixation",
+    "renders_after_mean": "mean renders per fixation after it",
+}
+
+#: What the scenario keys only it reads mean.
+KEYS: dict[str, str] = {
+    "scene.moving_target": "The marker moved along waypoints (procedure `tracking`).",
+    "scene.moving_target.name": "The moving target's name.",
+    "scene.moving_target.body": "The marker body that moves.",
+    "scene.moving_target.duration_s": "Time to pass all waypoints, s.",
+    "scene.moving_target.steps": "Fixations, at equal intervals from t = 0. Required.",
+    "scene.moving_target.waypoints_head_m": "Waypoints [[x, y, z], ...] in H at the start pose, at least 2, passed at equal times, m.",
+    "scene.moving_target.waypoints_world_m": "Waypoints [[x, y, z], ...] in W, at least 2, m.",
+    "scene.moving_target.random": "Random waypoints drawn from the seed instead.",
+    "scene.moving_target.random.waypoints": "Number of random waypoints.",
+    **{f"scene.moving_target.random.{k}": v for k, v in RANDOM_BOX_KEYS.items()},
+}
+
+
 TRACKING = register(
     Procedure(
         "tracking",
@@ -220,6 +245,9 @@ TRACKING = register(
         options=read_options,
         read_scene=read_moving_scene,
         fixations=_fixations,
+        results=RESULTS,
+        keys=KEYS,
+        rank=40,
     )
 )
 

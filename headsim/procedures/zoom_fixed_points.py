@@ -20,11 +20,11 @@ from headsim.active.principal import (
     principal_points_by_zoom,
     zoomed,
 )
+from headsim.procedures.contract import Procedure, register
 from headsim.run.context import simulator
 from headsim.run.events import Hub
 from headsim.run.outcomes import MeasurementRecord
 from headsim.run.table import format_table
-from headsim.scenario.registry import Procedure, register
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
 from headsim.sim import names
@@ -155,6 +155,30 @@ def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str,
     return {"block": ZoomSpec(zoom, poses, board_seed)}
 
 
+#: What its results.json ``experiment`` keys mean (beside ``procedure``).
+RESULTS: dict[str, str] = {
+    "zoom": "the focal length ratio of the second images",
+    "views": "board poses whose corners were found at both focal lengths",
+    "renders": "renders of the board at both focal lengths",
+    "fixed_point_px": "each camera's fixed point (u, v), px",
+    "truth_px": "each camera's principal point (cx, cy), px",
+    "error_px": "each camera's fixed point minus its principal point, px",
+    "std_px": "each camera's standard errors of (u, v), px",
+    "scale": "each camera's fitted scale f' / f",
+    "residual_rms_px": "each camera's RMS distance of the zoomed corners from the fit, px",
+    "points": "each camera's matched corners",
+    "reason": "why the fixed points were not found (only then)",
+}
+
+#: What the scenario keys only it reads mean.
+KEYS: dict[str, str] = {
+    "experiment.zoom_fixed_points": "Each camera's principal point as the fixed point of a zoom (procedure `zoom_fixed_points`): chessboard images at the head's focal lengths and at `zoom` times them; only pixels enter the fit.",
+    "experiment.zoom_fixed_points.zoom": "The focal length ratio of the second images.",
+    "experiment.zoom_fixed_points.poses": "Chessboard poses rendered at both focal lengths.",
+    "experiment.zoom_fixed_points.board_seed": "The seed of the board poses' draws (absent: the scenario's seed).",
+}
+
+
 ZOOM_FIXED_POINTS = register(
     Procedure(
         "zoom_fixed_points",
@@ -167,6 +191,9 @@ ZOOM_FIXED_POINTS = register(
         rows=lambda result, log: result.log_rows(log),
         options=read_options,
         fixations=lambda scenario: 0,
+        results=RESULTS,
+        keys=KEYS,
+        rank=90,
     )
 )
 

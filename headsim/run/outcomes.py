@@ -184,6 +184,43 @@ def by_texture(
     return tuple(out)
 
 
+#: What :meth:`SurfaceDraw.block`'s keys mean, under ``experiment`` (the markerless
+#: targets of Model 2, Model 1 and the one-step fixation).
+SURFACE_FIELDS: dict[str, str] = {
+    "surface_targets": "how the markerless targets were drawn and how they landed",
+    "surface_targets.asked": "targets asked for (`[scene.room] targets`)",
+    "surface_targets.listed": "of them, those listed (`[[scene.room.targets]]`), measured first",
+    "surface_targets.measured_as": "`surface` (by correlation) or `markers` (a marker put at "
+    "each point: the marker twin, `[scene.room] targets_as`)",
+    "surface_targets.drawn": "draws made, refused ones included",
+    "surface_targets.refused": "draws refused and drawn again, by cause (`no_surface`, `depth`, "
+    "`occluded`, `start_view`, `reach`)",
+    "surface_targets.false_fixation_limit": "the rule of a false fixation",
+    "surface_targets.targets": "each target: `name`, the `body` it lies on, `point_world_m`, "
+    "its `texture_class` (`rich`, `low`, `repetitive`, `occluded`: from truth at placement)",
+    "surface_targets.false_fixations": "measurements ok with an eye landed off the target",
+    "surface_targets.wrong_matches": "targets whose camera 2 made a confident match on the "
+    "wrong point (`wrong_match`)",
+    "surface_targets.wrong_matches_failed": "of those, the ones whose measurement then failed "
+    "(not false fixations: counted here, not hidden)",
+    "surface_targets.vergence_error_deg_median": "median vergence error of the fixations, degrees",
+    "surface_targets.vergence_error_deg_rms": "their RMS, degrees",
+    "surface_targets.by_texture": "per texture class (`rich`: pink noise, `low`, `repetitive`: "
+    "gratings, stripes, checks; `occluded`: part of either camera's template window hidden "
+    "from the other at the start pose), always all four",
+    "surface_targets.by_texture[].texture_class": "the class",
+    "surface_targets.by_texture[].asked": "targets placed in it, the failed ones included",
+    "surface_targets.by_texture[].measured": "those measured (ok)",
+    "surface_targets.by_texture[].error_pct_of_depth_rms": "their 3-D error RMS, % of depth",
+    "surface_targets.by_texture[].vergence_error_deg_median": "median vergence error, degrees",
+    "surface_targets.by_texture[].vergence_error_deg_rms": "its RMS, degrees",
+    "surface_targets.by_texture[].false_fixations": "measurements ok with an eye landed off",
+    "surface_targets.by_texture[].wrong_matches": "confident matches on the wrong point",
+    "surface_targets.by_texture[].failure_causes": "failures by cause",
+    "surface_targets.by_texture[].renders_per_point": "renders per target asked",
+}
+
+
 @dataclass(frozen=True)
 class SurfaceDraw:
     """How the markerless targets were drawn: ``asked`` targets, ``drawn`` draws in all,
@@ -388,6 +425,7 @@ class RunOutcome:
 __all__ = [
     "FALSE_FIXATION_FRACTION",
     "FALSE_FIXATION_MIN_M",
+    "SURFACE_FIELDS",
     "FixationScore",
     "FixationStats",
     "MeasurementRecord",

@@ -16,8 +16,8 @@ and timelines (docs/how-to/record.md lists them):
   ``/world/truth``, ``/world/estimate``, ``/world/error``,
   ``/world/current_target``, ``/world/calibration/positions``,
   ``/world/moving_target/path``, ``/world/areas/lines``, ``/world/areas/objects``;
-  the pursuit procedure adds ``/world/pursuit/path`` (the target's path) and
-  ``/world/pursuit/estimates`` (every frame's estimate so far), and logs
+  the live head's frames (:meth:`Recorder.pursued`) add
+  ``/world/pursuit/estimates`` (every frame's estimate so far), and log
   ``/world/truth``, ``/world/estimate``, ``/world/error``, the servo offsets
   and ``/measurements/error_mm``, ``.../error_pct_of_depth`` once per frame;
 - ``/servo/cam1/u_error_px``, ``/servo/cam2/u_error_px``, ``.../v_error_px``;
@@ -62,6 +62,7 @@ from headsim.active.calibration_report import CalibrationReport
 from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
 from headsim.errors import interrupted
+from headsim.procedures.contract import get
 from headsim.run import mjcf_rerun
 from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
 from headsim.run.outcomes import MeasurementRecord, RunOutcome
@@ -91,7 +92,6 @@ from headsim.run.rerun_cli import (
     viewer_stream_opened,
 )
 from headsim.run.summary import summary_text
-from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.events import ImageKind, ImageTaken
@@ -181,7 +181,7 @@ class Recorder:
         self.world_from_head_start = np.eye(4)
         self.objects: dict[str, str] = {}
         self.closed = False
-        self._pursuit_trail: list[np.ndarray] = []
+        self._frame_estimates: list[np.ndarray] = []
         self.sim: HeadSim | None = None  # the current phase's simulator
         #: Each camera's last whole image in the phase, the backdrop of the windows after it.
         self._last_full: dict[int, np.ndarray] = {}
@@ -270,10 +270,9 @@ class Recorder:
         self.world_from_head_start = sim.world_from_head()
         self._time()
         self._scene(sim)
-        procedure = self.scenario.experiment.procedure
         self.objects = (
             {o.body: names.RELATIVE_OBJECT_COLOURS[o.body] for o in self.scenario.scene.objects}
-            if name == "measurement" and procedure == "relative_positioning"
+            if name == "measurement"
             else {}
         )
         self._time()
@@ -442,18 +441,6 @@ class Recorder:
         """A live pursuit frame: truth, estimate and error on the frame timeline."""
         self.current_frame = frame
         self._time()
-        spec = self.scenario.scene.pursuit
-        if not self._pursuit_trail and spec is not None:
-            times = spec.sample_times(0.02)
-            path = [
-                spec.path.position(float(t)) for t in times if spec.visibility.visible(float(t))
-            ]
-            if len(path) > 1:
-                self.rec.log(
-                    "/world/pursuit/path",
-                    rr.LineStrips3D([np.array(path)], colors=[GREY], labels=["path"]),
-                    static=True,
-                )
         truth, estimate = record.truth_world_m, record.estimate_world_m
         if truth is not None:
             self.rec.log("/world/truth", rr.Points3D([truth], radii=0.003, colors=[WHITE]))
@@ -476,11 +463,11 @@ class Recorder:
             self.rec.log("/world/estimate", rr.Clear(recursive=False))
             self.rec.log("/world/error", rr.Clear(recursive=False))
             return
-        self._pursuit_trail.append(np.asarray(estimate, float))
+        self._frame_estimates.append(np.asarray(estimate, float))
         self.rec.log("/world/estimate", rr.Points3D([estimate], radii=0.004, colors=[GREEN]))
         self.rec.log(
             "/world/pursuit/estimates",
-            rr.Points3D(np.array(self._pursuit_trail), radii=0.0015, colors=[GREEN]),
+            rr.Points3D(np.array(self._frame_estimates), radii=0.0015, colors=[GREEN]),
         )
         if truth is not None:
             error = float(np.linalg.norm(estimate - truth))

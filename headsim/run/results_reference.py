@@ -4,16 +4,20 @@
 table, ``a[].b`` a key of each entry of a list, ``a.*`` each key of a table
 whose keys are data (a knowledge, a phase).  A path listed without any of its
 children is described as a whole (its keys are not listed one by one).
-:data:`EXPERIMENT_FIELDS` gives each procedure's ``experiment`` keys the same
-way, relative to ``experiment``.  :func:`undocumented` and
-:func:`documented_paths` compare a real results.json with both; the
-documentation hook (``tools/docs_pages.py``) writes the page from them.
+:func:`experiment_fields` gives each procedure's ``experiment`` keys the same
+way, relative to ``experiment``, from its declaration (``Procedure.results``).
+:func:`undocumented` and :func:`documented_paths` compare a real results.json
+with both; the documentation hook (``tools/docs_pages.py``) writes the page
+from them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from typing import Any
+
+from headsim.procedures.contract import procedures
+from headsim.run.outcomes import SURFACE_FIELDS
 
 _COUNTS = "full frames, windows, retakes and previews"
 
@@ -227,171 +231,17 @@ RESULTS_FIELDS: dict[str, str] = {
     "experiment.procedure": "the procedure's name",
 }
 
-_NONE: dict[str, str] = {}
-
-#: Each procedure's ``experiment`` keys beside ``procedure``, relative to ``experiment``.
 #: ``experiment`` keys a procedure writes only when it failed.
 FAILED_ONLY = frozenset({"reason"})
 
-#: Model 2's and Model 1's keys with markerless targets (none with markers).
-_SURFACE: dict[str, str] = {
-    "surface_targets": "how the markerless targets were drawn and how they landed",
-    "surface_targets.asked": "targets asked for (`[scene.room] targets`)",
-    "surface_targets.listed": "of them, those listed (`[[scene.room.targets]]`), measured first",
-    "surface_targets.measured_as": "`surface` (by correlation) or `markers` (a marker put at "
-    "each point: the marker twin, `[scene.room] targets_as`)",
-    "surface_targets.drawn": "draws made, refused ones included",
-    "surface_targets.refused": "draws refused and drawn again, by cause (`no_surface`, `depth`, "
-    "`occluded`, `start_view`, `reach`)",
-    "surface_targets.false_fixation_limit": "the rule of a false fixation",
-    "surface_targets.targets": "each target: `name`, the `body` it lies on, `point_world_m`, "
-    "its `texture_class` (`rich`, `low`, `repetitive`, `occluded`: from truth at placement)",
-    "surface_targets.false_fixations": "measurements ok with an eye landed off the target",
-    "surface_targets.wrong_matches": "targets whose camera 2 made a confident match on the "
-    "wrong point (`wrong_match`)",
-    "surface_targets.wrong_matches_failed": "of those, the ones whose measurement then failed "
-    "(not false fixations: counted here, not hidden)",
-    "surface_targets.vergence_error_deg_median": "median vergence error of the fixations, degrees",
-    "surface_targets.vergence_error_deg_rms": "their RMS, degrees",
-    "surface_targets.by_texture": "per texture class (`rich`: pink noise, `low`, `repetitive`: "
-    "gratings, stripes, checks; `occluded`: part of either camera's template window hidden "
-    "from the other at the start pose), always all four",
-    "surface_targets.by_texture[].texture_class": "the class",
-    "surface_targets.by_texture[].asked": "targets placed in it, the failed ones included",
-    "surface_targets.by_texture[].measured": "those measured (ok)",
-    "surface_targets.by_texture[].error_pct_of_depth_rms": "their 3-D error RMS, % of depth",
-    "surface_targets.by_texture[].vergence_error_deg_median": "median vergence error, degrees",
-    "surface_targets.by_texture[].vergence_error_deg_rms": "its RMS, degrees",
-    "surface_targets.by_texture[].false_fixations": "measurements ok with an eye landed off",
-    "surface_targets.by_texture[].wrong_matches": "confident matches on the wrong point",
-    "surface_targets.by_texture[].failure_causes": "failures by cause",
-    "surface_targets.by_texture[].renders_per_point": "renders per target asked",
-}
-
 #: ``experiment`` keys written only with markerless targets (``[scene.room] targets``).
-MARKERLESS_ONLY = frozenset(_SURFACE)
+MARKERLESS_ONLY = frozenset(SURFACE_FIELDS)
 
-EXPERIMENT_FIELDS: dict[str, dict[str, str]] = {
-    "model2": _SURFACE,
-    "model1": _SURFACE,
-    "fixation": _SURFACE,
-    "calibration": {
-        "check_targets": "each check target, before and after the calibration",
-        "check_targets[].name": "the target",
-        "check_targets[].error_m_uncalibrated": "its 3-D error with what the head was told, m "
-        "(NaN: failed)",
-        "check_targets[].error_m_calibrated": "its 3-D error calibrated, m (NaN: failed)",
-    },
-    "chessboard": {
-        "pattern": "inner corners (columns, rows)",
-        "square_m": "the squares' side, m",
-        "corners": "inner corners",
-        "corners_measured": "corners measured",
-        "widths_m": "each square's measured width, m",
-        "heights_m": "each square's measured height, m",
-        "true_widths_m": "their true widths, m",
-        "true_heights_m": "their true heights, m",
-        "width_mean_m": "mean width, m",
-        "width_std_m": "its std, m",
-        "height_mean_m": "mean height, m",
-        "height_std_m": "its std, m",
-        "side_mean_m": "mean of all sides, m",
-        "side_std_m": "its std, m",
-        "paper": "Tables III/IV's square side",
-        "paper.side_mean_m": "the paper's mean side, m (0.0303)",
-        "paper.side_std_m": "the paper's std, m (0.000677)",
-    },
-    "relative_positioning": {
-        "alpha1_rad": "the first fixation's encoder reading, rad",
-        "alpha2_rad": "the second fixation's encoder reading, rad",
-        "objects": "each object",
-        "objects[].name": "its body",
-        "objects[].colour": "its colour",
-        "objects[].area": "its measured area S1..S12 (0: none)",
-        "objects[].true_area": "its true area",
-        "objects[].agree": "whether they agree",
-        "objects[].margin_px": "the area test's margin for it, px (NaN: not compared)",
-        "objects[].gain_area": "its area by the gain-normalised test",
-        "objects[].gain_agree": "whether that agrees with the truth",
-        "objects[].columns_px": "u11, u12, u21, u22, px",
-        "objects[].position_head_m": "its true position in H, m",
-        "missing": "objects not seen in all four images",
-        "agree": "objects whose area agrees",
-        "disagree_outside_margin": "disagreements outside the margin (`null`: no threshold)",
-        "gain_agree": "agreements by the gain-normalised test",
-        "gain_disagree_outside_margin": "its disagreements outside the margin",
-        "margin_threshold_px": "the margin, px (`null`: none)",
-        "renders": "renders of both fixations",
-        "paper": "Sec. VI-C's `alpha1_rad`, `alpha2_rad` and `objects`",
-        "paper.alpha1_rad": "the paper's first fixation angle, rad",
-        "paper.alpha2_rad": "the paper's second fixation angle, rad",
-        "paper.objects": "the paper's number of objects",
-    },
-    "stereo": {
-        "poses": "board poses rendered",
-        "views": "board views kept (the whole board found in both images)",
-        "renders": "renders of the board views",
-        "corner_rms_px": "detected corners against their true projections, RMS, px",
-        "corner_max_px": "the same, largest, px",
-        "cameras": "each camera's parameters (`fx`, `fy`, `cx`, `cy`, `k1`, `k2`): `truth`, `mono` (calibrateCamera) and `stereo` (stereoCalibrate)",
-        "stereo_rms_px": "stereoCalibrate's reprojection RMS, px",
-        "baseline_m": "the calibrated baseline, |t|, m",
-        "true_baseline_m": "the true baseline, m",
-        "t_m": "camera 2 from camera 1: the calibrated translation, m",
-        "true_t_m": "the true translation, m",
-        "r": "the calibrated rotation (3 x 3)",
-        "true_r": "the true rotation (3 x 3)",
-        "rotation_error_rad": "angle between the calibrated and the true rotation, rad",
-        "max_rms_px": "the larger camera's reprojection RMS, px (acceptance: <= 0.2)",
-        "max_abs_focal_error_pct": "the largest focal-length error against the truth, % (acceptance: <= 0.5)",
-        "passed": "both acceptance figures met",
-        "head_frames": "each way of placing camera 1 in H (`label`, `rotation_error_rad`, `translation_error_m`, `max_error_m`, `max_error_pct_depth`, `mean_error_pct_depth`)",
-        "targets": "each target (`name`, `status`, `truth_head_m`, `estimate_head_m`, `estimate_world_m`, `uv1_px`, `uv2_px`), m, px",
-        "reason": "why the pair was not calibrated (only then, beside `poses`)",
-    },
-    "zoom_fixed_points": {
-        "zoom": "the focal length ratio of the second images",
-        "views": "board poses whose corners were found at both focal lengths",
-        "renders": "renders of the board at both focal lengths",
-        "fixed_point_px": "each camera's fixed point (u, v), px",
-        "truth_px": "each camera's principal point (cx, cy), px",
-        "error_px": "each camera's fixed point minus its principal point, px",
-        "std_px": "each camera's standard errors of (u, v), px",
-        "scale": "each camera's fitted scale f' / f",
-        "residual_rms_px": "each camera's RMS distance of the zoomed corners from the fit, px",
-        "points": "each camera's matched corners",
-        "reason": "why the fixed points were not found (only then)",
-    },
-    "tracking": {
-        "times_s": "each fixation's time, s",
-        "waypoints_world_m": "the path's waypoints in W, m",
-        "errors_world_m": "each fixation's error in W, m",
-        "renders_first": "renders of the first fixation",
-        "renders_after_mean": "mean renders per fixation after it",
-    },
-    "pursuit": {
-        "pursuit": "the pursuit spec as run (`path_kind`, `duration_s`, `frame_rate_hz`, "
-        "`latency_frames`, `exposure_s`, `blur_subframes`, `mode`, `predictor`, `saccade`, ...)",
-        "frames": "frames run",
-        "frames_present": "frames on which the target was present",
-        "frames_lost": "frames the target was lost",
-        "losses": "times it was lost",
-        "reacquisitions": "times it was found again",
-        "saccades": "saccades made",
-        "time_to_fixation_s": "time to the first fixation, s",
-        "lag_s": "the gaze's lag behind the target, s",
-        "offset_rms_px": "RMS image offset from the goal, px",
-        "position_rms_m": "RMS position error in W along the path, m",
-        "position_rms_pct_of_depth": "the same, % of depth",
-        "position_max_m": "largest position error, m",
-        "ended": "why the loop ended",
-        "vergence_error_median_deg": "median vergence error over the frames that found the "
-        "target (eye 2's goal ray against where eye 1's truly landed), deg",
-        "vergence_error_rms_deg": "the same, RMS, deg",
-        "per_frame": "each frame: `time_s`, `found`, `offsets_px`, `encoders_rad`, "
-        "`estimate_world_m`, `truth_world_m`, `error_m`, `vergence_error_deg`",
-    },
-}
+
+def experiment_fields() -> dict[str, dict[str, str]]:
+    """Each procedure's ``experiment`` keys beside ``procedure``, relative to ``experiment``:
+    its declaration's ``results``, in the registry's order."""
+    return {p.name: dict(p.results) for p in procedures()}
 
 
 def _child(fields: Mapping[str, str], parent: str, key: str) -> str | None:
@@ -426,7 +276,7 @@ def _walk(value: Any, path: str, fields: Mapping[str, str]) -> Iterator[tuple[st
 
 def _experiment_fields(results: Mapping[str, Any]) -> dict[str, str]:
     procedure = results.get("experiment", {}).get("procedure")
-    return {f"experiment.{k}": v for k, v in EXPERIMENT_FIELDS.get(procedure, {}).items()}
+    return {f"experiment.{k}": v for k, v in experiment_fields().get(procedure, {}).items()}
 
 
 def _pairs(results: Mapping[str, Any]) -> list[tuple[str, str | None]]:
@@ -445,10 +295,10 @@ def documented_paths(results: Mapping[str, Any]) -> set[str]:
 
 
 __all__ = [
-    "EXPERIMENT_FIELDS",
     "FAILED_ONLY",
     "MARKERLESS_ONLY",
     "RESULTS_FIELDS",
     "documented_paths",
+    "experiment_fields",
     "undocumented",
 ]

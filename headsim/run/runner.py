@@ -2,7 +2,7 @@
 
 The calibration is :mod:`headsim.run.calibrate`'s (or a calibration file's, as
 the scenario reader read it); the procedure is found by its name in
-:mod:`headsim.scenario.registry` (the built-in ones are :mod:`headsim.procedures`).
+:mod:`headsim.procedures.contract` (the built-in ones are :mod:`headsim.procedures`).
 What a run shows while it goes (progress, the Rerun recording) follows its
 events: the runner gives the simulator (and through it the servos and the
 procedure) a :class:`headsim.run.events.Hub` as event sink, and the hub passes
@@ -18,12 +18,12 @@ from dataclasses import replace
 
 from headsim.active.calibration_file import head_hash, read_calibration
 from headsim.active.calibration_report import CalibrationReport
+from headsim.procedures.contract import get
 from headsim.run.calibrate import calibrate
 from headsim.run.context import told
 from headsim.run.events import CalibrationDone, Hub, RunFinished, Subscriber
 from headsim.run.outcomes import MeasurementRecord, RunRenders
 from headsim.run.result import RunResult
-from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario
 from headsim.sim.events import RenderCounts
 

@@ -20,9 +20,9 @@ import mujoco
 import numpy as np
 
 from headsim.active.calibration_report import calibration_block
+from headsim.procedures.contract import get
 from headsim.run.accuracy import MeasurementSummary, summaries
 from headsim.run.outcomes import FixationScore, MeasurementRecord, RunOutcome
-from headsim.scenario.registry import get
 from headsim.scenario.spec import experiment_record
 from headsim.sim.settings import settings_record
 from headsim.version import __version__

@@ -10,12 +10,12 @@ from __future__ import annotations
 import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
+from headsim.procedures.contract import get
 from headsim.run.accuracy import DepthBand, summaries
 from headsim.run.outcomes import RunOutcome, SurfaceDraw, TextureClassStats, fixation_stats
 from headsim.run.table import cell as _cell
 from headsim.run.table import format_table
 from headsim.run.table import mm as _mm
-from headsim.scenario.registry import get
 from headsim.scenario.spec import Scenario, TargetAcceptance
 from headsim.sim.events import RenderCounts
 

@@ -4,7 +4,8 @@ The type, what is allowed and the default come from the getters themselves
 (:func:`headsim.scenario.tables.collecting_keys`), recorded while the real
 loader reads every shipped scenario and :data:`VARIANTS` of them that reach the
 branches no shipped file takes.  Only the meaning is written here, one line per
-key (:data:`DESCRIPTIONS`); the documentation's scenario reference is made from
+key: :data:`DESCRIPTIONS` for the shared keys, each procedure's ``keys`` for its own
+(:func:`descriptions`); the documentation's scenario reference is made from
 :func:`accepted_keys`, and a test fails when a key has no line or a line no key.
 """
 
@@ -14,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from headsim.procedures.contract import procedures
 from headsim.scenario.loading import (
     read_toml,
     resolve_path,
@@ -21,6 +23,7 @@ from headsim.scenario.loading import (
     scenario_from_document,
     set_field,
 )
+from headsim.scenario.scene import POSITION_KEYS, RANDOM_BOX_KEYS
 from headsim.scenario.tables import KeyUse, collecting_keys
 from headsim.sim import imperfections
 from headsim.sim.model import MODELS_DIR
@@ -233,11 +236,29 @@ def _fold(uses: dict[str, KeyUse], seen: dict[str, KeyUse]) -> None:
     seen.clear()
 
 
+def descriptions() -> dict[str, str]:
+    """Every key's meaning: the shared ones, then each procedure's own."""
+    return {**DESCRIPTIONS, **{k: v for p in procedures() for k, v in p.keys.items()}}
+
+
 def accepted_keys() -> list[Key]:
-    """Every accepted key with its meaning (KeyError-free: a key without a line gets "")."""
+    """Every accepted key with its meaning (KeyError-free: a key without a line gets "").
+
+    A key a procedure declares that no shipped scenario or variant reaches (one registered
+    from outside the package) is listed with its meaning alone, after the others."""
+    meanings = descriptions()
+    uses = collect_uses()
     return [
-        Key(u.path, u.kind, u.allowed, u.default, DESCRIPTIONS.get(u.path) or _meaning(u.path))
-        for u in collect_uses().values()
+        *(
+            Key(u.path, u.kind, u.allowed, u.default, meanings.get(u.path) or _meaning(u.path))
+            for u in uses.values()
+        ),
+        *(
+            Key(path, "", "", "", text)
+            for p in procedures()
+            for path, text in p.keys.items()
+            if path not in uses
+        ),
     ]
 
 
@@ -261,18 +282,9 @@ _CAMERA = {
     "side_offset_m": "Optical centre along the camera's x from the yaw axis, m (mounting: up to 0.002).",
     "eye_axis_tilt_rad": "The eye's yaw axis leaning forward, rad (machining: a few mrad).",
 }
-_RANDOM_BOX = {
-    "depth_m": "Depth range z_h of the drawn points in H, m.",
-    "lateral": "Largest |x_h / z_h| of a drawn point (half the horizontal field, as a ratio).",
-    "vertical": "Largest |y_h / z_h| of a drawn point.",
-}
-_POSITION = {
-    "position_head_m": "Position in H at the start pose (neck and eyes at 0), m; or `position_world_m`.",
-    "position_world_m": "Position in W, m; or `position_head_m`.",
-}
-_PURSUIT = "scene.pursuit"
 
-#: One line per key: what it means, with its unit.
+#: One line per key every procedure shares: what it means, with its unit (a procedure's
+#: own keys are in its ``Procedure.keys``).
 DESCRIPTIONS: dict[str, str] = {
     "description": "One line saying what the experiment is; `headsim list` shows it. Required.",
     "seed": "Seed of the image noise and of every random layout; `--seed` replaces it.",
@@ -330,20 +342,6 @@ DESCRIPTIONS: dict[str, str] = {
     "experiment.calibration.layout": "Depths uniform in `depth_m`, or most balls at the near end and the rest far.",
     "experiment.calibration.positions_world_m": "The ball positions [[x, y, z], ...] in W, m, given instead of drawn (`targets` is their number).",
     "experiment.calibration.near_fraction": "`near_far` only: share of balls at the near end (default b / (a + b)).",
-    "experiment.stereo": "The calibrated stereo baseline (procedure `stereo`): Zhang's calibration from chessboard views, then each target triangulated at eye angle 0.",
-    "experiment.stereo.views": "Chessboard poses rendered for the calibration (at least 5 must show the whole board).",
-    "experiment.stereo.distance_m": "The board centre's distance from camera 1, [low, high], m.",
-    "experiment.stereo.max_tilt_rad": "The board's largest tilt about its x and y axes, rad.",
-    "experiment.stereo.refine_intrinsics": "stereoCalibrate refines each camera's K, k1, k2 (false: keeps each camera's own calibration).",
-    "experiment.stereo.board_seed": "The board poses' seed (default: the scenario's seed), so that a study can calibrate with the poses it drew before.",
-    "experiment.stereo.board_look": "How each camera finds the board: `full_frame`, or `windowed` (a binned preview, then a window on the board: the same corners).",
-    "experiment.stereo.from": "A stored stereo calibration file (`headsim.stereo.calibration_file`) to triangulate with instead of calibrating (no board keys then).",
-    "experiment.stereo.look": "With `from`: each camera's look for a target, the full frame or `once` (a binned preview, then a window where it shows the target).",
-    "experiment.stereo.pattern": "The board's inner corners, [columns, rows]: the chessboard scene's board, [8, 6].",
-    "experiment.zoom_fixed_points": "Each camera's principal point as the fixed point of a zoom (procedure `zoom_fixed_points`): chessboard images at the head's focal lengths and at `zoom` times them; only pixels enter the fit.",
-    "experiment.zoom_fixed_points.zoom": "The focal length ratio of the second images.",
-    "experiment.zoom_fixed_points.poses": "Chessboard poses rendered at both focal lengths.",
-    "experiment.zoom_fixed_points.board_seed": "The seed of the board poses' draws (absent: the scenario's seed).",
     "experiment.servo": "The eye and neck servo (`headsim.active.servo_types.ServoConfig`).",
     "experiment.servo.windows": "Render only a window around where the target is expected (false: every image a full frame; same answers, more pixels).",
     "experiment.servo.tolerance_px": "Stop when the target's column is this close to the goal (or within half an encoder step's motion), px.",
@@ -356,36 +354,12 @@ DESCRIPTIONS: dict[str, str] = {
     "scene.targets": "Fixed targets (model2, model1; for calibration: optional check targets).",
     "scene.targets[].name": "The target's name, unique (default `target_N`).",
     "scene.targets[].body": "The marker body that stands for the target.",
-    **{f"scene.targets[].{k}": v for k, v in _POSITION.items()},
+    **{f"scene.targets[].{k}": v for k, v in POSITION_KEYS.items()},
     "scene.random_targets": "More targets drawn from the seed, named `random_N`.",
     "scene.random_targets.count": "Number of random targets.",
     "scene.random_targets.body": "The marker body of every random target.",
-    **{f"scene.random_targets.{k}": v for k, v in _RANDOM_BOX.items()},
+    **{f"scene.random_targets.{k}": v for k, v in RANDOM_BOX_KEYS.items()},
     "scene.random_targets.within": "`box` refuses a drawn point out of reach and draws again one the scene hides; `reach` draws any refused point again (each redraw counted).",
-    "scene.chessboard": "The chessboard (procedure `chessboard`); it faces the head.",
-    "scene.chessboard.corners": 'Which inner corners are measured: `"all"` or an array of corner indices, row-major from the top-left.',
-    **{
-        f"scene.chessboard.{k}": "Top-left inner corner: " + v[0].lower() + v[1:]
-        for k, v in _POSITION.items()
-    },
-    "scene.blocks": "The blocks' cross point (procedure `relative_positioning`).",
-    **{f"scene.blocks.{k}": "Cross point: " + v[0].lower() + v[1:] for k, v in _POSITION.items()},
-    "scene.objects": "Objects measured relative to the cross point, each seen by both cameras at the start pose or in all four images at the cross point's fixations; those not listed are parked out of view.",
-    "scene.objects[].body": "The object body (`object_1`..`object_6`).",
-    **{f"scene.objects[].{k}": v for k, v in _POSITION.items()},
-    "scene.random_objects": "Objects at random positions instead of `[[scene.objects]]`, drawn from the seed.",
-    "scene.random_objects.count": "Number of objects placed.",
-    **{f"scene.random_objects.{k}": v for k, v in _RANDOM_BOX.items()},
-    "scene.moving_target": "The marker moved along waypoints (procedure `tracking`).",
-    "scene.moving_target.name": "The moving target's name.",
-    "scene.moving_target.body": "The marker body that moves.",
-    "scene.moving_target.duration_s": "Time to pass all waypoints, s.",
-    "scene.moving_target.steps": "Fixations, at equal intervals from t = 0. Required.",
-    "scene.moving_target.waypoints_head_m": "Waypoints [[x, y, z], ...] in H at the start pose, at least 2, passed at equal times, m.",
-    "scene.moving_target.waypoints_world_m": "Waypoints [[x, y, z], ...] in W, at least 2, m.",
-    "scene.moving_target.random": "Random waypoints drawn from the seed instead.",
-    "scene.moving_target.random.waypoints": "Number of random waypoints.",
-    **{f"scene.moving_target.random.{k}": v for k, v in _RANDOM_BOX.items()},
     "scene.room": "A textured room around the head (every procedure): floor, walls and table with generated textures, objects, clutter from the seed, and the light.",
     "scene.room.surface": "Texture class of the floor, walls and table: `pink` (1/f noise), `grating`, `low` (faint gradient), `repetitive` (stripes).",
     "scene.room.table_top_z_m": "Height of the table top in W's z, m (the eyes are about 0.2 m up; default -0.35); the clutter rests on it.",
@@ -422,42 +396,4 @@ DESCRIPTIONS: dict[str, str] = {
     "scene.room.objects[].vertices_m": "`mesh`: its vertices [[x, y, z], ...] in the object's frame (4-1000, within 2 m of its origin), m.",
     "scene.room.objects[].faces": "`mesh`: its triangles [[i, j, k], ...] of vertex indices, counter-clockwise seen from outside (each textured by projecting it onto the object-frame plane it faces most).",
     "scene.room.objects[].tile_m": "`plane` and `mesh`: the side of one texture tile on the surface, m.",
-    _PURSUIT: "The live head pursuing a moving marker (procedure `pursuit`).",
-    f"{_PURSUIT}.name": "The pursued target's name.",
-    f"{_PURSUIT}.body": "What moves: a marker body, or a `[[scene.room.objects]]` name (clicked once, then tracked without markers).",
-    f"{_PURSUIT}.duration_s": "Length of the pursuit, s.",
-    f"{_PURSUIT}.click_error_px": "A room object's pursuit: the user's click in camera 1's first image, error per axis, px.",
-    f"{_PURSUIT}.band_px": "A room object's pursuit: half-height of the band along camera 1's row in which camera 2 searches, px.",
-    f"{_PURSUIT}.path": "How the target moves.",
-    f"{_PURSUIT}.path.kind": "The kind of path; each kind takes its own keys below.",
-    f"{_PURSUIT}.path.points_world_m": "`waypoints`: the points [[x, y, z], ...] in W, m.",
-    f"{_PURSUIT}.path.speeds_m_s": "`waypoints`: the speed along each leg, m/s.",
-    f"{_PURSUIT}.path.centre_world_m": "`sinusoid`: the centre in W, m.",
-    f"{_PURSUIT}.path.amplitude_m": "`sinusoid`: the amplitude along x, y, z of W, m.",
-    f"{_PURSUIT}.path.frequency_hz": "`sinusoid`: the frequency, Hz.",
-    f"{_PURSUIT}.path.phase_rad": "`sinusoid`: the phase along x, y, z, rad.",
-    f"{_PURSUIT}.path.start_world_m": "`random_walk`, `throw`, `jump`: the start in W, m.",
-    f"{_PURSUIT}.path.max_speed_m_s": "`random_walk`: the largest speed, m/s.",
-    f"{_PURSUIT}.path.box_half_m": "`random_walk`: half the box it stays in, along x, y, z, m.",
-    f"{_PURSUIT}.path.seed": "`random_walk`: the walk's seed; default the scenario's `seed`.",
-    f"{_PURSUIT}.path.end_world_m": "`jump`: where the target is from `time_s` on, in W, m.",
-    f"{_PURSUIT}.path.time_s": "`jump`: when the target jumps from the start to the end, s.",
-    f"{_PURSUIT}.path.velocity_m_s": "`throw`: the initial velocity in W, m/s (then gravity).",
-    f"{_PURSUIT}.path.point_world_m": "`static`: the point in W, m.",
-    f"{_PURSUIT}.path.windows_s": "When the target is visible: [[appear_s, disappear_s], ...]; default always.",
-    f"{_PURSUIT}.live": "The live head's camera and motors.",
-    f"{_PURSUIT}.live.frame_rate_hz": "Camera frame rate, Hz.",
-    f"{_PURSUIT}.live.exposure_s": "Exposure time, s (> 0 with `blur_subframes` > 1: motion blur).",
-    f"{_PURSUIT}.live.blur_subframes": "Renders averaged per frame for motion blur.",
-    f"{_PURSUIT}.live.latency_frames": "Frames between an image and the command it causes.",
-    f"{_PURSUIT}.live.eye_max_speed": "Eye motor's speed limit, rad/s.",
-    f"{_PURSUIT}.live.eye_max_accel": "Eye motor's acceleration limit, rad/s^2.",
-    f"{_PURSUIT}.live.neck_max_speed": "Neck motors' speed limit, rad/s.",
-    f"{_PURSUIT}.live.neck_max_accel": "Neck motors' acceleration limit, rad/s^2.",
-    f"{_PURSUIT}.gaze": "The gaze behaviour.",
-    f"{_PURSUIT}.gaze.mode": "Model 1 with the neck, or the eyes alone.",
-    f"{_PURSUIT}.gaze.predictor": "A constant-velocity predictor against the latency.",
-    f"{_PURSUIT}.gaze.saccade": "Saccade profile: minimum jerk or bang-bang.",
-    f"{_PURSUIT}.gaze.saccade_threshold_rad": "A fixation correction larger than this starts a saccade, rad.",
-    f"{_PURSUIT}.gaze.fixation_tolerance_px": "Image error within which the target counts as fixated, px.",
 }

@@ -17,7 +17,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from headsim.scenario import registry
+from headsim.procedures import contract as registry
 from headsim.scenario.reach import ReachHead
 from headsim.scenario.reach_check import check_reach
 from headsim.scenario.scene import read_scene

@@ -446,14 +446,15 @@ def _head_of(settings: HeadSettings) -> ReachHead:
 
 def target_refusal(
     head: ReachHead,
-    procedure: str,
+    reach: str,
     p_world: np.ndarray,
     what: str = "target",
     radius_m: float = 0.0,
     occluders: tuple[Occluder, ...] = (),
 ) -> Refusal | None:
-    """The reach check of one target of ``procedure`` ("model1"; else Model 2 measures it)."""
-    if procedure == "model1":
+    """The reach check of one target that ``reach`` measures ("model1": the neck turns too;
+    else Model 2, the eyes from the start pose): a procedure's ``Procedure.reach``."""
+    if reach == "model1":
         return model1_refusal(head, p_world, what, True, radius_m, occluders, start_view=False)
     return model2_refusal(head, p_world, what, radius_m, occluders)
 

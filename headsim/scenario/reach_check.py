@@ -10,6 +10,7 @@ from collections.abc import Sequence
 import mujoco
 import numpy as np
 
+from headsim.procedures.contract import get
 from headsim.scenario.occlusion import scene_model, scene_occluders
 from headsim.scenario.reach import (
     ReachHead,
@@ -69,15 +70,16 @@ def _chessboard_corners_world(placement: Placement, corners: tuple[int, ...] | N
 
 
 def target_refusals(
-    head: ReachHead, procedure: str, scene: str, targets: Sequence[tuple[str, np.ndarray]]
+    head: ReachHead, reach: str, scene: str, targets: Sequence[tuple[str, np.ndarray]]
 ) -> list[Refusal | None]:
-    """Why ``procedure`` cannot measure each of ``targets`` (body, position in W, m) in turn
-    (None: it can), in ``scene`` as the earlier accepted targets left it."""
+    """Why ``reach`` (a procedure's ``Procedure.reach``) cannot measure each of ``targets``
+    (body, position in W, m) in turn (None: it can), in ``scene`` as the earlier accepted
+    targets left it."""
     placed: dict[str, np.ndarray] = {}
     refusals: list[Refusal | None] = []
     for body, p in targets:
         occluders = scene_occluders(scene, placed, body)
-        refusal = target_refusal(head, procedure, p, "target", body_radius(body), occluders)
+        refusal = target_refusal(head, reach, p, "target", body_radius(body), occluders)
         refusals.append(refusal)
         if refusal is None:
             placed[body] = p
@@ -92,7 +94,7 @@ def check_reach(ctx: Context, scenario: Scenario) -> None:
     # Random targets follow the listed ones; "box" keeps every draw as drawn.
     first_drawn = None if acceptance is None or acceptance.within != "box" else acceptance.listed
     listed = [(t.body, np.array(t.position_world_m)) for t in scene.targets]
-    refusals = target_refusals(head, procedure, scene.scene, listed)
+    refusals = target_refusals(head, get(procedure).reach, scene.scene, listed)
     for index, (target, refusal) in enumerate(zip(scene.targets, refusals, strict=True)):
         drawn = first_drawn is not None and index >= first_drawn
         _raise(ctx, target.source, refusal, drawn=drawn)

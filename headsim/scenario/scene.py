@@ -9,13 +9,15 @@ scenario's seed, one stream per use (``STREAM_*``).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from contextvars import ContextVar
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from headsim.geometry.sampling import sample_points_head
+from headsim.procedures.contract import get, procedures
 from headsim.scenario.pursuit import read_pursuit
 from headsim.scenario.reach import (
     Occluder,
@@ -25,11 +27,7 @@ from headsim.scenario.reach import (
     scene_occluders,
     target_refusal,
 )
-from headsim.scenario.registry import get
 from headsim.scenario.room import ROOM_HAS_TARGETS, ROOM_OCCLUDERS, read_room, room_occluders
-
-if TYPE_CHECKING:
-    from headsim.scenario.registry import SceneReader
 from headsim.scenario.schema import depth_range
 from headsim.scenario.spec import (
     MARKER_BODIES,
@@ -43,6 +41,19 @@ from headsim.scenario.tables import MISSING, Context, Table
 from headsim.sim import names
 from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadSettings
+
+#: What the keys of a position (:func:`read_position`) mean.
+POSITION_KEYS: dict[str, str] = {
+    "position_head_m": "Position in H at the start pose (neck and eyes at 0), m; or `position_world_m`.",
+    "position_world_m": "Position in W, m; or `position_head_m`.",
+}
+
+#: What the keys of a random box (``[scene.random_*]``) mean.
+RANDOM_BOX_KEYS: dict[str, str] = {
+    "depth_m": "Depth range z_h of the drawn points in H, m.",
+    "lateral": "Largest |x_h / z_h| of a drawn point (half the horizontal field, as a ratio).",
+    "vertical": "Largest |y_h / z_h| of a drawn point.",
+}
 
 
 def read_position(table: Table, settings: HeadSettings, default: Any = MISSING) -> np.ndarray:
@@ -109,7 +120,9 @@ def _redraw_out_of_reach(
     points_world = np.array(points_world)
     for k in range(len(points_world)):
         for _ in range(MAX_DRAWS):
-            refusal = target_refusal(head, procedure, points_world[k], "target", radius, occluders)
+            refusal = target_refusal(
+                head, get(procedure).reach, points_world[k], "target", radius, occluders
+            )
             if refusal is None or (redrawn is not None and refusal.code not in redrawn):
                 break
             refused[refusal.code] = refused.get(refusal.code, 0) + 1
@@ -205,9 +218,6 @@ def default_position(scene: str, body: str) -> np.ndarray:
 #: The names of the room's objects while ``[scene]`` is read (a pursuit may move one).
 ROOM_OBJECTS: ContextVar[tuple[str, ...]] = ContextVar("room_objects", default=())
 
-#: The procedures that measure ``[scene.room] targets`` (one servo, target by target).
-SURFACE_TARGET_PROCEDURES = ("model2", "model1", "fixation")
-
 
 def read_scene(
     doc: Table, ctx: Context, procedure: str, settings: HeadSettings, seed: int
@@ -216,11 +226,12 @@ def read_scene(
     found = get(procedure)
     table = doc.table("scene") or Table({}, "scene", ctx)
     room, surface_targets = read_room(table, seed)
-    if surface_targets is not None and procedure not in SURFACE_TARGET_PROCEDURES:
+    if surface_targets is not None and not found.markerless:
+        measuring = [p.name for p in procedures() if p.markerless]
         raise ctx.error(
             "scene.room.targets",
             f"markerless targets are not measured by the {procedure} procedure",
-            f"procedure = {' or '.join(SURFACE_TARGET_PROCEDURES)}, or targets = 0",
+            f"procedure = {' or '.join(measuring)}, or targets = 0",
         )
     # The room's surfaces and clutter can hide the procedure's targets.
     token = ROOM_OCCLUDERS.set(() if room is None else room_occluders(room))
@@ -235,6 +246,10 @@ def read_scene(
         ROOM_OBJECTS.reset(objects)
     table.done()
     return spec if room is None else replace(spec, room=room, surface_targets=surface_targets)
+
+
+#: ``read_scene(scene_table, ctx, settings, seed)``: a procedure's part of ``[scene]``.
+SceneReader = Callable[[Table, Context, HeadSettings, int], SceneSpec]
 
 
 def targets_reader(procedure: str, *, required: bool) -> SceneReader:

@@ -16,7 +16,7 @@ from typing import Any
 
 from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import INITIAL_DIRECTIONS_RAD
-from headsim.scenario import registry
+from headsim.procedures import contract as registry
 from headsim.scenario.calibration_design import LAYOUTS
 from headsim.scenario.spec import (
     MAX_DEPTH_M,

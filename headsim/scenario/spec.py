@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from headsim import paper
-from headsim.scenario import registry
+from headsim.procedures import contract as registry
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings, belief_sources
 from headsim.sim.textured_scene import RoomSpec

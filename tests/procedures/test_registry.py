@@ -1,10 +1,12 @@
 """A procedure defined here, registered through the public registry and run by ``headsim run``:
-its scene table, its results.json block, its summary lines and its recording rows, with no
-other module edited."""
+its own ``[experiment.marker_height]`` key, its scene table, its results.json block, its
+summary lines and its recording rows, and both generated reference pages, with no other
+module edited."""
 
 from __future__ import annotations
 
 import json
+import sys
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,10 +26,26 @@ from headsim.run.outcomes import MeasurementRecord
 from headsim.run.recording import Recorder
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.scene import targets_reader
-from headsim.scenario.spec import Scenario
+from headsim.scenario.spec import CalibrationSpec, Scenario
+from headsim.scenario.tables import Table
 from headsim.sim import names
 
 BODY = sorted(names.MARKER_COLOURS)[0]
+TOOLS = Path(__file__).resolve().parents[2] / "tools"
+
+
+@dataclass(frozen=True)
+class HeightSpec:
+    """``[experiment.marker_height]``: what is added to the height, m."""
+
+    offset_m: float = 0.0
+
+
+def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
+    block = table.table("marker_height") or Table({}, table.field("marker_height"), table.ctx)
+    offset_m = block.number("offset_m", 0.0, -1.0, 1.0)
+    block.done()
+    return {"block": HeightSpec(offset_m)}
 
 
 @dataclass(frozen=True)
@@ -45,7 +63,9 @@ def run_height(
     placement = scenario.scene.targets[0]
     with simulator(hub, "default", scenario) as sim:
         sim.set_body_pose(placement.body, np.array(placement.position_world_m))
-        return [], HeightResult(placement.body, float(sim.position(placement.body)[2]))
+        offset_m = scenario.experiment.block.offset_m
+        height_m = float(sim.position(placement.body)[2]) + offset_m
+        return [], HeightResult(placement.body, height_m)
 
 
 def rows(result: HeightResult, log: Recorder) -> None:
@@ -59,8 +79,14 @@ HEIGHT = procedures.Procedure(
     fields=lambda r: {"body": r.body, "height_m": r.height_m},
     summary=lambda r, paper: [f"Marker height: {r.body} at {r.height_m * 1000:.1f} mm"],
     rows=rows,
+    options=read_options,
     read_scene=targets_reader("marker_height", required=True),
     fixations=lambda scenario: 0,  # it fixates nothing
+    results={"body": "the marker measured", "height_m": "its height in W plus the offset, m"},
+    keys={
+        "experiment.marker_height": "What the height procedure adds.",
+        "experiment.marker_height.offset_m": "Added to the marker's height, m.",
+    },
 )
 
 
@@ -78,6 +104,7 @@ def test_a_new_procedure_runs_through_headsim_run(
     scenario.write_text(
         'description = "How high a marker stands"\nseed = 0\n\n'
         '[experiment]\nprocedure = "marker_height"\n\n'
+        "[experiment.marker_height]\noffset_m = 0.25\n\n"
         f'[[scene.targets]]\nbody = "{BODY}"\nposition_head_m = [0.02, 0.01, 0.6]\n'
     )
     loaded = load_scenario(scenario)
@@ -87,7 +114,7 @@ def test_a_new_procedure_runs_through_headsim_run(
     assert main(argv) == 0
     block: dict[str, Any] = json.loads((out / "results.json").read_text())["experiment"]
     assert block["procedure"] == "marker_height" and block["body"] == BODY
-    assert block["height_m"] == pytest.approx(loaded.scene.targets[0].position_world_m[2])
+    assert block["height_m"] == pytest.approx(loaded.scene.targets[0].position_world_m[2] + 0.25)
     summary = (out / "summary.txt").read_text()
     assert f"Marker height: {BODY} at {block['height_m'] * 1000:.1f} mm" in summary
     assert "OK: 0 measurements, none failed" in summary
@@ -104,3 +131,20 @@ def test_a_name_taken_twice_is_refused(registered: procedures.Procedure) -> None
         procedures.register(procedures.Procedure("marker_height", "default", run_height, dict))
     assert procedures.get("marker_height") is HEIGHT
     assert {"model2", "pursuit", "marker_height"} <= set(procedures.names())
+
+
+def test_a_new_procedure_appears_in_both_generated_references(
+    registered: procedures.Procedure,
+) -> None:
+    sys.path.insert(0, str(TOOLS))
+    try:
+        import docs_pages
+    finally:
+        sys.path.remove(str(TOOLS))
+    results = docs_pages.results_json_page()
+    section = results[results.index("### `marker_height`") :]
+    assert "| `body` | the marker measured |" in section
+    assert "| `height_m` | its height in W plus the offset, m |" in section
+    keys = docs_pages.scenario_keys_page()
+    assert "| `experiment.marker_height.offset_m` |" in keys
+    assert "Added to the marker's height, m. |" in keys

@@ -11,10 +11,11 @@ from pathlib import Path
 import pytest
 
 #: What ``headsim run`` without --rrd/--connect/--serve imports: the command line, the runner,
-#: every procedure (the registry imports them all) and every shipped scenario, loaded.
+#: every procedure (discovered, as the first lookup does) and every shipped scenario, loaded.
 UNRECORDED_RUN_IMPORTS = """
 import headsim, headsim.cli, headsim.cli.parser, headsim.cli.scenarios, headsim.cli.studies
 import headsim.procedures, headsim.run.runner, headsim.run.serialise, headsim.run.summary
+headsim.procedures.discover()
 from headsim.run.rerun_cli import recording_target
 from headsim.scenario.loading import load_scenario, scenario_files
 for path in scenario_files():

@@ -13,11 +13,11 @@ from shipped_runs import ShippedRun
 
 from headsim.cli import main
 from headsim.run.results_reference import (
-    EXPERIMENT_FIELDS,
     FAILED_ONLY,
     MARKERLESS_ONLY,
     RESULTS_FIELDS,
     documented_paths,
+    experiment_fields,
     undocumented,
 )
 from headsim.run.serialise import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
@@ -141,7 +141,7 @@ def test_every_scenario_runs_in_its_fast_variant(
     held = {p for p in documented_paths(results) if p.startswith("experiment.")}
     assert held - {"experiment.procedure"} == {
         f"experiment.{k}"
-        for k in EXPERIMENT_FIELDS[procedure]
+        for k in experiment_fields()[procedure]
         if k not in FAILED_ONLY and (markerless or k not in MARKERLESS_ONLY)
     }
     assert (directory / "summary.txt").read_text().strip() in out

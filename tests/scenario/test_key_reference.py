@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from headsim.scenario.key_reference import DESCRIPTIONS, accepted_keys, collect_uses
+from headsim.scenario.key_reference import accepted_keys, collect_uses, descriptions
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.tables import ScenarioError, collecting_keys, key_path
 
@@ -22,9 +22,10 @@ def uses() -> dict:
 
 
 def test_every_accepted_key_has_a_meaning_and_every_meaning_a_key(uses: dict) -> None:
-    assert [k for k in uses if not DESCRIPTIONS.get(k)] == []
-    assert [k for k in DESCRIPTIONS if k not in uses] == []
-    assert all("\n" not in d and len(d) <= 200 for d in DESCRIPTIONS.values())
+    meanings = descriptions()
+    assert [k for k in uses if not meanings.get(k)] == []
+    assert [k for k in meanings if k not in uses] == []
+    assert all("\n" not in d and len(d) <= 200 for d in meanings.values())
 
 
 def test_every_key_a_reader_names_is_reached_by_the_reference_documents(uses: dict) -> None:

@@ -10,9 +10,9 @@ from collections import Counter
 import numpy as np
 import pytest
 
+from headsim.procedures.contract import get
 from headsim.scenario.loading import load_scenario, scenario_files
 from headsim.scenario.reach import ReachHead, body_radius, scene_occluders, target_refusal
-from headsim.scenario.registry import get
 from headsim.scenario.spec import REFUSAL_REASONS
 
 #: At least 200 seeds each (issue 40): a sweep over seeds must never meet a refusal.

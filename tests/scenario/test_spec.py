@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from headsim.scenario.registry import get, names
+from headsim.procedures.contract import get, names
 from headsim.scenario.spec import (
     MARKER_BODIES,
     CalibrationSpec,

@@ -1,0 +1,66 @@
+"""Every registered procedure, the way dm_control's suite_test covers every task: its shipped
+scenario's fast variant runs through the command line, every key of its results block has a
+meaning it declares, and every key of its own scenario tables is in the key reference."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+
+import pytest
+from shipped_runs import ShippedRun
+
+from headsim.procedures.contract import get, names
+from headsim.run.results_reference import documented_paths, undocumented
+from headsim.scenario.key_reference import collect_uses, descriptions
+from headsim.scenario.loading import read_toml, scenario_files
+
+PROCEDURES = names()
+
+
+def shipped_scenario(procedure: str) -> str:
+    """The shipped scenario named as the procedure, else the first one that runs it."""
+    runs = sorted(
+        path.stem
+        for path in scenario_files()
+        if read_toml(path).get("experiment", {}).get("procedure") == procedure
+    )
+    assert runs, f"no shipped scenario runs {procedure!r}"
+    return procedure if procedure in runs else runs[0]
+
+
+@pytest.fixture(scope="module")
+def uses() -> dict:
+    return collect_uses()
+
+
+def test_the_procedures_are_listed_by_their_declared_rank() -> None:
+    ranked = [get(name) for name in PROCEDURES]
+    assert [(p.rank, p.name) for p in ranked] == sorted((p.rank, p.name) for p in ranked)
+    assert {"model2", "model1", "calibration", "pursuit", "stereo"} <= set(PROCEDURES)
+
+
+@pytest.mark.parametrize("procedure", PROCEDURES)
+def test_its_shipped_scenario_runs_and_every_results_key_has_a_meaning(
+    procedure: str, shipped_fast_run: Callable[[str], ShippedRun]
+) -> None:
+    run = shipped_fast_run(shipped_scenario(procedure))
+    assert run.code in (0, 1), run.out  # 1: a measurement failed, by a counted cause
+    results = json.loads((run.directory / "results.json").read_text())
+    assert results["experiment"]["procedure"] == procedure
+    assert [k for k in undocumented(results) if k.startswith("experiment")] == []
+    declared = {f"experiment.{k}" for k in get(procedure).results}
+    held = {p for p in documented_paths(results) if p.startswith("experiment.")}
+    assert held - {"experiment.procedure"} <= declared
+
+
+@pytest.mark.parametrize("procedure", PROCEDURES)
+def test_its_scenario_keys_are_in_the_key_reference(procedure: str, uses: dict) -> None:
+    keys = get(procedure).keys
+    assert [k for k in keys if k not in uses] == []  # each declared key is one the reader reads
+    meanings = descriptions()
+    assert all(meanings[k] == text for k, text in keys.items())
+    assert all("\n" not in text and 0 < len(text) <= 200 for text in keys.values())
+    own = {k.split(".")[0] + "." + k.split(".")[1].split("[")[0] for k in keys}
+    read = [k for k in uses if any(k == t or k.startswith((f"{t}.", f"{t}[")) for t in own)]
+    assert [k for k in read if not meanings.get(k)] == []
