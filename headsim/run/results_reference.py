@@ -79,7 +79,8 @@ RESULTS_FIELDS: dict[str, str] = {
     "settings.render": "the rendering fidelity: `offsamples`, `supersample`",
     "settings.head": "the head, only when it is not the paper's (absent: the paper's head)",
     "settings.head.name": "its name: a shipped head's, or the MJCF file's stem",
-    "settings.head.path": "its MJCF file",
+    "settings.head.path": "its MJCF file: `models/NAME.xml` for a shipped head (the same on "
+    "every checkout), a user's file by its path",
     "settings.head.mapping": "the names headsim uses in it (the scenario's `[head.mapping]`): "
     "`head_body`, `neck_yaw`, `neck_pitch`, `eyes`, `left_eye`, `right_eye`, `cameras`, "
     "`neck_roll`, `eye_tilt`, `version`, `vergence` (`null`: none)",

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Collection
 from dataclasses import asdict, dataclass, field, fields, replace
+from pathlib import Path
 from typing import Any
 
 from headsim.errors import BadInput
@@ -17,7 +18,7 @@ from headsim.geometry.camera_model import PinholeCamera, image_centre
 from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import BASELINE_M, ENCODER_RESOLUTION_RAD, INITIAL_DIRECTIONS_RAD, INTRINSICS
 from headsim.sim import imperfections
-from headsim.sim.heads import PAPER, HeadModel
+from headsim.sim.heads import MODELS_DIR, PAPER, HeadModel
 from headsim.sim.imperfections.distortion import K1, K2
 from headsim.sim.imperfections.noise import NOISE_STD
 from headsim.sim.tolerances import REALISTIC_BUDGET
@@ -419,8 +420,16 @@ def settings_record(settings: HeadSettings) -> dict[str, Any]:
             del camera["extra"]  # the layout of every record made before imperfection modules
     head = record.pop("head")
     if not settings.head.is_paper:
-        record["head"] = {**head, "path": str(settings.head.path)}
+        record["head"] = {**head, "path": _model_path(settings.head.path)}
     return record
+
+
+def _model_path(path: Path | None) -> str:
+    """A head's MJCF file as records give it: a shipped one as ``models/NAME.xml`` (the
+    same on every checkout and install), a user's as its path."""
+    if path is not None and path.resolve().is_relative_to(MODELS_DIR.resolve()):
+        return f"models/{path.resolve().relative_to(MODELS_DIR.resolve()).as_posix()}"
+    return str(path)
 
 
 def ideal_head(**overrides: object) -> HeadSettings:
