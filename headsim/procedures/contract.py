@@ -18,6 +18,7 @@ all, which :func:`get` and :func:`names` call once, on first use.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -33,6 +34,18 @@ SceneReader = Callable[[Any, Any, "HeadSettings", int], Any]
 #: What :func:`discover` calls: each imports a package of procedures.
 _LOADERS: list[Callable[[], object]] = []
 _loaded = False
+#: Held while loading: a lookup from another thread (a batch of heads, a sweep's workers)
+#: waits for the whole registry instead of seeing it half filled.
+_LOADING = threading.RLock()
+
+
+class _InLoad(threading.local):
+    active = False
+
+
+#: Whether this thread is loading (a module's import that looks a procedure up waits on
+#: no one and sees what is registered so far).
+_IN_LOAD = _InLoad()
 
 
 def on_first_lookup(load: Callable[[], object]) -> None:
@@ -45,10 +58,18 @@ def on_first_lookup(load: Callable[[], object]) -> None:
 def discover() -> None:
     """Import every package of procedures handed to :func:`on_first_lookup`, once."""
     global _loaded
-    if not _loaded:
-        _loaded = True
-        for load in tuple(_LOADERS):
-            load()
+    if _loaded:
+        return
+    with _LOADING:
+        if _loaded or _IN_LOAD.active:  # loaded while this thread waited, or loading now
+            return
+        _IN_LOAD.active = True
+        try:
+            for load in tuple(_LOADERS):
+                load()
+            _loaded = True
+        finally:
+            _IN_LOAD.active = False
 
 
 def _no_lines(result: Any, paper: bool) -> list[str]:

@@ -6,6 +6,7 @@ module edited."""
 from __future__ import annotations
 
 import json
+import subprocess
 import sys
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -148,3 +149,24 @@ def test_a_new_procedure_appears_in_both_generated_references(
     keys = docs_pages.scenario_keys_page()
     assert "| `experiment.marker_height.offset_m` |" in keys
     assert "Added to the marker's height, m. |" in keys
+
+
+def test_the_first_lookups_from_many_threads_all_see_every_procedure() -> None:
+    # A batch of heads or a sweep's workers look procedures up at once in a fresh
+    # process: none may see the registry half filled ("unknown value 'model2'").
+    script = (
+        "import threading, headsim\n"
+        "from headsim.procedures import contract\n"
+        "seen = []\n"
+        "def look():\n"
+        "    seen.append(set(contract.names()))\n"
+        "threads = [threading.Thread(target=look) for _ in range(16)]\n"
+        "[t.start() for t in threads]\n"
+        "[t.join() for t in threads]\n"
+        "print(sum('model2' in s and len(s) >= 10 for s in seen))\n"
+    )
+    for _ in range(3):
+        out = subprocess.run(
+            [sys.executable, "-c", script], capture_output=True, text=True, check=True
+        ).stdout
+        assert out.strip() == "16"
