@@ -36,9 +36,9 @@ import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.files import write_json_atomic
-from headsim.run.progress import Status
-from headsim.run.runner import run_scenario
-from headsim.run.serialise import results_payload
+from headsim.runs.progress import Status
+from headsim.runs.runner import run_scenario
+from headsim.runs.serialise import results_payload
 from headsim.scenario.loading import scenario_from_document
 from headsim.sim.heads import shipped
 from headsim.sim.model import on_head

@@ -46,7 +46,7 @@ from headsim.active.placement import calibration_layout
 from headsim.files import write_json_atomic
 from headsim.live.gaze import GazeMode, PursuitRun, SaccadeProfile
 from headsim.procedures.pursuit import PursuitResult
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import start_views
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, scenario_with_head

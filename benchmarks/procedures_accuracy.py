@@ -22,7 +22,7 @@ import numpy as np
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.active.measurement import HeadKnowledge
 from headsim.files import write_json_atomic
-from headsim.run.progress import Status
+from headsim.runs.progress import Status
 from headsim.sim.settings import HeadSettings, paper_head
 from headsim.studies import experiments
 

@@ -38,7 +38,7 @@ from headsim.active.calibration_file import knowledge_from_block
 from headsim.active.measurement import Measurement
 from headsim.active.placement import calibration_layout
 from headsim.files import write_json_atomic
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.reach import reach_refusal
 from headsim.scenario.spec import Scenario

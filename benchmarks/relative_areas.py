@@ -27,7 +27,7 @@ import numpy as np
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.files import write_json_atomic
 from headsim.procedures.relative import RelativeResult
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.scenario.area_layouts import area_layout
 from headsim.scenario.loading import scenario_from_document
 from headsim.sim import names

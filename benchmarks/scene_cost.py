@@ -18,7 +18,7 @@ from dataclasses import replace
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.files import write_json_atomic
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 from headsim.sim.simulator import HeadSim
 

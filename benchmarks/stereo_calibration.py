@@ -22,7 +22,7 @@ import numpy as np
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
 from headsim.files import write_json_atomic
 from headsim.procedures.stereo import FOCAL_BOUND, RMS_BOUND_PX, StereoResult
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 
 

@@ -31,20 +31,19 @@ def _built_in_procedures() -> None:
 _contract.on_first_lookup(_built_in_procedures)
 
 if TYPE_CHECKING:
-    # At run time ``headsim.run`` is the callable package (headsim/run/__init__.py); a
-    # type checker sees the function, so ``headsim.run(...)`` type-checks.
-    from headsim.run.library import load_scenario, run
-    from headsim.run.outcomes import MeasurementRow
-    from headsim.run.result import RunResult
+    from headsim.runs.library import load_scenario, run
+    from headsim.runs.outcomes import MeasurementRow
+    from headsim.runs.result import RunResult
     from headsim.scenario.spec import Scenario
     from headsim.scenario.tables import ScenarioError
     from headsim.sim.simulator import HeadSim
 
 #: Each lazily loaded name and the module that defines it.
 _LAZY = {
-    "load_scenario": "headsim.run.library",
-    "RunResult": "headsim.run.result",
-    "MeasurementRow": "headsim.run.outcomes",
+    "load_scenario": "headsim.runs.library",
+    "run": "headsim.runs.library",
+    "RunResult": "headsim.runs.result",
+    "MeasurementRow": "headsim.runs.outcomes",
     "Scenario": "headsim.scenario.spec",
     "ScenarioError": "headsim.scenario.tables",
     "HeadSim": "headsim.sim.simulator",
@@ -63,8 +62,6 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    if name == "run":  # the package headsim.run, which is callable (headsim.run.library.run)
-        return importlib.import_module("headsim.run")
     if name in _LAZY:
         value = getattr(importlib.import_module(_LAZY[name]), name)
         globals()[name] = value

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
-from headsim.run.result import RunResult
+from headsim.runs.result import RunResult
 
 
 @dataclass(frozen=True)
@@ -28,7 +28,7 @@ class ShippedRun:
 
 def run_shipped(name: str, directory: Path) -> ShippedRun:
     """``headsim run NAME --fast --out DIRECTORY`` in-process, keeping the runner's result."""
-    from headsim.run import runner
+    from headsim.runs import runner
 
     real = runner.run_scenario
     results: list[RunResult] = []

@@ -65,9 +65,9 @@ def test_the_api_page_renders_roles_types_and_each_entry_once(site: Path) -> Non
     assert not raw, f"{len(raw)} raw Sphinx roles, e.g. {raw[:3]}"
     assert not re.search(r"\w::\s", text), "a reST literal-block marker (::) shown raw"
     # A role naming an object on the page is a link to it (run's docstring names load_scenario).
-    assert 'href="#headsim.run.library.load_scenario"' in api
+    assert 'href="#headsim.runs.library.load_scenario"' in api
     # Signatures carry their annotations: load_scenario's ``fast: bool``.
-    entry = api.split('id="headsim.run.library.load_scenario"', 1)[1]
+    entry = api.split('id="headsim.runs.library.load_scenario"', 1)[1]
     signature = entry.split("doc-signature", 1)[1].split("</pre>", 1)[0]
     assert re.search(r"fast.*?:.*?bool", html.unescape(re.sub(r"<[^>]+>", "", signature)))
     # Each module's own entries (not methods: two classes may each have a ``describe``).

@@ -35,21 +35,21 @@ def _check(root: Path) -> str:
 def test_a_circle_through_type_checking_or_importlib_is_counted(tmp_path: Path) -> None:
     package = tmp_path / "headsim"
     (package / "scenario").mkdir(parents=True)
-    (package / "run").mkdir()
+    (package / "runs").mkdir()
     (package / "plugins").mkdir()
-    for folder in (package, package / "scenario", package / "run", package / "plugins"):
+    for folder in (package, package / "scenario", package / "runs", package / "plugins"):
         (folder / "__init__.py").write_text("")
     (package / "scenario" / "spec.py").write_text(
-        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from headsim.run.hub import Hub\n"
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from headsim.runs.hub import Hub\n"
     )
-    (package / "run" / "hub.py").write_text("from headsim.scenario.spec import Spec\n")
-    (package / "run" / "look.py").write_text(
+    (package / "runs" / "hub.py").write_text("from headsim.scenario.spec import Spec\n")
+    (package / "runs" / "look.py").write_text(
         'import importlib\nPLUGINS = "headsim.plugins"\n\n\ndef load(name):\n'
         '    importlib.import_module(PLUGINS + "." + name)\n'
     )
-    (package / "plugins" / "one.py").write_text("from headsim.run.look import load\n")
+    (package / "plugins" / "one.py").write_text("from headsim.runs.look import load\n")
     out = _check(tmp_path)
     assert "circles: 2" in out, out
-    assert "headsim.run.hub <-> headsim.scenario.spec" in out, out
-    assert "headsim.plugins.one <-> headsim.run.look" in out, out
-    assert "headsim.scenario.spec -> headsim.run.hub" in out, out  # upward, under TYPE_CHECKING
+    assert "headsim.runs.hub <-> headsim.scenario.spec" in out, out
+    assert "headsim.plugins.one <-> headsim.runs.look" in out, out
+    assert "headsim.scenario.spec -> headsim.runs.hub" in out, out  # upward, under TYPE_CHECKING

@@ -6,7 +6,7 @@ site as a generated file (nothing generated is committed):
 - ``reference/scenario-keys.md``: every key the scenario loader accepts, from the
   getters themselves (:mod:`headsim.scenario.key_reference`);
 - ``reference/results-json.md``: every key of results.json, from
-  :mod:`headsim.run.results_reference`;
+  :mod:`headsim.runs.results_reference`;
 - ``reference/command-line.md``: every command's ``--help``, from the parser;
 - ``reference/exit-codes.md``: the exit-code contract (:mod:`headsim.errors`).
 
@@ -26,7 +26,7 @@ from mkdocs.structure.files import File, Files
 from headsim import __version__
 from headsim.cli.parser import build_parser
 from headsim.errors import EXIT_MEANINGS
-from headsim.run.results_reference import RESULTS_FIELDS, experiment_fields
+from headsim.runs.results_reference import RESULTS_FIELDS, experiment_fields
 from headsim.scenario.key_reference import accepted_keys
 from headsim.scenario.loading import load_scenario, scenario_files
 
@@ -77,7 +77,7 @@ _RESULTS_INTRO = (
     "Written atomically at the end of a run (also when a measurement failed; not when the "
     "input was bad or the run was interrupted). It holds no wall time or date: the same "
     "scenario, seed and software give the same bytes. SI units; NaN is written as `null`. "
-    "Made at build time from `headsim.run.results_reference`: `a[]` stands for each entry "
+    "Made at build time from `headsim.runs.results_reference`: `a[]` stands for each entry "
     "of the list `a`, `a.*` for each key of a table whose keys are data (a knowledge, a "
     "phase); a key whose keys are not listed is described as a whole.\n"
 )

@@ -34,8 +34,8 @@ def run_payload(
     scenario: str, *, fast: bool = False, seed: int | None = None, **overrides: Any
 ) -> dict[str, Any]:
     """results.json's document of one scenario run (no files written)."""
-    from headsim.run.runner import run_scenario
-    from headsim.run.serialise import results_payload
+    from headsim.runs.runner import run_scenario
+    from headsim.runs.serialise import results_payload
     from headsim.scenario.loading import load_scenario
 
     loaded = load_scenario(scenario, fast=fast, seed=seed, overrides=overrides or None)

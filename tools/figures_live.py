@@ -55,7 +55,7 @@ def speed() -> str:
     and ``headsim reproduce --fast`` (its report's own ratio)."""
     import time
 
-    from headsim.run.runner import run_scenario
+    from headsim.runs.runner import run_scenario
     from headsim.scenario.loading import load_scenario
     from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock
     from headsim.studies.reproduce import reproduce as run
@@ -167,7 +167,7 @@ BELIEVED_GEOMETRY_M = {"baseline_m": 0.150, "neck_d1_m": 0.120, "neck_a2_m": 0.0
 def pursuit_belief() -> str:
     """``headsim run pursuit`` (1.5 s) on a head built off its design: measured with its
     belief, and with a belief that happens to be the truth (what a leak of truth gave)."""
-    from headsim.run.runner import run_scenario
+    from headsim.runs.runner import run_scenario
     from headsim.scenario.loading import load_scenario
 
     def rms(belief: dict[str, float]) -> Any:

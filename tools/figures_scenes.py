@@ -249,8 +249,8 @@ def _pursuit(body: str, seed: int) -> dict[str, Any]:
     marker on the same path (the crate then taken out of the room)."""
     import tomllib
 
-    from headsim.run.runner import run_scenario
-    from headsim.run.serialise import results_payload
+    from headsim.runs.runner import run_scenario
+    from headsim.runs.serialise import results_payload
     from headsim.scenario.loading import scenario_from_document
 
     doc = tomllib.loads((ROOT / "scenarios" / "pursuit_textured.toml").read_text())

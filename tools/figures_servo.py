@@ -181,7 +181,7 @@ def _bench_points(windows: bool = True, average: bool = False) -> dict[str, Any]
     """Model 2 on ``headsim bench``'s 12 ideal-camera targets (seed 0) with this servo config,
     run as a scenario: the measurements, every detection the servo made, renders and full
     frames per point."""
-    from headsim.run.runner import run_scenario
+    from headsim.runs.runner import run_scenario
     from headsim.scenario.loading import scenario_from_document
     from headsim.studies import experiments
     from headsim.studies.targets import random_targets_head

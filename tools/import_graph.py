@@ -34,7 +34,7 @@ LAYERS = (
     # procedures implement, so below both (it names none of their types).
     "procedures.contract",
     "scenario",
-    "run",
+    "runs",
     "procedures",
     "studies",
     "envs",

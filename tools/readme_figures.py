@@ -96,8 +96,8 @@ def quickstart_excerpt() -> str:
     """The README's excerpt of what ``headsim run quickstart`` prints (seed 0), cut from
     today's summary: its belief line, the calibration's first rows, the first markers and
     the whole-field line."""
-    from headsim.run.runner import run_scenario
-    from headsim.run.summary import summary_text
+    from headsim.runs.runner import run_scenario
+    from headsim.runs.summary import summary_text
     from headsim.scenario.loading import load_scenario
 
     lines = summary_text(run_scenario(load_scenario("quickstart", seed=0))).splitlines()

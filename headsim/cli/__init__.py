@@ -7,7 +7,7 @@ writable, disk full, a dependency missing); 130 interrupted.  No traceback
 reaches the user; ``--debug`` shows one.
 
 This package imports only the standard library (and :mod:`headsim.errors`,
-:mod:`headsim.run.outputs`, :mod:`headsim.sim.backend`) at the top of its modules, so
+:mod:`headsim.runs.outputs`, :mod:`headsim.sim.backend`) at the top of its modules, so
 that ``--help`` and ``list`` are answered before numpy or mujoco load; :func:`main`
 imports the commands inside its guard, so that an interrupt during start-up is exit 130
 and one line too.  The entry point is here (``headsim.cli:main``); one module per command
@@ -81,7 +81,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         import ctypes
 
         ctypes.pythonapi.PyRun_SimpleString(b"pass")
-    rerun_cli = sys.modules.get("headsim.run.rerun_cli")
+    rerun_cli = sys.modules.get("headsim.runs.rerun_cli")
     if argv is None and rerun_cli is not None and rerun_cli.viewer_streams_left_open():
         # Rerun's gRPC client, left with a viewer that does not answer, blocks the
         # interpreter's exit for ever, signals included: leave without it (all written).

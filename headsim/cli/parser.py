@@ -94,7 +94,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     run.add_argument(
         "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"
     )
-    from headsim.run.rerun_cli import add_recording_arguments
+    from headsim.runs.rerun_cli import add_recording_arguments
 
     add_recording_arguments(run)
     run.set_defaults(func=run_command)
@@ -199,7 +199,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         help="the batch back-end's device (backend = \"batch\"; default: the file's, else cpu)",
     )
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
-    from headsim.run.rerun_cli import add_recording_arguments
+    from headsim.runs.rerun_cli import add_recording_arguments
 
     add_recording_arguments(sweep, per_job=True)
     sweep.set_defaults(func=sweep_command)

@@ -27,18 +27,18 @@ from headsim.errors import (
     printable,
     raise_if_interrupted,
 )
-from headsim.run.outputs import Outputs
+from headsim.runs.outputs import Outputs
 
 #: The files ``headsim run`` writes in --out, besides the optional --rrd.
 RUN_FILES = ("results.json", "summary.txt", "timing.json")
 
 
 def run_command(args: argparse.Namespace) -> int:
-    from headsim.run.events import Subscriber
-    from headsim.run.rerun_cli import recording_target
-    from headsim.run.runner import run_scenario
-    from headsim.run.serialise import results_payload
-    from headsim.run.summary import summary_text
+    from headsim.runs.events import Subscriber
+    from headsim.runs.rerun_cli import recording_target
+    from headsim.runs.runner import run_scenario
+    from headsim.runs.serialise import results_payload
+    from headsim.runs.summary import summary_text
     from headsim.scenario.loading import load_scenario
     from headsim.scenario.tables import ScenarioError
 
@@ -67,7 +67,7 @@ def run_command(args: argparse.Namespace) -> int:
             observers.append(progress)
         recorder = None
         if target.wanted:
-            from headsim.run.recording import Recorder
+            from headsim.runs.recording import Recorder
 
             try:
                 recorder = Recorder(rrd, scenario, target=target)
@@ -131,7 +131,7 @@ def run_command(args: argparse.Namespace) -> int:
 
 def progress_observer(args: argparse.Namespace, total: int, unit: str) -> Any:
     """The run's progress on stderr: a bar on a terminal, plain lines otherwise; none when quiet."""
-    from headsim.run.progress import Counter, RunProgress
+    from headsim.runs.progress import Counter, RunProgress
 
     if getattr(args, "no_progress", False) or getattr(args, "quiet", False):
         return None
@@ -140,8 +140,8 @@ def progress_observer(args: argparse.Namespace, total: int, unit: str) -> Any:
 
 def calibrate_command(args: argparse.Namespace) -> int:
     from headsim.active.calibration_file import head_hash, write_calibration
-    from headsim.run.runner import calibrate_scenario
-    from headsim.run.serialise import calibration_block
+    from headsim.runs.runner import calibrate_scenario
+    from headsim.runs.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
     from headsim.scenario.tables import ScenarioError
 

@@ -10,7 +10,7 @@ import argparse
 from headsim.errors import (
     BadInput,
 )
-from headsim.run.outputs import Outputs
+from headsim.runs.outputs import Outputs
 
 
 def snapshot_command(args: argparse.Namespace) -> int:

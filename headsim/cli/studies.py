@@ -16,7 +16,7 @@ from headsim.errors import (
     ExitCode,
     printable,
 )
-from headsim.run.outputs import Outputs
+from headsim.runs.outputs import Outputs
 
 
 def reproduce_command(args: argparse.Namespace) -> int:
@@ -63,7 +63,7 @@ def sweep_command(args: argparse.Namespace) -> int:
     from headsim.studies.sweep_spec import load_sweep
 
     spec = load_sweep(args.sweep)
-    from headsim.run.rerun_cli import recording_target
+    from headsim.runs.rerun_cli import recording_target
 
     target = recording_target(args, per_job=True)
     outputs = Outputs()

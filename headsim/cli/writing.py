@@ -23,7 +23,7 @@ def file_size(path: Path) -> str:
 def write_all(files: dict[Path, object]) -> None:
     """Write the result files atomically; on a full disk remove the ones this call wrote."""
     from headsim.files import write_json_atomic, write_text_atomic
-    from headsim.run.outputs import disk_full
+    from headsim.runs.outputs import disk_full
 
     written: list[Path] = []
     for path, content in files.items():
@@ -64,7 +64,7 @@ def recording_failed(err: BaseException) -> bool:
 
 
 def recording_disk_full(rrd: Path, err: BaseException) -> Exception:
-    from headsim.run.outputs import disk_full
+    from headsim.runs.outputs import disk_full
 
     size = rrd.stat().st_size if rrd.is_file() else None
     return disk_full(rrd, None, err if isinstance(err, OSError) else None, written_bytes=size)

@@ -57,7 +57,7 @@ covers it, about one texel per pixel (:func:`plane_texture_px`): only disparity 
 its depth, not the texture's scale.  The target is where eye 1's optical axis (its
 goal pixel) meets the scene (``mujoco.mj_ray``, truth).  ``info``:
 ``vergence_error_deg``, the angle between eye 2's goal ray and the direction from eye 2
-to that point (:func:`headsim.run.landing.vergence_error_deg`; NaN when eye 1's ray
+to that point (:func:`headsim.runs.landing.vergence_error_deg`; NaN when eye 1's ray
 hits nothing), ``depth_m`` (the plane's), ``texture_seed``, and ``truth_world_m`` (that
 target); no ``found`` or ``offsets_px``.  Reward ``"vergence"`` (the default there):
 minus the vergence error over the camera's half horizontal field of view, capped at 1
@@ -88,7 +88,7 @@ from headsim.active.measurement import HeadKnowledge, to_world
 from headsim.estimators.model1 import model1
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, Frame, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
-from headsim.run.landing import landing, vergence_error_deg
+from headsim.runs.landing import landing, vergence_error_deg
 from headsim.sim.heads import HeadModel, shipped
 from headsim.sim.model import design, neck_of, on_head
 from headsim.sim.settings import (

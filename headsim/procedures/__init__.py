@@ -1,7 +1,7 @@
 """The procedures a scenario can name, one module each; :func:`discover` imports them all.
 
 Each module holds a procedure's run (on the run's simulator, event hub and what
-the head knows: :mod:`headsim.run.context`), its typed result, which writes its
+the head knows: :mod:`headsim.runs.context`), its typed result, which writes its
 results.json ``experiment`` fields, its summary lines and its recording rows, and
 what its keys mean, gathered in a :class:`~headsim.procedures.contract.Procedure`
 it registers.  :func:`discover` imports every module of this package, so a new

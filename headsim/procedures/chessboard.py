@@ -14,16 +14,16 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import Model2Config, measure_model2
 from headsim.procedures.contract import Procedure, register
-from headsim.run.context import (
+from headsim.runs.context import (
     PAPER,
     model2_config,
     record_measurement,
     servo_config,
     simulator,
 )
-from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.table import format_table, mm
+from headsim.runs.events import Hub
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.table import format_table, mm
 from headsim.scenario.scene import POSITION_KEYS, default_position, read_position, tuple3
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import (

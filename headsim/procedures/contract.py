@@ -117,7 +117,7 @@ class Procedure:
 
     What its keys mean: ``results`` its results.json ``experiment`` keys beside
     ``procedure`` (paths relative to ``experiment``: ``a.b``, ``a[].b``, ``a.*``, as in
-    :mod:`headsim.run.results_reference`), ``keys`` the scenario keys only it reads
+    :mod:`headsim.runs.results_reference`), ``keys`` the scenario keys only it reads
     (full paths: ``experiment.NAME.key``, ``scene.NAME.key``; the shared ones are in
     :mod:`headsim.scenario.key_reference`); both reference pages are made from them.
     ``rank`` orders the procedures in a scenario's error and the references (lower

@@ -10,10 +10,10 @@ import numpy as np
 
 from headsim.active.events import PhaseStarted
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
-from headsim.run.context import record_measurement, simulator
-from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.targets import marker_target
+from headsim.runs.context import record_measurement, simulator
+from headsim.runs.events import Hub
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.targets import marker_target
 from headsim.scenario.spec import Scenario
 from headsim.sim.simulator import HeadSim
 

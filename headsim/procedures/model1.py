@@ -10,10 +10,10 @@ from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
-from headsim.run.context import servo_config
-from headsim.run.events import Hub
-from headsim.run.outcomes import SURFACE_FIELDS, MeasurementRecord, SurfaceDraw
-from headsim.run.surface import measure_surface_targets
+from headsim.runs.context import servo_config
+from headsim.runs.events import Hub
+from headsim.runs.outcomes import SURFACE_FIELDS, MeasurementRecord, SurfaceDraw
+from headsim.runs.surface import measure_surface_targets
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
 from headsim.scenario.spec import CalibrationSpec, Scenario

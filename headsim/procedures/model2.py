@@ -10,10 +10,10 @@ from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model2 import measure_model2
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
-from headsim.run.context import model2_config, servo_config
-from headsim.run.events import Hub
-from headsim.run.outcomes import SURFACE_FIELDS, MeasurementRecord, SurfaceDraw
-from headsim.run.surface import measure_surface_targets
+from headsim.runs.context import model2_config, servo_config
+from headsim.runs.events import Hub
+from headsim.runs.outcomes import SURFACE_FIELDS, MeasurementRecord, SurfaceDraw
+from headsim.runs.surface import measure_surface_targets
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import CalibrationSpec, Scenario

@@ -35,11 +35,11 @@ from headsim.active.servo_types import Detector, ServoConfig
 from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
 from headsim.procedures.contract import Procedure, register
-from headsim.run.context import PARKED_WORLD_M
-from headsim.run.landing import landing, vergence_error_deg
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.surface import row_band_for
-from headsim.run.targets import marker_target
+from headsim.runs.context import PARKED_WORLD_M
+from headsim.runs.landing import landing, vergence_error_deg
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.surface import row_band_for
+from headsim.runs.targets import marker_target
 from headsim.scenario.pursuit import PursuitSpec, describe
 from headsim.scenario.scene import read_pursuit_scene
 from headsim.scenario.spec import MARKER_BODIES, STREAM_CLICKS, Scenario
@@ -49,7 +49,7 @@ from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import MatchConfig
 
 if TYPE_CHECKING:
-    from headsim.run.recording import Recorder
+    from headsim.runs.recording import Recorder
 
 
 @dataclass(frozen=True)
@@ -325,7 +325,7 @@ def log_path(result: PursuitResult, log: Recorder) -> None:
     """The target's path where it is visible, drawn once (static) in the recording."""
     import rerun as rr  # only when recording: Rerun costs a third of a second to import
 
-    from headsim.run.recording_layout import GREY
+    from headsim.runs.recording_layout import GREY
 
     spec = log.scenario.scene.pursuit
     if spec is None:

@@ -21,16 +21,16 @@ from headsim.estimators.areas import (
     compare_areas,
 )
 from headsim.procedures.contract import Procedure, register
-from headsim.run.context import (
+from headsim.runs.context import (
     PAPER,
     PARKED_WORLD_M,
     record_measurement,
     servo_config,
     simulator,
 )
-from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.table import cell, format_table
+from headsim.runs.events import Hub
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.table import cell, format_table
 from headsim.scenario.scene import (
     POSITION_KEYS,
     RANDOM_BOX_KEYS,
@@ -52,7 +52,7 @@ from headsim.vision.detection import Detection
 from headsim.vision.markers import find_markers
 
 if TYPE_CHECKING:
-    from headsim.run.recording import Recorder
+    from headsim.runs.recording import Recorder
 
 
 @dataclass(frozen=True)
@@ -155,7 +155,7 @@ class RelativeResult:
         """The lines L11, L12, L21, L22 of the two fixations and each object's area."""
         import rerun as rr  # only when recording: Rerun costs a third of a second to import
 
-        from headsim.run.recording_layout import GREEN, ORANGE, RED
+        from headsim.runs.recording_layout import GREEN, ORANGE, RED
 
         baseline = log.scenario.settings.baseline_m
         s = log.scenario.settings

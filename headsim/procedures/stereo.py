@@ -52,10 +52,10 @@ from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge
 from headsim.geometry.transforms import frame_deviation
 from headsim.procedures.contract import Procedure, register
-from headsim.run.context import simulator
-from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.table import cell, format_table, mm
+from headsim.runs.context import simulator
+from headsim.runs.events import Hub
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.table import cell, format_table, mm
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.spec import WHEN_GIVEN, CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
@@ -73,7 +73,7 @@ from headsim.stereo.views import (
 )
 
 if TYPE_CHECKING:
-    from headsim.run.recording import Recorder
+    from headsim.runs.recording import Recorder
 
 #: The baseline's acceptance figure: every reprojection RMS at most this, px ...
 RMS_BOUND_PX = 0.2
@@ -212,7 +212,7 @@ def log_estimates(log: Recorder, targets: tuple[StereoTarget, ...]) -> None:
     """Each triangulated target's estimate in W."""
     import rerun as rr  # only when recording: Rerun costs a third of a second to import
 
-    from headsim.run.recording_layout import GREEN
+    from headsim.runs.recording_layout import GREEN
 
     seen = [t for t in targets if t.ok]
     if seen:

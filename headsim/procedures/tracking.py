@@ -13,15 +13,15 @@ from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
 from headsim.procedures.contract import Procedure, register
-from headsim.run.context import (
+from headsim.runs.context import (
     record_measurement,
     servo_config,
     simulator,
 )
-from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.table import cell, mm
-from headsim.run.targets import marker_target
+from headsim.runs.events import Hub
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.table import cell, mm
+from headsim.runs.targets import marker_target
 from headsim.scenario.scene import (
     RANDOM_BOX_KEYS,
     finite_number,

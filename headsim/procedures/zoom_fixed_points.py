@@ -21,17 +21,17 @@ from headsim.active.principal import (
     zoomed,
 )
 from headsim.procedures.contract import Procedure, register
-from headsim.run.context import simulator
-from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.table import format_table
+from headsim.runs.context import simulator
+from headsim.runs.events import Hub
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.table import format_table
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
 from headsim.sim import names
 from headsim.sim.simulator import HeadSim
 
 if TYPE_CHECKING:
-    from headsim.run.recording import Recorder
+    from headsim.runs.recording import Recorder
 
 
 @dataclass(frozen=True)
@@ -90,7 +90,7 @@ class ZoomFixedPoints:
         """Each camera's fixed point in its image."""
         import rerun as rr  # only when recording: Rerun costs a third of a second to import
 
-        from headsim.run.recording_layout import GREEN
+        from headsim.runs.recording_layout import GREEN
 
         for cam, uv in zip(names.CAMERAS, self.run.principal_px, strict=True):
             log.rec.log(

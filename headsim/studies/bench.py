@@ -26,9 +26,9 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
 from headsim.estimators.throughput import run as estimator_throughput
 from headsim.files import write_json_atomic
-from headsim.run.events import MeasurementRecorded, Stamp
-from headsim.run.progress import Status
-from headsim.run.runner import run_scenario
+from headsim.runs.events import MeasurementRecorded, Stamp
+from headsim.runs.progress import Status
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario, scenario_from_document
 from headsim.scenario.spec import Scenario
 from headsim.sim.settings import HeadSettings, paper_head, preset

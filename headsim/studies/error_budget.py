@@ -49,7 +49,7 @@ from headsim.files import (
     write_text_atomic,
 )
 from headsim.geometry.kinematics import world_to_head
-from headsim.run.accuracy import DEPTH_BANDS_M
+from headsim.runs.accuracy import DEPTH_BANDS_M
 from headsim.sim.settings import HeadSettings
 
 #: The scenario the budget runs: the realistic head over the whole shared field.
@@ -223,8 +223,8 @@ def run_condition(
     condition: BudgetCondition, *, fast: bool, seed: int, scenario: str = SCENARIO
 ) -> dict[str, Any]:
     """Run the scenario with ``condition``'s fields set; one row of the budget."""
-    from headsim.run.runner import run_scenario
-    from headsim.run.serialise import calibration_block
+    from headsim.runs.runner import run_scenario
+    from headsim.runs.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
 
     overrides = dict(condition.overrides)

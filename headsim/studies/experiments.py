@@ -20,8 +20,8 @@ import numpy as np
 from headsim.active.calibration_file import knowledge_from_block
 from headsim.active.measurement import HeadKnowledge, Measurement, body_target
 from headsim.estimators.areas import AreaComparison, tally_areas
-from headsim.run.result import RunResult
-from headsim.run.runner import run_scenario
+from headsim.runs.result import RunResult
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.reach import ReachHead
 from headsim.scenario.reach_check import target_refusals

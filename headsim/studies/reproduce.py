@@ -45,7 +45,7 @@ from typing import Any
 
 from headsim.errors import EnvironmentProblem, OutputNotWritable
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
-from headsim.run.progress import Status, quiet
+from headsim.runs.progress import Status, quiet
 from headsim.studies.jobs import render_pool, spawn_context, start_workers
 from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
 from headsim.studies.reproduce_experiments import (

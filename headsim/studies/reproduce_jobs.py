@@ -23,9 +23,9 @@ from headsim.studies.reproduce_experiments import (
 #: What the jobs import, loaded by each worker as it starts (about 1 s), while the parent
 #: makes its render clock.
 WORKER_MODULES = (
-    "headsim.run.runner",
-    "headsim.run.serialise",
-    "headsim.run.summary",
+    "headsim.runs.runner",
+    "headsim.runs.serialise",
+    "headsim.runs.summary",
     "headsim.scenario.loading",
     "headsim.active.calibration_file",
     "headsim.studies.paper_tables",
@@ -62,8 +62,8 @@ def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str,
 @_plain_errors
 def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.active.calibration_file import head_hash, write_calibration
-    from headsim.run.runner import calibrate_scenario
-    from headsim.run.serialise import calibration_block
+    from headsim.runs.runner import calibrate_scenario
+    from headsim.runs.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario("calibration", fast=fast, seed=seed)
@@ -89,9 +89,9 @@ def _scenario_run(
     scenario_name: str, directory: Path, fast: bool, seed: int | None, overrides: dict[str, Any]
 ) -> dict[str, Any]:
     """One scenario run: its results.json and summary.txt written in ``directory``."""
-    from headsim.run.runner import run_scenario
-    from headsim.run.serialise import results_payload
-    from headsim.run.summary import summary_text
+    from headsim.runs.runner import run_scenario
+    from headsim.runs.serialise import results_payload
+    from headsim.runs.summary import summary_text
     from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario(scenario_name, fast=fast, seed=seed, overrides=overrides)

@@ -2,7 +2,7 @@
 
 A study states its experiment as scenario tables
 (:func:`headsim.scenario.loading.scenario_from_document`) and runs it with
-:func:`headsim.run.runner.run_scenario`.  What the head already knows (a
+:func:`headsim.runs.runner.run_scenario`.  What the head already knows (a
 calibration the study made) reaches the run the way a user's does: as a
 calibration file that the scenario names (``experiment.calibration.from``).
 """
@@ -20,7 +20,7 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.active.principal import PrincipalPointRun
 from headsim.procedures.stereo import StereoResult
 from headsim.procedures.zoom_fixed_points import ZoomFixedPoints
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.spec import Scenario
 from headsim.sim import names

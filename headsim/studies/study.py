@@ -55,7 +55,7 @@ import time
 from collections.abc import Sequence
 
 from headsim.errors import BadInput
-from headsim.run.progress import Status
+from headsim.runs.progress import Status
 from headsim.studies.calibrations import CalibrationCache
 from headsim.studies.methods import Progress, StudyConfig, quiet
 from headsim.studies.study_experiments import (

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from headsim.errors import BadInput
-from headsim.run.progress import Counter
+from headsim.runs.progress import Counter
 from headsim.scenario.tables import TargetRefused
 from headsim.studies.jobs import dask_client, execute, local_pool
 from headsim.studies.sweep_output import write_aggregate
@@ -64,7 +64,7 @@ def run_job(job: Job, marker_dir: str | None = None, recording: Any = None) -> d
 
     ``marker_dir``: a file named after the job sits there while it runs, so
     that after a crash the sweep knows which jobs were running.  ``recording``:
-    a :class:`headsim.run.rerun_cli.RecordingTarget` for every job (``--rrd DIR``,
+    a :class:`headsim.runs.rerun_cli.RecordingTarget` for every job (``--rrd DIR``,
     ``--connect``), or None.
     """
     marker = Path(marker_dir) / job.id if marker_dir else None
@@ -216,7 +216,7 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
     start = time.perf_counter()
     record: dict[str, Any] = {"id": job.id, "index": job.index, "params": job.params}
     try:
-        from headsim.run.runner import run_scenario
+        from headsim.runs.runner import run_scenario
         from headsim.scenario.loading import load_scenario
 
         overrides = {k: v for k, v in job.params.items() if k != "seed"}
@@ -224,8 +224,8 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
             job.scenario, fast=job.fast, seed=job.params.get("seed"), overrides=overrides
         )
         if recording is not None:
-            from headsim.run.recording import Recorder
-            from headsim.run.rerun_cli import job_target
+            from headsim.runs.recording import Recorder
+            from headsim.runs.rerun_cli import job_target
 
             with Recorder(
                 None, scenario, target=job_target(recording, job.id), recording=job.id

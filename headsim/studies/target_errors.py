@@ -15,7 +15,7 @@ import numpy as np
 
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.procedures.stereo import StoredStereoResult
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.sim.settings import HeadSettings
 from headsim.stereo.calibration import StereoCalibration
 from headsim.stereo.calibration_file import write_stereo_calibration

@@ -15,7 +15,7 @@ from headsim.active.calibration_file import (
     read_calibration,
 )
 from headsim.cli import main
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.tables import ScenarioError
 from headsim.sim.settings import HeadSettings, paper_head

@@ -20,7 +20,7 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.model2 import measure_model2
 from headsim.geometry.kinematics import head_to_world
-from headsim.run.targets import marker_target
+from headsim.runs.targets import marker_target
 from headsim.sim.settings import HeadSettings, preset
 from headsim.sim.simulator import HeadSim
 from headsim.studies.error_budget import first_order_offsets
@@ -111,7 +111,7 @@ vertical = 0.05
 
 
 def _scenario_estimates(path, overrides) -> np.ndarray:
-    from headsim.run.runner import run_scenario
+    from headsim.runs.runner import run_scenario
     from headsim.scenario.loading import load_scenario
 
     result = run_scenario(load_scenario(path, overrides=overrides))

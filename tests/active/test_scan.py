@@ -15,9 +15,9 @@ from headsim.active.model1 import measure_model1
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.search import scan_eye_poses
-from headsim.run.runner import run_scenario
-from headsim.run.serialise import results_payload
-from headsim.run.summary import summary_text
+from headsim.runs.runner import run_scenario
+from headsim.runs.serialise import results_payload
+from headsim.runs.summary import summary_text
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.reach import ReachHead, scene_occluders, target_refusal
 from headsim.sim.simulator import HeadSim

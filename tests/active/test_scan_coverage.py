@@ -22,7 +22,7 @@ from headsim.active.search import (
     search_poses,
 )
 from headsim.geometry.kinematics import head_to_world
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.reach import ReachHead, model2_refusal
 from headsim.sim.settings import paper_head, realistic_head

@@ -202,7 +202,7 @@ def test_nothing_the_head_runs_reads_the_simulators_placements() -> None:
 
 #: Modules that read the scene's truth (where a surface target is, where the eyes
 #: landed), for placing, scoring and recording: what the head runs never imports them.
-TRUTH_MODULES = ("headsim.run.landing", "headsim.scenario.surface_targets")
+TRUTH_MODULES = ("headsim.runs.landing", "headsim.scenario.surface_targets")
 
 
 def _imports(path: Path) -> set[str]:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from headsim.run.rerun_cli import VIEWER_WAIT_S
+from headsim.runs.rerun_cli import VIEWER_WAIT_S
 from tests.cli.test_faults import CLI, _env, assert_one_line_error, headsim
 
 

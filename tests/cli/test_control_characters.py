@@ -69,7 +69,7 @@ def test_an_error_shows_a_file_key_escaped(
 
 
 def test_progress_lines_show_a_target_name_escaped() -> None:
-    from headsim.run.progress import Counter
+    from headsim.runs.progress import Counter
 
     stream = io.StringIO()
     counter = Counter(

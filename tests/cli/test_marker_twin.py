@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from headsim.cli import main
-from headsim.run.surface import MARKER_OFFSET_M, TWIN_MARKER
+from headsim.runs.surface import MARKER_OFFSET_M, TWIN_MARKER
 
 
 def _run(name: str, out: Path) -> dict:

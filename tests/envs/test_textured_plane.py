@@ -216,4 +216,4 @@ def test_the_policies_never_import_the_scene_truth() -> None:
         elif isinstance(node, ast.Import):
             modules.update(alias.name for alias in node.names)
     assert "headsim.vision.correspondence" in modules  # the check sees its imports
-    assert not modules & {"headsim.run.landing", "headsim.scenario.surface_targets", "mujoco"}
+    assert not modules & {"headsim.runs.landing", "headsim.scenario.surface_targets", "mujoco"}

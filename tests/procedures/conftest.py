@@ -8,7 +8,7 @@ from collections.abc import Callable
 import pytest
 from shipped_runs import ShippedRun
 
-from headsim.run.result import RunResult
+from headsim.runs.result import RunResult
 
 
 @pytest.fixture

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from headsim.procedures.chessboard import ChessboardResult
-from headsim.run.result import RunResult
+from headsim.runs.result import RunResult
 
 
 def test_the_squares_measure_30_mm(fast_run: Callable[[str], RunResult]) -> None:

@@ -11,7 +11,7 @@ import pytest
 from shipped_runs import ShippedRun
 
 from headsim.procedures.contract import get, names
-from headsim.run.results_reference import documented_paths, undocumented
+from headsim.runs.results_reference import documented_paths, undocumented
 from headsim.scenario.key_reference import collect_uses, descriptions
 from headsim.scenario.loading import read_toml, scenario_files
 

@@ -13,7 +13,7 @@ from headsim.estimators.fixation import fixation
 from headsim.estimators.result import Flag, Method, Uncertainty
 from headsim.geometry.heads import fixating_eye_angles
 from headsim.procedures.fixation import FixationResult
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 
 #: An ideal head with a motor per eye, no image noise, three listed targets.

@@ -7,7 +7,7 @@ from collections.abc import Callable
 from headsim.estimators.result import Method
 from headsim.procedures.calibration import CalibrationCheck
 from headsim.procedures.model2 import Model2Result
-from headsim.run.result import RunResult
+from headsim.runs.result import RunResult
 
 
 def test_check_targets_are_far_better_after_the_calibration(

@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from headsim.procedures.pursuit import PursuitResult
-from headsim.run.result import RunResult
-from headsim.run.runner import run_scenario
+from headsim.runs.result import RunResult
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 
 

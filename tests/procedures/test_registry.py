@@ -21,10 +21,10 @@ from rerun.chunk import RrdReader
 from headsim import procedures
 from headsim.active.measurement import HeadKnowledge
 from headsim.cli import main
-from headsim.run.context import simulator
-from headsim.run.events import Hub
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.recording import Recorder
+from headsim.runs.context import simulator
+from headsim.runs.events import Hub
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.recording import Recorder
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.spec import CalibrationSpec, Scenario

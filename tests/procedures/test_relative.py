@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from headsim.procedures.relative import RelativeResult
-from headsim.run.result import RunResult
+from headsim.runs.result import RunResult
 
 
 def test_every_object_is_in_its_true_area(fast_run: Callable[[str], RunResult]) -> None:

@@ -16,8 +16,8 @@ from shipped_runs import ShippedRun
 from headsim.cli import main
 from headsim.live.head import LiveHead
 from headsim.procedures.pursuit import PursuitResult
-from headsim.run.runner import run_scenario
-from headsim.run.surface import false_fixation_limit_m
+from headsim.runs.runner import run_scenario
+from headsim.runs.surface import false_fixation_limit_m
 from headsim.scenario.loading import load_scenario, scenario_from_document
 
 

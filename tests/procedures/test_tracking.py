@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from headsim.procedures.tracking import TrackingResult
-from headsim.run.result import RunResult
+from headsim.runs.result import RunResult
 
 
 def test_every_fixation_is_within_3_mm(fast_run: Callable[[str], RunResult]) -> None:

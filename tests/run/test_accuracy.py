@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from headsim.run.accuracy import DEPTH_BANDS_M, summaries, summarise
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.summary import band_text
+from headsim.runs.accuracy import DEPTH_BANDS_M, summaries, summarise
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.summary import band_text
 
 from .helpers import LOST, measurement
 

@@ -9,9 +9,9 @@ from dataclasses import replace
 import pytest
 
 from headsim.active.failure import Failure, FailureCause
-from headsim.run.outcomes import FixationScore, MeasurementRecord, by_texture
-from headsim.run.summary import texture_text
-from headsim.run.texture_class import TEXTURE_CLASSES
+from headsim.runs.outcomes import FixationScore, MeasurementRecord, by_texture
+from headsim.runs.summary import texture_text
+from headsim.runs.texture_class import TEXTURE_CLASSES
 
 from .helpers import measurement
 

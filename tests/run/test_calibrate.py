@@ -10,8 +10,8 @@ from scipy.stats import chi2
 
 from headsim.active.failure import Failure, FailureCause
 from headsim.estimators.result import Status
-from headsim.run.calibrate import position_outcomes
-from headsim.run.runner import calibrate_scenario
+from headsim.runs.calibrate import position_outcomes
+from headsim.runs.runner import calibrate_scenario
 from headsim.scenario.loading import load_scenario
 
 

@@ -6,7 +6,7 @@ from dataclasses import asdict
 
 from headsim.active.measurement import HeadKnowledge
 from headsim.paper import INITIAL_DIRECTIONS_RAD as PAPER_INITIAL_DIRECTIONS
-from headsim.run.context import PAPER, PARKED_WORLD_M, model2_config, servo_config, told
+from headsim.runs.context import PAPER, PARKED_WORLD_M, model2_config, servo_config, told
 from headsim.scenario.loading import load_scenario
 
 

@@ -7,14 +7,14 @@ import pytest
 from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.eye_servo import EyeServo
 from headsim.active.neck_servo import NeckServo
-from headsim.run.events import (
+from headsim.runs.events import (
     CalibrationDone,
     MeasurementRecorded,
     RunFinished,
     Stamp,
 )
-from headsim.run.result import RunResult
-from headsim.run.runner import run_scenario
+from headsim.runs.result import RunResult
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.simulator import HeadSim

@@ -9,7 +9,7 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from headsim.run.landing import (
+from headsim.runs.landing import (
     angle_deg,
     fixation_error,
     fixation_truth,

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from headsim.active.eye_servo import EyeServo
-from headsim.run.landing import fixation_error, landing
+from headsim.runs.landing import fixation_error, landing
 from headsim.scenario.loading import load_scenario
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim

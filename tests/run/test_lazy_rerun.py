@@ -14,9 +14,9 @@ import pytest
 #: every procedure (discovered, as the first lookup does) and every shipped scenario, loaded.
 UNRECORDED_RUN_IMPORTS = """
 import headsim, headsim.cli, headsim.cli.parser, headsim.cli.scenarios, headsim.cli.studies
-import headsim.procedures, headsim.run.runner, headsim.run.serialise, headsim.run.summary
+import headsim.procedures, headsim.runs.runner, headsim.runs.serialise, headsim.runs.summary
 headsim.procedures.discover()
-from headsim.run.rerun_cli import recording_target
+from headsim.runs.rerun_cli import recording_target
 from headsim.scenario.loading import load_scenario, scenario_files
 for path in scenario_files():
     load_scenario(path.stem, fast=True)
@@ -48,7 +48,7 @@ def test_import_headsim_does_not_import_rerun(tmp_path: Path) -> None:
 def test_an_unrecorded_runs_imports_and_scenarios_do_not_import_rerun(tmp_path: Path) -> None:
     assert loaded_rerun(UNRECORDED_RUN_IMPORTS, tmp_path) == []
     # The check can fail: the recorder's module brings Rerun with it.
-    assert "rerun" in loaded_rerun("import headsim.run.recording", tmp_path)
+    assert "rerun" in loaded_rerun("import headsim.runs.recording", tmp_path)
 
 
 def test_a_run_imports_rerun_only_when_it_records(tmp_path: Path) -> None:

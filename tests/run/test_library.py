@@ -14,9 +14,9 @@ import pytest
 
 import headsim
 from headsim.cli import main
-from headsim.run.library import dotted_overrides
-from headsim.run.outcomes import MeasurementRow
-from headsim.run.result import RunResult
+from headsim.runs.library import dotted_overrides
+from headsim.runs.outcomes import MeasurementRow
+from headsim.runs.result import RunResult
 
 
 def plain_python(code: str, cwd: Path) -> str:
@@ -32,7 +32,7 @@ def plain_python(code: str, cwd: Path) -> str:
 def test_import_headsim_loads_neither_numpy_nor_mujoco(tmp_path: Path) -> None:
     out = plain_python(
         "import sys, headsim\n"
-        "print(sorted(m for m in ('numpy', 'mujoco', 'cv2', 'headsim.run.runner') if m in sys.modules))",
+        "print(sorted(m for m in ('numpy', 'mujoco', 'cv2', 'headsim.runs.runner') if m in sys.modules))",
         tmp_path,
     )
     assert out.strip() == "[]"
@@ -131,17 +131,18 @@ def test_a_loaded_scenario_keeps_its_seed() -> None:
         headsim.run(scenario, seed=3)
 
 
-def test_the_package_run_stays_a_package_too() -> None:
-    import headsim.run.runner
+def test_headsim_run_is_the_function_and_the_runs_package_is_apart() -> None:
+    import headsim.runs.runner
+    from headsim.runs.library import run
 
-    assert callable(headsim.run) and headsim.run.runner.run_scenario is not None
+    assert headsim.run is run and headsim.runs.runner.run_scenario is not None
     assert headsim.HeadSim.__name__ == "HeadSim" and "load_scenario" in dir(headsim)
 
 
 def test_a_result_in_a_notebook_is_short_and_its_summary_is_summary_txt(
     fast_run: RunResult, tmp_path: Path
 ) -> None:
-    from headsim.run.accuracy import summarise
+    from headsim.runs.accuracy import summarise
 
     rms = summarise(fast_run.records).error_pct_of_depth_rms
     n = len(fast_run.records)
@@ -179,7 +180,7 @@ def test_plot_draws_each_measured_error_at_its_depth_under_agg(fast_run: RunResu
 
 def test_a_type_checker_sees_headsim_run_as_the_function(tmp_path: Path) -> None:
     """mypy on a user's script: ``headsim.run(...)`` is a call returning a RunResult, not
-    "Module not callable" (the package headsim.run is callable only at run time)."""
+    "Module not callable"."""
     from mypy import api
 
     script = tmp_path / "user.py"
@@ -188,4 +189,4 @@ def test_a_type_checker_sees_headsim_run_as_the_function(tmp_path: Path) -> None
         [str(script), "--cache-dir", str(tmp_path / "cache"), "--follow-imports", "silent"]
     )
     assert status == 0 and "Module not callable" not in out, out + err
-    assert 'Revealed type is "headsim.run.result.RunResult"' in out, out
+    assert 'Revealed type is "headsim.runs.result.RunResult"' in out, out

@@ -12,7 +12,7 @@ import rerun as rr
 from rerun.chunk import RrdReader
 
 from headsim.cli import main
-from headsim.run import mjcf_rerun
+from headsim.runs import mjcf_rerun
 from headsim.sim.model import HEAD_PREFIX, MODELS_DIR
 
 MODEL_FILES = sorted(MODELS_DIR.glob("*.xml"))

@@ -9,8 +9,8 @@ import pytest
 from headsim.active.calibration_report import CalibrationReport, PositionOutcome
 from headsim.active.failure import Failure, FailureCause
 from headsim.estimators.result import Status
-from headsim.run.outcomes import RunRenders
-from headsim.run.result import RunResult
+from headsim.runs.outcomes import RunRenders
+from headsim.runs.result import RunResult
 from headsim.scenario.loading import load_scenario
 from headsim.sim.events import RenderCounts
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from headsim.errors import BadInput, DiskFull, OutputNotWritable
-from headsim.run.outputs import Outputs, disk_full, file_size_limit
+from headsim.runs.outputs import Outputs, disk_full, file_size_limit
 
 
 def read_only_dir(tmp_path: Path) -> Path:
@@ -89,7 +89,7 @@ def test_the_file_size_limit_is_read_and_named() -> None:
     soft, _ = resource.getrlimit(resource.RLIMIT_FSIZE)
     assert file_size_limit() == (None if soft == resource.RLIM_INFINITY else soft)
     code = (
-        "import errno; from headsim.run.outputs import disk_full, file_size_limit; "
+        "import errno; from headsim.runs.outputs import disk_full, file_size_limit; "
         "print(file_size_limit()); "
         "print(disk_full('/tmp/x.json', 120, OSError(errno.EFBIG, 'too large')))"
     )

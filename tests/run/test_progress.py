@@ -10,8 +10,8 @@ import sys
 from pathlib import Path
 
 from headsim.active.events import FixationStarted, PhaseStarted
-from headsim.run.events import Hub, RunFinished
-from headsim.run.progress import Counter, RunProgress, Status, time_left
+from headsim.runs.events import Hub, RunFinished
+from headsim.runs.progress import Counter, RunProgress, Status, time_left
 from headsim.scenario.loading import load_scenario
 
 DATA = Path(__file__).resolve().parents[1] / "data"

@@ -19,7 +19,7 @@ import pytest
 import rerun as rr
 from rerun.chunk import RrdReader
 
-from headsim.run.recording import RowColumns
+from headsim.runs.recording import RowColumns
 
 from .rrd import rows
 

@@ -12,7 +12,7 @@ from rerun.chunk import RrdReader
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.estimators.result import Status
-from headsim.run.recording_layout import calibration_markdown
+from headsim.runs.recording_layout import calibration_markdown
 from headsim.sim.events import RenderCounts
 
 

@@ -18,9 +18,9 @@ import pytest
 from rerun.chunk import RrdReader
 
 from headsim.cli import main
-from headsim.run import mjcf_textures
-from headsim.run.recording_layout import FOVEA_HALF_PX
-from headsim.run.recording_room import EYE_COLOURS, crop
+from headsim.runs import mjcf_textures
+from headsim.runs.recording_layout import FOVEA_HALF_PX
+from headsim.runs.recording_room import EYE_COLOURS, crop
 from headsim.scenario.loading import load_scenario
 from headsim.sim import names
 from headsim.sim.simulator import HeadSim

@@ -7,10 +7,10 @@ from __future__ import annotations
 import pytest
 
 from headsim.active.events import PhaseStarted
-from headsim.run.events import Stamp
-from headsim.run.result import RunResult
-from headsim.run.runner import run_scenario
-from headsim.run.serialise import results_payload
+from headsim.runs.events import Stamp
+from headsim.runs.result import RunResult
+from headsim.runs.runner import run_scenario
+from headsim.runs.serialise import results_payload
 from headsim.scenario.loading import load_scenario
 from headsim.sim.events import ImageKind, ImageTaken
 from headsim.sim.simulator import HeadSim

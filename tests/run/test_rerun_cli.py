@@ -13,7 +13,7 @@ import pytest
 from rerun.chunk import RrdReader
 
 from headsim.cli import main
-from headsim.run.rerun_cli import (
+from headsim.runs.rerun_cli import (
     DEFAULT_URL,
     RecordingArgumentError,
     add_recording_arguments,

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
-from headsim.run.results_reference import (
+from headsim.runs.results_reference import (
     MARKERLESS_ONLY,
     RESULTS_FIELDS,
     documented_paths,

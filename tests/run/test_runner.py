@@ -12,7 +12,7 @@ import pytest
 from shipped_runs import ShippedRun
 
 from headsim.cli import main
-from headsim.run.results_reference import (
+from headsim.runs.results_reference import (
     FAILED_ONLY,
     MARKERLESS_ONLY,
     RESULTS_FIELDS,
@@ -20,7 +20,7 @@ from headsim.run.results_reference import (
     experiment_fields,
     undocumented,
 )
-from headsim.run.serialise import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
+from headsim.runs.serialise import MEASUREMENT_KEYS, RESULTS_KEYS, RESULTS_SCHEMA
 from headsim.scenario.loading import load_scenario, scenario_files
 
 FILES = scenario_files()

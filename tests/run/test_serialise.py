@@ -24,8 +24,8 @@ from headsim.files import to_jsonable
 from headsim.procedures.model2 import Model2Result
 from headsim.procedures.pursuit import PursuitResult
 from headsim.procedures.tracking import TrackingResult
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.serialise import MEASUREMENT_KEYS, experiment_block, measurement_entry
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.serialise import MEASUREMENT_KEYS, experiment_block, measurement_entry
 from headsim.sim.events import RenderCounts
 
 from .helpers import LOST, measurement

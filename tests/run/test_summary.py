@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.estimators.result import Status
-from headsim.run.outcomes import RunRenders
-from headsim.run.result import RunResult
-from headsim.run.summary import format_table, summary_text
+from headsim.runs.outcomes import RunRenders
+from headsim.runs.result import RunResult
+from headsim.runs.summary import format_table, summary_text
 from headsim.scenario.loading import load_scenario
 from headsim.sim.events import RenderCounts
 
@@ -41,7 +41,7 @@ def test_a_failed_calibration_is_the_summarys_problem() -> None:
 def test_the_headline_gives_measured_of_accepted_and_of_drawn_and_the_edge_apart() -> None:
     from dataclasses import replace
 
-    from headsim.run.outcomes import MeasurementRecord
+    from headsim.runs.outcomes import MeasurementRecord
 
     from .helpers import LOST, measurement
 

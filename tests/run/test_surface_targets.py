@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 
 from headsim.cli import main
-from headsim.run.landing import Landing
-from headsim.run.outcomes import FALSE_FIXATION_MIN_M
-from headsim.run.runner import run_scenario
-from headsim.run.surface import Look, false_fixation_limit_m, score_fixation
+from headsim.runs.landing import Landing
+from headsim.runs.outcomes import FALSE_FIXATION_MIN_M
+from headsim.runs.runner import run_scenario
+from headsim.runs.surface import Look, false_fixation_limit_m, score_fixation
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.surface_targets import Click
 from headsim.scenario.tables import ScenarioError

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from headsim.run.targets import marker_target
+from headsim.runs.targets import marker_target
 from headsim.sim.simulator import HeadSim
 
 

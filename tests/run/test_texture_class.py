@@ -10,8 +10,8 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from headsim.run.landing import ray_direction_world
-from headsim.run.texture_class import patch_hidden, texture_class, texture_kinds
+from headsim.runs.landing import ray_direction_world
+from headsim.runs.texture_class import patch_hidden, texture_class, texture_kinds
 from headsim.scenario.surface_targets import camera_centre, visible
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim

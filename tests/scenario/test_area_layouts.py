@@ -8,7 +8,7 @@ import pytest
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
 from headsim.procedures.relative import relative_positioning
-from headsim.run.context import PARKED_WORLD_M
+from headsim.runs.context import PARKED_WORLD_M
 from headsim.scenario.area_layouts import area_layout, reference_angles
 from headsim.sim import names
 from headsim.sim.settings import paper_head

@@ -11,7 +11,7 @@ from headsim.estimators.calibration import calibrate_lines_of_sight
 from headsim.geometry.camera_model import PinholeCamera
 from headsim.geometry.kinematics import world_to_head
 from headsim.geometry.synthetic import StereoHead, observe, quantise
-from headsim.run.runner import calibrate_scenario
+from headsim.runs.runner import calibrate_scenario
 from headsim.scenario.calibration_design import near_far_depths, near_fraction, offset_std_limit
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.tables import ScenarioError

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from headsim.run.runner import run_scenario
+from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
 from headsim.scenario.spec import experiment_record
 from headsim.scenario.tables import ScenarioError

@@ -186,7 +186,7 @@ def test_an_unknown_procedure_is_named_with_every_registered_one(tmp_path: Path)
 
 
 def test_servo_windows_reach_the_servo_and_are_recorded_when_set(tmp_path: Path) -> None:
-    from headsim.run.context import servo_config
+    from headsim.runs.context import servo_config
     from headsim.scenario.spec import servo_record
 
     default = load_scenario(write_scenario(tmp_path, MINIMAL))

@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from headsim.run.mjcf_textures import mesh_mesh
+from headsim.runs.mjcf_textures import mesh_mesh
 from headsim.scenario.loading import load_scenario, scenario_from_document
 from headsim.scenario.surface_targets import (
     NotOnSurface,

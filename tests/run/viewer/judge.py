@@ -44,7 +44,7 @@ Region = tuple[int, int, int, int]  # x0, y0, x1, y1, px
 
 
 def view_regions(size: tuple[int, int] = WINDOW) -> dict[str, Region]:
-    """Each view's drawing area in a screenshot of :func:`headsim.run.recording_layout.blueprint`.
+    """Each view's drawing area in a screenshot of :func:`headsim.runs.recording_layout.blueprint`.
 
     The layout's shares: columns 2:3; right column rows 3:2:2 (cameras,
     plots, results), cameras side by side, three plots side by side.
@@ -148,7 +148,7 @@ def judge(image: np.ndarray) -> ViewJudgement:
 
 def room_view_regions(size: tuple[int, int] = WINDOW) -> dict[str, Region]:
     """Each view's drawing area in a screenshot of
-    :func:`headsim.run.recording_layout.room_blueprint`: columns 2:3; right column rows
+    :func:`headsim.runs.recording_layout.room_blueprint`: columns 2:3; right column rows
     3:2:2:2 (cameras; the four foveal views; plots and the status; tabs)."""
     width, height = size
     top, bottom = TOP_BAR_PX, height - TIME_PANEL_PX

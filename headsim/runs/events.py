@@ -24,7 +24,7 @@ from headsim.sim.events import ImageKind, ImageTaken, RenderCounts
 
 if TYPE_CHECKING:
     from headsim.active.calibration_report import CalibrationReport
-    from headsim.run.outcomes import MeasurementRecord, RunOutcome
+    from headsim.runs.outcomes import MeasurementRecord, RunOutcome
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,7 @@
   at each phase, at most one per ``interval_s`` in between (or one per item),
   and one at the end.
 - :class:`RunProgress`: a :class:`Counter` of a run's fixations, subscribed
-  to the run's events (:mod:`headsim.run.events`).
+  to the run's events (:mod:`headsim.runs.events`).
 - :class:`Status`: a command's phase messages (``headsim study``, ``bench``,
   ``reproduce``), each a line with the seconds since the start; a transient
   status is one redrawn tqdm line on a terminal instead.
@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any, TextIO
 
 from headsim.active.events import FixationStarted, PhaseStarted
 from headsim.errors import printable
-from headsim.run.events import RunFinished, Stamp
+from headsim.runs.events import RunFinished, Stamp
 
 if TYPE_CHECKING:
     from tqdm import tqdm
@@ -161,7 +161,7 @@ class Counter:
 
 class RunProgress:
     """A run's fixations as a :class:`Counter`, following the run's events (a
-    :class:`headsim.run.events.Subscriber`): a line, or the bar's title, at each phase."""
+    :class:`headsim.runs.events.Subscriber`): a line, or the bar's title, at each phase."""
 
     def __init__(self, counter: Counter) -> None:
         self.counter = counter

@@ -17,7 +17,7 @@ from collections.abc import Iterator, Mapping
 from typing import Any
 
 from headsim.procedures.contract import procedures
-from headsim.run.outcomes import SURFACE_FIELDS
+from headsim.runs.outcomes import SURFACE_FIELDS
 
 _COUNTS = "full frames, windows, retakes and previews"
 

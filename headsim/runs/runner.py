@@ -1,11 +1,11 @@
 """Running a scenario: calibrate if asked, run the procedure, collect the results.
 
-The calibration is :mod:`headsim.run.calibrate`'s (or a calibration file's, as
+The calibration is :mod:`headsim.runs.calibrate`'s (or a calibration file's, as
 the scenario reader read it); the procedure is found by its name in
 :mod:`headsim.procedures.contract` (the built-in ones are :mod:`headsim.procedures`).
 What a run shows while it goes (progress, the Rerun recording) follows its
 events: the runner gives the simulator (and through it the servos and the
-procedure) a :class:`headsim.run.events.Hub` as event sink, and the hub passes
+procedure) a :class:`headsim.runs.events.Hub` as event sink, and the hub passes
 every event on to the run's subscribers.  The runner adds its own events: the
 calibration's report and the finished run.
 """
@@ -19,11 +19,11 @@ from dataclasses import replace
 from headsim.active.calibration_file import head_hash, read_calibration
 from headsim.active.calibration_report import CalibrationReport
 from headsim.procedures.contract import get
-from headsim.run.calibrate import calibrate
-from headsim.run.context import told
-from headsim.run.events import CalibrationDone, Hub, RunFinished, Subscriber
-from headsim.run.outcomes import MeasurementRecord, RunRenders
-from headsim.run.result import RunResult
+from headsim.runs.calibrate import calibrate
+from headsim.runs.context import told
+from headsim.runs.events import CalibrationDone, Hub, RunFinished, Subscriber
+from headsim.runs.outcomes import MeasurementRecord, RunRenders
+from headsim.runs.result import RunResult
 from headsim.scenario.spec import Scenario
 from headsim.sim.events import RenderCounts
 

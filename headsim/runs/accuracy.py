@@ -16,7 +16,7 @@ import numpy as np
 
 from headsim.active.failure import Failure
 from headsim.active.measurement import Measurement
-from headsim.run.outcomes import MeasurementRecord
+from headsim.runs.outcomes import MeasurementRecord
 
 #: Depth bands of the honest headline, m: every target counts in exactly one.
 DEPTH_BANDS_M = ((0.0, 0.6), (0.6, 1.0), (1.0, math.inf))

@@ -1,6 +1,6 @@
 """A MuJoCo model's textured primitives as Rerun meshes that carry their texture.
 
-:mod:`headsim.run.mjcf_rerun` draws primitives in one colour each (a texture as its
+:mod:`headsim.runs.mjcf_rerun` draws primitives in one colour each (a texture as its
 mean colour); for a room (:mod:`headsim.sim.textured_scene`) the texture is what the
 eyes correlate on, so :func:`textured_mesh` turns a plane, box, cylinder or sphere
 whose material has an RGB texture into a ``Mesh3D`` in the geom's frame, with texture

@@ -7,9 +7,9 @@ import html
 import math
 from typing import TYPE_CHECKING
 
-from headsim.run.accuracy import summarise
-from headsim.run.outcomes import RunOutcome
-from headsim.run.summary import band_figure, summary_text
+from headsim.runs.accuracy import summarise
+from headsim.runs.outcomes import RunOutcome
+from headsim.runs.summary import band_figure, summary_text
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -108,7 +108,7 @@ class _ViewerStreams:
 
 
 def viewer_stream_opened() -> None:
-    """Note a stream to a viewer opened (:class:`headsim.run.recording.Recorder`)."""
+    """Note a stream to a viewer opened (:class:`headsim.runs.recording.Recorder`)."""
     _ViewerStreams.open += 1
 
 

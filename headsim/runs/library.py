@@ -9,7 +9,7 @@ What ``headsim.load_scenario``, ``headsim.run`` and ``docs/python.md`` stand on:
     columns = result.table()                 # pandas.DataFrame(columns)
 
 :func:`run` goes through the same runner as ``headsim run``
-(:func:`headsim.run.runner.run_scenario`) and writes nothing unless asked:
+(:func:`headsim.runs.runner.run_scenario`) and writes nothing unless asked:
 ``out`` for results.json and summary.txt (the bytes ``headsim run`` writes),
 ``record`` for a Rerun recording.  Bad input raises
 :class:`headsim.scenario.tables.ScenarioError`, one line naming the field and
@@ -22,7 +22,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from headsim.run.result import RunResult
+from headsim.runs.result import RunResult
 from headsim.scenario.loading import load_scenario as _load_scenario
 from headsim.scenario.spec import Scenario
 from headsim.scenario.tables import ScenarioError
@@ -94,11 +94,11 @@ def run(
     seed give the same measurements.
     """
     from headsim.files import write_json_atomic, write_text_atomic
-    from headsim.run.events import Subscriber
-    from headsim.run.outputs import Outputs
-    from headsim.run.runner import run_scenario
-    from headsim.run.serialise import results_payload
-    from headsim.run.summary import summary_text
+    from headsim.runs.events import Subscriber
+    from headsim.runs.outputs import Outputs
+    from headsim.runs.runner import run_scenario
+    from headsim.runs.serialise import results_payload
+    from headsim.runs.summary import summary_text
 
     if isinstance(scenario, Scenario):
         for name, given, drawn in (("seed", seed, scenario.seed), ("fast", fast, scenario.fast)):
@@ -117,12 +117,12 @@ def run(
         rrd = None if record is None else outputs.file(record, "record", atomic=False)
         subscribers: list[Subscriber] = []
         if progress:
-            from headsim.run.progress import Counter, RunProgress
+            from headsim.runs.progress import Counter, RunProgress
 
             subscribers.append(RunProgress(Counter(scenario.fixations, unit="fixations")))
         recorder = None
         if rrd is not None:
-            from headsim.run.recording import Recorder
+            from headsim.runs.recording import Recorder
 
             recorder = Recorder(rrd, scenario)
             subscribers.append(recorder)

@@ -10,11 +10,11 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from headsim.active.calibration_report import CalibrationReport
-from headsim.run import mjcf_rerun
+from headsim.runs import mjcf_rerun
 from headsim.scenario.spec import Scenario
 from headsim.sim.model import neck_of
 
-#: Half the side of a recorded fovea, px (:mod:`headsim.run.recording_room`; the
+#: Half the side of a recorded fovea, px (:mod:`headsim.runs.recording_room`; the
 #: template's half side is 20: the fovea is twice its size).
 FOVEA_HALF_PX = 40
 
@@ -123,7 +123,7 @@ def blueprint(scenario: Scenario | None = None) -> rrb.Blueprint:
 
 
 def room_blueprint(scenario: Scenario) -> rrb.Blueprint:
-    """A room run's layout (:mod:`headsim.run.recording_room`): the textured room in 3-D
+    """A room run's layout (:mod:`headsim.runs.recording_room`): the textured room in 3-D
     with the landing rays; both cameras; each eye's fovea beside camera 1's template and
     camera 2's matched patch; the match scores, the match status and the servo error;
     the joints, the measurements and the documents in tabs."""

@@ -1,6 +1,6 @@
 """results.json from the typed results: the one place that knows its keys and their order.
 
-``results.json`` (:mod:`headsim.run.results_reference` documents every key) holds
+``results.json`` (:mod:`headsim.runs.results_reference` documents every key) holds
 no wall time and no timestamp: the same scenario, seed and software give the
 same bytes.  SI units (m, rad, px); NaN becomes null when
 :func:`headsim.files.write_json_atomic` writes it.  The ``calibration`` block,
@@ -21,8 +21,8 @@ import numpy as np
 
 from headsim.active.calibration_report import calibration_block
 from headsim.procedures.contract import get
-from headsim.run.accuracy import MeasurementSummary, summaries
-from headsim.run.outcomes import FixationScore, MeasurementRecord, RunOutcome
+from headsim.runs.accuracy import MeasurementSummary, summaries
+from headsim.runs.outcomes import FixationScore, MeasurementRecord, RunOutcome
 from headsim.scenario.spec import experiment_record
 from headsim.sim.settings import settings_record
 from headsim.version import __version__
@@ -30,7 +30,7 @@ from headsim.version import __version__
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
 RESULTS_SCHEMA = "headsim.results/2"
 
-#: Keys of results.json and of each measurement in it (:mod:`headsim.run.results_reference` gives each its meaning).
+#: Keys of results.json and of each measurement in it (:mod:`headsim.runs.results_reference` gives each its meaning).
 RESULTS_KEYS = (
     "schema",
     "scenario",

@@ -18,9 +18,9 @@ Entity paths (docs/how-to/record.md lists them):
 - ``/world/landing/rays`` (each eye's goal ray from its true centre to the point it
   landed on, or 3 m where it hit nothing), ``/world/landing/points`` (the landed points)
   and ``/world/landing/targets`` (the intended ones): cyan camera 1, magenta camera 2,
-  red a false fixation (:mod:`headsim.run.surface`), every fixation so far.
+  red a false fixation (:mod:`headsim.runs.surface`), every fixation so far.
 
-The landings are truth (:class:`headsim.run.surface.LandingLog`, the scorer's own rule):
+The landings are truth (:class:`headsim.runs.surface.LandingLog`, the scorer's own rule):
 for the record only.
 """
 
@@ -34,10 +34,10 @@ import rerun as rr
 
 from headsim.active.events import Detected, FixationStarted, Matched, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
-from headsim.run.events import MeasurementRecorded, Stamp
-from headsim.run.landing import Landing
-from headsim.run.outcomes import MeasurementRecord
-from headsim.run.recording_layout import (
+from headsim.runs.events import MeasurementRecorded, Stamp
+from headsim.runs.landing import Landing
+from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.recording_layout import (
     FOVEA_HALF_PX,
     GREEN,
     ORANGE,
@@ -45,7 +45,7 @@ from headsim.run.recording_layout import (
     UI_RADIUS,
     UI_RADIUS_SMALL,
 )
-from headsim.run.surface import LandingLog
+from headsim.runs.surface import LandingLog
 from headsim.sim import names
 from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import MatchStatus, Template
@@ -81,7 +81,7 @@ def template_image(template: Template) -> np.ndarray:
 
 
 class RoomRecording:
-    """The room's entities, logged to ``rec`` by the :class:`~headsim.run.recording.Recorder`
+    """The room's entities, logged to ``rec`` by the :class:`~headsim.runs.recording.Recorder`
     (which hands on the events); ``later(fn, *args)`` runs ``fn`` on the recording's
     thread (JPEG encoding), after what was given before."""
 

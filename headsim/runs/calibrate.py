@@ -28,15 +28,15 @@ from headsim.active.failure import Failure
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
 from headsim.estimators.result import Status
-from headsim.run.context import (
+from headsim.runs.context import (
     PAPER,
     PARKED_WORLD_M,
     servo_config,
     simulator,
     told,
 )
-from headsim.run.events import CalibrationDone, Hub
-from headsim.run.targets import marker_target
+from headsim.runs.events import CalibrationDone, Hub
+from headsim.runs.targets import marker_target
 from headsim.scenario.calibration_design import near_far_depths, near_fraction
 from headsim.scenario.spec import STREAM_CALIBRATION, STREAM_DEPTH_NOISE, Scenario
 from headsim.sim import names

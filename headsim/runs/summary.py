@@ -1,7 +1,7 @@
 """The summary table of a run, for people: the calibration, the measurements, the experiment.
 
-It reads the typed results (:mod:`headsim.run.outcomes`); results.json is
-written by :mod:`headsim.run.serialise`.  The figures of the paper are shown
+It reads the typed results (:mod:`headsim.runs.outcomes`); results.json is
+written by :mod:`headsim.runs.serialise`.  The figures of the paper are shown
 beside ours for its head; lengths in mm, errors in % of depth.
 """
 
@@ -11,11 +11,11 @@ import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.procedures.contract import get
-from headsim.run.accuracy import DepthBand, summaries
-from headsim.run.outcomes import RunOutcome, SurfaceDraw, TextureClassStats, fixation_stats
-from headsim.run.table import cell as _cell
-from headsim.run.table import format_table
-from headsim.run.table import mm as _mm
+from headsim.runs.accuracy import DepthBand, summaries
+from headsim.runs.outcomes import RunOutcome, SurfaceDraw, TextureClassStats, fixation_stats
+from headsim.runs.table import cell as _cell
+from headsim.runs.table import format_table
+from headsim.runs.table import mm as _mm
 from headsim.scenario.spec import Scenario, TargetAcceptance
 from headsim.sim.events import RenderCounts
 

@@ -1,6 +1,6 @@
 """Recording a run to a Rerun ``.rrd`` file, replayed with ``rerun FILE.rrd``.
 
-A :class:`Recorder` is a :class:`headsim.run.events.Subscriber`: it logs the
+A :class:`Recorder` is a :class:`headsim.runs.events.Subscriber`: it logs the
 experiment's own images and detections as the procedures make them (no
 render is made for the record) and the results as they come.  Entity paths
 and timelines (docs/how-to/record.md lists them):
@@ -27,15 +27,15 @@ and timelines (docs/how-to/record.md lists them):
 - ``/results/scenario``, ``/results/calibration``, ``/results/summary``,
   ``/results/measurements`` (markdown text; each shown by its own view);
 - ``/world/model/<body>`` (Transform3D world_from_body when it moved) and
-  its geoms (:mod:`headsim.run.mjcf_rerun`): the head and the scene in 3-D.
+  its geoms (:mod:`headsim.runs.mjcf_rerun`): the head and the scene in 3-D.
 
 The :class:`Recorder` follows the events and logs the head, its scene and the
 results; the rows logged with every image are kept and sent as columns
 (:class:`RowColumns`).  The layout, the palette and the text documents are in
-:mod:`headsim.run.recording_layout`.
+:mod:`headsim.runs.recording_layout`.
 
 The stream goes to a file, a running viewer (``--connect``) or a served web
-viewer (``--serve``), or several (:class:`headsim.run.rerun_cli.RecordingTarget`).
+viewer (``--serve``), or several (:class:`headsim.runs.rerun_cli.RecordingTarget`).
 
 The stream is written as it goes and flushed after every measurement; it is
 closed with its footer when the run ends, also when it is interrupted
@@ -63,10 +63,10 @@ from headsim.active.events import Detected, FixationStarted, PhaseStarted
 from headsim.active.measurement import HeadKnowledge
 from headsim.errors import interrupted
 from headsim.procedures.contract import get
-from headsim.run import mjcf_rerun
-from headsim.run.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
-from headsim.run.outcomes import MeasurementRecord, RunOutcome
-from headsim.run.recording_layout import (
+from headsim.runs import mjcf_rerun
+from headsim.runs.events import CalibrationDone, MeasurementRecorded, RunFinished, Stamp
+from headsim.runs.outcomes import MeasurementRecord, RunOutcome
+from headsim.runs.recording_layout import (
     GREEN,
     GREY,
     ORANGE,
@@ -80,8 +80,8 @@ from headsim.run.recording_layout import (
     recording_id,
     scenario_markdown,
 )
-from headsim.run.recording_room import RoomRecording
-from headsim.run.rerun_cli import (
+from headsim.runs.recording_room import RoomRecording
+from headsim.runs.rerun_cli import (
     INTERRUPTED_VIEWER_WAIT_S,
     VIEWER_WAIT_S,
     RecordingTarget,
@@ -91,7 +91,7 @@ from headsim.run.rerun_cli import (
     viewer_stream_closed,
     viewer_stream_opened,
 )
-from headsim.run.summary import summary_text
+from headsim.runs.summary import summary_text
 from headsim.scenario.spec import Scenario
 from headsim.sim import names
 from headsim.sim.events import ImageKind, ImageTaken
@@ -124,7 +124,7 @@ class Recorder:
         recording: str | None = None,
     ):
         """``path``: the .rrd file; or ``target``: a file, a viewer to connect to, a server
-        to host (any of them; :mod:`headsim.run.rerun_cli`).  ``recording``: the recording
+        to host (any of them; :mod:`headsim.runs.rerun_cli`).  ``recording``: the recording
         id (default :func:`recording_id`)."""
         if target is None:
             if path is None:
@@ -200,7 +200,7 @@ class Recorder:
         self._background = ThreadPoolExecutor(1, thread_name_prefix="headsim-recording")
         self._pending: list[Future[None]] = []
         self._log_static()
-        #: A room run's foveas, matches and landings (:mod:`headsim.run.recording_room`).
+        #: A room run's foveas, matches and landings (:mod:`headsim.runs.recording_room`).
         self.room = (
             RoomRecording(self.rec, self._later, self.jpeg_quality)
             if scenario.scene.room is not None
@@ -209,7 +209,7 @@ class Recorder:
 
     # -- the subscriber -----------------------------------------------------------
     def notify(self, event: object, at: Stamp) -> None:
-        """Log ``event`` (see :mod:`headsim.run.events`) at ``at``'s frame and step."""
+        """Log ``event`` (see :mod:`headsim.runs.events`) at ``at``'s frame and step."""
         from headsim.live.gaze import PursuitFrame  # the live pursuit's frames
 
         if isinstance(event, PhaseStarted):

@@ -1,7 +1,7 @@
 """What a run found, as types: each measurement's record, the renders, the run.
 
 Frozen dataclasses, read by the summary, the recording and the studies;
-:mod:`headsim.run.serialise` is the one place that turns them into
+:mod:`headsim.runs.serialise` is the one place that turns them into
 results.json (docs/reference/results-json.md documents every key).  Each
 procedure's own result is its module's (:mod:`headsim.procedures`); the
 calibration's report is :mod:`headsim.active.calibration_report`'s.  Units are
@@ -390,7 +390,7 @@ class RunRenders:
 
 @dataclass(frozen=True)
 class RunOutcome:
-    """Everything a run found (:class:`headsim.run.result.RunResult` shows it).  ``failures``: why the run failed, one line each (empty: ok).
+    """Everything a run found (:class:`headsim.runs.result.RunResult` shows it).  ``failures``: why the run failed, one line each (empty: ok).
 
     ``experiment``: the procedure's own result (None: the procedure did not run,
     the calibration failed).  ``renders``: every image drawn, by phase and kind.

@@ -26,7 +26,7 @@ colour of its texture.  Body poses are ``Transform3D`` world_from_body at
 ``ROOT/<body>`` (a flat list under ``ROOT``, one entity per body), logged
 by :class:`BodyPoses` whenever a body moved since it was last logged.
 With ``textured=True`` a textured plane, box, cylinder or sphere (a room's) is a
-Mesh3D that carries its texture instead (:mod:`headsim.run.mjcf_textures`).
+Mesh3D that carries its texture instead (:mod:`headsim.runs.mjcf_textures`).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ import mujoco
 import numpy as np
 import rerun as rr
 
-from headsim.run.mjcf_textures import TEXTURED_KINDS, textured_mesh
+from headsim.runs.mjcf_textures import TEXTURED_KINDS, textured_mesh
 
 #: Entity path under which the model's bodies are logged.
 ROOT = "/world/model"
@@ -239,7 +239,7 @@ def log_model_geometry(
     a Mesh3D at ``ROOT/<body>/<geom>`` with its Transform3D body_from_geom.
     ``static=False`` logs them at the stream's current time instead.  ``textured``: a
     plane, box, cylinder or sphere with an RGB texture is a Mesh3D carrying it
-    (:mod:`headsim.run.mjcf_textures`) at ``ROOT/<body>/<geom>``, as a mesh is.
+    (:mod:`headsim.runs.mjcf_textures`) at ``ROOT/<body>/<geom>``, as a mesh is.
     """
     logged: list[LoggedGeom] = []
     invisible: list[str] = []

@@ -26,10 +26,10 @@ import numpy as np
 from headsim.active.events import Detected, PhaseStarted
 from headsim.active.markerless import MarkerlessPair
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
-from headsim.run.context import PARKED_WORLD_M, record_measurement, simulator
-from headsim.run.events import Hub, Stamp
-from headsim.run.landing import Landing, fixation_error, landing, vergence_error_deg
-from headsim.run.outcomes import (
+from headsim.runs.context import PARKED_WORLD_M, record_measurement, simulator
+from headsim.runs.events import Hub, Stamp
+from headsim.runs.landing import Landing, fixation_error, landing, vergence_error_deg
+from headsim.runs.outcomes import (
     FALSE_FIXATION_FRACTION,
     FALSE_FIXATION_MIN_M,
     FixationScore,
@@ -38,8 +38,8 @@ from headsim.run.outcomes import (
     by_texture,
     fixation_stats,
 )
-from headsim.run.targets import marker_target
-from headsim.run.texture_class import TEXTURE_CLASSES, texture_class, texture_kinds
+from headsim.runs.targets import marker_target
+from headsim.runs.texture_class import TEXTURE_CLASSES, texture_class, texture_kinds
 from headsim.scenario.spec import (
     MARKER_BODIES,
     STREAM_CLICKS,
@@ -370,7 +370,7 @@ def measure_surface_targets(
 
 
 def _classed(sim: HeadSim, scenario: Scenario, drawn: SurfaceDraw) -> SurfaceDraw:
-    """``drawn`` with each target's texture class (:mod:`headsim.run.texture_class`),
+    """``drawn`` with each target's texture class (:mod:`headsim.runs.texture_class`),
     decided at the start pose (truth, for the by-texture table)."""
     room = scenario.scene.room
     kinds = {} if room is None else texture_kinds(room)

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from headsim.run.landing import ray_direction_world
+from headsim.runs.landing import ray_direction_world
 from headsim.scenario.surface_targets import camera_centre, cast, visible
 from headsim.sim.simulator import HeadSim
 from headsim.sim.textured_scene import RoomSpec

@@ -11,8 +11,8 @@ from headsim import paper
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import Model2Config
 from headsim.active.servo_types import ServoConfig
-from headsim.run.events import Hub, MeasurementRecorded
-from headsim.run.outcomes import FixationScore, MeasurementRecord
+from headsim.runs.events import Hub, MeasurementRecorded
+from headsim.runs.outcomes import FixationScore, MeasurementRecord
 from headsim.scenario.spec import Scenario
 from headsim.sim.simulator import HeadSim
 
