@@ -35,12 +35,14 @@ from pathlib import Path
 
 #: "Adding a procedure", read from CONTRIBUTING.md: (the file, words that ask for it).
 PROCEDURE_RECIPE = (
-    ("headsim/procedures/NAME.py", "The run**, in `headsim/procedures/NAME.py`"),
-    ("headsim/procedures/__init__.py", "Import the module in `headsim/procedures/__init__.py`"),
-    ("docs/reference/results-json.md", "document the keys in docs/reference/results-json.md"),
-    ("scenarios/NAME.toml", "A scenario file** in `scenarios/`"),
-    ("tests/procedures/test_NAME.py", "Tests** under `tests/procedures/`"),
-    ("tests/scenario/test_NAME.py", "with a test under `tests/scenario/`"),
+    ("headsim/procedures/NAME.py", "**The module**, `headsim/procedures/NAME.py`"),
+    ("scenarios/NAME.toml", "**A scenario file** in `scenarios/`"),
+    ("tests/procedures/test_NAME.py", "**Its tests**, `tests/procedures/test_NAME.py`"),
+)
+#: "Adding an image imperfection", read from CONTRIBUTING.md likewise.
+IMPERFECTION_RECIPE = (
+    ("headsim/sim/imperfections/NAME.py", "is one module in `headsim/sim/imperfections/`"),
+    ("tests/sim/test_NAME.py", "adding one means the module and its test"),
 )
 #: A user's own head, read from docs/how-to/own-head.md: the MJCF file and its scenario.
 OWN_HEAD = ("my_head.xml", "scenarios/NAME.toml")
@@ -188,7 +190,8 @@ def main() -> int:
         print("a head: CONTRIBUTING.md has a recipe ('Adding a head'); count it by hand")
 
     print()
-    if section(contributing, "Adding an imperfection") is None:
+    imperfection = section(contributing, "Adding an image imperfection")
+    if imperfection is None:
         named = sorted(f for f, found in index.items() if IMPERFECTION in found)
         package = [f for f in named if f.startswith("headsim/")]
         areas = sorted({f.split("/")[1] for f in package if f.count("/") > 1})
@@ -200,7 +203,11 @@ def main() -> int:
         )
         print("    and", ", ".join(f"{n} in {d}/" for d, n in elsewhere.items() if n))
     else:
-        print("an imperfection: CONTRIBUTING.md has a recipe ('Adding an imperfection')")
+        steps = [f for f, w in IMPERFECTION_RECIPE if " ".join(w.split()) in imperfection]
+        gone = [f for f, w in IMPERFECTION_RECIPE if " ".join(w.split()) not in imperfection]
+        if gone:
+            print("steps of IMPERFECTION_RECIPE no longer in CONTRIBUTING.md:", ", ".join(gone))
+        report("a new image imperfection, CONTRIBUTING.md's recipe", steps)
     return 0
 
 

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from headsim.procedures.contract import names
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.tables import ScenarioError
 
@@ -176,10 +177,7 @@ def test_names_are_unique_and_required_tables_present(tmp_path: Path) -> None:
 
 def test_an_unknown_procedure_is_named_with_every_registered_one(tmp_path: Path) -> None:
     path = write_scenario(tmp_path, MINIMAL.replace('"model2"', '"model3"'))
-    allowed = (
-        "model2, model1, calibration, tracking, chessboard, relative_positioning, pursuit, stereo, "
-        "zoom_fixed_points, fixation"
-    )
+    allowed = ", ".join(names())  # every registered procedure, in their declared ranks
     message = f"{path}: experiment.procedure: unknown value 'model3' (allowed: {allowed})"
     with pytest.raises(ScenarioError, match=re.escape(message)):
         load_scenario(path)
