@@ -222,7 +222,7 @@ def test_no_servo_tracker_or_correspondence_imports_the_scene_truth() -> None:
     readers = [str(p.relative_to(SOURCE)) for p in files if _imports(p).intersection(TRUTH_MODULES)]
     assert readers == []
     # The check can see an import: the scorer's own module imports the placing one.
-    assert TRUTH_MODULES[1] in _imports(SOURCE / "run" / "landing.py")
+    assert TRUTH_MODULES[1] in _imports(SOURCE / "runs" / "landing.py")
 
 
 #: Where a scene's state is read: the simulator (its model, data, bodies' poses) and the
