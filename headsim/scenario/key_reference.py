@@ -27,6 +27,7 @@ from headsim.scenario.scene import POSITION_KEYS, RANDOM_BOX_KEYS
 from headsim.scenario.tables import KeyUse, collecting_keys
 from headsim.sim import imperfections
 from headsim.sim.model import MODELS_DIR
+from headsim.sim.settings import EYE_SETTINGS, IMAGE_SETTINGS
 
 
 @dataclass(frozen=True)
@@ -271,16 +272,11 @@ def _meaning(path: str) -> str:
 _CAMERA = {
     "": "One camera's settings; a missing key comes from the camera's preset.",
     "preset": "The camera's preset (default: `head.preset`).",
-    "width": "Image width, px.",
-    "height": "Image height, px.",
-    "kx": "Focal length along the image's u axis, px.",
-    "ky": "Focal length along the image's v axis, px.",
-    "cx": "Principal point's column, px (pixel centres at integer coordinates).",
-    "cy": "Principal point's row, px.",
-    **imperfections.meanings(),  # declared with each image imperfection
-    "nodal_offset_m": "Optical centre in front of the eye's yaw axis, m (lenses: 0.01-0.03).",
-    "side_offset_m": "Optical centre along the camera's x from the yaw axis, m (mounting: up to 0.002).",
-    "eye_axis_tilt_rad": "The eye's yaw axis leaning forward, rad (machining: a few mrad).",
+    # Each setting's meaning is declared with it: the camera's own (headsim.sim.settings),
+    # then each image imperfection's, in the order the camera table reads them.
+    **{s.name: s.meaning for s in IMAGE_SETTINGS},
+    **imperfections.meanings(),
+    **{s.name: s.meaning for s in EYE_SETTINGS},
 }
 
 #: One line per key every procedure shares: what it means, with its unit (a procedure's
