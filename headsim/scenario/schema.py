@@ -33,12 +33,16 @@ from headsim.sim.heads import HeadModel
 from headsim.sim.model import design, has_own_cameras, on_head
 from headsim.sim.optics import centre_ray_yaw
 from headsim.sim.settings import (
+    BACKLASH,
+    ENCODER_RESOLUTION,
     EYE_SETTINGS,
     IMAGE_SETTINGS,
     MAX_IMAGE_SIDE,
     MOUNT_PITCH,
     MOUNT_ROLL,
     MOUNT_YAW,
+    NECK_A2,
+    NECK_D1,
     CameraSettings,
     HeadBelief,
     HeadSettings,
@@ -268,11 +272,9 @@ def read_head(
         1.0,
         unit="m; narrower gives no usable vergence",
     )
-    d1 = head.number("neck_d1_m", base.neck_d1_m, 0.0, 2.0, unit="m")
-    a2 = head.number("neck_a2_m", base.neck_a2_m, 0.0, 1.0, unit="m")
-    resolution = head.number(
-        "encoder_resolution_rad", base.encoder_resolution_rad, 0.0, 0.01, lo_open=True, unit="rad"
-    )
+    d1 = read_setting(head, NECK_D1, base.neck_d1_m)
+    a2 = read_setting(head, NECK_A2, base.neck_a2_m)
+    resolution = read_setting(head, ENCODER_RESOLUTION, base.encoder_resolution_rad)
     initial = head.numbers("initial_direction_rad", 2, None, **_per_eye(MOUNT_YAW))
     yaw = head.numbers(MOUNT_YAW.name, 2, None, **_per_eye(MOUNT_YAW))
     if initial is not None and yaw is not None:
@@ -284,7 +286,7 @@ def read_head(
     )
     roll = head.numbers(MOUNT_ROLL.name, 2, (MOUNT_ROLL.fixed_default,) * 2, **_per_eye(MOUNT_ROLL))
     settle = head.choice("settle", ("kinematic", "physics"), "kinematic")
-    backlash = head.number("backlash_rad", base.backlash_rad, 0.0, 0.01, unit="rad")
+    backlash = read_setting(head, BACKLASH, base.backlash_rad)
     count_error = head.boolean("count_error", base.count_error)
     offsamples = head.integer("render_offsamples", base.render.offsamples, 0, 16)
     supersample = head.integer("render_supersample", base.render.supersample, 1, 8)

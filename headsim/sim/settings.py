@@ -360,6 +360,47 @@ def belief_sources(
     return out
 
 
+#: The true head's own numbers, each declared once (range, default, unit, meaning): read by
+#: :class:`HeadSettings`'s checks, the scenario schema's ``[head]`` and the key reference.
+NECK_D1 = Setting(
+    "neck_d1_m",
+    0.12,
+    0.0,
+    2.0,
+    "m",
+    "Height of the neck's pitch axis above its yaw base (D-H d1 of eq. 1), m; believed as "
+    "`head.baseline_m` is.",
+)
+NECK_A2 = Setting(
+    "neck_a2_m",
+    0.09,
+    0.0,
+    1.0,
+    "m",
+    "Height of H above the pitch axis (D-H a2 of eq. 1), m; believed as `head.baseline_m` is.",
+)
+ENCODER_RESOLUTION = Setting(
+    "encoder_resolution_rad",
+    ENCODER_RESOLUTION_RAD,
+    0.0,
+    0.01,
+    "rad",
+    "One encoder count of every joint, rad.",
+    lo_open=True,
+)
+BACKLASH = Setting(
+    "backlash_rad",
+    0.0,
+    0.0,
+    0.01,
+    "rad",
+    "Backlash: every joint settles half of it short, on the side it came from, rad.",
+)
+#: The head's declared numbers (``baseline_m`` is not yet: a scenario's range is narrower
+#: than a Python user's, see :data:`headsim.scenario.spec.MIN_BASELINE_M`).
+HEAD_SETTINGS = (NECK_D1, NECK_A2, ENCODER_RESOLUTION, BACKLASH)
+
+
 @dataclass(frozen=True)
 class HeadSettings:
     """The true head: baseline, neck D-H parameters, encoder, joints and the two cameras.
@@ -374,15 +415,15 @@ class HeadSettings:
     """
 
     baseline_m: float = BASELINE_M
-    neck_d1_m: float = 0.12
-    neck_a2_m: float = 0.09
-    encoder_resolution_rad: float = ENCODER_RESOLUTION_RAD
+    neck_d1_m: float = NECK_D1.fixed_default
+    neck_a2_m: float = NECK_A2.fixed_default
+    encoder_resolution_rad: float = ENCODER_RESOLUTION.fixed_default
     cameras: tuple[CameraSettings, CameraSettings] = field(
         default_factory=lambda: (CameraSettings(), CameraSettings())
     )
     seed: int = 0
     belief: HeadBelief | None = None
-    backlash_rad: float = 0.0
+    backlash_rad: float = BACKLASH.fixed_default
     count_error: bool = False
     render: RenderFidelity = field(default_factory=RenderFidelity)
     #: Which head: its MJCF and mapping (:mod:`headsim.sim.heads`); the lengths above are
@@ -391,11 +432,9 @@ class HeadSettings:
 
     def __post_init__(self) -> None:
         _check(isinstance(self.head, HeadModel), "head must be a headsim.sim.heads.HeadModel")
-        _finite("backlash_rad", self.backlash_rad)
-        _check(
-            0 <= self.backlash_rad <= 0.01,
-            f"backlash_rad must be within [0, 0.01] rad, got {self.backlash_rad}",
-        )
+        for setting in HEAD_SETTINGS:
+            problem = setting.check(getattr(self, setting.name))
+            _check(problem is None, str(problem))
         _check(
             isinstance(self.count_error, bool),
             f"count_error must be true or false, got {self.count_error!r}",
@@ -407,19 +446,6 @@ class HeadSettings:
         _finite("baseline_m", self.baseline_m)
         _check(
             0 < self.baseline_m <= 1.0, f"baseline_m must be > 0 and <= 1 m, got {self.baseline_m}"
-        )
-        _finite("neck_d1_m", self.neck_d1_m)
-        _finite("neck_a2_m", self.neck_a2_m)
-        _check(
-            0 <= self.neck_d1_m <= 2.0, f"neck_d1_m must be within [0, 2] m, got {self.neck_d1_m}"
-        )
-        _check(
-            0 <= self.neck_a2_m <= 1.0, f"neck_a2_m must be within [0, 1] m, got {self.neck_a2_m}"
-        )
-        _finite("encoder_resolution_rad", self.encoder_resolution_rad)
-        _check(
-            0 < self.encoder_resolution_rad <= 0.01,
-            f"encoder_resolution_rad must be > 0 and <= 0.01 rad, got {self.encoder_resolution_rad}",
         )
         _check(
             isinstance(self.cameras, tuple)

@@ -12,6 +12,7 @@ import pytest
 from headsim.sim.declared import Setting
 from headsim.sim.settings import (
     CAMERA_SETTINGS,
+    HEAD_SETTINGS,
     CameraSettings,
     HeadSettings,
     SettingsError,
@@ -36,7 +37,11 @@ from headsim.sim.simulator import HeadSim
         ),
         (lambda: CameraSettings(cx=700.0), "principal point cx = 700.0 px lies outside the image"),
         (lambda: CameraSettings(noise_std=-1.0), r"noise_std must be within \[0, 50\] grey levels"),
-        (lambda: HeadSettings(encoder_resolution_rad=0.0), "encoder_resolution_rad must be > 0"),
+        (
+            lambda: HeadSettings(encoder_resolution_rad=0.0),
+            r"encoder_resolution_rad must be within \(0, 0.01\] rad, got 0.0",
+        ),
+        (lambda: HeadSettings(neck_d1_m=float("nan")), "neck_d1_m must be a finite number"),
         (lambda: HeadSettings(cameras=(CameraSettings(),)), "cameras must be a pair"),
         (lambda: preset("fisheye"), "unknown preset 'fisheye'; allowed: ideal, paper"),
     ],
@@ -57,6 +62,18 @@ def test_each_camera_setting_is_checked_by_its_declaration(setting: Setting) -> 
     for outside in (setting.lo - step, setting.hi + step):
         with pytest.raises(SettingsError, match=f"^{setting.name} must be within"):
             CameraSettings(**{setting.name: type(setting.lo)(outside)})
+
+
+@pytest.mark.parametrize("setting", HEAD_SETTINGS, ids=lambda s: s.name)
+def test_each_head_setting_is_checked_by_its_declaration(setting: Setting) -> None:
+    """HeadSettings takes its defaults from the declaration and refuses just past either end
+    of the declared range (an open end: the end itself), naming the setting."""
+    assert getattr(HeadSettings(), setting.name) == setting.default and setting.meaning
+    step = 1e-9 * max(1.0, abs(setting.hi))
+    lo = setting.lo if setting.lo_open else setting.lo - step
+    for outside in (lo, setting.hi + step):
+        with pytest.raises(SettingsError, match=f"^{setting.name} must be within"):
+            HeadSettings(**{setting.name: outside})
 
 
 def test_unknown_scene_lists_the_scenes() -> None:
