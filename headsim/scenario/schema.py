@@ -43,6 +43,7 @@ from headsim.sim.settings import (
     MOUNT_YAW,
     NECK_A2,
     NECK_D1,
+    SIDE_OFFSET,
     CameraSettings,
     HeadBelief,
     HeadSettings,
@@ -368,9 +369,9 @@ def _read_belief(table: Table | None, base: HeadSettings) -> HeadBelief | None:
         )
     nominal = base.believed
     baseline = table.number("baseline_m", nominal.baseline_m, 0.0, 1.0, lo_open=True, unit="m")
-    d1 = table.number("neck_d1_m", nominal.neck_d1_m, 0.0, 2.0, unit="m")
-    a2 = table.number("neck_a2_m", nominal.neck_a2_m, 0.0, 1.0, unit="m")
-    side = table.numbers("side_offset_m", 2, nominal.side_offset_m, -0.02, 0.02, unit="m")
+    d1 = read_setting(table, NECK_D1, nominal.neck_d1_m)
+    a2 = read_setting(table, NECK_A2, nominal.neck_a2_m)
+    side = table.numbers(SIDE_OFFSET.name, 2, nominal.side_offset_m, **_per_eye(SIDE_OFFSET))
     table.done()
     return HeadBelief(
         baseline_m=baseline,

@@ -277,6 +277,47 @@ class RenderFidelity:
 FINE_RENDERING = RenderFidelity(offsamples=4, supersample=2)
 
 
+#: The true head's own numbers, each declared once (range, default, unit, meaning): read by
+#: :class:`HeadSettings`'s checks, the scenario schema's ``[head]`` and the key reference.
+NECK_D1 = Setting(
+    "neck_d1_m",
+    0.12,
+    0.0,
+    2.0,
+    "m",
+    "Height of the neck's pitch axis above its yaw base (D-H d1 of eq. 1), m; believed as "
+    "`head.baseline_m` is.",
+)
+NECK_A2 = Setting(
+    "neck_a2_m",
+    0.09,
+    0.0,
+    1.0,
+    "m",
+    "Height of H above the pitch axis (D-H a2 of eq. 1), m; believed as `head.baseline_m` is.",
+)
+ENCODER_RESOLUTION = Setting(
+    "encoder_resolution_rad",
+    ENCODER_RESOLUTION_RAD,
+    0.0,
+    0.01,
+    "rad",
+    "One encoder count of every joint, rad.",
+    lo_open=True,
+)
+BACKLASH = Setting(
+    "backlash_rad",
+    0.0,
+    0.0,
+    0.01,
+    "rad",
+    "Backlash: every joint settles half of it short, on the side it came from, rad.",
+)
+#: The head's declared numbers (``baseline_m`` is not yet: a scenario's range is narrower
+#: than a Python user's, see :data:`headsim.scenario.spec.MIN_BASELINE_M`).
+HEAD_SETTINGS = (NECK_D1, NECK_A2, ENCODER_RESOLUTION, BACKLASH)
+
+
 @dataclass(frozen=True)
 class HeadBelief:
     """What the head believes about its own geometry (its design drawings), m.
@@ -290,8 +331,8 @@ class HeadBelief:
     """
 
     baseline_m: float = BASELINE_M
-    neck_d1_m: float = 0.12
-    neck_a2_m: float = 0.09
+    neck_d1_m: float = NECK_D1.fixed_default
+    neck_a2_m: float = NECK_A2.fixed_default
     nodal_offset_m: tuple[float, float] = (0.0, 0.0)
     side_offset_m: tuple[float, float] = (0.0, 0.0)
 
@@ -301,11 +342,11 @@ class HeadBelief:
             0 < self.baseline_m <= 1.0,
             f"belief.baseline_m must be > 0 and <= 1 m, got {self.baseline_m}",
         )
-        for name, hi in (("neck_d1_m", 2.0), ("neck_a2_m", 1.0)):
-            value = getattr(self, name)
-            _finite(f"belief.{name}", value)
-            _check(0 <= value <= hi, f"belief.{name} must be within [0, {hi:g}] m, got {value}")
-        for name, lo, hi in (("nodal_offset_m", -0.05, 0.1), ("side_offset_m", -0.02, 0.02)):
+        for setting in (NECK_D1, NECK_A2):  # believed within the true head's range
+            problem = setting.check(getattr(self, setting.name))
+            _check(problem is None, f"belief.{problem}")
+        for setting in (NODAL_OFFSET, SIDE_OFFSET):  # per camera, within the camera's range
+            name, lo, hi = setting.name, setting.lo, setting.hi
             pair = getattr(self, name)
             _check(
                 isinstance(pair, tuple) and len(pair) == 2,
@@ -358,47 +399,6 @@ def belief_sources(
         else:
             out[key] = "truth"
     return out
-
-
-#: The true head's own numbers, each declared once (range, default, unit, meaning): read by
-#: :class:`HeadSettings`'s checks, the scenario schema's ``[head]`` and the key reference.
-NECK_D1 = Setting(
-    "neck_d1_m",
-    0.12,
-    0.0,
-    2.0,
-    "m",
-    "Height of the neck's pitch axis above its yaw base (D-H d1 of eq. 1), m; believed as "
-    "`head.baseline_m` is.",
-)
-NECK_A2 = Setting(
-    "neck_a2_m",
-    0.09,
-    0.0,
-    1.0,
-    "m",
-    "Height of H above the pitch axis (D-H a2 of eq. 1), m; believed as `head.baseline_m` is.",
-)
-ENCODER_RESOLUTION = Setting(
-    "encoder_resolution_rad",
-    ENCODER_RESOLUTION_RAD,
-    0.0,
-    0.01,
-    "rad",
-    "One encoder count of every joint, rad.",
-    lo_open=True,
-)
-BACKLASH = Setting(
-    "backlash_rad",
-    0.0,
-    0.0,
-    0.01,
-    "rad",
-    "Backlash: every joint settles half of it short, on the side it came from, rad.",
-)
-#: The head's declared numbers (``baseline_m`` is not yet: a scenario's range is narrower
-#: than a Python user's, see :data:`headsim.scenario.spec.MIN_BASELINE_M`).
-HEAD_SETTINGS = (NECK_D1, NECK_A2, ENCODER_RESOLUTION, BACKLASH)
 
 
 @dataclass(frozen=True)
