@@ -6,6 +6,7 @@ import ctypes.util
 import os
 import subprocess
 import sys
+from typing import Any
 
 import pytest
 
@@ -61,7 +62,8 @@ def test_each_camera_setting_is_checked_by_its_declaration(setting: Setting) -> 
     step = 1 if setting.integer else 1e-9 * max(1.0, abs(setting.hi))
     for outside in (setting.lo - step, setting.hi + step):
         with pytest.raises(SettingsError, match=f"^{setting.name} must be within"):
-            CameraSettings(**{setting.name: type(setting.lo)(outside)})
+            bad: dict[str, Any] = {setting.name: type(setting.lo)(outside)}
+            CameraSettings(**bad)
 
 
 @pytest.mark.parametrize("setting", HEAD_SETTINGS, ids=lambda s: s.name)
@@ -73,7 +75,8 @@ def test_each_head_setting_is_checked_by_its_declaration(setting: Setting) -> No
     lo = setting.lo if setting.lo_open else setting.lo - step
     for outside in (lo, setting.hi + step):
         with pytest.raises(SettingsError, match=f"^{setting.name} must be within"):
-            HeadSettings(**{setting.name: outside})
+            bad: dict[str, Any] = {setting.name: outside}
+            HeadSettings(**bad)
 
 
 def test_unknown_scene_lists_the_scenes() -> None:
