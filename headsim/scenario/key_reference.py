@@ -27,6 +27,14 @@ from headsim.scenario.scene import POSITION_KEYS, RANDOM_BOX_KEYS
 from headsim.scenario.tables import KeyUse, collecting_keys
 from headsim.sim import imperfections
 from headsim.sim.model import MODELS_DIR
+from headsim.sim.settings import (
+    BACKLASH,
+    ENCODER_RESOLUTION,
+    EYE_SETTINGS,
+    IMAGE_SETTINGS,
+    NECK_A2,
+    NECK_D1,
+)
 
 
 @dataclass(frozen=True)
@@ -271,16 +279,11 @@ def _meaning(path: str) -> str:
 _CAMERA = {
     "": "One camera's settings; a missing key comes from the camera's preset.",
     "preset": "The camera's preset (default: `head.preset`).",
-    "width": "Image width, px.",
-    "height": "Image height, px.",
-    "kx": "Focal length along the image's u axis, px.",
-    "ky": "Focal length along the image's v axis, px.",
-    "cx": "Principal point's column, px (pixel centres at integer coordinates).",
-    "cy": "Principal point's row, px.",
-    **imperfections.meanings(),  # declared with each image imperfection
-    "nodal_offset_m": "Optical centre in front of the eye's yaw axis, m (lenses: 0.01-0.03).",
-    "side_offset_m": "Optical centre along the camera's x from the yaw axis, m (mounting: up to 0.002).",
-    "eye_axis_tilt_rad": "The eye's yaw axis leaning forward, rad (machining: a few mrad).",
+    # Each setting's meaning is declared with it: the camera's own (headsim.sim.settings),
+    # then each image imperfection's, in the order the camera table reads them.
+    **{s.name: s.meaning for s in IMAGE_SETTINGS},
+    **imperfections.meanings(),
+    **{s.name: s.meaning for s in EYE_SETTINGS},
 }
 
 #: One line per key every procedure shares: what it means, with its unit (a procedure's
@@ -305,15 +308,13 @@ DESCRIPTIONS: dict[str, str] = {
     "head.mapping.cameras": "The two eye cameras, [Ca1, Ca2]: left, then right.",
     "head.preset": "Defaults for the head and both cameras: the ideal head, the paper's, or a realistic one.",
     "head.baseline_m": "True distance between the eyes' yaw axes (the optical centres, on them), m. Without `[belief]` the ideal and paper presets believe it too (`belief.sources`: `truth`).",
-    "head.neck_d1_m": "Height of the neck's pitch axis above its yaw base (D-H d1 of eq. 1), m; believed as `head.baseline_m` is.",
-    "head.neck_a2_m": "Height of H above the pitch axis (D-H a2 of eq. 1), m; believed as `head.baseline_m` is.",
-    "head.encoder_resolution_rad": "One encoder count of every joint, rad.",
+    **{f"head.{s.name}": s.meaning for s in (NECK_D1, NECK_A2, ENCODER_RESOLUTION)},
     "head.initial_direction_rad": "Each eye's effective initial direction alpha_ei, rad (or `mount_yaw_rad`, not both).",
     "head.mount_yaw_rad": "Each eye's raw mount yaw, rad (or `initial_direction_rad`, not both).",
     "head.mount_pitch_rad": "Each eye's mount pitch, rad.",
     "head.mount_roll_rad": "Each eye's mount roll, rad.",
     "head.settle": "How joints reach a commanded angle: set kinematically, or driven by MuJoCo's physics.",
-    "head.backlash_rad": "Backlash: every joint settles half of it short, on the side it came from, rad.",
+    f"head.{BACKLASH.name}": BACKLASH.meaning,
     "head.count_error": "If true, the true angle lies anywhere within the encoder count read (seeded).",
     "head.render_offsamples": "MuJoCo multisampling per pixel (Mesa caps it at 4).",
     "head.render_supersample": "Render this many times larger and area-average down (1: faster, coarser).",

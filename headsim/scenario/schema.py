@@ -28,11 +28,22 @@ from headsim.scenario.spec import (
 )
 from headsim.scenario.tables import MISSING, Context, Table, describe_value, short_value
 from headsim.sim import heads, imperfections, names
+from headsim.sim.declared import Setting
 from headsim.sim.heads import HeadModel
 from headsim.sim.model import design, has_own_cameras, on_head
 from headsim.sim.optics import centre_ray_yaw
 from headsim.sim.settings import (
+    BACKLASH,
+    ENCODER_RESOLUTION,
+    EYE_SETTINGS,
+    IMAGE_SETTINGS,
     MAX_IMAGE_SIDE,
+    MOUNT_PITCH,
+    MOUNT_ROLL,
+    MOUNT_YAW,
+    NECK_A2,
+    NECK_D1,
+    SIDE_OFFSET,
     CameraSettings,
     HeadBelief,
     HeadSettings,
@@ -56,6 +67,31 @@ FIRST_TABLES = (
 
 
 _PRESETS = ("ideal", "paper", "realistic")
+#: The image side that bounds each coordinate of the principal point.
+_IMAGE_SIDE = {"cx": "width", "cy": "height"}
+
+
+def read_setting(
+    table: Table,
+    setting: Setting,
+    default: Any = MISSING,
+    *,
+    hi: float | None = None,
+    unit: str | None = None,
+) -> Any:
+    """``setting``'s key of ``table``, checked against its declared range (``hi``, ``unit``:
+    a tighter upper end that depends on other keys, and how to say it)."""
+    if setting.integer:
+        return table.integer(setting.name, default, int(setting.lo), int(setting.hi))
+    return table.number(
+        setting.name,
+        default,
+        setting.lo,
+        setting.hi if hi is None else hi,
+        lo_open=setting.lo_open,
+        hi_open=setting.hi_open,
+        unit=setting.unit if unit is None else unit,
+    )
 
 
 def _read_camera(
@@ -67,35 +103,25 @@ def _read_camera(
         return on_head(preset(default_preset), head).cameras[index], default_preset
     name = table.choice("preset", _PRESETS, default_preset)
     base = on_head(preset(name), head).cameras[index]
-    width = table.integer("width", base.width, 16, MAX_IMAGE_SIDE)
-    height = table.integer("height", base.height, 16, MAX_IMAGE_SIDE)
-    kx = table.number("kx", base.kx, 1.0, 1e5, unit="px")
-    ky = table.number("ky", base.ky, 1.0, 1e5, unit="px")
-    cx_default = base.cx if base.cx is not None and base.cx <= width - 1 else None
-    cy_default = base.cy if base.cy is not None and base.cy <= height - 1 else None
-    cx = table.number("cx", cx_default, 0.0, width - 1.0, unit="px (inside the image)")
-    cy = table.number("cy", cy_default, 0.0, height - 1.0, unit="px (inside the image)")
+    values: dict[str, Any] = {}
+    for setting in IMAGE_SETTINGS:
+        if setting.default is None:  # the principal point: inside this image
+            size = values[_IMAGE_SIDE[setting.name]]
+            given = getattr(base, setting.name)
+            default = given if given is not None and given <= size - 1 else None
+            values[setting.name] = read_setting(
+                table, setting, default, hi=size - 1.0, unit=f"{setting.unit} (inside the image)"
+            )
+        else:
+            values[setting.name] = read_setting(table, setting, getattr(base, setting.name))
     # Every image imperfection's settings, with their declared ranges.
     image_settings = {
-        s.name: table.number(s.name, base.value(s.name), s.lo, s.hi, unit=s.unit)
-        for s in imperfections.all_settings()
+        s.name: read_setting(table, s, base.value(s.name)) for s in imperfections.all_settings()
     }
-    nodal = table.number("nodal_offset_m", base.nodal_offset_m, -0.05, 0.1, unit="m")
-    side = table.number("side_offset_m", base.side_offset_m, -0.02, 0.02, unit="m")
-    tilt = table.number("eye_axis_tilt_rad", base.eye_axis_tilt_rad, -0.1, 0.1, unit="rad")
+    for setting in EYE_SETTINGS:
+        values[setting.name] = read_setting(table, setting, getattr(base, setting.name))
     table.done()
-    camera = CameraSettings(
-        width=width,
-        height=height,
-        kx=kx,
-        ky=ky,
-        cx=cx,
-        cy=cy,
-        nodal_offset_m=nodal,
-        side_offset_m=side,
-        eye_axis_tilt_rad=tilt,
-        **camera_values(image_settings),
-    )
+    camera = CameraSettings(**values, **camera_values(image_settings))
     problem = _lens_problem(camera)
     if problem is not None:
         raise table.fail("k1", *problem)
@@ -106,6 +132,17 @@ def _read_camera(
             "k1", str(err), "a lens that does not fold over before the image centre"
         ) from err
     return camera, name
+
+
+def _per_eye(setting: Setting) -> dict[str, Any]:
+    """``setting``'s range as :meth:`Table.numbers` takes it (a camera setting given per eye)."""
+    return dict(
+        lo=setting.lo,
+        hi=setting.hi,
+        lo_open=setting.lo_open,
+        hi_open=setting.hi_open,
+        unit=setting.unit,
+    )
 
 
 def _lens_problem(camera: CameraSettings) -> tuple[str, str] | None:
@@ -236,22 +273,21 @@ def read_head(
         1.0,
         unit="m; narrower gives no usable vergence",
     )
-    d1 = head.number("neck_d1_m", base.neck_d1_m, 0.0, 2.0, unit="m")
-    a2 = head.number("neck_a2_m", base.neck_a2_m, 0.0, 1.0, unit="m")
-    resolution = head.number(
-        "encoder_resolution_rad", base.encoder_resolution_rad, 0.0, 0.01, lo_open=True, unit="rad"
-    )
-    mount_range: dict[str, Any] = dict(lo=-0.5, hi=0.5, lo_open=True, hi_open=True, unit="rad")
-    initial = head.numbers("initial_direction_rad", 2, None, **mount_range)
-    yaw = head.numbers("mount_yaw_rad", 2, None, **mount_range)
+    d1 = read_setting(head, NECK_D1, base.neck_d1_m)
+    a2 = read_setting(head, NECK_A2, base.neck_a2_m)
+    resolution = read_setting(head, ENCODER_RESOLUTION, base.encoder_resolution_rad)
+    initial = head.numbers("initial_direction_rad", 2, None, **_per_eye(MOUNT_YAW))
+    yaw = head.numbers(MOUNT_YAW.name, 2, None, **_per_eye(MOUNT_YAW))
     if initial is not None and yaw is not None:
         raise head.fail(
             "mount_yaw_rad", "given together with initial_direction_rad", "one of the two"
         )
-    pitch = head.numbers("mount_pitch_rad", 2, (0.0, 0.0), **mount_range)
-    roll = head.numbers("mount_roll_rad", 2, (0.0, 0.0), **mount_range)
+    pitch = head.numbers(
+        MOUNT_PITCH.name, 2, (MOUNT_PITCH.fixed_default,) * 2, **_per_eye(MOUNT_PITCH)
+    )
+    roll = head.numbers(MOUNT_ROLL.name, 2, (MOUNT_ROLL.fixed_default,) * 2, **_per_eye(MOUNT_ROLL))
     settle = head.choice("settle", ("kinematic", "physics"), "kinematic")
-    backlash = head.number("backlash_rad", base.backlash_rad, 0.0, 0.01, unit="rad")
+    backlash = read_setting(head, BACKLASH, base.backlash_rad)
     count_error = head.boolean("count_error", base.count_error)
     offsamples = head.integer("render_offsamples", base.render.offsamples, 0, 16)
     supersample = head.integer("render_supersample", base.render.supersample, 1, 8)
@@ -278,11 +314,11 @@ def read_head(
             else mount_yaw_for_direction(index + 1, direction, camera.pinhole())
         )
         field_name = "head.initial_direction_rad" if direction is not None else "head.mount_yaw_rad"
-        if not abs(mount_yaw) < 0.5:
+        if not MOUNT_YAW.allows(mount_yaw):
             raise ctx.error(
                 f"{field_name}[{index}]",
                 f"needs a mount yaw of {mount_yaw:.3f} rad for camera {index + 1}",
-                "a mount yaw within (-0.5, 0.5) rad",
+                f"a mount yaw within {MOUNT_YAW.range_text()}",
             )
         cameras.append(
             replace(
@@ -333,9 +369,9 @@ def _read_belief(table: Table | None, base: HeadSettings) -> HeadBelief | None:
         )
     nominal = base.believed
     baseline = table.number("baseline_m", nominal.baseline_m, 0.0, 1.0, lo_open=True, unit="m")
-    d1 = table.number("neck_d1_m", nominal.neck_d1_m, 0.0, 2.0, unit="m")
-    a2 = table.number("neck_a2_m", nominal.neck_a2_m, 0.0, 1.0, unit="m")
-    side = table.numbers("side_offset_m", 2, nominal.side_offset_m, -0.02, 0.02, unit="m")
+    d1 = read_setting(table, NECK_D1, nominal.neck_d1_m)
+    a2 = read_setting(table, NECK_A2, nominal.neck_a2_m)
+    side = table.numbers(SIDE_OFFSET.name, 2, nominal.side_offset_m, **_per_eye(SIDE_OFFSET))
     table.done()
     return HeadBelief(
         baseline_m=baseline,

@@ -18,6 +18,7 @@ from headsim.geometry.camera_model import PinholeCamera, image_centre
 from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import BASELINE_M, ENCODER_RESOLUTION_RAD, INITIAL_DIRECTIONS_RAD, INTRINSICS
 from headsim.sim import imperfections
+from headsim.sim.declared import Setting
 from headsim.sim.heads import MODELS_DIR, PAPER, HeadModel
 from headsim.sim.imperfections.distortion import K1, K2
 from headsim.sim.imperfections.noise import NOISE_STD
@@ -45,12 +46,77 @@ def _finite(name: str, value: float) -> None:
     )
 
 
-#: A camera's focal lengths, px.
-FOCAL_FIELDS = ("kx", "ky")
+#: A camera's own settings (those of its image imperfections are declared with each
+#: imperfection): the one declaration of each one's range, default, unit and meaning, which
+#: :class:`CameraSettings`'s checks, the scenario schema and the scenario-key reference read.
+WIDTH = Setting("width", 640, 16, MAX_IMAGE_SIDE, "px", "Image width, px.", integer=True)
+HEIGHT = Setting("height", 480, 16, MAX_IMAGE_SIDE, "px", "Image height, px.", integer=True)
+KX = Setting("kx", IDEAL_FOCAL_PX, 1.0, 1e5, "px", "Focal length along the image's u axis, px.")
+KY = Setting("ky", IDEAL_FOCAL_PX, 1.0, 1e5, "px", "Focal length along the image's v axis, px.")
+#: The principal point: its default (None) is the image centre, and it must lie inside the
+#: image, which the range here (any image's) only bounds.
+CX = Setting(
+    "cx",
+    None,
+    0.0,
+    MAX_IMAGE_SIDE - 1,
+    "px",
+    "Principal point's column, px (pixel centres at integer coordinates).",
+)
+CY = Setting("cy", None, 0.0, MAX_IMAGE_SIDE - 1, "px", "Principal point's row, px.")
+
+
+def _mount_angle(name: str, meaning: str) -> Setting:
+    """A tilt of the camera on its eye, set per eye in ``[head]`` (within 0.5 rad, so that
+    the two eyes' fields still overlap)."""
+    return Setting(name, 0.0, -0.5, 0.5, "rad", meaning, lo_open=True, hi_open=True)
+
+
+MOUNT_YAW = _mount_angle(
+    "mount_yaw_rad", "The eye's initial direction alpha_e (positive inward, like the eye angle)."
+)
+MOUNT_PITCH = _mount_angle("mount_pitch_rad", "The camera's pitch on its eye (0 in the paper).")
+MOUNT_ROLL = _mount_angle("mount_roll_rad", "The camera's roll on its eye (0 in the paper).")
+NODAL_OFFSET = Setting(
+    "nodal_offset_m",
+    0.0,
+    -0.05,
+    0.1,
+    "m",
+    "Optical centre in front of the eye's yaw axis, m (lenses: 0.01-0.03).",
+)
+SIDE_OFFSET = Setting(
+    "side_offset_m",
+    0.0,
+    -0.02,
+    0.02,
+    "m",
+    "Optical centre along the camera's x from the yaw axis, m (mounting: up to 0.002).",
+)
+EYE_AXIS_TILT = Setting(
+    "eye_axis_tilt_rad",
+    0.0,
+    -0.1,
+    0.1,
+    "rad",
+    "The eye's yaw axis leaning forward, rad (machining: a few mrad).",
+)
+
+
+#: The camera's image and lens, in the order a scenario's ``[cam1]``/``[cam2]`` reads them.
+IMAGE_SETTINGS = (WIDTH, HEIGHT, KX, KY, CX, CY)
+#: Where the optical centre sits on the eye, in the order a scenario's camera table reads them.
+EYE_SETTINGS = (NODAL_OFFSET, SIDE_OFFSET, EYE_AXIS_TILT)
+#: The mount's angles, set per eye in a scenario's ``[head]``.
+MOUNT_SETTINGS = (MOUNT_YAW, MOUNT_PITCH, MOUNT_ROLL)
+#: Every setting of :class:`CameraSettings` declared here (the imperfections' are declared
+#: with them).
+CAMERA_SETTINGS = (*IMAGE_SETTINGS, *MOUNT_SETTINGS, *EYE_SETTINGS)
 #: A camera's numeric settings, each checked to be finite; their order is also the
 #: order in which the Gymnasium environment draws them (headsim.envs.fixate).
 CAMERA_NUMBER_FIELDS = (
-    *FOCAL_FIELDS,
+    "kx",
+    "ky",
     "k1",
     "k2",
     "mount_yaw_rad",
@@ -86,59 +152,34 @@ class CameraSettings:
     distortion, image centre): this class adds the mount, noise and checks.
     """
 
-    width: int = 640
-    height: int = 480
-    kx: float = IDEAL_FOCAL_PX
-    ky: float = IDEAL_FOCAL_PX
+    width: int = int(WIDTH.fixed_default)
+    height: int = int(HEIGHT.fixed_default)
+    kx: float = KX.fixed_default
+    ky: float = KY.fixed_default
     cx: float | None = None
     cy: float | None = None
-    k1: float = K1.default
-    k2: float = K2.default
-    mount_yaw_rad: float = 0.0
-    mount_pitch_rad: float = 0.0
-    mount_roll_rad: float = 0.0
-    noise_std: float = NOISE_STD.default
-    nodal_offset_m: float = 0.0
-    side_offset_m: float = 0.0
-    eye_axis_tilt_rad: float = 0.0
+    k1: float = K1.fixed_default
+    k2: float = K2.fixed_default
+    mount_yaw_rad: float = MOUNT_YAW.fixed_default
+    mount_pitch_rad: float = MOUNT_PITCH.fixed_default
+    mount_roll_rad: float = MOUNT_ROLL.fixed_default
+    noise_std: float = NOISE_STD.fixed_default
+    nodal_offset_m: float = NODAL_OFFSET.fixed_default
+    side_offset_m: float = SIDE_OFFSET.fixed_default
+    eye_axis_tilt_rad: float = EYE_AXIS_TILT.fixed_default
     #: Settings of imperfections registered beyond the fields above, as (name, value)
     #: pairs (left out of the records while empty; see :func:`settings_record`).
     extra: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
-        for name in ("width", "height"):
-            value = getattr(self, name)
-            _check(
-                isinstance(value, int) and value > 0,
-                f"camera {name} must be a positive integer, got {value!r}",
-            )
-            _check(
-                value <= MAX_IMAGE_SIDE,
-                f"camera {name} = {value} px is larger than the off-screen buffer allows "
-                f"(at most {MAX_IMAGE_SIDE} px)",
-            )
-        for name in FOCAL_FIELDS:
-            value = getattr(self, name)
-            _finite(name, value)
-            _check(value > 0, f"focal length {name} must be > 0 px, got {value}")
-        for name in CAMERA_NUMBER_FIELDS[len(FOCAL_FIELDS) :]:
-            _finite(name, getattr(self, name))
-        _check(
-            -0.05 <= self.nodal_offset_m <= 0.1,
-            f"nodal_offset_m must be within [-0.05, 0.1] m, got {self.nodal_offset_m}",
-        )
-        _check(
-            abs(self.side_offset_m) <= 0.02,
-            f"side_offset_m must be within [-0.02, 0.02] m, got {self.side_offset_m}",
-        )
-        _check(
-            abs(self.eye_axis_tilt_rad) <= 0.1,
-            f"eye_axis_tilt_rad must be within [-0.1, 0.1] rad, got {self.eye_axis_tilt_rad}",
-        )
+        for setting in CAMERA_SETTINGS:
+            value = getattr(self, setting.name)
+            if value is not None:  # cx, cy: None is the image centre
+                problem = setting.check(value)
+                _check(problem is None, str(problem))
         for name, size in (("cx", self.width), ("cy", self.height)):
             value = getattr(self, name)
             if value is not None:
-                _finite(name, value)
                 _check(
                     0 <= value <= size - 1,
                     f"principal point {name} = {value} px lies outside the image [0, {size - 1}]",
@@ -153,11 +194,6 @@ class CameraSettings:
         for setting in imperfections.all_settings():
             problem = setting.check(self.value(setting.name))
             _check(problem is None, str(problem))
-        for name in ("mount_yaw_rad", "mount_pitch_rad", "mount_roll_rad"):
-            _check(
-                abs(getattr(self, name)) < 0.5,
-                f"{name} must be within (-0.5, 0.5) rad, got {getattr(self, name)}",
-            )
 
     def value(self, name: str) -> float:
         """The value of imperfection setting ``name``: its field, its ``extra`` entry, or
@@ -167,7 +203,7 @@ class CameraSettings:
         for key, value in self.extra:
             if key == name:
                 return value
-        return imperfections.setting(name).default
+        return imperfections.setting(name).fixed_default
 
     @property
     def principal(self) -> tuple[float, float]:
@@ -241,6 +277,47 @@ class RenderFidelity:
 FINE_RENDERING = RenderFidelity(offsamples=4, supersample=2)
 
 
+#: The true head's own numbers, each declared once (range, default, unit, meaning): read by
+#: :class:`HeadSettings`'s checks, the scenario schema's ``[head]`` and the key reference.
+NECK_D1 = Setting(
+    "neck_d1_m",
+    0.12,
+    0.0,
+    2.0,
+    "m",
+    "Height of the neck's pitch axis above its yaw base (D-H d1 of eq. 1), m; believed as "
+    "`head.baseline_m` is.",
+)
+NECK_A2 = Setting(
+    "neck_a2_m",
+    0.09,
+    0.0,
+    1.0,
+    "m",
+    "Height of H above the pitch axis (D-H a2 of eq. 1), m; believed as `head.baseline_m` is.",
+)
+ENCODER_RESOLUTION = Setting(
+    "encoder_resolution_rad",
+    ENCODER_RESOLUTION_RAD,
+    0.0,
+    0.01,
+    "rad",
+    "One encoder count of every joint, rad.",
+    lo_open=True,
+)
+BACKLASH = Setting(
+    "backlash_rad",
+    0.0,
+    0.0,
+    0.01,
+    "rad",
+    "Backlash: every joint settles half of it short, on the side it came from, rad.",
+)
+#: The head's declared numbers (``baseline_m`` is not yet: a scenario's range is narrower
+#: than a Python user's, see :data:`headsim.scenario.spec.MIN_BASELINE_M`).
+HEAD_SETTINGS = (NECK_D1, NECK_A2, ENCODER_RESOLUTION, BACKLASH)
+
+
 @dataclass(frozen=True)
 class HeadBelief:
     """What the head believes about its own geometry (its design drawings), m.
@@ -254,8 +331,8 @@ class HeadBelief:
     """
 
     baseline_m: float = BASELINE_M
-    neck_d1_m: float = 0.12
-    neck_a2_m: float = 0.09
+    neck_d1_m: float = NECK_D1.fixed_default
+    neck_a2_m: float = NECK_A2.fixed_default
     nodal_offset_m: tuple[float, float] = (0.0, 0.0)
     side_offset_m: tuple[float, float] = (0.0, 0.0)
 
@@ -265,11 +342,11 @@ class HeadBelief:
             0 < self.baseline_m <= 1.0,
             f"belief.baseline_m must be > 0 and <= 1 m, got {self.baseline_m}",
         )
-        for name, hi in (("neck_d1_m", 2.0), ("neck_a2_m", 1.0)):
-            value = getattr(self, name)
-            _finite(f"belief.{name}", value)
-            _check(0 <= value <= hi, f"belief.{name} must be within [0, {hi:g}] m, got {value}")
-        for name, lo, hi in (("nodal_offset_m", -0.05, 0.1), ("side_offset_m", -0.02, 0.02)):
+        for setting in (NECK_D1, NECK_A2):  # believed within the true head's range
+            problem = setting.check(getattr(self, setting.name))
+            _check(problem is None, f"belief.{problem}")
+        for setting in (NODAL_OFFSET, SIDE_OFFSET):  # per camera, within the camera's range
+            name, lo, hi = setting.name, setting.lo, setting.hi
             pair = getattr(self, name)
             _check(
                 isinstance(pair, tuple) and len(pair) == 2,
@@ -338,15 +415,15 @@ class HeadSettings:
     """
 
     baseline_m: float = BASELINE_M
-    neck_d1_m: float = 0.12
-    neck_a2_m: float = 0.09
-    encoder_resolution_rad: float = ENCODER_RESOLUTION_RAD
+    neck_d1_m: float = NECK_D1.fixed_default
+    neck_a2_m: float = NECK_A2.fixed_default
+    encoder_resolution_rad: float = ENCODER_RESOLUTION.fixed_default
     cameras: tuple[CameraSettings, CameraSettings] = field(
         default_factory=lambda: (CameraSettings(), CameraSettings())
     )
     seed: int = 0
     belief: HeadBelief | None = None
-    backlash_rad: float = 0.0
+    backlash_rad: float = BACKLASH.fixed_default
     count_error: bool = False
     render: RenderFidelity = field(default_factory=RenderFidelity)
     #: Which head: its MJCF and mapping (:mod:`headsim.sim.heads`); the lengths above are
@@ -355,11 +432,9 @@ class HeadSettings:
 
     def __post_init__(self) -> None:
         _check(isinstance(self.head, HeadModel), "head must be a headsim.sim.heads.HeadModel")
-        _finite("backlash_rad", self.backlash_rad)
-        _check(
-            0 <= self.backlash_rad <= 0.01,
-            f"backlash_rad must be within [0, 0.01] rad, got {self.backlash_rad}",
-        )
+        for setting in HEAD_SETTINGS:
+            problem = setting.check(getattr(self, setting.name))
+            _check(problem is None, str(problem))
         _check(
             isinstance(self.count_error, bool),
             f"count_error must be true or false, got {self.count_error!r}",
@@ -371,19 +446,6 @@ class HeadSettings:
         _finite("baseline_m", self.baseline_m)
         _check(
             0 < self.baseline_m <= 1.0, f"baseline_m must be > 0 and <= 1 m, got {self.baseline_m}"
-        )
-        _finite("neck_d1_m", self.neck_d1_m)
-        _finite("neck_a2_m", self.neck_a2_m)
-        _check(
-            0 <= self.neck_d1_m <= 2.0, f"neck_d1_m must be within [0, 2] m, got {self.neck_d1_m}"
-        )
-        _check(
-            0 <= self.neck_a2_m <= 1.0, f"neck_a2_m must be within [0, 1] m, got {self.neck_a2_m}"
-        )
-        _finite("encoder_resolution_rad", self.encoder_resolution_rad)
-        _check(
-            0 < self.encoder_resolution_rad <= 0.01,
-            f"encoder_resolution_rad must be > 0 and <= 0.01 rad, got {self.encoder_resolution_rad}",
         )
         _check(
             isinstance(self.cameras, tuple)

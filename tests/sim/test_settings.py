@@ -6,10 +6,20 @@ import ctypes.util
 import os
 import subprocess
 import sys
+from typing import Any
 
 import pytest
 
-from headsim.sim.settings import CameraSettings, HeadSettings, SettingsError, paper_head, preset
+from headsim.sim.declared import Setting
+from headsim.sim.settings import (
+    CAMERA_SETTINGS,
+    HEAD_SETTINGS,
+    CameraSettings,
+    HeadSettings,
+    SettingsError,
+    paper_head,
+    preset,
+)
 from headsim.sim.simulator import HeadSim
 
 
@@ -18,12 +28,21 @@ from headsim.sim.simulator import HeadSim
     [
         (lambda: HeadSettings(baseline_m=-0.15), "baseline_m must be > 0"),
         (lambda: HeadSettings(baseline_m=float("nan")), "baseline_m must be a finite number"),
-        (lambda: CameraSettings(width=5000), "larger than the off-screen buffer allows"),
-        (lambda: CameraSettings(height=0), "height must be a positive integer"),
-        (lambda: CameraSettings(kx=-5.0), "focal length kx must be > 0"),
+        (lambda: CameraSettings(width=5000), r"width must be within \[16, 4096\] px, got 5000"),
+        (lambda: CameraSettings(height=0), r"height must be within \[16, 4096\] px, got 0"),
+        (lambda: CameraSettings(height=240.0), "height must be an integer, got 240.0"),
+        (lambda: CameraSettings(kx=-5.0), r"kx must be within \[1, 100000\] px, got -5.0"),
+        (
+            lambda: CameraSettings(mount_roll_rad=0.5),
+            r"mount_roll_rad must be within \(-0.5, 0.5\)",
+        ),
         (lambda: CameraSettings(cx=700.0), "principal point cx = 700.0 px lies outside the image"),
         (lambda: CameraSettings(noise_std=-1.0), r"noise_std must be within \[0, 50\] grey levels"),
-        (lambda: HeadSettings(encoder_resolution_rad=0.0), "encoder_resolution_rad must be > 0"),
+        (
+            lambda: HeadSettings(encoder_resolution_rad=0.0),
+            r"encoder_resolution_rad must be within \(0, 0.01\] rad, got 0.0",
+        ),
+        (lambda: HeadSettings(neck_d1_m=float("nan")), "neck_d1_m must be a finite number"),
         (lambda: HeadSettings(cameras=(CameraSettings(),)), "cameras must be a pair"),
         (lambda: preset("fisheye"), "unknown preset 'fisheye'; allowed: ideal, paper"),
     ],
@@ -31,6 +50,33 @@ from headsim.sim.simulator import HeadSim
 def test_bad_settings_name_the_field(make, message: str) -> None:
     with pytest.raises(SettingsError, match=message):
         make()
+
+
+@pytest.mark.parametrize("setting", CAMERA_SETTINGS, ids=lambda s: s.name)
+def test_each_camera_setting_is_checked_by_its_declaration(setting: Setting) -> None:
+    """CameraSettings takes its defaults from the declaration and refuses just past either
+    end of the declared range, naming the setting."""
+    camera = CameraSettings()
+    assert getattr(camera, setting.name) == setting.default
+    assert setting.meaning and setting.name in CameraSettings.__dataclass_fields__
+    step = 1 if setting.integer else 1e-9 * max(1.0, abs(setting.hi))
+    for outside in (setting.lo - step, setting.hi + step):
+        with pytest.raises(SettingsError, match=f"^{setting.name} must be within"):
+            bad: dict[str, Any] = {setting.name: type(setting.lo)(outside)}
+            CameraSettings(**bad)
+
+
+@pytest.mark.parametrize("setting", HEAD_SETTINGS, ids=lambda s: s.name)
+def test_each_head_setting_is_checked_by_its_declaration(setting: Setting) -> None:
+    """HeadSettings takes its defaults from the declaration and refuses just past either end
+    of the declared range (an open end: the end itself), naming the setting."""
+    assert getattr(HeadSettings(), setting.name) == setting.default and setting.meaning
+    step = 1e-9 * max(1.0, abs(setting.hi))
+    lo = setting.lo if setting.lo_open else setting.lo - step
+    for outside in (lo, setting.hi + step):
+        with pytest.raises(SettingsError, match=f"^{setting.name} must be within"):
+            bad: dict[str, Any] = {setting.name: outside}
+            HeadSettings(**bad)
 
 
 def test_unknown_scene_lists_the_scenes() -> None:

@@ -11,40 +11,14 @@ registered imperfection in its declared ``order`` without naming any.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
 import numpy as np
 
+from headsim.sim.declared import Setting as Setting  # what an imperfection declares with
 from headsim.sim.gl_window import Window
-
-
-@dataclass(frozen=True)
-class Setting:
-    """One camera setting of an imperfection: a number within [lo, hi] ``unit``.
-
-    ``default`` is the ideal camera's (the imperfection off); ``example`` a value that
-    turns it on, for the generic tests that every imperfection moves a figure.
-    """
-
-    name: str
-    default: float
-    lo: float
-    hi: float
-    unit: str
-    meaning: str
-    example: float
-
-    def check(self, value: object) -> str | None:
-        """Why ``value`` is not allowed (None: it is)."""
-        if not (isinstance(value, (int, float)) and math.isfinite(value)):
-            return f"{self.name} must be a finite number, got {value!r}"
-        if not self.lo <= value <= self.hi:
-            unit = f" {self.unit}" if self.unit else ""
-            return f"{self.name} must be within [{self.lo:g}, {self.hi:g}]{unit}, got {value}"
-        return None
 
 
 class Camera(Protocol):
