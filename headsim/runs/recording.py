@@ -54,7 +54,6 @@ from datetime import timedelta
 from pathlib import Path
 from typing import Any
 
-import cv2
 import numpy as np
 import rerun as rr
 
@@ -80,7 +79,7 @@ from headsim.runs.recording_layout import (
     recording_id,
     scenario_markdown,
 )
-from headsim.runs.recording_room import RoomRecording
+from headsim.runs.recording_room import RoomRecording, log_jpeg
 from headsim.runs.rerun_cli import (
     INTERRUPTED_VIEWER_WAIT_S,
     VIEWER_WAIT_S,
@@ -343,18 +342,7 @@ class Recorder:
 
     def _log_image(self, cam: str, image: np.ndarray, frame: int, step: int) -> None:
         """The image as a JPEG (on the recording's thread: its own time)."""
-        ok, jpeg = cv2.imencode(
-            ".jpg",
-            cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
-            [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality],
-        )
-        if ok:
-            self.rec.set_time("frame", sequence=frame)
-            self.rec.set_time("step", sequence=step)
-            self.rec.log(
-                f"/world/head/{cam}/image",
-                rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg"),
-            )
+        log_jpeg(self.rec, f"/world/head/{cam}/image", image, frame, step, self.jpeg_quality)
 
     def _features(self, cam: str, frame: int, uv: tuple[float, float] | None) -> None:
         """The detection in the camera's image at ``frame`` (None: none, the last one goes)."""

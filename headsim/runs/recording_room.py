@@ -165,15 +165,7 @@ class RoomRecording:
         self.later(self._log_jpeg, path, fovea, frame, step)
 
     def _log_jpeg(self, path: str, image: np.ndarray, frame: int, step: int) -> None:
-        ok, jpeg = cv2.imencode(
-            ".jpg",
-            cv2.cvtColor(image, cv2.COLOR_RGB2BGR),
-            [cv2.IMWRITE_JPEG_QUALITY, self.jpeg_quality],
-        )
-        if ok:
-            self.rec.set_time("frame", sequence=frame)
-            self.rec.set_time("step", sequence=step)
-            self.rec.log(path, rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg"))
+        log_jpeg(self.rec, path, image, frame, step, self.jpeg_quality)
 
     def matched(self, event: Matched) -> None:
         """A match (logged at the recorder's current time): its box in the fovea, camera
@@ -281,6 +273,19 @@ class RoomRecording:
                     show_labels=False,
                 ),
             )
+
+
+def log_jpeg(
+    rec: rr.RecordingStream, path: str, image: np.ndarray, frame: int, step: int, quality: int
+) -> None:
+    """An RGB image logged at ``path`` as a JPEG of ``quality``, at its frame and step."""
+    ok, jpeg = cv2.imencode(
+        ".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, quality]
+    )
+    if ok:
+        rec.set_time("frame", sequence=frame)
+        rec.set_time("step", sequence=step)
+        rec.log(path, rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg"))
 
 
 def _end(landing: Landing) -> np.ndarray:
