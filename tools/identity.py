@@ -5,6 +5,11 @@ scenario's results.json byte-identical, and the bench's accuracy metrics equal.
 
     python tools/identity.py collect OUT_DIR [--jobs N] [--only NAME ...]
     python tools/identity.py compare BEFORE_DIR AFTER_DIR
+    python tools/identity.py fuzz OUT.json [--cases N]
+
+`fuzz` runs the scenario fuzzer's mutations (tests/scenario/test_fuzz_scenarios.py,
+same seed) and writes each case's outcome: accepted, or the refusal's message.
+`compare` lists the cases whose outcome changed when both folders hold a fuzz.json.
 
 `collect` runs `headsim run NAME --out ...` for every scenario shipped in
 headsim's scenarios folder, with and without --fast, plus `headsim bench --json`
@@ -76,6 +81,59 @@ def collect(dest: Path, jobs: int, only: list[str]) -> None:
         print("ran reproduce --fast", flush=True)
 
 
+def fuzz(dest: Path, cases: int) -> None:
+    """Each mutated scenario's outcome, in the fuzzer's order: "accepted" or the error text."""
+    import importlib.util
+    import random
+
+    from headsim.scenario.loading import load_scenario
+    from headsim.scenario.tables import ScenarioError
+
+    spec = importlib.util.spec_from_file_location(
+        "fuzz_cases", ROOT / "tests" / "scenario" / "test_fuzz_scenarios.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    rng = random.Random(module.SEED)
+    names = sorted(module.BASES)
+    outcomes: list[dict[str, str]] = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for case in range(cases):
+            base = names[case % len(names)]
+            kind, text = module.mutate(module.BASES[base], rng)
+            if rng.random() < 0.3:
+                kind2, text = module.mutate(text, rng)
+                kind = f"{kind}+{kind2}"
+            path = Path(tmp) / f"case{case}.toml"
+            path.write_text(text, encoding="utf-8", errors="surrogatepass")
+            try:
+                load_scenario(path)
+                outcome = "accepted"
+            except ScenarioError as err:
+                outcome = f"refused: {err}"
+            except Exception as err:  # a traceback the fuzzer test would fail on
+                outcome = f"TRACEBACK {type(err).__name__}: {err}"
+            outcomes.append({"case": str(case), "base": base, "kind": kind, "outcome": outcome})
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    dest.write_text(json.dumps(outcomes, indent=1))
+    tracebacks = sum(o["outcome"].startswith("TRACEBACK") for o in outcomes)
+    refused = sum(o["outcome"].startswith("refused") for o in outcomes)
+    print(f"fuzz: {cases} cases, {refused} refused, {tracebacks} tracebacks -> {dest}")
+
+
+def _compare_fuzz(pa: Path, pb: Path) -> int:
+    a_cases, b_cases = json.loads(pa.read_text()), json.loads(pb.read_text())
+    changed = [(a, b) for a, b in zip(a_cases, b_cases, strict=False) if a != b]
+    for a, b in changed:
+        print(f"  case {a['case']} ({a['base']}, {a['kind']}):")
+        print(f"    before: {a['outcome'][:300]}")
+        print(f"    after:  {b['outcome'][:300]}")
+    same = not changed and len(a_cases) == len(b_cases)
+    print(f"{'same' if same else 'DIFF'}  fuzz.json ({len(changed)} outcome(s) changed)")
+    return 0 if same else 1
+
+
 def _strip_timing(value: object) -> object:
     if isinstance(value, dict):
         return {
@@ -120,6 +178,8 @@ def compare(before: Path, after: Path) -> int:
         same = _strip_timing(a_doc) == _strip_timing(b_doc)
         bad += not same
         print(f"{'same' if same else 'DIFF'}  {name} (timings left out)")
+    if (before / "fuzz.json").exists() and (after / "fuzz.json").exists():
+        bad += _compare_fuzz(before / "fuzz.json", after / "fuzz.json")
     print(f"{bad} difference(s)")
     return 1 if bad else 0
 
@@ -136,7 +196,13 @@ def main() -> int:
     d = sub.add_parser("compare")
     d.add_argument("before", type=Path)
     d.add_argument("after", type=Path)
+    f = sub.add_parser("fuzz")
+    f.add_argument("dest", type=Path)
+    f.add_argument("--cases", type=int, default=2000)
     args = parser.parse_args()
+    if args.verb == "fuzz":
+        fuzz(args.dest, args.cases)
+        return 0
     if args.verb == "collect":
         collect(args.dest, args.jobs, args.only)
         return 0
