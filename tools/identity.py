@@ -114,6 +114,7 @@ def fuzz(dest: Path, cases: int) -> None:
                 outcome = f"refused: {err}"
             except Exception as err:  # a traceback the fuzzer test would fail on
                 outcome = f"TRACEBACK {type(err).__name__}: {err}"
+            outcome = outcome.replace(tmp, "TMP")  # the temporary folder differs per run
             outcomes.append({"case": str(case), "base": base, "kind": kind, "outcome": outcome})
     dest.parent.mkdir(parents=True, exist_ok=True)
     dest.write_text(json.dumps(outcomes, indent=1))
