@@ -44,6 +44,7 @@ def preset_name(text: str) -> str:
 def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     """The command line; ``with_study``: with the study's options (imports the study)."""
     from headsim.sim import names
+    from headsim.sim.heads import SHIPPED
 
     parser = argparse.ArgumentParser(
         prog="headsim",
@@ -88,7 +89,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     run.add_argument(
         "--head",
         metavar="HEAD",
-        help="run on another head: paper, independent_eyes, icub or an MJCF file's path "
+        help=f"run on another head: {', '.join(SHIPPED)} or an MJCF file's path "
         "(sets head.model)",
     )
     run.add_argument(

@@ -1,7 +1,8 @@
 """Heads as data: a head's MJCF file and the mapping that names its joints and cameras.
 
-A scenario names its head as a shipped one (:data:`SHIPPED`: ``paper``,
-``independent_eyes``) or as a user's MJCF file with a :class:`HeadMapping`.  The
+A scenario names its head as a shipped one (:data:`REGISTRY`: ``paper``, and each
+file in models/ that declares its description and mapping in its ``<custom>`` block)
+or as a user's MJCF file with a :class:`HeadMapping`.  The
 simulator takes every joint, body and camera name from the mapping, and the head's
 true kinematics from the compiled model.  :func:`check_head` holds a mapping
 against the model and says, naming the mapping's key, what the method needs
@@ -14,6 +15,8 @@ import math
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
+from typing import Any
+from xml.etree import ElementTree
 
 import mujoco
 import numpy as np
@@ -145,54 +148,67 @@ PAPER = HeadModel()
 
 #: The head and scene MJCF files: the repository's models/, installed as package data.
 MODELS_DIR = Path(str(resources.files("headsim.models")))
+#: The prefix of the ``<custom><text>`` entries by which a head file in models/ declares
+#: itself shipped: ``headsim:description`` (its line for ``headsim list``, the CLI and
+#: the docs) and ``headsim:mapping.KEY`` for each key of a scenario's ``[head.mapping]``
+#: (``cameras``: the two names, space-separated).
+DECLARATION = "headsim:"
+
+
+def declaration(path: Path) -> dict[str, str]:
+    """The ``headsim:`` entries of an MJCF file's ``<custom>`` block (prefix removed);
+    empty for a file that declares nothing."""
+    root = ElementTree.parse(path).getroot()
+    return {
+        str(text.get("name"))[len(DECLARATION) :]: str(text.get("data", ""))
+        for custom in root.iter("custom")
+        for text in custom.iter("text")
+        if str(text.get("name", "")).startswith(DECLARATION)
+    }
+
+
+def _declared_mapping(path: Path, declared: dict[str, str]) -> HeadMapping:
+    names: dict[str, Any] = {
+        key.removeprefix("mapping."): value
+        for key, value in declared.items()
+        if key.startswith("mapping.")
+    }
+    if "cameras" in names:
+        names["cameras"] = tuple(names["cameras"].split())
+    try:
+        return HeadMapping(**names)
+    except TypeError as err:  # a key HeadMapping does not have: a broken shipped file
+        raise ValueError(f"{path}: <custom> {DECLARATION}mapping: {err}") from None
+
+
+def _scan(models: Path) -> dict[str, tuple[HeadModel, str]]:
+    """Every head file in ``models`` that declares a description: by file stem, the head
+    and its description."""
+    found = {}
+    for path in sorted(models.glob("*.xml")):
+        declared = declaration(path)
+        if "description" in declared:
+            mapping = _declared_mapping(path, declared)
+            found[path.stem] = (HeadModel(path.stem, path, mapping), declared["description"])
+    return found
+
+
+_DECLARED = {
+    "paper": (PAPER, "the paper's head: 2-DOF neck, one motor counter-yawing both eyes"),
+    **_scan(MODELS_DIR),
+}
+#: The shipped heads by name: the paper's (built into every scene), then every head
+#: file in models/ that declares itself (:data:`DECLARATION`), alphabetically.
+REGISTRY: dict[str, HeadModel] = {name: head for name, (head, _) in _DECLARED.items()}
+#: Each shipped head's one line, for ``headsim list``, the CLI and the docs.
+SHIPPED: dict[str, str] = {name: line for name, (_, line) in _DECLARED.items()}
 
 
 def shipped(name: str) -> HeadModel:
-    """A shipped head by name (:data:`SHIPPED`)."""
-    if name == "paper":
-        return PAPER
-    if name == "icub":
-        return HeadModel(
-            name,
-            MODELS_DIR / "icub.xml",
-            HeadMapping(
-                head_body="head_center",
-                neck_yaw="neck_yaw",
-                neck_pitch="neck_pitch",
-                eyes="version_vergence",
-                left_eye="l_eye_pan",
-                right_eye="r_eye_pan",
-                cameras=("l_eye_camera", "r_eye_camera"),
-                neck_roll="neck_roll",
-                eye_tilt="eyes_tilt",
-                version="eyes_version_motor",
-                vergence="eyes_vergence_motor",
-            ),
-        )
-    if name == "independent_eyes":
-        return HeadModel(
-            name,
-            MODELS_DIR / "independent_eyes.xml",
-            HeadMapping(
-                head_body="head_frame",
-                neck_yaw="neck_yaw_joint",
-                neck_pitch="neck_pitch_joint",
-                eyes="independent",
-                left_eye="left_eye_pan",
-                right_eye="right_eye_pan",
-                cameras=("left_camera", "right_camera"),
-            ),
-        )
-    raise HeadError("model", f"unknown head {name!r}", f"{', '.join(SHIPPED)} or an MJCF file")
-
-
-#: Shipped heads by name, with a line each for ``headsim list``.
-SHIPPED = {
-    "paper": "the paper's head: 2-DOF neck, one motor counter-yawing both eyes",
-    "independent_eyes": "the paper's neck with a motor per eye",
-    "icub": "iCub 2.0 kinematics: neck pitch, roll, yaw; eye tilt, version and vergence; "
-    "320 x 240 cameras",
-}
+    """A shipped head by name (:data:`REGISTRY`)."""
+    if name not in REGISTRY:
+        raise HeadError("model", f"unknown head {name!r}", f"{', '.join(SHIPPED)} or an MJCF file")
+    return REGISTRY[name]
 
 
 @dataclass(frozen=True)
@@ -574,8 +590,11 @@ def _neck(
 
 __all__ = [
     "AXIS_TOLERANCE_RAD",
+    "DECLARATION",
     "EYE_KINDS",
+    "MODELS_DIR",
     "PAPER",
+    "REGISTRY",
     "SHIPPED",
     "DesignedCamera",
     "HeadError",
@@ -585,6 +604,7 @@ __all__ = [
     "actuator_coefficients",
     "actuator_on",
     "check_head",
+    "declaration",
     "eye_motor_range",
     "shipped",
 ]
