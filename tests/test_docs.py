@@ -16,6 +16,7 @@ from headsim import __version__
 from headsim.errors import EXIT_MEANINGS, ExitCode
 from headsim.scenario.key_reference import descriptions
 from headsim.scenario.loading import scenario_files
+from headsim.sim.heads import REGISTRY
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -114,6 +115,17 @@ def test_the_scenario_table_lists_every_shipped_scenario(site: Path) -> None:
     names = re.findall(r"<tr>\s*<td><code>(\w+)</code></td>", table)
     assert names == [path.stem for path in scenario_files()]
     assert len(names) >= 14
+
+
+@pytest.mark.parametrize(
+    ("page", "section"),
+    [("how-to/own-head.html", "a-shipped-head"), ("concepts/model.html", "heads")],
+)
+def test_the_head_tables_list_every_shipped_head(site: Path, page: str, section: str) -> None:
+    """Run your own head's and The model's generated tables: one row per registered head."""
+    after = (site / page).read_text().split(f'<h2 id="{section}">', 1)[1]
+    table = after.split("<table>", 1)[1].split("</table>", 1)[0]
+    assert re.findall(r"<tr>\s*<td><code>(\w+)</code>", table) == list(REGISTRY)
 
 
 def test_the_citation_file_cites_the_software_and_the_paper() -> None:
