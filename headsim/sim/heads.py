@@ -13,10 +13,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 from typing import Any
-from xml.etree import ElementTree
 
 import mujoco
 import numpy as np
@@ -24,6 +22,7 @@ import numpy as np
 from headsim.errors import BadInput
 from headsim.geometry.heads import Neck
 from headsim.sim import names
+from headsim.sim.head_files import DECLARATION, DECLARED, MODELS_DIR, SHIPPED
 
 #: How a head drives its two eye pan joints.
 EYE_KINDS = ("coupled", "independent", "version_vergence")
@@ -146,28 +145,7 @@ class HeadModel:
 PAPER = HeadModel()
 
 
-#: The head and scene MJCF files: the repository's models/, installed as package data.
-MODELS_DIR = Path(str(resources.files("headsim.models")))
-#: The prefix of the ``<custom><text>`` entries by which a head file in models/ declares
-#: itself shipped: ``headsim:description`` (its line for ``headsim list``, the CLI and
-#: the docs) and ``headsim:mapping.KEY`` for each key of a scenario's ``[head.mapping]``
-#: (``cameras``: the two names, space-separated).
-DECLARATION = "headsim:"
-
-
-def declaration(path: Path) -> dict[str, str]:
-    """The ``headsim:`` entries of an MJCF file's ``<custom>`` block (prefix removed);
-    empty for a file that declares nothing."""
-    root = ElementTree.parse(path).getroot()
-    return {
-        str(text.get("name"))[len(DECLARATION) :]: str(text.get("data", ""))
-        for custom in root.iter("custom")
-        for text in custom.iter("text")
-        if str(text.get("name", "")).startswith(DECLARATION)
-    }
-
-
-def _declared_mapping(path: Path, declared: dict[str, str]) -> HeadMapping:
+def _declared_mapping(name: str, declared: dict[str, str]) -> HeadMapping:
     names: dict[str, Any] = {
         key.removeprefix("mapping."): value
         for key, value in declared.items()
@@ -178,30 +156,19 @@ def _declared_mapping(path: Path, declared: dict[str, str]) -> HeadMapping:
     try:
         return HeadMapping(**names)
     except TypeError as err:  # a key HeadMapping does not have: a broken shipped file
-        raise ValueError(f"{path}: <custom> {DECLARATION}mapping: {err}") from None
+        raise ValueError(f"models/{name}.xml: <custom> {DECLARATION}mapping: {err}") from None
 
 
-def _scan(models: Path) -> dict[str, tuple[HeadModel, str]]:
-    """Every head file in ``models`` that declares a description: by file stem, the head
-    and its description."""
-    found = {}
-    for path in sorted(models.glob("*.xml")):
-        declared = declaration(path)
-        if "description" in declared:
-            mapping = _declared_mapping(path, declared)
-            found[path.stem] = (HeadModel(path.stem, path, mapping), declared["description"])
-    return found
-
-
-_DECLARED = {
-    "paper": (PAPER, "the paper's head: 2-DOF neck, one motor counter-yawing both eyes"),
-    **_scan(MODELS_DIR),
+#: The shipped heads by name (:data:`headsim.sim.head_files.SHIPPED` gives each one's
+#: line): the paper's, built into every scene, then every head file in models/ that
+#: declares itself, alphabetically.
+REGISTRY: dict[str, HeadModel] = {
+    "paper": PAPER,
+    **{
+        name: HeadModel(name, MODELS_DIR / f"{name}.xml", _declared_mapping(name, found))
+        for name, found in DECLARED.items()
+    },
 }
-#: The shipped heads by name: the paper's (built into every scene), then every head
-#: file in models/ that declares itself (:data:`DECLARATION`), alphabetically.
-REGISTRY: dict[str, HeadModel] = {name: head for name, (head, _) in _DECLARED.items()}
-#: Each shipped head's one line, for ``headsim list``, the CLI and the docs.
-SHIPPED: dict[str, str] = {name: line for name, (_, line) in _DECLARED.items()}
 
 
 def shipped(name: str) -> HeadModel:
@@ -590,7 +557,6 @@ def _neck(
 
 __all__ = [
     "AXIS_TOLERANCE_RAD",
-    "DECLARATION",
     "EYE_KINDS",
     "MODELS_DIR",
     "PAPER",
@@ -604,7 +570,6 @@ __all__ = [
     "actuator_coefficients",
     "actuator_on",
     "check_head",
-    "declaration",
     "eye_motor_range",
     "shipped",
 ]

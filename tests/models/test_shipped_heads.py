@@ -15,7 +15,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from headsim.sim.heads import MODELS_DIR, REGISTRY, SHIPPED, HeadMapping, declaration
+from headsim.sim.head_files import MODELS_DIR, SHIPPED, declaration
+from headsim.sim.heads import REGISTRY, HeadMapping
 from headsim.sim.model import design
 from tests.models.mjcf import (
     NAMED_KINDS,
