@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 from headsim import __version__
-from headsim.errors import EXIT_MEANINGS, ExitCode
+from headsim.errors import ExitCode
 from headsim.scenario.key_reference import descriptions
 from headsim.scenario.loading import scenario_files
 from headsim.sim.heads import REGISTRY
@@ -156,10 +156,6 @@ def test_a_broken_link_fails_the_build(tmp_path: Path) -> None:
     done = _build(tmp_path / "site", docs)
     assert done.returncode == 1
     assert re.search(r"python\.md.*no-such-page\.md", done.stderr), done.stderr
-
-
-def test_every_exit_code_has_its_meaning() -> None:
-    assert list(EXIT_MEANINGS) == list(ExitCode)
 
 
 def test_the_screenshot_tool_refuses_without_chromium_and_writes_nothing(tmp_path: Path) -> None:

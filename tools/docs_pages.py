@@ -26,7 +26,7 @@ from mkdocs.structure.files import File, Files
 
 from headsim import __version__
 from headsim.cli.parser import build_parser
-from headsim.errors import EXIT_MEANINGS
+from headsim.errors import EXIT_MEANINGS, ExitCode
 from headsim.runs.results_reference import RESULTS_FIELDS, experiment_fields
 from headsim.scenario.key_reference import accepted_keys
 from headsim.scenario.loading import load_scenario, scenario_files
@@ -144,9 +144,10 @@ def command_line_page() -> str:
 
 
 def exit_codes_page() -> str:
-    """The exit-code contract, from :data:`headsim.errors.EXIT_MEANINGS`."""
+    """The exit-code contract, from :data:`headsim.errors.EXIT_MEANINGS` (a code without a
+    meaning fails the build)."""
     rows = "\n".join(
-        f"| {int(code)} | `{code.name}` | {text} |" for code, text in EXIT_MEANINGS.items()
+        f"| {int(code)} | `{code.name}` | {EXIT_MEANINGS[code]} |" for code in ExitCode
     )
     return (
         "# Exit codes\n\nThe same for every command (`headsim.errors.ExitCode`). Every failure "
