@@ -3,9 +3,12 @@ its frames in W (docs/equations.md, "Frames and signs")."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import mujoco
 import numpy as np
 
+from headsim.sim.head_files import MODELS_DIR
 from headsim.sim.heads import REGISTRY, HeadMapping
 
 #: H's axes in W at all joints 0, as columns: x right, y down, z forward.
@@ -27,8 +30,13 @@ NAMED_KINDS = {
 }
 
 
+def head_file(name: str) -> Path:
+    """A shipped head's MJCF file (the paper's: models/head.xml, which the scenes include)."""
+    return REGISTRY[name].path or MODELS_DIR / "head.xml"
+
+
 def load(name: str) -> mujoco.MjModel:
-    return mujoco.MjModel.from_xml_path(str(REGISTRY[name].path))
+    return mujoco.MjModel.from_xml_path(str(head_file(name)))
 
 
 def names(name: str) -> HeadMapping:

@@ -1,6 +1,7 @@
-"""Every shipped head file in models/ (the registry, :data:`headsim.sim.heads.REGISTRY`),
-with real MuJoCo: its declaration, frames, axes, signs and cameras.  A head added to
-models/ is tested here with no edit; its own numbers (baseline, cameras, neck offsets
+"""Every shipped head (the registry, :data:`headsim.sim.heads.REGISTRY`: the paper's
+models/head.xml and each head file that declares itself), with real MuJoCo: its
+declaration, frames, axes, signs and cameras.  A head added to models/ is tested here
+with no edit; its own numbers (baseline, cameras, neck offsets
 as cited) are its own test's, tests/models/test_NAME.py.
 
 Every head keeps the project's frames (docs/equations.md, "Frames and signs"): W at the
@@ -22,6 +23,7 @@ from tests.models.mjcf import (
     NAMED_KINDS,
     TIGHT,
     W_FROM_H_HOME,
+    head_file,
     joint_axis_w,
     load,
     names,
@@ -31,8 +33,8 @@ from tests.models.mjcf import (
     w_from_opencv_camera,
 )
 
-#: Every shipped head that is a file of its own (the paper's is built into the scenes).
-HEADS = [name for name, head in REGISTRY.items() if head.path is not None]
+#: Every shipped head.
+HEADS = list(REGISTRY)
 #: Those with a neck yaw (a head may have none: Model 2 only).
 YAWING = [name for name in HEADS if REGISTRY[name].mapping.neck_yaw is not None]
 
@@ -237,7 +239,7 @@ def with_sphere_ahead_of(name: str, camera: str) -> mujoco.MjModel:
     home = posed(load(name))
     ahead_w = w_from_opencv_camera(home, load(name), camera)[:, 2]
     centre_w = home.cam_xpos[load(name).camera(camera).id] + SPHERE_DISTANCE_M * ahead_w
-    spec = mujoco.MjSpec.from_file(str(REGISTRY[name].path))
+    spec = mujoco.MjSpec.from_file(str(head_file(name)))
     spec.add_material(name="test_red", rgba=[1.0, 0.0, 0.0, 1.0], emission=1.0)
     body = spec.worldbody.add_body(name="test_target", pos=centre_w)
     body.add_geom(
@@ -294,7 +296,7 @@ def in_default_scene(name: str) -> mujoco.MjModel:
     for element in [*scene.actuators, *scene.equalities, *scene.keys]:
         scene.delete(element)
     scene.delete(scene.body("neck_base"))  # the paper head, its joints, geoms and cameras
-    spec = mujoco.MjSpec.from_file(str(REGISTRY[name].path))
+    spec = mujoco.MjSpec.from_file(str(head_file(name)))
     scene.worldbody.add_frame().attach_body(spec.worldbody.first_body(), PREFIX, "")
     return scene.compile()
 
