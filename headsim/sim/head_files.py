@@ -34,17 +34,30 @@ def declaration(path: Path) -> dict[str, str]:
     }
 
 
-#: Every head file in models/ that declares a description, by file stem, alphabetically:
-#: its entries.
-DECLARED: dict[str, dict[str, str]] = {
-    path.stem: found
-    for path in sorted(MODELS_DIR.glob("*.xml"))
-    if "description" in (found := declaration(path))
-}
+def declared_heads(models: Path) -> dict[str, dict[str, str]]:
+    """Every head file in ``models`` that declares a description, by file stem,
+    alphabetically: its entries."""
+    return {
+        path.stem: found
+        for path in sorted(models.glob("*.xml"))
+        if "description" in (found := declaration(path))
+    }
+
+
+#: The head files of models/ that declare themselves (:func:`declared_heads`).
+DECLARED = declared_heads(MODELS_DIR)
 #: Each shipped head's one line, for the CLI and the docs: the paper's, then the files'.
 SHIPPED: dict[str, str] = {
     "paper": PAPER_DESCRIPTION,
     **{name: found["description"] for name, found in DECLARED.items()},
 }
 
-__all__ = ["DECLARATION", "DECLARED", "MODELS_DIR", "PAPER_DESCRIPTION", "SHIPPED", "declaration"]
+__all__ = [
+    "DECLARATION",
+    "DECLARED",
+    "MODELS_DIR",
+    "PAPER_DESCRIPTION",
+    "SHIPPED",
+    "declaration",
+    "declared_heads",
+]

@@ -145,7 +145,9 @@ class HeadModel:
 PAPER = HeadModel()
 
 
-def _declared_mapping(name: str, declared: dict[str, str]) -> HeadMapping:
+def declared_head(path: Path, declared: dict[str, str]) -> HeadModel:
+    """The head a file in models/ declares (:mod:`headsim.sim.head_files`): named by its
+    stem, with the mapping its ``headsim:mapping.KEY`` entries give."""
     names: dict[str, Any] = {
         key.removeprefix("mapping."): value
         for key, value in declared.items()
@@ -154,9 +156,9 @@ def _declared_mapping(name: str, declared: dict[str, str]) -> HeadMapping:
     if "cameras" in names:
         names["cameras"] = tuple(names["cameras"].split())
     try:
-        return HeadMapping(**names)
+        return HeadModel(path.stem, path, HeadMapping(**names))
     except TypeError as err:  # a key HeadMapping does not have: a broken shipped file
-        raise ValueError(f"models/{name}.xml: <custom> {DECLARATION}mapping: {err}") from None
+        raise ValueError(f"{path.name}: <custom> {DECLARATION}mapping: {err}") from None
 
 
 #: The shipped heads by name (:data:`headsim.sim.head_files.SHIPPED` gives each one's
@@ -164,10 +166,7 @@ def _declared_mapping(name: str, declared: dict[str, str]) -> HeadMapping:
 #: declares itself, alphabetically.
 REGISTRY: dict[str, HeadModel] = {
     "paper": PAPER,
-    **{
-        name: HeadModel(name, MODELS_DIR / f"{name}.xml", _declared_mapping(name, found))
-        for name, found in DECLARED.items()
-    },
+    **{name: declared_head(MODELS_DIR / f"{name}.xml", found) for name, found in DECLARED.items()},
 }
 
 
@@ -570,6 +569,7 @@ __all__ = [
     "actuator_coefficients",
     "actuator_on",
     "check_head",
+    "declared_head",
     "eye_motor_range",
     "shipped",
 ]

@@ -12,12 +12,14 @@ with H there and on its eye's pan axis, and each pan angle positive inward.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import mujoco
 import numpy as np
 import pytest
 
-from headsim.sim.head_files import MODELS_DIR, SHIPPED, declaration
-from headsim.sim.heads import REGISTRY, HeadMapping
+from headsim.sim.head_files import MODELS_DIR, SHIPPED, declaration, declared_heads
+from headsim.sim.heads import REGISTRY, HeadMapping, declared_head
 from headsim.sim.model import design
 from tests.models.mjcf import (
     NAMED_KINDS,
@@ -77,6 +79,27 @@ def test_every_model_file_is_a_scene_the_papers_head_or_a_declared_head() -> Non
             HeadMapping.__dataclass_fields__
         ), path.name
     assert list(SHIPPED) == list(REGISTRY) and next(iter(SHIPPED)) == "paper"
+
+
+@pytest.mark.fast
+@pytest.mark.parametrize("name", [name for name in HEADS if REGISTRY[name].path is not None])
+def test_a_file_that_declares_itself_is_a_head_with_no_other_edit(
+    tmp_path: Path, name: str
+) -> None:
+    """A copy of a head file under a new name, with its own line, is found as a head and
+    holds as the original does; a mapping key HeadMapping lacks is refused naming both."""
+    text = head_file(name).read_text()
+    (tmp_path / "twin.xml").write_text(
+        text.replace(f'data="{SHIPPED[name]}"', 'data="a twin, for the test"')
+    )
+    (tmp_path / "scene_twin.xml").write_text("<mujoco/>")  # declares nothing: not a head
+    found = declared_heads(tmp_path)
+    assert list(found) == ["twin"] and found["twin"]["description"] == "a twin, for the test"
+    twin = declared_head(tmp_path / "twin.xml", found["twin"])
+    assert (twin.name, twin.mapping) == ("twin", REGISTRY[name].mapping)
+    assert design(twin) == design(REGISTRY[name])
+    with pytest.raises(ValueError, match=r"twin\.xml: <custom> headsim:mapping: .*'nose'"):
+        declared_head(tmp_path / "twin.xml", {**found["twin"], "mapping.nose": "n"})
 
 
 @pytest.mark.parametrize("name", HEADS)
