@@ -1,10 +1,9 @@
 """Each shipped head over its whole field, beside calibrated stereo on the same targets, and
 accuracy against baseline and focal length for the three kinds of head.
 
-Per head (``paper``: one motor counter-yawing both eyes; ``independent_eyes``: a motor
-per eye; ``icub``: iCub-like, version and vergence on its own 320 x 240 cameras) and
-procedure (Model 2 with the counter-yaw on every head; one-step fixation where the eyes
-can be pointed on their own): a realistic head calibrated with tape-measured balls,
+Per shipped head (``headsim.sim.heads.REGISTRY``: the paper's coupled eyes, a motor per
+eye, version and vergence) and procedure (Model 2 with the counter-yaw on every head;
+one-step fixation where the eyes can be pointed on their own): a realistic head calibrated with tape-measured balls,
 then seeded random targets over the field both cameras share at 0.3-1.5 m, kept by
 the reach check (what it refused is counted).  The same head's Zhang-calibrated stereo
 (``stereo`` procedure) then triangulates the very targets the procedure was given; its
@@ -40,15 +39,15 @@ from headsim.runs.progress import Status
 from headsim.runs.runner import run_scenario
 from headsim.runs.serialise import results_payload
 from headsim.scenario.loading import scenario_from_document
-from headsim.sim.heads import shipped
+from headsim.sim.heads import REGISTRY, shipped
 from headsim.sim.model import on_head
 from headsim.sim.settings import preset
 
-#: The heads, the kind of head each stands for, and the procedures each runs.
+#: Every shipped head: the kind of eyes it has, and the procedures it runs (fixation
+#: where each eye can be pointed on its own).
 HEADS = {
-    "paper": ("one motor", ("model2",)),
-    "independent_eyes": ("independent", ("model2", "fixation")),
-    "icub": ("iCub-like", ("model2", "fixation")),
+    name: (head.mapping.eyes, ("model2", "fixation") if head.mapping.independent else ("model2",))
+    for name, head in REGISTRY.items()
 }
 BANDS = ((0.0, 0.6, "0-0.6 m"), (0.6, 1.0, "0.6-1 m"), (1.0, np.inf, ">= 1 m"))
 SCALES = (0.6, 1.0, 1.6)

@@ -13,9 +13,10 @@ import pytest
 import yaml
 
 from headsim import __version__
-from headsim.errors import EXIT_MEANINGS, ExitCode
+from headsim.errors import ExitCode
 from headsim.scenario.key_reference import descriptions
 from headsim.scenario.loading import scenario_files
+from headsim.sim.heads import REGISTRY
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -116,6 +117,17 @@ def test_the_scenario_table_lists_every_shipped_scenario(site: Path) -> None:
     assert len(names) >= 14
 
 
+@pytest.mark.parametrize(
+    ("page", "section"),
+    [("how-to/own-head.html", "a-shipped-head"), ("concepts/model.html", "heads")],
+)
+def test_the_head_tables_list_every_shipped_head(site: Path, page: str, section: str) -> None:
+    """Run your own head's and The model's generated tables: one row per registered head."""
+    after = (site / page).read_text().split(f'<h2 id="{section}">', 1)[1]
+    table = after.split("<table>", 1)[1].split("</table>", 1)[0]
+    assert re.findall(r"<tr>\s*<td><code>(\w+)</code>", table) == list(REGISTRY)
+
+
 def test_the_citation_file_cites_the_software_and_the_paper() -> None:
     cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
     assert cff["cff-version"] == "1.2.0"
@@ -144,10 +156,6 @@ def test_a_broken_link_fails_the_build(tmp_path: Path) -> None:
     done = _build(tmp_path / "site", docs)
     assert done.returncode == 1
     assert re.search(r"python\.md.*no-such-page\.md", done.stderr), done.stderr
-
-
-def test_every_exit_code_has_its_meaning() -> None:
-    assert list(EXIT_MEANINGS) == list(ExitCode)
 
 
 def test_the_screenshot_tool_refuses_without_chromium_and_writes_nothing(tmp_path: Path) -> None:

@@ -11,9 +11,11 @@ A report, not a test: it prints counts and the files behind them, and exits 0.
   counts only while its words are still in the recipe), plus every file outside
   ``headsim/procedures/`` that names each registered procedure: a complete list (an
   import order, a reference table, a test pinning the registry) that a new one joins.
-- **A head**: CONTRIBUTING.md's recipe if it has one, else docs/how-to/own-head.md's
-  (a user's head is its MJCF file and a scenario file); a shipped head adds its model
-  file, its test, and every file that names each shipped head but ``paper``.
+- **A head**: CONTRIBUTING.md's "Adding a head" (else a user's head, docs/how-to/
+  own-head.md's MJCF file and scenario file, and a shipped head's model file and test),
+  plus every file that lists each shipped head but ``paper`` (all named within
+  ``LIST_SPAN`` lines: a table, a dict, an error's choices); files that name them only
+  apart, as examples, are shown beside it and not counted.
 - **An imperfection**: CONTRIBUTING.md's recipe if it has one, else the files that
   name the image noise (``noise_std``, one setting every renderer applies) in code or
   in a docs page's code span: where an image imperfection is declared, ranged,
@@ -46,6 +48,13 @@ IMPERFECTION_RECIPE = (
 )
 #: A user's own head, read from docs/how-to/own-head.md: the MJCF file and its scenario.
 OWN_HEAD = ("my_head.xml", "scenarios/NAME.toml")
+#: "Adding a head", read from CONTRIBUTING.md likewise.
+HEAD_RECIPE = (
+    ("models/NAME.xml", "**The model**, `models/NAME.xml`"),
+    ("tests/models/test_NAME.py", "**Its test**, `tests/models/test_NAME.py`"),
+)
+#: Lines within which a file must name every shipped head to hold a list of them.
+LIST_SPAN = 6
 #: The existing imperfection a new image imperfection follows.
 IMPERFECTION = "noise_std"
 SEARCHED = ("headsim", "tests", "docs", "tools", "benchmarks", "examples")
@@ -70,35 +79,65 @@ def line_counts(package: Path) -> tuple[int, int, int, int]:
     return modules, raw, non_blank, code
 
 
-def words(path: Path) -> set[str]:
+def located_words(path: Path) -> list[tuple[str, int]]:
     """The whole words a file names in code (identifiers, imports, string literals) or,
-    for Markdown, in code spans."""
+    for Markdown, in code spans; each with its line."""
     text = path.read_text(errors="replace")
     if path.suffix == ".md":
-        return {w for span in re.findall(r"`([^`\n]+)`", text) for w in re.findall(r"\w+", span)}
+        return [
+            (w, n)
+            for n, line in enumerate(text.splitlines(), 1)
+            for span in re.findall(r"`([^`\n]+)`", line)
+            for w in re.findall(r"\w+", span)
+        ]
     tree = ast.parse(text)
     docstrings = {
         id(node.value)
         for node in ast.walk(tree)
         if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
     }
-    found: set[str] = set()
+    found: list[tuple[str, int]] = []
     for node in ast.walk(tree):
+        line = getattr(node, "lineno", 0)
         if isinstance(node, ast.Constant) and isinstance(node.value, str):
             if id(node) in docstrings:
                 continue
-            found.update(re.findall(r"\w+", node.value))
+            found += [(w, line) for w in re.findall(r"\w+", node.value)]
         elif isinstance(node, ast.Name):
-            found.add(node.id)
+            found.append((node.id, line))
         elif isinstance(node, ast.Attribute):
-            found.add(node.attr)
+            found.append((node.attr, line))
         elif isinstance(node, ast.alias):
-            found.update(node.name.split("."))
+            found += [(w, line) for w in node.name.split(".")]
         elif isinstance(node, ast.arg | ast.keyword) and node.arg:
-            found.add(node.arg)
+            found.append((node.arg, line))
         elif isinstance(node, ast.ImportFrom) and node.module:
-            found.update(node.module.split("."))
+            found += [(w, line) for w in node.module.split(".")]
     return found
+
+
+def words(path: Path) -> set[str]:
+    """The whole words a file names in code or in Markdown code spans."""
+    return {w for w, _ in located_words(path)}
+
+
+def listing_all(root: Path, files: list[str], names: set[str]) -> list[str]:
+    """Of ``files``, those that name every one of ``names`` within :data:`LIST_SPAN`
+    lines: a list (a table, a dict, an error message's choices) that a new one joins,
+    not examples that name one each."""
+    listing = []
+    for f in files:
+        lines: dict[str, list[int]] = {}
+        for w, n in located_words(root / f):
+            if w in names:
+                lines.setdefault(w, []).append(n)
+        starts = sorted({n for found in lines.values() for n in found})
+        if len(lines) == len(names) and any(
+            all(any(s <= n < s + LIST_SPAN for n in found) for found in lines.values())
+            for s in starts
+        ):
+            listing.append(f)
+    return listing
 
 
 def searched_files(root: Path) -> dict[str, set[str]]:
@@ -176,18 +215,28 @@ def main() -> int:
         p.stem for p in (root / "models").glob("scene*.xml")
     }
     head_recipe = section(contributing, "Adding a head")
+    head_named = naming_all(index, shipped)
+    head_lists = listing_all(root, head_named, shipped)
     if head_recipe is None:
         report(
             "a user's own head (no CONTRIBUTING recipe; docs/how-to/own-head.md)", list(OWN_HEAD)
         )
-        head_lists = naming_all(index, shipped)
-        report(
-            f"a shipped head: models/NAME.xml, its test, and files naming every shipped head "
-            f"but paper ({', '.join(sorted(shipped))})",
-            sorted({"models/NAME.xml", "tests/models/test_NAME.py", *head_lists}),
-        )
+        steps = ["models/NAME.xml", "tests/models/test_NAME.py"]
     else:
-        print("a head: CONTRIBUTING.md has a recipe ('Adding a head'); count it by hand")
+        steps = [f for f, w in HEAD_RECIPE if " ".join(w.split()) in head_recipe]
+        gone = [f for f, w in HEAD_RECIPE if " ".join(w.split()) not in head_recipe]
+        if gone:
+            print("steps of HEAD_RECIPE no longer in CONTRIBUTING.md:", ", ".join(gone))
+    report(
+        f"a shipped head: {'CONTRIBUTING.md' + chr(39) + 's recipe' if head_recipe else 'its model and test'}, "
+        f"and files listing every shipped head but paper ({', '.join(sorted(shipped))}) "
+        f"within {LIST_SPAN} lines",
+        sorted({*steps, *head_lists}),
+    )
+    report(
+        "  files naming each of them apart (examples, not lists)",
+        sorted(set(head_named) - set(head_lists)),
+    )
 
     print()
     imperfection = section(contributing, "Adding an image imperfection")

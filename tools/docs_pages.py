@@ -11,7 +11,8 @@ site as a generated file (nothing generated is committed):
 - ``reference/exit-codes.md``: the exit-code contract (:mod:`headsim.errors`).
 
 and a page's ``<!-- generated:NAME -->`` is replaced by what ``GENERATED[NAME]`` makes:
-the package's version (the home page), the table of shipped scenarios (how to write one).
+the package's version (the home page), the table of shipped scenarios (how to write one),
+the shipped heads (run your own head) and their designs (the model).
 """
 
 from __future__ import annotations
@@ -25,10 +26,12 @@ from mkdocs.structure.files import File, Files
 
 from headsim import __version__
 from headsim.cli.parser import build_parser
-from headsim.errors import EXIT_MEANINGS
+from headsim.errors import EXIT_MEANINGS, ExitCode
 from headsim.runs.results_reference import RESULTS_FIELDS, experiment_fields
 from headsim.scenario.key_reference import accepted_keys
 from headsim.scenario.loading import load_scenario, scenario_files
+from headsim.sim.heads import REGISTRY, SHIPPED
+from headsim.sim.model import design, has_own_cameras
 
 
 def _cell(text: str) -> str:
@@ -141,9 +144,10 @@ def command_line_page() -> str:
 
 
 def exit_codes_page() -> str:
-    """The exit-code contract, from :data:`headsim.errors.EXIT_MEANINGS`."""
+    """The exit-code contract, from :data:`headsim.errors.EXIT_MEANINGS` (a code without a
+    meaning fails the build)."""
     rows = "\n".join(
-        f"| {int(code)} | `{code.name}` | {text} |" for code, text in EXIT_MEANINGS.items()
+        f"| {int(code)} | `{code.name}` | {EXIT_MEANINGS[code]} |" for code in ExitCode
     )
     return (
         "# Exit codes\n\nThe same for every command (`headsim.errors.ExitCode`). Every failure "
@@ -164,7 +168,64 @@ def scenarios_table() -> str:
     return "\n".join(rows)
 
 
-GENERATED = {"version": lambda: __version__, "scenarios": scenarios_table}
+def heads_table() -> str:
+    """Every shipped head (:data:`headsim.sim.heads.REGISTRY`): its name and its line."""
+    rows = ["| `head.model` | what |", "|---|---|"]
+    for name, line in SHIPPED.items():
+        rows.append(f"| `{name}`{' (default)' if name == 'paper' else ''} | {_cell(line)} |")
+    return "\n".join(rows)
+
+
+def _code(*names: str | None) -> str:
+    return ", ".join(f"`{n}`" for n in names if n is not None)
+
+
+def head_designs_table() -> str:
+    """Every shipped head's joints, eyes, baseline and cameras, read from its compiled
+    model at all joints zero (a shipped file that fails its checks fails the build)."""
+    rows = [
+        "| head | file | neck joints | eyes | baseline | cameras |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, head in REGISTRY.items():
+        m, designed = head.mapping, design(head)
+        held = f"; {_code(*m.held)} held at zero" if m.held else ""
+        if designed.neck.order == "pitch_yaw":
+            neck = (
+                f"{_code(m.neck_pitch)} at the base, then {_code(m.neck_yaw)} ((H10): H "
+                f"{designed.neck.forward_m * 1e3:g} mm ahead of the yaw axis, "
+                f"{(designed.neck_d1_m + designed.neck_a2_m) * 1e3:g} mm above the pitch axis)"
+            )
+        else:
+            neck = (
+                f"{_code(m.neck_yaw, m.neck_pitch)} (d1 {designed.neck_d1_m:g} m, "
+                f"a2 {designed.neck_a2_m:g} m)"
+            )
+        pans = _code(m.left_eye, m.right_eye)
+        eyes = {
+            "coupled": f"coupled: one motor turns {_code(m.left_eye)}, {_code(m.right_eye)} follows",
+            "independent": f"independent: {pans}, a motor each",
+            "version_vergence": f"version and vergence ({_code(m.version, m.vergence)}) "
+            f"over {pans}",
+        }[m.eyes]
+        camera = designed.cameras[0]
+        cameras = f"{_code(*m.cameras)}: {camera.width}x{camera.height}, f = {camera.fx_px:.2f} px"
+        if has_own_cameras(head):
+            cameras += ", kept under every preset"
+        file = "head.xml" if head.path is None else head.path.name
+        rows.append(
+            f"| `{name}`{' (default)' if name == 'paper' else ''} | `{file}` | {neck}{held} | "
+            f"{eyes} | {designed.baseline_m * 1e3:g} mm | {cameras} |"
+        )
+    return "\n".join(rows)
+
+
+GENERATED = {
+    "version": lambda: __version__,
+    "scenarios": scenarios_table,
+    "heads": heads_table,
+    "head-designs": head_designs_table,
+}
 MARKER = re.compile(r"<!-- generated:(?P<name>[\w-]+) -->")
 
 

@@ -44,6 +44,7 @@ def preset_name(text: str) -> str:
 def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     """The command line; ``with_study``: with the study's options (imports the study)."""
     from headsim.sim import names
+    from headsim.sim.head_files import SHIPPED
 
     parser = argparse.ArgumentParser(
         prog="headsim",
@@ -88,8 +89,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     run.add_argument(
         "--head",
         metavar="HEAD",
-        help="run on another head: paper, independent_eyes, icub or an MJCF file's path "
-        "(sets head.model)",
+        help=f"run on another head: {', '.join(SHIPPED)} or an MJCF file's path (sets head.model)",
     )
     run.add_argument(
         "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"

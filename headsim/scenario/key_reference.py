@@ -26,7 +26,7 @@ from headsim.scenario.loading import (
 from headsim.scenario.scene import POSITION_KEYS, RANDOM_BOX_KEYS
 from headsim.scenario.tables import KeyUse, collecting_keys
 from headsim.sim import imperfections
-from headsim.sim.model import MODELS_DIR
+from headsim.sim.heads import MODELS_DIR, SHIPPED
 from headsim.sim.settings import (
     BACKLASH,
     ENCODER_RESOLUTION,
@@ -293,7 +293,7 @@ DESCRIPTIONS: dict[str, str] = {
     "seed": "Seed of the image noise and of every random layout; `--seed` replaces it.",
     "fast": "Fields merged over the file by `--fast`: tables key by key, other values replaced.",
     "head": "The head's geometry and joints; missing keys come from `head.preset`.",
-    "head.model": "Which head: a shipped one (paper, independent_eyes, icub) or a path to your head's MJCF file.",
+    "head.model": f"Which head: a shipped one ({', '.join(SHIPPED)}) or a path to your head's MJCF file.",
     "head.mapping": "With an MJCF `head.model`: the names of its joints, body H and cameras.",
     "head.mapping.head_body": "The body whose frame is H at all joints zero (midway between the optical centres, x right, y down, z forward).",
     "head.mapping.neck_yaw": "The neck's yaw joint: about W's +z at the base, or above a pitch at the base (the iCub's); leave out on a head without one (Model 2 only).",

@@ -1,7 +1,8 @@
 """Heads as data: a head's MJCF file and the mapping that names its joints and cameras.
 
-A scenario names its head as a shipped one (:data:`SHIPPED`: ``paper``,
-``independent_eyes``) or as a user's MJCF file with a :class:`HeadMapping`.  The
+A scenario names its head as a shipped one (:data:`REGISTRY`: ``paper``, and each
+file in models/ that declares its description and mapping in its ``<custom>`` block)
+or as a user's MJCF file with a :class:`HeadMapping`.  The
 simulator takes every joint, body and camera name from the mapping, and the head's
 true kinematics from the compiled model.  :func:`check_head` holds a mapping
 against the model and says, naming the mapping's key, what the method needs
@@ -12,8 +13,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -21,6 +22,7 @@ import numpy as np
 from headsim.errors import BadInput
 from headsim.geometry.heads import Neck
 from headsim.sim import names
+from headsim.sim.head_files import DECLARATION, DECLARED, MODELS_DIR, SHIPPED
 
 #: How a head drives its two eye pan joints.
 EYE_KINDS = ("coupled", "independent", "version_vergence")
@@ -143,56 +145,36 @@ class HeadModel:
 PAPER = HeadModel()
 
 
-#: The head and scene MJCF files: the repository's models/, installed as package data.
-MODELS_DIR = Path(str(resources.files("headsim.models")))
+def declared_head(path: Path, declared: dict[str, str]) -> HeadModel:
+    """The head a file in models/ declares (:mod:`headsim.sim.head_files`): named by its
+    stem, with the mapping its ``headsim:mapping.KEY`` entries give."""
+    names: dict[str, Any] = {
+        key.removeprefix("mapping."): value
+        for key, value in declared.items()
+        if key.startswith("mapping.")
+    }
+    if "cameras" in names:
+        names["cameras"] = tuple(names["cameras"].split())
+    try:
+        return HeadModel(path.stem, path, HeadMapping(**names))
+    except TypeError as err:  # a key HeadMapping does not have: a broken shipped file
+        raise ValueError(f"{path.name}: <custom> {DECLARATION}mapping: {err}") from None
+
+
+#: The shipped heads by name (:data:`headsim.sim.head_files.SHIPPED` gives each one's
+#: line): the paper's, built into every scene, then every head file in models/ that
+#: declares itself, alphabetically.
+REGISTRY: dict[str, HeadModel] = {
+    "paper": PAPER,
+    **{name: declared_head(MODELS_DIR / f"{name}.xml", found) for name, found in DECLARED.items()},
+}
 
 
 def shipped(name: str) -> HeadModel:
-    """A shipped head by name (:data:`SHIPPED`)."""
-    if name == "paper":
-        return PAPER
-    if name == "icub":
-        return HeadModel(
-            name,
-            MODELS_DIR / "icub.xml",
-            HeadMapping(
-                head_body="head_center",
-                neck_yaw="neck_yaw",
-                neck_pitch="neck_pitch",
-                eyes="version_vergence",
-                left_eye="l_eye_pan",
-                right_eye="r_eye_pan",
-                cameras=("l_eye_camera", "r_eye_camera"),
-                neck_roll="neck_roll",
-                eye_tilt="eyes_tilt",
-                version="eyes_version_motor",
-                vergence="eyes_vergence_motor",
-            ),
-        )
-    if name == "independent_eyes":
-        return HeadModel(
-            name,
-            MODELS_DIR / "independent_eyes.xml",
-            HeadMapping(
-                head_body="head_frame",
-                neck_yaw="neck_yaw_joint",
-                neck_pitch="neck_pitch_joint",
-                eyes="independent",
-                left_eye="left_eye_pan",
-                right_eye="right_eye_pan",
-                cameras=("left_camera", "right_camera"),
-            ),
-        )
-    raise HeadError("model", f"unknown head {name!r}", f"{', '.join(SHIPPED)} or an MJCF file")
-
-
-#: Shipped heads by name, with a line each for ``headsim list``.
-SHIPPED = {
-    "paper": "the paper's head: 2-DOF neck, one motor counter-yawing both eyes",
-    "independent_eyes": "the paper's neck with a motor per eye",
-    "icub": "iCub 2.0 kinematics: neck pitch, roll, yaw; eye tilt, version and vergence; "
-    "320 x 240 cameras",
-}
+    """A shipped head by name (:data:`REGISTRY`)."""
+    if name not in REGISTRY:
+        raise HeadError("model", f"unknown head {name!r}", f"{', '.join(SHIPPED)} or an MJCF file")
+    return REGISTRY[name]
 
 
 @dataclass(frozen=True)
@@ -575,7 +557,9 @@ def _neck(
 __all__ = [
     "AXIS_TOLERANCE_RAD",
     "EYE_KINDS",
+    "MODELS_DIR",
     "PAPER",
+    "REGISTRY",
     "SHIPPED",
     "DesignedCamera",
     "HeadError",
@@ -585,6 +569,7 @@ __all__ = [
     "actuator_coefficients",
     "actuator_on",
     "check_head",
+    "declared_head",
     "eye_motor_range",
     "shipped",
 ]

@@ -10,6 +10,7 @@ import pytest
 from scenario.helpers import write_scenario
 
 from headsim.cli import main
+from headsim.sim.heads import SHIPPED
 
 #: Two hand-placed markers on the ideal head, its true baseline changed in [head].
 HAND_PLACED = """
@@ -131,7 +132,7 @@ def test_a_bad_head_flag_blames_the_flag(
     code, _, err = _run(capsys, "quickstart", "--head", "bogus", "--out", str(tmp_path / "out"))
     assert code == 2
     assert err.strip() == (
-        "headsim: error: --head: no shipped head or MJCF file 'bogus' (allowed: paper, "
-        "independent_eyes, icub, or a path to a head's MJCF .xml file)"
+        "headsim: error: --head: no shipped head or MJCF file 'bogus' (allowed: "
+        f"{', '.join(SHIPPED)}, or a path to a head's MJCF .xml file)"
     )
     assert not (tmp_path / "out").exists()
