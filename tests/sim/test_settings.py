@@ -26,7 +26,10 @@ from headsim.sim.simulator import HeadSim
 @pytest.mark.parametrize(
     ("make", "message"),
     [
-        (lambda: HeadSettings(baseline_m=-0.15), "baseline_m must be > 0"),
+        (
+            lambda: HeadSettings(baseline_m=-0.15),
+            r"baseline_m must be within \[0.01, 1\] m, got -0.15",
+        ),
         (lambda: HeadSettings(baseline_m=float("nan")), "baseline_m must be a finite number"),
         (lambda: CameraSettings(width=5000), r"width must be within \[16, 4096\] px, got 5000"),
         (lambda: CameraSettings(height=0), r"height must be within \[16, 4096\] px, got 0"),
