@@ -128,6 +128,9 @@ HEAD_KEYS: tuple[Declared, ...] = (
     RENDER_OFFSAMPLES,
     RENDER_SUPERSAMPLE,
 )
+#: Declared keys whose default the reader takes from other keys (``head.preset``) rather
+#: than from a preset's head: the reference says so.
+DEFAULT_FROM_OTHER_KEYS: tuple[Declared, ...] = (CAMERA_PRESET, CALIBRATION_LINES_OF_SIGHT)
 #: What each declared table means (a procedure's own table is its ``Procedure.keys``'s).
 TABLE_MEANINGS = {
     "head": "The head's geometry and joints; missing keys come from `head.preset`.",
@@ -185,9 +188,7 @@ def _read_camera(
             size = values[_IMAGE_SIDE[setting.name]]
             given = getattr(base, setting.name)
             default = given if given is not None and given <= size - 1 else None
-            values[setting.name] = table.setting(
-                setting, default, hi=size - 1.0, unit=f"{setting.unit} (inside the image)"
-            )
+            values[setting.name] = table.setting(setting, default, hi=size - 1.0)
         else:
             values[setting.name] = table.setting(setting, getattr(base, setting.name))
     # Every image imperfection's settings, with their declared ranges.

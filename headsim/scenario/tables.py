@@ -96,7 +96,7 @@ def declared_use(decl: Declared) -> tuple[str, str]:
 
 
 def _unit_text(setting: Setting) -> str:
-    return f"{setting.unit}; {setting.why}" if setting.why else setting.unit
+    return setting.unit + setting.unit_note
 
 
 def _integer_allowed(lo: int, hi: int) -> str:
@@ -150,7 +150,7 @@ def key_path(field_path: str) -> str:
     return re.sub(r"\[\d+\]", "[]", field_path)
 
 
-def _toml_value(value: Any) -> str:
+def toml_value(value: Any) -> str:
     if value is MISSING:
         return ""
     if value is None:
@@ -162,7 +162,7 @@ def _toml_value(value: Any) -> str:
     if isinstance(value, float):
         return f"{value:g}"
     if isinstance(value, (tuple, list)):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
     return str(value)
 
 
@@ -215,7 +215,7 @@ class Table:
         path = key_path(self.field(key))
         if first and path in seen:
             return
-        seen[path] = KeyUse(path, kind, key_path(allowed), _toml_value(default))
+        seen[path] = KeyUse(path, kind, key_path(allowed), toml_value(default))
 
     def _get(self, key: str) -> Any:
         return self.data[key] if self.has(key) else MISSING
@@ -223,12 +223,10 @@ class Table:
     def fail(self, key: str, message: str, allowed: str | None = None) -> ScenarioError:
         return self.ctx.error(self.field(key), message, allowed)
 
-    def setting(
-        self, decl: Declared, default: Any = MISSING, *, hi: float | None = None, unit: str = ""
-    ) -> Any:
+    def setting(self, decl: Declared, default: Any = MISSING, *, hi: float | None = None) -> Any:
         """``decl``'s key, read and checked as declared (``default``: instead of the
-        declared one, e.g. a preset's; ``hi``, ``unit``: a tighter upper end that depends on
-        other keys, and how to say it)."""
+        declared one, e.g. a preset's; ``hi``: a tighter upper end that depends on other
+        keys, which the declaration's ``unit_note`` says)."""
         if default is MISSING:
             default = declared_default(decl)
         if isinstance(decl, Flag):
@@ -244,7 +242,7 @@ class Table:
             hi=decl.hi if hi is None else hi,
             lo_open=decl.lo_open,
             hi_open=decl.hi_open,
-            unit=unit or _unit_text(decl),
+            unit=_unit_text(decl),
         )
         if decl.count > 1:
             return self.numbers(decl.name, decl.count, default, **limits)

@@ -23,7 +23,8 @@ class Setting:
     derived from other settings, as the principal point is from the image size, or,
     with ``optional``, left out); ``example`` a value that turns an imperfection on, for
     the generic tests that every imperfection moves a figure (None: not an
-    imperfection's); ``why`` is said after the range in a scenario's error.
+    imperfection's); ``unit_note`` is said right after the unit where a scenario's error
+    says what is allowed (why the range, or what bounds it further).
     """
 
     name: str
@@ -38,7 +39,7 @@ class Setting:
     integer: bool = False
     count: int = 1
     optional: bool = False
-    why: str = ""
+    unit_note: str = ""
 
     @property
     def fixed_default(self) -> float:

@@ -62,8 +62,17 @@ CX = Setting(
     MAX_IMAGE_SIDE - 1,
     "px",
     "Principal point's column, px (pixel centres at integer coordinates).",
+    unit_note=" (inside the image)",
 )
-CY = Setting("cy", None, 0.0, MAX_IMAGE_SIDE - 1, "px", "Principal point's row, px.")
+CY = Setting(
+    "cy",
+    None,
+    0.0,
+    MAX_IMAGE_SIDE - 1,
+    "px",
+    "Principal point's row, px.",
+    unit_note=" (inside the image)",
+)
 
 
 def _mount_angle(name: str, meaning: str) -> Setting:
@@ -329,7 +338,7 @@ BASELINE = Setting(
     "m",
     "True distance between the eyes' yaw axes (the optical centres, on them), m. Without "
     "`[belief]` the ideal and paper presets believe it too (`belief.sources`: `truth`).",
-    why="narrower gives no usable vergence",
+    unit_note="; narrower gives no usable vergence",
 )
 NECK_D1 = Setting(
     "neck_d1_m",
