@@ -1,10 +1,12 @@
 """The schema of the head and the experiment: ``[head]``, ``[cam1]``/``[cam2]``, ``[belief]``,
 ``[experiment]`` and ``[experiment.calibration]``.
 
-Each ``read_*``/``_read_*`` function lists the keys of one table with their
-ranges (the documentation's scenario-key reference lists them, made from these getters); missing keys
-come from the head's preset.  Lengths in metres, angles in radians, pixels as
-OpenCV's.
+Each key is declared once, beside the field it sets (:mod:`headsim.sim.settings`,
+:mod:`headsim.scenario.spec`; the loader's own here), and :func:`declared_keys` lists
+them by table: each ``read_*``/``_read_*`` function reads its table's declarations with
+:meth:`Table.setting`, and the scenario-key reference is made from the same list.
+Missing keys come from the head's preset.  Lengths in metres, angles in radians, pixels
+as OpenCV's.
 """
 
 from __future__ import annotations
@@ -352,33 +354,17 @@ def read_head(
     }
     head.done()
 
-    cameras = []
     own_cameras = has_own_cameras(head_model)  # not the paper's: nor its initial directions
+    cameras = []
     for index, key in enumerate(names.CAMERAS):
         camera, camera_preset = _read_camera(doc.table(key), index, preset_name, head_model)
-        if (
-            initial is None
-            and yaw is None
-            and camera_preset in ("paper", "realistic")
-            and not own_cameras
-        ):
-            direction = INITIAL_DIRECTIONS_RAD[index]
-        elif initial is not None:
+        if initial is not None:
             direction = initial[index]
+        elif yaw is None and camera_preset in ("paper", "realistic") and not own_cameras:
+            direction = INITIAL_DIRECTIONS_RAD[index]
         else:
             direction = None
-        mount_yaw = (
-            (yaw[index] if yaw is not None else 0.0)
-            if direction is None
-            else mount_yaw_for_direction(index + 1, direction, camera.pinhole())
-        )
-        field_name = "head.initial_direction_rad" if direction is not None else "head.mount_yaw_rad"
-        if not MOUNT_YAW.allows(mount_yaw):
-            raise ctx.error(
-                f"{field_name}[{index}]",
-                f"needs a mount yaw of {mount_yaw:.3f} rad for camera {index + 1}",
-                f"a mount yaw within {MOUNT_YAW.range_text()}",
-            )
+        mount_yaw = _mount_yaw(ctx, camera, index, direction, yaw)
         cameras.append(
             replace(
                 camera,
@@ -404,6 +390,29 @@ def read_head(
     given = () if belief_table is None else tuple(belief_table.data)
     sources = belief_sources(settings, base, given=given, source="file")
     return settings, preset_name, settle, sources
+
+
+def _mount_yaw(
+    ctx: Context,
+    camera: CameraSettings,
+    index: int,
+    direction: float | None,
+    yaws: tuple[float, float] | None,
+) -> float:
+    """Camera ``index``'s mount yaw: the one that gives it the effective initial
+    ``direction`` (None: the raw ``yaws``, else 0), checked against the mount's range."""
+    if direction is None:
+        mount_yaw = yaws[index] if yaws is not None else 0.0
+    else:
+        mount_yaw = mount_yaw_for_direction(index + 1, direction, camera.pinhole())
+    if not MOUNT_YAW.allows(mount_yaw):
+        field_name = "initial_direction_rad" if direction is not None else "mount_yaw_rad"
+        raise ctx.error(
+            f"head.{field_name}[{index}]",
+            f"needs a mount yaw of {mount_yaw:.3f} rad for camera {index + 1}",
+            f"a mount yaw within {MOUNT_YAW.range_text()}",
+        )
+    return mount_yaw
 
 
 def _read_belief(table: Table | None, base: HeadSettings) -> HeadBelief | None:
