@@ -89,7 +89,6 @@ def test_each_head_setting_is_checked_by_its_declaration(setting: Setting) -> No
             HeadSettings(**bad)
 
 
-@pytest.mark.fast
 @pytest.mark.parametrize("name", PRESETS)
 def test_every_value_the_settings_record_holds_is_a_declared_settings(name: str) -> None:
     """results.json's settings block records declared settings only (beside its structure:
