@@ -1,12 +1,16 @@
 """Every scenario key the loader accepts, with its type, limits, default and meaning.
 
-The type, what is allowed and the default come from the getters themselves
-(:func:`headsim.scenario.tables.collecting_keys`), recorded while the real
-loader reads every shipped scenario and :data:`VARIANTS` of them that reach the
-branches no shipped file takes.  Only the meaning is written here, one line per
-key: :data:`DESCRIPTIONS` for the shared keys, each procedure's ``keys`` for its own
-(:func:`descriptions`); the documentation's scenario reference is made from
-:func:`accepted_keys`, and a test fails when a key has no line or a line no key.
+The keys of the top level, ``[head]``, the cameras, ``[belief]`` and ``[experiment]``
+with its servo and calibration are made from their declarations
+(:func:`headsim.scenario.schema.declared_keys`): kind, what is allowed and meaning as
+declared, the default as declared or, for a key that a preset sets, as the presets give
+it.  The scene's tables, ``[head.mapping]`` and the procedures' own tables are still read
+by hand-written getters: those keys are recorded while the real loader reads every
+shipped scenario and :data:`VARIANTS` of them that reach the branches no shipped file
+takes (:func:`headsim.scenario.tables.collecting_keys`), their meanings written in
+:data:`DESCRIPTIONS` and each procedure's ``keys``.  The documentation's scenario
+reference is made from :func:`accepted_keys`, and a test fails when a key has no line or
+a line no key.
 """
 
 from __future__ import annotations
@@ -24,17 +28,19 @@ from headsim.scenario.loading import (
     set_field,
 )
 from headsim.scenario.scene import POSITION_KEYS, RANDOM_BOX_KEYS
-from headsim.scenario.tables import KeyUse, collecting_keys
-from headsim.sim import imperfections
-from headsim.sim.heads import MODELS_DIR, SHIPPED
-from headsim.sim.settings import (
-    BACKLASH,
-    ENCODER_RESOLUTION,
-    EYE_SETTINGS,
-    IMAGE_SETTINGS,
-    NECK_A2,
-    NECK_D1,
+from headsim.scenario.schema import DEFAULT_FROM_OTHER_KEYS, TABLE_MEANINGS, declared_keys
+from headsim.scenario.tables import (
+    KeyUse,
+    collecting_keys,
+    declared_default,
+    declared_use,
+    toml_value,
 )
+from headsim.sim import imperfections
+from headsim.sim.declared import Declared
+from headsim.sim.heads import SHIPPED, shipped
+from headsim.sim.model import MODELS_DIR, on_head
+from headsim.sim.settings import PRESETS, HeadSettings, preset
 
 
 @dataclass(frozen=True)
@@ -74,23 +80,8 @@ def _edits(*steps: tuple[str, Any]) -> Edit:
 
 
 _PATH = "scene.pursuit.path"
-#: Shipped scenarios changed to take the readers' other branches: (scenario, edit).
+#: Shipped scenarios changed to take the hand-written readers' other branches: (scenario, edit).
 VARIANTS: tuple[tuple[str, Edit], ...] = (
-    (
-        "quickstart",
-        _edits(
-            (
-                "belief",
-                {
-                    "baseline_m": 0.15,
-                    "neck_d1_m": 0.12,
-                    "neck_a2_m": 0.09,
-                    "side_offset_m": [0.0, 0.0],
-                },
-            ),
-        ),
-    ),
-    ("chessboard", _edits(("belief", {}))),  # the paper's preset: other belief defaults
     (  # listed markerless targets: on an object, and a world point on a surface
         "natural_field",
         _edits(
@@ -213,8 +204,54 @@ VARIANTS: tuple[tuple[str, Edit], ...] = (
 )
 
 
+def declared_uses() -> dict[str, KeyUse]:
+    """Every declared key and table, by path, as its declaration says it."""
+    uses = {table: KeyUse(table, "table", f"a [{table}] table", "") for table in TABLE_MEANINGS}
+    for table, decl in declared_keys():
+        path = f"{table}.{decl.name}" if table else decl.name
+        kind, allowed = declared_use(decl)
+        uses[path] = KeyUse(path, kind, allowed, _default_text(table, decl))
+    return uses
+
+
+def _default_text(table: str, decl: Declared) -> str:
+    """``decl``'s default as the reference shows it: the presets' value where a preset
+    sets the key ("depends on other keys" where they differ), else the declared one."""
+    if decl in DEFAULT_FROM_OTHER_KEYS:
+        return _DEPENDS
+    values = {toml_value(v) for v in _preset_values(table, decl)}
+    if len(values) > 1:
+        return _DEPENDS
+    if values:
+        return values.pop()
+    return toml_value(declared_default(decl))
+
+
+_DEPENDS = "depends on other keys"
+
+
+def _preset_values(table: str, decl: Declared) -> list[Any]:
+    """What each preset on each shipped head gives ``decl``'s key of ``table`` (empty: a
+    preset does not set it)."""
+    heads = [on_head(preset(p), shipped(h)) for p in PRESETS for h in SHIPPED]
+
+    def holder(head: HeadSettings) -> Any:
+        if table == "head":
+            return head.render if decl.name.startswith("render_") else head
+        if table == "belief":
+            return head.believed
+        return head.cameras[int(table[-1]) - 1] if table in ("cam1", "cam2") else None
+
+    name = decl.name.removeprefix("render_") if table == "head" else decl.name
+    if table in ("cam1", "cam2") and name in imperfections.meanings():
+        return [holder(h).value(name) for h in heads]
+    return [getattr(holder(h), name) for h in heads if hasattr(holder(h), name)]
+
+
 def collect_uses() -> dict[str, KeyUse]:
-    """Every key the getters read over the shipped scenarios and :data:`VARIANTS`, by path."""
+    """Every key the loader accepts, by path: the declared ones, then those the hand-written
+    getters read over the shipped scenarios and :data:`VARIANTS`."""
+    declared = declared_uses()
     uses: dict[str, KeyUse] = {}
     with collecting_keys() as seen:
         for path in scenario_files():
@@ -225,7 +262,7 @@ def collect_uses() -> dict[str, KeyUse]:
             path = resolve_path(name)
             scenario_from_document(edit(read_toml(path)), name, directory=path.parent)
             _fold(uses, seen)
-    return dict(sorted(uses.items()))
+    return dict(sorted({**uses, **declared}.items()))
 
 
 def _fold(uses: dict[str, KeyUse], seen: dict[str, KeyUse]) -> None:
@@ -246,7 +283,12 @@ def _fold(uses: dict[str, KeyUse], seen: dict[str, KeyUse]) -> None:
 
 def descriptions() -> dict[str, str]:
     """Every key's meaning: the shared ones, then each procedure's own."""
-    return {**DESCRIPTIONS, **{k: v for p in procedures() for k, v in p.keys.items()}}
+    return {
+        **TABLE_MEANINGS,
+        **{f"{t}.{d.name}" if t else d.name: d.meaning for t, d in declared_keys()},
+        **DESCRIPTIONS,
+        **{k: v for p in procedures() for k, v in p.keys.items()},
+    }
 
 
 def accepted_keys() -> list[Key]:
@@ -258,7 +300,7 @@ def accepted_keys() -> list[Key]:
     uses = collect_uses()
     return [
         *(
-            Key(u.path, u.kind, u.allowed, u.default, meanings.get(u.path) or _meaning(u.path))
+            Key(u.path, u.kind, u.allowed, u.default, meanings.get(u.path, ""))
             for u in uses.values()
         ),
         *(
@@ -270,30 +312,11 @@ def accepted_keys() -> list[Key]:
     ]
 
 
-def _meaning(path: str) -> str:
-    """A camera's imperfection setting's declared meaning (one registered after import)."""
-    table, _, name = path.partition(".")
-    return imperfections.meanings().get(name, "") if table in ("cam1", "cam2") else ""
-
-
-_CAMERA = {
-    "": "One camera's settings; a missing key comes from the camera's preset.",
-    "preset": "The camera's preset (default: `head.preset`).",
-    # Each setting's meaning is declared with it: the camera's own (headsim.sim.settings),
-    # then each image imperfection's, in the order the camera table reads them.
-    **{s.name: s.meaning for s in IMAGE_SETTINGS},
-    **imperfections.meanings(),
-    **{s.name: s.meaning for s in EYE_SETTINGS},
-}
-
-#: One line per key every procedure shares: what it means, with its unit (a procedure's
-#: own keys are in its ``Procedure.keys``).
+#: One line per key that a hand-written getter reads: what it means, with its unit (a
+#: declared key's meaning is in its declaration, a procedure's own keys' in its
+#: ``Procedure.keys``).
 DESCRIPTIONS: dict[str, str] = {
-    "description": "One line saying what the experiment is; `headsim list` shows it. Required.",
-    "seed": "Seed of the image noise and of every random layout; `--seed` replaces it.",
     "fast": "Fields merged over the file by `--fast`: tables key by key, other values replaced.",
-    "head": "The head's geometry and joints; missing keys come from `head.preset`.",
-    "head.model": f"Which head: a shipped one ({', '.join(SHIPPED)}) or a path to your head's MJCF file.",
     "head.mapping": "With an MJCF `head.model`: the names of its joints, body H and cameras.",
     "head.mapping.head_body": "The body whose frame is H at all joints zero (midway between the optical centres, x right, y down, z forward).",
     "head.mapping.neck_yaw": "The neck's yaw joint: about W's +z at the base, or above a pitch at the base (the iCub's); leave out on a head without one (Model 2 only).",
@@ -306,51 +329,7 @@ DESCRIPTIONS: dict[str, str] = {
     "head.mapping.left_eye": "The pan joint of the eye carrying Ca1 (at -x in H), positive inward.",
     "head.mapping.right_eye": "The pan joint of the eye carrying Ca2 (at +x in H), positive inward.",
     "head.mapping.cameras": "The two eye cameras, [Ca1, Ca2]: left, then right.",
-    "head.preset": "Defaults for the head and both cameras: the ideal head, the paper's, or a realistic one.",
-    "head.baseline_m": "True distance between the eyes' yaw axes (the optical centres, on them), m. Without `[belief]` the ideal and paper presets believe it too (`belief.sources`: `truth`).",
-    **{f"head.{s.name}": s.meaning for s in (NECK_D1, NECK_A2, ENCODER_RESOLUTION)},
-    "head.initial_direction_rad": "Each eye's effective initial direction alpha_ei, rad (or `mount_yaw_rad`, not both).",
-    "head.mount_yaw_rad": "Each eye's raw mount yaw, rad (or `initial_direction_rad`, not both).",
-    "head.mount_pitch_rad": "Each eye's mount pitch, rad.",
-    "head.mount_roll_rad": "Each eye's mount roll, rad.",
-    "head.settle": "How joints reach a commanded angle: set kinematically, or driven by MuJoCo's physics.",
-    f"head.{BACKLASH.name}": BACKLASH.meaning,
-    "head.count_error": "If true, the true angle lies anywhere within the encoder count read (seeded).",
-    "head.render_offsamples": "MuJoCo multisampling per pixel (Mesa caps it at 4).",
-    "head.render_supersample": "Render this many times larger and area-average down (1: faster, coarser).",
-    **{f"cam{i}" + (f".{k}" if k else ""): v for i in (1, 2) for k, v in _CAMERA.items()},
-    "belief": "What the head believes of itself; estimators use only this. Without it: the realistic preset's design, else the `[head]` values (results.json's `belief.sources` says which).",
-    "belief.baseline_m": "Believed baseline, m (default: the preset's belief, else the design's).",
-    "belief.neck_d1_m": "Believed neck d1, m (default as `belief.baseline_m`).",
-    "belief.neck_a2_m": "Believed neck a2, m (default as `belief.baseline_m`).",
-    "belief.side_offset_m": "Believed line-of-sight (side) offset per camera, m, until calibrated.",
-    "experiment": "What is measured and how.",
-    "experiment.procedure": "The procedure that runs (one module each in `headsim.procedures`). Required.",
-    "experiment.interpolate": "Sub-step fixation angles, interpolated between the last two encoder steps.",
-    "experiment.midline_px": "Model 2's near-midline remedy: an image whose target is nearer the goal column than this is taken again, px.",
-    "experiment.remedy_px": "Model 2's near-midline remedy: the eye angle of that image, as image motion away, px.",
-    "experiment.goal_columns_px": "The servo's goal column per camera, px, as the user tells the head (default: the image centres).",
-    "experiment.calibration": "Sec. V before the experiment, in the default scene (required by `calibration`).",
-    "experiment.calibration.from": "A `head.json` from `headsim calibrate` to use instead, relative to the scenario file.",
-    "experiment.calibration.targets": "Number of calibration-ball positions.",
-    "experiment.calibration.depth_m": "Depth range z_h of the ball positions in H, m.",
-    "experiment.calibration.lateral": "Largest |x_h / z_h| of a ball position.",
-    "experiment.calibration.vertical": "Largest |y_h / z_h| of a ball position.",
-    "experiment.calibration.depth_noise_m": "Error of the tape-measured depth of each ball, m.",
-    "experiment.calibration.position_noise_m": "Error of every measured coordinate of every ball, m.",
-    "experiment.calibration.extended": "Also fit each camera's v0, kx/ky and line-of-sight offset (beyond the paper).",
-    "experiment.calibration.lines_of_sight": "With `extended`: also fit each eye's line-of-sight offset.",
-    "experiment.calibration.layout": "Depths uniform in `depth_m`, or most balls at the near end and the rest far.",
     "experiment.calibration.positions_world_m": "The ball positions [[x, y, z], ...] in W, m, given instead of drawn (`targets` is their number).",
-    "experiment.calibration.near_fraction": "`near_far` only: share of balls at the near end (default b / (a + b)).",
-    "experiment.servo": "The eye and neck servo (`headsim.active.servo_types.ServoConfig`).",
-    "experiment.servo.windows": "Render only a window around where the target is expected (false: every image a full frame; same answers, more pixels).",
-    "experiment.servo.tolerance_px": "Stop when the target's column is this close to the goal (or within half an encoder step's motion), px.",
-    "experiment.servo.max_iterations": "Servo steps before the fixation gives up.",
-    "experiment.servo.probe_steps": "Encoder steps of the first probe when no gain is known (grown x4 until the image moves `min_probe_px`).",
-    "experiment.servo.min_probe_px": "Image motion a probe must cause before the gain is measured, px.",
-    "experiment.servo.min_secant_steps": "Moves shorter than this, in encoder steps, do not update the gain.",
-    "experiment.servo.average_fixation": "Average each fixation over images spread across one pixel (about twice the renders).",
     "scene": "What the procedure measures and where it is.",
     "scene.targets": "Fixed targets (model2, model1; for calibration: optional check targets).",
     "scene.targets[].name": "The target's name, unique (default `target_N`).",

@@ -21,7 +21,7 @@ from headsim.procedures import contract as registry
 from headsim.scenario.reach import ReachHead
 from headsim.scenario.reach_check import check_reach
 from headsim.scenario.scene import read_scene
-from headsim.scenario.schema import FIRST_TABLES, read_experiment, read_head
+from headsim.scenario.schema import DESCRIPTION, FIRST_TABLES, SEED, read_experiment, read_head
 from headsim.scenario.spec import Scenario
 from headsim.scenario.tables import Context, ScenarioError, Table, describe_value
 from headsim.scenario.toml_file import deep_line, read_toml, text_or_empty
@@ -195,8 +195,8 @@ def _build(
     files: dict[Path, dict[str, Any]],
 ) -> Scenario:
     top = Table(doc, "", ctx)
-    description = top.string("description")
-    file_seed = top.integer("seed", 0, 0, 2**32 - 1)
+    description = top.setting(DESCRIPTION)
+    file_seed = top.setting(SEED)
     seed = file_seed if seed is None else seed
     settings, preset_name, settle, sources = read_head(top, ctx, path.parent)
     settings = replace(settings, seed=seed)

@@ -1,10 +1,12 @@
 """The schema of the head and the experiment: ``[head]``, ``[cam1]``/``[cam2]``, ``[belief]``,
 ``[experiment]`` and ``[experiment.calibration]``.
 
-Each ``read_*``/``_read_*`` function lists the keys of one table with their
-ranges (the documentation's scenario-key reference lists them, made from these getters); missing keys
-come from the head's preset.  Lengths in metres, angles in radians, pixels as
-OpenCV's.
+Each key is declared once, beside the field it sets (:mod:`headsim.sim.settings`,
+:mod:`headsim.scenario.spec`; the loader's own here), and :func:`declared_keys` lists
+them by table: each ``read_*``/``_read_*`` function reads its table's declarations with
+:meth:`Table.setting`, and the scenario-key reference is made from the same list.
+Missing keys come from the head's preset.  Lengths in metres, angles in radians, pixels
+as OpenCV's.
 """
 
 from __future__ import annotations
@@ -17,33 +19,47 @@ from typing import Any
 from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import INITIAL_DIRECTIONS_RAD
 from headsim.procedures import contract as registry
-from headsim.scenario.calibration_design import LAYOUTS
 from headsim.scenario.spec import (
+    CALIBRATION_DEPTH,
+    CALIBRATION_LINES_OF_SIGHT,
+    CALIBRATION_SETTINGS,
+    CALIBRATION_SOURCE,
+    CALIBRATION_TARGETS,
+    GOAL_COLUMNS,
+    INTERPOLATE,
     MAX_DEPTH_M,
-    MIN_BASELINE_M,
-    MIN_DEPTH_M,
+    MIDLINE,
+    PROCEDURE,
+    REMEDY,
+    SERVO_SETTINGS,
     CalibrationSpec,
     ExperimentSpec,
     ServoSpec,
 )
 from headsim.scenario.tables import MISSING, Context, Table, describe_value, short_value
 from headsim.sim import heads, imperfections, names
-from headsim.sim.declared import Setting
+from headsim.sim.declared import Choice, Declared, Setting, Text
 from headsim.sim.heads import HeadModel
 from headsim.sim.model import design, has_own_cameras, on_head
 from headsim.sim.optics import centre_ray_yaw
 from headsim.sim.settings import (
     BACKLASH,
+    BASELINE,
+    BELIEF_SETTINGS,
+    COUNT_ERROR,
     ENCODER_RESOLUTION,
     EYE_SETTINGS,
     IMAGE_SETTINGS,
-    MAX_IMAGE_SIDE,
-    MOUNT_PITCH,
-    MOUNT_ROLL,
+    INITIAL_DIRECTION,
+    MOUNT_PITCHES,
+    MOUNT_ROLLS,
     MOUNT_YAW,
+    MOUNT_YAWS,
     NECK_A2,
     NECK_D1,
-    SIDE_OFFSET,
+    PRESET,
+    RENDER_OFFSAMPLES,
+    RENDER_SUPERSAMPLE,
     CameraSettings,
     HeadBelief,
     HeadSettings,
@@ -65,33 +81,98 @@ FIRST_TABLES = (
     "experiment",
 )
 
+#: The keys of the scenario's top level, ``[head]`` and ``[cam1]``/``[cam2]`` that are
+#: declared here, where the loader alone uses them.
+DESCRIPTION = Text(
+    "description",
+    None,
+    "One line saying what the experiment is; `headsim list` shows it. Required.",
+    required=True,
+)
+SEED = Setting(
+    "seed",
+    0,
+    0,
+    2**32 - 1,
+    "",
+    "Seed of the image noise and of every random layout; `--seed` replaces it.",
+    integer=True,
+)
+MODEL = Text(
+    "model",
+    "paper",
+    f"Which head: a shipped one ({', '.join(heads.SHIPPED)}) or a path to your head's MJCF file.",
+    max_length=1000,
+)
+SETTLE = Choice(
+    "settle",
+    ("kinematic", "physics"),
+    "kinematic",
+    "How joints reach a commanded angle: set kinematically, or driven by MuJoCo's physics.",
+)
+CAMERA_PRESET = replace(PRESET, meaning="The camera's preset (default: `head.preset`).")
+#: ``[head]``'s declared keys in the order it reads them (``model`` and ``[head.mapping]``,
+#: which names an MJCF file's parts, are read by :func:`_read_head_model`).
+HEAD_KEYS: tuple[Declared, ...] = (
+    MODEL,
+    PRESET,
+    BASELINE,
+    NECK_D1,
+    NECK_A2,
+    ENCODER_RESOLUTION,
+    INITIAL_DIRECTION,
+    MOUNT_YAWS,
+    MOUNT_PITCHES,
+    MOUNT_ROLLS,
+    SETTLE,
+    BACKLASH,
+    COUNT_ERROR,
+    RENDER_OFFSAMPLES,
+    RENDER_SUPERSAMPLE,
+)
+#: Declared keys whose default the reader takes from other keys (``head.preset``) rather
+#: than from a preset's head: the reference says so.
+DEFAULT_FROM_OTHER_KEYS: tuple[Declared, ...] = (CAMERA_PRESET, CALIBRATION_LINES_OF_SIGHT)
+#: What each declared table means (a procedure's own table is its ``Procedure.keys``'s).
+TABLE_MEANINGS = {
+    "head": "The head's geometry and joints; missing keys come from `head.preset`.",
+    "cam1": "One camera's settings; a missing key comes from the camera's preset.",
+    "cam2": "One camera's settings; a missing key comes from the camera's preset.",
+    "belief": "What the head believes of itself; estimators use only this. Without it: the "
+    "realistic preset's design, else the `[head]` values (results.json's `belief.sources` "
+    "says which).",
+    "experiment": "What is measured and how.",
+    "experiment.calibration": "Sec. V before the experiment, in the default scene (required "
+    "by `calibration`).",
+    "experiment.servo": "The eye and neck servo (`headsim.active.servo_types.ServoConfig`).",
+}
 
-_PRESETS = ("ideal", "paper", "realistic")
+
+def declared_keys() -> tuple[tuple[str, Declared], ...]:
+    """Every key declared for the loader, as (its table's path, its declaration): the
+    scenario-key reference is made from these (a camera's imperfections as registered now,
+    the procedure's choices as registered now)."""
+    procedure = replace(PROCEDURE, choices=registry.names())
+    return (
+        ("", DESCRIPTION),
+        ("", SEED),
+        *(("head", d) for d in HEAD_KEYS),
+        *((f"cam{i}", d) for i in (1, 2) for d in _camera_keys()),
+        *(("belief", d) for d in BELIEF_SETTINGS),
+        ("experiment", procedure),
+        *(("experiment", d) for d in (INTERPOLATE, MIDLINE, REMEDY, GOAL_COLUMNS)),
+        *(("experiment.calibration", d) for d in CALIBRATION_SETTINGS),
+        *(("experiment.servo", d) for d in SERVO_SETTINGS),
+    )
+
+
+def _camera_keys() -> tuple[Declared, ...]:
+    """A camera table's keys, with the imperfections registered now."""
+    return (CAMERA_PRESET, *IMAGE_SETTINGS, *imperfections.all_settings(), *EYE_SETTINGS)
+
+
 #: The image side that bounds each coordinate of the principal point.
 _IMAGE_SIDE = {"cx": "width", "cy": "height"}
-
-
-def read_setting(
-    table: Table,
-    setting: Setting,
-    default: Any = MISSING,
-    *,
-    hi: float | None = None,
-    unit: str | None = None,
-) -> Any:
-    """``setting``'s key of ``table``, checked against its declared range (``hi``, ``unit``:
-    a tighter upper end that depends on other keys, and how to say it)."""
-    if setting.integer:
-        return table.integer(setting.name, default, int(setting.lo), int(setting.hi))
-    return table.number(
-        setting.name,
-        default,
-        setting.lo,
-        setting.hi if hi is None else hi,
-        lo_open=setting.lo_open,
-        hi_open=setting.hi_open,
-        unit=setting.unit if unit is None else unit,
-    )
 
 
 def _read_camera(
@@ -101,7 +182,7 @@ def _read_camera(
     camera (:func:`headsim.sim.model.on_head`)."""
     if table is None:
         return on_head(preset(default_preset), head).cameras[index], default_preset
-    name = table.choice("preset", _PRESETS, default_preset)
+    name = table.setting(CAMERA_PRESET, default_preset)
     base = on_head(preset(name), head).cameras[index]
     values: dict[str, Any] = {}
     for setting in IMAGE_SETTINGS:
@@ -109,17 +190,15 @@ def _read_camera(
             size = values[_IMAGE_SIDE[setting.name]]
             given = getattr(base, setting.name)
             default = given if given is not None and given <= size - 1 else None
-            values[setting.name] = read_setting(
-                table, setting, default, hi=size - 1.0, unit=f"{setting.unit} (inside the image)"
-            )
+            values[setting.name] = table.setting(setting, default, hi=size - 1.0)
         else:
-            values[setting.name] = read_setting(table, setting, getattr(base, setting.name))
+            values[setting.name] = table.setting(setting, getattr(base, setting.name))
     # Every image imperfection's settings, with their declared ranges.
     image_settings = {
-        s.name: read_setting(table, s, base.value(s.name)) for s in imperfections.all_settings()
+        s.name: table.setting(s, base.value(s.name)) for s in imperfections.all_settings()
     }
     for setting in EYE_SETTINGS:
-        values[setting.name] = read_setting(table, setting, getattr(base, setting.name))
+        values[setting.name] = table.setting(setting, getattr(base, setting.name))
     table.done()
     camera = CameraSettings(**values, **camera_values(image_settings))
     problem = _lens_problem(camera)
@@ -132,17 +211,6 @@ def _read_camera(
             "k1", str(err), "a lens that does not fold over before the image centre"
         ) from err
     return camera, name
-
-
-def _per_eye(setting: Setting) -> dict[str, Any]:
-    """``setting``'s range as :meth:`Table.numbers` takes it (a camera setting given per eye)."""
-    return dict(
-        lo=setting.lo,
-        hi=setting.hi,
-        lo_open=setting.lo_open,
-        hi_open=setting.hi_open,
-        unit=setting.unit,
-    )
 
 
 def _lens_problem(camera: CameraSettings) -> tuple[str, str] | None:
@@ -264,62 +332,39 @@ def read_head(
     head = doc.table("head") or Table({}, "head", ctx)
     head_model = _read_head_model(head, ctx, Path.cwd() if directory is None else directory)
     _designed(head_model, ctx)
-    preset_name = head.choice("preset", _PRESETS, "ideal")
+    preset_name = head.setting(PRESET)
     base = on_head(preset(preset_name), head_model)
-    baseline = head.number(
-        "baseline_m",
-        base.baseline_m,
-        MIN_BASELINE_M,
-        1.0,
-        unit="m; narrower gives no usable vergence",
-    )
-    d1 = read_setting(head, NECK_D1, base.neck_d1_m)
-    a2 = read_setting(head, NECK_A2, base.neck_a2_m)
-    resolution = read_setting(head, ENCODER_RESOLUTION, base.encoder_resolution_rad)
-    initial = head.numbers("initial_direction_rad", 2, None, **_per_eye(MOUNT_YAW))
-    yaw = head.numbers(MOUNT_YAW.name, 2, None, **_per_eye(MOUNT_YAW))
+    true = {
+        s.name: head.setting(s, getattr(base, s.name))
+        for s in (BASELINE, NECK_D1, NECK_A2, ENCODER_RESOLUTION)
+    }
+    initial = head.setting(INITIAL_DIRECTION)
+    yaw = head.setting(MOUNT_YAWS)
     if initial is not None and yaw is not None:
         raise head.fail(
             "mount_yaw_rad", "given together with initial_direction_rad", "one of the two"
         )
-    pitch = head.numbers(
-        MOUNT_PITCH.name, 2, (MOUNT_PITCH.fixed_default,) * 2, **_per_eye(MOUNT_PITCH)
-    )
-    roll = head.numbers(MOUNT_ROLL.name, 2, (MOUNT_ROLL.fixed_default,) * 2, **_per_eye(MOUNT_ROLL))
-    settle = head.choice("settle", ("kinematic", "physics"), "kinematic")
-    backlash = read_setting(head, BACKLASH, base.backlash_rad)
-    count_error = head.boolean("count_error", base.count_error)
-    offsamples = head.integer("render_offsamples", base.render.offsamples, 0, 16)
-    supersample = head.integer("render_supersample", base.render.supersample, 1, 8)
+    pitch = head.setting(MOUNT_PITCHES)
+    roll = head.setting(MOUNT_ROLLS)
+    settle = head.setting(SETTLE)
+    joints = {s.name: head.setting(s, getattr(base, s.name)) for s in (BACKLASH, COUNT_ERROR)}
+    render = {
+        s.name: head.setting(s, getattr(base.render, s.name.removeprefix("render_")))
+        for s in (RENDER_OFFSAMPLES, RENDER_SUPERSAMPLE)
+    }
     head.done()
 
-    cameras = []
     own_cameras = has_own_cameras(head_model)  # not the paper's: nor its initial directions
+    cameras = []
     for index, key in enumerate(names.CAMERAS):
         camera, camera_preset = _read_camera(doc.table(key), index, preset_name, head_model)
-        if (
-            initial is None
-            and yaw is None
-            and camera_preset in ("paper", "realistic")
-            and not own_cameras
-        ):
-            direction = INITIAL_DIRECTIONS_RAD[index]
-        elif initial is not None:
+        if initial is not None:
             direction = initial[index]
+        elif yaw is None and camera_preset in ("paper", "realistic") and not own_cameras:
+            direction = INITIAL_DIRECTIONS_RAD[index]
         else:
             direction = None
-        mount_yaw = (
-            (yaw[index] if yaw is not None else 0.0)
-            if direction is None
-            else mount_yaw_for_direction(index + 1, direction, camera.pinhole())
-        )
-        field_name = "head.initial_direction_rad" if direction is not None else "head.mount_yaw_rad"
-        if not MOUNT_YAW.allows(mount_yaw):
-            raise ctx.error(
-                f"{field_name}[{index}]",
-                f"needs a mount yaw of {mount_yaw:.3f} rad for camera {index + 1}",
-                f"a mount yaw within {MOUNT_YAW.range_text()}",
-            )
+        mount_yaw = _mount_yaw(ctx, camera, index, direction, yaw)
         cameras.append(
             replace(
                 camera,
@@ -331,15 +376,13 @@ def read_head(
     belief_table = doc.table("belief")
     try:
         settings = HeadSettings(
-            baseline_m=baseline,
-            neck_d1_m=d1,
-            neck_a2_m=a2,
-            encoder_resolution_rad=resolution,
+            **true,
+            **joints,
             cameras=(cameras[0], cameras[1]),
-            backlash_rad=backlash,
-            count_error=count_error,
             belief=_read_belief(belief_table, base),
-            render=RenderFidelity(offsamples=offsamples, supersample=supersample),
+            render=RenderFidelity(
+                offsamples=render["render_offsamples"], supersample=render["render_supersample"]
+            ),
             head=head_model,
         )
     except SettingsError as err:  # pragma: no cover - the checks above are stricter
@@ -347,6 +390,29 @@ def read_head(
     given = () if belief_table is None else tuple(belief_table.data)
     sources = belief_sources(settings, base, given=given, source="file")
     return settings, preset_name, settle, sources
+
+
+def _mount_yaw(
+    ctx: Context,
+    camera: CameraSettings,
+    index: int,
+    direction: float | None,
+    yaws: tuple[float, float] | None,
+) -> float:
+    """Camera ``index``'s mount yaw: the one that gives it the effective initial
+    ``direction`` (None: the raw ``yaws``, else 0), checked against the mount's range."""
+    if direction is None:
+        mount_yaw = yaws[index] if yaws is not None else 0.0
+    else:
+        mount_yaw = mount_yaw_for_direction(index + 1, direction, camera.pinhole())
+    if not MOUNT_YAW.allows(mount_yaw):
+        field_name = "initial_direction_rad" if direction is not None else "mount_yaw_rad"
+        raise ctx.error(
+            f"head.{field_name}[{index}]",
+            f"needs a mount yaw of {mount_yaw:.3f} rad for camera {index + 1}",
+            f"a mount yaw within {MOUNT_YAW.range_text()}",
+        )
+    return mount_yaw
 
 
 def _read_belief(table: Table | None, base: HeadSettings) -> HeadBelief | None:
@@ -368,18 +434,9 @@ def _read_belief(table: Table | None, base: HeadSettings) -> HeadBelief | None:
             "of sight's offset with [experiment.calibration] lines_of_sight = true",
         )
     nominal = base.believed
-    baseline = table.number("baseline_m", nominal.baseline_m, 0.0, 1.0, lo_open=True, unit="m")
-    d1 = read_setting(table, NECK_D1, nominal.neck_d1_m)
-    a2 = read_setting(table, NECK_A2, nominal.neck_a2_m)
-    side = table.numbers(SIDE_OFFSET.name, 2, nominal.side_offset_m, **_per_eye(SIDE_OFFSET))
+    values = {s.name: table.setting(s, getattr(nominal, s.name)) for s in BELIEF_SETTINGS}
     table.done()
-    return HeadBelief(
-        baseline_m=baseline,
-        neck_d1_m=d1,
-        neck_a2_m=a2,
-        nodal_offset_m=nominal.nodal_offset_m,
-        side_offset_m=(side[0], side[1]),
-    )
+    return replace(nominal, **values)
 
 
 def _read_calibration(table: Table | None, lines_default: bool = False) -> CalibrationSpec | None:
@@ -387,20 +444,18 @@ def _read_calibration(table: Table | None, lines_default: bool = False) -> Calib
     if table is None:
         return None
     positions = _calibration_positions(table)
+    defaults = {
+        CALIBRATION_TARGETS.name: MISSING if positions is None else len(positions),
+        CALIBRATION_LINES_OF_SIGHT.name: lines_default,
+    }
+    values: dict[str, Any] = {}
+    for setting in CALIBRATION_SETTINGS:
+        values[setting.name] = table.setting(setting, defaults.get(setting.name, MISSING))
+        if setting is CALIBRATION_DEPTH:  # an empty range is named before the keys after it
+            _check_depth_range(table, values[setting.name])
     spec = CalibrationSpec(
-        targets=table.integer("targets", 60 if positions is None else len(positions), 3, 1000),
-        depth_m=depth_range(table, (0.25, 0.6)),
-        lateral=table.number("lateral", 0.16, 0.0, 1.0, lo_open=True, unit="(|x_h / z_h|)"),
-        vertical=table.number("vertical", 0.08, 0.0, 1.0, unit="(|y_h / z_h|)"),
-        depth_noise_m=table.number("depth_noise_m", 0.0, 0.0, 0.1, unit="m"),
-        extended=table.boolean("extended", True),
-        position_noise_m=table.number("position_noise_m", 0.0, 0.0, 0.1, unit="m"),
-        lines_of_sight=table.boolean("lines_of_sight", lines_default),
-        source=table.string("from", None, max_length=1000),
-        layout=table.choice("layout", LAYOUTS, "uniform"),
-        near_fraction=table.number(
-            "near_fraction", None, 0.0, 1.0, lo_open=True, hi_open=True, unit="(share of balls)"
-        ),
+        **{k: v for k, v in values.items() if k != CALIBRATION_SOURCE.name},
+        source=values[CALIBRATION_SOURCE.name],
         positions_world_m=positions,
     )
     table.done()
@@ -456,7 +511,12 @@ def _calibration_positions(table: Table) -> tuple[tuple[float, float, float], ..
 
 
 def depth_range(table: Table, default: tuple[float, float]) -> tuple[float, float]:
-    lo, hi = table.numbers("depth_m", 2, default, MIN_DEPTH_M, MAX_DEPTH_M, unit="m")
+    """``depth_m``: a depth range [near, far] in H, m, within the calibration's limits."""
+    return _check_depth_range(table, table.setting(CALIBRATION_DEPTH, default))
+
+
+def _check_depth_range(table: Table, depth_m: tuple[float, float]) -> tuple[float, float]:
+    lo, hi = depth_m
     if not lo < hi:
         raise table.fail("depth_m", f"[{lo:g}, {hi:g}] is empty", "[near, far] with near < far")
     return lo, hi
@@ -464,15 +524,12 @@ def depth_range(table: Table, default: tuple[float, float]) -> tuple[float, floa
 
 def interpolate_option(table: Table) -> dict[str, Any]:
     """``interpolate``: the fixation angle between the last two encoder steps (Model 1 and 2)."""
-    return {"interpolate": table.boolean("interpolate", True)}
+    return {INTERPOLATE.name: table.setting(INTERPOLATE)}
 
 
 def near_midline_options(table: Table) -> dict[str, Any]:
     """``midline_px``, ``remedy_px``: Model 2's near-midline remedy."""
-    return {
-        "midline_px": table.number("midline_px", 25.0, 0.0, 1000.0, unit="px"),
-        "remedy_px": table.number("remedy_px", 120.0, 0.0, 1000.0, lo_open=True, unit="px"),
-    }
+    return {s.name: table.setting(s) for s in (MIDLINE, REMEDY)}
 
 
 def read_experiment(doc: Table, ctx: Context, preset_name: str = "ideal") -> ExperimentSpec:
@@ -480,28 +537,16 @@ def read_experiment(doc: Table, ctx: Context, preset_name: str = "ideal") -> Exp
     table = doc.table("experiment")
     if table is None:
         raise ctx.error("experiment", "missing", "an [experiment] table with a procedure")
-    procedure = table.choice("procedure", registry.names())
+    procedure = table.setting(replace(PROCEDURE, choices=registry.names()))
     calibration = _read_calibration(table.table("calibration"), preset_name == "realistic")
     options = registry.get(procedure).options(table, calibration)
-    goals = table.numbers("goal_columns_px", 2, None, 0.0, MAX_IMAGE_SIDE - 1.0, unit="px")
+    goals = table.setting(GOAL_COLUMNS)
     if goals is not None:
         options["goal_columns_px"] = (goals[0], goals[1])
     servo_table = table.table("servo")
     servo = ServoSpec()
     if servo_table is not None:
-        servo = ServoSpec(
-            tolerance_px=servo_table.number(
-                "tolerance_px", 0.1, 0.0, 10.0, lo_open=True, unit="px"
-            ),
-            max_iterations=servo_table.integer("max_iterations", 25, 1, 1000),
-            probe_steps=servo_table.integer("probe_steps", 16, 1, 10000),
-            min_probe_px=servo_table.number(
-                "min_probe_px", 2.0, 0.0, 100.0, lo_open=True, unit="px"
-            ),
-            min_secant_steps=servo_table.integer("min_secant_steps", 8, 1, 1000),
-            average_fixation=servo_table.boolean("average_fixation", False),
-            windows=servo_table.boolean("windows", True),
-        )
+        servo = ServoSpec(**{s.name: servo_table.setting(s) for s in SERVO_SETTINGS})
         servo_table.done()
     table.done()
     return ExperimentSpec(procedure, calibration, servo=servo, **options)

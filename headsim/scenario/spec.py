@@ -17,17 +17,15 @@ import numpy as np
 
 from headsim import paper
 from headsim.procedures import contract as registry
+from headsim.scenario.calibration_design import LAYOUTS
 from headsim.sim import names
-from headsim.sim.settings import HeadSettings, belief_sources
+from headsim.sim.declared import Choice, Flag, Setting, Text
+from headsim.sim.settings import MAX_IMAGE_SIDE, HeadSettings, belief_sources
 from headsim.sim.textured_scene import RoomSpec
 
 if TYPE_CHECKING:
     from headsim.active.calibration_file import StoredCalibration
     from headsim.scenario.pursuit import PursuitSpec
-
-#: The narrowest baseline a scenario may set, m: below it vergence carries no depth.
-MIN_BASELINE_M = 0.01
-
 
 #: Bodies of the default scene that can be measured, and the colour each is found by.
 MARKER_BODIES = {**names.MARKER_COLOURS, names.CALIBRATION_BALL: "yellow"}
@@ -46,6 +44,197 @@ MIN_DEPTH_M = 0.1
 
 #: Farthest a target may be, m: beyond it one encoder step is centimetres of depth.
 MAX_DEPTH_M = 10.0
+
+
+#: The calibration's keys (``[experiment.calibration]``), each declared once; the ball
+#: positions, given as an array of points, are read by the schema alone.
+CALIBRATION_SOURCE = Text(
+    "from",
+    None,
+    "A `head.json` from `headsim calibrate` to use instead, relative to the scenario file.",
+    max_length=1000,
+)
+CALIBRATION_TARGETS = Setting(
+    "targets", 60, 3, 1000, "", "Number of calibration-ball positions.", integer=True
+)
+_CALIBRATION_DEPTH_M = (0.25, 0.6)
+CALIBRATION_DEPTH = Setting(
+    "depth_m",
+    _CALIBRATION_DEPTH_M,
+    MIN_DEPTH_M,
+    MAX_DEPTH_M,
+    "m",
+    "Depth range z_h of the ball positions in H, m.",
+    count=2,
+)
+CALIBRATION_LATERAL = Setting(
+    "lateral",
+    0.16,
+    0.0,
+    1.0,
+    "(|x_h / z_h|)",
+    "Largest |x_h / z_h| of a ball position.",
+    lo_open=True,
+)
+CALIBRATION_VERTICAL = Setting(
+    "vertical", 0.08, 0.0, 1.0, "(|y_h / z_h|)", "Largest |y_h / z_h| of a ball position."
+)
+CALIBRATION_DEPTH_NOISE = Setting(
+    "depth_noise_m", 0.0, 0.0, 0.1, "m", "Error of the tape-measured depth of each ball, m."
+)
+CALIBRATION_EXTENDED = Flag(
+    "extended",
+    True,
+    "Also fit each camera's v0, kx/ky and line-of-sight offset (beyond the paper).",
+)
+CALIBRATION_POSITION_NOISE = Setting(
+    "position_noise_m",
+    0.0,
+    0.0,
+    0.1,
+    "m",
+    "Error of every measured coordinate of every ball, m.",
+)
+CALIBRATION_LINES_OF_SIGHT = Flag(
+    "lines_of_sight", False, "With `extended`: also fit each eye's line-of-sight offset."
+)
+CALIBRATION_LAYOUT = Choice(
+    "layout",
+    LAYOUTS,
+    "uniform",
+    "Depths uniform in `depth_m`, or most balls at the near end and the rest far.",
+)
+CALIBRATION_NEAR_FRACTION = Setting(
+    "near_fraction",
+    None,
+    0.0,
+    1.0,
+    "(share of balls)",
+    "`near_far` only: share of balls at the near end (default b / (a + b)).",
+    lo_open=True,
+    hi_open=True,
+    optional=True,
+)
+#: The calibration's declared keys, in the order ``[experiment.calibration]`` reads them.
+CALIBRATION_SETTINGS = (
+    CALIBRATION_TARGETS,
+    CALIBRATION_DEPTH,
+    CALIBRATION_LATERAL,
+    CALIBRATION_VERTICAL,
+    CALIBRATION_DEPTH_NOISE,
+    CALIBRATION_EXTENDED,
+    CALIBRATION_POSITION_NOISE,
+    CALIBRATION_LINES_OF_SIGHT,
+    CALIBRATION_SOURCE,
+    CALIBRATION_LAYOUT,
+    CALIBRATION_NEAR_FRACTION,
+)
+
+#: The servo's keys (``[experiment.servo]``), each declared once.
+SERVO_SETTINGS = (
+    Setting(
+        "tolerance_px",
+        0.1,
+        0.0,
+        10.0,
+        "px",
+        "Stop when the target's column is this close to the goal (or within half an encoder "
+        "step's motion), px.",
+        lo_open=True,
+    ),
+    Setting(
+        "max_iterations",
+        25,
+        1,
+        1000,
+        "",
+        "Servo steps before the fixation gives up.",
+        integer=True,
+    ),
+    Setting(
+        "probe_steps",
+        16,
+        1,
+        10000,
+        "",
+        "Encoder steps of the first probe when no gain is known (grown x4 until the image "
+        "moves `min_probe_px`).",
+        integer=True,
+    ),
+    Setting(
+        "min_probe_px",
+        2.0,
+        0.0,
+        100.0,
+        "px",
+        "Image motion a probe must cause before the gain is measured, px.",
+        lo_open=True,
+    ),
+    Setting(
+        "min_secant_steps",
+        8,
+        1,
+        1000,
+        "",
+        "Moves shorter than this, in encoder steps, do not update the gain.",
+        integer=True,
+    ),
+    Flag(
+        "average_fixation",
+        False,
+        "Average each fixation over images spread across one pixel (about twice the renders).",
+    ),
+    Flag(
+        "windows",
+        True,
+        "Render only a window around where the target is expected (false: every image a full "
+        "frame; same answers, more pixels).",
+    ),
+)
+
+#: ``[experiment]``'s keys that every procedure may read (a procedure's own are its
+#: ``Procedure.keys``); ``procedure`` names one of the registered procedures.
+PROCEDURE = Choice(
+    "procedure",
+    (),
+    None,
+    "The procedure that runs (one module each in `headsim.procedures`). Required.",
+    required=True,
+)
+INTERPOLATE = Flag(
+    "interpolate",
+    True,
+    "Sub-step fixation angles, interpolated between the last two encoder steps.",
+)
+MIDLINE = Setting(
+    "midline_px",
+    25.0,
+    0.0,
+    1000.0,
+    "px",
+    "Model 2's near-midline remedy: an image whose target is nearer the goal column than "
+    "this is taken again, px.",
+)
+REMEDY = Setting(
+    "remedy_px",
+    120.0,
+    0.0,
+    1000.0,
+    "px",
+    "Model 2's near-midline remedy: the eye angle of that image, as image motion away, px.",
+    lo_open=True,
+)
+GOAL_COLUMNS = Setting(
+    "goal_columns_px",
+    None,
+    0.0,
+    MAX_IMAGE_SIDE - 1.0,
+    "px",
+    "The servo's goal column per camera, px, as the user tells the head (default: the "
+    "image centres).",
+    count=2,
+    optional=True,
+)
 
 
 #: Independent random streams drawn from the scenario seed.
@@ -87,18 +276,21 @@ class CalibrationSpec:
     ``depth_m``, ``lateral``, ``vertical`` and ``layout`` are then not used).
     """
 
-    targets: int = 60
-    depth_m: tuple[float, float] = (0.25, 0.6)
-    lateral: float = 0.16
-    vertical: float = 0.08
-    depth_noise_m: float = 0.0
-    extended: bool = True
-    position_noise_m: float = 0.0
-    lines_of_sight: bool = False
+    targets: int = int(CALIBRATION_TARGETS.fixed_default)
+    depth_m: tuple[float, float] = _CALIBRATION_DEPTH_M
+    lateral: float = CALIBRATION_LATERAL.fixed_default
+    vertical: float = CALIBRATION_VERTICAL.fixed_default
+    depth_noise_m: float = CALIBRATION_DEPTH_NOISE.fixed_default
+    extended: bool = CALIBRATION_EXTENDED.default
+    position_noise_m: float = CALIBRATION_POSITION_NOISE.fixed_default
+    lines_of_sight: bool = CALIBRATION_LINES_OF_SIGHT.default
     source: str | None = None
     layout: str = "uniform"
     near_fraction: float | None = None
     positions_world_m: tuple[tuple[float, float, float], ...] | None = None
+
+
+_SERVO: dict[str, Any] = {s.name: s.default for s in SERVO_SETTINGS}
 
 
 @dataclass(frozen=True)
@@ -110,13 +302,13 @@ class ServoSpec:
     so results.json records it only when set (:data:`UNANSWERED_SERVO_KEYS`).
     """
 
-    tolerance_px: float = 0.1
-    max_iterations: int = 25
-    probe_steps: int = 16
-    min_probe_px: float = 2.0
-    min_secant_steps: int = 8
-    average_fixation: bool = False
-    windows: bool = True
+    tolerance_px: float = _SERVO["tolerance_px"]
+    max_iterations: int = _SERVO["max_iterations"]
+    probe_steps: int = _SERVO["probe_steps"]
+    min_probe_px: float = _SERVO["min_probe_px"]
+    min_secant_steps: int = _SERVO["min_secant_steps"]
+    average_fixation: bool = _SERVO["average_fixation"]
+    windows: bool = _SERVO["windows"]
 
 
 #: Servo keys that change only the renders, never an answer: results.json records
@@ -140,9 +332,9 @@ class ExperimentSpec:
 
     procedure: str
     calibration: CalibrationSpec | None
-    interpolate: bool = True
-    midline_px: float = 25.0
-    remedy_px: float = 120.0
+    interpolate: bool = INTERPOLATE.default
+    midline_px: float = MIDLINE.fixed_default
+    remedy_px: float = REMEDY.fixed_default
     servo: ServoSpec = field(default_factory=ServoSpec)
     #: The servo's goal column (u10, u20) of Ca1, Ca2, px, as the user tells the head
     #: (e.g. the principal point's, found with ``headsim.active.principal``); None: image centres.

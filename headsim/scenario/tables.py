@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from headsim.errors import BadInput
+from headsim.sim.declared import Choice, Declared, Flag, Setting, Text
 
 MISSING = object()
 
@@ -68,6 +69,48 @@ def describe_value(value: Any) -> str:
     return type(value).__name__
 
 
+def declared_default(decl: Declared) -> Any:
+    """What a getter returns for ``decl``'s key when the file leaves it out (MISSING: the
+    file must give it, or the caller passes a default derived from other keys)."""
+    if isinstance(decl, Flag):
+        return decl.default
+    if isinstance(decl, Setting):
+        return None if decl.optional else MISSING if decl.default is None else decl.default
+    return MISSING if decl.required else decl.default
+
+
+def declared_use(decl: Declared) -> tuple[str, str]:
+    """``decl``'s kind and what it allows, as the getter that reads it says them."""
+    if isinstance(decl, Flag):
+        return "boolean", "true, false"
+    if isinstance(decl, Choice):
+        return "choice", ", ".join(decl.choices)
+    if isinstance(decl, Text):
+        return "string", _text_allowed(decl.max_length, decl.what)
+    if decl.integer:
+        return "integer", _integer_allowed(int(decl.lo), int(decl.hi))
+    each = _range_text(decl.lo, decl.hi, decl.lo_open, decl.hi_open, _unit_text(decl))
+    if decl.count > 1:
+        return "numbers", _numbers_allowed(decl.count, each)
+    return "number", f"a number {each}"
+
+
+def _unit_text(setting: Setting) -> str:
+    return setting.unit + setting.unit_note
+
+
+def _integer_allowed(lo: int, hi: int) -> str:
+    return f"an integer from {lo} to {hi}"
+
+
+def _text_allowed(max_length: int, what: str | None) -> str:
+    return (what or "one line of text") + f", at most {max_length} characters"
+
+
+def _numbers_allowed(length: int, each: str) -> str:
+    return f"an array of {length} numbers, each {each}"
+
+
 def _range_text(lo: float | None, hi: float | None, lo_open: bool, hi_open: bool, unit: str) -> str:
     parts = []
     if lo is not None:
@@ -107,7 +150,7 @@ def key_path(field_path: str) -> str:
     return re.sub(r"\[\d+\]", "[]", field_path)
 
 
-def _toml_value(value: Any) -> str:
+def toml_value(value: Any) -> str:
     if value is MISSING:
         return ""
     if value is None:
@@ -119,7 +162,7 @@ def _toml_value(value: Any) -> str:
     if isinstance(value, float):
         return f"{value:g}"
     if isinstance(value, (tuple, list)):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+        return "[" + ", ".join(toml_value(v) for v in value) + "]"
     return str(value)
 
 
@@ -172,13 +215,38 @@ class Table:
         path = key_path(self.field(key))
         if first and path in seen:
             return
-        seen[path] = KeyUse(path, kind, key_path(allowed), _toml_value(default))
+        seen[path] = KeyUse(path, kind, key_path(allowed), toml_value(default))
 
     def _get(self, key: str) -> Any:
         return self.data[key] if self.has(key) else MISSING
 
     def fail(self, key: str, message: str, allowed: str | None = None) -> ScenarioError:
         return self.ctx.error(self.field(key), message, allowed)
+
+    def setting(self, decl: Declared, default: Any = MISSING, *, hi: float | None = None) -> Any:
+        """``decl``'s key, read and checked as declared (``default``: instead of the
+        declared one, e.g. a preset's; ``hi``: a tighter upper end that depends on other
+        keys, which the declaration's ``unit_note`` says)."""
+        if default is MISSING:
+            default = declared_default(decl)
+        if isinstance(decl, Flag):
+            return self.boolean(decl.name, default)
+        if isinstance(decl, Choice):
+            return self.choice(decl.name, decl.choices, default)
+        if isinstance(decl, Text):
+            return self.string(decl.name, default, decl.max_length, decl.what)
+        if decl.integer:
+            return self.integer(decl.name, default, int(decl.lo), int(decl.hi))
+        limits: dict[str, Any] = dict(
+            lo=decl.lo,
+            hi=decl.hi if hi is None else hi,
+            lo_open=decl.lo_open,
+            hi_open=decl.hi_open,
+            unit=_unit_text(decl),
+        )
+        if decl.count > 1:
+            return self.numbers(decl.name, decl.count, default, **limits)
+        return self.number(decl.name, default, **limits)
 
     def number(
         self,
@@ -227,7 +295,7 @@ class Table:
 
     def integer(self, key: str, default: Any = MISSING, lo: int = 0, hi: int = 10**6) -> int:
         value = self._get(key)
-        allowed = f"an integer from {lo} to {hi}"
+        allowed = _integer_allowed(lo, hi)
         self._note(key, "integer", allowed, default)
         if value is MISSING:
             if default is MISSING:
@@ -255,7 +323,7 @@ class Table:
     ) -> str:
         """A one-line string; ``what`` says what it names (an error's "allowed" text)."""
         value = self._get(key)
-        allowed = (what or "one line of text") + f", at most {max_length} characters"
+        allowed = _text_allowed(max_length, what)
         self._note(key, "string", allowed, default)
         if value is MISSING:
             if default is MISSING:
@@ -295,7 +363,7 @@ class Table:
     ) -> tuple[float, ...]:
         value = self._get(key)
         each = _range_text(lo, hi, lo_open, hi_open, unit)
-        allowed = f"an array of {length} numbers, each {each}"
+        allowed = _numbers_allowed(length, each)
         self._note(key, "numbers", allowed, default)
         if value is MISSING:
             if default is MISSING:

@@ -1,9 +1,10 @@
-"""A declared setting: one number's type, range, default, unit and meaning, in one place.
+"""A declared setting: one key's type, range, default, unit and meaning, in one place.
 
-A camera's settings (:mod:`headsim.sim.settings`) and every image imperfection's
-(:mod:`headsim.sim.imperfections`) are declared as :class:`Setting`; the Python checks
-(:class:`headsim.sim.settings.CameraSettings`), the scenario schema's checks and the
-scenario-key reference's meanings are all read from the declaration.
+Every scenario key of the head, its cameras, its belief and the experiment is declared
+as one of these (:class:`Setting` a number or an array of numbers, :class:`Flag`,
+:class:`Choice`, :class:`Text`) beside the field it sets; the Python checks (e.g.
+:class:`headsim.sim.settings.CameraSettings`), the scenario loader's getters and
+one-line errors, and the scenario-key reference are all read from the declaration.
 """
 
 from __future__ import annotations
@@ -15,16 +16,19 @@ from dataclasses import dataclass
 @dataclass(frozen=True)
 class Setting:
     """One number within ``lo`` .. ``hi`` ``unit`` (``lo_open``/``hi_open``: that end
-    excluded; ``integer``: whole numbers only).
+    excluded; ``integer``: whole numbers only; ``count`` > 1: an array of that many, each
+    in range, e.g. one per eye).
 
     ``default`` is the ideal camera's (for an imperfection: the imperfection off; None:
-    derived from other settings, as the principal point is from the image size);
-    ``example`` a value that turns an imperfection on, for the generic tests that every
-    imperfection moves a figure (None: not an imperfection's).
+    derived from other settings, as the principal point is from the image size, or,
+    with ``optional``, left out); ``example`` a value that turns an imperfection on, for
+    the generic tests that every imperfection moves a figure (None: not an
+    imperfection's); ``unit_note`` is said right after the unit where a scenario's error
+    says what is allowed (why the range, or what bounds it further).
     """
 
     name: str
-    default: float | None
+    default: float | tuple[float, ...] | None
     lo: float
     hi: float
     unit: str
@@ -33,11 +37,14 @@ class Setting:
     lo_open: bool = False
     hi_open: bool = False
     integer: bool = False
+    count: int = 1
+    optional: bool = False
+    unit_note: str = ""
 
     @property
     def fixed_default(self) -> float:
         """The default, which is a number (TypeError where it is derived)."""
-        if self.default is None:
+        if not isinstance(self.default, (int, float)):
             raise TypeError(f"{self.name}'s default is derived from other settings")
         return self.default
 
@@ -63,3 +70,41 @@ class Setting:
         if not self.allows(value):
             return f"{self.name} must be within {self.range_text()}, got {value}"
         return None
+
+
+@dataclass(frozen=True)
+class Flag:
+    """A key that is true or false."""
+
+    name: str
+    default: bool
+    meaning: str
+
+
+@dataclass(frozen=True)
+class Choice:
+    """A key that names one of ``choices`` (``default`` None with ``required``: the file
+    must give it)."""
+
+    name: str
+    choices: tuple[str, ...]
+    default: str | None
+    meaning: str
+    required: bool = False
+
+
+@dataclass(frozen=True)
+class Text:
+    """A one-line string of at most ``max_length`` characters; ``what`` says what it names
+    (None: any text); ``default`` None: left out, or with ``required`` the file must give it."""
+
+    name: str
+    default: str | None
+    meaning: str
+    max_length: int = 200
+    what: str | None = None
+    required: bool = False
+
+
+#: Any declared key.
+Declared = Setting | Flag | Choice | Text

@@ -18,7 +18,7 @@ from headsim.geometry.camera_model import PinholeCamera, image_centre
 from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import BASELINE_M, ENCODER_RESOLUTION_RAD, INITIAL_DIRECTIONS_RAD, INTRINSICS
 from headsim.sim import imperfections
-from headsim.sim.declared import Setting
+from headsim.sim.declared import Choice, Flag, Setting
 from headsim.sim.heads import MODELS_DIR, PAPER, HeadModel
 from headsim.sim.imperfections.distortion import K1, K2
 from headsim.sim.imperfections.noise import NOISE_STD
@@ -62,8 +62,17 @@ CX = Setting(
     MAX_IMAGE_SIDE - 1,
     "px",
     "Principal point's column, px (pixel centres at integer coordinates).",
+    unit_note=" (inside the image)",
 )
-CY = Setting("cy", None, 0.0, MAX_IMAGE_SIDE - 1, "px", "Principal point's row, px.")
+CY = Setting(
+    "cy",
+    None,
+    0.0,
+    MAX_IMAGE_SIDE - 1,
+    "px",
+    "Principal point's row, px.",
+    unit_note=" (inside the image)",
+)
 
 
 def _mount_angle(name: str, meaning: str) -> Setting:
@@ -100,6 +109,31 @@ EYE_AXIS_TILT = Setting(
     0.1,
     "rad",
     "The eye's yaw axis leaning forward, rad (machining: a few mrad).",
+)
+
+
+#: The mount's angles as a scenario's ``[head]`` sets them, one per eye (the yaw given
+#: either raw or as the eye's effective initial direction, not both).
+INITIAL_DIRECTION = replace(
+    MOUNT_YAW,
+    name="initial_direction_rad",
+    default=None,
+    count=2,
+    optional=True,
+    meaning="Each eye's effective initial direction alpha_ei, rad (or `mount_yaw_rad`, not both).",
+)
+MOUNT_YAWS = replace(
+    MOUNT_YAW,
+    default=None,
+    count=2,
+    optional=True,
+    meaning="Each eye's raw mount yaw, rad (or `initial_direction_rad`, not both).",
+)
+MOUNT_PITCHES = replace(
+    MOUNT_PITCH, default=(0.0, 0.0), count=2, meaning="Each eye's mount pitch, rad."
+)
+MOUNT_ROLLS = replace(
+    MOUNT_ROLL, default=(0.0, 0.0), count=2, meaning="Each eye's mount roll, rad."
 )
 
 
@@ -243,6 +277,28 @@ def camera_values(values: dict[str, float]) -> dict[str, Any]:
     return {**own, "extra": extra} if extra else own
 
 
+RENDER_OFFSAMPLES = Setting(
+    "render_offsamples",
+    4,
+    0,
+    16,
+    "",
+    "MuJoCo multisampling per pixel (Mesa caps it at 4).",
+    integer=True,
+)
+RENDER_SUPERSAMPLE = Setting(
+    "render_supersample",
+    2,
+    1,
+    8,
+    "",
+    "Render this many times larger and area-average down (1: faster, coarser).",
+    integer=True,
+)
+#: :class:`RenderFidelity`'s settings, as a scenario's ``[head]`` names them.
+RENDER_SETTINGS = (RENDER_OFFSAMPLES, RENDER_SUPERSAMPLE)
+
+
 @dataclass(frozen=True)
 class RenderFidelity:
     """How finely the eye images are rendered: the one knob for edge accuracy.
@@ -259,18 +315,13 @@ class RenderFidelity:
     faster default.
     """
 
-    offsamples: int = 4
-    supersample: int = 2
+    offsamples: int = int(RENDER_OFFSAMPLES.fixed_default)
+    supersample: int = int(RENDER_SUPERSAMPLE.fixed_default)
 
     def __post_init__(self) -> None:
-        _check(
-            isinstance(self.offsamples, int) and 0 <= self.offsamples <= 16,
-            f"render offsamples must be an integer within [0, 16], got {self.offsamples!r}",
-        )
-        _check(
-            isinstance(self.supersample, int) and 1 <= self.supersample <= 8,
-            f"render supersample must be an integer within [1, 8], got {self.supersample!r}",
-        )
+        for setting in RENDER_SETTINGS:
+            problem = setting.check(getattr(self, setting.name.removeprefix("render_")))
+            _check(problem is None, str(problem))
 
 
 #: Rendering whose marker-centroid floor is <= 0.05 px: the default (see :class:`RenderFidelity`).
@@ -279,6 +330,16 @@ FINE_RENDERING = RenderFidelity(offsamples=4, supersample=2)
 
 #: The true head's own numbers, each declared once (range, default, unit, meaning): read by
 #: :class:`HeadSettings`'s checks, the scenario schema's ``[head]`` and the key reference.
+BASELINE = Setting(
+    "baseline_m",
+    BASELINE_M,
+    0.01,
+    1.0,
+    "m",
+    "True distance between the eyes' yaw axes (the optical centres, on them), m. Without "
+    "`[belief]` the ideal and paper presets believe it too (`belief.sources`: `truth`).",
+    unit_note="; narrower gives no usable vergence",
+)
 NECK_D1 = Setting(
     "neck_d1_m",
     0.12,
@@ -313,9 +374,27 @@ BACKLASH = Setting(
     "rad",
     "Backlash: every joint settles half of it short, on the side it came from, rad.",
 )
-#: The head's declared numbers (``baseline_m`` is not yet: a scenario's range is narrower
-#: than a Python user's, see :data:`headsim.scenario.spec.MIN_BASELINE_M`).
-HEAD_SETTINGS = (NECK_D1, NECK_A2, ENCODER_RESOLUTION, BACKLASH)
+COUNT_ERROR = Flag(
+    "count_error",
+    False,
+    "If true, the true angle lies anywhere within the encoder count read (seeded).",
+)
+#: The head's declared numbers.
+HEAD_SETTINGS = (BASELINE, NECK_D1, NECK_A2, ENCODER_RESOLUTION, BACKLASH)
+#: What the head believes of itself (:class:`HeadBelief`), within the true head's ranges.
+BELIEVED_BASELINE = replace(
+    BASELINE, meaning="Believed baseline, m (default: the preset's belief, else the design's)."
+)
+BELIEVED_D1 = replace(NECK_D1, meaning="Believed neck d1, m (default as `belief.baseline_m`).")
+BELIEVED_A2 = replace(NECK_A2, meaning="Believed neck a2, m (default as `belief.baseline_m`).")
+BELIEVED_SIDE_OFFSET = replace(
+    SIDE_OFFSET,
+    default=(0.0, 0.0),
+    count=2,
+    meaning="Believed line-of-sight (side) offset per camera, m, until calibrated.",
+)
+#: The believed quantities a scenario's ``[belief]`` sets, in the order it reads them.
+BELIEF_SETTINGS = (BELIEVED_BASELINE, BELIEVED_D1, BELIEVED_A2, BELIEVED_SIDE_OFFSET)
 
 
 @dataclass(frozen=True)
@@ -330,19 +409,14 @@ class HeadBelief:
     a calibration measures it (the forward one needs the intrinsics to act).
     """
 
-    baseline_m: float = BASELINE_M
+    baseline_m: float = BASELINE.fixed_default
     neck_d1_m: float = NECK_D1.fixed_default
     neck_a2_m: float = NECK_A2.fixed_default
     nodal_offset_m: tuple[float, float] = (0.0, 0.0)
     side_offset_m: tuple[float, float] = (0.0, 0.0)
 
     def __post_init__(self) -> None:
-        _finite("belief.baseline_m", self.baseline_m)
-        _check(
-            0 < self.baseline_m <= 1.0,
-            f"belief.baseline_m must be > 0 and <= 1 m, got {self.baseline_m}",
-        )
-        for setting in (NECK_D1, NECK_A2):  # believed within the true head's range
+        for setting in (BASELINE, NECK_D1, NECK_A2):  # believed within the true head's range
             problem = setting.check(getattr(self, setting.name))
             _check(problem is None, f"belief.{problem}")
         for setting in (NODAL_OFFSET, SIDE_OFFSET):  # per camera, within the camera's range
@@ -414,7 +488,7 @@ class HeadSettings:
     encoder count that is read (uniform, seeded per joint and count), not on it.
     """
 
-    baseline_m: float = BASELINE_M
+    baseline_m: float = BASELINE.fixed_default
     neck_d1_m: float = NECK_D1.fixed_default
     neck_a2_m: float = NECK_A2.fixed_default
     encoder_resolution_rad: float = ENCODER_RESOLUTION.fixed_default
@@ -442,10 +516,6 @@ class HeadSettings:
         _check(
             self.belief is None or isinstance(self.belief, HeadBelief),
             "belief must be a HeadBelief or None",
-        )
-        _finite("baseline_m", self.baseline_m)
-        _check(
-            0 < self.baseline_m <= 1.0, f"baseline_m must be > 0 and <= 1 m, got {self.baseline_m}"
         )
         _check(
             isinstance(self.cameras, tuple)
@@ -552,6 +622,13 @@ def realistic_head(**overrides: object) -> HeadSettings:
 
 
 PRESETS = {"ideal": ideal_head, "paper": paper_head, "realistic": realistic_head}
+#: ``[head] preset`` (and a camera's own ``preset``): where every key left out comes from.
+PRESET = Choice(
+    "preset",
+    tuple(PRESETS),
+    "ideal",
+    "Defaults for the head and both cameras: the ideal head, the paper's, or a realistic one.",
+)
 
 
 def preset(name: str, **overrides: object) -> HeadSettings:

@@ -1,5 +1,6 @@
 """The scenario-key reference: every key the loader accepts has a meaning, and each
-meaning names a key; the type, range and default are the getters' own."""
+meaning names a key; the type, range and default are the declarations' (or, for the
+hand-written getters, the getters' own), and the loader's errors say the same."""
 
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ import pytest
 
 from headsim.scenario.key_reference import accepted_keys, collect_uses, descriptions
 from headsim.scenario.loading import load_scenario
+from headsim.scenario.schema import declared_keys
 from headsim.scenario.tables import ScenarioError, collecting_keys, key_path
+from headsim.sim.declared import Choice, Declared, Flag, Setting, Text
 
 ROOT = Path(__file__).resolve().parents[2]
 GETTERS = {"number", "integer", "boolean", "string", "choice", "numbers", "table", "tables", "has"}
@@ -72,3 +75,42 @@ def test_collecting_notes_nothing_outside_and_indices_as_brackets() -> None:
     with collecting_keys() as seen:
         load_scenario("quickstart")
     assert "experiment.calibration.targets" in seen and "scene" in seen
+
+
+def _declared_paths() -> list[object]:
+    paths = ((f"{table}.{d.name}" if table else d.name, d) for table, d in declared_keys())
+    return [pytest.param(path, decl, id=path) for path, decl in paths]
+
+
+def _outside(decl: Declared) -> object:
+    """A value the declaration refuses: the wrong type, or below its range."""
+    if isinstance(decl, (Flag, Text)):
+        return 5
+    if isinstance(decl, Choice):
+        return "no_such_choice"
+    below = int(decl.lo) - 1 if decl.integer else decl.lo - 1.0
+    return [below] * decl.count if decl.count > 1 else below
+
+
+@pytest.mark.parametrize(("path", "decl"), _declared_paths())
+def test_a_declared_keys_error_says_what_its_reference_entry_allows(
+    path: str, decl: Declared, uses: dict
+) -> None:
+    """The loader's one-line error for a declared key and the reference's entry come from the
+    one declaration: a value outside it is refused naming the key and what the reference
+    says is allowed (the principal point's upper end is the image's, tighter than any
+    image's)."""
+    entry = uses[path]
+    assert descriptions()[path] == decl.meaning and decl.meaning
+    with pytest.raises(ScenarioError) as refused:
+        load_scenario("quickstart", overrides={path: _outside(decl)})
+    message = str(refused.value)
+    assert f": {refused.value.field}: " in message
+    assert key_path(refused.value.field).removesuffix("[]") == path
+    if isinstance(decl, Setting) and decl.name in ("cx", "cy"):
+        assert refused.value.allowed == entry.allowed.replace(
+            "4095", "639" if decl.name == "cx" else "479"
+        )
+    else:
+        assert refused.value.allowed == entry.allowed
+    assert "\n" not in message

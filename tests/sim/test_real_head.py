@@ -309,7 +309,7 @@ def test_supersampled_rendering_keeps_pixel_centres_and_sharpens_the_centroid() 
 
 
 def test_bad_render_fidelity_names_its_key() -> None:
-    with pytest.raises(SettingsError, match="render supersample must be"):
+    with pytest.raises(SettingsError, match=r"render_supersample must be within \[1, 8\], got 0"):
         RenderFidelity(supersample=0)
 
 

@@ -10,15 +10,22 @@ from typing import Any
 
 import pytest
 
+from headsim.sim import imperfections
 from headsim.sim.declared import Setting
 from headsim.sim.settings import (
+    BELIEF_SETTINGS,
     CAMERA_SETTINGS,
+    COUNT_ERROR,
     HEAD_SETTINGS,
+    NODAL_OFFSET,
+    PRESETS,
+    RENDER_SETTINGS,
     CameraSettings,
     HeadSettings,
     SettingsError,
     paper_head,
     preset,
+    settings_record,
 )
 from headsim.sim.simulator import HeadSim
 
@@ -26,7 +33,10 @@ from headsim.sim.simulator import HeadSim
 @pytest.mark.parametrize(
     ("make", "message"),
     [
-        (lambda: HeadSettings(baseline_m=-0.15), "baseline_m must be > 0"),
+        (
+            lambda: HeadSettings(baseline_m=-0.15),
+            r"baseline_m must be within \[0.01, 1\] m, got -0.15",
+        ),
         (lambda: HeadSettings(baseline_m=float("nan")), "baseline_m must be a finite number"),
         (lambda: CameraSettings(width=5000), r"width must be within \[16, 4096\] px, got 5000"),
         (lambda: CameraSettings(height=0), r"height must be within \[16, 4096\] px, got 0"),
@@ -77,6 +87,21 @@ def test_each_head_setting_is_checked_by_its_declaration(setting: Setting) -> No
         with pytest.raises(SettingsError, match=f"^{setting.name} must be within"):
             bad: dict[str, Any] = {setting.name: outside}
             HeadSettings(**bad)
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_every_value_the_settings_record_holds_is_a_declared_settings(name: str) -> None:
+    """results.json's settings block records declared settings only (beside its structure:
+    the cameras, seed, belief and render tables), each under its declared name."""
+    record = settings_record(preset(name))
+    structure = {"cameras", "seed", "belief", "render"}
+    assert set(record) - structure == {s.name for s in (*HEAD_SETTINGS, COUNT_ERROR)}
+    camera_names = {s.name for s in (*CAMERA_SETTINGS, *imperfections.all_settings())}
+    assert all(set(camera) == camera_names for camera in record["cameras"])
+    assert {f"render_{key}" for key in record["render"]} == {s.name for s in RENDER_SETTINGS}
+    belief = record["belief"]
+    believed = {s.name for s in BELIEF_SETTINGS} | {NODAL_OFFSET.name}
+    assert belief is None or set(belief) == believed
 
 
 def test_unknown_scene_lists_the_scenes() -> None:
