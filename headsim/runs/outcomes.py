@@ -19,6 +19,7 @@ import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.active.measurement import Measurement
+from headsim.codec import declared, doc
 from headsim.scenario.spec import Scenario
 from headsim.scenario.surface_targets import SurfaceTarget
 from headsim.sim.events import RenderCounts
@@ -26,45 +27,57 @@ from headsim.sim.events import RenderCounts
 # -- the run ----------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@declared
 class FixationScore:
     """Where a markerless target's fixation truly landed, scored (truth: never told the head).
 
     Each eye's goal ray (its goal column, on the row its image showed the target) at its
     true pose where its servo left it fixated (Model 2: camera 1 at step 1, camera 2 at
-    step 2; Model 1: both at the neck's fixation), cast into the scene.
-    ``vergence_error_deg``: eye 2's goal ray against the direction to eye 1's landed
-    point; ``error_deg``/``error_m``: each eye's ray against the intended target, and its
-    landed point's distance from it; ``landed``: the objects hit ("" none);
-    ``click_error_px``: |clicked - true| of the click the head was told;
-    ``image_error_px``: each eye's look at its fixation, |where its image said the clicked
-    point is - where that surface point truly was| (eye 1: the tracker's drift; eye 2: the
-    correspondence error; the click's own error apart); ``match_sigma_px``: the spread the matched template's texture allows at the
-    image noise (Cramer-Rao, one axis: the theory's correspondence noise); ``match_score``,
-    ``match_ambiguity``, ``match_status``: camera 2's last confident correspondence (else
-    its last; None: none made); ``false_fixation``: the measurement is ok but an eye
-    landed more than ``false_fixation_limit_m`` from the target (or on nothing).  NaN (no
-    landing) when the measurement failed.  ``match_error_px``: camera 2's last confident
-    look's image error, whatever the measurement's outcome (NaN: none); ``wrong_match``:
-    that error is more than the false-fixation limit seen from camera 2 (a confident
-    match on the wrong point, counted also where the measurement then failed).
+    step 2; Model 1: both at the neck's fixation), cast into the scene.  NaN (no
+    landing) where the measurement failed.  Each field's meaning is declared with it.
     """
 
-    vergence_error_deg: float
-    error_deg: tuple[float, float]
-    error_m: tuple[float, float]
-    landed: tuple[str, str]
-    landed_world_m: tuple[tuple[float, ...] | None, tuple[float, ...] | None]
-    click_error_px: float
-    image_error_px: tuple[float, float]
-    match_sigma_px: float | None
-    match_score: float | None
-    match_ambiguity: float | None
-    match_status: str | None
-    false_fixation: bool
-    false_fixation_limit_m: float
-    match_error_px: float = math.nan
-    wrong_match: bool = False
+    vergence_error_deg: float = doc(
+        "angle between eye 2's goal ray and the direction from eye 2 to the point eye 1 landed on, degrees (`null`: the measurement failed)"
+    )
+    error_deg: tuple[float, float] = doc(
+        "each eye's goal ray against the direction to the intended target, degrees"
+    )
+    error_m: tuple[float, float] = doc(
+        "each eye's landed point's distance from the intended target, m"
+    )
+    landed: tuple[str, str] = doc('the object each eye\'s ray hit (`""`: none or not converged)')
+    landed_world_m: tuple[tuple[float, ...] | None, tuple[float, ...] | None] = doc(
+        "each eye's landed point in W, m (`null`: none)"
+    )
+    click_error_px: float = doc(
+        "|clicked - true| of the click in camera 1's image the head was told, px"
+    )
+    image_error_px: tuple[float, float] = doc(
+        "each eye's look at its fixation: |where its image said the clicked surface point is - its true projection|, px (eye 1: the tracker's drift; eye 2: the correspondence error; the click's error apart)"
+    )
+    match_sigma_px: float | None = doc(
+        "the location spread the matched template's texture allows at the image noise (Cramer-Rao, one axis), px: the theory's correspondence noise"
+    )
+    match_score: float | None = doc(
+        "camera 2's last confident correspondence (else its last): peak NCC"
+    )
+    match_ambiguity: float | None = doc("its second-best peak over the best")
+    match_status: str | None = doc(
+        "its status (`ok`, `low texture`, `ambiguous`, `occluded`, `lost`)"
+    )
+    false_fixation: bool = doc(
+        "the measurement is ok but an eye landed farther than `false_fixation_limit_m` from the target (or on nothing)"
+    )
+    false_fixation_limit_m: float = doc("that distance: 1 % of the target's depth, at least 5 mm")
+    match_error_px: float = doc(
+        "camera 2's last confident look: |where its match put the clicked point - its true projection|, px, whatever the measurement's outcome (`null`: no confident match)",
+        default=math.nan,
+    )
+    wrong_match: bool = doc(
+        "that error exceeds the false-fixation limit seen from camera 2 (`false_fixation_limit_m` / depth x camera 2's focal length): a confident match on the wrong point, counted also where the measurement then failed",
+        default=False,
+    )
 
 
 #: A fixation is false beyond this fraction of the target's depth ...

@@ -27,7 +27,7 @@ def _calibration_lines(report: CalibrationReport, paper: bool) -> list[str]:
         f"Calibration of the initial directions (Sec. V): {report.fixated} of "
         f"{report.targets} ball positions fixated, {report.renders.total} renders"
     ]
-    missed = [p.status_text for p in report.positions if p.failure is not None]
+    missed = [p.status for p in report.positions if p.failure is not None]
     if missed:
         counts: dict[str, int] = {}
         for status in missed:
