@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import enum
+import math
 import types
 import typing
 from collections.abc import Callable, Mapping
@@ -148,25 +149,30 @@ def _encode_fields(obj: Any) -> dict[str, Any]:
 
 def decode(cls: type[T], data: Mapping[str, Any], **given: Any) -> T:
     """The ``cls`` that :func:`encode` wrote as ``data`` (``given``: fields set instead of
-    read).  A missing key whose field has no default raises KeyError naming it; a value
-    of the wrong kind TypeError, an array of the wrong shape ValueError."""
+    read).  A missing key whose field has no default raises KeyError naming its path; a
+    value of the wrong kind TypeError, an array of the wrong shape ValueError."""
+    return _decode(cls, data, "", given)
+
+
+def _decode(cls: type[T], data: Any, path: str, given: Mapping[str, Any]) -> T:
     if not isinstance(data, Mapping):
-        raise TypeError(f"{cls.__name__}: a table expected, got {type(data).__name__}")
+        raise TypeError(f"{path or cls.__name__}: a table expected, got {data!r}")
     hints = _hints(cls)
     values: dict[str, Any] = {}
     for f in dataclasses.fields(cls):  # type: ignore[arg-type]
         d = declaration(f)
         if not f.init or f.name in given or f.name in values or d.skip:
             continue
-        found, raw = _lookup(data, d.key or f.name)
+        key = d.key or f.name
+        found, raw = _lookup(data, key)
         if not found:
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
-                raise KeyError(d.key or f.name)
+                raise KeyError(f"{path}{key}")
             continue
         if d.read is not None:
             values.update(d.read(raw))
         else:
-            values[f.name] = _value(hints[f.name], raw, d.key or f.name, d.shape)
+            values[f.name] = _value(hints[f.name], raw, f"{path}{key}", d.shape)
     return cls(**values, **given)
 
 
@@ -194,7 +200,7 @@ def _value(hint: Any, raw: Any, key: str, shape: tuple[int, ...] | None = None) 
             raise ValueError(f"{key}: not {' x '.join(map(str, shape))} finite numbers")
         return array
     if dataclasses.is_dataclass(hint) and isinstance(hint, type):
-        return decode(hint, raw)
+        return _decode(hint, raw, f"{key}.", {})
     if isinstance(hint, type) and issubclass(hint, enum.Enum):
         return hint(raw)
     if origin in (tuple, list):
@@ -203,8 +209,8 @@ def _value(hint: Any, raw: Any, key: str, shape: tuple[int, ...] | None = None) 
         if origin is tuple and (len(args) != 2 or args[1] is not Ellipsis):
             if len(raw) != len(args):
                 raise ValueError(f"{key}: {len(args)} values expected, got {len(raw)}")
-            return tuple(_value(a, v, key) for a, v in zip(args, raw, strict=True))
-        items = [_value(args[0], v, key) for v in raw] if args else list(raw)
+            return tuple(_value(a, v, f"{key}[]") for a, v in zip(args, raw, strict=True))
+        items = [_value(args[0], v, f"{key}[]") for v in raw] if args else list(raw)
         return tuple(items) if origin is tuple else items
     if origin is dict or hint is dict:
         if not isinstance(raw, Mapping):
@@ -216,8 +222,10 @@ def _value(hint: Any, raw: Any, key: str, shape: tuple[int, ...] | None = None) 
 
 def _scalar(hint: Any, raw: Any, key: str) -> Any:
     """A number, text or flag as read (an int stays an int where a float is declared, so
-    that it is written back as it was)."""
+    that it is written back as it was; null where a float is declared is NaN)."""
     if hint is float:
+        if raw is None:  # NaN, as the writer wrote it
+            return math.nan
         ok = isinstance(raw, (int, float)) and not isinstance(raw, bool)
     elif hint is int:
         ok = isinstance(raw, int) and not isinstance(raw, bool)
