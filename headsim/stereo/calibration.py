@@ -107,11 +107,11 @@ class StereoCalibration:
     ``true_cam2_from_cam1`` and ``true_head_from_cam1`` from the simulator.
     """
 
-    mono1: CameraCalibration
-    mono2: CameraCalibration
-    cam1: CameraCalibration
-    cam2: CameraCalibration
-    stereo_rms_px: float
+    mono1: CameraCalibration = doc("camera 1's calibrateCamera result")
+    mono2: CameraCalibration = doc("camera 2's calibrateCamera result")
+    cam1: CameraCalibration = doc("camera 1's intrinsics used for measuring")
+    cam2: CameraCalibration = doc("camera 2's intrinsics used for measuring")
+    stereo_rms_px: float = doc("stereoCalibrate's reprojection RMS over both cameras, px")
     cam2_from_cam1: np.ndarray = doc("OpenCV's R, T as a transform", shape=(4, 4))
     true_cam2_from_cam1: np.ndarray = doc("the simulator's", shape=(4, 4))
     true_head_from_cam1: np.ndarray = doc("camera 1 in H, the simulator's", shape=(4, 4))
