@@ -22,6 +22,7 @@ LAYERS = (
     "version",
     "errors",
     "files",
+    "codec",
     "paper",
     "geometry",
     "estimators",

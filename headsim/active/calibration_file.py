@@ -25,10 +25,10 @@ from typing import Any
 from headsim.active.calibration_report import (
     CalibrationReport,
     CalibrationSource,
-    calibration_from_block,
-    render_counts_from_block,
+    KnowledgeReport,
 )
 from headsim.active.measurement import HeadKnowledge
+from headsim.codec import decode
 from headsim.files import to_jsonable, write_json_atomic
 from headsim.sim.events import RenderCounts
 from headsim.sim.settings import HeadSettings, settings_record
@@ -86,16 +86,7 @@ class StoredCalibration:
 
 def knowledge_from_block(block: dict[str, Any]) -> HeadKnowledge:
     """The :class:`HeadKnowledge` of a results.json ``calibration`` block's ``knowledge``."""
-    known = block["knowledge"]
-    return HeadKnowledge(
-        alpha_e=tuple(float(a) for a in known["alpha_e_rad"]),  # type: ignore[arg-type]
-        v0=tuple(None if v is None else float(v) for v in known["v0_px"]),  # type: ignore[arg-type]
-        kx_over_ky=tuple(float(r) for r in known["kx_over_ky"]),  # type: ignore[arg-type]
-        u0=tuple(None if u is None else float(u) for u in known.get("u0_px", [None, None])),  # type: ignore[arg-type]
-        los_offset_m=None
-        if known.get("los_offset_m") is None
-        else tuple(float(o) for o in known["los_offset_m"]),  # type: ignore[arg-type]
-    )
+    return decode(KnowledgeReport, block["knowledge"]).head_knowledge()
 
 
 def write_calibration(
@@ -170,14 +161,15 @@ def calibration_for_head(
             "`headsim calibrate SCENARIO --out FILE`"
         )
     try:
+        counts = block.get("render_counts")  # none in a file from before previews counted
         source = CalibrationSource(
             path=str(path),
             scenario=str(doc.get("scenario", "")),
             seed=int(doc.get("seed", 0)),
             head_hash=stored_hash,
-            render_counts=render_counts_from_block(block),
+            render_counts=None if counts is None else RenderCounts.from_dict(counts),
         )
-        report = calibration_from_block(block, renders=RenderCounts(), source=source)
+        report = decode(CalibrationReport, block, renders=RenderCounts(), source=source)
     except (KeyError, TypeError, ValueError) as err:
         raise CalibrationFileError(f"{path} is malformed: {err!r} missing or wrong") from err
     return StoredCalibration(

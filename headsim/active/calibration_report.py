@@ -1,19 +1,22 @@
-"""The Sec. V calibration's report, and its ``calibration`` block both ways.
+"""The Sec. V calibration's report: results.json's ``calibration`` block, declared once.
 
 The block is what results.json's ``calibration`` holds and what a calibration
-file (head.json, :mod:`headsim.active.calibration_file`) stores;
-:func:`calibration_from_block` reads back what :func:`calibration_block` wrote.
+file (head.json, :mod:`headsim.active.calibration_file`) stores; both are
+:func:`headsim.codec.encode` of a :class:`CalibrationReport`, read back by
+:func:`headsim.codec.decode`, and documented from the same fields.
 Units are in the names: m, rad, px; positions in W unless named otherwise.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from headsim.active.failure import Failure, FailureCause
+from headsim.active.failure import Failure
+from headsim.active.measurement import HeadKnowledge
+from headsim.codec import declared, doc, encode
 from headsim.estimators.result import Status
 from headsim.sim.events import RenderCounts
 
@@ -43,7 +46,7 @@ class VerticalReference:
     kx_over_ky_truth: list[float]
 
 
-@dataclass(frozen=True)
+@declared
 class LinesOfSightFit:
     """The extended line-of-sight fit beside the truth.
 
@@ -53,41 +56,62 @@ class LinesOfSightFit:
 
     alpha_e_rad: list[float]
     offset_m: list[float]
-    std_errors_alpha_e_rad: list[float]
-    std_errors_offset_m: list[float]
-    offset_truth_m: list[float]
-    covariance: list[list[float]]
-    effective_baseline_m: float
-    effective_baseline_std_m: float
-    effective_baseline_truth_m: float
-    separable: bool
-    message: str
+    std_errors_alpha_e_rad: list[float] = doc("1-sigma of alpha_e", key="std_errors.alpha_e_rad")
+    std_errors_offset_m: list[float] = doc("1-sigma of s1, s2", key="std_errors.offset_m")
+    offset_truth_m: list[float] = doc("the true s1, s2")
+    covariance: list[list[float]] = doc("of (alpha_e1, alpha_e2, s1, s2)")
+    effective_baseline_m: float = doc("the baseline the fit implies")
+    effective_baseline_std_m: float = doc("its 1-sigma")
+    effective_baseline_truth_m: float = doc("the true one")
+    separable: bool = doc("whether the offsets could be told from alpha_e")
+    message: str = doc("the fit's remark")
 
 
-@dataclass(frozen=True)
+@declared
 class KnowledgeReport:
-    """What the calibration taught the head (its :class:`HeadKnowledge`, as numbers)."""
+    """What the calibration taught the head (its :class:`HeadKnowledge`, as numbers;
+    ``u0_px`` and ``los_offset_m`` default to a file written before they were kept)."""
 
     alpha_e_rad: list[float]
     v0_px: list[float | None]
     kx_over_ky: list[float]
-    u0_px: list[float | None]
-    los_offset_m: list[float] | None
+    u0_px: list[float | None] = doc("", default_factory=lambda: [None, None])
+    los_offset_m: list[float] | None = None
+
+    def head_knowledge(self) -> HeadKnowledge:
+        """The :class:`HeadKnowledge` these numbers are."""
+        a1, a2 = (float(a) for a in self.alpha_e_rad)
+        v1, v2 = (None if v is None else float(v) for v in self.v0_px)
+        r1, r2 = (float(r) for r in self.kx_over_ky)
+        u1, u2 = (None if u is None else float(u) for u in self.u0_px)
+        offsets = self.los_offset_m
+        return HeadKnowledge(
+            alpha_e=(a1, a2),
+            v0=(v1, v2),
+            kx_over_ky=(r1, r2),
+            u0=(u1, u2),
+            los_offset_m=None if offsets is None else (float(offsets[0]), float(offsets[1])),
+        )
 
 
-@dataclass(frozen=True)
+@declared
 class PositionOutcome:
-    """One calibration position: fixated (``failure`` None) or why not."""
+    """One calibration position: fixated (``failure`` None) or why not (``status``)."""
 
-    failure: Failure | None
+    status: str = doc('"ok", or the failure\'s message', init=False, compare=False)
+    failure: Failure | None = doc("None: fixated")
 
-    @property
-    def status_text(self) -> str:
-        """ "ok", or the failure's message (results.json's "status")."""
-        return "ok" if self.failure is None else self.failure.message
+    def __post_init__(self) -> None:
+        text = "ok" if self.failure is None else self.failure.message
+        object.__setattr__(self, "status", text)
 
 
-@dataclass(frozen=True)
+def _counts(counts: RenderCounts | None) -> dict[str, int] | None:
+    """Render counts as results.json holds them (their ``total`` added)."""
+    return None if counts is None else counts.as_dict()
+
+
+@declared
 class CalibrationSource:
     """Where a calibration read from a file came from (``[experiment.calibration] from``)."""
 
@@ -98,45 +122,124 @@ class CalibrationSource:
     #: the renders the calibration took when it ran, by kind (None if the file does not
     #: say: one written before calibration blocks had ``render_counts``, whose
     #: ``renders`` left the previews out)
-    render_counts: RenderCounts | None
+    render_counts: RenderCounts | None = doc(
+        "its renders when it ran",
+        write=lambda s: _counts(s.render_counts),
+        read=lambda v: {"render_counts": None if v is None else RenderCounts.from_dict(v)},
+    )
 
 
-@dataclass(frozen=True)
+def _status(text: str) -> dict[str, Any]:
+    ok = text == "ok"
+    return {"status": Status.OK if ok else Status.FAILED, "detail": "" if ok else text}
+
+
+#: Written only where the layout was made (the fit's fields after it).
+_LAID = "layout"
+
+
+@declared
 class CalibrationReport:
     """The Sec. V calibration: results.json's ``calibration`` block.
 
     ``status``: OK, or FAILED with ``detail`` "failed: why".  ``layout`` is None
-    when the ball positions could not be laid out (nothing below it was tried);
-    the fit's fields are None when the fit did not run.  ``renders``: every image the
-    calibration drew, by kind (previews included; none for one read from a file).  ``rendered_frames``
-    (pixels rendered, in full frames) is set by ``headsim calibrate`` only;
-    ``source`` only for a calibration read from a file.
+    when the ball positions could not be laid out (nothing below it was tried, nor
+    written); the fit's fields are None when the fit did not run.  ``renders``: every
+    image the calibration drew, by kind (previews included; none for one read from a
+    file).  ``rendered_frames`` (pixels rendered, in full frames) is set by
+    ``headsim calibrate`` only; ``source`` only for a calibration read from a file.
     """
 
-    status: Status
-    detail: str
-    targets: int
-    fixated: int
-    renders: RenderCounts
-    positions: tuple[PositionOutcome, ...]
-    layout: CalibrationLayout | None = None
-    depth_noise_m: float = 0.0
-    position_noise_m: float = 0.0
-    lines_of_sight_fit: bool = False
-    extended: bool = False
-    alpha_e_rad: list[float] | None = None
-    alpha_e_std_rad: list[float] | None = None
-    alpha_e_covariance_rad2: list[list[float]] | None = None
-    alpha_e_truth_rad: list[float] | None = None
-    alpha_e_error_rad: list[float] | None = None
-    alpha_e_paper_rad: list[float] | None = None
-    converged: bool = False
-    depth_residual_rms_m: float | None = None
-    vertical_reference: VerticalReference | None = None
-    lines_of_sight: LinesOfSightFit | None = None
-    knowledge: KnowledgeReport | None = None
-    rendered_frames: float | None = None
-    source: CalibrationSource | None = None
+    status: Status = doc(
+        "`ok`, or its failure's cause (too few positions seen because ..., a degenerate "
+        "layout because ..., no vertical spread for the extended fit)",
+        write=lambda r: r.status_text,
+        read=_status,
+    )
+    detail: str = doc("why it failed", skip=True)
+    targets: int = doc("layout positions")
+    fixated: int = doc("positions fixated")
+    renders: RenderCounts = doc(
+        "as the run's, for the calibration (in `from`, a stored calibration's, `null` for "
+        "one written before schema 2)",
+        key="render_counts",
+        whole=True,
+        write=lambda r: _counts(r.renders),
+        read=lambda v: {"renders": RenderCounts.from_dict(v)},
+    )
+    layout: CalibrationLayout | None = doc(
+        "the positions: `kind` (a layout, or `given`), `near_fraction`, `depth_m`, "
+        "`lateral`, `vertical`, `positions_world_m`",
+        default=None,
+        whole=True,
+        only_with=_LAID,
+    )
+    depth_noise_m: float = doc(
+        "error of the tape-measured depth of each ball, m", default=0.0, only_with=_LAID
+    )
+    position_noise_m: float = doc(
+        "error of every measured coordinate of every ball, m", default=0.0, only_with=_LAID
+    )
+    lines_of_sight_fit: bool = doc(
+        "whether the extended line-of-sight fit was asked for", default=False, only_with=_LAID
+    )
+    extended: bool = doc("whether the extended fit (v0, kx/ky) ran", default=False, only_with=_LAID)
+    alpha_e_rad: list[float] | None = doc(
+        "the fitted alpha_e of each camera, rad", default=None, only_with=_LAID
+    )
+    alpha_e_std_rad: list[float] | None = doc("its 1-sigma, rad", default=None, only_with=_LAID)
+    alpha_e_covariance_rad2: list[list[float]] | None = doc(
+        "its covariance, rad^2", default=None, only_with=_LAID
+    )
+    alpha_e_truth_rad: list[float] | None = doc(
+        "the true alpha_e, rad", default=None, only_with=_LAID
+    )
+    alpha_e_error_rad: list[float] | None = doc(
+        "fitted minus true, rad", default=None, only_with=_LAID
+    )
+    alpha_e_paper_rad: list[float] | None = doc("the paper's, rad", default=None, only_with=_LAID)
+    converged: bool = doc("whether the fit converged", default=False, only_with=_LAID)
+    depth_residual_rms_m: float | None = doc(
+        "RMS of the fit's depth residuals, m", default=None, only_with=_LAID
+    )
+    vertical_reference: VerticalReference | None = doc(
+        "`v0_px`, `kx_over_ky` with their `_std` and `_truth` (`null`: not extended)",
+        default=None,
+        whole=True,
+        only_with=_LAID,
+    )
+    lines_of_sight: LinesOfSightFit | None = doc(
+        "the extended fit: `alpha_e_rad`, `offset_m`, `std_errors`, `covariance` of "
+        "(alpha_e1, alpha_e2, s1, s2), `offset_truth_m`, `effective_baseline_m` with "
+        "`_std_m` and `_truth_m`, `separable`, `message` (`null`: not asked for)",
+        default=None,
+        whole=True,
+        only_with=_LAID,
+    )
+    knowledge: KnowledgeReport | None = doc(
+        "what the head measured with afterwards (`los_offset_m` included)",
+        default=None,
+        whole=True,
+        only_with=_LAID,
+    )
+    positions: tuple[PositionOutcome, ...] = doc(
+        "each layout position's `status` and `failure`, as a measurement's",
+        default=(),
+        whole=True,
+    )
+    rendered_frames: float | None = doc(
+        "pixels rendered, in full frames (`headsim calibrate` only)",
+        default=None,
+        omit_if_none=True,
+    )
+    source: CalibrationSource | None = doc(
+        "a stored calibration's origin: its `path`, `scenario`, `seed`, `head_hash` and "
+        "`render_counts` (absent: it ran here)",
+        key="from",
+        default=None,
+        omit_if_none=True,
+        whole=True,
+    )
 
     @property
     def ok(self) -> bool:
@@ -148,150 +251,10 @@ class CalibrationReport:
         return "ok" if self.ok else self.detail
 
 
-def render_counts_from_block(block: dict[str, Any]) -> RenderCounts | None:
-    """The ``render_counts`` of a ``calibration`` block read back (None: the block has none,
-    as one written before renders counted previews, whose ``renders`` counted them apart)."""
-    entry = block.get("render_counts")
-    return None if entry is None else RenderCounts.from_dict(entry)
-
-
-def _position_entry(p: PositionOutcome) -> dict[str, Any]:
-    return {"status": p.status_text, "failure": None if p.failure is None else p.failure.as_dict()}
-
-
-def _lines_entry(lines: LinesOfSightFit) -> dict[str, Any]:
-    return {
-        "alpha_e_rad": lines.alpha_e_rad,
-        "offset_m": lines.offset_m,
-        "std_errors": {
-            "alpha_e_rad": lines.std_errors_alpha_e_rad,
-            "offset_m": lines.std_errors_offset_m,
-        },
-        "offset_truth_m": lines.offset_truth_m,
-        "covariance": lines.covariance,  # (alpha_e1, alpha_e2, s1, s2)
-        "effective_baseline_m": lines.effective_baseline_m,
-        "effective_baseline_std_m": lines.effective_baseline_std_m,
-        "effective_baseline_truth_m": lines.effective_baseline_truth_m,
-        "separable": lines.separable,
-        "message": lines.message,
-    }
-
-
 def calibration_block(report: CalibrationReport) -> dict[str, Any]:
     """The calibration as results.json's ``calibration`` block (and head.json's) holds it."""
-    block: dict[str, Any] = {
-        "status": report.status_text,
-        "targets": report.targets,
-        "fixated": report.fixated,
-        "render_counts": report.renders.as_dict(),
-    }
-    layout = report.layout
-    if layout is not None:
-        block.update(
-            layout={
-                "kind": layout.kind,
-                "near_fraction": layout.near_fraction,
-                "depth_m": layout.depth_m,
-                "lateral": layout.lateral,
-                "vertical": layout.vertical,
-                "positions_world_m": layout.positions_world_m,
-            },
-            depth_noise_m=report.depth_noise_m,
-            position_noise_m=report.position_noise_m,
-            lines_of_sight_fit=report.lines_of_sight_fit,
-            extended=report.extended,
-            alpha_e_rad=report.alpha_e_rad,
-            alpha_e_std_rad=report.alpha_e_std_rad,
-            alpha_e_covariance_rad2=report.alpha_e_covariance_rad2,
-            alpha_e_truth_rad=report.alpha_e_truth_rad,
-            alpha_e_error_rad=report.alpha_e_error_rad,
-            alpha_e_paper_rad=report.alpha_e_paper_rad,
-            converged=report.converged,
-            depth_residual_rms_m=report.depth_residual_rms_m,
-            vertical_reference=None
-            if report.vertical_reference is None
-            else asdict(report.vertical_reference),
-            lines_of_sight=None
-            if report.lines_of_sight is None
-            else _lines_entry(report.lines_of_sight),
-            knowledge=None if report.knowledge is None else asdict(report.knowledge),
-        )
-    block["positions"] = [_position_entry(p) for p in report.positions]
-    if report.rendered_frames is not None:
-        block["rendered_frames"] = report.rendered_frames
-    if report.source is not None:
-        counts = report.source.render_counts
-        block["from"] = {
-            **asdict(report.source),
-            "render_counts": None if counts is None else counts.as_dict(),
-        }
+    block: dict[str, Any] = encode(report)
     return block
-
-
-def _failure(entry: dict[str, Any] | None) -> Failure | None:
-    if entry is None:
-        return None
-    return Failure(FailureCause(entry["cause"]), entry["stage"], entry["camera"], entry["detail"])
-
-
-def calibration_from_block(
-    block: dict[str, Any],
-    *,
-    renders: RenderCounts | None = None,
-    source: CalibrationSource | None = None,
-) -> CalibrationReport:
-    """The report of a ``calibration`` block read back from JSON (head.json), as written.
-
-    ``renders`` and ``source`` replace the block's own (a calibration read from a file;
-    a block written before renders counted previews has no ``render_counts``).
-    """
-    if renders is None:
-        renders = RenderCounts.from_dict(block["render_counts"])
-    status = block["status"]
-    layout = block.get("layout")
-    lines = block.get("lines_of_sight")
-    vertical = block.get("vertical_reference")
-    knowledge = block.get("knowledge")
-    return CalibrationReport(
-        status=Status.OK if status == "ok" else Status.FAILED,
-        detail="" if status == "ok" else status,
-        targets=block["targets"],
-        fixated=block["fixated"],
-        renders=renders,
-        positions=tuple(PositionOutcome(_failure(p["failure"])) for p in block["positions"]),
-        layout=None if layout is None else CalibrationLayout(**layout),
-        depth_noise_m=block.get("depth_noise_m", 0.0),
-        position_noise_m=block.get("position_noise_m", 0.0),
-        lines_of_sight_fit=block.get("lines_of_sight_fit", False),
-        extended=block.get("extended", False),
-        alpha_e_rad=block.get("alpha_e_rad"),
-        alpha_e_std_rad=block.get("alpha_e_std_rad"),
-        alpha_e_covariance_rad2=block.get("alpha_e_covariance_rad2"),
-        alpha_e_truth_rad=block.get("alpha_e_truth_rad"),
-        alpha_e_error_rad=block.get("alpha_e_error_rad"),
-        alpha_e_paper_rad=block.get("alpha_e_paper_rad"),
-        converged=block.get("converged", False),
-        depth_residual_rms_m=block.get("depth_residual_rms_m"),
-        vertical_reference=None if vertical is None else VerticalReference(**vertical),
-        lines_of_sight=None
-        if lines is None
-        else LinesOfSightFit(
-            alpha_e_rad=lines["alpha_e_rad"],
-            offset_m=lines["offset_m"],
-            std_errors_alpha_e_rad=lines["std_errors"]["alpha_e_rad"],
-            std_errors_offset_m=lines["std_errors"]["offset_m"],
-            offset_truth_m=lines["offset_truth_m"],
-            covariance=lines["covariance"],
-            effective_baseline_m=lines["effective_baseline_m"],
-            effective_baseline_std_m=lines["effective_baseline_std_m"],
-            effective_baseline_truth_m=lines["effective_baseline_truth_m"],
-            separable=lines["separable"],
-            message=lines["message"],
-        ),
-        knowledge=None if knowledge is None else KnowledgeReport(**knowledge),
-        rendered_frames=block.get("rendered_frames"),
-        source=source,
-    )
 
 
 __all__ = [
@@ -303,6 +266,4 @@ __all__ = [
     "PositionOutcome",
     "VerticalReference",
     "calibration_block",
-    "calibration_from_block",
-    "render_counts_from_block",
 ]

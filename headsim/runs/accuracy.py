@@ -10,40 +10,40 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from headsim.active.failure import Failure
 from headsim.active.measurement import Measurement
+from headsim.codec import declared, doc
 from headsim.runs.outcomes import MeasurementRecord
 
 #: Depth bands of the honest headline, m: every target counts in exactly one.
 DEPTH_BANDS_M = ((0.0, 0.6), (0.6, 1.0), (1.0, math.inf))
 
 
-@dataclass(frozen=True)
+@declared
 class DepthBand:
-    """One depth band: its name (e.g. "0.6-1 m"), the targets measured in it (``count``)
-    and their RMS error, %; ``asked``: every target whose true depth lies in it, failed
-    ones included."""
+    """One depth band: its name (e.g. "0.6-1 m"), the targets measured in it (``count``),
+    every target whose true depth lies in it (``asked``, failed ones included) and the
+    measured ones' RMS error, %."""
 
-    band: str
-    count: int
-    error_pct_of_depth_rms: float
-    asked: int = 0
+    band: str = doc("the band")
+    count: int = doc("measurements in it")
+    asked: int = doc("targets whose true depth lies in it, the failed ones included")
+    error_pct_of_depth_rms: float = doc("their RMS error, % of depth")
 
 
-@dataclass(frozen=True)
+@declared
 class TargetGroup:
     """Some of the measurements, named apart: how many, how many ok, their RMS error, %."""
 
-    count: int
-    ok: int
-    error_pct_of_depth_rms: float
+    count: int = doc("how many")
+    ok: int = doc("how many succeeded")
+    error_pct_of_depth_rms: float = doc("their RMS error, % of depth")
 
 
-@dataclass(frozen=True)
+@declared
 class MeasurementSummary:
     """The measurements made with one knowledge: counts, errors (m, % of depth), renders.
 
@@ -55,23 +55,28 @@ class MeasurementSummary:
     not show whole to both cameras (the edge of the field), apart.
     """
 
-    count: int
-    ok: int
-    failed: int
-    error_m_mean: float
-    error_m_max: float
-    error_pct_of_depth_mean: float
-    error_pct_of_depth_max: float
-    renders_per_point: float
-    servo_residual_px_max: float
-    searched: int
-    search_renders: int
-    failure_causes: dict[str, int]
-    error_pct_of_depth_rms: float
-    by_depth: tuple[DepthBand, ...]
-    scanned: int = 0
-    scan_renders: int = 0
-    outside_start_view: TargetGroup = TargetGroup(0, 0, float("nan"))
+    count: int = doc("measurements")
+    ok: int = doc("measurements that succeeded")
+    failed: int = doc("measurements that failed")
+    error_m_mean: float = doc("mean 3-D error, m")
+    error_m_max: float = doc("largest 3-D error, m")
+    error_pct_of_depth_mean: float = doc("mean error, % of depth")
+    error_pct_of_depth_max: float = doc("largest error, % of depth")
+    renders_per_point: float = doc("renders per measurement")
+    servo_residual_px_max: float = doc("largest servo residual, px")
+    searched: int = doc("measurements that needed a search")
+    search_renders: int = doc("their search renders")
+    failure_causes: dict[str, int] = doc("cause -> count")
+    error_pct_of_depth_rms: float = doc("RMS error of all targets, % of depth")
+    by_depth: tuple[DepthBand, ...] = doc("per depth band 0-0.6, 0.6-1, >= 1 m")
+    scanned: int = doc(
+        "measurements that scanned for a target the start pose did not show", default=0
+    )
+    scan_renders: int = doc("their scan renders", default=0)
+    outside_start_view: TargetGroup = doc(
+        "the targets the start pose did not show whole to both cameras (the field's edge, a labelled subset)",
+        default=TargetGroup(0, 0, float("nan")),
+    )
 
 
 def _band_name(lo: float, hi: float) -> str:
@@ -114,8 +119,8 @@ def summarise(
             DepthBand(
                 _band_name(lo, hi),
                 int(np.sum(sel)),
-                _rms_pct(pct[sel]),
                 sum(lo <= r.measurement.depth_m < hi for r in records),
+                _rms_pct(pct[sel]),
             )
             for lo, hi in DEPTH_BANDS_M
             for sel in [np.array([lo <= m.depth_m < hi for m in ok], dtype=bool)]

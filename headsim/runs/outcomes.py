@@ -19,6 +19,7 @@ import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.active.measurement import Measurement
+from headsim.codec import declared, describe, doc, encode
 from headsim.scenario.spec import Scenario
 from headsim.scenario.surface_targets import SurfaceTarget
 from headsim.sim.events import RenderCounts
@@ -26,45 +27,57 @@ from headsim.sim.events import RenderCounts
 # -- the run ----------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@declared
 class FixationScore:
     """Where a markerless target's fixation truly landed, scored (truth: never told the head).
 
     Each eye's goal ray (its goal column, on the row its image showed the target) at its
     true pose where its servo left it fixated (Model 2: camera 1 at step 1, camera 2 at
-    step 2; Model 1: both at the neck's fixation), cast into the scene.
-    ``vergence_error_deg``: eye 2's goal ray against the direction to eye 1's landed
-    point; ``error_deg``/``error_m``: each eye's ray against the intended target, and its
-    landed point's distance from it; ``landed``: the objects hit ("" none);
-    ``click_error_px``: |clicked - true| of the click the head was told;
-    ``image_error_px``: each eye's look at its fixation, |where its image said the clicked
-    point is - where that surface point truly was| (eye 1: the tracker's drift; eye 2: the
-    correspondence error; the click's own error apart); ``match_sigma_px``: the spread the matched template's texture allows at the
-    image noise (Cramer-Rao, one axis: the theory's correspondence noise); ``match_score``,
-    ``match_ambiguity``, ``match_status``: camera 2's last confident correspondence (else
-    its last; None: none made); ``false_fixation``: the measurement is ok but an eye
-    landed more than ``false_fixation_limit_m`` from the target (or on nothing).  NaN (no
-    landing) when the measurement failed.  ``match_error_px``: camera 2's last confident
-    look's image error, whatever the measurement's outcome (NaN: none); ``wrong_match``:
-    that error is more than the false-fixation limit seen from camera 2 (a confident
-    match on the wrong point, counted also where the measurement then failed).
+    step 2; Model 1: both at the neck's fixation), cast into the scene.  NaN (no
+    landing) where the measurement failed.  Each field's meaning is declared with it.
     """
 
-    vergence_error_deg: float
-    error_deg: tuple[float, float]
-    error_m: tuple[float, float]
-    landed: tuple[str, str]
-    landed_world_m: tuple[tuple[float, ...] | None, tuple[float, ...] | None]
-    click_error_px: float
-    image_error_px: tuple[float, float]
-    match_sigma_px: float | None
-    match_score: float | None
-    match_ambiguity: float | None
-    match_status: str | None
-    false_fixation: bool
-    false_fixation_limit_m: float
-    match_error_px: float = math.nan
-    wrong_match: bool = False
+    vergence_error_deg: float = doc(
+        "angle between eye 2's goal ray and the direction from eye 2 to the point eye 1 landed on, degrees (`null`: the measurement failed)"
+    )
+    error_deg: tuple[float, float] = doc(
+        "each eye's goal ray against the direction to the intended target, degrees"
+    )
+    error_m: tuple[float, float] = doc(
+        "each eye's landed point's distance from the intended target, m"
+    )
+    landed: tuple[str, str] = doc('the object each eye\'s ray hit (`""`: none or not converged)')
+    landed_world_m: tuple[tuple[float, ...] | None, tuple[float, ...] | None] = doc(
+        "each eye's landed point in W, m (`null`: none)"
+    )
+    click_error_px: float = doc(
+        "|clicked - true| of the click in camera 1's image the head was told, px"
+    )
+    image_error_px: tuple[float, float] = doc(
+        "each eye's look at its fixation: |where its image said the clicked surface point is - its true projection|, px (eye 1: the tracker's drift; eye 2: the correspondence error; the click's error apart)"
+    )
+    match_sigma_px: float | None = doc(
+        "the location spread the matched template's texture allows at the image noise (Cramer-Rao, one axis), px: the theory's correspondence noise"
+    )
+    match_score: float | None = doc(
+        "camera 2's last confident correspondence (else its last): peak NCC"
+    )
+    match_ambiguity: float | None = doc("its second-best peak over the best")
+    match_status: str | None = doc(
+        "its status (`ok`, `low texture`, `ambiguous`, `occluded`, `lost`)"
+    )
+    false_fixation: bool = doc(
+        "the measurement is ok but an eye landed farther than `false_fixation_limit_m` from the target (or on nothing)"
+    )
+    false_fixation_limit_m: float = doc("that distance: 1 % of the target's depth, at least 5 mm")
+    match_error_px: float = doc(
+        "camera 2's last confident look: |where its match put the clicked point - its true projection|, px, whatever the measurement's outcome (`null`: no confident match)",
+        default=math.nan,
+    )
+    wrong_match: bool = doc(
+        "that error exceeds the false-fixation limit seen from camera 2 (`false_fixation_limit_m` / depth x camera 2's focal length): a confident match on the wrong point, counted also where the measurement then failed",
+        default=False,
+    )
 
 
 #: A fixation is false beyond this fraction of the target's depth ...
@@ -130,34 +143,22 @@ def fixation_stats(records: Sequence[MeasurementRecord]) -> FixationStats:
     )
 
 
-@dataclass(frozen=True)
+@declared
 class TextureClassStats:
     """The markerless targets of one texture class (``rich``, ``low``, ``repetitive``,
-    ``occluded``): ``asked`` (every one placed in it), ``measured`` (ok), their 3-D error
-    RMS in % of depth (NaN: none measured), ``fixation`` (vergence, false fixations,
-    failures by cause) and renders per point (NaN: none asked)."""
+    ``occluded``), as results.json's ``by_texture[]`` holds them (NaN: none measured,
+    or none asked)."""
 
-    texture_class: str
-    asked: int
-    measured: int
-    error_pct_of_depth_rms: float
-    fixation: FixationStats
-    renders_per_point: float
-
-    def entry(self) -> dict[str, Any]:
-        """results.json's ``by_texture[]``."""
-        return {
-            "texture_class": self.texture_class,
-            "asked": self.asked,
-            "measured": self.measured,
-            "error_pct_of_depth_rms": self.error_pct_of_depth_rms,
-            "vergence_error_deg_median": self.fixation.vergence_error_deg_median,
-            "vergence_error_deg_rms": self.fixation.vergence_error_deg_rms,
-            "false_fixations": self.fixation.false_fixations,
-            "wrong_matches": self.fixation.wrong_matches,
-            "failure_causes": dict(self.fixation.failure_causes),
-            "renders_per_point": self.renders_per_point,
-        }
+    texture_class: str = doc("the class")
+    asked: int = doc("targets placed in it, the failed ones included")
+    measured: int = doc("those measured (ok)")
+    error_pct_of_depth_rms: float = doc("their 3-D error RMS, % of depth")
+    vergence_error_deg_median: float = doc("median vergence error, degrees")
+    vergence_error_deg_rms: float = doc("its RMS, degrees")
+    false_fixations: int = doc("measurements ok with an eye landed off")
+    wrong_matches: int = doc("confident matches on the wrong point")
+    failure_causes: dict[str, int] = doc("failures by cause")
+    renders_per_point: float = doc("renders per target asked")
 
 
 def by_texture(
@@ -169,56 +170,24 @@ def by_texture(
     for name in order:
         group = [r for r in records if classes.get(r.measurement.name) == name]
         pct = np.array([r.measurement.error_pct_of_depth for r in group if r.measurement.ok])
+        fixation = fixation_stats(group)
         out.append(
             TextureClassStats(
                 texture_class=name,
                 asked=len(group),
                 measured=int(pct.size),
                 error_pct_of_depth_rms=float(np.sqrt(np.mean(pct**2))) if pct.size else math.nan,
-                fixation=fixation_stats(group),
+                vergence_error_deg_median=fixation.vergence_error_deg_median,
+                vergence_error_deg_rms=fixation.vergence_error_deg_rms,
+                false_fixations=fixation.false_fixations,
+                wrong_matches=fixation.wrong_matches,
+                failure_causes=dict(fixation.failure_causes),
                 renders_per_point=float(np.mean([r.measurement.renders for r in group]))
                 if group
                 else math.nan,
             )
         )
     return tuple(out)
-
-
-#: What :meth:`SurfaceDraw.block`'s keys mean, under ``experiment`` (the markerless
-#: targets of Model 2, Model 1 and the one-step fixation).
-SURFACE_FIELDS: dict[str, str] = {
-    "surface_targets": "how the markerless targets were drawn and how they landed",
-    "surface_targets.asked": "targets asked for (`[scene.room] targets`)",
-    "surface_targets.listed": "of them, those listed (`[[scene.room.targets]]`), measured first",
-    "surface_targets.measured_as": "`surface` (by correlation) or `markers` (a marker put at "
-    "each point: the marker twin, `[scene.room] targets_as`)",
-    "surface_targets.drawn": "draws made, refused ones included",
-    "surface_targets.refused": "draws refused and drawn again, by cause (`no_surface`, `depth`, "
-    "`occluded`, `start_view`, `reach`)",
-    "surface_targets.false_fixation_limit": "the rule of a false fixation",
-    "surface_targets.targets": "each target: `name`, the `body` it lies on, `point_world_m`, "
-    "its `texture_class` (`rich`, `low`, `repetitive`, `occluded`: from truth at placement)",
-    "surface_targets.false_fixations": "measurements ok with an eye landed off the target",
-    "surface_targets.wrong_matches": "targets whose camera 2 made a confident match on the "
-    "wrong point (`wrong_match`)",
-    "surface_targets.wrong_matches_failed": "of those, the ones whose measurement then failed "
-    "(not false fixations: counted here, not hidden)",
-    "surface_targets.vergence_error_deg_median": "median vergence error of the fixations, degrees",
-    "surface_targets.vergence_error_deg_rms": "their RMS, degrees",
-    "surface_targets.by_texture": "per texture class (`rich`: pink noise, `low`, `repetitive`: "
-    "gratings, stripes, checks; `occluded`: part of either camera's template window hidden "
-    "from the other at the start pose), always all four",
-    "surface_targets.by_texture[].texture_class": "the class",
-    "surface_targets.by_texture[].asked": "targets placed in it, the failed ones included",
-    "surface_targets.by_texture[].measured": "those measured (ok)",
-    "surface_targets.by_texture[].error_pct_of_depth_rms": "their 3-D error RMS, % of depth",
-    "surface_targets.by_texture[].vergence_error_deg_median": "median vergence error, degrees",
-    "surface_targets.by_texture[].vergence_error_deg_rms": "its RMS, degrees",
-    "surface_targets.by_texture[].false_fixations": "measurements ok with an eye landed off",
-    "surface_targets.by_texture[].wrong_matches": "confident matches on the wrong point",
-    "surface_targets.by_texture[].failure_causes": "failures by cause",
-    "surface_targets.by_texture[].renders_per_point": "renders per target asked",
-}
 
 
 @dataclass(frozen=True)
@@ -242,31 +211,83 @@ class SurfaceDraw:
 
     def block(self) -> dict[str, Any]:
         """results.json's ``experiment.surface_targets``."""
-        stats = self.stats
-        return {
-            "asked": self.asked,
-            "listed": self.listed,
-            "measured_as": self.measured_as,
-            "drawn": self.drawn,
-            "refused": dict(self.refused),
-            "false_fixation_limit": f"max({FALSE_FIXATION_FRACTION:g} x depth, "
-            f"{FALSE_FIXATION_MIN_M:g} m)",
-            "targets": [
-                {
-                    "name": t.name,
-                    "body": t.body,
-                    "point_world_m": list(t.point_world_m),
-                    "texture_class": t.texture_class,
-                }
-                for t in self.targets
-            ],
-            "false_fixations": None if stats is None else stats.false_fixations,
-            "wrong_matches": None if stats is None else stats.wrong_matches,
-            "wrong_matches_failed": None if stats is None else stats.wrong_matches_failed,
-            "vergence_error_deg_median": None if stats is None else stats.vergence_error_deg_median,
-            "vergence_error_deg_rms": None if stats is None else stats.vergence_error_deg_rms,
-            "by_texture": [c.entry() for c in self.by_texture],
+        block: dict[str, Any] = encode(SurfaceBlock.of(self))
+        return block
+
+
+def _target_entries(block: SurfaceBlock) -> list[dict[str, Any]]:
+    return [
+        {
+            "name": t.name,
+            "body": t.body,
+            "point_world_m": list(t.point_world_m),
+            "texture_class": t.texture_class,
         }
+        for t in block.targets
+    ]
+
+
+@declared
+class SurfaceBlock:
+    """How the markerless targets were drawn and how they landed: results.json's
+    ``experiment.surface_targets`` (the fixations' figures None until measured)."""
+
+    asked: int = doc("targets asked for (`[scene.room] targets`)")
+    listed: int = doc("of them, those listed (`[[scene.room.targets]]`), measured first")
+    measured_as: str = doc(
+        "`surface` (by correlation) or `markers` (a marker put at each point: the marker twin, `[scene.room] targets_as`)"
+    )
+    drawn: int = doc("draws made, refused ones included")
+    refused: dict[str, int] = doc(
+        "draws refused and drawn again, by cause (`no_surface`, `depth`, `occluded`, `start_view`, `reach`)"
+    )
+    false_fixation_limit: str = doc("the rule of a false fixation")
+    targets: tuple[SurfaceTarget, ...] = doc(
+        "each target: `name`, the `body` it lies on, `point_world_m`, its `texture_class` (`rich`, `low`, `repetitive`, `occluded`: from truth at placement)",
+        whole=True,
+        write=_target_entries,
+    )
+    false_fixations: int | None = doc("measurements ok with an eye landed off the target")
+    wrong_matches: int | None = doc(
+        "targets whose camera 2 made a confident match on the wrong point (`wrong_match`)"
+    )
+    wrong_matches_failed: int | None = doc(
+        "of those, the ones whose measurement then failed (not false fixations: counted here, not hidden)"
+    )
+    vergence_error_deg_median: float | None = doc("median vergence error of the fixations, degrees")
+    vergence_error_deg_rms: float | None = doc("their RMS, degrees")
+    by_texture: tuple[TextureClassStats, ...] = doc(
+        "per texture class (`rich`: pink noise, `low`, `repetitive`: gratings, stripes, checks; `occluded`: part of either camera's template window hidden from the other at the start pose), always all four"
+    )
+
+    @classmethod
+    def of(cls, draw: SurfaceDraw) -> SurfaceBlock:
+        """The block of ``draw``."""
+        stats = draw.stats
+        return cls(
+            asked=draw.asked,
+            listed=draw.listed,
+            measured_as=draw.measured_as,
+            drawn=draw.drawn,
+            refused=draw.refused,
+            false_fixation_limit=f"max({FALSE_FIXATION_FRACTION:g} x depth, "
+            f"{FALSE_FIXATION_MIN_M:g} m)",
+            targets=draw.targets,
+            false_fixations=None if stats is None else stats.false_fixations,
+            wrong_matches=None if stats is None else stats.wrong_matches,
+            wrong_matches_failed=None if stats is None else stats.wrong_matches_failed,
+            vergence_error_deg_median=None if stats is None else stats.vergence_error_deg_median,
+            vergence_error_deg_rms=None if stats is None else stats.vergence_error_deg_rms,
+            by_texture=draw.by_texture,
+        )
+
+
+#: What the ``surface_targets`` block's keys mean, under ``experiment`` (the markerless
+#: targets of Model 2, Model 1 and the one-step fixation), from :class:`SurfaceBlock`.
+SURFACE_FIELDS: dict[str, str] = {
+    "surface_targets": "how the markerless targets were drawn and how they landed",
+    **describe(SurfaceBlock, "surface_targets."),
+}
 
 
 Vector3 = tuple[float, float, float]
@@ -432,6 +453,7 @@ __all__ = [
     "MeasurementRow",
     "RunOutcome",
     "RunRenders",
+    "SurfaceBlock",
     "SurfaceDraw",
     "TextureClassStats",
     "by_texture",

@@ -1,11 +1,11 @@
-"""results.json from the typed results: the one place that knows its keys and their order.
+"""results.json from the typed results: its document declared once, key by key.
 
-``results.json`` (:mod:`headsim.runs.results_reference` documents every key) holds
-no wall time and no timestamp: the same scenario, seed and software give the
-same bytes.  SI units (m, rad, px); NaN becomes null when
-:func:`headsim.files.write_json_atomic` writes it.  The ``calibration`` block,
-which a calibration file (head.json) holds too, is
-:func:`headsim.active.calibration_report.calibration_block`'s.
+``results.json`` (every key's meaning is read from the declarations below and in the
+types they hold, :mod:`headsim.runs.results_reference`) holds no wall time and no
+timestamp: the same scenario, seed and software give the same bytes.  SI units (m,
+rad, px); NaN becomes null when :func:`headsim.files.write_json_atomic` writes it.
+The ``calibration`` block, which a calibration file (head.json) holds too, is a
+:class:`~headsim.active.calibration_report.CalibrationReport`'s.
 """
 
 from __future__ import annotations
@@ -19,7 +19,10 @@ import cv2
 import mujoco
 import numpy as np
 
-from headsim.active.calibration_report import calibration_block
+from headsim.active.calibration_report import CalibrationReport, calibration_block
+from headsim.active.failure import Failure
+from headsim.codec import declared, doc, encode, keys
+from headsim.estimators.result import Method
 from headsim.procedures.contract import get
 from headsim.runs.accuracy import MeasurementSummary, summaries
 from headsim.runs.outcomes import FixationScore, MeasurementRecord, RunOutcome
@@ -30,47 +33,7 @@ from headsim.version import __version__
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
 RESULTS_SCHEMA = "headsim.results/2"
 
-#: Keys of results.json and of each measurement in it (:mod:`headsim.runs.results_reference` gives each its meaning).
-RESULTS_KEYS = (
-    "schema",
-    "scenario",
-    "seed",
-    "status",
-    "failures",
-    "software",
-    "settings",
-    "belief",
-    "render_counts",
-    "rendered_frames",
-    "calibration",
-    "measurements",
-    "summary",
-    "experiment",
-)
-MEASUREMENT_KEYS = (
-    "name",
-    "method",
-    "status",
-    "failure",
-    "knowledge",
-    "step",
-    "time_s",
-    "estimate_head_m",
-    "truth_head_m",
-    "estimate_world_m",
-    "truth_world_m",
-    "error_head_m",
-    "error_m",
-    "depth_m",
-    "error_pct_of_depth",
-    "covariance_head_m2",
-    "renders",
-    "search_renders",
-    "scan_renders",
-    "servo_residual_px",
-    "details",
-    "fixation",
-)
+_COUNTS = "full frames, windows, retakes and previews"
 
 
 def software_versions() -> dict[str, str]:
@@ -93,85 +56,197 @@ def software_versions() -> dict[str, str]:
     }
 
 
-def measurement_entry(record: MeasurementRecord) -> dict[str, Any]:
-    """One measurement as results.json holds it (NaN becomes null)."""
-    m = record.measurement
-    return {
-        "name": m.name,
-        "method": m.method.value,
-        "status": m.status_text,
-        "failure": None if m.failure is None else m.failure.as_dict(),
-        "knowledge": record.knowledge,
-        "step": record.step,
-        "time_s": record.time_s,
-        "estimate_head_m": m.estimate_head_m,
-        "truth_head_m": m.truth_head_m,
-        "estimate_world_m": m.estimate_world_m,
-        "truth_world_m": m.truth_world_m,
-        "error_head_m": m.error_head_m,
-        "error_m": float(np.linalg.norm(m.error_head_m)),
-        "depth_m": m.depth_m,
-        "error_pct_of_depth": m.error_pct_of_depth,
-        "covariance_head_m2": m.covariance_head_m2,
-        "renders": m.renders,
-        "search_renders": m.search_renders,
-        "scan_renders": m.scan_renders,
-        "servo_residual_px": list(m.servo_residual_px),
-        "details": dict(m.details),
-        "fixation": None if record.fixation is None else fixation_entry(record.fixation),
-    }
+@declared
+class MeasurementEntry:
+    """One measurement as results.json's ``measurements[]`` holds it."""
+
+    name: str = doc(
+        "the target (`corner_i_j` for chessboard corners, `blocks` for the cross point)"
+    )
+    method: Method = doc("`model2`, `model1` or `fixation`")
+    status: str = doc(
+        '`"ok"`, or why it failed (`"Ca2 at step 1: target lost (and at 12 eye angles searched)"`, ...)'
+    )
+    failure: Failure | None = doc(
+        "`null`, or the cause: `cause` (`lost`, `cut`, `occluded`, `low texture`, `ambiguous`, `joint limit`, `iteration limit`, `estimator`), `stage` (`step 1`, `step 2`, `fixation`, `estimate`), `camera` (1, 2 or `null`), `detail`",
+        whole=True,
+    )
+    knowledge: str = doc('what the head knew: `"none"` or `"calibrated"`')
+    step: int = doc("its step in the recording")
+    time_s: float | None = doc("tracking: the target's time, s; else `null`")
+    estimate_head_m: np.ndarray = doc("the estimate in H, m")
+    truth_head_m: np.ndarray = doc("the truth in H, m")
+    estimate_world_m: np.ndarray = doc("the estimate in W through eq. (3) and the neck encoders, m")
+    truth_world_m: np.ndarray = doc("the truth in W, m")
+    error_head_m: np.ndarray = doc("estimate minus truth in H, m")
+    error_m: float = doc("its length, m")
+    depth_m: float = doc("the true depth z_h, m")
+    error_pct_of_depth: float = doc("`error_m` in % of `depth_m`")
+    covariance_head_m2: np.ndarray = doc("first-order covariance of the estimate in H, m^2")
+    renders: int = doc(f"renders this measurement took ({_COUNTS})")
+    search_renders: int = doc("renders it spent finding a lost target again (in `renders`)")
+    scan_renders: int = doc(
+        "renders of `search_renders` spent scanning the joints' ranges for a target the head's pose did not show"
+    )
+    servo_residual_px: tuple[float, ...] = doc("each servo's final image offset from its goal, px")
+    details: dict[str, float] = doc("angles and pixels used (`alpha1_rad`, `u11_px`, ...)")
+    fixation: FixationScore | None = doc(
+        "a markerless target's landing truth (`[scene.room] targets`; `null`: a marker's): each eye's goal ray at its true pose where its servo converged (Model 2: camera 1 at step 1, camera 2 at step 2; Model 1: both at the fixation), cast into the scene; truth, never told the head"
+    )
+
+    @classmethod
+    def of(cls, record: MeasurementRecord) -> MeasurementEntry:
+        """The entry of ``record``."""
+        m = record.measurement
+        return cls(
+            name=m.name,
+            method=m.method,
+            status=m.status_text,
+            failure=m.failure,
+            knowledge=record.knowledge,
+            step=record.step,
+            time_s=record.time_s,
+            estimate_head_m=m.estimate_head_m,
+            truth_head_m=m.truth_head_m,
+            estimate_world_m=m.estimate_world_m,
+            truth_world_m=m.truth_world_m,
+            error_head_m=m.error_head_m,
+            error_m=float(np.linalg.norm(m.error_head_m)),
+            depth_m=m.depth_m,
+            error_pct_of_depth=m.error_pct_of_depth,
+            covariance_head_m2=m.covariance_head_m2,
+            renders=m.renders,
+            search_renders=m.search_renders,
+            scan_renders=m.scan_renders,
+            servo_residual_px=m.servo_residual_px,
+            details=m.details,
+            fixation=record.fixation,
+        )
 
 
-def fixation_entry(f: FixationScore) -> dict[str, Any]:
-    """A markerless target's landing truth as results.json holds it (NaN becomes null)."""
-    return {
-        "vergence_error_deg": f.vergence_error_deg,
-        "error_deg": list(f.error_deg),
-        "error_m": list(f.error_m),
-        "landed": list(f.landed),
-        "landed_world_m": [None if p is None else list(p) for p in f.landed_world_m],
-        "click_error_px": f.click_error_px,
-        "image_error_px": list(f.image_error_px),
-        "match_sigma_px": f.match_sigma_px,
-        "match_score": f.match_score,
-        "match_ambiguity": f.match_ambiguity,
-        "match_status": f.match_status,
-        "false_fixation": f.false_fixation,
-        "false_fixation_limit_m": f.false_fixation_limit_m,
-        "match_error_px": f.match_error_px,
-        "wrong_match": f.wrong_match,
-    }
+@declared
+class ScenarioRecord:
+    """The scenario as run: results.json's ``scenario``."""
+
+    name: str = doc("the scenario's name")
+    file: str = doc("its file's name")
+    description: str = doc("its `description`")
+    procedure: str = doc("its `[experiment] procedure`")
+    fast: bool = doc("whether the fast variant ran")
+    preset: str = doc("the head preset (`ideal`, `paper`, `realistic`)")
+    scene: dict[str, Any] = doc(
+        "the checked scene: every placement in W, random ones drawn",
+        parts={
+            "scene": "the MJCF scene",
+            "targets": "the targets to measure, each a placement in W",
+            "chessboard": "the chessboard's placement, or `null`",
+            "corners": "the chessboard's inner corners (columns, rows), or `null`",
+            "blocks": "the crossed blocks' placement, or `null`",
+            "objects": "the relative-positioning objects' placements",
+            "parked": "the bodies parked out of sight",
+            "moving": "the moving target's path, or `null`",
+            "pursuit": "the live pursuit's target and path, or `null`",
+            "room": "the textured room (`[scene.room]`): its seed, surface texture, table and walls, every object (clutter drawn from the seed included) and the light; `null`: none",
+            "surface_targets": "`[scene.room] targets` and its keys (`count`, `depth_m`, `lateral`, `vertical`, `click_error_px`, `band_px`, `listed`, `targets_as`); `null`: none",
+            "acceptance": "how the targets came to be measured (`null`: a procedure without targets)",
+            "acceptance.within": "`[scene.random_targets] within` (`box` or `reach`; `null`: no random targets)",
+            "acceptance.listed": "the `[[scene.targets]]` entries",
+            "acceptance.drawn": "random draws made, refused ones included",
+            "acceptance.refused": "draws the reach check refused, by reason (`depth`, `eye_range`, `neck_range`, `neck_offset`, `not_in_any_view`, `occluded`, `start_view`)",
+            "acceptance.accepted": "the targets measured, listed and drawn",
+            "acceptance.outside_start_view": "the names of the accepted targets the start pose does not show whole to both cameras",
+        },
+    )
+    experiment: dict[str, Any] = doc("the `[experiment]` options as read (the servo's included)")
 
 
-def summary_entry(s: MeasurementSummary) -> dict[str, Any]:
-    """One knowledge's statistics as results.json's ``summary`` holds them."""
-    return {
-        "count": s.count,
-        "ok": s.ok,
-        "failed": s.failed,
-        "error_m_mean": s.error_m_mean,
-        "error_m_max": s.error_m_max,
-        "error_pct_of_depth_mean": s.error_pct_of_depth_mean,
-        "error_pct_of_depth_max": s.error_pct_of_depth_max,
-        "renders_per_point": s.renders_per_point,
-        "servo_residual_px_max": s.servo_residual_px_max,
-        "searched": s.searched,
-        "search_renders": s.search_renders,
-        "failure_causes": dict(s.failure_causes),
-        "error_pct_of_depth_rms": s.error_pct_of_depth_rms,
-        "by_depth": [
-            {
-                "band": b.band,
-                "count": b.count,
-                "asked": b.asked,
-                "error_pct_of_depth_rms": b.error_pct_of_depth_rms,
-            }
-            for b in s.by_depth
-        ],
-        "scanned": s.scanned,
-        "scan_renders": s.scan_renders,
-        "outside_start_view": asdict(s.outside_start_view),
-    }
+@declared
+class ResultsDocument:
+    """results.json: its keys in the order written."""
+
+    schema: str = doc(
+        '`"headsim.results/2"` (2: one render count, every image drawn, previews included, in `render_counts`)'
+    )
+    scenario: ScenarioRecord = doc(
+        "the scenario as run: its file, its procedure and its checked scene"
+    )
+    seed: int = doc("the seed used")
+    status: str = doc('`"ok"` or `"failed"`')
+    failures: tuple[str, ...] = doc(
+        "one line per failed measurement (or calibration, or object not seen)"
+    )
+    software: dict[str, str] = doc(
+        "versions of headsim, Python, MuJoCo, NumPy, SciPy, OpenCV, rerun-sdk"
+    )
+    settings: dict[str, Any] = doc(
+        "the true head",
+        parts={
+            "baseline_m": "the baseline, m",
+            "neck_d1_m": "the neck's d1, m",
+            "neck_a2_m": "the neck's a2, m",
+            "encoder_resolution_rad": "one encoder count, rad",
+            "cameras": "each camera's settings (`kx`, `ky`, `cx`, `cy`, `width`, `height`, `k1`, `k2`, `noise_std`, `mount_yaw_rad`, `mount_pitch_rad`, `mount_roll_rad`, `nodal_offset_m`, `side_offset_m`, `eye_axis_tilt_rad`)",
+            "seed": "the seed of the head's own draws",
+            "belief": "what the head was told it is, as given (`null`: the truth)",
+            "backlash_rad": "play of every joint's gearing, rad",
+            "count_error": "whether the true angle lies anywhere within the count read, not on it",
+            "render": "the rendering fidelity: `offsamples`, `supersample`",
+            "head": "the head, only when it is not the paper's (absent: the paper's head)",
+            "head.name": "its name: a shipped head's, or the MJCF file's stem",
+            "head.path": "its MJCF file: `models/NAME.xml` for a shipped head (the same on every checkout), a user's file by its path",
+            "head.mapping": "the names headsim uses in it (the scenario's `[head.mapping]`): `head_body`, `neck_yaw`, `neck_pitch`, `eyes`, `left_eye`, `right_eye`, `cameras`, `neck_roll`, `eye_tilt`, `version`, `vergence` (`null`: none)",
+            "settle_mode": "how the servo waits for the joints to settle",
+        },
+    )
+    belief: dict[str, Any] = doc(
+        "what the head believed and measured with",
+        parts={
+            "baseline_m": "the believed baseline, m",
+            "neck_d1_m": "the believed neck d1, m",
+            "neck_a2_m": "the believed neck a2, m",
+            "nodal_offset_m": "the believed nodal offset, m (recorded; no estimate uses it, since it acts only through the goal column's angle off the optical axis)",
+            "side_offset_m": "the believed side offset, m",
+            "sources": "where each believed quantity above came from: `design` (the head's design), `preset` (the realistic preset's own belief), `file` (the scenario's `[belief]`), `given` (a `HeadBelief` given in Python), or `truth` (equal to the true head's, which the scenario changed in `[head]` and the belief followed)",
+        },
+    )
+    render_counts: dict[str, Any] = doc(
+        "every image the simulator drew, each one a render",
+        parts={
+            "*": "one phase: `calibration`, `experiment` or `overall`",
+            "*.images": "full frames",
+            "*.windows": "windows",
+            "*.retakes": "windows retaken whole at the same instant",
+            "*.previews": "binned previews",
+            "*.total": "all of them (full frames, windows, retakes and previews)",
+            "*.in_measurements": "`experiment` only: the sum of its measurements' `renders`",
+            "*.outside_measurements": "`experiment` only: renders of the procedure that belong to no measurement",
+        },
+    )
+    rendered_frames: dict[str, float] = doc(
+        "pixels rendered, in full frames (a window counts its share; also in `timing.json`)",
+        parts={
+            "calibration": "during the calibration",
+            "experiment": "during the experiment",
+            "total": "both",
+        },
+    )
+    calibration: CalibrationReport | None = doc(
+        "`null`, or the Sec. V calibration (a calibration file holds the same block)"
+    )
+    measurements: tuple[MeasurementEntry, ...] = doc("one entry per measurement, in order")
+    summary: dict[str, MeasurementSummary] = doc(
+        "the measurements' statistics, per knowledge",
+        each='one knowledge (`"none"`, `"calibrated"`)',
+    )
+    experiment: dict[str, Any] = doc(
+        "the procedure's own results (below)",
+        parts={"procedure": "the procedure's name"},
+    )
+
+
+#: Keys of results.json and of each measurement in it, in the order written.
+RESULTS_KEYS = keys(ResultsDocument)
+MEASUREMENT_KEYS = keys(MeasurementEntry)
 
 
 # -- each procedure's experiment ---------------------------------------------------------
@@ -185,51 +260,54 @@ def experiment_block(procedure: str, experiment: object | None) -> dict[str, Any
     }
 
 
-def results_payload(result: RunOutcome) -> dict[str, Any]:
-    """The results.json document (plain data; :func:`headsim.files.write_json_atomic` writes it)."""
+def results_document(result: RunOutcome) -> ResultsDocument:
+    """What results.json holds of ``result``."""
     s = result.scenario
     edge = () if s.scene.acceptance is None else s.scene.acceptance.outside_start_view
-    return {
-        "schema": RESULTS_SCHEMA,
-        "scenario": {
-            "name": s.name,
-            "file": s.path.name,
-            "description": s.description,
-            "procedure": s.experiment.procedure,
-            "fast": s.fast,
-            "preset": s.preset,
-            "scene": asdict(s.scene),
-            "experiment": experiment_record(s.experiment),
-        },
-        "seed": s.seed,
-        "status": "ok" if result.ok else "failed",
-        "failures": list(result.failures),
-        "software": software_versions(),
-        "settings": {**settings_record(s.settings), "settle_mode": s.settle_mode},
+    return ResultsDocument(
+        schema=RESULTS_SCHEMA,
+        scenario=ScenarioRecord(
+            name=s.name,
+            file=s.path.name,
+            description=s.description,
+            procedure=s.experiment.procedure,
+            fast=s.fast,
+            preset=s.preset,
+            scene=asdict(s.scene),
+            experiment=experiment_record(s.experiment),
+        ),
+        seed=s.seed,
+        status="ok" if result.ok else "failed",
+        failures=result.failures,
+        software=software_versions(),
+        settings={**settings_record(s.settings), "settle_mode": s.settle_mode},
         # The truth above; what the head believes (and its estimators use) here.
-        "belief": {**asdict(s.settings.believed), "sources": s.believed_from},
-        "render_counts": result.renders.as_dict(),
-        "rendered_frames": result.rendered_frames,
-        "calibration": None
-        if result.calibration is None
-        else calibration_block(result.calibration),
-        "measurements": [measurement_entry(r) for r in result.records],
-        "summary": {
-            label: summary_entry(m) for label, m in summaries(result.records, edge).items()
-        },
-        "experiment": experiment_block(s.experiment.procedure, result.experiment),
-    }
+        belief={**asdict(s.settings.believed), "sources": s.believed_from},
+        render_counts=result.renders.as_dict(),
+        rendered_frames=result.rendered_frames,
+        calibration=result.calibration,
+        measurements=tuple(MeasurementEntry.of(r) for r in result.records),
+        summary=summaries(result.records, edge),
+        experiment=experiment_block(s.experiment.procedure, result.experiment),
+    )
+
+
+def results_payload(result: RunOutcome) -> dict[str, Any]:
+    """The results.json document (plain data; :func:`headsim.files.write_json_atomic` writes it)."""
+    payload: dict[str, Any] = encode(results_document(result))
+    return payload
 
 
 __all__ = [
     "MEASUREMENT_KEYS",
     "RESULTS_KEYS",
     "RESULTS_SCHEMA",
+    "MeasurementEntry",
+    "ResultsDocument",
+    "ScenarioRecord",
     "calibration_block",
     "experiment_block",
-    "fixation_entry",
-    "measurement_entry",
+    "results_document",
     "results_payload",
     "software_versions",
-    "summary_entry",
 ]

@@ -27,7 +27,7 @@ def _calibration_lines(report: CalibrationReport, paper: bool) -> list[str]:
         f"Calibration of the initial directions (Sec. V): {report.fixated} of "
         f"{report.targets} ball positions fixated, {report.renders.total} renders"
     ]
-    missed = [p.status_text for p in report.positions if p.failure is not None]
+    missed = [p.status for p in report.positions if p.failure is not None]
     if missed:
         counts: dict[str, int] = {}
         for status in missed:
@@ -242,8 +242,7 @@ def texture_text(c: TextureClassStats) -> str:
     3-D RMS, vergence error, false fixations, failures by cause, renders per point."""
     if not c.asked:
         return f"{c.texture_class}: no targets"
-    f = c.fixation
-    causes = ", ".join(f"{n} {k}" for k, n in f.failure_causes.items()) or "none"
+    causes = ", ".join(f"{n} {k}" for k, n in c.failure_causes.items()) or "none"
     if not c.measured:
         return (
             f"{c.texture_class}: 0 of {c.asked} measured; failures by cause: {causes}; "
@@ -252,8 +251,8 @@ def texture_text(c: TextureClassStats) -> str:
     return (
         f"{c.texture_class}: {c.measured} of {c.asked} measured, 3-D RMS "
         f"{_cell(c.error_pct_of_depth_rms, '.3f')} % of depth; vergence error median "
-        f"{_cell(f.vergence_error_deg_median, '.4f')} deg, RMS "
-        f"{_cell(f.vergence_error_deg_rms, '.4f')} deg; false fixations {f.false_fixations}; "
+        f"{_cell(c.vergence_error_deg_median, '.4f')} deg, RMS "
+        f"{_cell(c.vergence_error_deg_rms, '.4f')} deg; false fixations {c.false_fixations}; "
         f"failures by cause: {causes}; {_cell(c.renders_per_point, '.1f')} renders per point"
     )
 

@@ -10,11 +10,11 @@ extrinsics ``(R, T)`` map camera 1 to camera 2: ``cam2_from_cam1``
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
+from headsim.codec import declared, doc
 from headsim.geometry.transforms import invert_transform, rotation_angle
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.frames import head_from_cam1_from_extrinsics
@@ -43,7 +43,7 @@ def undistort_normalized_points(uv: np.ndarray, K: np.ndarray, dist: np.ndarray)
     return xy.reshape(-1, 2)
 
 
-@dataclass(frozen=True)
+@declared
 class CameraCalibration:
     """One camera's Zhang calibration beside the simulator's truth.
 
@@ -54,12 +54,12 @@ class CameraCalibration:
     ``image_size`` (width, height) px.
     """
 
-    K: np.ndarray
-    dist: np.ndarray
-    rms_px: float
-    true_K: np.ndarray
-    true_dist: np.ndarray
-    image_size: tuple[int, int]
+    K: np.ndarray = doc("the fitted camera matrix, px", shape=(3, 3))
+    dist: np.ndarray = doc("the fitted k1, k2, p1, p2, k3", shape=(5,))
+    rms_px: float = doc("the fit's reprojection RMS, px")
+    true_K: np.ndarray = doc("the simulator's camera matrix, px", shape=(3, 3))
+    true_dist: np.ndarray = doc("the simulator's distortion", shape=(5,))
+    image_size: tuple[int, int] = doc("width, height, px")
 
     @property
     def focal_rel_errors(self) -> tuple[float, float]:
@@ -95,7 +95,7 @@ class CameraCalibration:
         return math.atan(float(undistort_normalized_points(centre, self.K, self.dist)[0, 0]))
 
 
-@dataclass(frozen=True)
+@declared
 class StereoCalibration:
     """The pair's calibration at eye angle 0 beside the simulator's truth.
 
@@ -107,16 +107,16 @@ class StereoCalibration:
     ``true_cam2_from_cam1`` and ``true_head_from_cam1`` from the simulator.
     """
 
-    mono1: CameraCalibration
-    mono2: CameraCalibration
-    cam1: CameraCalibration
-    cam2: CameraCalibration
-    stereo_rms_px: float
-    cam2_from_cam1: np.ndarray
-    true_cam2_from_cam1: np.ndarray
-    true_head_from_cam1: np.ndarray
-    views: int
-    refined: bool
+    mono1: CameraCalibration = doc("camera 1's calibrateCamera result")
+    mono2: CameraCalibration = doc("camera 2's calibrateCamera result")
+    cam1: CameraCalibration = doc("camera 1's intrinsics used for measuring")
+    cam2: CameraCalibration = doc("camera 2's intrinsics used for measuring")
+    stereo_rms_px: float = doc("stereoCalibrate's reprojection RMS over both cameras, px")
+    cam2_from_cam1: np.ndarray = doc("OpenCV's R, T as a transform", shape=(4, 4))
+    true_cam2_from_cam1: np.ndarray = doc("the simulator's", shape=(4, 4))
+    true_head_from_cam1: np.ndarray = doc("camera 1 in H, the simulator's", shape=(4, 4))
+    views: int = doc("chessboard views used")
+    refined: bool = doc("whether stereoCalibrate refined the intrinsics")
 
     @property
     def R(self) -> np.ndarray:

@@ -13,8 +13,11 @@ from headsim.active.calibration_file import (
     head_fields,
     head_hash,
     read_calibration,
+    write_calibration,
 )
+from headsim.active.calibration_report import CalibrationReport, calibration_block
 from headsim.cli import main
+from headsim.codec import decode
 from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.tables import ScenarioError
@@ -61,6 +64,15 @@ def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
     block = stored["calibration"]
     assert block["status"] == "ok" and block["render_counts"]["previews"] > 0
     assert len(block["alpha_e_std_rad"]) == 2 and block["vertical_reference"] is not None
+    # Read back, the block is the report that was written, and writes the same bytes.
+    again = write_calibration(
+        tmp_path / "again.json",
+        load_scenario("quickstart").settings,
+        calibration_block(decode(CalibrationReport, block)),
+        stored["scenario"],
+        stored["seed"],
+    )
+    assert again.read_bytes() == head_file.read_bytes()
 
     scenario_file = tmp_path / "measure.toml"
     scenario_file.write_text(SCENARIO.format(head=head_file, extra=""))

@@ -9,6 +9,7 @@ from dataclasses import replace
 import pytest
 
 from headsim.active.failure import Failure, FailureCause
+from headsim.codec import encode
 from headsim.runs.outcomes import FixationScore, MeasurementRecord, by_texture
 from headsim.runs.summary import texture_text
 from headsim.runs.texture_class import TEXTURE_CLASSES
@@ -63,14 +64,14 @@ def test_each_class_counts_its_targets_failed_ones_by_cause() -> None:
         "f": "repetitive",
     }
     rich, low, repetitive, occluded = by_texture(records, classes, TEXTURE_CLASSES)
-    assert (rich.asked, rich.measured, rich.fixation.false_fixations) == (2, 2, 1)
+    assert (rich.asked, rich.measured, rich.false_fixations) == (2, 2, 1)
     assert rich.error_pct_of_depth_rms == pytest.approx(math.sqrt((0.2**2 + 0.4**2) / 2))
-    assert rich.fixation.vergence_error_deg_median == pytest.approx(0.02)
-    assert rich.fixation.vergence_error_deg_rms == pytest.approx(math.sqrt((0.01**2 + 0.03**2) / 2))
-    assert (low.asked, low.measured, low.fixation.failure_causes) == (2, 0, {"low texture": 2})
+    assert rich.vergence_error_deg_median == pytest.approx(0.02)
+    assert rich.vergence_error_deg_rms == pytest.approx(math.sqrt((0.01**2 + 0.03**2) / 2))
+    assert (low.asked, low.measured, low.failure_causes) == (2, 0, {"low texture": 2})
     assert math.isnan(low.error_pct_of_depth_rms)
     assert (repetitive.asked, repetitive.measured) == (2, 1)
-    assert repetitive.fixation.failure_causes == {"ambiguous": 1}
+    assert repetitive.failure_causes == {"ambiguous": 1}
     assert (occluded.asked, occluded.measured) == (0, 0)
     assert sum(c.asked for c in (rich, low, repetitive, occluded)) == len(records)
     assert rich.renders_per_point == 7.0
@@ -82,7 +83,7 @@ def test_each_class_counts_its_targets_failed_ones_by_cause() -> None:
     assert texture_text(repetitive).startswith(
         "repetitive: 1 of 2 measured, 3-D RMS 0.100 % of depth"
     )
-    entry = repetitive.entry()
+    entry = encode(repetitive)
     assert entry["failure_causes"] == {"ambiguous": 1} and entry["asked"] == 2
 
 

@@ -17,7 +17,7 @@ from headsim.sim.events import RenderCounts
 
 def test_a_report_is_ok_only_with_status_ok_and_names_why_not() -> None:
     failed = CalibrationReport(
-        Status.FAILED, "failed: degenerate layout", 4, 1, RenderCounts(images=12), ()
+        Status.FAILED, "failed: degenerate layout", 4, 1, RenderCounts(images=12)
     )
     assert not failed.ok and failed.status_text == "failed: degenerate layout"
     ok = replace(failed, status=Status.OK, detail="")
@@ -28,8 +28,8 @@ def test_a_report_is_ok_only_with_status_ok_and_names_why_not() -> None:
 
 def test_a_position_is_ok_without_a_failure() -> None:
     cut = Failure(FailureCause.CUT, "step 2", 1, "after 2 moves")
-    assert PositionOutcome(None).status_text == "ok"
-    assert PositionOutcome(cut).status_text == "Ca1 at step 2: target cut (after 2 moves)"
+    assert PositionOutcome(None).status == "ok"
+    assert PositionOutcome(cut).status == "Ca1 at step 2: target cut (after 2 moves)"
 
 
 def test_a_run_is_ok_without_failures() -> None:

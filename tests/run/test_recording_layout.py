@@ -102,7 +102,7 @@ def test_the_3d_view_starts_behind_and_above_the_head(recorded: tuple[Path, dict
 
 def test_the_calibration_document_reads_the_report() -> None:
     failed = CalibrationReport(
-        Status.FAILED, "failed: too few positions seen", 8, 2, RenderCounts(images=30), ()
+        Status.FAILED, "failed: too few positions seen", 8, 2, RenderCounts(images=30)
     )
     assert calibration_markdown(failed) == "# Calibration\n\nfailed: too few positions seen\n"
     ok = replace(

@@ -16,16 +16,15 @@ from headsim.active.calibration_report import (
     PositionOutcome,
     VerticalReference,
     calibration_block,
-    calibration_from_block,
-    render_counts_from_block,
 )
+from headsim.codec import decode, encode
 from headsim.estimators.result import Method, Status
 from headsim.files import to_jsonable
 from headsim.procedures.model2 import Model2Result
 from headsim.procedures.pursuit import PursuitResult
 from headsim.procedures.tracking import TrackingResult
 from headsim.runs.outcomes import MeasurementRecord
-from headsim.runs.serialise import MEASUREMENT_KEYS, experiment_block, measurement_entry
+from headsim.runs.serialise import MEASUREMENT_KEYS, MeasurementEntry, experiment_block
 from headsim.sim.events import RenderCounts
 
 from .helpers import LOST, measurement
@@ -81,11 +80,11 @@ def test_the_enums_write_the_strings_results_json_always_had() -> None:
 
 
 def test_a_measurement_writes_its_method_status_and_failure_as_documented() -> None:
-    ok = measurement_entry(MeasurementRecord(measurement(0.003, 0.5), "none", 0))
+    ok = encode(MeasurementEntry.of(MeasurementRecord(measurement(0.003, 0.5), "none", 0)))
     assert list(ok) == list(MEASUREMENT_KEYS)
     assert ok["method"] == "model2" and ok["status"] == "ok" and ok["failure"] is None
     assert ok["error_m"] == pytest.approx(0.003)
-    lost = measurement_entry(MeasurementRecord(measurement(0.0, 0.5, LOST), "none", 1))
+    lost = encode(MeasurementEntry.of(MeasurementRecord(measurement(0.0, 0.5, LOST), "none", 1)))
     assert lost["status"] == "Ca2 at step 1: target lost (and at 12 eye angles searched)"
     assert lost["failure"] == {
         "cause": "lost",
@@ -96,7 +95,7 @@ def test_a_measurement_writes_its_method_status_and_failure_as_documented() -> N
 
 
 def test_a_calibration_that_could_not_lay_out_its_positions_writes_five_keys() -> None:
-    report = CalibrationReport(Status.FAILED, "failed: no room", 8, 0, RenderCounts(), ())
+    report = CalibrationReport(Status.FAILED, "failed: no room", 8, 0, RenderCounts())
     block = calibration_block(report)
     assert block == {
         "status": "failed: no room",
@@ -121,9 +120,9 @@ def test_a_calibration_block_reads_back_to_the_same_report_and_bytes() -> None:
     }
     assert list(block)[-2:] == ["positions", "rendered_frames"]
     assert block["positions"][1] == {"status": LOST.message, "failure": LOST.as_dict()}
-    assert calibration_from_block(block) == report
+    assert decode(CalibrationReport, block) == report
     source = CalibrationSource("/tmp/head.json", "quickstart", 0, "abc", report.renders)
-    stored = calibration_from_block(block, renders=RenderCounts(), source=source)
+    stored = decode(CalibrationReport, block, renders=RenderCounts(), source=source)
     assert stored.renders.total == 0 and stored.ok
     again = calibration_block(stored)
     assert list(again)[-1] == "from" and again["from"]["render_counts"]["total"] == 40
@@ -139,10 +138,9 @@ def test_a_block_from_before_renders_counted_previews_says_nothing_of_them() -> 
     # not today's, so a calibration read from it reports none rather than a wrong one.
     block = {k: v for k, v in calibration_block(_full_report()).items() if k != "render_counts"}
     old = {**block, "renders": 31}
-    assert render_counts_from_block(old) is None
     with pytest.raises(KeyError, match="render_counts"):
-        calibration_from_block(old)
-    assert calibration_from_block(old, renders=RenderCounts()).renders == RenderCounts()
+        decode(CalibrationReport, old)
+    assert decode(CalibrationReport, old, renders=RenderCounts()).renders == RenderCounts()
 
 
 def test_each_experiment_writes_the_procedure_first() -> None:

@@ -22,7 +22,7 @@ def test_columns_are_padded_first_left_then_right() -> None:
 def test_a_failed_calibration_is_the_summarys_problem() -> None:
     scenario = load_scenario("quickstart", fast=True)
     counts = RenderCounts(images=20, windows=6, retakes=1, previews=4)
-    report = CalibrationReport(Status.FAILED, "failed: too few positions seen", 8, 2, counts, ())
+    report = CalibrationReport(Status.FAILED, "failed: too few positions seen", 8, 2, counts)
     result = RunResult(
         scenario=scenario,
         calibration=report,

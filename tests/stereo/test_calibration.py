@@ -79,6 +79,9 @@ def test_a_calibration_written_and_read_back_triangulates_exactly_as_before(
     )
     uv1, uv2 = np.array([[300.0, 200.0]]), np.array([[280.0, 201.0]])
     assert np.array_equal(triangulate(calib, uv1, uv2), triangulate(back, uv1, uv2))
+    # What was read back writes the same bytes.
+    again = write_stereo_calibration(tmp_path / "again.json", back)
+    assert again.read_bytes() == (tmp_path / "zhang.json").read_bytes()
 
 
 def test_a_malformed_stereo_calibration_file_says_what_is_wrong(calibrated, tmp_path) -> None:
@@ -87,7 +90,9 @@ def test_a_malformed_stereo_calibration_file_says_what_is_wrong(calibrated, tmp_
     doc = json.loads(path.read_text())
     doc["cam1"]["K"] = [[1.0, 0.0]]
     path.write_text(json.dumps(doc))
-    with pytest.raises(StereoCalibrationFileError, match=r"zhang.json is malformed: not 3 x 3"):
+    with pytest.raises(
+        StereoCalibrationFileError, match=r"zhang.json is malformed: cam1.K: not 3 x 3"
+    ):
         read_stereo_calibration(path)
     path.write_text(json.dumps({**doc, "version": 9}))
     with pytest.raises(StereoCalibrationFileError, match="has version 9; this headsim reads 1"):
