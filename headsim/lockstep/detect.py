@@ -1,12 +1,12 @@
 """A marker's centroid in many images at once: :func:`headsim.vision.markers.find_marker`'s
 answers, with the per-image work done over the whole stack.
 
-The images are stacked one above the other with a blank row between them, so that one
-colour-weight pass, one threshold and one connected-components call serve them all (no
-blob crosses a blank row).  An image with no blob is LOST; one whose only blob touches
-its border is CUT; one with a single blob gets its rim-weighted centroid from sums over
-the stack, then :func:`~headsim.vision.markers.asymmetry`'s shape test as
-``find_marker`` does.  An image with several pieces of the colour goes to
+One colour-weight pass and one threshold serve every image, and each image's pixels of
+the colour are bounded by reductions over the stack; an image with none is LOST at once.
+Only the few pixels around each image's blob are then labelled: an image whose only
+blob touches its border is CUT; one with a single blob gets its rim-weighted centroid and
+:func:`~headsim.vision.markers.asymmetry`'s shape test over the same window, in the same
+order, as ``find_marker``; an image with several pieces of the colour goes to
 ``find_marker`` itself (its largest-blob and nearby-piece rules), so every answer is
 ``find_marker``'s.
 """
@@ -34,12 +34,17 @@ def colour_weight_u8(images: np.ndarray, colour: str) -> np.ndarray:
     if colour not in COLOURS:
         raise ValueError(f"unknown marker colour {colour!r}; allowed: {', '.join(COLOURS)}")
     mask = COLOURS[colour]
-    on = np.min(images[..., [k for k in range(3) if mask[k]]], axis=-1)
-    off_channels = [k for k in range(3) if not mask[k]]
+    if images.size == 0:
+        return np.zeros(images.shape[:-1], np.uint8)
+    shape = images.shape[:-1]
+    channels = cv2.split(np.ascontiguousarray(images).reshape(-1, shape[-1], 3))
+    on_channels = [c for c, m in zip(channels, mask, strict=True) if m]
+    off_channels = [c for c, m in zip(channels, mask, strict=True) if not m]
+    on = on_channels[0] if len(on_channels) == 1 else cv2.min(*on_channels)
     if not off_channels:
-        return on
-    off = np.max(images[..., off_channels], axis=-1)
-    return np.where(on > off, on - off, 0).astype(np.uint8)
+        return np.asarray(on).reshape(shape)
+    off = off_channels[0] if len(off_channels) == 1 else cv2.max(*off_channels)
+    return np.asarray(cv2.subtract(on, off)).reshape(shape)
 
 
 def find_markers_stacked(
@@ -51,42 +56,43 @@ def find_markers_stacked(
     count, height, width = images.shape[:3]
     if count == 0:
         return []
-    rows = height + 1  # each image and a blank row under it
-    weight = np.zeros((count, rows, width), np.uint8)
-    weight[:, :height] = colour_weight_u8(images, colour)
-    flat = weight.reshape(count * rows, width)
-    binary = (flat > threshold * 255.0).astype(np.uint8)
-    n_labels, _, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
-    pieces = np.zeros(count, np.int64)
-    owner = stats[1:, cv2.CC_STAT_TOP] // rows  # the image each blob lies in
-    np.add.at(pieces, owner, 1)
-    # The blob and a one-pixel rim around it: the dilated mask (a blob off the border
-    # never reaches the blank row or the next image).
-    rim = cv2.dilate(binary, _RIM, borderType=cv2.BORDER_CONSTANT, borderValue=0)
-    rimmed = np.where(rim > 0, flat, 0).reshape(count, rows, width)
+    weight = colour_weight_u8(images, colour)
+    inked = weight > threshold * 255.0
+    rows: np.ndarray = np.any(inked, axis=2)
+    columns: np.ndarray = np.any(inked, axis=1)
     out = [Detection(DetectionStatus.LOST, None, 0.0)] * count
-    for label in range(1, n_labels):
-        image = int(owner[label - 1])
-        if pieces[image] > 1:
+    for image in np.flatnonzero(rows.any(axis=1)):
+        ys, xs = np.flatnonzero(rows[image]), np.flatnonzero(columns[image])
+        # Every piece of the colour, and a pixel around them for the rim.
+        y0, y1 = max(int(ys[0]) - 1, 0), min(int(ys[-1]) + 2, height)
+        x0, x1 = max(int(xs[0]) - 1, 0), min(int(xs[-1]) + 2, width)
+        binary = inked[image, y0:y1, x0:x1].astype(np.uint8)
+        pieces, _, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
+        if pieces > 2:
+            out[image] = find_marker(images[image], colour, threshold)
             continue
-        x, y, w, h = (int(stats[label, k]) for k in range(4))
-        y -= image * rows
+        x, y, w, h = (int(stats[1, k]) for k in range(4))
+        x, y = x + x0, y + y0
         if x == 0 or y == 0 or x + w >= width or y + h >= height:
-            area = float(stats[label, cv2.CC_STAT_AREA])
-            out[image] = Detection(DetectionStatus.CUT, None, area)
-        else:
-            out[image] = _single(rimmed[image], x - 1, y - 1, x + w + 1, y + h + 1)
-    for crowded in np.flatnonzero(pieces > 1):
-        out[int(crowded)] = find_marker(images[crowded], colour, threshold)
+            out[image] = Detection(DetectionStatus.CUT, None, float(stats[1, cv2.CC_STAT_AREA]))
+            continue
+        rim = cv2.dilate(binary, _RIM, borderType=cv2.BORDER_CONSTANT, borderValue=0)
+        rimmed = np.where(rim > 0, weight[image, y0:y1, x0:x1], 0)
+        out[image] = _single(rimmed, x - 1 - x0, y - 1 - y0, (x0, y0), (w + 2, h + 2))
     return out
 
 
-def _single(rimmed: np.ndarray, x0: int, y0: int, x1: int, y1: int) -> Detection:
-    """The one blob's detection from its rim-weighted window, as ``find_marker`` measures
-    it (the same sums in the same order) with its shape test."""
-    wts = rimmed[y0:y1, x0:x1].astype(np.float64) / 255.0
+def _single(
+    rimmed: np.ndarray, left: int, top: int, origin: tuple[int, int], size: tuple[int, int]
+) -> Detection:
+    """The one blob's detection from its rim-weighted window (``size`` px from (``left``,
+    ``top``) of ``rimmed``, whose pixel (0, 0) is the image's ``origin``), measured as
+    ``find_marker`` measures it (the same sums in the same order), with its shape test."""
+    wts = rimmed[top : top + size[1], left : left + size[0]].astype(np.float64) / 255.0
     total = float(wts.sum())
-    vs, us = np.mgrid[y0:y1, x0:x1]
+    x0, y0 = origin[0] + left, origin[1] + top
+    us = np.arange(x0, x0 + size[0])[None, :]  # find_marker's mgrid, broadcast
+    vs = np.arange(y0, y0 + size[1])[:, None]
     u = float((wts * us).sum() / total)
     v = float((wts * vs).sum() / total)
     if total >= MIN_SHAPE_AREA_PX and asymmetry(wts, u - x0, v - y0) > MAX_ASYMMETRY:

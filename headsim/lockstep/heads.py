@@ -125,6 +125,7 @@ class LockstepHeads:
         #: When each head's last frame ended (a latent command is due a latency after), s.
         self._last_end = np.zeros(n)
         self._renderer: ViewRenderer | None = None
+        self._opengl_before_s = 0.0  # in renderers since replaced by larger ones
         #: Eye images drawn.
         self.images = 0
 
@@ -382,12 +383,19 @@ class LockstepHeads:
             renderer.largest_px[0] < need[0] or renderer.largest_px[1] < need[1]
         ):
             need = (max(need[0], renderer.largest_px[0]), max(need[1], renderer.largest_px[1]))
+            self._opengl_before_s += renderer.opengl_cpu_s
             renderer.close()
             renderer = None
         if renderer is None:
             renderer = ViewRenderer(views[0].model, need)
             self._renderer = renderer
         return renderer
+
+    @property
+    def opengl_cpu_s(self) -> float:
+        """CPU seconds spent in OpenGL's draws and reads so far (the renderer's)."""
+        now = 0.0 if self._renderer is None else self._renderer.opengl_cpu_s
+        return self._opengl_before_s + now
 
     def describe(self) -> str:
         """The renderer, in words."""

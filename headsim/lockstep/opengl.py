@@ -11,6 +11,7 @@ by one grey level now and then (float32 viewport arithmetic).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -62,11 +63,15 @@ class ViewRenderer:
         self._option.geomgroup[names.HEAD_VISUAL_GROUP] = 0  # as the classic eye renderer
         #: Canvases drawn.
         self.views = 0
+        #: CPU seconds of this process (llvmpipe's threads included) spent in OpenGL's
+        #: draws and reads: the rest of a step's CPU is the host's.
+        self.opengl_cpu_s = 0.0
 
     def draw(self, views: Sequence[EyeView]) -> list[np.ndarray]:
         """Each view's pinhole canvas, uint8 (h, w, 3), supersampling area-averaged out."""
         renderer = self._renderer
         context = mjr_context(renderer)
+        make_current(renderer)
         images = []
         for view in views:
             width, height = (view.supersample * s for s in view.canvas_px)
@@ -77,11 +82,12 @@ class ViewRenderer:
                 )
             use_model(renderer, view.model)
             renderer.update_scene(view.data, camera=view.camera, scene_option=self._option)
-            make_current(renderer)
             rect = mujoco.MjrRect(0, 0, width, height)
-            mujoco.mjr_render(rect, renderer.scene, context)
             pixels = np.empty((height, width, 3), np.uint8)
+            start = time.process_time()
+            mujoco.mjr_render(rect, renderer.scene, context)
             mujoco.mjr_readPixels(pixels, None, rect, context)
+            self.opengl_cpu_s += time.process_time() - start
             upright: np.ndarray = np.ascontiguousarray(pixels[::-1])  # OpenGL's rows: bottom-up
             if view.supersample > 1:
                 upright = cv2.resize(upright, view.canvas_px, interpolation=cv2.INTER_AREA)
