@@ -50,7 +50,9 @@ class _Build:
     settings: HeadSettings
     built: BuiltModel
     qadr: np.ndarray  # the motors' qpos addresses
-    feeds: tuple[tuple[tuple[int, float, float, float], ...], ...]
+    drive: tuple[tuple[int, ...], tuple[int, ...], tuple[float, ...]]  # actuator, motor, gear
+    feed_velocity_s: np.ndarray  # per actuator of ``drive``: the driver's feed-forwards
+    feed_acceleration_s2: np.ndarray
     low: np.ndarray
     high: np.ndarray
     home: int
@@ -118,6 +120,12 @@ class LockstepHeads:
         self._data = [mujoco.MjData(first.built.model) for _ in range(n)]
         limits = (self.config.neck_limits, self.config.neck_limits, self.config.eye_limits)
         self.motors = VelocityMotors(n, limits)
+        self._drive = first.drive
+        self._acts = np.array(first.drive[0], np.int64)
+        self._motor_of = np.array(first.drive[1], np.int64)
+        self._gears = np.array(first.drive[2])
+        self._feed_v = np.tile(first.feed_velocity_s, (n, 1))
+        self._feed_a = np.tile(first.feed_acceleration_s2, (n, 1))
         self.paths: list[Path | None] = [None] * n
         self.step_count = np.zeros(n, np.int64)
         self.frame_index = np.zeros(n, np.int64)
@@ -160,7 +168,13 @@ class LockstepHeads:
             settings,
             built,
             np.array([int(model.joint(j).qposadr[0]) for j in joints]),
-            driver.feeds,
+            (
+                tuple(act for pairs in driver.feeds for act, _, _, _ in pairs),
+                tuple(m for m, pairs in enumerate(driver.feeds) for _ in pairs),
+                tuple(gear for pairs in driver.feeds for _, gear, _, _ in pairs),
+            ),
+            np.array([fv for pairs in driver.feeds for _, _, fv, _ in pairs]),
+            np.array([fa for pairs in driver.feeds for _, _, _, fa in pairs]),
             np.array([float(model.joint(j).range[0]) for j in joints]),
             np.array([float(model.joint(j).range[1]) for j in joints]),
             home,
@@ -197,7 +211,15 @@ class LockstepHeads:
         changed = False
         for head, wanted in zip(ids, settings, strict=True):
             if wanted != self._heads[head].settings:
-                self._heads[head] = self._build(wanted)
+                build = self._build(wanted)
+                if build.drive != self._drive:
+                    raise SettingsError(
+                        "lockstep heads must share their motors' actuators and gears "
+                        "(one kind of head)"
+                    )
+                self._heads[head] = build
+                self._feed_v[head] = build.feed_velocity_s
+                self._feed_a[head] = build.feed_acceleration_s2
                 self._streams[head] = _Stream(wanted.seed, [0, 0])
                 changed = True
         if changed:
@@ -282,57 +304,63 @@ class LockstepHeads:
         """``nstep`` physics steps of ``ids``: the motors' references advanced in numpy,
         the physics in one batch rollout, the targets moved at every step."""
         nu = self.batch.model.nu
-        moving = [h for h in ids if self._moves(h)]
+        moving = [row for row, head in enumerate(ids) if self._moves(head)]
         spec = _CTRL_AND_MOCAP if moving else _CTRL
         width = mujoco.mj_stateSize(self.batch.model, spec)
+        refs, vels, accs = self.motors.ramp(ids, self._speeds(ids, nstep), self.dt)
         control = np.empty((len(ids), nstep, width))
-        for j in range(nstep):
-            now = (self.step_count[ids] + j) * self.dt
-            if self.config.latency_frames:
-                self._apply_due(ids, now)
-            self.motors.advance(ids, self.dt)
-            self._write_ctrl(ids)
-            control[:, j, :nu] = self._ctrl[ids]
-            if moving:
-                control[:, j, nu:] = self._mocap_pos[ids].reshape(len(ids), -1)
-                for row, head in enumerate(ids):
-                    if self._moves(head):
-                        path, mocap = self.paths[head], self._heads[head].mocap
-                        assert path is not None
-                        at = float(self.step_count[head] + j) * self.dt
-                        control[row, j, nu + 3 * mocap : nu + 3 * mocap + 3] = path.position(at)
+        control[:, :, :nu] = self._ctrl[ids][:, None, :]
+        control[:, :, self._acts] = self._drive_ctrl(ids, refs, vels, accs).transpose(1, 0, 2)
+        if moving:
+            control[:, :, nu:] = self._mocap_pos[ids].reshape(len(ids), 1, -1)
+            for row in moving:
+                head = ids[row]
+                path, mocap = self.paths[head], self._heads[head].mocap
+                assert path is not None
+                column = nu + 3 * mocap
+                for j in range(nstep):
+                    at = float(self.step_count[head] + j) * self.dt
+                    control[row, j, column : column + 3] = path.position(at)
         self.batch.rollout(nstep, control, control_spec=spec, record=(), ids=ids)
         self.step_count[ids] += nstep
         self._place_targets(ids)
         self.batch.forward(ids)
 
+    def _speeds(self, ids: np.ndarray, nstep: int) -> np.ndarray:
+        """The speed each motor of ``ids`` is commanded during each of the next ``nstep``
+        steps (nstep, m, 3): a latent command takes over at the first step it is due."""
+        now = self.motors.speed[ids]
+        if not self.config.latency_frames:
+            return np.broadcast_to(now, (nstep, *now.shape))
+        speeds = np.empty((nstep, *now.shape))
+        for j in range(nstep):
+            for row, head in enumerate(ids):
+                queue, at = self._queues[head], float(self.step_count[head] + j) * self.dt
+                while queue and queue[0][0] <= at + 1e-12:
+                    self.motors.set_speed(np.array([head]), queue.popleft()[1][None, :])
+                    now[row] = self.motors.speed[head]
+            speeds[j] = now
+        return speeds
+
     def _moves(self, head: int) -> bool:
         path = self.paths[head]
         return path is not None and self._heads[head].mocap >= 0 and not isinstance(path, Static)
 
-    def _apply_due(self, ids: np.ndarray, now: np.ndarray) -> None:
-        for head, at in zip(ids, now, strict=True):
-            queue = self._queues[head]
-            while queue and queue[0][0] <= at + 1e-12:
-                self.motors.set_speed(np.array([head]), queue.popleft()[1][None, :])
+    def _drive_ctrl(
+        self, ids: np.ndarray, ref: np.ndarray, vel: np.ndarray, acc: np.ndarray
+    ) -> np.ndarray:
+        """The driven actuators' controls from references (..., m, 3), as the classic
+        driver writes them: gear * (ref + fv vel + fa acc), term for term."""
+        m = self._motor_of
+        return self._gears * (
+            ref[..., m] + self._feed_v[ids] * vel[..., m] + self._feed_a[ids] * acc[..., m]
+        )
 
     def _write_ctrl(self, ids: np.ndarray) -> None:
-        """Each head's actuators from its motors' references, as the classic driver writes them."""
-        ref, vel, acc = self.motors.ref[ids], self.motors.vel[ids], self.motors.acc[ids]
-        first = self._heads[ids[0]].feeds
-        if all(self._heads[h].feeds == first for h in ids):
-            for motor, actuators in enumerate(first):
-                for act, gear, fv, fa in actuators:
-                    self._ctrl[ids, act] = gear * (
-                        ref[:, motor] + fv * vel[:, motor] + fa * acc[:, motor]
-                    )
-            return
-        for row, head in enumerate(ids):
-            for motor, actuators in enumerate(self._heads[head].feeds):
-                for act, gear, fv, fa in actuators:
-                    self._ctrl[head, act] = gear * (
-                        ref[row, motor] + fv * vel[row, motor] + fa * acc[row, motor]
-                    )
+        """``ids``' driven actuators from their motors' references now."""
+        motors = self.motors
+        drive = self._drive_ctrl(ids, motors.ref[ids], motors.vel[ids], motors.acc[ids])
+        self._ctrl[ids[:, None], self._acts] = drive
 
     # -- images ------------------------------------------------------------------
     def _render(self, ids: np.ndarray) -> np.ndarray:

@@ -42,21 +42,32 @@ class VelocityMotors:
         """Ramp ``ids``' motors to ``speeds_rad_s`` (m, 3), clipped to the speed limits."""
         self.speed[ids] = np.clip(speeds_rad_s, -self.max_speed, self.max_speed)
 
-    def advance(self, ids: np.ndarray, dt: float) -> None:
-        """Advance ``ids``' references by ``dt`` s."""
-        vel, ref = self.vel[ids], self.ref[ids]
-        wanted = np.minimum(np.maximum(self.speed[ids], -self.max_speed), self.max_speed)
-        step = self.max_accel * dt
-        dv = np.minimum(np.maximum(wanted - vel, -step), step)
-        acc = dv / dt
-        vel = vel + dv
-        ref = ref + vel * dt
+    def ramp(
+        self, ids: np.ndarray, speeds_rad_s: np.ndarray, dt: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Advance ``ids``' references by one step of ``dt`` s per row of ``speeds_rad_s``
+        (nstep, m, 3): the commanded speed during each step.  Returns each step's
+        (ref, vel, acc), each (nstep, m, 3), and keeps the last."""
+        nstep = len(speeds_rad_s)
+        refs, vels, accs = (np.empty((nstep, len(ids), 3)) for _ in range(3))
+        ref, vel = self.ref[ids], self.vel[ids]
+        acc = self.acc[ids]
         low, high = self.low[ids], self.high[ids]
-        out = (ref < low) | (ref > high)
-        ref = np.minimum(np.maximum(ref, low), high)
-        vel[out] = 0.0
-        acc[out] = 0.0
+        step = self.max_accel * dt
+        for j in range(nstep):
+            wanted = np.minimum(np.maximum(speeds_rad_s[j], -self.max_speed), self.max_speed)
+            dv = np.minimum(np.maximum(wanted - vel, -step), step)
+            acc = dv / dt
+            vel = vel + dv
+            ref = ref + vel * dt
+            out = (ref < low) | (ref > high)
+            if out.any():
+                ref = np.minimum(np.maximum(ref, low), high)
+                vel[out] = 0.0
+                acc[out] = 0.0
+            refs[j], vels[j], accs[j] = ref, vel, acc
         self.ref[ids], self.vel[ids], self.acc[ids] = ref, vel, acc
+        return refs, vels, accs
 
 
 __all__ = ["VelocityMotors"]
