@@ -22,6 +22,9 @@ from headsim.sim.textured_scene import RoomSpec
 from .motors import VelocityMotors
 from .opengl import EyeView, ViewRenderer
 
+#: The pose arrays an eye image depends on, as ``mujoco.batch`` binds them (MjData's names).
+POSE_FIELDS = ("geom_xpos", "geom_xmat", "cam_xpos", "cam_xmat", "light_xpos", "light_xdir")
+
 #: Compiled heads kept for reuse, by their settings (the least recently used goes first).
 BUILDS_KEPT = 64
 _CTRL = int(mujoco.mjtState.mjSTATE_CTRL)
@@ -118,6 +121,8 @@ class LockstepHeads:
         self._ctrl = self.batch.bind("ctrl")
         self._mocap_pos = self.batch.bind("mocap_pos")
         self._data = [mujoco.MjData(first.built.model) for _ in range(n)]
+        # Bound before any call, so that the batch refreshes them after each.
+        self._poses = {name: self.batch.bind(name) for name in POSE_FIELDS}
         limits = (self.config.neck_limits, self.config.neck_limits, self.config.eye_limits)
         self.motors = VelocityMotors(n, limits)
         self._drive = first.drive
@@ -189,9 +194,18 @@ class LockstepHeads:
             self._builds.popitem(last=False)
         return build
 
+    def poses(self) -> dict[str, np.ndarray]:
+        """Every head's pose arrays a renderer reads (:data:`POSE_FIELDS`), rows per head,
+        after its last step: what a device renderer uploads."""
+        return dict(self._poses)
+
     def settings(self, head: int) -> HeadSettings:
         """Head ``head``'s settings."""
         return self._heads[head].settings
+
+    def camera_names(self, head: int) -> tuple[str, str]:
+        """Head ``head``'s eye cameras as compiled into its model (Ca1, Ca2)."""
+        return self._heads[head].built.names.cameras
 
     def model(self, head: int) -> mujoco.MjModel:
         """Head ``head``'s compiled model (shared by heads of equal settings)."""
@@ -445,4 +459,4 @@ def _given(canvas: np.ndarray) -> Callable[[Window | None], np.ndarray]:
     return draw
 
 
-__all__ = ["BUILDS_KEPT", "Frames", "LockstepHeads"]
+__all__ = ["BUILDS_KEPT", "POSE_FIELDS", "Frames", "LockstepHeads"]
