@@ -48,7 +48,9 @@ from headsim.sim.settings import SettingsError
 class FixateVectorEnv(VectorEnv):
     """``num_envs`` :class:`~headsim.envs.fixate.FixateEnv` heads in lockstep (see the
     module docstring).  ``supersample``: images' supersampling (None: the head's).
-    Every other keyword is ``FixateEnv``'s."""
+    ``renderer``: :data:`headsim.lockstep.heads.RENDERERS` (default ``"auto"``: MuJoCo
+    Warp on a GPU, else OpenGL on the CPU; :meth:`describe` says which).  Every other
+    keyword is ``FixateEnv``'s."""
 
     metadata: dict[str, Any] = {  # noqa: RUF012 (gymnasium.VectorEnv declares it an instance attribute)
         "render_modes": ["rgb_array"],
@@ -56,7 +58,12 @@ class FixateVectorEnv(VectorEnv):
     }
 
     def __init__(
-        self, num_envs: int = 1, *, supersample: int | None = None, **env_kwargs: Any
+        self,
+        num_envs: int = 1,
+        *,
+        supersample: int | None = None,
+        renderer: str = "auto",
+        **env_kwargs: Any,
     ) -> None:
         if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
             raise SettingsError(f"num_envs must be a whole number >= 1, got {num_envs!r}")
@@ -75,6 +82,7 @@ class FixateVectorEnv(VectorEnv):
             target_body=TARGET_BODY,
             prepare=template.prepare_model,
             supersample=supersample,
+            renderer=renderer,
         )
         self.num_envs = num_envs
         self.render_mode = template.render_mode

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import ctypes.util
 from collections import OrderedDict, deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import mujoco
 import numpy as np
@@ -25,6 +27,8 @@ from .opengl import EyeView, ViewRenderer
 #: The pose arrays an eye image depends on, as ``mujoco.batch`` binds them (MjData's names).
 POSE_FIELDS = ("geom_xpos", "geom_xmat", "cam_xpos", "cam_xmat", "light_xpos", "light_xdir")
 
+#: The renderers lockstep heads draw through ("auto": chosen per device, :func:`_resolve`).
+RENDERERS = ("auto", "opengl", "warp-cpu", "warp-cuda")
 #: Compiled heads kept for reuse, by their settings (the least recently used goes first).
 BUILDS_KEPT = 64
 _CTRL = int(mujoco.mjtState.mjSTATE_CTRL)
@@ -81,7 +85,10 @@ class LockstepHeads:
     ``config``: the live head's timing (no exposure or motion blur here).  ``target_body``:
     the mocap body each head's path moves.  ``prepare``: edits a freshly compiled model
     (before its motors are tuned).  ``supersample``: each image's supersampling (None:
-    each head's ``render.supersample``, the classic renderer's images).
+    each head's ``render.supersample``, the classic renderer's images).  ``renderer``: one
+    of :data:`RENDERERS`: ``"auto"`` takes MuJoCo Warp on a GPU where Warp finds one, else
+    the classic OpenGL renderer on the CPU (faster there); ``"warp-cpu"`` runs the device
+    path on Warp's CPU device (for tests).  :meth:`describe` says which runs.
     """
 
     def __init__(
@@ -96,6 +103,7 @@ class LockstepHeads:
         prepare: Callable[[mujoco.MjModel], None] | None = None,
         supersample: int | None = None,
         threads: int = 1,
+        renderer: str = "auto",
     ) -> None:
         if isinstance(n, bool) or not isinstance(n, int) or n < 1:
             raise SettingsError(f"n must be a whole number >= 1, got {n!r}")
@@ -107,6 +115,11 @@ class LockstepHeads:
             )
         if supersample is not None and not (isinstance(supersample, int) and 1 <= supersample <= 8):
             raise SettingsError(f"supersample must be None or 1..8, got {supersample!r}")
+        if renderer not in RENDERERS:
+            raise SettingsError(f"renderer must be one of {', '.join(RENDERERS)}, got {renderer!r}")
+        #: The renderer that runs: "opengl", "warp-cpu" or "warp-cuda".
+        self.renderer = _resolve(renderer)
+        self._warp: Any = None
         self.n = n
         self._scene, self._room, self._target = scene, room, target_body
         self._prepare, self._supersample = prepare, supersample
@@ -380,19 +393,7 @@ class LockstepHeads:
     def _render(self, ids: np.ndarray) -> np.ndarray:
         """Both eyes of every head in ``ids``, drawn through one context and finished from
         each head's own streams: (m, 2, H, W, 3) uint8."""
-        views = []
-        for head in ids:
-            build = self._heads[head]
-            data = self.batch.get_data(int(head), self._data[head])
-            k = (
-                build.settings.render.supersample
-                if self._supersample is None
-                else self._supersample
-            )
-            for camera, canvas in zip(build.built.names.cameras, build.built.canvases, strict=True):
-                views.append(EyeView(build.built.model, data, camera, canvas.size, k))
-        renderer = self._renderer_for(views)
-        canvases = renderer.draw(views)
+        canvases = self._draw_opengl(ids) if self._warp_device is None else self._cast(ids)
         images = []
         for row, head in enumerate(ids):
             build, stream = self._heads[head], self._streams[head]
@@ -414,6 +415,60 @@ class LockstepHeads:
         if len(shapes) != 1:
             raise SettingsError(f"lockstep heads must share one image size, got {sorted(shapes)}")
         return np.array(images, np.uint8)
+
+    @property
+    def _warp_device(self) -> str | None:
+        return None if self.renderer == "opengl" else self.renderer.removeprefix("warp-")
+
+    def _cast(self, ids: np.ndarray) -> list[np.ndarray]:
+        """``ids``' pinhole canvases cast by MuJoCo Warp: every head in one call."""
+        first = self._heads[0]
+        if any(build is not first for build in self._heads):
+            raise SettingsError(
+                f"renderer {self.renderer!r}: heads on MuJoCo Warp share one head's settings "
+                "(cameras, baseline, noise); allowed: randomise only the targets, or "
+                "renderer='opengl'"
+            )
+        if self._warp is None:
+            from headsim.lockstep.warp_eyes import WarpEyes
+
+            sizes = {canvas.size for canvas in first.built.canvases}
+            if len(sizes) != 1:
+                raise SettingsError(
+                    f"renderer {self.renderer!r}: both eyes' canvases must be one size, "
+                    f"got {sorted(sizes)}"
+                )
+            k = (
+                first.settings.render.supersample
+                if self._supersample is None
+                else self._supersample
+            )
+            self._warp = WarpEyes(
+                first.built.model,
+                first.built.names.cameras,
+                sizes.pop(),
+                self.n,
+                device=self._warp_device or "cpu",
+                samples_per_pixel=k,
+            )
+        self._warp.cast(self.poses())
+        cast = self._warp.images()
+        return [cast[head, index] for head in ids for index in range(2)]
+
+    def _draw_opengl(self, ids: np.ndarray) -> list[np.ndarray]:
+        """``ids``' pinhole canvases drawn in turn through one OpenGL context."""
+        views = []
+        for head in ids:
+            build = self._heads[head]
+            data = self.batch.get_data(int(head), self._data[head])
+            k = (
+                build.settings.render.supersample
+                if self._supersample is None
+                else self._supersample
+            )
+            for camera, canvas in zip(build.built.names.cameras, build.built.canvases, strict=True):
+                views.append(EyeView(build.built.model, data, camera, canvas.size, k))
+        return self._renderer_for(views).draw(views)
 
     def _renderer_for(self, views: Sequence[EyeView]) -> ViewRenderer:
         need = (
@@ -441,13 +496,30 @@ class LockstepHeads:
 
     def describe(self) -> str:
         """The renderer, in words."""
-        return f"classic OpenGL renderer on the CPU: {self.n} heads, one context"
+        if self._warp_device is None:
+            return f"classic OpenGL renderer on the CPU: {self.n} heads, one context"
+        return f"MuJoCo Warp on {self._warp_device}: {self.n} heads x 2 cameras in one call"
 
     def close(self) -> None:
         """Free the OpenGL context."""
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+
+
+def _resolve(renderer: str) -> str:
+    """The renderer ``renderer`` names here ("auto": Warp on a GPU if Warp finds one)."""
+    if renderer == "auto":
+        if ctypes.util.find_library("cuda") is None:  # no driver: no GPU, and no Warp import
+            return "opengl"
+        from headsim.sim.batch import cuda_available
+
+        return "warp-cuda" if cuda_available() else "opengl"
+    if renderer == "warp-cuda":
+        from headsim.sim.batch import check_device
+
+        check_device("cuda")  # a one-line refusal where Warp finds no GPU
+    return renderer
 
 
 def _given(canvas: np.ndarray) -> Callable[[Window | None], np.ndarray]:
@@ -459,4 +531,4 @@ def _given(canvas: np.ndarray) -> Callable[[Window | None], np.ndarray]:
     return draw
 
 
-__all__ = ["BUILDS_KEPT", "POSE_FIELDS", "Frames", "LockstepHeads"]
+__all__ = ["BUILDS_KEPT", "POSE_FIELDS", "RENDERERS", "Frames", "LockstepHeads"]

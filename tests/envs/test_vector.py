@@ -140,3 +140,21 @@ def test_bad_arguments_name_what_is_allowed() -> None:
     with pytest.raises(ValueError, match=r"actions must have shape \(2, 3\)"):
         venv.step(np.zeros(3, np.float32))
     venv.close()
+
+
+def test_the_device_path_steps_the_same_episodes_on_warps_cpu_device() -> None:
+    """renderer="warp-cpu": the GPU's code (one Warp call for every head's two eyes), run on
+    Warp's CPU device; the marker is where the OpenGL heads see it (two rasterisers)."""
+    opengl, warp = FixateVectorEnv(2, renderer="opengl"), FixateVectorEnv(2, renderer="warp-cpu")
+    assert "Warp on cpu" in warp.describe() and "OpenGL" in opengl.describe()
+    action = np.full((2, 3), 0.3, np.float32)
+    for venv in (opengl, warp):
+        venv.reset(seed=4)
+    ours, theirs = warp.step(action), opengl.step(action)
+    np.testing.assert_array_equal(ours[0]["encoders"], theirs[0]["encoders"])  # same physics
+    assert ours[-1]["found"].all() and theirs[-1]["found"].all()
+    np.testing.assert_allclose(ours[-1]["offsets_px"], theirs[-1]["offsets_px"], atol=0.3)
+    opengl.close()
+    warp.close()
+    with pytest.raises(SettingsError, match="renderer must be one of auto, opengl"):
+        FixateVectorEnv(1, renderer="vulkan")
