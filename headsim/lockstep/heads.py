@@ -230,6 +230,7 @@ class LockstepHeads:
         heads: Sequence[int] | np.ndarray,
         settings: Sequence[HeadSettings],
         paths: Sequence[Path | None],
+        images: bool = True,
     ) -> Frames:
         """Start ``heads`` afresh at home with ``settings`` and target ``paths``, and take
         each one's frame 0.  A head whose settings change gets new image streams (as a
@@ -268,7 +269,7 @@ class LockstepHeads:
             np.stack([self._heads[h].high for h in ids]),
         )
         self._write_ctrl(ids)
-        return self.capture(ids)
+        return self.capture(ids, images)
 
     def _place_targets(self, ids: np.ndarray) -> None:
         for head in ids:
@@ -290,8 +291,10 @@ class LockstepHeads:
             self._queues[head].append((self._last_end[head] + self.config.latency_s, speed))
 
     # -- time --------------------------------------------------------------------
-    def capture(self, heads: Sequence[int] | np.ndarray) -> Frames:
-        """Advance ``heads`` to their next frame and take it (both cameras of every one)."""
+    def capture(self, heads: Sequence[int] | np.ndarray, images: bool = True) -> Frames:
+        """Advance ``heads`` to their next frame and take it (both cameras of every one;
+        with ``images=False`` none are drawn here, for a caller that renders the heads'
+        :meth:`poses` itself, and ``Frames.images`` is empty)."""
         ids = np.asarray(heads, np.int64)
         period = self.config.period_s
         time_s = self.step_count[ids] * self.dt
@@ -318,7 +321,7 @@ class LockstepHeads:
         frames = Frames(
             ids,
             goal * self.dt,
-            self._render(ids),
+            self._render(ids) if images else np.empty((len(ids), 2, 0, 0, 3), np.uint8),
             encoders,
             truth,
             truth_joints,

@@ -89,6 +89,10 @@ class WarpEyes:
             mjw.render(self._m, d, self._rc)
         self.calls += 1
 
+    def synchronize(self) -> None:
+        """Wait until the device has done what was launched."""
+        self._wp.synchronize_device(self.device)
+
     def images(self) -> np.ndarray:
         """The last cast's pinhole canvases, copied back: (nworld, 2, h, w, 3) uint8 RGB."""
         width, height = self.size
