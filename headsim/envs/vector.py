@@ -203,33 +203,35 @@ class FixateVectorEnv(VectorEnv):
         self._truths[ids] = frames.truth_target_world_m
         height, width = frames.images.shape[2:4]
         seen = find_markers_stacked(frames.images.reshape(-1, height, width, 3), TARGET_COLOUR)
-        for row, head in enumerate(ids):
-            one, two = seen[2 * row], seen[2 * row + 1]
-            found = one.found and two.found and one.uv is not None and two.uv is not None
-            self._found[head] = found
-            if found:
-                (u1, v1), (u2, v2) = one.uv, two.uv  # type: ignore[misc]
-                self._offsets[head] = np.array([u1, u2, (v1 + v2) / 2]) - self._goals[head]
-            else:
-                self._offsets[head] = np.nan
+        uv = np.full((len(ids), 2, 2), np.nan)
+        for index, detection in enumerate(seen):
+            if detection.found and detection.uv is not None:
+                uv[index // 2, index % 2] = detection.uv
+        found = ~np.isnan(uv).any(axis=(1, 2))
+        self._found[ids] = found
+        seen_uv = np.stack([uv[:, 0, 0], uv[:, 1, 0], (uv[:, 0, 1] + uv[:, 1, 1]) / 2], axis=1)
+        self._offsets[ids] = np.where(found[:, None], seen_uv - self._goals[ids], np.nan)
+        rows = {int(head): row for row, head in enumerate(ids)}
+        for settings, members in self._by_settings(ids).items():
+            encoders = frames.encoders_rad[[rows[head] for head in members]]
+            self._estimates[members] = estimate_world(encoders, settings, self.template.knowledge)
+
+    def _by_settings(self, ids: np.ndarray) -> dict[Any, np.ndarray]:
+        """``ids`` grouped by their heads' settings (one group when none is randomised)."""
         groups: dict[Any, list[int]] = {}
         for head in ids:
             groups.setdefault(self.heads.settings(head), []).append(int(head))
-        for settings, members in groups.items():
-            encoders = frames.encoders_rad[np.searchsorted(ids, members)]
-            self._estimates[members] = estimate_world(encoders, settings, self.template.knowledge)
+        return {settings: np.array(members) for settings, members in groups.items()}
 
     def _score(self, ids: np.ndarray) -> None:
         """Rewards and ends of ``ids``' episodes after a step, as ``FixateEnv.step`` scores."""
         template = self.template
-        for head in ids:
-            settings = self.heads.settings(head)
-            rows = slice(head, head + 1)
+        for settings, heads in self._by_settings(ids).items():
             if template.reward_kind == "offsets":
-                reward = offsets_reward(self._offsets[rows], self._found[rows], settings)
+                reward = offsets_reward(self._offsets[heads], self._found[heads], settings)
             else:
-                reward = position_reward(self._estimates[rows], self._truths[rows], settings)
-            self._rewards[head] = reward[0]
+                reward = position_reward(self._estimates[heads], self._truths[heads], settings)
+            self._rewards[heads] = reward
         within = np.all(np.abs(self._offsets[ids]) <= template.tolerance_px, axis=1)
         self._terminations[ids] = self._found[ids] & within
         self._truncations[ids] = ~self._terminations[ids] & (self._steps[ids] >= template.max_steps)

@@ -69,31 +69,36 @@ class ViewRenderer:
 
     def draw(self, views: Sequence[EyeView]) -> list[np.ndarray]:
         """Each view's pinhole canvas, uint8 (h, w, 3), supersampling area-averaged out."""
+        kinds = {(view.canvas_px, view.supersample) for view in views}
+        if len(kinds) != 1:
+            return [image for view in views for image in self.draw([view])]
+        ((canvas_px, k),) = kinds
+        width, height = k * canvas_px[0], k * canvas_px[1]
+        if width > self.largest_px[0] or height > self.largest_px[1]:
+            raise ValueError(
+                f"a {width}x{height} view does not fit this renderer's "
+                f"{self.largest_px[0]}x{self.largest_px[1]} buffer"
+            )
         renderer = self._renderer
         context = mjr_context(renderer)
         make_current(renderer)
-        images = []
-        for view in views:
-            width, height = (view.supersample * s for s in view.canvas_px)
-            if width > self.largest_px[0] or height > self.largest_px[1]:
-                raise ValueError(
-                    f"a {width}x{height} view does not fit this renderer's "
-                    f"{self.largest_px[0]}x{self.largest_px[1]} buffer"
-                )
+        rect = mujoco.MjrRect(0, 0, width, height)
+        pixels = np.empty((len(views), height, width, 3), np.uint8)
+        for view, read in zip(views, pixels, strict=True):
             use_model(renderer, view.model)
             renderer.update_scene(view.data, camera=view.camera, scene_option=self._option)
-            rect = mujoco.MjrRect(0, 0, width, height)
-            pixels = np.empty((height, width, 3), np.uint8)
             start = time.process_time()
             mujoco.mjr_render(rect, renderer.scene, context)
-            mujoco.mjr_readPixels(pixels, None, rect, context)
+            mujoco.mjr_readPixels(read, None, rect, context)
             self.opengl_cpu_s += time.process_time() - start
-            upright: np.ndarray = np.ascontiguousarray(pixels[::-1])  # OpenGL's rows: bottom-up
-            if view.supersample > 1:
-                upright = cv2.resize(upright, view.canvas_px, interpolation=cv2.INTER_AREA)
-            images.append(upright)
         self.views += len(views)
-        return images
+        # OpenGL's rows run bottom-up.  The stack is area-averaged as one tall image: each
+        # k x k block lies within one view (heights are whole multiples of k).
+        upright: np.ndarray = np.ascontiguousarray(pixels[:, ::-1]).reshape(-1, width, 3)
+        if k > 1:
+            size = (canvas_px[0], canvas_px[1] * len(views))
+            upright = cv2.resize(upright, size, interpolation=cv2.INTER_AREA)
+        return list(upright.reshape(len(views), canvas_px[1], canvas_px[0], 3))
 
     def close(self) -> None:
         """Free the OpenGL context."""

@@ -32,11 +32,13 @@ def test_make_vec_builds_batched_spaces() -> None:
     venv.close()
 
 
-def test_each_head_steps_as_the_single_env_does_autoresets_included() -> None:
+@pytest.mark.parametrize("reward", ["offsets", "position"])
+def test_each_head_steps_as_the_single_env_does_autoresets_included(reward: str) -> None:
     """Randomised cameras and noise, moving targets, episodes of 3 steps: every head's
     observations, rewards, flags and infos are the single env's, seeded s + i, reset
     when its episode ends."""
     kwargs: dict[str, Any] = {
+        "reward": reward,
         "max_steps": 3,
         "randomise": {"kx": (100.0, 130.0), "noise_std": (0.0, 2.0), "speed_m_s": (0.0, 0.3)},
     }
