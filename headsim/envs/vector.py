@@ -218,10 +218,13 @@ class FixateVectorEnv(VectorEnv):
 
     def _by_settings(self, ids: np.ndarray) -> dict[Any, np.ndarray]:
         """``ids`` grouped by their heads' settings (one group when none is randomised)."""
-        groups: dict[Any, list[int]] = {}
-        for head in ids:
-            groups.setdefault(self.heads.settings(head), []).append(int(head))
-        return {settings: np.array(members) for settings, members in groups.items()}
+        groups: dict[int, list[int]] = {}
+        kept: dict[int, Any] = {}
+        for head in ids:  # heads of equal settings share one settings object: no deep hash
+            settings = self.heads.settings(head)
+            groups.setdefault(id(settings), []).append(int(head))
+            kept[id(settings)] = settings
+        return {kept[key]: np.array(members) for key, members in groups.items()}
 
     def _score(self, ids: np.ndarray) -> None:
         """Rewards and ends of ``ids``' episodes after a step, as ``FixateEnv.step`` scores."""

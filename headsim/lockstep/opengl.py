@@ -92,13 +92,15 @@ class ViewRenderer:
             mujoco.mjr_readPixels(read, None, rect, context)
             self.opengl_cpu_s += time.process_time() - start
         self.views += len(views)
-        # OpenGL's rows run bottom-up.  The stack is area-averaged as one tall image: each
-        # k x k block lies within one view (heights are whole multiples of k).
-        upright: np.ndarray = np.ascontiguousarray(pixels[:, ::-1]).reshape(-1, width, 3)
+        # The stack is area-averaged as one tall image: each k x k block lies within one
+        # view (heights are whole multiples of k), and turning the rows upright after
+        # (OpenGL's run bottom-up) moves whole blocks, so the pixels are the same.
+        canvases: np.ndarray = pixels.reshape(-1, width, 3)
         if k > 1:
             size = (canvas_px[0], canvas_px[1] * len(views))
-            upright = cv2.resize(upright, size, interpolation=cv2.INTER_AREA)
-        return list(upright.reshape(len(views), canvas_px[1], canvas_px[0], 3))
+            canvases = cv2.resize(canvases, size, interpolation=cv2.INTER_AREA)
+        upright = canvases.reshape(len(views), canvas_px[1], canvas_px[0], 3)[:, ::-1]
+        return list(np.ascontiguousarray(upright))
 
     def close(self) -> None:
         """Free the OpenGL context."""
