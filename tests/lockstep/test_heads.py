@@ -14,8 +14,10 @@ from headsim.envs.fixate import TARGET_BODY, FixateEnv
 from headsim.live.head import LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
 from headsim.lockstep import LockstepHeads
+from headsim.scenario.loading import load_scenario
 from headsim.sim.settings import SettingsError
 from headsim.sim.simulator import for_settings
+from headsim.vision.markers import find_marker
 
 STEPS = 5
 
@@ -96,3 +98,39 @@ def test_bad_arguments_name_what_is_allowed() -> None:
         LockstepHeads(1, env.base_settings, LiveConfig(exposure_s=0.01))
     with pytest.raises(SettingsError, match="'nothing' is not a movable"):
         LockstepHeads(1, env.base_settings, target_body="nothing")
+
+
+def test_the_quick_starts_heads_at_its_targets_see_what_the_classic_heads_see() -> None:
+    """The quick start's realistic head (distorted lenses, noise, mounts and tolerances, its
+    own seed) before each of its targets, turning: the classic live head's images and
+    encoders, bit for bit."""
+    scenario = load_scenario("quickstart", fast=True)
+    settings = scenario.settings
+    targets = [Static(t.position_world_m) for t in scenario.scene.targets]
+    n = len(targets)
+    config = LiveConfig(latency_frames=0)
+    heads = LockstepHeads(n, settings, config, target_body="marker_red")
+    ids = np.arange(n)
+    frames = [heads.reset(ids, [settings] * n, targets)]
+    speeds = np.array([[0.2, -0.1, 0.4], [-0.3, 0.1, -0.2], [0.1, 0.2, 0.3]])[:n]
+    heads.command_velocity(ids, speeds)
+    frames.append(heads.capture(ids))
+    heads.close()
+    assert frames[0].images.shape[2:] == (480, 640, 3)
+    seen = [find_marker(frames[-1].images[h, c], "red").area_px for h in ids for c in (0, 1)]
+    assert min(seen) > 0  # every eye sees its head's target: the images are not empty views
+    for head in range(n):
+        with for_settings(settings) as sim:
+            live = LiveHead(sim, config, target_body="marker_red", path=targets[head])
+            classic = [live.capture()]
+
+            def command(motors, _now, s=speeds[head]) -> None:
+                for motor, speed in enumerate(s):
+                    motors.set_velocity(motor, float(speed))
+
+            live.now(command)
+            classic.append(live.capture())
+        for ours, theirs in zip(frames, classic, strict=True):
+            np.testing.assert_array_equal(ours.images[head, 0], theirs.images[0])
+            np.testing.assert_array_equal(ours.images[head, 1], theirs.images[1])
+            np.testing.assert_array_equal(ours.encoders_rad[head], theirs.encoders_rad)
