@@ -5,8 +5,8 @@
 (``gymnasium.make_vec(..., vectorization_mode="async",
 vector_kwargs={"context": "spawn"})``) the entry point imports this module.
 ``gymnasium.make_vec(FIXATE_ID, num_envs=N, vectorization_mode="vector_entry_point")``
-makes :class:`headsim.envs.vector.FixateVectorEnv`: N heads rendered in batches by
-MuJoCo Warp (``headsim[batch]``).
+makes :class:`headsim.envs.vector.FixateVectorEnv`: N heads in lockstep over arrays
+(:mod:`headsim.lockstep`).
 """
 
 from __future__ import annotations

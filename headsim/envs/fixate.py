@@ -84,7 +84,7 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from headsim.active.measurement import HeadKnowledge, to_world
+from headsim.active.measurement import HeadKnowledge
 from headsim.estimators.model1 import model1
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, Frame, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
@@ -177,6 +177,110 @@ def plane_texture_px(focal_px: float) -> int:
     per pixel at the plane's centre seen straight on with focal length ``focal_px``."""
     need = 2.0 * math.tan(math.radians(PLANE_HALF_ANGLE_DEG)) * focal_px
     return int(min(max(2 ** math.ceil(math.log2(need)), 64), 2048))
+
+
+def _draw(rng: np.random.Generator, ranges: dict[str, tuple[float, float]], name: str) -> float:
+    lo, hi = ranges[name]
+    return float(rng.uniform(lo, hi)) if hi > lo else lo
+
+
+def draw_settings(
+    rng: np.random.Generator, base: HeadSettings, ranges: dict[str, tuple[float, float]]
+) -> HeadSettings:
+    """An episode's head: each camera's and the head's randomised fields drawn from
+    ``ranges`` (in :data:`CAMERA_FIELDS`' order, camera 1 first), then its noise seed."""
+    cameras = []
+    for cam in base.cameras:
+        changes: dict[str, Any] = {f: _draw(rng, ranges, f) for f in CAMERA_FIELDS if f in ranges}
+        cameras.append(replace(cam, **changes))
+    head: dict[str, Any] = {f: _draw(rng, ranges, f) for f in HEAD_FIELDS if f in ranges}
+    seed_noise = int(rng.integers(0, 2**31 - 1))
+    if all(c.noise_std == 0 for c in cameras):
+        seed_noise = 0  # noiseless images do not depend on it: keep the renderer
+    return replace(base, cameras=(cameras[0], cameras[1]), seed=seed_noise, **head)
+
+
+def draw_marker_path(
+    rng: np.random.Generator,
+    settings: HeadSettings,
+    ranges: dict[str, tuple[float, float]],
+    options: dict[str, Any],
+    duration_s: float,
+) -> Waypoints | Static:
+    """An episode's marker: at a drawn depth and bearing from the head at home (or at
+    ``options["target_world_m"]``), still or on a straight path at a drawn speed."""
+    depth = _draw(rng, ranges, "depth_m")
+    azimuth, elevation = _draw(rng, ranges, "bearing_rad"), _draw(rng, ranges, "bearing_rad")
+    start = _head_at_home(settings) + depth * np.array(
+        [
+            math.sin(azimuth) * math.cos(elevation),
+            math.cos(azimuth) * math.cos(elevation),
+            math.sin(elevation),
+        ]
+    )
+    if "target_world_m" in options:
+        start = np.asarray(options["target_world_m"], float)
+    speed = _draw(rng, ranges, "speed_m_s")
+    if speed > 0:
+        direction = rng.normal(size=3)
+        direction /= np.linalg.norm(direction)
+        end = start + direction * speed * duration_s
+        return Waypoints((tuple(start), tuple(end)), (speed,))
+    return Static(tuple(start))
+
+
+def marker_goals(settings: HeadSettings) -> np.ndarray:
+    """Where the marker should be seen: (u1, u2, mean v) of the cameras' image centres, px."""
+    (u10, v10), (u20, v20) = (c.image_centre for c in settings.cameras)
+    return np.array([u10, u20, (v10 + v20) / 2])
+
+
+def offsets_reward(offsets_px: np.ndarray, found: np.ndarray, settings: HeadSettings) -> np.ndarray:
+    """Reward ``"offsets"`` of rows of image offsets (m, 3): minus the mean share of half
+    the image, each capped at 1; -1 where the marker is not seen."""
+    cam = settings.cameras[0]
+    scale = np.array([cam.width / 2, cam.width / 2, cam.height / 2])
+    shares = np.minimum(np.abs(offsets_px) / scale, 1.0)
+    return np.where(found, -np.mean(np.where(found[:, None], shares, 0.0), axis=1), -1.0)
+
+
+def position_reward(
+    estimate_world_m: np.ndarray, truth_world_m: np.ndarray, settings: HeadSettings
+) -> np.ndarray:
+    """Reward ``"position"`` of rows (m, 3; NaN: none): minus the estimate's 3-D error over
+    the truth's distance from the head at home, capped at 1; -1 without either.
+    Scoring only: the truth judges the estimate, it never enters it."""
+    distance = np.linalg.norm(truth_world_m - _head_at_home(settings), axis=1)
+    error = np.linalg.norm(estimate_world_m - truth_world_m, axis=1)
+    reward = -np.minimum(error / np.where(distance > 0, distance, 1.0), 1.0)
+    return np.where(np.isnan(reward), -1.0, reward)
+
+
+def estimate_world(
+    encoders_rad: np.ndarray, settings: HeadSettings, knowledge: HeadKnowledge
+) -> np.ndarray:
+    """The head's Model 1 estimates from rows of (neck yaw, neck pitch, eye) encoder
+    readings (m, 3) and its belief, as if fixated: (m, 3) in W, m; NaN where the eyes do
+    not converge."""
+    belief = knowledge.head_belief_of(settings)
+    estimate = model1(
+        encoders_rad[:, 2],
+        belief.baseline_m,
+        alpha_e=knowledge.alpha_e,
+        los_offset_m=knowledge.line_of_sight_offsets_of(settings),
+    )
+    neck = neck_of(settings.head)
+    world = np.asarray(
+        neck.head_to_world(
+            estimate.positions,
+            encoders_rad[:, 0],
+            encoders_rad[:, 1],
+            belief.neck_d1_m,
+            belief.neck_a2_m,
+        ),
+        float,
+    ).reshape(-1, 3)
+    return np.where(np.asarray(estimate.valid, bool)[:, None], world, np.nan)
 
 
 class FixateEnv(gymnasium.Env):
@@ -303,29 +407,13 @@ class FixateEnv(gymnasium.Env):
     def period_s(self) -> float:
         return self.live_config.period_s
 
-    def _draw(self, ranges: dict[str, tuple[float, float]], name: str) -> float:
-        lo, hi = ranges[name]
-        return float(self.np_random.uniform(lo, hi)) if hi > lo else lo
-
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         super().reset(seed=seed)
         options = options or {}
-        ranges = {**self.defaults, **self.randomise, **_check_ranges(options.get("randomise", {}))}
-        cameras = []
-        for cam in self.base_settings.cameras:
-            changes: dict[str, Any] = {
-                f: self._draw(ranges, f) for f in CAMERA_FIELDS if f in ranges
-            }
-            cameras.append(replace(cam, **changes))
-        head: dict[str, Any] = {f: self._draw(ranges, f) for f in HEAD_FIELDS if f in ranges}
-        seed_noise = int(self.np_random.integers(0, 2**31 - 1))
-        if all(c.noise_std == 0 for c in cameras):
-            seed_noise = 0  # noiseless images do not depend on it: keep the renderer
-        settings = replace(
-            self.base_settings, cameras=(cameras[0], cameras[1]), seed=seed_noise, **head
-        )
+        ranges = self.episode_ranges(options)
+        settings = draw_settings(self.np_random, self.base_settings, ranges)
         if self._sim is None or settings != self._settings:
             if self._sim is not None:
                 self._sim.close()
@@ -338,31 +426,14 @@ class FixateEnv(gymnasium.Env):
         sim = self._sim
         sim.reset()
         if self._room is not None:
-            self._place_plane(sim, self._draw(ranges, "plane_depth_m"))
+            self._place_plane(sim, _draw(self.np_random, ranges, "plane_depth_m"))
             self._live = LiveHead(sim, self.live_config)
             self._steps = 0
             self._frame = self._live.capture()
             return self._observation(), self._info(self._measure())
-        depth = self._draw(ranges, "depth_m")
-        azimuth, elevation = self._draw(ranges, "bearing_rad"), self._draw(ranges, "bearing_rad")
-        start = _head_at_home(settings) + depth * np.array(
-            [
-                math.sin(azimuth) * math.cos(elevation),
-                math.cos(azimuth) * math.cos(elevation),
-                math.sin(elevation),
-            ]
+        path = draw_marker_path(
+            self.np_random, settings, ranges, options, self.max_steps * self.period_s
         )
-        if "target_world_m" in options:
-            start = np.asarray(options["target_world_m"], float)
-        speed = self._draw(ranges, "speed_m_s")
-        path: Waypoints | Static
-        if speed > 0:
-            direction = self.np_random.normal(size=3)
-            direction /= np.linalg.norm(direction)
-            end = start + direction * speed * self.max_steps * self.period_s
-            path = Waypoints((tuple(start), tuple(end)), (speed,))
-        else:
-            path = Static(tuple(start))
         self._live = LiveHead(sim, self.live_config, target_body=TARGET_BODY, path=path)
         self._steps = 0
         self._frame = self._live.capture()
@@ -402,14 +473,22 @@ class FixateEnv(gymnasium.Env):
             self._info(measured),
         )
 
+    def episode_ranges(self, options: dict[str, Any]) -> dict[str, tuple[float, float]]:
+        """The ranges an episode's fields are drawn from: the defaults, the env's
+        ``randomise``, then ``options["randomise"]``."""
+        return {**self.defaults, **self.randomise, **_check_ranges(options.get("randomise", {}))}
+
     def _prepare_model(self, sim: HeadSim) -> None:
+        self.prepare_model(sim.model)
+
+    def prepare_model(self, model: mujoco.MjModel) -> None:
         """This env's own model: its target's size and the renderer's multisampling."""
         if self._room is None:
-            geom = sim.model.geom(TARGET_BODY)
-            sim.model.geom_size[geom.id, 0] = self.target_radius_m
-            sim.model.geom_rbound[geom.id] = self.target_radius_m
+            geom = model.geom(TARGET_BODY)
+            model.geom_size[geom.id, 0] = self.target_radius_m
+            model.geom_rbound[geom.id] = self.target_radius_m
         # Read when the renderer is made, at the first render (after this).
-        sim.model.vis.quality.offsamples = self.multisamples
+        model.vis.quality.offsamples = self.multisamples
 
     def _place_plane(self, sim: HeadSim, depth_m: float) -> None:
         """The episode's plane: ``depth_m`` straight ahead of the eyes' centre at rest,
@@ -436,8 +515,7 @@ class FixateEnv(gymnasium.Env):
     # -- measurements ------------------------------------------------------------
     def _goals(self) -> np.ndarray:
         assert self._settings is not None
-        (u10, v10), (u20, v20) = (c.image_centre for c in self._settings.cameras)
-        return np.array([u10, u20, (v10 + v20) / 2])
+        return marker_goals(self._settings)
 
     def _measure(self) -> dict[str, Any]:
         assert self._frame is not None
@@ -480,40 +558,27 @@ class FixateEnv(gymnasium.Env):
 
     def _estimate(self) -> np.ndarray | None:
         """The head's Model 1 estimate from the encoders and its belief (W, m), as if fixated."""
-        assert self._frame is not None and self._sim is not None
-        yaw, pitch, eye = (float(a) for a in self._frame.encoders_rad)
-        belief = self.knowledge.head_belief(self._sim)
-        estimate = model1(
-            [eye],
-            belief.baseline_m,
-            alpha_e=self.knowledge.alpha_e,
-            los_offset_m=self.knowledge.line_of_sight_offsets(self._sim),
-        )
-        if not bool(estimate.valid[0]):  # eyes parallel or diverging
-            return None
-        return to_world(self._sim, estimate.positions[0], (yaw, pitch), belief)
+        assert self._frame is not None and self._settings is not None
+        encoders = self._frame.encoders_rad.astype(float)[None, :]
+        estimate = estimate_world(encoders, self._settings, self.knowledge)[0]
+        return None if np.isnan(estimate).any() else estimate  # eyes parallel or diverging
 
     def _reward(self, measured: dict[str, Any]) -> float:
         assert self._frame is not None and self._settings is not None
         if self.reward_kind == "offsets":
-            if not measured["found"]:
-                return -1.0
-            cam = self._settings.cameras[0]
-            scale = np.array([cam.width / 2, cam.width / 2, cam.height / 2])
-            return -float(np.mean(np.minimum(np.abs(measured["offsets_px"]) / scale, 1.0)))
+            found = np.array([measured["found"]])
+            return float(offsets_reward(measured["offsets_px"][None, :], found, self._settings)[0])
         if self.reward_kind == "vergence":
             error = measured["vergence_error_deg"]
             if math.isnan(error):
                 return -1.0
             half_view_deg = self._angle_deg(self._settings.cameras[1].width / 2)
             return -min(error / half_view_deg, 1.0)
-        # Scoring only: the truth judges the head's estimate, it never enters it.
         estimate, truth = measured["estimate_world_m"], measured["truth_world_m"]
-        if truth is None or estimate is None:
-            return -1.0
-        s = self._settings
-        distance = float(np.linalg.norm(truth - _head_at_home(s)))
-        return -min(float(np.linalg.norm(estimate - truth)) / distance, 1.0)
+        rows = [
+            np.full(3, np.nan) if v is None else np.asarray(v, float) for v in (estimate, truth)
+        ]
+        return float(position_reward(rows[0][None, :], rows[1][None, :], self._settings)[0])
 
     def _observation(self) -> dict[str, np.ndarray]:
         assert self._frame is not None
@@ -556,6 +621,14 @@ __all__ = [
     "MOTOR_SPEED_LIMITS_RAD_S",
     "SCENES",
     "SCENE_REWARDS",
+    "TARGET_BODY",
+    "TARGET_COLOUR",
     "FixateEnv",
+    "draw_marker_path",
+    "draw_settings",
+    "estimate_world",
+    "marker_goals",
+    "offsets_reward",
     "plane_texture_px",
+    "position_reward",
 ]

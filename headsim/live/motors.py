@@ -263,6 +263,12 @@ class MotorDriver:
                 self.data.ctrl[act] = gear * (motor.ref + fv * motor.vel + fa * motor.acc)
 
     @property
+    def feeds(self) -> tuple[tuple[tuple[int, float, float, float], ...], ...]:
+        """Per motor, each actuator it drives: (actuator id, gear, velocity feed-forward s,
+        acceleration feed-forward s^2), as tuned for this model."""
+        return tuple(tuple(pairs) for pairs in self._act)
+
+    @property
     def references(self) -> np.ndarray:
         """(3,) reference positions, rad."""
         return np.array([m.ref for m in self.motors])

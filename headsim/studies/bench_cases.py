@@ -84,6 +84,7 @@ CASES: dict[str, BenchCase] = {
         BenchCase("scene_cost", "figures", "scene_cost.py"),
         BenchCase("search_cases", "long", "search_cases.py"),
         BenchCase("batch_sweep", "long", "batch_sweep.py"),
+        BenchCase("batch_device", "long", "batch_device.py"),
         BenchCase("render_fidelity", "long", "render_fidelity.py"),
         BenchCase("relative_areas", "long", "relative_areas.py"),
         BenchCase("reach_and_zoom", "long", "reach_and_zoom.py"),

@@ -141,9 +141,11 @@ def asymmetry(weights: np.ndarray, u: float, v: float) -> float:
     partial = float(np.mean((inked > 0.1) & (inked < 0.9))) if inked.size else 0.0
     soften = _SOFTEN_HARD_EDGE_PX if partial < _HARD_EDGE_SHARE else _SOFTEN_PX
     pad = 4  # room for the softening and the moves: the blob stays inside
-    padded = np.pad(weights.astype(np.float32), pad)
+    padded = cv2.copyMakeBorder(
+        weights.astype(np.float32), pad, pad, pad, pad, cv2.BORDER_CONSTANT, value=0.0
+    )
     a = cv2.GaussianBlur(padded, (0, 0), soften, borderType=cv2.BORDER_CONSTANT)
-    b = np.ascontiguousarray(a[::-1, ::-1])
+    b = cv2.flip(a, -1)
     du, dv = (w - 1) / 2 - u, (h - 1) / 2 - v  # moves the centroid to the middle
     size = (w + 2 * pad, h + 2 * pad)
     shift_a = np.array([[1.0, 0.0, du], [0.0, 1.0, dv]], dtype=np.float32)
