@@ -1,4 +1,5 @@
-"""The study's command line: clear errors for unknown names, and a sweep with progress and files."""
+"""The study's command line (``headsim study``; ``python -m headsim.studies.study`` its
+deprecated alias): clear errors for unknown names, and a sweep with progress and files."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from headsim.studies.target_errors import measure_methods
 CONFIG = StudyConfig.quick()
 
 
-def test_unknown_names_are_clear_errors(calibrations) -> None:
+def test_unknown_names_are_clear_errors(calibrations, capsys) -> None:
     with pytest.raises(ValueError, match="unknown sweep 'nope'; allowed: depth, focal"):
         sweep_experiment("nope", CONFIG)
     with pytest.raises(ValueError, match="unknown methods"):
@@ -22,6 +23,9 @@ def test_unknown_names_are_clear_errors(calibrations) -> None:
     with pytest.raises(SystemExit) as exit_info:
         study.main(["--sweep", "nope", "--out", "unused"])
     assert exit_info.value.code == 2
+    # The deprecated alias is the headsim parser's command, and says so.
+    err = capsys.readouterr().err
+    assert study.ALIAS_NOTE in err and "headsim study: error: argument --sweep" in err
 
 
 def test_the_command_runs_a_sweep_with_progress_and_files(tmp_path, capsys) -> None:
