@@ -46,12 +46,21 @@ from typing import Any
 from headsim.errors import EnvironmentProblem, OutputNotWritable
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.runs.progress import Status, quiet
-from headsim.studies.jobs import render_pool, spawn_context, start_workers
+from headsim.studies.jobs import (
+    PlannedJob,
+    interrupt_deferred,
+    render_pool,
+    schedule,
+    spawn_context,
+    start_workers,
+)
 from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
 from headsim.studies.reproduce_experiments import (
+    COSTS,
     REALISTIC_BOARD_JOB,
     SCENARIO_JOBS,
     STUDY_JOB,
+    SWEEP_COST,
     JobOutcome,
     ReproduceError,
 )
@@ -66,7 +75,6 @@ from headsim.studies.reproduce_jobs import (
     zhang_job,
 )
 from headsim.studies.reproduce_report import main_figure, report_sections, report_text
-from headsim.studies.reproduce_schedule import PlannedJob, interrupt_deferred, schedule
 
 
 def reproduce(
@@ -190,11 +198,23 @@ def reproduce(
         path = str(out)
         head = lambda done: done["calibration"]["path"]  # noqa: E731
         plan = [
-            PlannedJob("calibration", calibrate_job, (), lambda done: (path, fast, seed)),
-            PlannedJob("zhang", zhang_job, (), lambda done: (fast, seed)),
-            PlannedJob("fixed_point", fixed_point_job, (), lambda done: (fast, seed)),
             PlannedJob(
-                REALISTIC_BOARD_JOB, realistic_board_job, (), lambda done: (path, fast, seed)
+                "calibration",
+                calibrate_job,
+                (),
+                lambda done: (path, fast, seed),
+                COSTS["calibration"],
+            ),
+            PlannedJob("zhang", zhang_job, (), lambda done: (fast, seed), COSTS["zhang"]),
+            PlannedJob(
+                "fixed_point", fixed_point_job, (), lambda done: (fast, seed), COSTS["fixed_point"]
+            ),
+            PlannedJob(
+                REALISTIC_BOARD_JOB,
+                realistic_board_job,
+                (),
+                lambda done: (path, fast, seed),
+                COSTS[REALISTIC_BOARD_JOB],
             ),
             *(
                 PlannedJob(
@@ -204,6 +224,7 @@ def reproduce(
                     functools.partial(
                         lambda done, name: (name, path, fast, seed, head(done)), name=name
                     ),
+                    COSTS[name],
                 )
                 for name in SCENARIO_JOBS
             ),
@@ -219,6 +240,7 @@ def reproduce(
                     done["zhang"],
                     done["fixed_point"],
                 ),
+                COSTS[STUDY_JOB],
             ),
             *(
                 PlannedJob(
@@ -226,6 +248,7 @@ def reproduce(
                     study_job,
                     (),
                     functools.partial(lambda d, n: (n, path, fast, seed), n=name),
+                    SWEEP_COST,
                 )
                 for name in state["sweeps"]
             ),

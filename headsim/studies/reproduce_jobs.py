@@ -4,15 +4,12 @@ the head's calibration, Zhang's, the fixed points', the scenarios, Tables V/VI, 
 from __future__ import annotations
 
 import dataclasses
-import functools
-import os
 import time
-import traceback
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
+from headsim.studies.jobs import plain_errors
 from headsim.studies.reproduce_experiments import (
     FIXED_POINT_TARGETS,
     REALISTIC_BOARD_JOB,
@@ -34,32 +31,7 @@ WORKER_MODULES = (
 )
 
 
-class JobError(RuntimeError):
-    """An experiment failed in its worker; the message says why (picklable, unlike
-    some of the errors it stands for: a worker must not break the pool)."""
-
-
-def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str, Any]]:
-    @functools.wraps(job)
-    def run(*args: Any) -> dict[str, Any]:
-        began, cpu = time.time(), time.process_time()
-        try:
-            data = job(*args)
-        except Exception as err:
-            raise JobError(why(err)) from None
-        # Where and when it ran (report.json's timeline: the critical path).
-        data["worker"] = {
-            "pid": os.getpid(),
-            "start": began,
-            "end": time.time(),
-            "cpu_s": time.process_time() - cpu,
-        }
-        return data
-
-    return run
-
-
-@_plain_errors
+@plain_errors
 def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.active.calibration_file import head_hash, write_calibration
     from headsim.runs.runner import calibrate_scenario
@@ -110,14 +82,14 @@ def _scenario_run(
     }
 
 
-@_plain_errors
+@plain_errors
 def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
     scenario_name, _ = SCENARIO_JOBS[name]
     overrides = {"experiment.calibration.from": head}
     return _scenario_run(scenario_name, Path(out) / name, fast, seed, overrides)
 
 
-@_plain_errors
+@plain_errors
 def realistic_board_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     """The chessboard on the realistic preset, calibrated by the scenario itself: the
     paper's rig had real tolerances, which the paper preset's ideal mechanics lack."""
@@ -133,7 +105,7 @@ def _study_config(fast: bool, seed: int | None) -> Any:
     return make(seed=seed or 0)
 
 
-@_plain_errors
+@plain_errors
 def zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
     """Zhang's stereo calibration of the one head, once (it needs no head.json)."""
     from headsim.scenario.loading import load_scenario
@@ -145,7 +117,7 @@ def zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
     return {"calibration": calibration, "renders": renders, "wall_s": time.perf_counter() - start}
 
 
-@_plain_errors
+@plain_errors
 def fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
     """The zoom fixed points and the Sec. V calibration on their columns, once (beyond the
     paper: the active method that the focal length's change does not move)."""
@@ -162,7 +134,7 @@ def fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
     return {"fixed": fixed, "targets": targets, "wall_s": time.perf_counter() - start}
 
 
-@_plain_errors
+@plain_errors
 def tables_job(
     out: str,
     fast: bool,
@@ -216,7 +188,7 @@ def tables_job(
     return data
 
 
-@_plain_errors
+@plain_errors
 def study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.studies.study_experiments import compare_figures, run_experiment, sweep_experiment
     from headsim.studies.study_output import summary_rows, write_experiment
@@ -234,8 +206,3 @@ def study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, An
             "seconds": result.seconds,
         }
     )
-
-
-def why(err: BaseException) -> str:
-    text = "".join(traceback.format_exception_only(type(err), err)).strip()
-    return text.splitlines()[-1] if text else repr(err)
