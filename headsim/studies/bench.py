@@ -37,6 +37,7 @@ from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
 from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
 from headsim.studies.render_clock import RenderClock
+from headsim.studies.rows import run_row
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
 from headsim.studies.targets import random_targets_head, visible_vertical_range
 
@@ -364,27 +365,16 @@ PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "trackin
 def scenario_metrics(name: str) -> Metrics:
     """Run a scenario's fast variant: failures, RMS error (% of depth) and renders."""
     scenario = load_scenario(name, fast=True)
-    result = run_scenario(scenario)
-    # Measurements made without the scenario's calibration (its "before" checks) do not count.
-    calibrated = result.calibration is not None
-    errors = [
-        r.measurement.error_pct_of_depth
-        for r in result.records
-        if r.measurement.ok and (r.knowledge != "none" or not calibrated)
-    ]
+    row = run_row(run_scenario(scenario))
+    rms = row["rms_error_pct_depth"]
     metrics = {
-        f"scenario.{name}.failures": float(len(result.failures)),
-        f"scenario.{name}.rms_error_pct_depth": float(np.sqrt(np.mean(np.square(errors))))
-        if errors
-        else math.inf,
+        f"scenario.{name}.failures": float(row["failures"]),
+        f"scenario.{name}.rms_error_pct_depth": math.inf if rms is None else rms,
         # Per fixation, so that +0.5 renders per point is one tolerance everywhere.
-        f"scenario.{name}.renders_per_point": float(result.renders.overall.total)
-        / max(scenario.fixations, 1),
+        f"scenario.{name}.renders_per_point": float(row["renders"]) / max(scenario.fixations, 1),
     }
-    if result.calibration and result.calibration.layout is not None:
-        metrics[f"scenario.{name}.calibration_max_error_rad"] = float(
-            np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
-        )
+    if row["calibration_max_error_rad"] is not None:
+        metrics[f"scenario.{name}.calibration_max_error_rad"] = row["calibration_max_error_rad"]
     return metrics
 
 

@@ -46,12 +46,11 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from headsim.errors import BadInput
 from headsim.runs.progress import Counter
 from headsim.scenario.tables import TargetRefused
 from headsim.studies.jobs import dask_client, execute, local_pool
+from headsim.studies.rows import run_row
 from headsim.studies.sweep_output import write_aggregate
 from headsim.studies.sweep_spec import BatchOptions, Job, SweepSpec
 
@@ -233,33 +232,7 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
                 result = run_scenario(scenario, [recorder])
         else:
             result = run_scenario(scenario)
-        calibrated = result.calibration is not None
-        acceptance = result.scenario.scene.acceptance
-        ok = [r.measurement for r in result.records if r.measurement.ok]
-        used = [
-            r.measurement
-            for r in result.records
-            if r.measurement.ok and (r.knowledge != "none" or not calibrated)
-        ]
-        errors_mm = [1000 * float(np.linalg.norm(m.error_head_m)) for m in used]
-        pct = [m.error_pct_of_depth for m in used]
-        record.update(
-            status="ok" if result.ok else "failed",
-            failures=len(result.failures),
-            failure_reasons=list(result.failures),
-            measurements_ok=len(ok),
-            measurements=len(result.records),
-            rms_error_pct_depth=float(np.sqrt(np.mean(np.square(pct)))) if pct else None,
-            mean_error_mm=float(np.mean(errors_mm)) if errors_mm else None,
-            max_error_mm=float(np.max(errors_mm)) if errors_mm else None,
-            renders=result.renders.overall.total,
-            targets_redrawn=acceptance.refused_total if acceptance is not None else 0,
-            calibration_max_error_rad=float(
-                np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
-            )
-            if result.calibration is not None and result.calibration.layout is not None
-            else None,
-        )
+        record.update(run_row(result))
     except TargetRefused as err:  # this job's values: its failure, not the sweep file's
         record.update(
             status="refused",
