@@ -103,12 +103,21 @@ def map_jobs(
     scheduler: str | None = None,
     on_record: Callable[[dict[str, Any]], None] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run ``function(job, None)`` for every job on local processes or Dask; records in job order.
+    """Run ``function(job, None)`` for every job; records in job order.
 
-    The same machinery as :func:`headsim.studies.sweep.run_sweep` (spawned processes, one retry,
-    crash-proof) for any picklable jobs with ``id`` and ``index``, such as the
-    insensitivity study's conditions.
+    One local worker: in this process, one job after the other (an error is raised, not
+    retried).  More, or a Dask ``scheduler``: the same machinery as
+    :func:`headsim.studies.sweep.run_sweep` (spawned processes, one retry, crash-proof) for
+    any picklable jobs with ``id`` and ``index``, such as the insensitivity study's
+    conditions.
     """
+    if workers == 1 and scheduler is None:
+        done = []
+        for job in jobs:
+            done.append(function(job, None))
+            if on_record is not None:
+                on_record(done[-1])
+        return done
     records: dict[str, dict[str, Any]] = {}
 
     def keep(record: dict[str, Any]) -> None:
