@@ -1,6 +1,7 @@
 """The campaigns' job engine: jobs on spawned local processes or a Dask cluster, each
-retried once and a crashed worker survived (:func:`execute`, :func:`map_jobs`); jobs with
-needs, the longest path to the end first (:func:`schedule`); and the render workers' pool."""
+retried once and a crashed worker survived (:func:`execute`, :func:`map_jobs`); the log
+a campaign resumes from (:func:`read_log`, :func:`append_record`); jobs with needs, the
+longest path to the end first (:func:`schedule`); and the render workers' pool."""
 
 from __future__ import annotations
 
@@ -9,8 +10,10 @@ import concurrent.futures.process  # noqa: F401  execute() reads cf.process; onl
 import contextlib
 import functools
 import importlib
+import json
 import multiprocessing
 import os
+import queue
 import signal
 import threading
 import time
@@ -18,7 +21,9 @@ import traceback
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol, TypeVar
+
+from headsim.errors import EnvironmentProblem
 
 #: Attempts per job: the first and one retry.
 ATTEMPTS = 2
@@ -141,6 +146,38 @@ def map_jobs(
             function,
         )
     return [records[job.id] for job in jobs]
+
+
+# -- resuming ---------------------------------------------------------------------------
+
+
+def read_log(path: Path) -> dict[str, dict[str, Any]]:
+    """Finished jobs from a campaign's log (``jobs.jsonl``: a record per line, as each job
+    ended), by id: a campaign resumes with the jobs not in it.  A torn last line (a killed
+    writer) is ignored."""
+    records: dict[str, dict[str, Any]] = {}
+    if not path.exists():
+        return records
+    for line in path.read_text(encoding="utf-8").splitlines():
+        try:
+            record = json.loads(line)
+        except json.JSONDecodeError:
+            continue
+        records[record["id"]] = record
+    return records
+
+
+def append_record(path: Path, record: dict[str, Any]) -> None:
+    """Append one record as a line, after ending a torn last line if a killed writer left one."""
+    line = (json.dumps(record, sort_keys=True) + "\n").encode()
+    with path.open("a+b") as handle:
+        if handle.tell() > 0:
+            handle.seek(-1, os.SEEK_END)
+            if handle.read(1) != b"\n":
+                line = b"\n" + line
+        handle.write(line)
+        handle.flush()
+        os.fsync(handle.fileno())
 
 
 # -- jobs with needs ------------------------------------------------------------------
@@ -357,3 +394,70 @@ def start_workers(pool: cf.Executor, workers: int) -> list[cf.Future[int]]:
     """Start ``workers`` processes of ``pool`` now, rather than at its first jobs: a
     spawned pool starts one process per job it is given while none is idle."""
     return [pool.submit(os.getpid) for _ in range(workers)]
+
+
+#: How long a render pool's workers may take to start and load their modules, s.
+WORKERS_START_S = 300.0
+
+
+class WorkersNotStarted(EnvironmentProblem):
+    """The worker processes did not start (exit 3)."""
+
+
+class _Closing(Protocol):
+    def close(self) -> None: ...
+
+
+Made = TypeVar("Made", bound=_Closing)
+
+
+def started_render_pool(
+    workers: int, preload: tuple[str, ...], meanwhile: Callable[[], Made]
+) -> tuple[cf.Executor, Made]:
+    """A :func:`render_pool` whose ``workers`` have started and imported ``preload``, and
+    what ``meanwhile()`` made while they started (closed if they do not start).
+
+    Returns once every worker is ready and waits, idle; a worker that fails to start, or
+    workers not started within :data:`WORKERS_START_S`, raise :class:`WorkersNotStarted`.
+    """
+    ready = spawn_context().Queue()
+    pool = render_pool(workers, preload, ready)
+    made = None
+    try:
+        with interrupt_deferred():
+            starting = start_workers(pool, workers)
+        made = meanwhile()
+        deadline, started = time.monotonic() + WORKERS_START_S, 0
+        while started < workers:  # bounded by the deadline
+            try:
+                ready.get(timeout=0.05)
+                started += 1
+            except queue.Empty:
+                failed = [f.exception() for f in starting if f.done() and f.exception()]
+                if failed:
+                    raise WorkersNotStarted(f"a worker failed to start: {failed[0]!r}") from None
+                if time.monotonic() > deadline:
+                    raise WorkersNotStarted(
+                        f"{workers - started} of {workers} workers not started "
+                        f"within {WORKERS_START_S:.0f} s"
+                    ) from None
+        return pool, made
+    except BaseException:
+        stop_pool(pool)
+        if made is not None:
+            made.close()
+        raise
+
+
+def stop_pool(pool: cf.Executor) -> None:
+    """Stop the pool's workers now, whatever they run."""
+    pool.shutdown(wait=False, cancel_futures=True)
+    terminate_children()
+
+
+def terminate_children() -> None:
+    """Terminate every child process: each is one of the pool's workers, including
+    one caught half-started (Ctrl-C while the pool spawned it, which the pool does
+    not know of yet, and for which the exit would otherwise wait forever)."""
+    for process in multiprocessing.active_children():
+        process.terminate()

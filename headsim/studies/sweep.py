@@ -37,7 +37,6 @@ end ``DIR/aggregate.csv``, ``DIR/aggregate.json`` and a plot per swept field.
 from __future__ import annotations
 
 import functools
-import json
 import os
 import signal
 import time
@@ -49,7 +48,7 @@ from typing import Any
 from headsim.errors import BadInput
 from headsim.runs.progress import Counter
 from headsim.scenario.tables import TargetRefused
-from headsim.studies.jobs import dask_client, execute, local_pool
+from headsim.studies.jobs import append_record, dask_client, execute, local_pool, read_log
 from headsim.studies.rows import run_row
 from headsim.studies.sweep_output import write_aggregate
 from headsim.studies.sweep_spec import BatchOptions, Job, SweepSpec
@@ -268,33 +267,6 @@ class SweepOutcome:
         return [r for r in self.records.values() if r.get("status") != "ok"]
 
 
-def read_log(path: Path) -> dict[str, dict[str, Any]]:
-    """Finished jobs from ``jobs.jsonl``; a torn last line (a killed writer) is ignored."""
-    records: dict[str, dict[str, Any]] = {}
-    if not path.exists():
-        return records
-    for line in path.read_text(encoding="utf-8").splitlines():
-        try:
-            record = json.loads(line)
-        except json.JSONDecodeError:
-            continue
-        records[record["id"]] = record
-    return records
-
-
-def _append(path: Path, record: dict[str, Any]) -> None:
-    """Append one record as a line, after ending a torn last line if a killed writer left one."""
-    line = (json.dumps(record, sort_keys=True) + "\n").encode()
-    with path.open("a+b") as handle:
-        if handle.tell() > 0:
-            handle.seek(-1, os.SEEK_END)
-            if handle.read(1) != b"\n":
-                line = b"\n" + line
-        handle.write(line)
-        handle.flush()
-        os.fsync(handle.fileno())
-
-
 def run_sweep(
     spec: SweepSpec,
     out_dir: str | Path,
@@ -341,7 +313,7 @@ def run_sweep(
     job_function = functools.partial(run_job, recording=recording) if recording else run_job
 
     def on_record(record: dict[str, Any]) -> None:
-        _append(log, record)
+        append_record(log, record)
         done[record["id"]] = record
         if bar is not None:
             bar.update(note="" if record.get("status") == "ok" else "(this one failed)")
