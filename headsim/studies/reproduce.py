@@ -17,7 +17,7 @@ One head (the scenarios' ``paper`` head) is calibrated once (Sec. V, the
   kept (the changed focal length), on the same head with the same Sec. V
   calibration (head.json), one Zhang stereo calibration and one zoom
   fixed-point calibration (:mod:`headsim.studies.paper_tables`; the study's other
-  heads and changes are left to ``python -m headsim.studies.study``).
+  heads and changes are left to ``headsim study``).
 
 The head's calibration, Zhang's and the fixed points' run first, side by
 side; then the longest experiments first, so that the workers finish together.
