@@ -37,7 +37,7 @@ from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
 from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
 from headsim.studies.render_clock import RenderClock
-from headsim.studies.rows import run_row
+from headsim.studies.scenario_jobs import run_row
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
 from headsim.studies.targets import random_targets_head, visible_vertical_range
 

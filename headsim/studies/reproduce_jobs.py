@@ -16,6 +16,7 @@ from headsim.studies.reproduce_experiments import (
     SCENARIO_JOBS,
     TABLES_HEAD,
 )
+from headsim.studies.scenario_jobs import Job
 
 #: What the jobs import, loaded by each worker as it starts (about 1 s), while the parent
 #: makes its render clock.
@@ -57,16 +58,13 @@ def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     }
 
 
-def _scenario_run(
-    scenario_name: str, directory: Path, fast: bool, seed: int | None, overrides: dict[str, Any]
-) -> dict[str, Any]:
+def _scenario_run(job: Job, directory: Path) -> dict[str, Any]:
     """One scenario run: its results.json and summary.txt written in ``directory``."""
     from headsim.runs.runner import run_scenario
     from headsim.runs.serialise import results_payload
     from headsim.runs.summary import summary_text
-    from headsim.scenario.loading import load_scenario
 
-    scenario = load_scenario(scenario_name, fast=fast, seed=seed, overrides=overrides)
+    scenario = job.load()
     start = time.perf_counter()
     result = run_scenario(scenario)
     wall = time.perf_counter() - start
@@ -85,8 +83,8 @@ def _scenario_run(
 @plain_errors
 def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
     scenario_name, _ = SCENARIO_JOBS[name]
-    overrides = {"experiment.calibration.from": head}
-    return _scenario_run(scenario_name, Path(out) / name, fast, seed, overrides)
+    params = {"experiment.calibration.from": head, "seed": seed}
+    return _scenario_run(Job(0, name, scenario_name, fast, params), Path(out) / name)
 
 
 @plain_errors
@@ -94,8 +92,9 @@ def realistic_board_job(out: str, fast: bool, seed: int | None) -> dict[str, Any
     """The chessboard on the realistic preset, calibrated by the scenario itself: the
     paper's rig had real tolerances, which the paper preset's ideal mechanics lack."""
     scenario_name, _ = SCENARIO_JOBS["chessboard"]
-    directory = Path(out) / REALISTIC_BOARD_JOB
-    return _scenario_run(scenario_name, directory, fast, seed, {"head.preset": "realistic"})
+    params = {"head.preset": "realistic", "seed": seed}
+    job = Job(0, REALISTIC_BOARD_JOB, scenario_name, fast, params)
+    return _scenario_run(job, Path(out) / REALISTIC_BOARD_JOB)
 
 
 def _study_config(fast: bool, seed: int | None) -> Any:

@@ -54,9 +54,9 @@ Its options are the ``headsim`` parser's (:func:`headsim.cli.parser.add_study_ar
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
-from collections.abc import Sequence
 
 from headsim.errors import BadInput
 from headsim.runs.progress import Status
@@ -72,14 +72,6 @@ from headsim.studies.study_output import print_result, write_experiment
 
 #: Printed by the deprecated alias ``python -m headsim.studies.study``.
 ALIAS_NOTE = "note: python -m headsim.studies.study is deprecated; run: headsim study ..."
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m headsim.studies.study ARGS``: the deprecated alias of ``headsim study ARGS``."""
-    from headsim.cli import main as headsim_main
-
-    print(ALIAS_NOTE, file=sys.stderr)
-    return headsim_main(["study", *(sys.argv[1:] if argv is None else argv)])
 
 
 def run(args: argparse.Namespace) -> int:
@@ -140,5 +132,6 @@ def _budget(args: argparse.Namespace, progress: Progress) -> int:
     return 1 if failed else 0
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+if __name__ == "__main__":  # the deprecated alias: this process becomes ``headsim study``
+    print(ALIAS_NOTE, file=sys.stderr, flush=True)
+    os.execv(sys.executable, [sys.executable, "-m", "headsim.cli", "study", *sys.argv[1:]])

@@ -49,9 +49,9 @@ from headsim.errors import BadInput
 from headsim.runs.progress import Counter
 from headsim.scenario.tables import TargetRefused
 from headsim.studies.jobs import append_record, dask_client, execute, local_pool, read_log
-from headsim.studies.rows import run_row
+from headsim.studies.scenario_jobs import Job, run_row
 from headsim.studies.sweep_output import write_aggregate
-from headsim.studies.sweep_spec import BatchOptions, Job, SweepSpec
+from headsim.studies.sweep_spec import BatchOptions, SweepSpec
 
 #: Fault injection for tests: job indices (comma-separated) whose process dies.
 CRASH_ENV = "HEADSIM_SWEEP_CRASH_JOBS"
@@ -215,12 +215,8 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
     record: dict[str, Any] = {"id": job.id, "index": job.index, "params": job.params}
     try:
         from headsim.runs.runner import run_scenario
-        from headsim.scenario.loading import load_scenario
 
-        overrides = {k: v for k, v in job.params.items() if k != "seed"}
-        scenario = load_scenario(
-            job.scenario, fast=job.fast, seed=job.params.get("seed"), overrides=overrides
-        )
+        scenario = job.load()
         if recording is not None:
             from headsim.runs.recording import Recorder
             from headsim.runs.rerun_cli import job_target

@@ -1,13 +1,38 @@
-"""A scenario run as a campaign's row: the figures that the sweep's aggregate and the bench's
-scenario metrics read from one :class:`~headsim.runs.result.RunResult`."""
+"""A scenario run as a campaign's job (a scenario with fields set and a seed) and as its
+row: the figures that the sweep's aggregate and the bench's scenario metrics read from one
+:class:`~headsim.runs.result.RunResult`."""
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from headsim.runs.result import RunResult
+if TYPE_CHECKING:
+    from headsim.runs.result import RunResult
+    from headsim.scenario.spec import Scenario
+
+
+@dataclass(frozen=True)
+class Job:
+    """One scenario run: its position, a stable id, and the fields it sets (``seed``: the
+    run's seed)."""
+
+    index: int
+    id: str
+    scenario: str
+    fast: bool
+    params: dict[str, Any]
+
+    def load(self) -> Scenario:
+        """The checked scenario: its file (or name) with the fields set."""
+        from headsim.scenario.loading import load_scenario
+
+        overrides = {k: v for k, v in self.params.items() if k != "seed"}
+        return load_scenario(
+            self.scenario, fast=self.fast, seed=self.params.get("seed"), overrides=overrides
+        )
 
 
 def run_row(result: RunResult) -> dict[str, Any]:
