@@ -146,8 +146,7 @@ def tables_job(
     from headsim.active.calibration_file import read_calibration
     from headsim.scenario.loading import load_scenario
     from headsim.studies import paper_tables
-    from headsim.studies.study_experiments import compare_figures
-    from headsim.studies.study_output import summary_rows, write_experiment
+    from headsim.studies.study_output import experiment_record, write_experiment
 
     settings = load_scenario(TABLES_HEAD, fast=fast, seed=seed).settings
     stored = read_calibration(head, settings).knowledge
@@ -160,10 +159,7 @@ def tables_job(
     own = result.seconds + zhang["wall_s"] + fixed["wall_s"]
     data = to_jsonable(
         {
-            "title": result.experiment.title,
-            "summary": summary_rows(result),
-            "figures": compare_figures(result),
-            "files": {k: str(p) for k, p in files.items()},
+            **experiment_record(result, files),
             "seconds": own,
             "zhang": {
                 "seconds": zhang["wall_s"],
@@ -189,19 +185,11 @@ def tables_job(
 
 @plain_errors
 def study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, Any]:
-    from headsim.studies.study_experiments import compare_figures, run_experiment, sweep_experiment
-    from headsim.studies.study_output import summary_rows, write_experiment
+    from headsim.studies.study_experiments import run_experiment, sweep_experiment
+    from headsim.studies.study_output import experiment_record, write_experiment
 
     config = _study_config(fast, seed)
     experiment = sweep_experiment(name.removeprefix("sweep_"), config)
     result = run_experiment(experiment, config)
     files = write_experiment(result, Path(out) / "study")
-    return to_jsonable(
-        {
-            "title": experiment.title,
-            "summary": summary_rows(result),
-            "figures": compare_figures(result) if experiment.kind == "compare" else None,
-            "files": {k: str(p) for k, p in files.items()},
-            "seconds": result.seconds,
-        }
-    )
+    return to_jsonable(experiment_record(result, files))
