@@ -14,7 +14,6 @@ import math
 import sys
 import tempfile
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -27,7 +26,7 @@ from headsim.active.placement import calibration_layout
 from headsim.estimators.throughput import run as estimator_throughput
 from headsim.files import write_json_atomic
 from headsim.runs.events import MeasurementRecorded, Stamp
-from headsim.runs.progress import Status
+from headsim.runs.progress import Progress, Status, quiet
 from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario, scenario_from_document
 from headsim.scenario.spec import Scenario
@@ -40,12 +39,6 @@ from headsim.studies.render_clock import RenderClock
 from headsim.studies.scenario_jobs import run_row
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
 from headsim.studies.targets import random_targets_head, visible_vertical_range
-
-Progress = Callable[[str], None]
-
-
-def _quiet(_: str) -> None:
-    pass
 
 
 @dataclass(frozen=True)
@@ -163,7 +156,7 @@ PARTS = tuple(c.name for c in of_kind("regress"))
 def suite(
     seed: int = 0,
     faults: Faults | None = None,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
     parts: tuple[str, ...] = PARTS,
 ) -> Metrics:
     """Run the fixed suite; metrics by name (see ``benchmarks/tolerances.json``)."""
@@ -419,10 +412,10 @@ def main(args: Any) -> int:
 
 def _regress(args: Any, parts: tuple[str, ...]) -> int:
     """The regression cases ``parts``: run, compare, print, maybe update the baseline."""
-    quiet = getattr(args, "quiet", False)
+    silent = getattr(args, "quiet", False)
     start = time.perf_counter()
-    status = None if quiet else Status("headsim bench", transient=True)
-    metrics = suite(seed=args.seed, progress=_quiet if status is None else status, parts=parts)
+    status = None if silent else Status("headsim bench", transient=True)
+    metrics = suite(seed=args.seed, progress=quiet if status is None else status, parts=parts)
     wall = time.perf_counter() - start
     if status is not None:
         status.close()

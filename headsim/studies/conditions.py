@@ -11,10 +11,11 @@ from typing import Any
 import numpy as np
 
 from headsim.errors import JobFailed
+from headsim.runs.progress import Progress, quiet
 from headsim.sim.settings import HeadSettings
 from headsim.studies.calibrations import CalibrationCache, Calibrations, calibrate_methods
 from headsim.studies.jobs import map_jobs
-from headsim.studies.methods import SWEEP_METHODS, Progress, StudyConfig, quiet
+from headsim.studies.methods import SWEEP_METHODS, StudyConfig
 from headsim.studies.target_errors import Summary, TargetError, measure_methods, summarise
 
 

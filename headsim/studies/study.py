@@ -59,9 +59,9 @@ import sys
 import time
 
 from headsim.errors import BadInput
-from headsim.runs.progress import Status
+from headsim.runs.progress import Progress, Status, quiet
 from headsim.studies.calibrations import CalibrationCache
-from headsim.studies.methods import Progress, StudyConfig, quiet
+from headsim.studies.methods import StudyConfig
 from headsim.studies.study_experiments import (
     SWEEPS,
     compare_experiment,
