@@ -185,14 +185,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         "sweep", metavar="SWEEP", help="a sweep file (.toml), e.g. sweeps/focal.toml"
     )
     sweep.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
-    sweep.add_argument(
-        "--workers", type=positive_int, default=1, metavar="N", help="local processes (default 1)"
-    )
-    sweep.add_argument(
-        "--scheduler",
-        metavar="tcp://HOST:PORT",
-        help="run the jobs on this Dask scheduler instead (pip install 'headsim[dask]')",
-    )
+    add_pool_arguments(sweep, "the jobs")
     sweep.add_argument(
         "--device",
         choices=("cpu", "cuda"),
@@ -248,6 +241,22 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     return parser
 
 
+def add_pool_arguments(command: argparse.ArgumentParser, what: str) -> None:
+    """A campaign's pool (:mod:`headsim.studies.jobs`): local processes or a Dask scheduler."""
+    command.add_argument(
+        "--workers",
+        type=positive_int,
+        default=1,
+        metavar="N",
+        help=f"run {what} on N local processes (default 1)",
+    )
+    command.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help=f"run {what} on this Dask scheduler instead (pip install 'headsim[dask]')",
+    )
+
+
 STUDY_DESCRIPTION = (
     "Calibrated stereo against the active method: the Tables V/VI comparison, changes of "
     "focal length, principal point and distortion after calibration, and sweeps (depth, focal, "
@@ -278,11 +287,4 @@ def add_study_arguments(study: argparse.ArgumentParser) -> None:
     study.add_argument(
         "--fast", action="store_true", help="small calibrations and two values per sweep"
     )
-    study.add_argument(
-        "--workers", type=int, default=1, metavar="N", help="run conditions on N local processes"
-    )
-    study.add_argument(
-        "--scheduler",
-        metavar="tcp://HOST:PORT",
-        help="run conditions on this Dask scheduler (pip install 'headsim[dask]')",
-    )
+    add_pool_arguments(study, "the conditions")

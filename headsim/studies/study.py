@@ -58,7 +58,6 @@ import os
 import sys
 import time
 
-from headsim.errors import BadInput
 from headsim.runs.progress import Progress, Status, quiet
 from headsim.studies.calibrations import CalibrationCache
 from headsim.studies.methods import StudyConfig
@@ -76,8 +75,6 @@ ALIAS_NOTE = "note: python -m headsim.studies.study is deprecated; run: headsim 
 
 def run(args: argparse.Namespace) -> int:
     """``headsim study``: run what ``args`` asks for; 0 on success."""
-    if args.workers < 1:
-        raise BadInput(f"--workers must be >= 1, got {args.workers}")
     make = StudyConfig.quick if args.fast else StudyConfig
     config = make(preset=args.preset, seed=args.seed)
     progress: Progress = quiet if args.quiet else Status("headsim study")
