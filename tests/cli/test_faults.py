@@ -183,7 +183,9 @@ def test_no_space_on_the_device_itself_is_exit_3(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("command", [("sweep", "sweeps/focal.toml"), ("study", "--sweep", "depth")])
-def test_workers_0_is_bad_input_and_creates_nothing(tmp_path: Path, command: tuple[str, ...]) -> None:
+def test_workers_0_is_bad_input_and_creates_nothing(
+    tmp_path: Path, command: tuple[str, ...]
+) -> None:
     root = Path(__file__).resolve().parents[2]
     name, *rest = command
     argv = [str(root / a) if a.endswith(".toml") else a for a in rest]
