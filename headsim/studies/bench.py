@@ -36,6 +36,7 @@ from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
 from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
 from headsim.studies.render_clock import RenderClock
+from headsim.studies.reproduce_experiments import SCENARIO_JOBS
 from headsim.studies.scenario_jobs import run_row
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
 from headsim.studies.targets import random_targets_head, visible_vertical_range
@@ -351,8 +352,8 @@ def _realistic_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     return metrics
 
 
-#: The paper scenarios whose fast variants the suite runs.
-PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "tracking")
+#: The paper scenarios whose fast variants the suite runs: those ``headsim reproduce`` runs.
+PAPER_SCENARIOS = tuple(scenario for scenario, _ in SCENARIO_JOBS.values())
 
 
 def scenario_metrics(name: str) -> Metrics:
