@@ -2,7 +2,7 @@
 
 Each run prints progress on stderr, a table per experiment on stdout, and
 writes ``<name>.csv``, ``<name>_targets.csv``, ``<name>.json`` and
-``<name>.png`` beside ``results.json`` in --out (see ``headsim.studies.study``):
+``<name>.png`` beside ``results.json`` in --out (``headsim study``, whose options it takes):
 
     python benchmarks/insensitivity_study.py --experiment compare --out out/study
     python benchmarks/insensitivity_study.py --sweep depth --out out/study
@@ -14,8 +14,9 @@ calibrations and two values per sweep (a smoke run of about a minute).
 
 from __future__ import annotations
 
-import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
-from headsim.studies.study import main
+import sys
+
+from headsim.cli import main
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(main(["study", *sys.argv[1:]]))

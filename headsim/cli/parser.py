@@ -185,14 +185,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         "sweep", metavar="SWEEP", help="a sweep file (.toml), e.g. sweeps/focal.toml"
     )
     sweep.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
-    sweep.add_argument(
-        "--workers", type=positive_int, default=1, metavar="N", help="local processes (default 1)"
-    )
-    sweep.add_argument(
-        "--scheduler",
-        metavar="tcp://HOST:PORT",
-        help="run the jobs on this Dask scheduler instead (pip install 'headsim[dask]')",
-    )
+    add_pool_arguments(sweep, "the jobs")
     sweep.add_argument(
         "--device",
         choices=("cpu", "cuda"),
@@ -207,11 +200,8 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     study = commands.add_parser(
         "study", help="the insensitivity study: stereo against the active method, sweeps, plots"
     )
-    if with_study:  # the study module (stereo, principal points) loads only for it
-        from headsim.studies.study import STUDY_DESCRIPTION, add_arguments
-
-        study.description = STUDY_DESCRIPTION
-        add_arguments(study)
+    if with_study:  # its sweeps' names load the study (stereo, principal points): only for it
+        add_study_arguments(study)
     study.set_defaults(func=study_command)
 
     bench = commands.add_parser(
@@ -249,3 +239,52 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     for sub in commands.choices.values():  # every command states the exit-code contract
         sub.epilog = sub.epilog or EXIT_CODES_HELP
     return parser
+
+
+def add_pool_arguments(command: argparse.ArgumentParser, what: str) -> None:
+    """A campaign's pool (:mod:`headsim.studies.jobs`): local processes or a Dask scheduler."""
+    command.add_argument(
+        "--workers",
+        type=positive_int,
+        default=1,
+        metavar="N",
+        help=f"run {what} on N local processes (default 1)",
+    )
+    command.add_argument(
+        "--scheduler",
+        metavar="tcp://HOST:PORT",
+        help=f"run {what} on this Dask scheduler instead (pip install 'headsim[dask]')",
+    )
+
+
+STUDY_DESCRIPTION = (
+    "Calibrated stereo against the active method: the Tables V/VI comparison, changes of "
+    "focal length, principal point and distortion after calibration, and sweeps (depth, focal, "
+    "principal, k1, noise, encoder), and the realistic head's error budget; writes CSV, JSON "
+    "and PNG to --out."
+)
+
+
+def add_study_arguments(study: argparse.ArgumentParser) -> None:
+    """``headsim study``'s description and options (loads the study's sweeps for their names)."""
+    from headsim.studies.study_experiments import SWEEPS
+
+    study.description = STUDY_DESCRIPTION
+    what = study.add_mutually_exclusive_group(required=True)
+    what.add_argument(
+        "--experiment",
+        choices=["compare", "budget"],
+        help="compare: the Tables V/VI comparison; budget: the realistic head's error budget "
+        "(headsim.studies.error_budget; scenario realistic_field, whatever --preset)",
+    )
+    what.add_argument("--sweep", choices=sorted(SWEEPS), help="one sweep")
+    what.add_argument(
+        "--all", action="store_true", help="the comparison, every sweep and the error budget"
+    )
+    study.add_argument("--out", required=True, help="output directory (created if missing)")
+    study.add_argument("--preset", default="paper", choices=["ideal", "paper"])
+    study.add_argument("--seed", type=int, default=0)
+    study.add_argument(
+        "--fast", action="store_true", help="small calibrations and two values per sweep"
+    )
+    add_pool_arguments(study, "the conditions")

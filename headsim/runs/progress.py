@@ -225,5 +225,9 @@ class Status:
             self._bar = None
 
 
+#: A progress callback: takes one line of news.
+Progress = Callable[[str], None]
+
+
 def quiet(_: str) -> None:
     """A progress callback that says nothing (``--quiet``)."""

@@ -14,7 +14,6 @@ import math
 import sys
 import tempfile
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -27,7 +26,7 @@ from headsim.active.placement import calibration_layout
 from headsim.estimators.throughput import run as estimator_throughput
 from headsim.files import write_json_atomic
 from headsim.runs.events import MeasurementRecorded, Stamp
-from headsim.runs.progress import Status
+from headsim.runs.progress import Progress, Status, quiet
 from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario, scenario_from_document
 from headsim.scenario.spec import Scenario
@@ -37,14 +36,10 @@ from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
 from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
 from headsim.studies.render_clock import RenderClock
+from headsim.studies.reproduce_experiments import SCENARIO_JOBS
+from headsim.studies.scenario_jobs import run_row
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
 from headsim.studies.targets import random_targets_head, visible_vertical_range
-
-Progress = Callable[[str], None]
-
-
-def _quiet(_: str) -> None:
-    pass
 
 
 @dataclass(frozen=True)
@@ -162,7 +157,7 @@ PARTS = tuple(c.name for c in of_kind("regress"))
 def suite(
     seed: int = 0,
     faults: Faults | None = None,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
     parts: tuple[str, ...] = PARTS,
 ) -> Metrics:
     """Run the fixed suite; metrics by name (see ``benchmarks/tolerances.json``)."""
@@ -357,34 +352,23 @@ def _realistic_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     return metrics
 
 
-#: The paper scenarios whose fast variants the suite runs.
-PAPER_SCENARIOS = ("calibration", "chessboard", "relative_positioning", "tracking")
+#: The paper scenarios whose fast variants the suite runs: those ``headsim reproduce`` runs.
+PAPER_SCENARIOS = tuple(scenario for scenario, _ in SCENARIO_JOBS.values())
 
 
 def scenario_metrics(name: str) -> Metrics:
     """Run a scenario's fast variant: failures, RMS error (% of depth) and renders."""
     scenario = load_scenario(name, fast=True)
-    result = run_scenario(scenario)
-    # Measurements made without the scenario's calibration (its "before" checks) do not count.
-    calibrated = result.calibration is not None
-    errors = [
-        r.measurement.error_pct_of_depth
-        for r in result.records
-        if r.measurement.ok and (r.knowledge != "none" or not calibrated)
-    ]
+    row = run_row(run_scenario(scenario))
+    rms = row["rms_error_pct_depth"]
     metrics = {
-        f"scenario.{name}.failures": float(len(result.failures)),
-        f"scenario.{name}.rms_error_pct_depth": float(np.sqrt(np.mean(np.square(errors))))
-        if errors
-        else math.inf,
+        f"scenario.{name}.failures": float(row["failures"]),
+        f"scenario.{name}.rms_error_pct_depth": math.inf if rms is None else rms,
         # Per fixation, so that +0.5 renders per point is one tolerance everywhere.
-        f"scenario.{name}.renders_per_point": float(result.renders.overall.total)
-        / max(scenario.fixations, 1),
+        f"scenario.{name}.renders_per_point": float(row["renders"]) / max(scenario.fixations, 1),
     }
-    if result.calibration and result.calibration.layout is not None:
-        metrics[f"scenario.{name}.calibration_max_error_rad"] = float(
-            np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
-        )
+    if row["calibration_max_error_rad"] is not None:
+        metrics[f"scenario.{name}.calibration_max_error_rad"] = row["calibration_max_error_rad"]
     return metrics
 
 
@@ -429,10 +413,10 @@ def main(args: Any) -> int:
 
 def _regress(args: Any, parts: tuple[str, ...]) -> int:
     """The regression cases ``parts``: run, compare, print, maybe update the baseline."""
-    quiet = getattr(args, "quiet", False)
+    silent = getattr(args, "quiet", False)
     start = time.perf_counter()
-    status = None if quiet else Status("headsim bench", transient=True)
-    metrics = suite(seed=args.seed, progress=_quiet if status is None else status, parts=parts)
+    status = None if silent else Status("headsim bench", transient=True)
+    metrics = suite(seed=args.seed, progress=quiet if status is None else status, parts=parts)
     wall = time.perf_counter() - start
     if status is not None:
         status.close()

@@ -20,10 +20,11 @@ from headsim.active.principal import (
 )
 from headsim.geometry.stereo_view import StereoView
 from headsim.procedures.stereo import StereoResult
+from headsim.runs.progress import Progress, quiet
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import start_views
 from headsim.stereo.calibration import StereoCalibration
-from headsim.studies.methods import METHODS, Progress, StudyConfig, quiet
+from headsim.studies.methods import METHODS, StudyConfig
 from headsim.studies.scenario_runs import calibration_run, zhang_run, zoom_fixed_points_run
 
 

@@ -11,10 +11,11 @@ from typing import Any
 import numpy as np
 
 from headsim.errors import JobFailed
+from headsim.runs.progress import Progress, quiet
 from headsim.sim.settings import HeadSettings
 from headsim.studies.calibrations import CalibrationCache, Calibrations, calibrate_methods
 from headsim.studies.jobs import map_jobs
-from headsim.studies.methods import SWEEP_METHODS, Progress, StudyConfig, quiet
+from headsim.studies.methods import SWEEP_METHODS, StudyConfig
 from headsim.studies.target_errors import Summary, TargetError, measure_methods, summarise
 
 
@@ -96,9 +97,9 @@ def run_conditions(
 ) -> list[ConditionResult]:
     """Measure every condition; ``base`` maps each condition's ``group`` to the head calibrated for "kept".
 
-    With ``workers`` > 1 or a Dask ``scheduler`` the conditions run as jobs of
-    :func:`headsim.studies.jobs.map_jobs` (the "kept" calibrations are made here once
-    and shipped with them); otherwise one after the other in this process.
+    The conditions run as jobs of :func:`headsim.studies.jobs.map_jobs` (with ``workers``
+    > 1 or a Dask ``scheduler`` the "kept" calibrations are made here once and shipped
+    with them).
     """
     methods = tuple(methods)
     jobs = []
@@ -130,15 +131,9 @@ def run_conditions(
             f"RMS % of depth: {figures}  [{result.seconds:.1f} s]"
         )
 
-    if workers == 1 and scheduler is None:
-        records = []
-        for job in jobs:
-            records.append(measure_condition(job))
-            report(records[-1])
-    else:
-        records = map_jobs(
-            measure_condition, jobs, workers=workers, scheduler=scheduler, on_record=report
-        )
+    records = map_jobs(
+        measure_condition, jobs, workers=workers, scheduler=scheduler, on_record=report
+    )
     failed = [r for r in records if r.get("status") != "ok"]
     if failed:
         raise JobFailed(f"{len(failed)} condition(s) failed: {failed[0].get('error')}")

@@ -303,15 +303,15 @@ def run_budget(
         )
     progress(f"== budget: the realistic head's error budget ({len(conditions)} conditions)")
     jobs = [BudgetJob(k, f"{k}-{c.name}", c, fast, seed) for k, c in enumerate(conditions)]
-    if workers == 1 and scheduler is None:
-        rows = []
-        for job in jobs:
-            rows.append(run_job(job)["row"])
-            progress(f"  {job.condition.name}: {rows[-1]['rms_3d_pct']:.3f} % of depth")
-        return rows
+
+    def report(record: dict[str, Any]) -> None:
+        if record.get("status") == "ok":
+            row = record["row"]
+            progress(f"  {row['condition']}: {row['rms_3d_pct']:.3f} % of depth")
+
     from headsim.studies.jobs import map_jobs
 
-    records = map_jobs(run_job, jobs, workers=workers, scheduler=scheduler)
+    records = map_jobs(run_job, jobs, workers=workers, scheduler=scheduler, on_record=report)
     bad = [r for r in records if r.get("status") != "ok"]
     if bad:
         raise RuntimeError(f"budget condition {bad[0]['id']} failed: {bad[0].get('error')}")

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
@@ -20,6 +20,7 @@ import numpy as np
 from headsim.active.calibration_file import knowledge_from_block
 from headsim.active.measurement import HeadKnowledge, Measurement, body_target
 from headsim.estimators.areas import AreaComparison, tally_areas
+from headsim.runs.progress import Progress, quiet
 from headsim.runs.result import RunResult
 from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import scenario_from_document
@@ -39,12 +40,6 @@ BALL = body_target(names.CALIBRATION_BALL, MarkerDetector("yellow"))
 DEPTH_BANDS_M = ((0.3, 0.6), (0.6, 1.0), (1.0, 1.5))
 #: Rows within this many px of the image centre row count as "near the centre row".
 CENTRE_ROW_BAND_PX = 100.0
-
-Progress = Callable[[str], None]
-
-
-def _quiet(_: str) -> None:
-    pass
 
 
 def centre_row_offset_px(settings: HeadSettings, m: Measurement) -> float:
@@ -113,7 +108,7 @@ def model2_accuracy(
     calibrate: bool = False,
     calibration_targets: int = 60,
     vertical: tuple[float, float] | None = None,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
 ) -> dict[str, Any]:
     """Model 2 over the depth bands, after Sec. V calibration if ``calibrate``.
 
@@ -226,7 +221,7 @@ def paper_error_budget(
     rng_seed: int,
     targets_per_band: int = 12,
     calibration_targets: int = 60,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
 ) -> dict[str, Any]:
     """x/z errors with the paper's cameras, and with each imperfection off in turn."""
     budget = {}
@@ -338,7 +333,7 @@ def area_tally(
 def relative_areas(
     rng: np.random.Generator,
     layouts: int = 9,
-    progress: Progress = _quiet,
+    progress: Progress = quiet,
     settings: HeadSettings | None = None,
 ) -> dict[str, Any]:
     """Eq. (12) on pixels against the geometric truth over random object layouts.
@@ -403,7 +398,7 @@ SERVO_CASES = {
 
 
 def servo_robustness(
-    rng: np.random.Generator, points: int = 8, progress: Progress = _quiet
+    rng: np.random.Generator, points: int = 8, progress: Progress = quiet
 ) -> dict[str, Any]:
     """The servo, told nothing, over focal lengths 0.5x-2x and shifted principal points."""
     out = {}

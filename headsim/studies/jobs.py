@@ -1,17 +1,29 @@
-"""The orchestrators' job pool: jobs on spawned local processes or a Dask cluster, each
-retried once and a crashed worker survived, and the render workers' pool."""
+"""The campaigns' job engine: jobs on spawned local processes or a Dask cluster, each
+retried once and a crashed worker survived (:func:`execute`, :func:`map_jobs`); the log
+a campaign resumes from (:func:`read_log`, :func:`append_record`); jobs with needs, the
+longest path to the end first (:func:`schedule`); and the render workers' pool."""
 
 from __future__ import annotations
 
 import concurrent.futures as cf
 import concurrent.futures.process  # noqa: F401  execute() reads cf.process; only a process pool loads it
+import contextlib
+import functools
 import importlib
+import json
 import multiprocessing
 import os
+import queue
 import signal
-from collections.abc import Callable
+import threading
+import time
+import traceback
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol, TypeVar
+
+from headsim.errors import EnvironmentProblem
 
 #: Attempts per job: the first and one retry.
 ATTEMPTS = 2
@@ -96,12 +108,21 @@ def map_jobs(
     scheduler: str | None = None,
     on_record: Callable[[dict[str, Any]], None] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run ``function(job, None)`` for every job on local processes or Dask; records in job order.
+    """Run ``function(job, None)`` for every job; records in job order.
 
-    The same machinery as :func:`headsim.studies.sweep.run_sweep` (spawned processes, one retry,
-    crash-proof) for any picklable jobs with ``id`` and ``index``, such as the
-    insensitivity study's conditions.
+    One local worker: in this process, one job after the other (an error is raised, not
+    retried).  More, or a Dask ``scheduler``: the same machinery as
+    :func:`headsim.studies.sweep.run_sweep` (spawned processes, one retry, crash-proof) for
+    any picklable jobs with ``id`` and ``index``, such as the insensitivity study's
+    conditions.
     """
+    if workers == 1 and scheduler is None:
+        done = []
+        for job in jobs:
+            done.append(function(job, None))
+            if on_record is not None:
+                on_record(done[-1])
+        return done
     records: dict[str, dict[str, Any]] = {}
 
     def keep(record: dict[str, Any]) -> None:
@@ -125,6 +146,187 @@ def map_jobs(
             function,
         )
     return [records[job.id] for job in jobs]
+
+
+# -- resuming ---------------------------------------------------------------------------
+
+
+def read_log(path: Path) -> dict[str, dict[str, Any]]:
+    """Finished jobs from a campaign's log (``jobs.jsonl``: a record per line, as each job
+    ended), by id: a campaign resumes with the jobs not in it.  A torn last line (a killed
+    writer) is ignored."""
+    records: dict[str, dict[str, Any]] = {}
+    if not path.exists():
+        return records
+    for line in path.read_text(encoding="utf-8").splitlines():
+        try:
+            record = json.loads(line)
+        except json.JSONDecodeError:
+            continue
+        records[record["id"]] = record
+    return records
+
+
+def append_record(path: Path, record: dict[str, Any]) -> None:
+    """Append one record as a line, after ending a torn last line if a killed writer left one."""
+    line = (json.dumps(record, sort_keys=True) + "\n").encode()
+    with path.open("a+b") as handle:
+        if handle.tell() > 0:
+            handle.seek(-1, os.SEEK_END)
+            if handle.read(1) != b"\n":
+                line = b"\n" + line
+        handle.write(line)
+        handle.flush()
+        os.fsync(handle.fileno())
+
+
+# -- jobs with needs ------------------------------------------------------------------
+
+
+class JobError(RuntimeError):
+    """An experiment failed in its worker; the message says why (picklable, unlike
+    some of the errors it stands for: a worker must not break the pool)."""
+
+
+def plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str, Any]]:
+    """``job`` for a worker: any error becomes a :class:`JobError`, and its data says where
+    and when it ran (``worker``: pid, start, end, CPU time)."""
+
+    @functools.wraps(job)
+    def run(*args: Any) -> dict[str, Any]:
+        began, cpu = time.time(), time.process_time()
+        try:
+            data = job(*args)
+        except Exception as err:
+            raise JobError(why(err)) from None
+        # Where and when it ran (report.json's timeline: the critical path).
+        data["worker"] = {
+            "pid": os.getpid(),
+            "start": began,
+            "end": time.time(),
+            "cpu_s": time.process_time() - cpu,
+        }
+        return data
+
+    return run
+
+
+def why(err: BaseException) -> str:
+    """The last line of ``err``'s report: its type and message."""
+    text = "".join(traceback.format_exception_only(type(err), err)).strip()
+    return text.splitlines()[-1] if text else repr(err)
+
+
+@dataclass(frozen=True)
+class PlannedJob:
+    """A job of the run: what it runs, the jobs it needs, and its arguments from their data."""
+
+    name: str
+    run: Callable[..., dict[str, Any]]
+    needs: tuple[str, ...]
+    args: Callable[[dict[str, dict[str, Any]]], tuple[Any, ...]]
+    #: What it costs, in any unit common to the plan (``headsim reproduce``: render-times).
+    cost: float
+
+
+def critical_order(plan: list[PlannedJob]) -> dict[str, float]:
+    """Each job's longest path to the end of the run (its cost and its dependents'): the
+    priority of list scheduling."""
+    level: dict[str, float] = {}
+    for job in reversed(_topological(plan)):
+        after = [level[j.name] for j in plan if job.name in j.needs]
+        level[job.name] = job.cost + max(after, default=0.0)
+    return level
+
+
+def _topological(plan: list[PlannedJob]) -> list[PlannedJob]:
+    order: list[PlannedJob] = []
+    placed: set[str] = set()
+    for _ in range(len(plan)):  # bounded: one job placed per pass at least
+        for job in plan:
+            if job.name not in placed and all(n in placed for n in job.needs):
+                order.append(job)
+                placed.add(job.name)
+        if len(order) == len(plan):
+            return order
+    raise ValueError(
+        f"jobs with unmet or circular needs: {sorted({j.name for j in plan} - placed)}"
+    )
+
+
+@contextlib.contextmanager
+def interrupt_deferred() -> Iterator[None]:
+    """Ctrl-C waits until the block ends (then KeyboardInterrupt): a worker the pool
+    is spawning is never left half-started (it would print a traceback and stay
+    unknown to the pool).  Only in the main thread; elsewhere it does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if caught:
+        raise KeyboardInterrupt
+
+
+def schedule(
+    pool: cf.Executor,
+    workers: int,
+    plan: list[PlannedJob],
+    finished: Callable[[str, dict[str, Any] | None, str, float], None],
+    skipped: Callable[[str, str], None],
+    ran: Callable[[str, dict[str, Any]], None],
+) -> str:
+    """Run ``plan`` on ``pool``, at most ``workers`` jobs at a time: of the jobs whose
+    needs are done, the one with the longest path to the end first (the pool
+    would otherwise start them in the order they were queued, whatever frees
+    first).  A job whose need failed is skipped.  Returns why it ended."""
+    level = critical_order(plan)
+    waiting = sorted(plan, key=lambda j: -level[j.name])
+    done: dict[str, dict[str, Any]] = {}
+    failed: set[str] = set()
+    running: dict[cf.Future[dict[str, Any]], tuple[str, float]] = {}
+    # Ended jobs are reported after the next jobs started: a report (a figure) must
+    # not keep a worker idle.
+    ended: list[tuple[str, dict[str, Any] | None, str, float]] = []
+    for _ in range(2 * len(plan) + 1):  # each pass starts or ends a job at least
+        for job in list(waiting):
+            missing = next((n for n in job.needs if n in failed), None)
+            if missing is not None:
+                waiting.remove(job)
+                failed.add(job.name)
+                skipped(job.name, missing)
+            elif len(running) < workers and all(n in done for n in job.needs):
+                waiting.remove(job)
+                with interrupt_deferred():
+                    future = pool.submit(job.run, *job.args(done))
+                running[future] = (job.name, time.perf_counter())
+        for report in ended:
+            finished(*report)
+        ended.clear()
+        if not running:
+            return (
+                "every job ended"
+                if not waiting
+                else f"stuck: {[j.name for j in waiting]} wait for jobs that never ran"
+            )
+        ready, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+        for future in ready:
+            name, began = running.pop(future)
+            try:
+                data = future.result()
+            except Exception as err:
+                failed.add(name)
+                error = str(err) if isinstance(err, JobError) else why(err)
+                ended.append((name, None, error, time.perf_counter() - began))
+                continue
+            ran(name, data)
+            done[name] = data
+            ended.append((name, data, "", time.perf_counter() - began))
+    return "stopped: more passes than jobs allow"
 
 
 def local_pool(workers: int) -> cf.Executor:
@@ -192,3 +394,70 @@ def start_workers(pool: cf.Executor, workers: int) -> list[cf.Future[int]]:
     """Start ``workers`` processes of ``pool`` now, rather than at its first jobs: a
     spawned pool starts one process per job it is given while none is idle."""
     return [pool.submit(os.getpid) for _ in range(workers)]
+
+
+#: How long a render pool's workers may take to start and load their modules, s.
+WORKERS_START_S = 300.0
+
+
+class WorkersNotStarted(EnvironmentProblem):
+    """The worker processes did not start (exit 3)."""
+
+
+class _Closing(Protocol):
+    def close(self) -> None: ...
+
+
+Made = TypeVar("Made", bound=_Closing)
+
+
+def started_render_pool(
+    workers: int, preload: tuple[str, ...], meanwhile: Callable[[], Made]
+) -> tuple[cf.Executor, Made]:
+    """A :func:`render_pool` whose ``workers`` have started and imported ``preload``, and
+    what ``meanwhile()`` made while they started (closed if they do not start).
+
+    Returns once every worker is ready and waits, idle; a worker that fails to start, or
+    workers not started within :data:`WORKERS_START_S`, raise :class:`WorkersNotStarted`.
+    """
+    ready = spawn_context().Queue()
+    pool = render_pool(workers, preload, ready)
+    made = None
+    try:
+        with interrupt_deferred():
+            starting = start_workers(pool, workers)
+        made = meanwhile()
+        deadline, started = time.monotonic() + WORKERS_START_S, 0
+        while started < workers:  # bounded by the deadline
+            try:
+                ready.get(timeout=0.05)
+                started += 1
+            except queue.Empty:
+                failed = [f.exception() for f in starting if f.done() and f.exception()]
+                if failed:
+                    raise WorkersNotStarted(f"a worker failed to start: {failed[0]!r}") from None
+                if time.monotonic() > deadline:
+                    raise WorkersNotStarted(
+                        f"{workers - started} of {workers} workers not started "
+                        f"within {WORKERS_START_S:.0f} s"
+                    ) from None
+        return pool, made
+    except BaseException:
+        stop_pool(pool)
+        if made is not None:
+            made.close()
+        raise
+
+
+def stop_pool(pool: cf.Executor) -> None:
+    """Stop the pool's workers now, whatever they run."""
+    pool.shutdown(wait=False, cancel_futures=True)
+    terminate_children()
+
+
+def terminate_children() -> None:
+    """Terminate every child process: each is one of the pool's workers, including
+    one caught half-started (Ctrl-C while the pool spawned it, which the pool does
+    not know of yet, and for which the exit would otherwise wait forever)."""
+    for process in multiprocessing.active_children():
+        process.terminate()

@@ -3,7 +3,6 @@ and its progress callback (the study's lowest module: plots and every study modu
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -33,13 +32,6 @@ METHOD_LABELS = {
 }
 TARGET = body_target(names.MARKERS[0], MarkerDetector("red"))
 BALL = body_target(names.CALIBRATION_BALL, MarkerDetector("yellow"))
-
-
-Progress = Callable[[str], None]
-
-
-def quiet(_: str) -> None:
-    """A progress callback that says nothing."""
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ the images, so each target is servoed once and every active method's
 estimate is computed from those same images (:func:`measure_paired`; the
 renders are counted once, on ``active_centre``).  The study's other parts (a
 second base head with centred principal points, the 0.7x zoom,
-principal-point and k1 changes) are left to ``python -m headsim.studies.study``.
+principal-point and k1 changes) are left to ``headsim study``.
 """
 
 from __future__ import annotations

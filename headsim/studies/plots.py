@@ -1,6 +1,6 @@
 """Every figure of the orchestrators, with matplotlib's Agg backend, written atomically.
 
-The study (:mod:`headsim.studies.study`) draws one PNG per experiment:
+The study (``headsim study``, :mod:`headsim.studies.study`) draws one PNG per experiment:
 
 - the comparison: per group (a head), the Tables V/VI errors target by target
   (left) and the RMS error of every method in every condition (right), on a

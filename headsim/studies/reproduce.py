@@ -17,7 +17,7 @@ One head (the scenarios' ``paper`` head) is calibrated once (Sec. V, the
   kept (the changed focal length), on the same head with the same Sec. V
   calibration (head.json), one Zhang stereo calibration and one zoom
   fixed-point calibration (:mod:`headsim.studies.paper_tables`; the study's other
-  heads and changes are left to ``python -m headsim.studies.study``).
+  heads and changes are left to ``headsim study``).
 
 The head's calibration, Zhang's and the fixed points' run first, side by
 side; then the longest experiments first, so that the workers finish together.
@@ -32,9 +32,7 @@ from __future__ import annotations
 
 import functools
 import importlib
-import multiprocessing
 import os
-import queue
 import statistics
 import sys
 import threading
@@ -43,15 +41,23 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from headsim.errors import EnvironmentProblem, OutputNotWritable
+from headsim.errors import OutputNotWritable
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.runs.progress import Status, quiet
-from headsim.studies.jobs import render_pool, spawn_context, start_workers
+from headsim.studies.jobs import (
+    PlannedJob,
+    schedule,
+    started_render_pool,
+    stop_pool,
+    terminate_children,
+)
 from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
 from headsim.studies.reproduce_experiments import (
+    COSTS,
     REALISTIC_BOARD_JOB,
     SCENARIO_JOBS,
     STUDY_JOB,
+    SWEEP_COST,
     JobOutcome,
     ReproduceError,
 )
@@ -66,7 +72,6 @@ from headsim.studies.reproduce_jobs import (
     zhang_job,
 )
 from headsim.studies.reproduce_report import main_figure, report_sections, report_text
-from headsim.studies.reproduce_schedule import PlannedJob, interrupt_deferred, schedule
 
 
 def reproduce(
@@ -93,7 +98,9 @@ def reproduce(
     except OSError as err:
         raise OutputNotWritable(f"--out: cannot create {out}: {err.strerror}") from err
     start, epoch = time.perf_counter(), time.time()
-    pool, clock = _start(workers)
+    # The workers load what their jobs import (about 1 s) while this process makes its
+    # clock, whose renders are then timed on a quiet machine.
+    pool, clock = started_render_pool(workers, WORKER_MODULES, RenderClock)
     render_s = clock.sample(CLOCK_RENDERS[0])
     state: dict[str, Any] = {
         "status": "running",
@@ -190,11 +197,23 @@ def reproduce(
         path = str(out)
         head = lambda done: done["calibration"]["path"]  # noqa: E731
         plan = [
-            PlannedJob("calibration", calibrate_job, (), lambda done: (path, fast, seed)),
-            PlannedJob("zhang", zhang_job, (), lambda done: (fast, seed)),
-            PlannedJob("fixed_point", fixed_point_job, (), lambda done: (fast, seed)),
             PlannedJob(
-                REALISTIC_BOARD_JOB, realistic_board_job, (), lambda done: (path, fast, seed)
+                "calibration",
+                calibrate_job,
+                (),
+                lambda done: (path, fast, seed),
+                COSTS["calibration"],
+            ),
+            PlannedJob("zhang", zhang_job, (), lambda done: (fast, seed), COSTS["zhang"]),
+            PlannedJob(
+                "fixed_point", fixed_point_job, (), lambda done: (fast, seed), COSTS["fixed_point"]
+            ),
+            PlannedJob(
+                REALISTIC_BOARD_JOB,
+                realistic_board_job,
+                (),
+                lambda done: (path, fast, seed),
+                COSTS[REALISTIC_BOARD_JOB],
             ),
             *(
                 PlannedJob(
@@ -204,6 +223,7 @@ def reproduce(
                     functools.partial(
                         lambda done, name: (name, path, fast, seed, head(done)), name=name
                     ),
+                    COSTS[name],
                 )
                 for name in SCENARIO_JOBS
             ),
@@ -219,6 +239,7 @@ def reproduce(
                     done["zhang"],
                     done["fixed_point"],
                 ),
+                COSTS[STUDY_JOB],
             ),
             *(
                 PlannedJob(
@@ -226,6 +247,7 @@ def reproduce(
                     study_job,
                     (),
                     functools.partial(lambda d, n: (n, path, fast, seed), n=name),
+                    SWEEP_COST,
                 )
                 for name in state["sweeps"]
             ),
@@ -270,14 +292,14 @@ def reproduce(
         progress(f"scheduler: {ended}")
         # Every job ended and its files are written: the idle workers are stopped
         # rather than left to tear down their interpreters and GL contexts (~0.5 s).
-        _terminate_children()
+        terminate_children()
         state["status"] = (
             "ok" if calibration and all(o.status == "ok" for o in outcomes.values()) else "failed"
         )
     except KeyboardInterrupt:
         state["status"] = "interrupted"
         # Stop the workers now: their experiments are lost, the finished ones are kept.
-        _stop(pool)
+        stop_pool(pool)
         write_report()
         raise
     finally:
@@ -306,64 +328,6 @@ def reproduce(
         timeline["render_time_end"] = {"pid": os.getpid(), "start": 0.0, "end": time.time() - epoch}
     write_report()
     return state
-
-
-#: How long the workers may take to start and load their modules, s.
-WORKERS_START_S = 300.0
-
-
-def _start(workers: int) -> tuple[Any, RenderClock]:
-    """The pool, its workers started, and the render clock (made meanwhile).
-
-    The workers load what their jobs import (about 1 s) while this process makes
-    its clock; this returns once every worker is ready and waits, idle, so that
-    the clock's renders are timed on a quiet machine.
-    """
-    ready = spawn_context().Queue()
-    pool = render_pool(workers, WORKER_MODULES, ready)
-    clock = None
-    try:
-        with interrupt_deferred():
-            starting = start_workers(pool, workers)
-        clock = RenderClock()
-        deadline, started = time.monotonic() + WORKERS_START_S, 0
-        while started < workers:  # bounded by the deadline
-            try:
-                ready.get(timeout=0.05)
-                started += 1
-            except queue.Empty:
-                failed = [f.exception() for f in starting if f.done() and f.exception()]
-                if failed:
-                    raise WorkersNotStarted(f"a worker failed to start: {failed[0]!r}") from None
-                if time.monotonic() > deadline:
-                    raise WorkersNotStarted(
-                        f"{workers - started} of {workers} workers not started "
-                        f"within {WORKERS_START_S:.0f} s"
-                    ) from None
-        return pool, clock
-    except BaseException:
-        _stop(pool)
-        if clock is not None:
-            clock.close()
-        raise
-
-
-class WorkersNotStarted(EnvironmentProblem):
-    """The worker processes did not start (exit 3)."""
-
-
-def _stop(pool: Any) -> None:
-    """Stop the pool's workers now, whatever they run."""
-    pool.shutdown(wait=False, cancel_futures=True)
-    _terminate_children()
-
-
-def _terminate_children() -> None:
-    """Terminate every child process: each is one of the pool's workers, including
-    one caught half-started (Ctrl-C while the pool spawned it, which the pool does
-    not know of yet, and for which the exit would otherwise wait forever)."""
-    for process in multiprocessing.active_children():
-        process.terminate()
 
 
 def main(args: Any) -> int:

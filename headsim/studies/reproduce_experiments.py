@@ -25,7 +25,7 @@ TABLES_SCOPE = (
     "calibration (stereo) and one zoom fixed-point calibration (the fixed-point methods, "
     "beyond the paper, fewer ball positions than head.json): the six target positions, as calibrated and with the focal length "
     "x1.5. The three image-centre methods servo once and are computed from the same images. "
-    "Smaller than `python -m headsim.studies.study --experiment compare`, which also measures a "
+    "Smaller than `headsim study --experiment compare`, which also measures a "
     "second head with centred principal points and the 0.7x zoom, principal-point and k1 "
     "changes (beyond the paper's tables)."
 )

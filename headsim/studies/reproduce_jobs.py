@@ -4,21 +4,19 @@ the head's calibration, Zhang's, the fixed points', the scenarios, Tables V/VI, 
 from __future__ import annotations
 
 import dataclasses
-import functools
-import os
 import time
-import traceback
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
+from headsim.studies.jobs import plain_errors
 from headsim.studies.reproduce_experiments import (
     FIXED_POINT_TARGETS,
     REALISTIC_BOARD_JOB,
     SCENARIO_JOBS,
     TABLES_HEAD,
 )
+from headsim.studies.scenario_jobs import Job
 
 #: What the jobs import, loaded by each worker as it starts (about 1 s), while the parent
 #: makes its render clock.
@@ -34,32 +32,7 @@ WORKER_MODULES = (
 )
 
 
-class JobError(RuntimeError):
-    """An experiment failed in its worker; the message says why (picklable, unlike
-    some of the errors it stands for: a worker must not break the pool)."""
-
-
-def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str, Any]]:
-    @functools.wraps(job)
-    def run(*args: Any) -> dict[str, Any]:
-        began, cpu = time.time(), time.process_time()
-        try:
-            data = job(*args)
-        except Exception as err:
-            raise JobError(why(err)) from None
-        # Where and when it ran (report.json's timeline: the critical path).
-        data["worker"] = {
-            "pid": os.getpid(),
-            "start": began,
-            "end": time.time(),
-            "cpu_s": time.process_time() - cpu,
-        }
-        return data
-
-    return run
-
-
-@_plain_errors
+@plain_errors
 def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.active.calibration_file import head_hash, write_calibration
     from headsim.runs.runner import calibrate_scenario
@@ -85,16 +58,13 @@ def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     }
 
 
-def _scenario_run(
-    scenario_name: str, directory: Path, fast: bool, seed: int | None, overrides: dict[str, Any]
-) -> dict[str, Any]:
+def _scenario_run(job: Job, directory: Path) -> dict[str, Any]:
     """One scenario run: its results.json and summary.txt written in ``directory``."""
     from headsim.runs.runner import run_scenario
     from headsim.runs.serialise import results_payload
     from headsim.runs.summary import summary_text
-    from headsim.scenario.loading import load_scenario
 
-    scenario = load_scenario(scenario_name, fast=fast, seed=seed, overrides=overrides)
+    scenario = job.load()
     start = time.perf_counter()
     result = run_scenario(scenario)
     wall = time.perf_counter() - start
@@ -110,20 +80,21 @@ def _scenario_run(
     }
 
 
-@_plain_errors
+@plain_errors
 def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
     scenario_name, _ = SCENARIO_JOBS[name]
-    overrides = {"experiment.calibration.from": head}
-    return _scenario_run(scenario_name, Path(out) / name, fast, seed, overrides)
+    params = {"experiment.calibration.from": head, "seed": seed}
+    return _scenario_run(Job(0, name, scenario_name, fast, params), Path(out) / name)
 
 
-@_plain_errors
+@plain_errors
 def realistic_board_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     """The chessboard on the realistic preset, calibrated by the scenario itself: the
     paper's rig had real tolerances, which the paper preset's ideal mechanics lack."""
     scenario_name, _ = SCENARIO_JOBS["chessboard"]
-    directory = Path(out) / REALISTIC_BOARD_JOB
-    return _scenario_run(scenario_name, directory, fast, seed, {"head.preset": "realistic"})
+    params = {"head.preset": "realistic", "seed": seed}
+    job = Job(0, REALISTIC_BOARD_JOB, scenario_name, fast, params)
+    return _scenario_run(job, Path(out) / REALISTIC_BOARD_JOB)
 
 
 def _study_config(fast: bool, seed: int | None) -> Any:
@@ -133,7 +104,7 @@ def _study_config(fast: bool, seed: int | None) -> Any:
     return make(seed=seed or 0)
 
 
-@_plain_errors
+@plain_errors
 def zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
     """Zhang's stereo calibration of the one head, once (it needs no head.json)."""
     from headsim.scenario.loading import load_scenario
@@ -145,7 +116,7 @@ def zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
     return {"calibration": calibration, "renders": renders, "wall_s": time.perf_counter() - start}
 
 
-@_plain_errors
+@plain_errors
 def fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
     """The zoom fixed points and the Sec. V calibration on their columns, once (beyond the
     paper: the active method that the focal length's change does not move)."""
@@ -162,7 +133,7 @@ def fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
     return {"fixed": fixed, "targets": targets, "wall_s": time.perf_counter() - start}
 
 
-@_plain_errors
+@plain_errors
 def tables_job(
     out: str,
     fast: bool,
@@ -175,8 +146,7 @@ def tables_job(
     from headsim.active.calibration_file import read_calibration
     from headsim.scenario.loading import load_scenario
     from headsim.studies import paper_tables
-    from headsim.studies.study_experiments import compare_figures
-    from headsim.studies.study_output import summary_rows, write_experiment
+    from headsim.studies.study_output import experiment_record, write_experiment
 
     settings = load_scenario(TABLES_HEAD, fast=fast, seed=seed).settings
     stored = read_calibration(head, settings).knowledge
@@ -189,10 +159,7 @@ def tables_job(
     own = result.seconds + zhang["wall_s"] + fixed["wall_s"]
     data = to_jsonable(
         {
-            "title": result.experiment.title,
-            "summary": summary_rows(result),
-            "figures": compare_figures(result),
-            "files": {k: str(p) for k, p in files.items()},
+            **experiment_record(result, files),
             "seconds": own,
             "zhang": {
                 "seconds": zhang["wall_s"],
@@ -216,26 +183,13 @@ def tables_job(
     return data
 
 
-@_plain_errors
+@plain_errors
 def study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, Any]:
-    from headsim.studies.study_experiments import compare_figures, run_experiment, sweep_experiment
-    from headsim.studies.study_output import summary_rows, write_experiment
+    from headsim.studies.study_experiments import run_experiment, sweep_experiment
+    from headsim.studies.study_output import experiment_record, write_experiment
 
     config = _study_config(fast, seed)
     experiment = sweep_experiment(name.removeprefix("sweep_"), config)
     result = run_experiment(experiment, config)
     files = write_experiment(result, Path(out) / "study")
-    return to_jsonable(
-        {
-            "title": experiment.title,
-            "summary": summary_rows(result),
-            "figures": compare_figures(result) if experiment.kind == "compare" else None,
-            "files": {k: str(p) for k, p in files.items()},
-            "seconds": result.seconds,
-        }
-    )
-
-
-def why(err: BaseException) -> str:
-    text = "".join(traceback.format_exception_only(type(err), err)).strip()
-    return text.splitlines()[-1] if text else repr(err)
+    return to_jsonable(experiment_record(result, files))

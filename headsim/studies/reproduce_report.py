@@ -294,7 +294,7 @@ def report_text(
                     "The fixed-point methods' Sec. V calibration uses "
                     f"{data['fixed_point'].get('targets', '?')} ball positions, fewer than "
                     "head.json's (their rows are the zoom's after/before ratios; "
-                    "`python -m headsim.studies.study` calibrates them with as many as the head).",
+                    "`headsim study` calibrates them with as many as the head).",
                 ]
         if outcome is not None:
             where = f"`{name}/`" if name in SCENARIO_JOBS else "`study/`"

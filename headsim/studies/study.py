@@ -42,22 +42,25 @@ row per target), ``<name>.json`` and ``<name>.png`` beside ``results.json``,
 which indexes every experiment written to the directory.  The realistic
 head's error budget (``--experiment budget``) is :mod:`headsim.studies.error_budget`.
 
-    python -m headsim.studies.study --experiment compare --out out/study
-    python -m headsim.studies.study --sweep depth --out out/study [--fast]
-    python -m headsim.studies.study --experiment budget --out out/study [--fast]
-    python -m headsim.studies.study --all --out out/study
+    headsim study --experiment compare --out out/study
+    headsim study --sweep depth --out out/study [--fast]
+    headsim study --experiment budget --out out/study [--fast]
+    headsim study --all --out out/study
+
+Its options are the ``headsim`` parser's (:func:`headsim.cli.parser.add_study_arguments`);
+``python -m headsim.studies.study`` is a deprecated alias of ``headsim study``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import time
-from collections.abc import Sequence
 
-from headsim.errors import BadInput
-from headsim.runs.progress import Status
+from headsim.runs.progress import Progress, Status, quiet
 from headsim.studies.calibrations import CalibrationCache
-from headsim.studies.methods import Progress, StudyConfig, quiet
+from headsim.studies.methods import StudyConfig
 from headsim.studies.study_experiments import (
     SWEEPS,
     compare_experiment,
@@ -66,66 +69,15 @@ from headsim.studies.study_experiments import (
 )
 from headsim.studies.study_output import print_result, write_experiment
 
-# -- command line ------------------------------------------------------------------------
-
-
-def add_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
-    """The study's options (shared by ``python -m headsim.studies.study`` and ``headsim study``)."""
-    what = parser.add_mutually_exclusive_group(required=True)
-    what.add_argument(
-        "--experiment",
-        choices=["compare", "budget"],
-        help="compare: the Tables V/VI comparison; budget: the realistic head's error budget "
-        "(headsim.studies.error_budget; scenario realistic_field, whatever --preset)",
-    )
-    what.add_argument("--sweep", choices=sorted(SWEEPS), help="one sweep")
-    what.add_argument(
-        "--all", action="store_true", help="the comparison, every sweep and the error budget"
-    )
-    parser.add_argument("--out", required=True, help="output directory (created if missing)")
-    parser.add_argument("--preset", default="paper", choices=["ideal", "paper"])
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument(
-        "--fast", action="store_true", help="small calibrations and two values per sweep"
-    )
-    parser.add_argument(
-        "--workers", type=int, default=1, metavar="N", help="run conditions on N local processes"
-    )
-    parser.add_argument(
-        "--scheduler",
-        metavar="tcp://HOST:PORT",
-        help="run conditions on this Dask scheduler (pip install 'headsim[dask]')",
-    )
-    return parser
-
-
-STUDY_DESCRIPTION = (
-    "Calibrated stereo against the active method: the Tables V/VI comparison, changes of "
-    "focal length, principal point and distortion after calibration, and sweeps (depth, focal, "
-    "principal, k1, noise, encoder), and the realistic head's error budget; writes CSV, JSON "
-    "and PNG to --out."
-)
-
-
-def build_parser() -> argparse.ArgumentParser:
-    return add_arguments(
-        argparse.ArgumentParser(
-            prog="python -m headsim.studies.study", description=STUDY_DESCRIPTION
-        )
-    )
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    return run(build_parser().parse_args(argv))
+#: Printed by the deprecated alias ``python -m headsim.studies.study``.
+ALIAS_NOTE = "note: python -m headsim.studies.study is deprecated; run: headsim study ..."
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run what ``args`` (see :func:`add_arguments`) asks for; 0 on success."""
-    if args.workers < 1:
-        raise BadInput(f"--workers must be >= 1, got {args.workers}")
+    """``headsim study``: run what ``args`` asks for; 0 on success."""
     make = StudyConfig.quick if args.fast else StudyConfig
     config = make(preset=args.preset, seed=args.seed)
-    progress: Progress = quiet if getattr(args, "quiet", False) else Status("headsim study")
+    progress: Progress = quiet if args.quiet else Status("headsim study")
     cache = CalibrationCache(config, progress)
     if args.experiment == "budget":
         return _budget(args, progress)
@@ -177,5 +129,6 @@ def _budget(args: argparse.Namespace, progress: Progress) -> int:
     return 1 if failed else 0
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+if __name__ == "__main__":  # the deprecated alias: this process becomes ``headsim study``
+    print(ALIAS_NOTE, file=sys.stderr, flush=True)
+    os.execv(sys.executable, [sys.executable, "-m", "headsim.cli", "study", *sys.argv[1:]])

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from headsim.active.principal import zoomed
+from headsim.runs.progress import Progress, quiet
 from headsim.sim.settings import HeadSettings, preset
 from headsim.studies.calibrations import CalibrationCache, Calibrations
 from headsim.studies.conditions import Condition, ConditionResult, run_conditions
@@ -23,7 +24,7 @@ from headsim.studies.head_changes import (
     with_encoder,
     with_noise,
 )
-from headsim.studies.methods import METHODS, SWEEP_METHODS, Progress, StudyConfig, quiet
+from headsim.studies.methods import METHODS, SWEEP_METHODS, StudyConfig
 from headsim.studies.target_errors import Summary
 from headsim.studies.targets import depth_targets, table_targets
 

@@ -79,6 +79,18 @@ def target_rows(result: ExperimentResult) -> list[dict[str, Any]]:
     return rows
 
 
+def experiment_record(result: ExperimentResult, files: dict[str, Path]) -> dict[str, Any]:
+    """A written experiment as a campaign's row: its title, summary rows, the comparison's
+    figures (None for a sweep), its files and seconds."""
+    return {
+        "title": result.experiment.title,
+        "summary": summary_rows(result),
+        "figures": compare_figures(result) if result.experiment.kind == "compare" else None,
+        "files": {k: str(p) for k, p in files.items()},
+        "seconds": result.seconds,
+    }
+
+
 def write_experiment(
     result: ExperimentResult, out_dir: str | Path, figure: bool = True
 ) -> dict[str, Path]:

@@ -37,7 +37,6 @@ end ``DIR/aggregate.csv``, ``DIR/aggregate.json`` and a plot per swept field.
 from __future__ import annotations
 
 import functools
-import json
 import os
 import signal
 import time
@@ -46,14 +45,13 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from headsim.errors import BadInput
 from headsim.runs.progress import Counter
 from headsim.scenario.tables import TargetRefused
-from headsim.studies.jobs import dask_client, execute, local_pool
+from headsim.studies.jobs import append_record, dask_client, execute, local_pool, read_log
+from headsim.studies.scenario_jobs import Job, run_row
 from headsim.studies.sweep_output import write_aggregate
-from headsim.studies.sweep_spec import BatchOptions, Job, SweepSpec
+from headsim.studies.sweep_spec import BatchOptions, SweepSpec
 
 #: Fault injection for tests: job indices (comma-separated) whose process dies.
 CRASH_ENV = "HEADSIM_SWEEP_CRASH_JOBS"
@@ -217,12 +215,8 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
     record: dict[str, Any] = {"id": job.id, "index": job.index, "params": job.params}
     try:
         from headsim.runs.runner import run_scenario
-        from headsim.scenario.loading import load_scenario
 
-        overrides = {k: v for k, v in job.params.items() if k != "seed"}
-        scenario = load_scenario(
-            job.scenario, fast=job.fast, seed=job.params.get("seed"), overrides=overrides
-        )
+        scenario = job.load()
         if recording is not None:
             from headsim.runs.recording import Recorder
             from headsim.runs.rerun_cli import job_target
@@ -233,33 +227,7 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
                 result = run_scenario(scenario, [recorder])
         else:
             result = run_scenario(scenario)
-        calibrated = result.calibration is not None
-        acceptance = result.scenario.scene.acceptance
-        ok = [r.measurement for r in result.records if r.measurement.ok]
-        used = [
-            r.measurement
-            for r in result.records
-            if r.measurement.ok and (r.knowledge != "none" or not calibrated)
-        ]
-        errors_mm = [1000 * float(np.linalg.norm(m.error_head_m)) for m in used]
-        pct = [m.error_pct_of_depth for m in used]
-        record.update(
-            status="ok" if result.ok else "failed",
-            failures=len(result.failures),
-            failure_reasons=list(result.failures),
-            measurements_ok=len(ok),
-            measurements=len(result.records),
-            rms_error_pct_depth=float(np.sqrt(np.mean(np.square(pct)))) if pct else None,
-            mean_error_mm=float(np.mean(errors_mm)) if errors_mm else None,
-            max_error_mm=float(np.max(errors_mm)) if errors_mm else None,
-            renders=result.renders.overall.total,
-            targets_redrawn=acceptance.refused_total if acceptance is not None else 0,
-            calibration_max_error_rad=float(
-                np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
-            )
-            if result.calibration is not None and result.calibration.layout is not None
-            else None,
-        )
+        record.update(run_row(result))
     except TargetRefused as err:  # this job's values: its failure, not the sweep file's
         record.update(
             status="refused",
@@ -293,33 +261,6 @@ class SweepOutcome:
     @property
     def failed(self) -> list[dict[str, Any]]:
         return [r for r in self.records.values() if r.get("status") != "ok"]
-
-
-def read_log(path: Path) -> dict[str, dict[str, Any]]:
-    """Finished jobs from ``jobs.jsonl``; a torn last line (a killed writer) is ignored."""
-    records: dict[str, dict[str, Any]] = {}
-    if not path.exists():
-        return records
-    for line in path.read_text(encoding="utf-8").splitlines():
-        try:
-            record = json.loads(line)
-        except json.JSONDecodeError:
-            continue
-        records[record["id"]] = record
-    return records
-
-
-def _append(path: Path, record: dict[str, Any]) -> None:
-    """Append one record as a line, after ending a torn last line if a killed writer left one."""
-    line = (json.dumps(record, sort_keys=True) + "\n").encode()
-    with path.open("a+b") as handle:
-        if handle.tell() > 0:
-            handle.seek(-1, os.SEEK_END)
-            if handle.read(1) != b"\n":
-                line = b"\n" + line
-        handle.write(line)
-        handle.flush()
-        os.fsync(handle.fileno())
 
 
 def run_sweep(
@@ -368,7 +309,7 @@ def run_sweep(
     job_function = functools.partial(run_job, recording=recording) if recording else run_job
 
     def on_record(record: dict[str, Any]) -> None:
-        _append(log, record)
+        append_record(log, record)
         done[record["id"]] = record
         if bar is not None:
             bar.update(note="" if record.get("status") == "ok" else "(this one failed)")

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from headsim.errors import BadInput
+from headsim.studies.scenario_jobs import Job
 
 
 class SweepError(BadInput, ValueError):
@@ -23,17 +24,6 @@ class SweepError(BadInput, ValueError):
     def __init__(self, source: str, path: str, message: str, allowed: str | None = None) -> None:
         text = f"{source}: {path}: {message}" if path else f"{source}: {message}"
         super().__init__(text + (f" (allowed: {allowed})" if allowed else ""))
-
-
-@dataclass(frozen=True)
-class Job:
-    """One scenario run: its position, a stable id, and the fields it sets."""
-
-    index: int
-    id: str
-    scenario: str
-    fast: bool
-    params: dict[str, Any]
 
 
 #: How a sweep's jobs run: one scenario run at a time per process, or in lockstep batches

@@ -182,13 +182,18 @@ def test_no_space_on_the_device_itself_is_exit_3(tmp_path: Path) -> None:
     assert not (tmp_path / "out").exists()
 
 
-def test_workers_0_is_bad_input_and_creates_nothing(tmp_path: Path) -> None:
-    sweep = Path(__file__).resolve().parents[2] / "sweeps" / "focal.toml"
-    result = headsim("sweep", str(sweep), "--out", str(tmp_path / "sw"), "--workers", "0")
+@pytest.mark.parametrize("command", [("sweep", "sweeps/focal.toml"), ("study", "--sweep", "depth")])
+def test_workers_0_is_bad_input_and_creates_nothing(
+    tmp_path: Path, command: tuple[str, ...]
+) -> None:
+    root = Path(__file__).resolve().parents[2]
+    name, *rest = command
+    argv = [str(root / a) if a.endswith(".toml") else a for a in rest]
+    result = headsim(name, *argv, "--out", str(tmp_path / "out"), "--workers", "0")
     assert result.returncode == 2
     assert "Traceback" not in result.stderr
     assert "argument --workers: 0 is not allowed (allowed: an integer >= 1)" in result.stderr
-    assert not (tmp_path / "sw").exists()
+    assert not (tmp_path / "out").exists()
 
 
 # -- interruption -----------------------------------------------------------------

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from headsim.runs.progress import quiet
 from headsim.sim import names
 from headsim.sim.simulator import HeadSim
 from headsim.studies.methods import (
@@ -13,7 +14,6 @@ from headsim.studies.methods import (
     SWEEP_METHODS,
     TARGET,
     StudyConfig,
-    quiet,
 )
 
 

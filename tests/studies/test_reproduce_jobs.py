@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from headsim.studies.jobs import render_pool
-from headsim.studies.reproduce_jobs import JobError, scenario_job
+from headsim.studies.jobs import JobError, render_pool
+from headsim.studies.reproduce_jobs import scenario_job
 
 
 def test_a_failing_job_says_why_and_leaves_the_pool_working(tmp_path: Path) -> None:

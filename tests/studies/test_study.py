@@ -1,11 +1,15 @@
-"""The study's command line: clear errors for unknown names, and a sweep with progress and files."""
+"""The study's command line (``headsim study``; ``python -m headsim.studies.study`` its
+deprecated alias): clear errors for unknown names, and a sweep with progress and files."""
 
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 
 import pytest
 
+from headsim import cli
 from headsim.studies import study
 from headsim.studies.methods import StudyConfig
 from headsim.studies.study_experiments import sweep_experiment
@@ -19,13 +23,20 @@ def test_unknown_names_are_clear_errors(calibrations) -> None:
         sweep_experiment("nope", CONFIG)
     with pytest.raises(ValueError, match="unknown methods"):
         measure_methods(calibrations.settings, calibrations, [[0, 0, 1]], ("laser",))
-    with pytest.raises(SystemExit) as exit_info:
-        study.main(["--sweep", "nope", "--out", "unused"])
-    assert exit_info.value.code == 2
+    # The deprecated alias is the headsim parser's command, and says so.
+    alias = subprocess.run(
+        [sys.executable, "-m", "headsim.studies.study", "--sweep", "nope", "--out", "unused"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert alias.returncode == 2
+    assert study.ALIAS_NOTE in alias.stderr
+    assert "headsim study: error: argument --sweep: invalid choice: 'nope'" in alias.stderr
 
 
 def test_the_command_runs_a_sweep_with_progress_and_files(tmp_path, capsys) -> None:
-    assert study.main(["--sweep", "depth", "--fast", "--out", str(tmp_path)]) == 0
+    assert cli.main(["study", "--sweep", "depth", "--fast", "--out", str(tmp_path)]) == 0
     captured = capsys.readouterr()
     assert "calibrating every method on paper" in captured.err
     assert "[2/2] paper: 1.5 (kept)" in captured.err

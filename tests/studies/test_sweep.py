@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
-from headsim.studies.sweep import CRASH_ENV, read_log, run_sweep
+from headsim.studies.jobs import read_log
+from headsim.studies.sweep import CRASH_ENV, run_sweep
 from headsim.studies.sweep_spec import load_sweep
 
 DATA = Path(__file__).resolve().parents[1] / "data"
