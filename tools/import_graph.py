@@ -31,6 +31,7 @@ LAYERS = (
     "stereo",
     "active",
     "live",
+    "lockstep",
     # The procedure contract: the interface the scenario reader and the runner call and the
     # procedures implement, so below both (it names none of their types).
     "procedures.contract",
@@ -164,16 +165,22 @@ def main() -> int:
     upward = sorted(
         (m, t) for m, ts in edges.items() for t in ts if 0 <= layer(m) < layer(t) and layer(t) >= 0
     )
+    unlayered = sorted(m for m in edges if m != "headsim" and layer(m) < 0)
     largest = sorted(lines.items(), key=lambda item: -item[1])
     print(f"modules: {len(edges)}; imports between them: {sum(map(len, edges.values()))}")
     print(f"circles: {len(found)}", *(" <-> ".join(c) for c in found), sep="\n  ")
     print(f"upward imports ({' < '.join(LAYERS)}): {len(upward)}")
     for m, t in upward:
         print(f"  {m} -> {t}")
+    print(
+        f"modules in no layer (add their package to LAYERS): {len(unlayered)}",
+        *unlayered,
+        sep="\n  ",
+    )
     print("largest modules:", ", ".join(f"{m} ({n})" for m, n in largest[:5]))
     over = [m for m, n in largest if n > MAX_LINES]
     print(f"over {MAX_LINES} lines: {len(over)}", *over, sep="\n  ")
-    return 1 if found or upward or over else 0
+    return 1 if found or upward or unlayered or over else 0
 
 
 if __name__ == "__main__":
