@@ -137,7 +137,7 @@ def calibrate_head(
     base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0), los_offset_m=None)
     rng = rng or np.random.default_rng(0)
     start = sim.render_count
-    parked = sim.position(body)  # put the target back afterwards: it must not hide others
+    parked = sim.truth.position(body)  # put the target back afterwards: it must not hide others
     alpha1, alpha2, depths, rows = [], [], [], []
     outcomes: list[Failure | None] = []
     # Plain first; near the midline the y images hold almost no x offset (NO_Y,
@@ -244,7 +244,8 @@ def calibrate_head(
             kx_over_ky=(vertical[0].kx_over_ky, vertical[1].kx_over_ky),
         )
     truth = tuple(
-        sim.effective_initial_direction(camera, base.reference(sim, camera)[0]) for camera in (1, 2)
+        sim.truth.effective_initial_direction(camera, base.reference(sim, camera)[0])
+        for camera in (1, 2)
     )
     return CalibrationRun(
         fit=fit,
