@@ -1,9 +1,10 @@
 """The smallest head the measurement path needs, and the truth channel kept apart from it.
 
 A :class:`Head` has joints it reads and commands, two cameras it grabs from at once,
-a clock, and a belief about its own geometry.  :class:`~headsim.sim.simulator.HeadSim`
-is one; :class:`~headsim.head.replay.ReplayHead` (a recording) is another; a robot's
-driver is a third.  What is truly where (for placing targets and scoring) is a
+a clock, and a belief about its own geometry.  The simulator is one
+(:class:`~headsim.head.sim_head.SimHead` over a :class:`~headsim.sim.simulator.HeadSim`);
+:class:`~headsim.head.replay.ReplayHead` (a recording) is another; a robot's driver is a
+third.  What is truly where (for placing targets and scoring) is a
 :class:`Truth`, which only a simulator has: nothing measuring may ask a head for it.
 
 Joints are the head's motors ("neck_yaw", "neck_pitch", "eye", and "eye2" with

@@ -18,7 +18,7 @@ taken is reported to the simulator's event sink (:mod:`headsim.sim.events`).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 import mujoco
@@ -27,8 +27,6 @@ import numpy as np
 from headsim.geometry.kinematics import eye_from_camera_rotation
 from headsim.geometry.stereo_view import StereoView
 from headsim.geometry.transforms import apply_transform, homogeneous, invert_transform
-from headsim.head.camera_info import CameraInfo, camera_info_of
-from headsim.head.interface import JointReading, StampedImage, StereoFrame
 from headsim.sim import names
 from headsim.sim.events import NO_EVENTS, EventSink, ImageKind, ImageTaken
 from headsim.sim.heads import actuator_on, eye_motor_range
@@ -45,9 +43,6 @@ from headsim.sim.render import Window, context_key, make_eye_renderer
 from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
 from headsim.sim.textured_scene import RoomSpec
 
-#: The frame period of :meth:`HeadSim.grab_stereo`'s clock, s (30 frames a second).
-FRAME_PERIOD_S = 1.0 / 30.0
-
 #: A camera: 1 or 2 (the paper's Ca1, Ca2), its MJCF name "cam1"/"cam2", or a names.Camera.
 CameraId = int | str | names.Camera
 
@@ -55,7 +50,7 @@ CameraId = int | str | names.Camera
 class HeadSim:
     """A head in a scene: command joints, settle, read encoders, render, read truth.
 
-    It is a :class:`~headsim.head.interface.Head` (``joint_names`` ... ``camera_infos``);
+    :class:`headsim.head.sim_head.SimHead` makes it a :class:`~headsim.head.interface.Head`;
     its truth channel is :attr:`truth` (itself: a simulator knows where everything is).
     """
 
@@ -116,14 +111,6 @@ class HeadSim:
             else None
         )
         self._commands = Commands()
-        #: The clock's time beyond MuJoCo's, s: what commanded motions and grabs took.
-        self._elapsed_s = 0.0
-        #: Each eye's camera as the head believes it (its calibration): by default its
-        #: cameras' intrinsics, as a Zhang calibration gives them to within its error.
-        self.believed_camera_infos: tuple[CameraInfo, CameraInfo] = (
-            camera_info_of(self.settings.cameras[0].pinhole(), mapping.cameras[0]),
-            camera_info_of(self.settings.cameras[1].pinhole(), mapping.cameras[1]),
-        )
         #: Bodies placed so far (targets moved: earlier images are out of date).
         self.placements = 0
         self._renderer = make_eye_renderer(
@@ -243,6 +230,10 @@ class HeadSim:
                     f"outside its range [{low}, {high}] rad"
                 )
 
+    def commanded(self) -> dict[str, float]:
+        """Each motor's current command, rad."""
+        return {motor: float(getattr(self._commands, motor)) for motor in self.motors}
+
     def command_eye_steps(self, steps: int) -> None:
         """Command the eye motor to a whole number of encoder steps."""
         self.command(eye=int(steps) * self.settings.encoder_resolution_rad)
@@ -331,80 +322,25 @@ class HeadSim:
             self._quantise(self._read("neck_pitch", self.names.neck_pitch)),
         )
 
+    def joint_speeds(self) -> dict[str, float]:
+        """Each motor's joint speed, rad/s (0 at rest; kinematic settling leaves it at rest)."""
+        return {
+            motor: float(self.data.qvel[self._dofadr[joint]])
+            for motor, joint in self._motor_joint.items()
+        }
+
     @property
     def belief(self) -> HeadBelief:
         """What the head believes of its own geometry (its design); see ``HeadSettings.believed``."""
         return self.settings.believed
 
-    # -- the Head interface (headsim.head.interface) -------------------------
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """Its motors: "neck_yaw" (if it has one), "neck_pitch", "eye" and, with
-        independent eyes, "eye2"."""
-        return self.motors
-
-    def joint_limits(self, joint: str) -> tuple[float, float]:
-        """:meth:`joint_range`."""
-        return self.joint_range(joint)
-
-    def now(self) -> float:
-        """The simulated clock, s: MuJoCo's time plus what commanded motions and grabs took."""
-        return float(self.data.time) + self._elapsed_s
-
-    def read_joints(self) -> JointReading:
-        """The encoders (quantised), rad, and the joints' speeds, rad/s (0 at rest)."""
-        yaw, pitch = self.neck_encoders()
-        eye1, eye2 = self.eye_encoders()
-        positions = {"neck_yaw": yaw, "neck_pitch": pitch, "eye": eye1, "eye2": eye2}
-        return JointReading(
-            self.now(),
-            {motor: positions[motor] for motor in self.motors},
-            {
-                motor: float(self.data.qvel[self._dofadr[self._motor_joint[motor]]])
-                for motor in self.motors
-            },
-        )
-
-    def command_position(self, positions_rad: Mapping[str, float]) -> None:
-        """``move(**positions_rad)``."""
-        self.move(**positions_rad)
-
-    def command_velocity(self, velocities_rad_s: Mapping[str, float], duration_s: float) -> None:
-        """Each named motor's command moved by rate x ``duration_s`` and settled; the clock
-        advances by ``duration_s`` (kinematic settling) or by the physics' own steps."""
-        if not (math.isfinite(duration_s) and duration_s >= 0):
-            raise SettingsError(f"duration_s must be finite and >= 0, got {duration_s}")
-        targets = {
-            motor: float(getattr(self._commands, motor)) + rate * duration_s
-            for motor, rate in velocities_rad_s.items()
-            if self._joint_of(motor)
-        }
-        self.move(**targets)
-        if self.settle_mode == "kinematic":
-            self._elapsed_s += duration_s
-
-    def grab_stereo(self) -> StereoFrame:
-        """Both eyes' next full images, taken at the same instant (skew 0); the clock
-        then advances by one frame period."""
-        time_s = self.now()
-        left, right = self.camera_infos()
-        frame = StereoFrame(
-            StampedImage(time_s, self.render(1), left),
-            StampedImage(time_s, self.render(2), right),
-        )
-        self._elapsed_s += FRAME_PERIOD_S
-        return frame
-
-    def camera_infos(self) -> tuple[CameraInfo, CameraInfo]:
-        """Each eye's camera as the head believes it (:attr:`believed_camera_infos`)."""
-        return self.believed_camera_infos
-
+    # -- ground truth ------------------------------------------------------
     @property
     def truth(self) -> HeadSim:
-        """The truth channel (:class:`~headsim.head.interface.Truth`): placing and scoring only."""
+        """The truth channel (:class:`~headsim.head.interface.Truth`), for placing and scoring
+        only: code that measures reaches truth through it alone, so a test can shut it."""
         return self
 
-    # -- ground truth ------------------------------------------------------
     def true_joint_angles(self) -> dict[str, float]:
         """True joint angles by joint name, rad (not quantised)."""
         return {joint: float(self.data.qpos[adr]) for joint, adr in self._qadr.items()}

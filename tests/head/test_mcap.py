@@ -13,7 +13,7 @@ import pytest
 from mcap.reader import make_reader
 
 from headsim.head.camera_info import camera_info_of
-from headsim.head.interface import JointReading, StampedImage, StereoFrame
+from headsim.head.interface import Head, JointReading, StampedImage, StereoFrame
 from headsim.head.mcap_log import (
     Command,
     HeadLog,
@@ -23,9 +23,10 @@ from headsim.head.mcap_log import (
     read_log,
 )
 from headsim.head.replay import ReplayDiverged, ReplayHead, pair_by_stamp
+from headsim.head.sim_head import FRAME_PERIOD_S, SimHead
 from headsim.head.stereo_look import StereoEstimate, look_and_estimate, triangulate_rays
 from headsim.sim.names import MARKER_COLOURS
-from headsim.sim.settings import ideal_head
+from headsim.sim.settings import SettingsError, ideal_head
 from headsim.sim.simulator import HeadSim
 
 #: The eye poses the recorded procedure turns to, rad.
@@ -65,7 +66,7 @@ class _Keep(RecordingHead):
 def recorded(tmp_path_factory: pytest.TempPathFactory) -> Recorded:
     path = tmp_path_factory.mktemp("mcap") / "run.mcap"
     with HeadSim("default", ideal_head()) as sim, McapRecorder(path) as recorder:
-        head = _Keep(sim, recorder)
+        head = _Keep(SimHead(sim), recorder)
         estimates = look_and_estimate(head, POSES, MARKER_COLOURS)
         for e in estimates:
             recorder.estimate(e.name, e.point_head_m, e.time_s)
@@ -193,3 +194,22 @@ def test_rays_meet_at_the_point_they_were_cast_through() -> None:
     assert gap == pytest.approx(0.002, rel=0.05)
     with pytest.raises(ValueError, match="parallel"):
         triangulate_rays(origins, [np.array([0, 0, 1.0]), np.array([0, 0, 2.0])])
+
+
+@pytest.mark.render
+def test_the_simulator_is_a_head() -> None:
+    with HeadSim("default", ideal_head()) as sim:
+        head = SimHead(sim)
+        assert isinstance(head, Head)
+        assert head.joint_names == ("neck_yaw", "neck_pitch", "eye")
+        head.command_velocity({"eye": 0.1}, 0.5)
+        reading = head.read_joints()
+        steps = round(0.05 / sim.settings.encoder_resolution_rad)
+        assert reading.positions_rad["eye"] == steps * sim.settings.encoder_resolution_rad
+        assert reading.time_s == 0.5
+        frame = head.grab_stereo()
+        assert frame.skew_s == 0.0 and frame.left.time_s == 0.5
+        assert frame.left.image.shape == (480, 640, 3)
+        assert head.now() == pytest.approx(0.5 + FRAME_PERIOD_S)
+        with pytest.raises(SettingsError, match="no motor 'eye2'"):
+            head.command_velocity({"eye2": 0.1}, 0.1)
