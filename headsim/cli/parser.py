@@ -94,6 +94,12 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     run.add_argument(
         "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"
     )
+    run.add_argument(
+        "--mcap",
+        metavar="FILE",
+        help="also record the run as ROS 2 messages in MCAP: images, CameraInfo, JointState, "
+        "TF, commands, estimates (needs headsim[mcap])",
+    )
     from headsim.runs.rerun_cli import add_recording_arguments
 
     add_recording_arguments(run)

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from headsim.errors import BadInput
+from headsim.errors import BadInput, EnvironmentProblem
 from headsim.geometry.kinematics import head_from_camera
 from headsim.head.camera_info import CameraInfo
 from headsim.head.interface import Head, JointReading, StampedImage, StereoFrame
@@ -104,7 +104,7 @@ class McapRecorder:
         try:
             from mcap_ros2.writer import Writer
         except ImportError:
-            raise LogError(
+            raise EnvironmentProblem(
                 "recording to MCAP needs the mcap extra: pip install 'headsim[mcap]'"
             ) from None
         self.topics = topics or Topics()
@@ -352,7 +352,9 @@ def _messages(path: Path, topics: Sequence[str]) -> Iterator[tuple[str, Any, flo
         from mcap.reader import make_reader
         from mcap_ros2.decoder import DecoderFactory
     except ImportError:
-        raise LogError("reading MCAP needs the mcap extra: pip install 'headsim[mcap]'") from None
+        raise EnvironmentProblem(
+            "reading MCAP needs the mcap extra: pip install 'headsim[mcap]'"
+        ) from None
     if not path.is_file():
         raise LogError(f"no recording {path}")
     with path.open("rb") as stream:
