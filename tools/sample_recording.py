@@ -28,7 +28,7 @@ TOPICS = Topics(
 POSES = ({"eye": 0.0}, {"eye": 0.04}, {"eye": 0.08}, {"eye": 0.12})
 
 MAPPING = """\
-# The mapping for examples/recording/markers.mcap (docs: how-to/estimate-from-a-recording).
+# The mapping for examples/recording/markers.mcap (docs: how-to/real-head).
 [topics]
 images = ["/left/image_raw", "/right/image_raw"]
 camera_infos = ["/left/camera_info", "/right/camera_info"]

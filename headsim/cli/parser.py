@@ -150,7 +150,7 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
         "image with Ca2's nearest in time, the joints interpolated to it), triangulate them "
         "with the head's belief and its cameras' CameraInfo, and write DIR/results.json. "
         "Topics, joint names, signs, belief and targets come from the mapping file "
-        "(docs: how-to/estimate-from-a-recording). Exit status: 0 every target estimated, "
+        "(docs: how-to/real-head). Exit status: 0 every target estimated, "
         "1 a target was not, 2 bad input, 3 the mcap extra missing or DIR not writable.",
     )
     estimate.add_argument("log", metavar="LOG.mcap", help="the recording")
