@@ -278,10 +278,10 @@ class LineOfSightTruth:
 def line_of_sight_truth(sim: HeadSim, knowledge: HeadKnowledge) -> LineOfSightTruth:
     """Ground truth for the extended calibration's offsets (scoring only)."""
     believed = knowledge.head_belief(sim).baseline_m
-    half_error = 0.5 * (sim.settings.baseline_m - believed)
+    half_error = 0.5 * (sim.truth.settings.baseline_m - believed)
     out = []
     for camera, sign in ((1, -1.0), (2, 1.0)):
-        cam = sim.camera_settings(camera)
+        cam = sim.truth.camera_settings(camera)
         u0 = knowledge.reference(sim, camera)[0]
         t = float(cam.pinhole().column_angle(u0))
         own = cam.side_offset_m * math.cos(t) - cam.nodal_offset_m * math.sin(t)

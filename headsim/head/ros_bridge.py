@@ -4,8 +4,9 @@ what a robot's drivers publish and taking what its forward controllers take.
 After each position command it applies (and once at the start), it publishes the
 joint states, then each eye's CameraInfo and image (latched: transient local).
 Velocity commands turn the joints on a ``period_s`` timer; when the rates return to
-zero it publishes the joint states and a stereo pair.  Stamps are the simulated
-clock's.  ``python -m headsim.head.ros_bridge`` runs the paper head in the default
+zero it publishes the joint states and a stereo pair.  Every ``resend_s`` it sends its
+last messages again (a subscriber that missed one is not left waiting).  Stamps are
+the simulated clock's.  ``python -m headsim.head.ros_bridge`` runs the paper head in the default
 scene until interrupted.
 """
 
@@ -23,7 +24,13 @@ from headsim.head.sim_head import SimHead
 class SimBridge:
     """A node serving ``head`` on ``topics`` (see the module docstring)."""
 
-    def __init__(self, head: SimHead, topics: Topics | None = None, period_s: float = 0.02) -> None:
+    def __init__(
+        self,
+        head: SimHead,
+        topics: Topics | None = None,
+        period_s: float = 0.02,
+        resend_s: float = 1.0,
+    ) -> None:
         rclpy, sensor, std, _ = ros_modules()
         self.head = head
         self.topics = topics or Topics()
@@ -49,6 +56,8 @@ class SimBridge:
         )
         self.period_s = period_s
         self.node.create_timer(period_s, self._tick)
+        self.node.create_timer(resend_s, self._resend)
+        self._last: list[tuple[Any, Any]] = []
         #: Commands applied, of each kind.
         self.applied = {"position": 0, "velocity": 0}
         self.publish_state()
@@ -78,7 +87,7 @@ class SimBridge:
                 list(info.R),
                 list(info.P),
             )
-            self._info_pubs[index].publish(info_msg)
+            self._send(self._info_pubs[index], info_msg)
             image = sensor.Image()
             set_stamp(image.header, stamped.time_s)
             image.header.frame_id = frame_id
@@ -86,11 +95,20 @@ class SimBridge:
             image.encoding = "rgb8"
             image.step = image.width * 3
             image.data = stamped.image.tobytes()
-            self._image_pubs[index].publish(image)
+            self._send(self._image_pubs[index], image)
+
+    def _send(self, publisher: Any, msg: Any) -> None:
+        publisher.publish(msg)
+        self._last = [(p, m) for p, m in self._last if p is not publisher] + [(publisher, msg)]
+
+    def _resend(self) -> None:
+        with self._lock:
+            for publisher, msg in self._last:
+                publisher.publish(msg)
 
     def publish_state(self) -> None:
         """The joint states now, then a fresh stereo pair."""
-        self._joint_pub.publish(self._joint_msg(self.head.read_joints()))
+        self._send(self._joint_pub, self._joint_msg(self.head.read_joints()))
         self._publish_frame(self.head.grab_stereo())
 
     def _on_position(self, msg: Any) -> None:
@@ -113,7 +131,7 @@ class SimBridge:
         with self._lock:
             if self._rates:
                 self.head.command_velocity(self._rates, self.period_s)
-                self._joint_pub.publish(self._joint_msg(self.head.read_joints()))
+                self._send(self._joint_pub, self._joint_msg(self.head.read_joints()))
 
 
 def main() -> None:  # pragma: no cover - a long-running node

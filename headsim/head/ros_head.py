@@ -134,7 +134,11 @@ class RosHead:
         self.node = rclpy.create_node(node_name)
         self._changed = threading.Condition()
         self._arrivals = 0
-        self._settled_at = 0
+        #: The stamp of the joint state that ended the last command, and the arrival
+        #: number of the last image grabbed: a grab takes images stamped at or after the
+        #: one, arrived after the other.
+        self._settled_s = -np.inf
+        self._grabbed = 0
         #: Each eye's latest images: (arrival number, stamp in s, image).
         self._images: list[list[tuple[int, float, np.ndarray]]] = [[], []]
         self._infos: list[CameraInfo | None] = [None, None]
@@ -245,7 +249,8 @@ class RosHead:
 
         self._wait(there, f"joints reaching {dict(positions_rad)}")
         with self._changed:
-            self._settled_at = self._arrivals
+            assert self._joints is not None
+            self._settled_s = self._joints.time_s
 
     def command_velocity(self, velocities_rad_s: Mapping[str, float], duration_s: float) -> None:
         """Publish the rates, wait ``duration_s`` (wall clock), then publish zeros."""
@@ -256,20 +261,27 @@ class RosHead:
             self._joints = None
         self._wait(lambda: self._joints is not None, "joint states after the motion")
         with self._changed:
-            self._settled_at = self._arrivals
+            assert self._joints is not None
+            self._settled_s = self._joints.time_s
 
     def grab_stereo(self) -> StereoFrame:
-        """The newest left image that arrived after the last command settled, with the right
-        image nearest it in time (waiting for one from each eye)."""
+        """The newest left image taken since the last command settled (stamped at or after
+        the joint state that ended it) and not grabbed before, with the right image nearest
+        it in time (waiting for one from each eye)."""
 
         def fresh(index: int) -> list[tuple[int, float, np.ndarray]]:
-            return [image for image in self._images[index] if image[0] > self._settled_at]
+            return [
+                image
+                for image in self._images[index]
+                if image[0] > self._grabbed and image[1] >= self._settled_s
+            ]
 
         left_info, right_info = self.camera_infos()
         self._wait(lambda: bool(fresh(0)) and bool(fresh(1)), "new images from both eyes")
         with self._changed:
             _, left_s, left = fresh(0)[-1]
             _, right_s, right = min(fresh(1), key=lambda image: abs(image[1] - left_s))
+            self._grabbed = self._arrivals
         return StereoFrame(
             StampedImage(left_s, left, left_info), StampedImage(right_s, right, right_info)
         )

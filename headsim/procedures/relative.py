@@ -295,7 +295,9 @@ def relative_positioning(
             sim.truth.effective_initial_direction(1),
             sim.truth.effective_initial_direction(2),
         )
-        truth = areas_from_geometry(truth_h, alpha1, alpha2, sim.settings.baseline_m, effective)
+        truth = areas_from_geometry(
+            truth_h, alpha1, alpha2, sim.truth.settings.baseline_m, effective
+        )
         comparison = compare_areas(pixel_areas, truth, u11, u12, u21, u22, u10, u20)
         areas.update(zip(seen, (int(a) for a in pixel_areas), strict=True))
         true_areas.update(zip(seen, (int(a) for a in truth), strict=True))

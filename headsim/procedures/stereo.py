@@ -392,11 +392,11 @@ def head_frames(sim: HeadSim, calib: StereoCalibration) -> dict[str, np.ndarray]
     paper's eye-geometry ones, which turn camera 1 about H's y by the true mount yaw; the
     true effective initial direction (what a perfect Sec. V calibration returns); that
     minus the calibrated centre-ray angle; and 0 (cameras parallel to H)."""
-    baseline = sim.settings.baseline_m
+    baseline = sim.truth.settings.baseline_m
     effective = sim.truth.effective_initial_direction(1)
     frames = (
         calib.head_from_cam1,
-        head_from_cam1_from_eye(sim.settings.cameras[0].mount_yaw_rad, baseline),
+        head_from_cam1_from_eye(sim.truth.settings.cameras[0].mount_yaw_rad, baseline),
         head_from_cam1_from_eye(effective, baseline),
         head_from_cam1_from_eye(effective - calib.cam1.centre_ray_yaw_rad, baseline),
         head_from_cam1_from_eye(0.0, baseline),

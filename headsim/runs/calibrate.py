@@ -95,8 +95,10 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
         truth_alpha_e = [
             sim.truth.effective_initial_direction(c, known.reference(sim, c)[0]) for c in (1, 2)
         ]
-        truth_v0 = [sim.camera_settings(c).principal[1] for c in (1, 2)]
-        truth_ratio = [sim.camera_settings(c).kx / sim.camera_settings(c).ky for c in (1, 2)]
+        truth_v0 = [sim.truth.camera_settings(c).principal[1] for c in (1, 2)]
+        truth_ratio = [
+            sim.truth.camera_settings(c).kx / sim.truth.camera_settings(c).ky for c in (1, 2)
+        ]
         planned = CalibrationReport(
             status=Status.OK,
             detail="",

@@ -89,7 +89,7 @@ def ray_direction_world(sim: HeadSim, camera: CameraId, goal_uv: Sequence[float]
     """The unit direction in W of the true camera's ray through pixel ``goal_uv`` (lens
     distortion undone exactly), at the camera's true pose now."""
     index = sim.camera_index(camera)
-    xy = sim.settings.cameras[index].pinhole().normalise(np.asarray(goal_uv, dtype=float))
+    xy = sim.truth.settings.cameras[index].pinhole().normalise(np.asarray(goal_uv, dtype=float))
     xy = np.asarray(xy, dtype=float).reshape(-1)[:2]
     world_from_cam = sim.truth.world_from_camera(index + 1)
     return _unit(world_from_cam[:3, :3] @ np.array([xy[0], xy[1], 1.0]))

@@ -354,7 +354,7 @@ def measure_surface_targets(
                 if marker_at is not None:
                     looks = {c: _nearest(x, where) for c, x in looks.items()}
                 last = log.last(2, lambda encoders: True)
-                focal2 = sim.camera_settings(2).kx
+                focal2 = sim.truth.camera_settings(2).kx
                 score = score_fixation(looks, where, depth, m.ok, told, match, last, focal2)
                 records.append(record_measurement(hub, m, label, step, fixation=score))
             sim.set_body_pose(TWIN_MARKER, np.array(PARKED_WORLD_M))

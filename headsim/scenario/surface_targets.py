@@ -350,7 +350,7 @@ def draw_targets(
     ``margin2_px`` inside camera 2's unless None), else drawn again (counted by cause)."""
     origin = (camera_centre(sim, 1) + camera_centre(sim, 2)) / 2
     world_from_head = sim.truth.world_from_head()[:3, :3]
-    head = ReachHead.of(sim.settings)
+    head = ReachHead.of(sim.truth.settings)
     refused: dict[str, int] = {}
     out: list[SurfaceTarget] = []
     drawn = 0

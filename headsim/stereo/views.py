@@ -101,7 +101,7 @@ def _board_outline() -> np.ndarray:
 def _fully_visible(sim: HeadSim, points_head: np.ndarray, margin_px: float) -> bool:
     """True when both cameras image every point inside the image, on the lens's valid branch."""
     for index in (1, 2):
-        cam = sim.camera_settings(index)
+        cam = sim.truth.camera_settings(index)
         p_cam = sim.truth.transform_points(points_head, "head", names.CAMERAS[index - 1])
         if np.any(p_cam[:, 2] <= 0.05):
             return False
@@ -146,7 +146,7 @@ def sample_board_pose(
     cols, rows = CHESSBOARD_PATTERN
     centre_board = np.array([(cols - 1) / 2, (rows - 1) / 2, 0.0]) * CHESSBOARD_SQUARE_M
     outline = _board_outline()
-    cam = sim.camera_settings(1)
+    cam = sim.truth.camera_settings(1)
     half_u, half_v = cam.width / 2 / cam.kx, cam.height / 2 / cam.ky
     for _ in range(max_attempts):
         distance = rng.uniform(lo, hi)

@@ -25,7 +25,9 @@ from headsim.sim.simulator import HeadSim
 pytestmark = [
     pytest.mark.e2e,
     # the ROS 2 wheels' message generator imports lark-parser 0.12, which imports sre_parse and sre_constants
-    pytest.mark.filterwarnings("ignore:module 'sre_(parse|constants)' is deprecated:DeprecationWarning"),
+    pytest.mark.filterwarnings(
+        "ignore:module 'sre_(parse|constants)' is deprecated:DeprecationWarning"
+    ),
 ]
 
 POSES = ({"eye": 0.0}, {"eye": 0.06}, {"eye": 0.1})
