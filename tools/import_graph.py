@@ -28,6 +28,8 @@ LAYERS = (
     "estimators",
     "sim",
     "vision",
+    # The Head interface, its recordings and replays: the simulator is one head.
+    "head",
     "stereo",
     "active",
     "live",

@@ -137,7 +137,7 @@ def calibrate_head(
     base = replace(knowledge or HeadKnowledge(), alpha_e=(0.0, 0.0), los_offset_m=None)
     rng = rng or np.random.default_rng(0)
     start = sim.render_count
-    parked = sim.position(body)  # put the target back afterwards: it must not hide others
+    parked = sim.truth.position(body)  # put the target back afterwards: it must not hide others
     alpha1, alpha2, depths, rows = [], [], [], []
     outcomes: list[Failure | None] = []
     # Plain first; near the midline the y images hold almost no x offset (NO_Y,
@@ -244,7 +244,8 @@ def calibrate_head(
             kx_over_ky=(vertical[0].kx_over_ky, vertical[1].kx_over_ky),
         )
     truth = tuple(
-        sim.effective_initial_direction(camera, base.reference(sim, camera)[0]) for camera in (1, 2)
+        sim.truth.effective_initial_direction(camera, base.reference(sim, camera)[0])
+        for camera in (1, 2)
     )
     return CalibrationRun(
         fit=fit,
@@ -277,10 +278,10 @@ class LineOfSightTruth:
 def line_of_sight_truth(sim: HeadSim, knowledge: HeadKnowledge) -> LineOfSightTruth:
     """Ground truth for the extended calibration's offsets (scoring only)."""
     believed = knowledge.head_belief(sim).baseline_m
-    half_error = 0.5 * (sim.settings.baseline_m - believed)
+    half_error = 0.5 * (sim.truth.settings.baseline_m - believed)
     out = []
     for camera, sign in ((1, -1.0), (2, 1.0)):
-        cam = sim.camera_settings(camera)
+        cam = sim.truth.camera_settings(camera)
         u0 = knowledge.reference(sim, camera)[0]
         t = float(cam.pinhole().column_angle(u0))
         own = cam.side_offset_m * math.cos(t) - cam.nodal_offset_m * math.sin(t)

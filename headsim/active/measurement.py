@@ -93,7 +93,7 @@ class Target:
 
 def body_target(name: str, detector: Detector) -> Target:
     """A target whose true position is a body's origin (markers, the block cross point)."""
-    return Target(name, detector, lambda sim: sim.position(name))
+    return Target(name, detector, lambda sim: sim.truth.position(name))
 
 
 @dataclass(frozen=True)
@@ -175,7 +175,7 @@ def failed_measurement(
         search_renders=search_renders,
         scan_renders=scan_renders,
         estimate_head_m=_nan3(),
-        truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
+        truth_head_m=sim.truth.transform_points(truth_world, "world", "head")[0],
         estimate_world_m=_nan3(),
         truth_world_m=truth_world,
         covariance_head_m2=np.full((3, 3), np.nan),
@@ -210,7 +210,7 @@ def estimated_measurement(
         method=Method(method),
         status=Status.OK,
         estimate_head_m=estimate_head,
-        truth_head_m=sim.transform_points(truth_world, "world", "head")[0],
+        truth_head_m=sim.truth.transform_points(truth_world, "world", "head")[0],
         estimate_world_m=to_world(sim, estimate_head, neck_rad, belief),
         truth_world_m=truth_world,
         covariance_head_m2=covariance[0] if covariance is not None else np.full((3, 3), np.nan),

@@ -184,14 +184,14 @@ def principal_points_by_zoom(
     ``distance_range_m`` of the board defaults to 0.5-0.9 m times the zoomed
     head's :func:`view_scale` (a narrower view needs the board further away).
     """
-    settings = before.settings
-    if after.settings != zoomed(settings, zoom):
+    settings = before.truth.settings
+    if after.truth.settings != zoomed(settings, zoom):
         raise ValueError(
             f"principal points: after.settings must be before.settings zoomed {zoom}x "
             "(zoomed(before.settings, zoom))"
         )
     rng = rng or np.random.default_rng(0)
-    narrow = after.settings if zoom > 1 else settings
+    narrow = after.truth.settings if zoom > 1 else settings
     if distance_range_m is None:
         scale = view_scale(narrow)
         distance_range_m = (0.5 * scale, 0.9 * scale)

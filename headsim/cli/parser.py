@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 
+from headsim.cli.estimate import estimate_command
 from headsim.cli.scenarios import calibrate_command, list_command, run_command
 from headsim.cli.snapshot import snapshot_command
 from headsim.cli.studies import bench_command, reproduce_command, study_command, sweep_command
@@ -94,6 +95,12 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     run.add_argument(
         "--no-progress", action="store_true", help="no progress on stderr (see also --quiet)"
     )
+    run.add_argument(
+        "--mcap",
+        metavar="FILE",
+        help="also record the run as ROS 2 messages in MCAP: images, CameraInfo, JointState, "
+        "TF, commands, estimates (needs headsim[mcap])",
+    )
     from headsim.runs.rerun_cli import add_recording_arguments
 
     add_recording_arguments(run)
@@ -135,6 +142,26 @@ def build_parser(with_study: bool = True) -> argparse.ArgumentParser:
     repro.add_argument("--sweeps", action="store_true", help="also the insensitivity sweeps (long)")
     repro.add_argument("--seed", type=int, metavar="N", help="seed (default 0)")
     repro.set_defaults(func=reproduce_command)
+
+    estimate = commands.add_parser(
+        "estimate",
+        help="estimate targets offline from any head's MCAP recording (ROS 2 messages)",
+        description="Find the mapping's targets in every stereo pair of a recording (Ca1's "
+        "image with Ca2's nearest in time, the joints interpolated to it), triangulate them "
+        "with the head's belief and its cameras' CameraInfo, and write DIR/results.json. "
+        "Topics, joint names, signs, belief and targets come from the mapping file "
+        "(docs: how-to/real-head). Exit status: 0 every target estimated, "
+        "1 a target was not, 2 bad input, 3 the mcap extra missing or DIR not writable.",
+    )
+    estimate.add_argument("log", metavar="LOG.mcap", help="the recording")
+    estimate.add_argument(
+        "--mapping", required=True, metavar="MAP.toml", help="topics, joints, belief, targets"
+    )
+    estimate.add_argument(
+        "--truth", metavar="TRUTH.json", help="score against these points (name: [x, y, z] in H, m)"
+    )
+    estimate.add_argument("--out", required=True, metavar="DIR", help="output directory (created)")
+    estimate.set_defaults(func=estimate_command)
 
     listing = commands.add_parser(
         "list",

@@ -61,6 +61,8 @@ def run_command(args: argparse.Namespace) -> int:
         for name in RUN_FILES:
             outputs.file(out / name, "--out")
         rrd = outputs.file(target.rrd, "--rrd", atomic=False) if target.rrd else None
+        mcap_path = getattr(args, "mcap", None)
+        mcap = outputs.file(Path(mcap_path), "--mcap", atomic=False) if mcap_path else None
         observers: list[Subscriber] = []
         progress = progress_observer(args, scenario.fixations, "fixations")
         if progress is not None:
@@ -78,6 +80,15 @@ def run_command(args: argparse.Namespace) -> int:
             observers.append(recorder)
             if target.serve:
                 print(f"serving the run live at {target.web_viewer_url}", flush=True)
+        mcap_run = None
+        if mcap is not None:
+            from headsim.runs.mcap_run import McapRun
+
+            try:
+                mcap_run = McapRun(mcap)
+            except OSError as err:
+                raise OutputNotWritable(f"--mcap: cannot write {mcap}: {err}") from err
+            observers.append(mcap_run)
         start = time.perf_counter()
         state = Interrupted()
         try:
@@ -87,6 +98,9 @@ def run_command(args: argparse.Namespace) -> int:
             if recorder is not None:
                 with suppress(Exception):  # the writer may have died with the run
                     recorder.close()
+            if mcap_run is not None:
+                with suppress(Exception):
+                    mcap_run.close()
             if not (isinstance(err, KeyboardInterrupt) or state.signalled):
                 if rrd is not None and recording_failed(err):
                     raise recording_disk_full(rrd, err) from err
@@ -97,6 +111,8 @@ def run_command(args: argparse.Namespace) -> int:
         # --serve keeps the stream open after a finished run; it is closed after serving.
         if recorder is not None and not target.serve:
             close_recorder(recorder, rrd)
+        if mcap_run is not None:
+            mcap_run.close()
         wall = time.perf_counter() - start
         text = summary_text(result, getattr(args, "head", None))
         write_all(
@@ -124,6 +140,8 @@ def run_command(args: argparse.Namespace) -> int:
     )
     if rrd is not None:
         print(printable(f"recording {rrd} ({file_size(rrd)}): open it with  rerun {rrd}"))
+    if mcap is not None:
+        print(printable(f"MCAP recording {mcap} ({file_size(mcap)}): ROS 2 messages"))
     if recorder is not None and target.serve:
         serve_until_interrupted(recorder, target.web_viewer_url)
     return 0 if result.ok else 1

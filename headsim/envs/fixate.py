@@ -497,7 +497,7 @@ class FixateEnv(gymnasium.Env):
         texture_id = sim.model.texture(f"{PLANE_NAME}_texture").id
         spec = TextureSpec(self.texture, seed=seed, size_px=int(sim.model.tex_width[texture_id]))
         sim.set_texture(f"{PLANE_NAME}_texture", to_rgb(texture_grey(spec), tint_of(seed)))
-        eyes = (sim.world_from_camera(1)[:3, 3] + sim.world_from_camera(2)[:3, 3]) / 2
+        eyes = (sim.truth.world_from_camera(1)[:3, 3] + sim.truth.world_from_camera(2)[:3, 3]) / 2
         half = depth_m * math.tan(math.radians(PLANE_HALF_ANGLE_DEG))
         front = np.array([0.0, depth_m + PLANE_HALF_THICKNESS_M, 0.0])
         sim.model.body_pos[sim.model.body(PLANE_NAME).id] = eyes + front

@@ -290,9 +290,14 @@ def relative_positioning(
         cols = np.array([columns[name] for name in seen])
         u11, u12, u21, u22 = cols.T
         pixel_areas = areas_from_pixels(u11, u12, u21, u22, u10, u20, alpha1=alpha1, alpha2=alpha2)
-        truth_h = np.array([sim.position(name, "head") for name in seen])
-        effective = (sim.effective_initial_direction(1), sim.effective_initial_direction(2))
-        truth = areas_from_geometry(truth_h, alpha1, alpha2, sim.settings.baseline_m, effective)
+        truth_h = np.array([sim.truth.position(name, "head") for name in seen])
+        effective = (
+            sim.truth.effective_initial_direction(1),
+            sim.truth.effective_initial_direction(2),
+        )
+        truth = areas_from_geometry(
+            truth_h, alpha1, alpha2, sim.truth.settings.baseline_m, effective
+        )
         comparison = compare_areas(pixel_areas, truth, u11, u12, u21, u22, u10, u20)
         areas.update(zip(seen, (int(a) for a in pixel_areas), strict=True))
         true_areas.update(zip(seen, (int(a) for a in truth), strict=True))
@@ -338,12 +343,12 @@ def run_relative(
         # A cross point's detection has the status and uv the servo reads; it is never
         # windowed (only blob detectors are), so it stands in for a Detection.
         cross = cast(Detector, find_cross_point)
-        reference = Target(names.BLOCKS, cross, lambda s: s.position(names.BLOCKS))
+        reference = Target(names.BLOCKS, cross, lambda s: s.truth.position(names.BLOCKS))
         run = relative_positioning(
             sim, EyeServo(sim, servo_config(scenario)), reference, colours, knowledge
         )  # the reference's fixation is the phase's one step
         (step,) = hub.steps
-        positions_head = {o.body: sim.position(o.body, "head") for o in scene.objects}
+        positions_head = {o.body: sim.truth.position(o.body, "head") for o in scene.objects}
     records = [record_measurement(hub, run.reference, label, step)]
     resolution = scenario.settings.encoder_resolution_rad
     details = run.reference.details

@@ -392,11 +392,11 @@ def head_frames(sim: HeadSim, calib: StereoCalibration) -> dict[str, np.ndarray]
     paper's eye-geometry ones, which turn camera 1 about H's y by the true mount yaw; the
     true effective initial direction (what a perfect Sec. V calibration returns); that
     minus the calibrated centre-ray angle; and 0 (cameras parallel to H)."""
-    baseline = sim.settings.baseline_m
-    effective = sim.effective_initial_direction(1)
+    baseline = sim.truth.settings.baseline_m
+    effective = sim.truth.effective_initial_direction(1)
     frames = (
         calib.head_from_cam1,
-        head_from_cam1_from_eye(sim.settings.cameras[0].mount_yaw_rad, baseline),
+        head_from_cam1_from_eye(sim.truth.settings.cameras[0].mount_yaw_rad, baseline),
         head_from_cam1_from_eye(effective, baseline),
         head_from_cam1_from_eye(effective - calib.cam1.centre_ray_yaw_rad, baseline),
         head_from_cam1_from_eye(0.0, baseline),
@@ -464,7 +464,7 @@ def measure_targets(
         truth = {t.name: np.array(t.position_world_m) for t in targets}
         hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         sim.move(eye=0.0)
-        world_from_head = sim.world_from_head()
+        world_from_head = sim.truth.world_from_head()
         frames = head_frames(sim, calib)
         for placement in targets:
             hub.begin(placement.name)
@@ -475,7 +475,7 @@ def measure_targets(
             except StereoError as missed:
                 renders.append(sim.render_count - start)
                 unknown = np.full(3, np.nan)
-                truth_head = sim.position(placement.body, "head")
+                truth_head = sim.truth.position(placement.body, "head")
                 rows.append(
                     StereoTarget(
                         placement.name, str(missed), truth_head, unknown, unknown, None, None

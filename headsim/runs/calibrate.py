@@ -66,7 +66,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
             near = (spec.near_fraction or near_fraction(spec.depth_m)) if near_far else None
             positions = (
                 calibration_layout(
-                    sim.stereo_views(),
+                    sim.truth.stereo_views(),
                     np.random.default_rng([seed, STREAM_CALIBRATION]),
                     spec.targets,
                     spec.depth_m,
@@ -93,10 +93,12 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
         ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
         # At the servo's goal columns, as the fit's error is (the image centres by default).
         truth_alpha_e = [
-            sim.effective_initial_direction(c, known.reference(sim, c)[0]) for c in (1, 2)
+            sim.truth.effective_initial_direction(c, known.reference(sim, c)[0]) for c in (1, 2)
         ]
-        truth_v0 = [sim.camera_settings(c).principal[1] for c in (1, 2)]
-        truth_ratio = [sim.camera_settings(c).kx / sim.camera_settings(c).ky for c in (1, 2)]
+        truth_v0 = [sim.truth.camera_settings(c).principal[1] for c in (1, 2)]
+        truth_ratio = [
+            sim.truth.camera_settings(c).kx / sim.truth.camera_settings(c).ky for c in (1, 2)
+        ]
         planned = CalibrationReport(
             status=Status.OK,
             detail="",

@@ -89,9 +89,9 @@ def ray_direction_world(sim: HeadSim, camera: CameraId, goal_uv: Sequence[float]
     """The unit direction in W of the true camera's ray through pixel ``goal_uv`` (lens
     distortion undone exactly), at the camera's true pose now."""
     index = sim.camera_index(camera)
-    xy = sim.settings.cameras[index].pinhole().normalise(np.asarray(goal_uv, dtype=float))
+    xy = sim.truth.settings.cameras[index].pinhole().normalise(np.asarray(goal_uv, dtype=float))
     xy = np.asarray(xy, dtype=float).reshape(-1)[:2]
-    world_from_cam = sim.world_from_camera(index + 1)
+    world_from_cam = sim.truth.world_from_camera(index + 1)
     return _unit(world_from_cam[:3, :3] @ np.array([xy[0], xy[1], 1.0]))
 
 
@@ -99,7 +99,7 @@ def landing(sim: HeadSim, camera: CameraId, goal_uv: Sequence[float]) -> Landing
     """Where ``camera``'s ray through ``goal_uv`` (the servo's goal pixel), at the camera's
     true pose now, meets the scene."""
     index = sim.camera_index(camera)
-    origin = sim.world_from_camera(index + 1)[:3, 3].copy()
+    origin = sim.truth.world_from_camera(index + 1)[:3, 3].copy()
     direction = ray_direction_world(sim, index + 1, goal_uv)
     point, distance, geom = cast(sim.model, sim.data, origin, direction)
     geom_name = body_name = ""

@@ -263,10 +263,10 @@ class Recorder:
         self.estimates = {}
         self.knowledge = knowledge
         self.effective_alpha_e = (
-            sim.effective_initial_direction(1),
-            sim.effective_initial_direction(2),
+            sim.truth.effective_initial_direction(1),
+            sim.truth.effective_initial_direction(2),
         )
-        self.world_from_head_start = sim.world_from_head()
+        self.world_from_head_start = sim.truth.world_from_head()
         self._time()
         self._scene(sim)
         self.objects = (
@@ -578,7 +578,7 @@ class Recorder:
                 rows.add(
                     path, frame, step, rr.Transform3D, translation=translation, quaternion=xyzw
                 )
-        world_from_head = sim.world_from_head()
+        world_from_head = sim.truth.world_from_head()
         rows.add(
             "/world/head",
             frame,
@@ -590,7 +590,7 @@ class Recorder:
         origins, vectors = [], []
         target = self.truth.get(self.label)
         for index, cam in enumerate(names.CAMERAS):
-            head_from_camera = sim.head_from_camera(index + 1)
+            head_from_camera = sim.truth.head_from_camera(index + 1)
             rows.add(
                 f"/world/head/{cam}",
                 frame,
@@ -599,7 +599,7 @@ class Recorder:
                 translation=head_from_camera[:3, 3],
                 mat3x3=head_from_camera[:3, :3],
             )
-            world_from_camera = sim.world_from_camera(index + 1)
+            world_from_camera = sim.truth.world_from_camera(index + 1)
             centre = world_from_camera[:3, 3]
             length = 1.0 if target is None else 1.2 * float(np.linalg.norm(target - centre))
             origins.append(centre)

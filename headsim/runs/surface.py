@@ -121,7 +121,7 @@ class LandingLog:
             goal = (self.goal_u[event.camera - 1], event.uv_px[1])
             true_uv = None
             if self.target is not None:
-                u, v = self.sim.project(self.target()[None, :], event.camera)[0]
+                u, v = self.sim.truth.project(self.target()[None, :], event.camera)[0]
                 true_uv = (float(u), float(v))
             seen = (float(event.uv_px[0]), float(event.uv_px[1]))
             self.looks.append(
@@ -323,7 +323,7 @@ def measure_surface_targets(
                     # The twin: the ordinary marker target, detected by its colour.
                     sim.set_body_pose(TWIN_MARKER, marker_at)
                     target = marker_target(placed.name, TWIN_MARKER)
-                    where = sim.position(TWIN_MARKER)
+                    where = sim.truth.position(TWIN_MARKER)
                     told = None
                 else:
                     told = click(sim, np.array(placed.point_world_m), clicks, spec.click_error_px)
@@ -339,7 +339,7 @@ def measure_surface_targets(
                     target = Target(placed.name, pair, _true_point(placed))
                     where = point_world(sim, placed.body, placed.point_body_m)
                 # Depth at the start pose (a failure leaves the head wherever it gave up).
-                truth_head = sim.transform_points(where, "world", "head")[0]
+                truth_head = sim.truth.transform_points(where, "world", "head")[0]
                 depth = float(truth_head[2])
                 m = measure(sim, shared, target, knowledge)
                 if not m.ok:
@@ -354,7 +354,7 @@ def measure_surface_targets(
                 if marker_at is not None:
                     looks = {c: _nearest(x, where) for c, x in looks.items()}
                 last = log.last(2, lambda encoders: True)
-                focal2 = sim.camera_settings(2).kx
+                focal2 = sim.truth.camera_settings(2).kx
                 score = score_fixation(looks, where, depth, m.ok, told, match, last, focal2)
                 records.append(record_measurement(hub, m, label, step, fixation=score))
             sim.set_body_pose(TWIN_MARKER, np.array(PARKED_WORLD_M))

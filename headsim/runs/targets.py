@@ -9,7 +9,7 @@ from headsim.vision.markers import MarkerDetector
 
 def marker_target(name: str, body: str) -> Target:
     """A marker body of the default scene, found by its colour, named ``name``."""
-    return Target(name, MarkerDetector(MARKER_BODIES[body]), lambda sim: sim.position(body))
+    return Target(name, MarkerDetector(MARKER_BODIES[body]), lambda sim: sim.truth.position(body))
 
 
 __all__ = ["marker_target"]

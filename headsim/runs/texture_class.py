@@ -42,7 +42,7 @@ def patch_hidden(
     p = np.asarray(point_world_m, dtype=float)
     offsets = np.linspace(-half_px, half_px, grid)
     for seen, other in ((1, 2), (2, 1)):
-        u, v = sim.project(p[None, :], seen)[0]
+        u, v = sim.truth.project(p[None, :], seen)[0]
         origin = camera_centre(sim, seen)
         for du in offsets:
             for dv in offsets:

@@ -246,7 +246,7 @@ def on_surface(sim: SceneState, name: str, point_world_m: ArrayLike) -> SurfaceT
 
 def camera_centre(sim: HeadSim, camera: int) -> np.ndarray:
     """Camera ``camera``'s (1, 2) true optical centre now, W, m."""
-    return sim.world_from_camera(camera)[:3, 3].copy()
+    return sim.truth.world_from_camera(camera)[:3, 3].copy()
 
 
 def visible(sim: HeadSim, camera: int, point_world_m: ArrayLike) -> bool:
@@ -278,7 +278,7 @@ def click(
     """The click on a target in camera 1's image at the simulator's pose now (call it at
     the start pose, once): its true projection plus a normal error of ``error_px`` per
     axis drawn from ``rng``."""
-    true_uv = sim.project(np.asarray(point_world_m, dtype=float)[None, :], 1)[0]
+    true_uv = sim.truth.project(np.asarray(point_world_m, dtype=float)[None, :], 1)[0]
     clicked = true_uv + rng.normal(0.0, error_px, 2) if error_px > 0 else true_uv
     return Click(
         (float(true_uv[0]), float(true_uv[1])), (float(clicked[0]), float(clicked[1])), error_px
@@ -298,9 +298,9 @@ class DrawnTargets:
 def in_image(sim: HeadSim, camera: int, p: np.ndarray, margin_px: float = 0.0) -> bool:
     """Whether the point projects into ``camera``'s image at least ``margin_px`` inside."""
     cam = sim.camera_settings(camera)
-    if sim.transform_points(p, "world", names.CAMERAS[camera - 1])[0][2] <= 0:
+    if sim.truth.transform_points(p, "world", names.CAMERAS[camera - 1])[0][2] <= 0:
         return False
-    u, v = sim.project(p[None, :], camera)[0]
+    u, v = sim.truth.project(p[None, :], camera)[0]
     m = margin_px
     return bool(m <= u <= cam.width - 1 - m and m <= v <= cam.height - 1 - m)
 
@@ -318,7 +318,7 @@ def surface_refusal(
     ``margin2_px``: how far inside camera 2's (None: camera 2 need only see it)."""
     if p is None:
         return "no_surface"
-    depth = float(sim.transform_points(p, "world", "head")[0][2])
+    depth = float(sim.truth.transform_points(p, "world", "head")[0][2])
     if not depth_m[0] <= depth <= depth_m[1]:
         return "depth"
     if not (visible(sim, 1, p) and visible(sim, 2, p)):
@@ -349,8 +349,8 @@ def draw_targets(
     :func:`surface_refusal` finds nothing wrong (``margin_px`` inside camera 1's image,
     ``margin2_px`` inside camera 2's unless None), else drawn again (counted by cause)."""
     origin = (camera_centre(sim, 1) + camera_centre(sim, 2)) / 2
-    world_from_head = sim.world_from_head()[:3, :3]
-    head = ReachHead.of(sim.settings)
+    world_from_head = sim.truth.world_from_head()[:3, :3]
+    head = ReachHead.of(sim.truth.settings)
     refused: dict[str, int] = {}
     out: list[SurfaceTarget] = []
     drawn = 0

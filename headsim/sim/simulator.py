@@ -48,7 +48,11 @@ CameraId = int | str | names.Camera
 
 
 class HeadSim:
-    """A head in a scene: command joints, settle, read encoders, render, read truth."""
+    """A head in a scene: command joints, settle, read encoders, render, read truth.
+
+    :class:`headsim.head.sim_head.SimHead` makes it a :class:`~headsim.head.interface.Head`;
+    its truth channel is :attr:`truth` (itself: a simulator knows where everything is).
+    """
 
     def __init__(
         self,
@@ -226,6 +230,10 @@ class HeadSim:
                     f"outside its range [{low}, {high}] rad"
                 )
 
+    def commanded(self) -> dict[str, float]:
+        """Each motor's current command, rad."""
+        return {motor: float(getattr(self._commands, motor)) for motor in self.motors}
+
     def command_eye_steps(self, steps: int) -> None:
         """Command the eye motor to a whole number of encoder steps."""
         self.command(eye=int(steps) * self.settings.encoder_resolution_rad)
@@ -314,12 +322,25 @@ class HeadSim:
             self._quantise(self._read("neck_pitch", self.names.neck_pitch)),
         )
 
+    def joint_speeds(self) -> dict[str, float]:
+        """Each motor's joint speed, rad/s (0 at rest; kinematic settling leaves it at rest)."""
+        return {
+            motor: float(self.data.qvel[self._dofadr[joint]])
+            for motor, joint in self._motor_joint.items()
+        }
+
     @property
     def belief(self) -> HeadBelief:
         """What the head believes of its own geometry (its design); see ``HeadSettings.believed``."""
         return self.settings.believed
 
     # -- ground truth ------------------------------------------------------
+    @property
+    def truth(self) -> HeadSim:
+        """The truth channel (:class:`~headsim.head.interface.Truth`), for placing and scoring
+        only: code that measures reaches truth through it alone, so a test can shut it."""
+        return self
+
     def true_joint_angles(self) -> dict[str, float]:
         """True joint angles by joint name, rad (not quantised)."""
         return {joint: float(self.data.qpos[adr]) for joint, adr in self._qadr.items()}

@@ -191,7 +191,9 @@ def calibrate_stereo(
         )
     sim.move(eye=0.0)
     mono = [
-        _calibrate_camera(views, index, sim.camera_matrix(index), sim.dist_coeffs(index))
+        _calibrate_camera(
+            views, index, sim.truth.camera_matrix(index), sim.truth.dist_coeffs(index)
+        )
         for index in (1, 2)
     ]
     flags = CALIBRATION_FLAGS | (
@@ -224,7 +226,9 @@ def calibrate_stereo(
     cam2_from_cam1 = np.eye(4)
     cam2_from_cam1[:3, :3] = R
     cam2_from_cam1[:3, 3] = np.asarray(T, dtype=float).ravel()
-    true_cam2_from_cam1 = invert_transform(sim.world_from_camera(2)) @ sim.world_from_camera(1)
+    true_cam2_from_cam1 = invert_transform(
+        sim.truth.world_from_camera(2)
+    ) @ sim.truth.world_from_camera(1)
     return StereoCalibration(
         mono1=mono[0],
         mono2=mono[1],
@@ -233,7 +237,7 @@ def calibrate_stereo(
         stereo_rms_px=float(rms),
         cam2_from_cam1=cam2_from_cam1,
         true_cam2_from_cam1=true_cam2_from_cam1,
-        true_head_from_cam1=sim.head_from_camera(1),
+        true_head_from_cam1=sim.truth.head_from_camera(1),
         views=views.count,
         refined=refine_intrinsics,
     )

@@ -125,5 +125,5 @@ def measure_point_stereo(
         uvs.append(detection.uv)
     p_head = triangulate(calib, np.array([uvs[0]]), np.array([uvs[1]]), head_from_cam1)[0]
     return StereoMeasurement(
-        uv1=uvs[0], uv2=uvs[1], p_head=p_head, true_p_head=sim.position(target, "head")
+        uv1=uvs[0], uv2=uvs[1], p_head=p_head, true_p_head=sim.truth.position(target, "head")
     )

@@ -101,8 +101,8 @@ def _board_outline() -> np.ndarray:
 def _fully_visible(sim: HeadSim, points_head: np.ndarray, margin_px: float) -> bool:
     """True when both cameras image every point inside the image, on the lens's valid branch."""
     for index in (1, 2):
-        cam = sim.camera_settings(index)
-        p_cam = sim.transform_points(points_head, "head", names.CAMERAS[index - 1])
+        cam = sim.truth.camera_settings(index)
+        p_cam = sim.truth.transform_points(points_head, "head", names.CAMERAS[index - 1])
         if np.any(p_cam[:, 2] <= 0.05):
             return False
         uv = project_points(p_cam, cam)
@@ -146,7 +146,7 @@ def sample_board_pose(
     cols, rows = CHESSBOARD_PATTERN
     centre_board = np.array([(cols - 1) / 2, (rows - 1) / 2, 0.0]) * CHESSBOARD_SQUARE_M
     outline = _board_outline()
-    cam = sim.camera_settings(1)
+    cam = sim.truth.camera_settings(1)
     half_u, half_v = cam.width / 2 / cam.kx, cam.height / 2 / cam.ky
     for _ in range(max_attempts):
         distance = rng.uniform(lo, hi)
@@ -178,7 +178,7 @@ def _quat_from_rotation(rotation: np.ndarray) -> np.ndarray:
 
 def place_chessboard(sim: HeadSim, head_from_board: np.ndarray) -> None:
     """Put the scene's chessboard at ``head_from_board`` (4, 4), a pose in H."""
-    world_from_board = sim.world_from_head() @ head_from_board
+    world_from_board = sim.truth.world_from_head() @ head_from_board
     sim.set_body_pose(
         names.CHESSBOARD, world_from_board[:3, 3], _quat_from_rotation(world_from_board[:3, :3])
     )
@@ -225,7 +225,7 @@ def chessboard_views(
     if n_poses < 1:
         raise StereoError(f"n_poses must be >= 1, got {n_poses}")
     sim.move(eye=0.0, neck_yaw=0.0, neck_pitch=0.0)
-    world_from_head = sim.world_from_head()
+    world_from_head = sim.truth.world_from_head()
     object_points = chessboard_object_points()
     renders_before = sim.render_count
     kept: list[tuple[np.ndarray, ...]] = []
@@ -239,7 +239,7 @@ def chessboard_views(
         if detected[0] is None or detected[1] is None:
             continue
         points_world = object_points @ world_from_board[:3, :3].T + world_from_board[:3, 3]
-        truth = [sim.project(points_world, camera) for camera in (1, 2)]
+        truth = [sim.truth.project(points_world, camera) for camera in (1, 2)]
         kept.append((detected[0], detected[1], truth[0], truth[1], head_from_board))
     sizes = tuple((c.width, c.height) for c in sim.settings.cameras)
     empty = np.zeros((0, len(object_points), 2))

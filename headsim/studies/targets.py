@@ -29,7 +29,7 @@ TABLE_TARGETS_HEAD = (
 
 def place_in_head(sim: HeadSim, body: str, p_head: np.ndarray) -> None:
     """Move ``body`` to ``p_head`` (3,), a point in the head frame H, m."""
-    sim.set_body_pose(body, sim.transform_points(p_head, "head", "world")[0])
+    sim.set_body_pose(body, sim.truth.transform_points(p_head, "head", "world")[0])
 
 
 def table_targets(count: int = len(TABLE_TARGETS_HEAD)) -> np.ndarray:
