@@ -11,7 +11,7 @@ export MUJOCO_GL ?= egl
 $(BIN)/headsim: pyproject.toml
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[test,batch]'
+	$(BIN)/pip install -q -e '.[test,batch,ros]'
 	@touch $@
 
 setup: $(BIN)/headsim
