@@ -175,7 +175,10 @@ def draw_window(
     the origin of a buffer of the window's own size, made for it and deleted after
     the read, not the context's: ``mjr_render`` clears all of its viewport that the
     buffer holds, and a whole frame's multisampled buffer costs more to clear than a
-    small window to draw.
+    small window to draw.  Making and deleting the buffer costs about 0.12 ms of a
+    window's 1.9 ms of CPU on llvmpipe; buffers kept and reused per size made no window
+    faster, and rounding sizes up to share them made windows slower (a larger buffer
+    to clear).
     """
     from OpenGL import GL
 
