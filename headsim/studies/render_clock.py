@@ -51,4 +51,4 @@ class RenderClock:
 
 
 #: Renders timed before the workers' first jobs and after they end (the unit: the quieter median).
-CLOCK_RENDERS = (21, 7)
+CLOCK_RENDERS = (7, 5)
