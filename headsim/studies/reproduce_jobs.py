@@ -62,8 +62,8 @@ def _plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str,
 @_plain_errors
 def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.active.calibration_file import head_hash, write_calibration
+    from headsim.codec import encode
     from headsim.runs.runner import calibrate_scenario
-    from headsim.runs.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario("calibration", fast=fast, seed=seed)
@@ -72,7 +72,7 @@ def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     wall = time.perf_counter() - start
     if not report.ok:
         raise RuntimeError(f"calibration failed: {report.status_text}")
-    block = calibration_block(report)
+    block = encode(report)
     path = write_calibration(
         (Path(out) / "head.json").resolve(), scenario.settings, block, "calibration", scenario.seed
     )
@@ -89,6 +89,7 @@ def _scenario_run(
     scenario_name: str, directory: Path, fast: bool, seed: int | None, overrides: dict[str, Any]
 ) -> dict[str, Any]:
     """One scenario run: its results.json and summary.txt written in ``directory``."""
+    from headsim.codec import encode
     from headsim.runs.runner import run_scenario
     from headsim.runs.serialise import results_payload
     from headsim.runs.summary import summary_text
@@ -104,7 +105,7 @@ def _scenario_run(
     return {
         "results": payload,
         "wall_s": wall,
-        "render_counts": result.renders.as_dict(),
+        "render_counts": encode(result.renders),
         "rendered_frames": result.rendered_frames,
         "points": len(result.records),
     }
