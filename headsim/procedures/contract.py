@@ -104,14 +104,14 @@ class Procedure:
 
     ``run(scenario, hub, knowledge, label)``: the records of its measurements and
     its result (``knowledge`` is what the head knows, ``label`` says whether it was
-    calibrated), of the declared type ``result`` (:func:`headsim.codec.declared`; or one of
-    the tuple's): its fields are results.json's ``experiment`` keys beside ``procedure``
-    (:func:`headsim.codec.encode` writes them), and their declarations say what they mean
-    (:attr:`results`).  The other functions take that result: ``summary(result, paper)`` its lines in the
-    summary table; ``ok_line(result, measured)`` the table's last line when the run
-    succeeded; ``failures`` what failed beyond its measurements; ``rows(result, log)``
-    what it adds to a recording, through ``log.rec``.  ``scene`` is the MJCF scene
-    (``headsim.sim.names.SCENES``) it runs in.
+    calibrated), of the declared type ``result`` (:func:`headsim.codec.declared`; or
+    one of the tuple's): its fields are results.json's ``experiment`` keys beside
+    ``procedure`` (:func:`headsim.codec.encode` writes them), and their declarations
+    say what they mean (:attr:`results`).  The other functions take that result:
+    ``summary(result, paper)`` its lines in the summary table; ``ok_line(result,
+    measured)`` the table's last line when the run succeeded; ``failures`` what failed
+    beyond its measurements; ``rows(result, log)`` what it adds to a recording, through
+    ``log.rec``.  ``scene`` is the MJCF scene (``headsim.sim.names.SCENES``) it runs in.
 
     Its scenario block: ``options(table, calibration)`` reads the ``[experiment]``
     keys it takes (the :class:`~headsim.scenario.spec.ExperimentSpec` fields they
@@ -119,9 +119,10 @@ class Procedure:
     ``[scene]`` tables (None: it takes none); ``fixations(scenario)`` is how many
     fixations it makes after the calibration (for the progress bar).
 
-    What its keys mean: ``keys`` the scenario keys only it reads
-    (full paths: ``experiment.NAME.key``, ``scene.NAME.key``; the shared ones are in
-    :mod:`headsim.scenario.key_reference`); both reference pages are made from them.
+    What its keys mean: ``keys`` the scenario keys only it reads (full paths:
+    ``experiment.NAME.key``, ``scene.NAME.key``; the shared ones are in
+    :mod:`headsim.scenario.key_reference`); both reference pages are made from them and
+    from its result's declaration.
     ``rank`` orders the procedures in a scenario's error and the references (lower
     first, then by name).  ``reach`` is the reach check its targets take (``"model2"``:
     each eye fixates from the start pose; ``"model1"``: the neck turns too);
