@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 import headsim  # noqa: F401  (chooses MUJOCO_GL before mujoco loads)
+from headsim.codec import encode
 from headsim.files import write_json_atomic
 from headsim.procedures.stereo import FOCAL_BOUND, RMS_BOUND_PX, StereoResult
 from headsim.runs.runner import run_scenario
@@ -35,7 +36,7 @@ def run_preset(name: str, poses: int, seed: int) -> dict[str, Any]:
     result = run_scenario(scenario)
     seconds = time.perf_counter() - start
     assert isinstance(result.experiment, StereoResult)
-    return {"preset": name, "run_s": seconds, **result.experiment.block()}
+    return {"preset": name, "run_s": seconds, **encode(result.experiment)}
 
 
 def print_preset(r: dict[str, Any]) -> None:

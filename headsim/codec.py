@@ -40,7 +40,8 @@ class Declared:
     fields that value sets; ``parts``: the meanings of a table's keys whose type is
     not declared here (relative paths, as :func:`describe` gives them); ``each``: the
     meaning of each key of a table whose keys are data (``dict[str, X]``); ``shape``:
-    an array's shape, checked (with finiteness) when read.
+    an array's shape, checked (with finiteness) when read; ``flat``: a declared type's
+    keys written (and described) beside the field's own, not in a table of their own.
     """
 
     meaning: str
@@ -54,6 +55,7 @@ class Declared:
     each: str | None = None
     shape: tuple[int, ...] | None = None
     whole: bool = False
+    flat: bool = False
 
 
 def doc(
@@ -63,6 +65,7 @@ def doc(
     default_factory: Any = dataclasses.MISSING,
     init: bool = True,
     compare: bool = True,
+    repr: bool = True,
     **declared: Any,
 ) -> Any:
     """A dataclass field with its meaning (and :class:`Declared`'s other keywords)."""
@@ -71,6 +74,7 @@ def doc(
         default_factory=default_factory,
         init=init,
         compare=compare,
+        repr=repr,
         metadata={_KEY: Declared(meaning, **declared)},
     )
 
@@ -103,7 +107,10 @@ def keys(cls: type) -> tuple[str, ...]:
     out: dict[str, None] = {}
     for f in dataclasses.fields(cls):
         d = declaration(f)
-        if not d.skip:
+        inner = _inner(_hints(cls)[f.name])[0] if d.flat else None
+        if inner is not None:
+            out.update(dict.fromkeys(keys(inner)))
+        elif not d.skip:
             out[(d.key or f.name).split(".")[0]] = None
     return tuple(out)
 
@@ -137,7 +144,9 @@ def _encode_fields(obj: Any) -> dict[str, Any]:
             continue
         table, *inner = (d.key or f.name).split(".")
         written = encode(d.write(obj) if d.write is not None else value)
-        if inner:
+        if d.flat:
+            out.update(written)
+        elif inner:
             out.setdefault(table, {})[".".join(inner)] = written
         else:
             out[table] = written
@@ -164,6 +173,11 @@ def _decode(cls: type[T], data: Any, path: str, given: Mapping[str, Any]) -> T:
         if not f.init or f.name in given or f.name in values or d.skip:
             continue
         key = d.key or f.name
+        if d.flat:
+            inner, _ = _inner(hints[f.name])
+            if inner is not None and _keys_held(inner, data):
+                values[f.name] = _decode(inner, data, path, {})
+            continue
         found, raw = _lookup(data, key)
         if not found:
             if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
@@ -174,6 +188,11 @@ def _decode(cls: type[T], data: Any, path: str, given: Mapping[str, Any]) -> T:
         else:
             values[f.name] = _value(hints[f.name], raw, f"{path}{key}", d.shape)
     return cls(**values, **given)
+
+
+def _keys_held(cls: type, data: Mapping[str, Any]) -> bool:
+    """Whether ``data`` holds any of the keys ``cls`` writes."""
+    return any(k in data for k in keys(cls))
 
 
 def _lookup(data: Mapping[str, Any], key: str) -> tuple[bool, Any]:
@@ -252,6 +271,10 @@ def describe(cls: type, prefix: str = "") -> dict[str, str]:
         if d.skip:
             continue
         path = f"{prefix}{d.key or f.name}"
+        if d.flat:
+            inner, _ = _inner(hints[f.name])
+            out.update(describe(inner, prefix) if inner is not None else {})
+            continue
         out[path] = d.meaning
         for part, meaning in d.parts.items():
             out[f"{path}.{part}"] = meaning

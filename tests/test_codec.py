@@ -13,7 +13,9 @@ import pytest
 from headsim.active.calibration_report import CalibrationReport
 from headsim.codec import declared, decode, describe, doc, encode, keys
 from headsim.files import to_jsonable
+from headsim.runs.outcomes import RunRenders
 from headsim.runs.serialise import ResultsDocument
+from headsim.sim.events import RenderCounts
 from headsim.stereo.calibration import StereoCalibration
 
 pytestmark = pytest.mark.fast
@@ -121,3 +123,54 @@ def test_the_reference_lists_every_key_by_its_path() -> None:
 def test_every_key_of_the_result_files_has_a_meaning(cls: type) -> None:
     fields = describe(cls)
     assert len(fields) >= 10 and [path for path, meaning in fields.items() if not meaning] == []
+
+
+@declared
+class Figures:
+    """Figures written beside their owner's keys."""
+
+    frames: int = doc("frames run")
+    lag_s: float = doc("lag, s", default=math.nan)
+
+
+@declared
+class WithFigures:
+    """A spec, then its figures flat beside it (left out while None)."""
+
+    spec: dict[str, Any] = doc("the spec")
+    figures: Figures | None = doc("the figures", default=None, flat=True, omit_if_none=True)
+
+
+def test_a_flat_field_writes_reads_and_describes_its_keys_beside_its_owners() -> None:
+    whole = WithFigures({"kind": "jump"}, Figures(3, 0.25))
+    block = encode(whole)
+    assert block == {"spec": {"kind": "jump"}, "frames": 3, "lag_s": 0.25}
+    assert decode(WithFigures, block) == whole
+    assert encode(WithFigures({"kind": "jump"})) == {"spec": {"kind": "jump"}}
+    assert decode(WithFigures, {"spec": {}}).figures is None
+    assert keys(WithFigures) == ("spec", "frames", "lag_s")
+    assert describe(WithFigures) == {"spec": "the spec", "frames": "frames run", "lag_s": "lag, s"}
+
+
+def test_render_counts_write_their_total_and_each_phase_and_read_back() -> None:
+    calibration, experiment = RenderCounts(images=2, previews=1), RenderCounts(3, 4, 1, 0)
+    renders = RunRenders(calibration, experiment, in_measurements=6)
+    block = encode(renders)
+    assert block["calibration"] == {
+        "images": 2,
+        "windows": 0,
+        "retakes": 0,
+        "previews": 1,
+        "total": 3,
+    }
+    assert block["experiment"] == {
+        **{"images": 3, "windows": 4, "retakes": 1, "previews": 0, "total": 8},
+        **{"in_measurements": 6, "outside_measurements": 2},
+    }
+    assert block["overall"]["total"] == 11 and list(block) == [
+        "calibration",
+        "experiment",
+        "overall",
+    ]
+    assert decode(RenderCounts, block["experiment"]) == experiment
+    assert decode(RunRenders, block) == renders

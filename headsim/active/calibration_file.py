@@ -167,7 +167,7 @@ def calibration_for_head(
             scenario=str(doc.get("scenario", "")),
             seed=int(doc.get("seed", 0)),
             head_hash=stored_hash,
-            render_counts=None if counts is None else RenderCounts.from_dict(counts),
+            render_counts=None if counts is None else decode(RenderCounts, counts),
         )
         report = decode(CalibrationReport, block, renders=RenderCounts(), source=source)
     except (KeyError, TypeError, ValueError) as err:

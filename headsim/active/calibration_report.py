@@ -16,7 +16,7 @@ import numpy as np
 
 from headsim.active.failure import Failure
 from headsim.active.measurement import HeadKnowledge
-from headsim.codec import declared, doc, encode
+from headsim.codec import declared, doc
 from headsim.estimators.result import Status
 from headsim.sim.events import RenderCounts
 
@@ -106,11 +106,6 @@ class PositionOutcome:
         object.__setattr__(self, "status", text)
 
 
-def _counts(counts: RenderCounts | None) -> dict[str, int] | None:
-    """Render counts as results.json holds them (their ``total`` added)."""
-    return None if counts is None else counts.as_dict()
-
-
 @declared
 class CalibrationSource:
     """Where a calibration read from a file came from (``[experiment.calibration] from``)."""
@@ -122,11 +117,7 @@ class CalibrationSource:
     #: the renders the calibration took when it ran, by kind (None if the file does not
     #: say: one written before calibration blocks had ``render_counts``, whose
     #: ``renders`` left the previews out)
-    render_counts: RenderCounts | None = doc(
-        "its renders when it ran",
-        write=lambda s: _counts(s.render_counts),
-        read=lambda v: {"render_counts": None if v is None else RenderCounts.from_dict(v)},
-    )
+    render_counts: RenderCounts | None = doc("its renders when it ran")
 
 
 def _status(text: str) -> dict[str, Any]:
@@ -164,8 +155,6 @@ class CalibrationReport:
         "one written before schema 2)",
         key="render_counts",
         whole=True,
-        write=lambda r: _counts(r.renders),
-        read=lambda v: {"renders": RenderCounts.from_dict(v)},
     )
     layout: CalibrationLayout | None = doc(
         "the positions: `kind` (a layout, or `given`), `near_fraction`, `depth_m`, "
@@ -251,12 +240,6 @@ class CalibrationReport:
         return "ok" if self.ok else self.detail
 
 
-def calibration_block(report: CalibrationReport) -> dict[str, Any]:
-    """The calibration as results.json's ``calibration`` block (and head.json's) holds it."""
-    block: dict[str, Any] = encode(report)
-    return block
-
-
 __all__ = [
     "CalibrationLayout",
     "CalibrationReport",
@@ -265,5 +248,4 @@ __all__ = [
     "LinesOfSightFit",
     "PositionOutcome",
     "VerticalReference",
-    "calibration_block",
 ]

@@ -34,6 +34,7 @@ RUN_FILES = ("results.json", "summary.txt", "timing.json")
 
 
 def run_command(args: argparse.Namespace) -> int:
+    from headsim.codec import encode
     from headsim.runs.events import Subscriber
     from headsim.runs.rerun_cli import recording_target
     from headsim.runs.runner import run_scenario
@@ -124,7 +125,7 @@ def run_command(args: argparse.Namespace) -> int:
                     "fast": scenario.fast,
                     "wall_s": wall,
                     "phases_s": result.timing_s,
-                    "render_counts": result.renders.as_dict(),
+                    "render_counts": encode(result.renders),
                     "rendered_frames": result.rendered_frames,
                     "rrd_bytes": rrd.stat().st_size if rrd is not None else None,
                 },
@@ -158,8 +159,8 @@ def progress_observer(args: argparse.Namespace, total: int, unit: str) -> Any:
 
 def calibrate_command(args: argparse.Namespace) -> int:
     from headsim.active.calibration_file import head_hash, write_calibration
+    from headsim.codec import encode
     from headsim.runs.runner import calibrate_scenario
-    from headsim.runs.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
     from headsim.scenario.tables import ScenarioError
 
@@ -197,9 +198,7 @@ def calibrate_command(args: argparse.Namespace) -> int:
         )
         return 1
     try:
-        write_calibration(
-            out, scenario.settings, calibration_block(report), scenario.name, scenario.seed
-        )
+        write_calibration(out, scenario.settings, encode(report), scenario.name, scenario.seed)
     except OSError as err:
         raise OutputNotWritable(f"cannot write {out}: {err.strerror or err}") from err
     alpha, std = report.alpha_e_rad, report.alpha_e_std_rad

@@ -3,7 +3,6 @@ calibration, and how much better the calibration made it."""
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -11,6 +10,7 @@ import numpy as np
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import measure_model2
+from headsim.codec import declared, doc
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.runs.context import model2_config, servo_config, told
@@ -23,24 +23,22 @@ from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
 
 
-@dataclass(frozen=True)
+@declared
 class CheckTarget:
     """A check target: its 3-D error before and after the calibration, m (NaN: failed)."""
 
-    name: str
-    error_m_uncalibrated: float
-    error_m_calibrated: float
+    name: str = doc("the target")
+    error_m_uncalibrated: float = doc("its 3-D error with what the head was told, m (NaN: failed)")
+    error_m_calibrated: float = doc("its 3-D error calibrated, m (NaN: failed)")
 
 
-@dataclass(frozen=True)
+@declared
 class CalibrationCheck:
     """Each check target before and after the calibration."""
 
-    check_targets: tuple[CheckTarget, ...]
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: ``check_targets``."""
-        return {"check_targets": [asdict(c) for c in self.check_targets]}
+    check_targets: tuple[CheckTarget, ...] = doc(
+        "each check target, before and after the calibration"
+    )
 
     def summary_lines(self, paper: bool) -> list[str]:
         """The table of each check target's error before and after."""
@@ -96,27 +94,16 @@ def _fixations(scenario: Scenario) -> int:
     return 2 * len(scenario.scene.targets)  # each check target before and after
 
 
-#: What its results.json ``experiment`` keys mean (beside ``procedure``).
-RESULTS: dict[str, str] = {
-    "check_targets": "each check target, before and after the calibration",
-    "check_targets[].name": "the target",
-    "check_targets[].error_m_uncalibrated": "its 3-D error with what the head was told, m "
-    "(NaN: failed)",
-    "check_targets[].error_m_calibrated": "its 3-D error calibrated, m (NaN: failed)",
-}
-
-
 CALIBRATION = register(
     Procedure(
         "calibration",
         "default",
         run_calibration_check,
-        fields=CalibrationCheck.block,
+        CalibrationCheck,
         summary=CalibrationCheck.summary_lines,
         options=read_options,
         read_scene=targets_reader("calibration", required=False),
         fixations=_fixations,
-        results=RESULTS,
         rank=30,
     )
 )

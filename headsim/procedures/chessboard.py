@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -13,6 +13,7 @@ from headsim.active.events import FixationStarted, MeasurementDone, PhaseStarted
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import Model2Config, measure_model2
+from headsim.codec import declared, doc
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import (
     PAPER,
@@ -42,37 +43,33 @@ from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 
 
-@dataclass(frozen=True)
+@declared
 class ChessboardPaper:
     """Table III/IV's square side, mean and std, m."""
 
-    side_mean_m: float
-    side_std_m: float
+    side_mean_m: float = doc("the paper's mean side, m (0.0303)")
+    side_std_m: float = doc("the paper's std, m (0.000677)")
 
 
-@dataclass(frozen=True)
+@declared
 class ChessboardResult:
     """The chessboard's inner corners with Model 2 and the squares they give (Sec. VI-A), m."""
 
-    pattern: list[int]
-    square_m: float
-    corners: int
-    corners_measured: int
-    widths_m: np.ndarray
-    heights_m: np.ndarray
-    true_widths_m: np.ndarray
-    true_heights_m: np.ndarray
-    width_mean_m: float
-    width_std_m: float
-    height_mean_m: float
-    height_std_m: float
-    side_mean_m: float
-    side_std_m: float
-    paper: ChessboardPaper
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: every field, in order."""
-        return asdict(self)
+    pattern: list[int] = doc("inner corners (columns, rows)")
+    square_m: float = doc("the squares' side, m")
+    corners: int = doc("inner corners")
+    corners_measured: int = doc("corners measured")
+    widths_m: np.ndarray = doc("each square's measured width, m")
+    heights_m: np.ndarray = doc("each square's measured height, m")
+    true_widths_m: np.ndarray = doc("their true widths, m")
+    true_heights_m: np.ndarray = doc("their true heights, m")
+    width_mean_m: float = doc("mean width, m")
+    width_std_m: float = doc("its std, m")
+    height_mean_m: float = doc("mean height, m")
+    height_std_m: float = doc("its std, m")
+    side_mean_m: float = doc("mean of all sides, m")
+    side_std_m: float = doc("its std, m")
+    paper: ChessboardPaper = doc("Tables III/IV's square side")
 
     def summary_lines(self, paper: bool) -> list[str]:
         """The squares' widths, heights and all sides beside the truth (and the paper's)."""
@@ -294,27 +291,6 @@ def _fixations(scenario: Scenario) -> int:
     return len(scenario.scene.corners or range(corner_count()))
 
 
-#: What its results.json ``experiment`` keys mean (beside ``procedure``).
-RESULTS: dict[str, str] = {
-    "pattern": "inner corners (columns, rows)",
-    "square_m": "the squares' side, m",
-    "corners": "inner corners",
-    "corners_measured": "corners measured",
-    "widths_m": "each square's measured width, m",
-    "heights_m": "each square's measured height, m",
-    "true_widths_m": "their true widths, m",
-    "true_heights_m": "their true heights, m",
-    "width_mean_m": "mean width, m",
-    "width_std_m": "its std, m",
-    "height_mean_m": "mean height, m",
-    "height_std_m": "its std, m",
-    "side_mean_m": "mean of all sides, m",
-    "side_std_m": "its std, m",
-    "paper": "Tables III/IV's square side",
-    "paper.side_mean_m": "the paper's mean side, m (0.0303)",
-    "paper.side_std_m": "the paper's std, m (0.000677)",
-}
-
 #: What the scenario keys only it reads mean.
 KEYS: dict[str, str] = {
     "scene.chessboard": "The chessboard (procedure `chessboard`); it faces the head.",
@@ -331,12 +307,11 @@ CHESSBOARD = register(
         "chessboard",
         "chessboard",
         run_chessboard,
-        fields=ChessboardResult.block,
+        ChessboardResult,
         summary=ChessboardResult.summary_lines,
         options=read_options,
         read_scene=read_chessboard,
         fixations=_fixations,
-        results=RESULTS,
         keys=KEYS,
         rank=50,
     )

@@ -2,10 +2,10 @@
 
 A :class:`Procedure` is what the generic code (the scenario reader, the runner,
 results.json, the summary, the recording, the two reference pages) needs of a
-procedure, and nothing of its result's type: the result is handed back to the
-procedure's own functions.  It also declares what its keys mean: its
-results.json ``experiment`` keys (``results``) and its own scenario keys
-(``keys``), from which the reference pages are made.
+procedure: its result's declared type (whose declaration gives results.json's
+``experiment`` keys and what they mean) and the functions the result is handed
+back to.  It also declares what its own scenario keys mean (``keys``); the
+reference pages are made from both.
 
 This module is the interface the generic layers call and the procedures
 implement, so it sits below them (``tools/import_graph.py``'s LAYERS: below
@@ -22,6 +22,8 @@ import threading
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
+
+from headsim.codec import describe
 
 if TYPE_CHECKING:
     from headsim.active.measurement import HeadKnowledge
@@ -102,12 +104,14 @@ class Procedure:
 
     ``run(scenario, hub, knowledge, label)``: the records of its measurements and
     its result (``knowledge`` is what the head knows, ``label`` says whether it was
-    calibrated).  The other functions take that result: ``fields`` its
-    results.json ``experiment`` fields; ``summary(result, paper)`` its lines in the
-    summary table; ``ok_line(result, measured)`` the table's last line when the run
-    succeeded; ``failures`` what failed beyond its measurements; ``rows(result, log)``
-    what it adds to a recording, through ``log.rec``.  ``scene`` is the MJCF scene
-    (``headsim.sim.names.SCENES``) it runs in.
+    calibrated), of the declared type ``result`` (:func:`headsim.codec.declared`; or
+    one of the tuple's): its fields are results.json's ``experiment`` keys beside
+    ``procedure`` (:func:`headsim.codec.encode` writes them), and their declarations
+    say what they mean (:attr:`results`).  The other functions take that result:
+    ``summary(result, paper)`` its lines in the summary table; ``ok_line(result,
+    measured)`` the table's last line when the run succeeded; ``failures`` what failed
+    beyond its measurements; ``rows(result, log)`` what it adds to a recording, through
+    ``log.rec``.  ``scene`` is the MJCF scene (``headsim.sim.names.SCENES``) it runs in.
 
     Its scenario block: ``options(table, calibration)`` reads the ``[experiment]``
     keys it takes (the :class:`~headsim.scenario.spec.ExperimentSpec` fields they
@@ -115,11 +119,10 @@ class Procedure:
     ``[scene]`` tables (None: it takes none); ``fixations(scenario)`` is how many
     fixations it makes after the calibration (for the progress bar).
 
-    What its keys mean: ``results`` its results.json ``experiment`` keys beside
-    ``procedure`` (paths relative to ``experiment``: ``a.b``, ``a[].b``, ``a.*``, as in
-    :mod:`headsim.runs.results_reference`), ``keys`` the scenario keys only it reads
-    (full paths: ``experiment.NAME.key``, ``scene.NAME.key``; the shared ones are in
-    :mod:`headsim.scenario.key_reference`); both reference pages are made from them.
+    What its keys mean: ``keys`` the scenario keys only it reads (full paths:
+    ``experiment.NAME.key``, ``scene.NAME.key``; the shared ones are in
+    :mod:`headsim.scenario.key_reference`); both reference pages are made from them and
+    from its result's declaration.
     ``rank`` orders the procedures in a scenario's error and the references (lower
     first, then by name).  ``reach`` is the reach check its targets take (``"model2"``:
     each eye fixates from the start pose; ``"model1"``: the neck turns too);
@@ -129,7 +132,7 @@ class Procedure:
     name: str
     scene: str
     run: Callable[[Any, Any, HeadKnowledge, str], tuple[Sequence[Any], Any]]
-    fields: Callable[[Any], dict[str, Any]]
+    result: type | tuple[type, ...]
     summary: Callable[[Any, bool], list[str]] = _no_lines
     ok_line: Callable[[Any, int], str] = _measured_line
     failures: Callable[[Any], tuple[str, ...]] = _no_failures
@@ -138,11 +141,21 @@ class Procedure:
     read_scene: SceneReader | None = None
     fixations: Callable[[Any], int] = _each_target
     needs: frozenset[str] = frozenset()
-    results: Mapping[str, str] = field(default_factory=dict)
     keys: Mapping[str, str] = field(default_factory=dict)
     rank: int = 100
     reach: str = "model2"
     markerless: bool = False
+
+    @property
+    def results(self) -> dict[str, str]:
+        """What its results.json ``experiment`` keys beside ``procedure`` mean, from its
+        result type's declaration (paths relative to ``experiment``: ``a.b``, ``a[].b``,
+        ``a.*``, as in :mod:`headsim.runs.results_reference`)."""
+        out: dict[str, str] = {}
+        for kind in self.result if isinstance(self.result, tuple) else (self.result,):
+            for path, meaning in describe(kind).items():
+                out.setdefault(path, meaning)
+        return out
 
 
 #: Every registered procedure, by name.

@@ -5,17 +5,17 @@ one-motor design gives up."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 from headsim.active.fixation import fixation_servo, measure_fixation
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.neck_servo import NeckServo
+from headsim.codec import declared
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.runs.context import servo_config
 from headsim.runs.events import Hub
-from headsim.runs.outcomes import SURFACE_FIELDS, MeasurementRecord, SurfaceDraw
+from headsim.runs.outcomes import MeasurementRecord, SurfaceResult
 from headsim.runs.surface import measure_surface_targets
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
@@ -24,20 +24,9 @@ from headsim.scenario.tables import Table
 from headsim.sim.simulator import HeadSim
 
 
-@dataclass(frozen=True)
-class FixationResult:
-    """One-step fixation on each target; ``surface``: how the markerless targets were
-    drawn (None: marker targets)."""
-
-    surface: SurfaceDraw | None = None
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: ``surface_targets`` with markerless ones."""
-        return {} if self.surface is None else {"surface_targets": self.surface.block()}
-
-    def failures(self) -> tuple[str, ...]:
-        """Markerless targets that could not be drawn."""
-        return () if self.surface is None or not self.surface.failure else (self.surface.failure,)
+@declared
+class FixationResult(SurfaceResult):
+    """One-step fixation on each target (the markerless targets: :class:`SurfaceResult`)."""
 
 
 def run_fixation(
@@ -59,7 +48,7 @@ def run_fixation(
         scored, drawn = measure_surface_targets(
             scenario, hub, knowledge, label, servo, measure, both_views=True
         )
-        return scored, FixationResult(drawn)
+        return scored, FixationResult.of(drawn)
     records = measure_each_target(scenario, hub, knowledge, [(knowledge, label)], servo, measure)
     return records, FixationResult()
 
@@ -74,12 +63,11 @@ FIXATION = register(
         "fixation",
         "default",
         run_fixation,
-        fields=FixationResult.block,
+        FixationResult,
         failures=FixationResult.failures,
         options=read_options,
         read_scene=targets_reader("fixation", required=True),
         needs=frozenset({"independent_eyes"}),
-        results=SURFACE_FIELDS,
         markerless=True,
         rank=95,
     )

@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
+from headsim.codec import declared
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.runs.context import servo_config
 from headsim.runs.events import Hub
-from headsim.runs.outcomes import SURFACE_FIELDS, MeasurementRecord, SurfaceDraw
+from headsim.runs.outcomes import MeasurementRecord, SurfaceResult
 from headsim.runs.surface import measure_surface_targets
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
@@ -21,20 +21,9 @@ from headsim.scenario.tables import Table
 from headsim.sim.simulator import HeadSim
 
 
-@dataclass(frozen=True)
-class Model1Result:
-    """Model 1 on each target; ``surface``: how the markerless targets were
-    drawn (None: marker targets)."""
-
-    surface: SurfaceDraw | None = None
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: ``surface_targets`` with markerless ones."""
-        return {} if self.surface is None else {"surface_targets": self.surface.block()}
-
-    def failures(self) -> tuple[str, ...]:
-        """Markerless targets that could not be drawn."""
-        return () if self.surface is None or not self.surface.failure else (self.surface.failure,)
+@declared
+class Model1Result(SurfaceResult):
+    """Model 1 on each target (the markerless targets: :class:`SurfaceResult`)."""
 
 
 def run_model1(
@@ -58,7 +47,7 @@ def run_model1(
             measure,
             both_views=True,  # the neck servo's first look is with both cameras
         )
-        return scored, Model1Result(drawn)
+        return scored, Model1Result.of(drawn)
     records = measure_each_target(
         scenario,
         hub,
@@ -80,12 +69,11 @@ MODEL1 = register(
         "model1",
         "default",
         run_model1,
-        fields=Model1Result.block,
+        Model1Result,
         failures=Model1Result.failures,
         options=read_options,
         read_scene=targets_reader("model1", required=True),
         needs=frozenset({"neck_yaw"}),
-        results=SURFACE_FIELDS,
         markerless=True,
         reach="model1",
         rank=20,

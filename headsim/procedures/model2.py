@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model2 import measure_model2
+from headsim.codec import declared
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.runs.context import model2_config, servo_config
 from headsim.runs.events import Hub
-from headsim.runs.outcomes import SURFACE_FIELDS, MeasurementRecord, SurfaceDraw
+from headsim.runs.outcomes import MeasurementRecord, SurfaceResult
 from headsim.runs.surface import measure_surface_targets
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option, near_midline_options
@@ -21,20 +21,9 @@ from headsim.scenario.tables import Table
 from headsim.sim.simulator import HeadSim
 
 
-@dataclass(frozen=True)
-class Model2Result:
-    """Model 2 on each target; ``surface``: how the markerless targets were
-    drawn (None: marker targets)."""
-
-    surface: SurfaceDraw | None = None
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: ``surface_targets`` with markerless ones."""
-        return {} if self.surface is None else {"surface_targets": self.surface.block()}
-
-    def failures(self) -> tuple[str, ...]:
-        """Markerless targets that could not be drawn."""
-        return () if self.surface is None or not self.surface.failure else (self.surface.failure,)
+@declared
+class Model2Result(SurfaceResult):
+    """Model 2 on each target (the markerless targets: :class:`SurfaceResult`)."""
 
 
 def run_model2(
@@ -55,7 +44,7 @@ def run_model2(
             lambda sim: EyeServo(sim, servo_config(scenario)),
             measure,
         )
-        return scored, Model2Result(drawn)
+        return scored, Model2Result.of(drawn)
     records = measure_each_target(
         scenario,
         hub,
@@ -77,11 +66,10 @@ MODEL2 = register(
         "model2",
         "default",
         run_model2,
-        fields=Model2Result.block,
+        Model2Result,
         failures=Model2Result.failures,
         options=read_options,
         read_scene=targets_reader("model2", required=True),
-        results=SURFACE_FIELDS,
         markerless=True,
         rank=10,
     )

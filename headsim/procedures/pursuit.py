@@ -22,7 +22,7 @@ its record a ``PursuitFrame`` event.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -32,6 +32,7 @@ from headsim.active.markerless import MarkerlessPair
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import Detector, ServoConfig
+from headsim.codec import declared, doc
 from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
 from headsim.procedures.contract import Procedure, register
@@ -52,7 +53,7 @@ if TYPE_CHECKING:
     from headsim.runs.recording import Recorder
 
 
-@dataclass(frozen=True)
+@declared
 class PursuitFigures:
     """The figures that score a live pursuit, over the frames on which the target was present.
 
@@ -63,43 +64,45 @@ class PursuitFigures:
     nearest the marker's centre (truth: each eye's true pose at the frame).
     """
 
-    frames: int
-    frames_present: int
-    frames_lost: int
-    losses: int
-    reacquisitions: int
-    saccades: int
-    time_to_fixation_s: float
-    lag_s: float
-    offset_rms_px: float
-    position_rms_m: float
-    position_rms_pct_of_depth: float
-    position_max_m: float
-    ended: str
-    vergence_error_median_deg: float = math.nan
-    vergence_error_rms_deg: float = math.nan
+    frames: int = doc("frames run")
+    frames_present: int = doc("frames on which the target was present")
+    frames_lost: int = doc("frames the target was lost")
+    losses: int = doc("times it was lost")
+    reacquisitions: int = doc("times it was found again")
+    saccades: int = doc("saccades made")
+    time_to_fixation_s: float = doc("time to the first fixation, s")
+    lag_s: float = doc("the gaze's lag behind the target, s")
+    offset_rms_px: float = doc("RMS image offset from the goal, px")
+    position_rms_m: float = doc("RMS position error in W along the path, m")
+    position_rms_pct_of_depth: float = doc("the same, % of depth")
+    position_max_m: float = doc("largest position error, m")
+    ended: str = doc("why the loop ended")
+    vergence_error_median_deg: float = doc(
+        "median vergence error over the frames that found the target (eye 2's goal ray against where eye 1's truly landed), deg",
+        default=math.nan,
+    )
+    vergence_error_rms_deg: float = doc("the same, RMS, deg", default=math.nan)
 
 
-@dataclass(frozen=True)
+@declared
 class PursuitResult:
     """The live pursuit: the spec as run, its figures and each frame (None when it never
     started), and why it failed, one line each; ``run``: the gaze loop's own record, for a
     study's figures beyond these (not in results.json)."""
 
-    pursuit: dict[str, Any]
-    figures: PursuitFigures | None = None
-    per_frame: dict[str, Any] | None = None
-    failures: tuple[str, ...] = ()
-    run: PursuitRun | None = field(default=None, compare=False, repr=False)
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: the spec, then the figures and each frame."""
-        block: dict[str, Any] = {"pursuit": self.pursuit}
-        if self.figures is not None:
-            block.update(asdict(self.figures))
-        if self.per_frame is not None:
-            block["per_frame"] = self.per_frame
-        return block
+    pursuit: dict[str, Any] = doc(
+        "the pursuit spec as run (`path_kind`, `duration_s`, `frame_rate_hz`, `latency_frames`, `exposure_s`, `blur_subframes`, `mode`, `predictor`, `saccade`, ...)"
+    )
+    figures: PursuitFigures | None = doc(
+        "the figures (their keys beside `pursuit`)", default=None, flat=True, omit_if_none=True
+    )
+    per_frame: dict[str, Any] | None = doc(
+        "each frame: `time_s`, `found`, `offsets_px`, `encoders_rad`, `estimate_world_m`, `truth_world_m`, `error_m`, `vergence_error_deg`",
+        default=None,
+        omit_if_none=True,
+    )
+    failures: tuple[str, ...] = doc("", default=(), skip=True)
+    run: PursuitRun | None = doc("", default=None, compare=False, repr=False, skip=True)
 
     def summary_lines(self, paper: bool = False) -> list[str]:
         """The summary's lines for a pursuit run (none when it never started)."""
@@ -340,30 +343,6 @@ def log_path(result: PursuitResult, log: Recorder) -> None:
         )
 
 
-#: What its results.json ``experiment`` keys mean (beside ``procedure``).
-RESULTS: dict[str, str] = {
-    "pursuit": "the pursuit spec as run (`path_kind`, `duration_s`, `frame_rate_hz`, "
-    "`latency_frames`, `exposure_s`, `blur_subframes`, `mode`, `predictor`, `saccade`, ...)",
-    "frames": "frames run",
-    "frames_present": "frames on which the target was present",
-    "frames_lost": "frames the target was lost",
-    "losses": "times it was lost",
-    "reacquisitions": "times it was found again",
-    "saccades": "saccades made",
-    "time_to_fixation_s": "time to the first fixation, s",
-    "lag_s": "the gaze's lag behind the target, s",
-    "offset_rms_px": "RMS image offset from the goal, px",
-    "position_rms_m": "RMS position error in W along the path, m",
-    "position_rms_pct_of_depth": "the same, % of depth",
-    "position_max_m": "largest position error, m",
-    "ended": "why the loop ended",
-    "vergence_error_median_deg": "median vergence error over the frames that found the "
-    "target (eye 2's goal ray against where eye 1's truly landed), deg",
-    "vergence_error_rms_deg": "the same, RMS, deg",
-    "per_frame": "each frame: `time_s`, `found`, `offsets_px`, `encoders_rad`, "
-    "`estimate_world_m`, `truth_world_m`, `error_m`, `vergence_error_deg`",
-}
-
 _PURSUIT = "scene.pursuit"
 #: What the scenario keys only it reads mean.
 KEYS: dict[str, str] = {
@@ -413,14 +392,13 @@ PURSUIT = register(
         "pursuit",
         "default",
         run_pursuit,
-        fields=PursuitResult.block,
+        PursuitResult,
         summary=PursuitResult.summary_lines,
         ok_line=PursuitResult.ok_line,
         failures=PursuitResult.failure_lines,
         rows=log_path,
         read_scene=read_pursuit_scene,
         fixations=_fixations,
-        results=RESULTS,
         keys=KEYS,
         rank=70,
     )

@@ -4,8 +4,8 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
-from typing import TYPE_CHECKING, Any, cast
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -14,6 +14,7 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model2 import Model2Config, measure_model2
 from headsim.active.servo_types import Detector
+from headsim.codec import declared, doc
 from headsim.estimators.areas import (
     AreaComparison,
     areas_from_geometry,
@@ -55,57 +56,51 @@ if TYPE_CHECKING:
     from headsim.runs.recording import Recorder
 
 
-@dataclass(frozen=True)
+@declared
 class RelativeObject:
     """One object of relative positioning: its area S1..S12 (0: none), measured and true."""
 
-    name: str
-    colour: str
-    area: int
-    true_area: int
-    agree: bool
-    margin_px: float
-    gain_area: int
-    gain_agree: bool
-    columns_px: list[float]
-    position_head_m: np.ndarray
+    name: str = doc("its body")
+    colour: str = doc("its colour")
+    area: int = doc("its measured area S1..S12 (0: none)")
+    true_area: int = doc("its true area")
+    agree: bool = doc("whether they agree")
+    margin_px: float = doc("the area test's margin for it, px (NaN: not compared)")
+    gain_area: int = doc("its area by the gain-normalised test")
+    gain_agree: bool = doc("whether that agrees with the truth")
+    columns_px: list[float] = doc("u11, u12, u21, u22, px")
+    position_head_m: np.ndarray = doc("its true position in H, m")
     #: The gain-normalised test's distance from an area boundary, px (NaN: not compared);
     #: for studies, not written to results.json.
-    gain_margin_px: float
+    gain_margin_px: float = doc("", default=math.nan, skip=True)
 
 
-@dataclass(frozen=True)
+@declared
 class RelativePaper:
     """Sec. VI-C's fixation angles, rad, and number of objects."""
 
-    alpha1_rad: float
-    alpha2_rad: float
-    objects: int
+    alpha1_rad: float = doc("the paper's first fixation angle, rad")
+    alpha2_rad: float = doc("the paper's second fixation angle, rad")
+    objects: int = doc("the paper's number of objects")
 
 
-@dataclass(frozen=True)
+@declared
 class RelativeResult:
     """Relative positioning (Sec. III, VI-C): the two fixations' angles, rad, and each object."""
 
-    alpha1_rad: float
-    alpha2_rad: float
-    objects: tuple[RelativeObject, ...]
-    missing: list[str]
-    agree: int
-    disagree_outside_margin: int | None
-    gain_agree: int
-    gain_disagree_outside_margin: int | None
-    margin_threshold_px: float | None
-    renders: int
-    paper: RelativePaper
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: every field, in order (each object's but
-        ``gain_margin_px``)."""
-        block = asdict(self)
-        for entry in block["objects"]:
-            del entry["gain_margin_px"]
-        return block
+    alpha1_rad: float = doc("the first fixation's encoder reading, rad")
+    alpha2_rad: float = doc("the second fixation's encoder reading, rad")
+    objects: tuple[RelativeObject, ...] = doc("each object")
+    missing: list[str] = doc("objects not seen in all four images")
+    agree: int = doc("objects whose area agrees")
+    disagree_outside_margin: int | None = doc(
+        "disagreements outside the margin (`null`: no threshold)"
+    )
+    gain_agree: int = doc("agreements by the gain-normalised test")
+    gain_disagree_outside_margin: int | None = doc("its disagreements outside the margin")
+    margin_threshold_px: float | None = doc("the margin, px (`null`: none)")
+    renders: int = doc("renders of both fixations")
+    paper: RelativePaper = doc("Sec. VI-C's `alpha1_rad`, `alpha2_rad` and `objects`")
 
     def failures(self) -> tuple[str, ...]:
         """Each object not seen in all four images."""
@@ -443,34 +438,6 @@ def read_blocks(table: Table, ctx: Context, settings: HeadSettings, seed: int) -
     )
 
 
-#: What its results.json ``experiment`` keys mean (beside ``procedure``).
-RESULTS: dict[str, str] = {
-    "alpha1_rad": "the first fixation's encoder reading, rad",
-    "alpha2_rad": "the second fixation's encoder reading, rad",
-    "objects": "each object",
-    "objects[].name": "its body",
-    "objects[].colour": "its colour",
-    "objects[].area": "its measured area S1..S12 (0: none)",
-    "objects[].true_area": "its true area",
-    "objects[].agree": "whether they agree",
-    "objects[].margin_px": "the area test's margin for it, px (NaN: not compared)",
-    "objects[].gain_area": "its area by the gain-normalised test",
-    "objects[].gain_agree": "whether that agrees with the truth",
-    "objects[].columns_px": "u11, u12, u21, u22, px",
-    "objects[].position_head_m": "its true position in H, m",
-    "missing": "objects not seen in all four images",
-    "agree": "objects whose area agrees",
-    "disagree_outside_margin": "disagreements outside the margin (`null`: no threshold)",
-    "gain_agree": "agreements by the gain-normalised test",
-    "gain_disagree_outside_margin": "its disagreements outside the margin",
-    "margin_threshold_px": "the margin, px (`null`: none)",
-    "renders": "renders of both fixations",
-    "paper": "Sec. VI-C's `alpha1_rad`, `alpha2_rad` and `objects`",
-    "paper.alpha1_rad": "the paper's first fixation angle, rad",
-    "paper.alpha2_rad": "the paper's second fixation angle, rad",
-    "paper.objects": "the paper's number of objects",
-}
-
 #: What the scenario keys only it reads mean.
 KEYS: dict[str, str] = {
     "scene.blocks": "The blocks' cross point (procedure `relative_positioning`).",
@@ -492,13 +459,12 @@ RELATIVE_POSITIONING = register(
         "relative_positioning",
         "blocks",
         run_relative,
-        fields=RelativeResult.block,
+        RelativeResult,
         summary=RelativeResult.summary_lines,
         failures=RelativeResult.failures,
         rows=RelativeResult.log_rows,
         read_scene=read_blocks,
         fixations=lambda scenario: 1,  # the cross point's
-        results=RESULTS,
         keys=KEYS,
         rank=60,
     )

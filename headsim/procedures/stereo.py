@@ -40,7 +40,7 @@ and the block holds only ``head_frames`` and ``targets``.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -50,6 +50,7 @@ from headsim.active.chessboard import look_for_board
 from headsim.active.events import PhaseStarted
 from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge
+from headsim.codec import declared, doc
 from headsim.geometry.transforms import frame_deviation
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import simulator
@@ -227,7 +228,7 @@ def log_estimates(log: Recorder, targets: tuple[StereoTarget, ...]) -> None:
         )
 
 
-@dataclass(frozen=True)
+@declared
 class StereoResult:
     """The baseline's calibration beside the truth, and its targets (module docstring).
 
@@ -235,33 +236,39 @@ class StereoResult:
     ``t_m``/``r`` OpenCV's T (camera 1's origin in camera 2's frame, m) and R.
     """
 
-    poses: int
-    views: int
-    renders: int
-    corner_rms_px: float
-    corner_max_px: float
-    cameras: tuple[dict[str, Parameter], dict[str, Parameter]]
-    stereo_rms_px: float
-    baseline_m: float
-    true_baseline_m: float
-    t_m: np.ndarray
-    true_t_m: np.ndarray
-    r: np.ndarray
-    true_r: np.ndarray
-    rotation_error_rad: float
-    max_rms_px: float
-    max_abs_focal_error_pct: float
-    passed: bool
-    head_frames: tuple[HeadFrame, ...]
-    targets: tuple[StereoTarget, ...]
+    poses: int = doc("board poses rendered")
+    views: int = doc("board views kept (the whole board found in both images)")
+    renders: int = doc("renders of the board views")
+    corner_rms_px: float = doc("detected corners against their true projections, RMS, px")
+    corner_max_px: float = doc("the same, largest, px")
+    cameras: tuple[dict[str, Parameter], dict[str, Parameter]] = doc(
+        "each camera's parameters (`fx`, `fy`, `cx`, `cy`, `k1`, `k2`): `truth`, `mono` (calibrateCamera) and `stereo` (stereoCalibrate)"
+    )
+    stereo_rms_px: float = doc("stereoCalibrate's reprojection RMS, px")
+    baseline_m: float = doc("the calibrated baseline, |t|, m")
+    true_baseline_m: float = doc("the true baseline, m")
+    t_m: np.ndarray = doc("camera 2 from camera 1: the calibrated translation, m")
+    true_t_m: np.ndarray = doc("the true translation, m")
+    r: np.ndarray = doc("the calibrated rotation (3 x 3)")
+    true_r: np.ndarray = doc("the true rotation (3 x 3)")
+    rotation_error_rad: float = doc("angle between the calibrated and the true rotation, rad")
+    max_rms_px: float = doc("the larger camera's reprojection RMS, px (acceptance: <= 0.2)")
+    max_abs_focal_error_pct: float = doc(
+        "the largest focal-length error against the truth, % (acceptance: <= 0.5)"
+    )
+    passed: bool = doc("both acceptance figures met")
+    head_frames: tuple[HeadFrame, ...] = doc(
+        "each way of placing camera 1 in H (`label`, `rotation_error_rad`, `translation_error_m`, `max_error_m`, `max_error_pct_depth`, `mean_error_pct_depth`)",
+        whole=True,
+    )
+    targets: tuple[StereoTarget, ...] = doc(
+        "each target (`name`, `status`, `truth_head_m`, `estimate_head_m`, `estimate_world_m`, `uv1_px`, `uv2_px`), m, px",
+        whole=True,
+    )
     #: The calibration itself, for a study that triangulates with it later (not in results.json).
-    calibration: StereoCalibration | None = field(default=None, compare=False, repr=False)
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: every field but the calibration, in order."""
-        block = asdict(self)
-        del block["calibration"]
-        return block
+    calibration: StereoCalibration | None = doc(
+        "", default=None, compare=False, repr=False, skip=True
+    )
 
     def failures(self) -> tuple[str, ...]:
         return target_failures(self.targets)
@@ -302,20 +309,21 @@ class StoredStereoSpec:
 LOOKS = ("full_frame", "once")
 
 
-@dataclass(frozen=True)
+@declared
 class StoredStereoResult:
     """The targets triangulated with a stored calibration (``source``): each way of placing
     camera 1 in H, each target, and (not in results.json) each target's renders."""
 
-    source: str
-    head_frames: tuple[HeadFrame, ...]
-    targets: tuple[StereoTarget, ...]
-    target_renders: tuple[int, ...]
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: ``head_frames`` and ``targets``."""
-        block = asdict(self)
-        return {"head_frames": block["head_frames"], "targets": block["targets"]}
+    source: str = doc("", skip=True)
+    head_frames: tuple[HeadFrame, ...] = doc(
+        "each way of placing camera 1 in H (`label`, `rotation_error_rad`, `translation_error_m`, `max_error_m`, `max_error_pct_depth`, `mean_error_pct_depth`)",
+        whole=True,
+    )
+    targets: tuple[StereoTarget, ...] = doc(
+        "each target (`name`, `status`, `truth_head_m`, `estimate_head_m`, `estimate_world_m`, `uv1_px`, `uv2_px`), m, px",
+        whole=True,
+    )
+    target_renders: tuple[int, ...] = doc("", skip=True)
 
     def failures(self) -> tuple[str, ...]:
         return target_failures(self.targets)
@@ -333,16 +341,12 @@ class StoredStereoResult:
         log_estimates(log, self.targets)
 
 
-@dataclass(frozen=True)
+@declared
 class NotCalibrated:
     """The board views left too few to calibrate from: ``reason`` says how many were kept."""
 
-    poses: int
-    reason: str
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: the poses and why no calibration."""
-        return asdict(self)
+    poses: int = doc("board poses rendered")
+    reason: str = doc("why the pair was not calibrated (only then, beside `poses`)")
 
     def failures(self) -> tuple[str, ...]:
         return (f"stereo calibration: {self.reason}",)
@@ -622,30 +626,6 @@ def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str,
     return {"block": StereoSpec(views, (low, high), tilt, refine, board_seed, board_look)}
 
 
-#: What its results.json ``experiment`` keys mean (beside ``procedure``).
-RESULTS: dict[str, str] = {
-    "poses": "board poses rendered",
-    "views": "board views kept (the whole board found in both images)",
-    "renders": "renders of the board views",
-    "corner_rms_px": "detected corners against their true projections, RMS, px",
-    "corner_max_px": "the same, largest, px",
-    "cameras": "each camera's parameters (`fx`, `fy`, `cx`, `cy`, `k1`, `k2`): `truth`, `mono` (calibrateCamera) and `stereo` (stereoCalibrate)",
-    "stereo_rms_px": "stereoCalibrate's reprojection RMS, px",
-    "baseline_m": "the calibrated baseline, |t|, m",
-    "true_baseline_m": "the true baseline, m",
-    "t_m": "camera 2 from camera 1: the calibrated translation, m",
-    "true_t_m": "the true translation, m",
-    "r": "the calibrated rotation (3 x 3)",
-    "true_r": "the true rotation (3 x 3)",
-    "rotation_error_rad": "angle between the calibrated and the true rotation, rad",
-    "max_rms_px": "the larger camera's reprojection RMS, px (acceptance: <= 0.2)",
-    "max_abs_focal_error_pct": "the largest focal-length error against the truth, % (acceptance: <= 0.5)",
-    "passed": "both acceptance figures met",
-    "head_frames": "each way of placing camera 1 in H (`label`, `rotation_error_rad`, `translation_error_m`, `max_error_m`, `max_error_pct_depth`, `mean_error_pct_depth`)",
-    "targets": "each target (`name`, `status`, `truth_head_m`, `estimate_head_m`, `estimate_world_m`, `uv1_px`, `uv2_px`), m, px",
-    "reason": "why the pair was not calibrated (only then, beside `poses`)",
-}
-
 #: What the scenario keys only it reads mean.
 KEYS: dict[str, str] = {
     "experiment.stereo": "The calibrated stereo baseline (procedure `stereo`): Zhang's calibration from chessboard views, then each target triangulated at eye angle 0.",
@@ -666,16 +646,15 @@ STEREO = register(
         "stereo",
         "default",
         run_stereo,
-        # The result is a StereoResult, NotCalibrated where the views were too few, or a
-        # StoredStereoResult with a stored calibration.
-        fields=lambda result: result.block(),
+        # A StereoResult, NotCalibrated where the views were too few, or a StoredStereoResult
+        # with a stored calibration.
+        (StereoResult, NotCalibrated, StoredStereoResult),
         summary=lambda result, paper: result.summary_lines(paper),
         ok_line=lambda result, measured: result.ok_line(measured),
         failures=lambda result: result.failures(),
         rows=lambda result, log: result.log_rows(log),
         options=read_options,
         read_scene=targets_reader("stereo", required=False),
-        results=RESULTS,
         keys=KEYS,
         rank=80,
     )

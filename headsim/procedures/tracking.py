@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -12,6 +12,7 @@ from headsim.active.events import FixationStarted, MeasurementDone, PhaseStarted
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
+from headsim.codec import declared, doc
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import (
     record_measurement,
@@ -45,19 +46,15 @@ from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
 
 
-@dataclass(frozen=True)
+@declared
 class TrackingResult:
     """Tracking a moving target with Model 1: times, s; waypoints and errors in W, m."""
 
-    times_s: np.ndarray
-    waypoints_world_m: list[tuple[float, float, float]]
-    errors_world_m: np.ndarray
-    renders_first: int
-    renders_after_mean: float
-
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields: every field, in order."""
-        return asdict(self)
+    times_s: np.ndarray = doc("each fixation's time, s")
+    waypoints_world_m: list[tuple[float, float, float]] = doc("the path's waypoints in W, m")
+    errors_world_m: np.ndarray = doc("each fixation's error in W, m")
+    renders_first: int = doc("renders of the first fixation")
+    renders_after_mean: float = doc("mean renders per fixation after it")
 
     def summary_lines(self, paper: bool) -> list[str]:
         """One line: the fixations made, their error in W and their renders."""
@@ -211,15 +208,6 @@ def _fixations(scenario: Scenario) -> int:
     return scenario.scene.moving.steps if scenario.scene.moving else 0
 
 
-#: What its results.json ``experiment`` keys mean (beside ``procedure``).
-RESULTS: dict[str, str] = {
-    "times_s": "each fixation's time, s",
-    "waypoints_world_m": "the path's waypoints in W, m",
-    "errors_world_m": "each fixation's error in W, m",
-    "renders_first": "renders of the first fixation",
-    "renders_after_mean": "mean renders per fixation after it",
-}
-
 #: What the scenario keys only it reads mean.
 KEYS: dict[str, str] = {
     "scene.moving_target": "The marker moved along waypoints (procedure `tracking`).",
@@ -240,12 +228,11 @@ TRACKING = register(
         "tracking",
         "default",
         run_tracking,
-        fields=TrackingResult.block,
+        TrackingResult,
         summary=TrackingResult.summary_lines,
         options=read_options,
         read_scene=read_moving_scene,
         fixations=_fixations,
-        results=RESULTS,
         keys=KEYS,
         rank=40,
     )

@@ -20,6 +20,7 @@ from headsim.active.principal import (
     principal_points_by_zoom,
     zoomed,
 )
+from headsim.codec import declared, doc
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import simulator
 from headsim.runs.events import Hub
@@ -44,27 +45,41 @@ class ZoomSpec:
     board_seed: int | None = None
 
 
-@dataclass(frozen=True)
+@declared
 class ZoomFixedPoints:
-    """Each camera's zoom fixed point beside the truth (``run``: the fits themselves)."""
+    """Each camera's zoom fixed point beside the truth, by camera (``run``: the fits
+    themselves)."""
 
-    run: PrincipalPointRun
+    zoom: float = doc("the focal length ratio of the second images")
+    views: int = doc("board poses whose corners were found at both focal lengths")
+    renders: int = doc("renders of the board at both focal lengths")
+    fixed_point_px: tuple[tuple[float, float], ...] = doc("each camera's fixed point (u, v), px")
+    truth_px: tuple[tuple[float, float], ...] = doc("each camera's principal point (cx, cy), px")
+    error_px: np.ndarray = doc("each camera's fixed point minus its principal point, px")
+    std_px: tuple[np.ndarray, ...] = doc("each camera's standard errors of (u, v), px")
+    scale: tuple[float, ...] = doc("each camera's fitted scale f' / f")
+    residual_rms_px: tuple[float, ...] = doc(
+        "each camera's RMS distance of the zoomed corners from the fit, px"
+    )
+    points: tuple[int, ...] = doc("each camera's matched corners")
+    run: PrincipalPointRun = doc("", skip=True)
 
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment`` fields."""
-        r = self.run
-        return {
-            "zoom": r.zoom,
-            "views": r.views,
-            "renders": r.renders,
-            "fixed_point_px": [list(p) for p in r.principal_px],
-            "truth_px": [list(p) for p in r.truth_px],
-            "error_px": r.errors_px.tolist(),
-            "std_px": [f.std_px.tolist() for f in r.fits],
-            "scale": [f.scale for f in r.fits],
-            "residual_rms_px": [f.residual_rms_px for f in r.fits],
-            "points": [f.points for f in r.fits],
-        }
+    @classmethod
+    def of(cls, run: PrincipalPointRun) -> ZoomFixedPoints:
+        """The fixed points that ``run`` found."""
+        return cls(
+            zoom=run.zoom,
+            views=run.views,
+            renders=run.renders,
+            fixed_point_px=run.principal_px,
+            truth_px=run.truth_px,
+            error_px=run.errors_px,
+            std_px=tuple(f.std_px for f in run.fits),
+            scale=tuple(f.scale for f in run.fits),
+            residual_rms_px=tuple(f.residual_rms_px for f in run.fits),
+            points=tuple(f.points for f in run.fits),
+            run=run,
+        )
 
     def summary_lines(self, paper: bool) -> list[str]:
         """Each camera's fixed point beside the principal point."""
@@ -98,14 +113,11 @@ class ZoomFixedPoints:
             )
 
 
-@dataclass(frozen=True)
+@declared
 class NotFound:
     """The fixed points could not be fitted: ``reason`` says why."""
 
-    reason: str
-
-    def block(self) -> dict[str, Any]:
-        return {"reason": self.reason}
+    reason: str = doc("why the fixed points were not found (only then)")
 
     def failures(self) -> tuple[str, ...]:
         return (f"zoom fixed points: {self.reason}",)
@@ -139,7 +151,7 @@ def run_zoom_fixed_points(
             )
         except PrincipalPointError as error:
             return [], NotFound(str(error))
-    return [], ZoomFixedPoints(run)
+    return [], ZoomFixedPoints.of(run)
 
 
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
@@ -155,21 +167,6 @@ def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str,
     return {"block": ZoomSpec(zoom, poses, board_seed)}
 
 
-#: What its results.json ``experiment`` keys mean (beside ``procedure``).
-RESULTS: dict[str, str] = {
-    "zoom": "the focal length ratio of the second images",
-    "views": "board poses whose corners were found at both focal lengths",
-    "renders": "renders of the board at both focal lengths",
-    "fixed_point_px": "each camera's fixed point (u, v), px",
-    "truth_px": "each camera's principal point (cx, cy), px",
-    "error_px": "each camera's fixed point minus its principal point, px",
-    "std_px": "each camera's standard errors of (u, v), px",
-    "scale": "each camera's fitted scale f' / f",
-    "residual_rms_px": "each camera's RMS distance of the zoomed corners from the fit, px",
-    "points": "each camera's matched corners",
-    "reason": "why the fixed points were not found (only then)",
-}
-
 #: What the scenario keys only it reads mean.
 KEYS: dict[str, str] = {
     "experiment.zoom_fixed_points": "Each camera's principal point as the fixed point of a zoom (procedure `zoom_fixed_points`): chessboard images at the head's focal lengths and at `zoom` times them; only pixels enter the fit.",
@@ -184,14 +181,13 @@ ZOOM_FIXED_POINTS = register(
         "zoom_fixed_points",
         "chessboard",
         run_zoom_fixed_points,
-        fields=lambda result: result.block(),
+        (ZoomFixedPoints, NotFound),
         summary=lambda result, paper: result.summary_lines(paper),
         ok_line=lambda result, measured: result.ok_line(measured),
         failures=lambda result: result.failures() if isinstance(result, NotFound) else (),
         rows=lambda result, log: result.log_rows(log),
         options=read_options,
         fixations=lambda scenario: 0,
-        results=RESULTS,
         keys=KEYS,
         rank=90,
     )

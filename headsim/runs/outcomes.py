@@ -13,13 +13,13 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
 from headsim.active.measurement import Measurement
-from headsim.codec import declared, describe, doc, encode
+from headsim.codec import declared, doc
 from headsim.scenario.spec import Scenario
 from headsim.scenario.surface_targets import SurfaceTarget
 from headsim.sim.events import RenderCounts
@@ -209,22 +209,15 @@ class SurfaceDraw:
     #: how each was measured: ``surface`` (by correlation) or ``markers`` (the twin)
     measured_as: str = "surface"
 
-    def block(self) -> dict[str, Any]:
-        """results.json's ``experiment.surface_targets``."""
-        block: dict[str, Any] = encode(SurfaceBlock.of(self))
-        return block
 
+@dataclass(frozen=True)
+class DrawnTarget:
+    """A markerless target as results.json lists it (its point in W only)."""
 
-def _target_entries(block: SurfaceBlock) -> list[dict[str, Any]]:
-    return [
-        {
-            "name": t.name,
-            "body": t.body,
-            "point_world_m": list(t.point_world_m),
-            "texture_class": t.texture_class,
-        }
-        for t in block.targets
-    ]
+    name: str
+    body: str
+    point_world_m: tuple[float, float, float]
+    texture_class: str
 
 
 @declared
@@ -242,10 +235,9 @@ class SurfaceBlock:
         "draws refused and drawn again, by cause (`no_surface`, `depth`, `occluded`, `start_view`, `reach`)"
     )
     false_fixation_limit: str = doc("the rule of a false fixation")
-    targets: tuple[SurfaceTarget, ...] = doc(
+    targets: tuple[DrawnTarget, ...] = doc(
         "each target: `name`, the `body` it lies on, `point_world_m`, its `texture_class` (`rich`, `low`, `repetitive`, `occluded`: from truth at placement)",
         whole=True,
-        write=_target_entries,
     )
     false_fixations: int | None = doc("measurements ok with an eye landed off the target")
     wrong_matches: int | None = doc(
@@ -272,7 +264,9 @@ class SurfaceBlock:
             refused=draw.refused,
             false_fixation_limit=f"max({FALSE_FIXATION_FRACTION:g} x depth, "
             f"{FALSE_FIXATION_MIN_M:g} m)",
-            targets=draw.targets,
+            targets=tuple(
+                DrawnTarget(t.name, t.body, t.point_world_m, t.texture_class) for t in draw.targets
+            ),
             false_fixations=None if stats is None else stats.false_fixations,
             wrong_matches=None if stats is None else stats.wrong_matches,
             wrong_matches_failed=None if stats is None else stats.wrong_matches_failed,
@@ -282,12 +276,27 @@ class SurfaceBlock:
         )
 
 
-#: What the ``surface_targets`` block's keys mean, under ``experiment`` (the markerless
-#: targets of Model 2, Model 1 and the one-step fixation), from :class:`SurfaceBlock`.
-SURFACE_FIELDS: dict[str, str] = {
-    "surface_targets": "how the markerless targets were drawn and how they landed",
-    **describe(SurfaceBlock, "surface_targets."),
-}
+@declared
+class SurfaceResult:
+    """A procedure's result on each target (Model 2, Model 1, the one-step fixation): with
+    markerless targets (``[scene.room] targets``), how they were drawn; ``failure``: why
+    some could not be (empty: none)."""
+
+    surface_targets: SurfaceBlock | None = doc(
+        "how the markerless targets were drawn and how they landed",
+        default=None,
+        omit_if_none=True,
+    )
+    failure: str = doc("", default="", skip=True)
+
+    @classmethod
+    def of(cls, draw: SurfaceDraw) -> Self:
+        """The result of measuring the targets of ``draw``."""
+        return cls(SurfaceBlock.of(draw), draw.failure)
+
+    def failures(self) -> tuple[str, ...]:
+        """Markerless targets that could not be drawn."""
+        return (self.failure,) if self.failure else ()
 
 
 Vector3 = tuple[float, float, float]
@@ -370,43 +379,36 @@ def measurement_table(rows: tuple[MeasurementRow, ...]) -> dict[str, list[Any]]:
     return table
 
 
-@dataclass(frozen=True)
+@declared
 class RunRenders:
     """Every image a run's simulators drew (whole frames, windows, retakes and previews:
-    each one a render), by phase.
+    each one a render), by phase: results.json's ``render_counts``.
 
     ``in_measurements``: the experiment's renders that its measurements count (their
     ``renders`` summed); ``outside_measurements`` the rest: renders of the procedure
     that belong to no measurement (relative positioning's four images of the objects
     at the two fixations; every frame of a live pursuit, which records none).
+    ``overall``: the calibration's and the experiment's together.
     """
 
-    calibration: RenderCounts
-    experiment: RenderCounts
-    in_measurements: int
+    calibration: RenderCounts = doc("during the calibration")
+    experiment: RenderCounts = doc("during the experiment")
+    in_measurements: int = doc(
+        "`experiment` only: the sum of its measurements' `renders`",
+        key="experiment.in_measurements",
+    )
+    outside_measurements: int = doc(
+        "`experiment` only: renders of the procedure that belong to no measurement",
+        key="experiment.outside_measurements",
+        init=False,
+        compare=False,
+    )
+    overall: RenderCounts = doc("both", init=False, compare=False)
 
-    @property
-    def overall(self) -> RenderCounts:
-        """The calibration's and the experiment's together."""
-        return self.calibration + self.experiment
-
-    @property
-    def outside_measurements(self) -> int:
-        """The experiment's renders that no measurement counts."""
-        return self.experiment.total - self.in_measurements
-
-    def as_dict(self) -> dict[str, Any]:
-        """results.json's ``render_counts``: each phase's and the run's renders by kind; the
-        experiment's split into those its measurements count and the rest."""
-        return {
-            "calibration": self.calibration.as_dict(),
-            "experiment": {
-                **self.experiment.as_dict(),
-                "in_measurements": self.in_measurements,
-                "outside_measurements": self.outside_measurements,
-            },
-            "overall": self.overall.as_dict(),
-        }
+    def __post_init__(self) -> None:
+        outside = self.experiment.total - self.in_measurements
+        object.__setattr__(self, "outside_measurements", outside)
+        object.__setattr__(self, "overall", self.calibration + self.experiment)
 
 
 @dataclass(frozen=True)
@@ -446,7 +448,7 @@ class RunOutcome:
 __all__ = [
     "FALSE_FIXATION_FRACTION",
     "FALSE_FIXATION_MIN_M",
-    "SURFACE_FIELDS",
+    "DrawnTarget",
     "FixationScore",
     "FixationStats",
     "MeasurementRecord",
@@ -455,6 +457,7 @@ __all__ = [
     "RunRenders",
     "SurfaceBlock",
     "SurfaceDraw",
+    "SurfaceResult",
     "TextureClassStats",
     "by_texture",
     "fixation_stats",

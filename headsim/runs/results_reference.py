@@ -19,7 +19,7 @@ from typing import Any
 
 from headsim.codec import describe
 from headsim.procedures.contract import procedures
-from headsim.runs.outcomes import SURFACE_FIELDS
+from headsim.runs.outcomes import SurfaceResult
 from headsim.runs.serialise import ResultsDocument
 
 #: Every key of results.json outside ``experiment``'s procedure keys, in the order written:
@@ -30,7 +30,7 @@ RESULTS_FIELDS: dict[str, str] = describe(ResultsDocument)
 FAILED_ONLY = frozenset({"reason"})
 
 #: ``experiment`` keys written only with markerless targets (``[scene.room] targets``).
-MARKERLESS_ONLY = frozenset(SURFACE_FIELDS)
+MARKERLESS_ONLY = frozenset(describe(SurfaceResult))
 
 
 def experiment_fields() -> dict[str, dict[str, str]]:

@@ -19,14 +19,14 @@ import cv2
 import mujoco
 import numpy as np
 
-from headsim.active.calibration_report import CalibrationReport, calibration_block
+from headsim.active.calibration_report import CalibrationReport
 from headsim.active.failure import Failure
-from headsim.codec import declared, doc, encode, keys
+from headsim.codec import declared, describe, doc, encode, keys
 from headsim.estimators.result import Method
-from headsim.procedures.contract import get
 from headsim.runs.accuracy import MeasurementSummary, summaries
-from headsim.runs.outcomes import FixationScore, MeasurementRecord, RunOutcome
+from headsim.runs.outcomes import FixationScore, MeasurementRecord, RunOutcome, RunRenders
 from headsim.scenario.spec import experiment_record
+from headsim.sim.events import RenderCounts
 from headsim.sim.settings import settings_record
 from headsim.version import __version__
 
@@ -160,6 +160,23 @@ class ScenarioRecord:
     experiment: dict[str, Any] = doc("the `[experiment]` options as read (the servo's included)")
 
 
+def _phase_parts() -> dict[str, str]:
+    """``render_counts``' keys, ``*`` one phase, from :class:`RunRenders`' declaration: each
+    phase's counts, then the experiment's own."""
+    own = {
+        path.removeprefix("experiment."): meaning
+        for path, meaning in describe(RunRenders).items()
+        if path.startswith("experiment.")
+    }
+    return {
+        "*": "one phase: `calibration`, `experiment` or `overall`",
+        **{f"*.{key}": meaning for key, meaning in {**describe(RenderCounts), **own}.items()},
+    }
+
+
+_PHASE_PARTS = _phase_parts()
+
+
 @declared
 class ResultsDocument:
     """results.json: its keys in the order written."""
@@ -209,18 +226,10 @@ class ResultsDocument:
             "sources": "where each believed quantity above came from: `design` (the head's design), `preset` (the realistic preset's own belief), `file` (the scenario's `[belief]`), `given` (a `HeadBelief` given in Python), or `truth` (equal to the true head's, which the scenario changed in `[head]` and the belief followed)",
         },
     )
-    render_counts: dict[str, Any] = doc(
+    render_counts: RunRenders = doc(
         "every image the simulator drew, each one a render",
-        parts={
-            "*": "one phase: `calibration`, `experiment` or `overall`",
-            "*.images": "full frames",
-            "*.windows": "windows",
-            "*.retakes": "windows retaken whole at the same instant",
-            "*.previews": "binned previews",
-            "*.total": "all of them (full frames, windows, retakes and previews)",
-            "*.in_measurements": "`experiment` only: the sum of its measurements' `renders`",
-            "*.outside_measurements": "`experiment` only: renders of the procedure that belong to no measurement",
-        },
+        whole=True,
+        parts=_PHASE_PARTS,
     )
     rendered_frames: dict[str, float] = doc(
         "pixels rendered, in full frames (a window counts its share; also in `timing.json`)",
@@ -256,7 +265,7 @@ def experiment_block(procedure: str, experiment: object | None) -> dict[str, Any
     """results.json's ``experiment``: the procedure, then its result's fields (none if it did not run)."""
     return {
         "procedure": procedure,
-        **({} if experiment is None else get(procedure).fields(experiment)),
+        **({} if experiment is None else encode(experiment)),
     }
 
 
@@ -283,7 +292,7 @@ def results_document(result: RunOutcome) -> ResultsDocument:
         settings={**settings_record(s.settings), "settle_mode": s.settle_mode},
         # The truth above; what the head believes (and its estimators use) here.
         belief={**asdict(s.settings.believed), "sources": s.believed_from},
-        render_counts=result.renders.as_dict(),
+        render_counts=result.renders,
         rendered_frames=result.rendered_frames,
         calibration=result.calibration,
         measurements=tuple(MeasurementEntry.of(r) for r in result.records),
@@ -305,7 +314,6 @@ __all__ = [
     "MeasurementEntry",
     "ResultsDocument",
     "ScenarioRecord",
-    "calibration_block",
     "experiment_block",
     "results_document",
     "results_payload",

@@ -12,7 +12,7 @@ import numpy as np
 from headsim.active.calibration_report import CalibrationReport
 from headsim.procedures.contract import get
 from headsim.runs.accuracy import DepthBand, summaries
-from headsim.runs.outcomes import RunOutcome, SurfaceDraw, TextureClassStats, fixation_stats
+from headsim.runs.outcomes import RunOutcome, SurfaceBlock, TextureClassStats, fixation_stats
 from headsim.runs.table import cell as _cell
 from headsim.runs.table import format_table
 from headsim.runs.table import mm as _mm
@@ -154,8 +154,8 @@ def _measurement_lines(result: RunOutcome) -> list[str]:
     acceptance = result.scenario.scene.acceptance
     edge = () if acceptance is None else acceptance.outside_start_view
     markerless = any(r.fixation is not None for r in records)
-    surface = getattr(result.experiment, "surface", None)
-    if isinstance(surface, SurfaceDraw) and surface.listed == surface.asked:
+    surface = getattr(result.experiment, "surface_targets", None)
+    if isinstance(surface, SurfaceBlock) and surface.listed == surface.asked:
         markerless = False  # listed points only: not the whole field
     for label, s in summaries(records, edge).items():
         lines.append(
@@ -201,8 +201,8 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
     if not stats.count:
         return []
     lines = []
-    surface = getattr(result.experiment, "surface", None)
-    if isinstance(surface, SurfaceDraw):
+    surface = getattr(result.experiment, "surface_targets", None)
+    if isinstance(surface, SurfaceBlock):
         refused = ", ".join(f"{n} {c}" for c, n in surface.refused.items()) or "none"
         listed = f"{surface.listed} listed, " if surface.listed else ""
         what = "markerless targets" if surface.measured_as == "surface" else "points"
@@ -212,7 +212,7 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
         )
     ok = sum(1 for r in result.records if r.fixation is not None and r.measurement.ok)
     causes = ", ".join(f"{n} {c}" for c, n in stats.failure_causes.items()) or "none"
-    twin = isinstance(surface, SurfaceDraw) and surface.measured_as == "markers"
+    twin = isinstance(surface, SurfaceBlock) and surface.measured_as == "markers"
     if twin:
         lines.append(
             "  each measured with a marker put there (5 mm out along the normal), not by "
@@ -229,7 +229,7 @@ def _markerless_lines(result: RunOutcome) -> list[str]:
         f"({stats.wrong_matches_failed} of them in failed measurements); "
         f"failures by cause: {causes}"
     )
-    if isinstance(surface, SurfaceDraw) and surface.by_texture:
+    if isinstance(surface, SurfaceBlock) and surface.by_texture:
         lines.append(
             "  by texture class (truth at placement; occluded: part of a template hidden):"
         )

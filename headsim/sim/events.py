@@ -11,11 +11,12 @@ only reads.
 from __future__ import annotations
 
 import enum
-from dataclasses import asdict, astuple, dataclass, fields, replace
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
 
+from headsim.codec import declared, doc
 from headsim.sim.render import Window
 
 
@@ -47,34 +48,29 @@ class ImageKind(enum.Enum):
     PREVIEW = "preview"  # the whole view binned ``binning`` x ``binning``, to place a window
 
 
-@dataclass(frozen=True)
+@declared
 class RenderCounts:
     """Images the simulator drew, by kind; every one of them is a render (``total``), the
-    way ``HeadSim.render_count`` counts them.
+    way ``HeadSim.render_count`` counts them (results.json's meanings below).
 
     ``images``: whole frames (FULL); ``windows``: windows (WINDOW); ``retakes``: the
     instant of a window that missed taken again, whole or as the window a preview
     placed (RETAKE); ``previews``: binned previews (PREVIEW).
     """
 
-    images: int = 0
-    windows: int = 0
-    retakes: int = 0
-    previews: int = 0
+    images: int = doc("full frames", default=0)
+    windows: int = doc("windows", default=0)
+    retakes: int = doc("windows retaken whole at the same instant", default=0)
+    previews: int = doc("binned previews", default=0)
+    total: int = doc(
+        "all of them (full frames, windows, retakes and previews)", init=False, compare=False
+    )
 
-    @property
-    def total(self) -> int:
-        """Every render: images, windows, retakes and previews."""
-        return self.images + self.windows + self.retakes + self.previews
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "total", sum(self._kinds()))
 
-    def as_dict(self) -> dict[str, int]:
-        """The counts by kind and their ``total``, as results.json holds them."""
-        return {**asdict(self), "total": self.total}
-
-    @classmethod
-    def from_dict(cls, entry: dict[str, int]) -> RenderCounts:
-        """The counts of :meth:`as_dict` read back (its ``total`` follows from them)."""
-        return cls(**{f.name: int(entry[f.name]) for f in fields(cls)})
+    def _kinds(self) -> tuple[int, int, int, int]:
+        return (self.images, self.windows, self.retakes, self.previews)
 
     def counted(self, kind: ImageKind) -> RenderCounts:
         """These counts and one image of ``kind``."""
@@ -82,10 +78,10 @@ class RenderCounts:
         return replace(self, **{field: getattr(self, field) + 1})
 
     def __add__(self, other: RenderCounts) -> RenderCounts:
-        return RenderCounts(*(a + b for a, b in zip(astuple(self), astuple(other), strict=True)))
+        return RenderCounts(*(a + b for a, b in zip(self._kinds(), other._kinds(), strict=True)))
 
     def __sub__(self, other: RenderCounts) -> RenderCounts:
-        return RenderCounts(*(a - b for a, b in zip(astuple(self), astuple(other), strict=True)))
+        return RenderCounts(*(a - b for a, b in zip(self._kinds(), other._kinds(), strict=True)))
 
 
 #: The field of :class:`RenderCounts` that counts each kind of image.

@@ -223,8 +223,8 @@ def run_condition(
     condition: BudgetCondition, *, fast: bool, seed: int, scenario: str = SCENARIO
 ) -> dict[str, Any]:
     """Run the scenario with ``condition``'s fields set; one row of the budget."""
+    from headsim.codec import encode
     from headsim.runs.runner import run_scenario
-    from headsim.runs.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
 
     overrides = dict(condition.overrides)
@@ -239,7 +239,7 @@ def run_condition(
     depth = truth[:, 2]
     pct = 100 * np.linalg.norm(error, axis=1) / depth if ok else np.zeros(0)
     pct_xz = 100 * np.linalg.norm(error[:, [0, 2]], axis=1) / depth if ok else np.zeros(0)
-    calibration = calibration_block(result.calibration) if result.calibration else {}
+    calibration = encode(result.calibration) if result.calibration else {}
     lines = calibration.get("lines_of_sight")
     row: dict[str, Any] = {
         "condition": condition.name,

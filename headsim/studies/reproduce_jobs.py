@@ -35,8 +35,8 @@ WORKER_MODULES = (
 @plain_errors
 def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     from headsim.active.calibration_file import head_hash, write_calibration
+    from headsim.codec import encode
     from headsim.runs.runner import calibrate_scenario
-    from headsim.runs.serialise import calibration_block
     from headsim.scenario.loading import load_scenario
 
     scenario = load_scenario("calibration", fast=fast, seed=seed)
@@ -45,7 +45,7 @@ def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
     wall = time.perf_counter() - start
     if not report.ok:
         raise RuntimeError(f"calibration failed: {report.status_text}")
-    block = calibration_block(report)
+    block = encode(report)
     path = write_calibration(
         (Path(out) / "head.json").resolve(), scenario.settings, block, "calibration", scenario.seed
     )
@@ -60,6 +60,7 @@ def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
 
 def _scenario_run(job: Job, directory: Path) -> dict[str, Any]:
     """One scenario run: its results.json and summary.txt written in ``directory``."""
+    from headsim.codec import encode
     from headsim.runs.runner import run_scenario
     from headsim.runs.serialise import results_payload
     from headsim.runs.summary import summary_text
@@ -74,7 +75,7 @@ def _scenario_run(job: Job, directory: Path) -> dict[str, Any]:
     return {
         "results": payload,
         "wall_s": wall,
-        "render_counts": result.renders.as_dict(),
+        "render_counts": encode(result.renders),
         "rendered_frames": result.rendered_frames,
         "points": len(result.records),
     }

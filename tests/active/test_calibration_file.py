@@ -15,9 +15,9 @@ from headsim.active.calibration_file import (
     read_calibration,
     write_calibration,
 )
-from headsim.active.calibration_report import CalibrationReport, calibration_block
+from headsim.active.calibration_report import CalibrationReport
 from headsim.cli import main
-from headsim.codec import decode
+from headsim.codec import decode, encode
 from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.tables import ScenarioError
@@ -68,7 +68,7 @@ def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
     again = write_calibration(
         tmp_path / "again.json",
         load_scenario("quickstart").settings,
-        calibration_block(decode(CalibrationReport, block)),
+        encode(decode(CalibrationReport, block)),
         stored["scenario"],
         stored["seed"],
     )

@@ -1,16 +1,21 @@
 """Every registered procedure, the way dm_control's suite_test covers every task: its shipped
-scenario's fast variant runs through the command line, every key of its results block has a
-meaning it declares, and every key of its own scenario tables is in the key reference."""
+scenario's fast variant runs through the command line, its results block reads back as its
+declared result type and is written again unchanged, every key of it has a meaning that type
+declares, and every key of its own scenario tables is in the key reference."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Callable
+from typing import Any
 
 import pytest
 from shipped_runs import ShippedRun
 
-from headsim.procedures.contract import get, names
+from headsim.codec import declaration, decode, encode
+from headsim.files import to_jsonable
+from headsim.procedures.contract import Procedure, get, names
 from headsim.runs.results_reference import documented_paths, undocumented
 from headsim.scenario.key_reference import collect_uses, descriptions
 from headsim.scenario.loading import read_toml, scenario_files
@@ -27,6 +32,26 @@ def shipped_scenario(procedure: str) -> str:
     )
     assert runs, f"no shipped scenario runs {procedure!r}"
     return procedure if procedure in runs else runs[0]
+
+
+def read_back(procedure: Procedure, block: dict[str, Any]) -> object:
+    """``block`` (without ``procedure``) read as the first of the procedure's result types
+    that reads it (its fields not written, and without a default, given as None)."""
+    kinds = procedure.result if isinstance(procedure.result, tuple) else (procedure.result,)
+    errors = []
+    for kind in kinds:
+        unwritten = {
+            f.name: None
+            for f in dataclasses.fields(kind)
+            if declaration(f).skip
+            and f.default is dataclasses.MISSING
+            and f.default_factory is dataclasses.MISSING
+        }
+        try:
+            return decode(kind, block, **unwritten)
+        except (KeyError, TypeError, ValueError) as error:
+            errors.append(f"{kind.__name__}: {error}")
+    raise AssertionError("; ".join(errors))
 
 
 @pytest.fixture(scope="module")
@@ -48,6 +73,9 @@ def test_its_shipped_scenario_runs_and_every_results_key_has_a_meaning(
     assert run.code in (0, 1), run.out  # 1: a measurement failed, by a counted cause
     results = json.loads((run.directory / "results.json").read_text())
     assert results["experiment"]["procedure"] == procedure
+    block = {k: v for k, v in results["experiment"].items() if k != "procedure"}
+    result = read_back(get(procedure), block)
+    assert json.loads(json.dumps(to_jsonable(encode(result)))) == block
     assert [k for k in undocumented(results) if k.startswith("experiment")] == []
     declared = {f"experiment.{k}" for k in get(procedure).results}
     held = {p for p in documented_paths(results) if p.startswith("experiment.")}

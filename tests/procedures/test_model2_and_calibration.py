@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from headsim.codec import encode
 from headsim.estimators.result import Method
 from headsim.procedures.calibration import CalibrationCheck
 from headsim.procedures.model2 import Model2Result
@@ -29,5 +30,5 @@ def test_model2_adds_nothing_beyond_its_measurements(
 ) -> None:
     result = fast_run("quickstart")
     assert result.ok, result.failures
-    assert result.experiment == Model2Result() and result.experiment.block() == {}
+    assert result.experiment == Model2Result() and encode(result.experiment) == {}
     assert {r.measurement.method for r in result.records} == {Method.MODEL2}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from headsim.codec import encode
 from headsim.procedures.pursuit import PursuitResult
 from headsim.runs.result import RunResult
 from headsim.runs.runner import run_scenario
@@ -32,7 +33,7 @@ def test_a_jump_is_refixated_and_the_run_is_kept_for_studies() -> None:
     result = run_scenario(load_scenario("pursuit", fast=True, overrides=overrides))
     e = result.experiment
     assert isinstance(e, PursuitResult) and e.figures is not None and e.run is not None
-    assert e.block()["pursuit"]["path_kind"] == "jump" and "run" not in e.block()
+    assert encode(e)["pursuit"]["path_kind"] == "jump" and "run" not in encode(e)
     since_jump = e.run.time_to_fixation_s(1.0, since_s=0.1)
     assert 0.0 < since_jump < 0.5  # refixated within the run, after the jump
     assert e.figures.frames == len(e.run.records) and e.figures.losses == 0

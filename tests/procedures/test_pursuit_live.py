@@ -7,6 +7,7 @@ import math
 from dataclasses import replace
 
 from headsim.active.measurement import HeadKnowledge
+from headsim.codec import encode
 from headsim.live import Visibility
 from headsim.procedures.pursuit import PursuitFigures, PursuitResult, run_pursuit
 from headsim.scenario.loading import load_scenario
@@ -67,7 +68,7 @@ def test_a_target_never_present_is_a_failure_named_before_any_image() -> None:
     records, experiment = run_pursuit(scenario, Sink(), HeadKnowledge(), "pursuit")
     assert records == []
     assert experiment.failures == (f"{pursuit.name}: never present in the run",)
-    assert experiment.block() == {"pursuit": experiment.pursuit}
+    assert encode(experiment) == {"pursuit": experiment.pursuit}
     assert experiment.pursuit["duration_s"] == pursuit.duration_s
     assert [type(e).__name__ for e in events] == ["PhaseStarted"]
 

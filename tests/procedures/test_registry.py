@@ -21,6 +21,7 @@ from rerun.chunk import RrdReader
 from headsim import procedures
 from headsim.active.measurement import HeadKnowledge
 from headsim.cli import main
+from headsim.codec import declared, doc
 from headsim.runs.context import simulator
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord
@@ -49,13 +50,13 @@ def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str,
     return {"block": HeightSpec(offset_m)}
 
 
-@dataclass(frozen=True)
+@declared
 class HeightResult:
     """How high the scene's first target stands in W, m (the truth: this procedure only
     reads the scene)."""
 
-    body: str
-    height_m: float
+    body: str = doc("the marker measured")
+    height_m: float = doc("its height in W plus the offset, m")
 
 
 def run_height(
@@ -77,13 +78,12 @@ HEIGHT = procedures.Procedure(
     "marker_height",
     "default",
     run_height,
-    fields=lambda r: {"body": r.body, "height_m": r.height_m},
+    HeightResult,
     summary=lambda r, paper: [f"Marker height: {r.body} at {r.height_m * 1000:.1f} mm"],
     rows=rows,
     options=read_options,
     read_scene=targets_reader("marker_height", required=True),
     fixations=lambda scenario: 0,  # it fixates nothing
-    results={"body": "the marker measured", "height_m": "its height in W plus the offset, m"},
     keys={
         "experiment.marker_height": "What the height procedure adds.",
         "experiment.marker_height.offset_m": "Added to the marker's height, m.",
@@ -129,7 +129,9 @@ def test_a_new_procedure_runs_through_headsim_run(
 
 def test_a_name_taken_twice_is_refused(registered: procedures.Procedure) -> None:
     with pytest.raises(ValueError, match="already registered"):
-        procedures.register(procedures.Procedure("marker_height", "default", run_height, dict))
+        procedures.register(
+            procedures.Procedure("marker_height", "default", run_height, HeightResult)
+        )
     assert procedures.get("marker_height") is HEIGHT
     assert {"model2", "pursuit", "marker_height"} <= set(procedures.names())
 

@@ -15,7 +15,6 @@ from headsim.active.calibration_report import (
     LinesOfSightFit,
     PositionOutcome,
     VerticalReference,
-    calibration_block,
 )
 from headsim.codec import decode, encode
 from headsim.estimators.result import Method, Status
@@ -96,7 +95,7 @@ def test_a_measurement_writes_its_method_status_and_failure_as_documented() -> N
 
 def test_a_calibration_that_could_not_lay_out_its_positions_writes_five_keys() -> None:
     report = CalibrationReport(Status.FAILED, "failed: no room", 8, 0, RenderCounts())
-    block = calibration_block(report)
+    block = encode(report)
     assert block == {
         "status": "failed: no room",
         "targets": 8,
@@ -108,7 +107,7 @@ def test_a_calibration_that_could_not_lay_out_its_positions_writes_five_keys() -
 
 def test_a_calibration_block_reads_back_to_the_same_report_and_bytes() -> None:
     report = _full_report()
-    text = json.dumps(to_jsonable(calibration_block(report)), indent=2)
+    text = json.dumps(to_jsonable(encode(report)), indent=2)
     block = json.loads(text)
     assert list(block)[:5] == ["status", "targets", "fixated", "render_counts", "layout"]
     assert block["render_counts"] == {
@@ -124,7 +123,7 @@ def test_a_calibration_block_reads_back_to_the_same_report_and_bytes() -> None:
     source = CalibrationSource("/tmp/head.json", "quickstart", 0, "abc", report.renders)
     stored = decode(CalibrationReport, block, renders=RenderCounts(), source=source)
     assert stored.renders.total == 0 and stored.ok
-    again = calibration_block(stored)
+    again = encode(stored)
     assert list(again)[-1] == "from" and again["from"]["render_counts"]["total"] == 40
     # What results.json held before the typed report: the block, no renders, then "from".
     nothing = {"images": 0, "windows": 0, "retakes": 0, "previews": 0, "total": 0}
@@ -136,7 +135,7 @@ def test_a_calibration_block_reads_back_to_the_same_report_and_bytes() -> None:
 def test_a_block_from_before_renders_counted_previews_says_nothing_of_them() -> None:
     # head.json written by a headsim whose "renders" left the previews out: its count is
     # not today's, so a calibration read from it reports none rather than a wrong one.
-    block = {k: v for k, v in calibration_block(_full_report()).items() if k != "render_counts"}
+    block = {k: v for k, v in encode(_full_report()).items() if k != "render_counts"}
     old = {**block, "renders": 31}
     with pytest.raises(KeyError, match="render_counts"):
         decode(CalibrationReport, old)
