@@ -23,6 +23,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from headsim.sim.declared import Section
+
 if TYPE_CHECKING:
     from headsim.active.measurement import HeadKnowledge
     from headsim.sim.settings import HeadSettings
@@ -119,7 +121,8 @@ class Procedure:
     ``procedure`` (paths relative to ``experiment``: ``a.b``, ``a[].b``, ``a.*``, as in
     :mod:`headsim.runs.results_reference`), ``keys`` the scenario keys only it reads
     (full paths: ``experiment.NAME.key``, ``scene.NAME.key``; the shared ones are in
-    :mod:`headsim.scenario.key_reference`); both reference pages are made from them.
+    :mod:`headsim.scenario.key_reference`), or, declared with their types and ranges,
+    ``sections`` (the tables only it reads); both reference pages are made from them.
     ``rank`` orders the procedures in a scenario's error and the references (lower
     first, then by name).  ``reach`` is the reach check its targets take (``"model2"``:
     each eye fixates from the start pose; ``"model1"``: the neck turns too);
@@ -140,6 +143,7 @@ class Procedure:
     needs: frozenset[str] = frozenset()
     results: Mapping[str, str] = field(default_factory=dict)
     keys: Mapping[str, str] = field(default_factory=dict)
+    sections: Sequence[Section] = ()
     rank: int = 100
     reach: str = "model2"
     markerless: bool = False

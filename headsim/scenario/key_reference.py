@@ -37,9 +37,9 @@ from headsim.scenario.tables import (
     toml_value,
 )
 from headsim.sim import imperfections
-from headsim.sim.declared import Declared
-from headsim.sim.heads import SHIPPED, shipped
-from headsim.sim.model import MODELS_DIR, on_head
+from headsim.sim.declared import Declared, Section, Setting
+from headsim.sim.heads import MAPPING, SHIPPED, shipped
+from headsim.sim.model import on_head
 from headsim.sim.settings import PRESETS, HeadSettings, preset
 
 
@@ -79,7 +79,6 @@ def _edits(*steps: tuple[str, Any]) -> Edit:
     return edit
 
 
-_PATH = "scene.pursuit.path"
 #: Shipped scenarios changed to take the hand-written readers' other branches: (scenario, edit).
 VARIANTS: tuple[tuple[str, Edit], ...] = (
     (  # listed markerless targets: on an object, and a world point on a surface
@@ -106,108 +105,31 @@ VARIANTS: tuple[tuple[str, Edit], ...] = (
             ("scene.moving_target.random", {"waypoints": 3}),
         ),
     ),
-    (
-        "pursuit",
-        _edits(
-            (
-                _PATH,
-                {
-                    "kind": "sinusoid",
-                    "centre_world_m": [0.0, 1.0, 0.21],
-                    "amplitude_m": [0.1, 0.0, 0.05],
-                    "frequency_hz": 0.5,
-                    "phase_rad": [0.0, 0.0, 0.0],
-                },
-            ),
-        ),
-    ),
-    (
-        "pursuit",
-        _edits(
-            (
-                _PATH,
-                {
-                    "kind": "random_walk",
-                    "start_world_m": [0.0, 1.0, 0.21],
-                    "max_speed_m_s": 0.3,
-                    "box_half_m": [0.2, 0.2, 0.1],
-                    "seed": 5,
-                },
-            ),
-        ),
-    ),
-    (
-        "pursuit",
-        _edits(
-            (
-                _PATH,
-                {"kind": "throw", "start_world_m": [0.0, 1.0, 0.21], "velocity_m_s": [0, 0, 1.5]},
-            ),
-            ("scene.pursuit.duration_s", 0.4),
-        ),
-    ),
-    ("pursuit", _edits((_PATH, {"kind": "static", "point_world_m": [0.0, 1.0, 0.21]}))),
-    (
-        "pursuit",
-        _edits(
-            (
-                _PATH,
-                {
-                    "kind": "jump",
-                    "start_world_m": [0.0, 1.0, 0.21],
-                    "end_world_m": [0.1, 1.0, 0.25],
-                    "time_s": 0.1,
-                },
-            ),
-        ),
-    ),
-    (  # a head as an MJCF file and its mapping: the shipped independent_eyes file's
-        "quickstart",
-        _edits(
-            ("head.model", str(MODELS_DIR / "independent_eyes.xml")),
-            (
-                "head.mapping",
-                {
-                    "head_body": "head_frame",
-                    "neck_yaw": "neck_yaw_joint",
-                    "neck_pitch": "neck_pitch_joint",
-                    "eyes": "independent",
-                    "left_eye": "left_eye_pan",
-                    "right_eye": "right_eye_pan",
-                    "cameras": ["left_camera", "right_camera"],
-                },
-            ),
-        ),
-    ),
-    (  # the same with version and vergence, a neck roll and an eye tilt: the icub file's
-        "quickstart",
-        _edits(
-            ("head.model", str(MODELS_DIR / "icub.xml")),
-            (
-                "head.mapping",
-                {
-                    "head_body": "head_center",
-                    "neck_yaw": "neck_yaw",
-                    "neck_pitch": "neck_pitch",
-                    "neck_roll": "neck_roll",
-                    "eyes": "version_vergence",
-                    "left_eye": "l_eye_pan",
-                    "right_eye": "r_eye_pan",
-                    "version": "eyes_version_motor",
-                    "vergence": "eyes_vergence_motor",
-                    "eye_tilt": "eyes_tilt",
-                    "cameras": ["l_eye_camera", "r_eye_camera"],
-                },
-            ),
-        ),
-    ),
 )
+
+
+def sections() -> tuple[Section, ...]:
+    """The tables declared as sections: ``[head.mapping]`` and the procedures' own."""
+    return (MAPPING, *(s for p in procedures() for s in p.sections))
+
+
+def _declared() -> list[tuple[str, Declared]]:
+    """Every declared key, as (its table's path, its declaration)."""
+    return [*declared_keys(), *((s.key_path, d) for s in sections() for d in s.keys)]
 
 
 def declared_uses() -> dict[str, KeyUse]:
     """Every declared key and table, by path, as its declaration says it."""
     uses = {table: KeyUse(table, "table", f"a [{table}] table", "") for table in TABLE_MEANINGS}
-    for table, decl in declared_keys():
+    for section in sections():
+        kind, allowed = "table", f"a [{section.path}] table"
+        if section.many:
+            kind, allowed = (
+                "tables",
+                f"an array of tables, [[{section.path}]], at most {section.many}",
+            )
+        uses[section.path] = KeyUse(section.path, kind, allowed, "")
+    for table, decl in _declared():
         path = f"{table}.{decl.name}" if table else decl.name
         kind, allowed = declared_use(decl)
         uses[path] = KeyUse(path, kind, allowed, _default_text(table, decl))
@@ -218,6 +140,8 @@ def _default_text(table: str, decl: Declared) -> str:
     """``decl``'s default as the reference shows it: the presets' value where a preset
     sets the key ("depends on other keys" where they differ), else the declared one."""
     if decl in DEFAULT_FROM_OTHER_KEYS:
+        return _DEPENDS
+    if isinstance(decl, Setting) and decl.default is None and not (decl.optional or decl.required):
         return _DEPENDS
     values = {toml_value(v) for v in _preset_values(table, decl)}
     if len(values) > 1:
@@ -285,7 +209,8 @@ def descriptions() -> dict[str, str]:
     """Every key's meaning: the shared ones, then each procedure's own."""
     return {
         **TABLE_MEANINGS,
-        **{f"{t}.{d.name}" if t else d.name: d.meaning for t, d in declared_keys()},
+        **{s.path: s.meaning for s in sections()},
+        **{f"{t}.{d.name}" if t else d.name: d.meaning for t, d in _declared()},
         **DESCRIPTIONS,
         **{k: v for p in procedures() for k, v in p.keys.items()},
     }
@@ -317,18 +242,6 @@ def accepted_keys() -> list[Key]:
 #: ``Procedure.keys``).
 DESCRIPTIONS: dict[str, str] = {
     "fast": "Fields merged over the file by `--fast`: tables key by key, other values replaced.",
-    "head.mapping": "With an MJCF `head.model`: the names of its joints, body H and cameras.",
-    "head.mapping.head_body": "The body whose frame is H at all joints zero (midway between the optical centres, x right, y down, z forward).",
-    "head.mapping.neck_yaw": "The neck's yaw joint: about W's +z at the base, or above a pitch at the base (the iCub's); leave out on a head without one (Model 2 only).",
-    "head.mapping.neck_pitch": "The neck's pitch joint, about W's +x (above the yaw, or at the base through W's origin), positive looking up.",
-    "head.mapping.neck_roll": "The neck's roll joint, held at zero (leave out on a head without one).",
-    "head.mapping.eyes": "How the eyes are driven: one motor on `left_eye` with `right_eye` following (coupled), a motor each (independent), or version and vergence actuators (version_vergence).",
-    "head.mapping.version": 'With `eyes = "version_vergence"`: the actuator of length (left - right) / 2.',
-    "head.mapping.vergence": 'With `eyes = "version_vergence"`: the actuator of length left + right.',
-    "head.mapping.eye_tilt": "The eyes' common tilt joint, held at zero (leave out on a head without one).",
-    "head.mapping.left_eye": "The pan joint of the eye carrying Ca1 (at -x in H), positive inward.",
-    "head.mapping.right_eye": "The pan joint of the eye carrying Ca2 (at +x in H), positive inward.",
-    "head.mapping.cameras": "The two eye cameras, [Ca1, Ca2]: left, then right.",
     "experiment.calibration.positions_world_m": "The ball positions [[x, y, z], ...] in W, m, given instead of drawn (`targets` is their number).",
     "scene": "What the procedure measures and where it is.",
     "scene.targets": "Fixed targets (model2, model1; for calibration: optional check targets).",

@@ -264,40 +264,16 @@ def _read_head_model(head: Table, ctx: Context, directory: Path) -> HeadModel:
             "a [head.mapping] table naming its joints and cameras",
         )
     m = mapping_table
-
-    def joint_name(key: str, default: Any = MISSING) -> Any:
-        kind = {"head_body": "body", "version": "actuator", "vergence": "actuator"}
-        what = f"the name of a {kind.get(key, 'joint')} in the head's MJCF file"
-        if default is not MISSING:
-            what += " (or leave it out)"
-        return m.string(key, default, what=what)
-
-    cameras = m._get("cameras")
+    cameras = m._get(heads.CAMERAS.name)
     if not (
         isinstance(cameras, list)
         and len(cameras) == 2
         and all(isinstance(c, str) and c for c in cameras)
     ):
-        raise m.fail(
-            "cameras",
-            "must name two cameras",
-            "an array of two camera names [left (Ca1), right (Ca2)]",
-        )
-    m._note("cameras", "strings", "an array of two camera names [left (Ca1), right (Ca2)]", MISSING)
+        raise m.fail(heads.CAMERAS.name, "must name two cameras", heads.CAMERAS.allowed)
+    parts = {d.name: m.setting(d) for d in heads.MAPPING.keys if d is not heads.CAMERAS}
     try:
-        mapping = heads.HeadMapping(
-            head_body=joint_name("head_body"),
-            neck_yaw=joint_name("neck_yaw", None),
-            neck_pitch=joint_name("neck_pitch"),
-            eyes=m.choice("eyes", heads.EYE_KINDS),
-            left_eye=joint_name("left_eye"),
-            right_eye=joint_name("right_eye"),
-            cameras=(cameras[0], cameras[1]),
-            neck_roll=joint_name("neck_roll", None),
-            eye_tilt=joint_name("eye_tilt", None),
-            version=joint_name("version", None),
-            vergence=joint_name("vergence", None),
-        )
+        mapping = heads.HeadMapping(**parts, cameras=(cameras[0], cameras[1]))
     except heads.HeadError as err:
         raise ctx.error(f"head.mapping.{err.key}", err.problem, err.allowed) from None
     m.done()

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from headsim.errors import BadInput
-from headsim.sim.declared import Choice, Declared, Flag, Setting, Text
+from headsim.sim.declared import Array, Choice, Declared, Flag, Section, Setting, Text
 
 MISSING = object()
 
@@ -74,6 +74,8 @@ def declared_default(decl: Declared) -> Any:
     file must give it, or the caller passes a default derived from other keys)."""
     if isinstance(decl, Flag):
         return decl.default
+    if isinstance(decl, Array):
+        return MISSING if decl.required else decl.default
     if isinstance(decl, Setting):
         return None if decl.optional else MISSING if decl.default is None else decl.default
     return MISSING if decl.required else decl.default
@@ -83,6 +85,8 @@ def declared_use(decl: Declared) -> tuple[str, str]:
     """``decl``'s kind and what it allows, as the getter that reads it says them."""
     if isinstance(decl, Flag):
         return "boolean", "true, false"
+    if isinstance(decl, Array):
+        return "array", decl.allowed
     if isinstance(decl, Choice):
         return "choice", ", ".join(decl.choices)
     if isinstance(decl, Text):
@@ -223,16 +227,26 @@ class Table:
     def fail(self, key: str, message: str, allowed: str | None = None) -> ScenarioError:
         return self.ctx.error(self.field(key), message, allowed)
 
-    def setting(self, decl: Declared, default: Any = MISSING, *, hi: float | None = None) -> Any:
+    def setting(
+        self,
+        decl: Declared,
+        default: Any = MISSING,
+        *,
+        hi: float | None = None,
+        choices: tuple[str, ...] | None = None,
+    ) -> Any:
         """``decl``'s key, read and checked as declared (``default``: instead of the
-        declared one, e.g. a preset's; ``hi``: a tighter upper end that depends on other
-        keys, which the declaration's ``unit_note`` says)."""
+        declared one, e.g. a preset's or one from the scenario's seed; ``hi``: a tighter
+        upper end that depends on other keys; ``choices``: those the scene offers, e.g.
+        the room's objects besides the markers)."""
         if default is MISSING:
             default = declared_default(decl)
         if isinstance(decl, Flag):
             return self.boolean(decl.name, default)
+        if isinstance(decl, Array):
+            raise TypeError(f"{decl.name}: an array's reader checks it")
         if isinstance(decl, Choice):
-            return self.choice(decl.name, decl.choices, default)
+            return self.choice(decl.name, choices or decl.choices, default)
         if isinstance(decl, Text):
             return self.string(decl.name, default, decl.max_length, decl.what)
         if decl.integer:
@@ -377,6 +391,14 @@ class Table:
             self._check_number(f"{key}[{i}]", v, lo, hi, lo_open, hi_open, allowed)
             for i, v in enumerate(value)
         )
+
+    def section(self, section: Section) -> Table | None:
+        """``section``'s table below this one (None: not given)."""
+        return self.table(section.path.rsplit(".", 1)[-1])
+
+    def sections(self, section: Section) -> list[Table]:
+        """``section``'s array of tables below this one (empty: not given)."""
+        return self.tables(section.path.rsplit(".", 1)[-1], section.many)
 
     def table(self, key: str) -> Table | None:
         value = self._get(key)
