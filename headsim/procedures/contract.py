@@ -119,10 +119,10 @@ class Procedure:
 
     What its keys mean: ``results`` its results.json ``experiment`` keys beside
     ``procedure`` (paths relative to ``experiment``: ``a.b``, ``a[].b``, ``a.*``, as in
-    :mod:`headsim.runs.results_reference`), ``keys`` the scenario keys only it reads
-    (full paths: ``experiment.NAME.key``, ``scene.NAME.key``; the shared ones are in
-    :mod:`headsim.scenario.key_reference`), or, declared with their types and ranges,
-    ``sections`` (the tables only it reads); both reference pages are made from them.
+    :mod:`headsim.runs.results_reference`), ``keys`` the scenario tables only it reads
+    (``[experiment.NAME]``, ``[scene.NAME]``), each key declared with its type, range,
+    default and meaning, which its reader reads through; both reference pages are made
+    from them.
     ``rank`` orders the procedures in a scenario's error and the references (lower
     first, then by name).  ``reach`` is the reach check its targets take (``"model2"``:
     each eye fixates from the start pose; ``"model1"``: the neck turns too);
@@ -142,8 +142,7 @@ class Procedure:
     fixations: Callable[[Any], int] = _each_target
     needs: frozenset[str] = frozenset()
     results: Mapping[str, str] = field(default_factory=dict)
-    keys: Mapping[str, str] = field(default_factory=dict)
-    sections: Sequence[Section] = ()
+    keys: Sequence[Section] = ()
     rank: int = 100
     reach: str = "model2"
     markerless: bool = False

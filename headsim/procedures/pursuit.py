@@ -377,7 +377,7 @@ PURSUIT = register(
         read_scene=read_pursuit_scene,
         fixations=_fixations,
         results=RESULTS,
-        sections=SECTIONS,
+        keys=SECTIONS,
         rank=70,
     )
 )

@@ -22,6 +22,7 @@ from headsim.procedures import contract as registry
 from headsim.scenario.spec import (
     CALIBRATION_DEPTH,
     CALIBRATION_LINES_OF_SIGHT,
+    CALIBRATION_POSITIONS,
     CALIBRATION_SETTINGS,
     CALIBRATION_SOURCE,
     CALIBRATION_TARGETS,
@@ -135,6 +136,7 @@ HEAD_KEYS: tuple[Declared, ...] = (
 DEFAULT_FROM_OTHER_KEYS: tuple[Declared, ...] = (CAMERA_PRESET, CALIBRATION_LINES_OF_SIGHT)
 #: What each declared table means (a procedure's own table is its ``Procedure.keys``'s).
 TABLE_MEANINGS = {
+    "fast": "Fields merged over the file by `--fast`: tables key by key, other values replaced.",
     "head": "The head's geometry and joints; missing keys come from `head.preset`.",
     "cam1": "One camera's settings; a missing key comes from the camera's preset.",
     "cam2": "One camera's settings; a missing key comes from the camera's preset.",
@@ -161,6 +163,7 @@ def declared_keys() -> tuple[tuple[str, Declared], ...]:
         *(("belief", d) for d in BELIEF_SETTINGS),
         ("experiment", procedure),
         *(("experiment", d) for d in (INTERPOLATE, MIDLINE, REMEDY, GOAL_COLUMNS)),
+        ("experiment.calibration", CALIBRATION_POSITIONS),
         *(("experiment.calibration", d) for d in CALIBRATION_SETTINGS),
         *(("experiment.servo", d) for d in SERVO_SETTINGS),
     )
@@ -428,7 +431,7 @@ def _read_calibration(table: Table | None, lines_default: bool = False) -> Calib
     for setting in CALIBRATION_SETTINGS:
         values[setting.name] = table.setting(setting, defaults.get(setting.name, MISSING))
         if setting is CALIBRATION_DEPTH:  # an empty range is named before the keys after it
-            _check_depth_range(table, values[setting.name])
+            check_depth_range(table, values[setting.name])
     spec = CalibrationSpec(
         **{k: v for k, v in values.items() if k != CALIBRATION_SOURCE.name},
         source=values[CALIBRATION_SOURCE.name],
@@ -461,12 +464,11 @@ def _read_calibration(table: Table | None, lines_default: bool = False) -> Calib
 
 def _calibration_positions(table: Table) -> tuple[tuple[float, float, float], ...] | None:
     """``positions_world_m``: the calibration ball's positions, given (None: drawn)."""
-    key = "positions_world_m"
+    key, allowed = CALIBRATION_POSITIONS.name, CALIBRATION_POSITIONS.allowed
     value = table.data.get(key)
     table.has(key)
     if value is None:
         return None
-    allowed = "an array of 3 to 1000 [x, y, z] positions in W, m"
     if (
         not isinstance(value, list)
         or not 3 <= len(value) <= 1000
@@ -486,12 +488,7 @@ def _calibration_positions(table: Table) -> tuple[tuple[float, float, float], ..
     )
 
 
-def depth_range(table: Table, default: tuple[float, float]) -> tuple[float, float]:
-    """``depth_m``: a depth range [near, far] in H, m, within the calibration's limits."""
-    return _check_depth_range(table, table.setting(CALIBRATION_DEPTH, default))
-
-
-def _check_depth_range(table: Table, depth_m: tuple[float, float]) -> tuple[float, float]:
+def check_depth_range(table: Table, depth_m: tuple[float, float]) -> tuple[float, float]:
     lo, hi = depth_m
     if not lo < hi:
         raise table.fail("depth_m", f"[{lo:g}, {hi:g}] is empty", "[near, far] with near < far")

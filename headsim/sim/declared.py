@@ -105,6 +105,7 @@ class Text:
     max_length: int = 200
     what: str | None = None
     required: bool = False
+    derived: bool = False  # with default None: the reader derives it (e.g. ``target_N``)
 
 
 @dataclass(frozen=True)
@@ -116,7 +117,7 @@ class Array:
     allowed: str
     meaning: str
     required: bool = False
-    default: tuple[object, ...] | None = None
+    default: object = None
 
 
 #: Any declared key.
