@@ -54,8 +54,10 @@ def accepted_keys() -> list[Key]:
     """Every accepted key with its meaning, by path."""
     keys = {t: Key(t, "table", f"a [{t}] table", "", m) for t, m in TABLE_MEANINGS.items()}
     for s in sections():
-        allowed = f"an array of tables, [[{s.path}]], at most {s.many}"
-        keys[s.path] = Key(s.path, *(("tables", allowed) if s.many else ("table", f"a [{s.path}] table")), "", s.meaning)  # fmt: skip
+        kind, allowed = "table", f"a [{s.path}] table"
+        if s.many:
+            kind, allowed = "tables", f"an array of tables, [[{s.path}]], at most {s.many}"
+        keys[s.path] = Key(s.path, kind, allowed, "", s.meaning)
     for table, decl in _declared():
         path = f"{table}.{decl.name}" if table else decl.name
         kind, allowed = declared_use(decl)

@@ -1,8 +1,8 @@
 """A declared setting: one key's type, range, default, unit and meaning, in one place.
 
 Every scenario key is declared as one of these (:class:`Setting` a number or an array of
-numbers, :class:`Flag`, :class:`Choice`, :class:`Text`) beside the field it sets, and each
-table as a :class:`Section` of them; the Python checks (e.g.
+numbers, :class:`Flag`, :class:`Choice`, :class:`Text`, :class:`Array` a list of points its
+reader checks) beside the field it sets, and each table as a :class:`Section` of them; the Python checks (e.g.
 :class:`headsim.sim.settings.CameraSettings`), the scenario loader's getters and
 one-line errors, and the scenario-key reference are all read from the declaration.
 """
