@@ -4,7 +4,7 @@
 site as a generated file (nothing generated is committed):
 
 - ``reference/scenario-keys.md``: every key the scenario loader accepts, from the
-  declarations and the getters (:mod:`headsim.scenario.key_reference`);
+  declarations (:mod:`headsim.scenario.key_reference`);
 - ``reference/results-json.md``: every key of results.json, from
   :mod:`headsim.runs.results_reference`;
 - ``reference/command-line.md``: every command's ``--help``, from the parser;
@@ -42,11 +42,9 @@ def scenario_keys_page() -> str:
     """Every accepted key as one table per top-level table."""
     out = [
         "# Scenario keys\n",
-        "Every key the scenario loader accepts, made at build time: a declared key's type, "
-        "what is allowed, default and meaning are its declaration's (the loader reads it from "
-        "the same declaration), the other keys' are the readers' own, recorded while they read "
-        "every shipped scenario (and variants that take their other branches), with the "
-        "meanings of `headsim.scenario.key_reference.descriptions()`. Lengths m, angles rad, pixels as "
+        "Every key the scenario loader accepts, made at build time from its declaration: "
+        "its type, what is allowed, default and meaning (the loader reads the key through "
+        "the same declaration, `headsim.scenario.key_reference`). Lengths m, angles rad, pixels as "
         "OpenCV's; `[]` stands for any entry of an array of tables. *required* means "
         "the file must give it where its table is read; a default that other keys set "
         "(a preset, the image size) says so. How to write a file: "

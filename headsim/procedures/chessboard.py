@@ -25,7 +25,12 @@ from headsim.runs.context import (
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord
 from headsim.runs.table import format_table, mm
-from headsim.scenario.scene import POSITION_KEYS, default_position, read_position, tuple3
+from headsim.scenario.scene import (
+    default_position,
+    position_of,
+    read_position,
+    tuple3,
+)
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import (
     CHESSBOARD_PATTERN,
@@ -38,6 +43,7 @@ from headsim.scenario.spec import (
 )
 from headsim.scenario.tables import Context, Table, describe_value
 from headsim.sim import names
+from headsim.sim.declared import Array, Section
 from headsim.sim.events import EventSink
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
@@ -253,11 +259,11 @@ def run_chessboard(
 
 def read_chessboard(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
     """``[scene.chessboard]``: where the board's top-left inner corner is; which corners."""
-    board = table.table("chessboard") or Table({}, "scene.chessboard", ctx)
+    board = table.section(BOARD) or Table({}, BOARD.path, ctx)
     position = read_position(board, settings, default_position("chessboard", names.CHESSBOARD))
     count = corner_count()
-    corners_value = board.data.get("corners", "all")
-    board.has("corners")
+    corners_value = board.data.get(_CORNERS.name, "all")
+    board.has(_CORNERS.name)
     allowed = f'"all" or an array of corner indices 0..{count - 1} (row-major from the top-left)'
     if corners_value == "all":
         corners = None
@@ -291,15 +297,9 @@ def _fixations(scenario: Scenario) -> int:
     return len(scenario.scene.corners or range(corner_count()))
 
 
-#: What the scenario keys only it reads mean.
-KEYS: dict[str, str] = {
-    "scene.chessboard": "The chessboard (procedure `chessboard`); it faces the head.",
-    "scene.chessboard.corners": 'Which inner corners are measured: `"all"` or an array of corner indices, row-major from the top-left.',
-    **{
-        f"scene.chessboard.{k}": "Top-left inner corner: " + v[0].lower() + v[1:]
-        for k, v in POSITION_KEYS.items()
-    },
-}
+#: The scenario table only it reads.
+_CORNERS = Array("corners", '"all" or an array of corner indices (row-major from the top-left)', 'Which inner corners are measured: `"all"` or an array of corner indices, row-major from the top-left.', default=("all",))  # fmt: skip
+BOARD = Section("scene.chessboard", "The chessboard (procedure `chessboard`); it faces the head.", (_CORNERS, *position_of("Top-left inner corner")))  # fmt: skip
 
 
 CHESSBOARD = register(
@@ -312,7 +312,7 @@ CHESSBOARD = register(
         options=read_options,
         read_scene=read_chessboard,
         fixations=_fixations,
-        keys=KEYS,
+        keys=(BOARD,),
         rank=50,
     )
 )

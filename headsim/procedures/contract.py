@@ -19,11 +19,12 @@ all, which :func:`get` and :func:`names` call once, on first use.
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from headsim.codec import describe
+from headsim.sim.declared import Section
 
 if TYPE_CHECKING:
     from headsim.active.measurement import HeadKnowledge
@@ -119,10 +120,10 @@ class Procedure:
     ``[scene]`` tables (None: it takes none); ``fixations(scenario)`` is how many
     fixations it makes after the calibration (for the progress bar).
 
-    What its keys mean: ``keys`` the scenario keys only it reads (full paths:
-    ``experiment.NAME.key``, ``scene.NAME.key``; the shared ones are in
-    :mod:`headsim.scenario.key_reference`); both reference pages are made from them and
-    from its result's declaration.
+    What its keys mean: ``keys`` the scenario tables only it reads (``[experiment.NAME]``,
+    ``[scene.NAME]``), each key declared with its type, range, default and meaning, which
+    its reader reads through; both reference pages are made from them and from its
+    result's declaration.
     ``rank`` orders the procedures in a scenario's error and the references (lower
     first, then by name).  ``reach`` is the reach check its targets take (``"model2"``:
     each eye fixates from the start pose; ``"model1"``: the neck turns too);
@@ -141,7 +142,7 @@ class Procedure:
     read_scene: SceneReader | None = None
     fixations: Callable[[Any], int] = _each_target
     needs: frozenset[str] = frozenset()
-    keys: Mapping[str, str] = field(default_factory=dict)
+    keys: Sequence[Section] = ()
     rank: int = 100
     reach: str = "model2"
     markerless: bool = False

@@ -41,7 +41,7 @@ from headsim.runs.landing import landing, vergence_error_deg
 from headsim.runs.outcomes import MeasurementRecord
 from headsim.runs.surface import row_band_for
 from headsim.runs.targets import marker_target
-from headsim.scenario.pursuit import PursuitSpec, describe
+from headsim.scenario.pursuit import SECTIONS, PursuitSpec, describe
 from headsim.scenario.scene import read_pursuit_scene
 from headsim.scenario.spec import MARKER_BODIES, STREAM_CLICKS, Scenario
 from headsim.scenario.surface_targets import Click, camera_centre, cast, click
@@ -343,50 +343,6 @@ def log_path(result: PursuitResult, log: Recorder) -> None:
         )
 
 
-_PURSUIT = "scene.pursuit"
-#: What the scenario keys only it reads mean.
-KEYS: dict[str, str] = {
-    _PURSUIT: "The live head pursuing a moving marker (procedure `pursuit`).",
-    f"{_PURSUIT}.name": "The pursued target's name.",
-    f"{_PURSUIT}.body": "What moves: a marker body, or a `[[scene.room.objects]]` name (clicked once, then tracked without markers).",
-    f"{_PURSUIT}.duration_s": "Length of the pursuit, s.",
-    f"{_PURSUIT}.click_error_px": "A room object's pursuit: the user's click in camera 1's first image, error per axis, px.",
-    f"{_PURSUIT}.band_px": "A room object's pursuit: half-height of the band along camera 1's row in which camera 2 searches, px.",
-    f"{_PURSUIT}.path": "How the target moves.",
-    f"{_PURSUIT}.path.kind": "The kind of path; each kind takes its own keys below.",
-    f"{_PURSUIT}.path.points_world_m": "`waypoints`: the points [[x, y, z], ...] in W, m.",
-    f"{_PURSUIT}.path.speeds_m_s": "`waypoints`: the speed along each leg, m/s.",
-    f"{_PURSUIT}.path.centre_world_m": "`sinusoid`: the centre in W, m.",
-    f"{_PURSUIT}.path.amplitude_m": "`sinusoid`: the amplitude along x, y, z of W, m.",
-    f"{_PURSUIT}.path.frequency_hz": "`sinusoid`: the frequency, Hz.",
-    f"{_PURSUIT}.path.phase_rad": "`sinusoid`: the phase along x, y, z, rad.",
-    f"{_PURSUIT}.path.start_world_m": "`random_walk`, `throw`, `jump`: the start in W, m.",
-    f"{_PURSUIT}.path.max_speed_m_s": "`random_walk`: the largest speed, m/s.",
-    f"{_PURSUIT}.path.box_half_m": "`random_walk`: half the box it stays in, along x, y, z, m.",
-    f"{_PURSUIT}.path.seed": "`random_walk`: the walk's seed; default the scenario's `seed`.",
-    f"{_PURSUIT}.path.end_world_m": "`jump`: where the target is from `time_s` on, in W, m.",
-    f"{_PURSUIT}.path.time_s": "`jump`: when the target jumps from the start to the end, s.",
-    f"{_PURSUIT}.path.velocity_m_s": "`throw`: the initial velocity in W, m/s (then gravity).",
-    f"{_PURSUIT}.path.point_world_m": "`static`: the point in W, m.",
-    f"{_PURSUIT}.path.windows_s": "When the target is visible: [[appear_s, disappear_s], ...]; default always.",
-    f"{_PURSUIT}.live": "The live head's camera and motors.",
-    f"{_PURSUIT}.live.frame_rate_hz": "Camera frame rate, Hz.",
-    f"{_PURSUIT}.live.exposure_s": "Exposure time, s (> 0 with `blur_subframes` > 1: motion blur).",
-    f"{_PURSUIT}.live.blur_subframes": "Renders averaged per frame for motion blur.",
-    f"{_PURSUIT}.live.latency_frames": "Frames between an image and the command it causes.",
-    f"{_PURSUIT}.live.eye_max_speed": "Eye motor's speed limit, rad/s.",
-    f"{_PURSUIT}.live.eye_max_accel": "Eye motor's acceleration limit, rad/s^2.",
-    f"{_PURSUIT}.live.neck_max_speed": "Neck motors' speed limit, rad/s.",
-    f"{_PURSUIT}.live.neck_max_accel": "Neck motors' acceleration limit, rad/s^2.",
-    f"{_PURSUIT}.gaze": "The gaze behaviour.",
-    f"{_PURSUIT}.gaze.mode": "Model 1 with the neck, or the eyes alone.",
-    f"{_PURSUIT}.gaze.predictor": "A constant-velocity predictor against the latency.",
-    f"{_PURSUIT}.gaze.saccade": "Saccade profile: minimum jerk or bang-bang.",
-    f"{_PURSUIT}.gaze.saccade_threshold_rad": "A fixation correction larger than this starts a saccade, rad.",
-    f"{_PURSUIT}.gaze.fixation_tolerance_px": "Image error within which the target counts as fixated, px.",
-}
-
-
 PURSUIT = register(
     Procedure(
         "pursuit",
@@ -399,7 +355,7 @@ PURSUIT = register(
         rows=log_path,
         read_scene=read_pursuit_scene,
         fixations=_fixations,
-        keys=KEYS,
+        keys=SECTIONS,
         rank=70,
     )
 )

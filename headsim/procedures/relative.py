@@ -33,17 +33,19 @@ from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord
 from headsim.runs.table import cell, format_table
 from headsim.scenario.scene import (
-    POSITION_KEYS,
-    RANDOM_BOX_KEYS,
+    POSITION,
+    RANDOM_BOX,
     default_position,
+    position_of,
     random_points_head,
     read_position,
     start_head_to_world,
     tuple3,
 )
 from headsim.scenario.spec import STREAM_OBJECTS, Placement, Scenario, SceneSpec
-from headsim.scenario.tables import MISSING, Context, Table
+from headsim.scenario.tables import Context, Table
 from headsim.sim import names
+from headsim.sim.declared import Choice, Section, Setting
 from headsim.sim.events import EventSink
 from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadSettings
@@ -398,24 +400,24 @@ def run_relative(
 
 def read_blocks(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> SceneSpec:
     """``[scene.blocks]`` (the cross point) and ``[[scene.objects]]``/``[scene.random_objects]``."""
-    blocks = table.table("blocks") or Table({}, "scene.blocks", ctx)
+    blocks = table.section(BLOCKS) or Table({}, BLOCKS.path, ctx)
     reference = read_position(blocks, settings, default_position("blocks", names.BLOCKS))
     blocks.done()
     objects: list[Placement] = []
-    for entry in table.tables("objects", len(names.RELATIVE_OBJECTS)):
-        body = entry.choice("body", names.RELATIVE_OBJECTS)
+    for entry in table.sections(OBJECTS):
+        body = entry.setting(_OBJECT)
         position = read_position(entry, settings)
         entry.done()
         if any(o.body == body for o in objects):
             raise entry.fail("body", f"{body!r} is placed twice", "each object once")
         objects.append(Placement(body, body, tuple3(position), entry.path))
-    random_table = table.table("random_objects")
+    random_table = table.section(RANDOM_OBJECTS)
     if random_table is not None:
         if objects:
             raise random_table.fail(
                 "count", "given together with [[scene.objects]]", "one of the two"
             )
-        count = random_table.integer("count", MISSING, 1, len(names.RELATIVE_OBJECTS))
+        count = random_table.setting(_COUNT)
         rng = np.random.default_rng([seed, STREAM_OBJECTS])
         points = start_head_to_world(settings, random_points_head(random_table, count, rng))
         random_table.done()
@@ -438,20 +440,12 @@ def read_blocks(table: Table, ctx: Context, settings: HeadSettings, seed: int) -
     )
 
 
-#: What the scenario keys only it reads mean.
-KEYS: dict[str, str] = {
-    "scene.blocks": "The blocks' cross point (procedure `relative_positioning`).",
-    **{
-        f"scene.blocks.{k}": "Cross point: " + v[0].lower() + v[1:]
-        for k, v in POSITION_KEYS.items()
-    },
-    "scene.objects": "Objects measured relative to the cross point, each seen by both cameras at the start pose or in all four images at the cross point's fixations; those not listed are parked out of view.",
-    "scene.objects[].body": "The object body (`object_1`..`object_6`).",
-    **{f"scene.objects[].{k}": v for k, v in POSITION_KEYS.items()},
-    "scene.random_objects": "Objects at random positions instead of `[[scene.objects]]`, drawn from the seed.",
-    "scene.random_objects.count": "Number of objects placed.",
-    **{f"scene.random_objects.{k}": v for k, v in RANDOM_BOX_KEYS.items()},
-}
+#: The scenario tables only it reads.
+_OBJECT = Choice("body", names.RELATIVE_OBJECTS, None, "The object body (`object_1`..`object_6`).", required=True)  # fmt: skip
+_COUNT = Setting("count", None, 1, len(names.RELATIVE_OBJECTS), "", "Number of objects placed.", integer=True, required=True)  # fmt: skip
+BLOCKS = Section("scene.blocks", "The blocks' cross point (procedure `relative_positioning`).", position_of("Cross point"))  # fmt: skip
+OBJECTS = Section("scene.objects", "Objects measured relative to the cross point, each seen by both cameras at the start pose or in all four images at the cross point's fixations; those not listed are parked out of view.", (_OBJECT, *POSITION), many=len(names.RELATIVE_OBJECTS))  # fmt: skip
+RANDOM_OBJECTS = Section("scene.random_objects", "Objects at random positions instead of `[[scene.objects]]`, drawn from the seed.", (_COUNT, *RANDOM_BOX))  # fmt: skip
 
 
 RELATIVE_POSITIONING = register(
@@ -465,7 +459,7 @@ RELATIVE_POSITIONING = register(
         rows=RelativeResult.log_rows,
         read_scene=read_blocks,
         fixations=lambda scenario: 1,  # the cross point's
-        keys=KEYS,
+        keys=(BLOCKS, OBJECTS, RANDOM_OBJECTS),
         rank=60,
     )
 )

@@ -60,6 +60,7 @@ from headsim.runs.table import cell, format_table, mm
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.spec import WHEN_GIVEN, CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
+from headsim.sim.declared import Array, Choice, Flag, Section, Setting, Text
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.calibration import MIN_VIEWS, CameraCalibration, StereoCalibration
 from headsim.stereo.calibration import calibrate_stereo as zhang_calibration
@@ -562,15 +563,22 @@ def run_stereo(
     return [], result
 
 
+# fmt: off
+_FROM = Text("from", None, "A stored stereo calibration file (`headsim.stereo.calibration_file`) to triangulate with instead of calibrating (no board keys then).", max_length=1000)
+_LOOK = Choice("look", LOOKS, "full_frame", "With `from`: each camera's look for a target, the full frame or `once` (a binned preview, then a window where it shows the target).")
+_VIEWS = Setting("views", StereoSpec.views, MIN_VIEWS, 1000, "", "Chessboard poses rendered for the calibration (at least 5 must show the whole board).", integer=True)
+_DISTANCE = Setting("distance_m", StereoSpec.distance_m, 0.1, 5.0, "m", "The board centre's distance from camera 1, [low, high], m.", count=2)
+_TILT = Setting("max_tilt_rad", StereoSpec.max_tilt_rad, 0.0, 1.2, "rad", "The board's largest tilt about its x and y axes, rad.")
+_REFINE = Flag("refine_intrinsics", StereoSpec.refine_intrinsics, "stereoCalibrate refines each camera's K, k1, k2 (false: keeps each camera's own calibration).")
+_SEED = Setting("board_seed", None, 0, 2**32 - 1, "", "The board poses' seed (default: the scenario's seed), so that a study can calibrate with the poses it drew before.", integer=True, optional=True)
+_BOARD_LOOK = Choice("board_look", BOARD_LOOKS, StereoSpec.board_look, "How each camera finds the board: `full_frame`, or `windowed` (a binned preview, then a window on the board: the same corners).")
+_PATTERN = Array("pattern", f"[{CHESSBOARD_PATTERN[0]}, {CHESSBOARD_PATTERN[1]}] (the chessboard scene's inner corners)", "The board's inner corners, [columns, rows]: the chessboard scene's board, [8, 6].", default=CHESSBOARD_PATTERN)
+#: ``[experiment.stereo]``: a calibration from board views, or a stored one (``from``).
+STEREO_TABLE = Section("experiment.stereo", "The calibrated stereo baseline (procedure `stereo`): Zhang's calibration from chessboard views, then each target triangulated at eye angle 0.", (_FROM, _LOOK, _VIEWS, _DISTANCE, _TILT, _REFINE, _SEED, _BOARD_LOOK, _PATTERN))
+# fmt: on
 #: The keys of ``[experiment.stereo]`` that only a calibration from board views reads.
-BOARD_KEYS = (
-    "views",
-    "distance_m",
-    "max_tilt_rad",
-    "refine_intrinsics",
-    "pattern",
-    "board_seed",
-    "board_look",
+BOARD_KEYS = tuple(
+    d.name for d in (_VIEWS, _DISTANCE, _TILT, _REFINE, _PATTERN, _SEED, _BOARD_LOOK)
 )
 
 
@@ -587,58 +595,33 @@ def _stored_spec(stereo: Table, source: str) -> StoredStereoSpec:
         read_stereo_calibration(path)
     except StereoCalibrationFileError as err:
         raise stereo.fail("from", str(err), "a stereo calibration file") from err
-    look = stereo.choice("look", LOOKS, "full_frame")
+    look = stereo.setting(_LOOK)
     stereo.done()
     return StoredStereoSpec(str(path), look)
 
 
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
     """``[experiment.stereo]``: the board views (:class:`StereoSpec`), and the pattern; or ``from``, a stored calibration (:class:`StoredStereoSpec`)."""
-    stereo = table.table("stereo") or Table({}, table.field("stereo"), table.ctx)
-    source = stereo.string("from", None, max_length=1000)
+    stereo = table.section(STEREO_TABLE) or Table({}, table.field("stereo"), table.ctx)
+    source = stereo.setting(_FROM)
     if source is not None:
         return {"block": _stored_spec(stereo, source)}
-    if stereo.has("look"):
+    if stereo.has(_LOOK.name):
         raise stereo.fail("look", "given without from", "look with a stored calibration only")
-    default = StereoSpec()
-    views = stereo.integer("views", default.views, MIN_VIEWS, 1000)
-    low, high = stereo.numbers(
-        "distance_m", 2, default.distance_m, 0.1, 5.0, lo_open=False, unit="m"
-    )
+    views = stereo.setting(_VIEWS)
+    low, high = stereo.setting(_DISTANCE)
     if low > high:
         raise stereo.fail(
             "distance_m", f"[{low:g}, {high:g}] is reversed", "[low, high], low <= high"
         )
-    tilt = stereo.number("max_tilt_rad", default.max_tilt_rad, 0.0, 1.2, unit="rad")
-    refine = stereo.boolean("refine_intrinsics", default.refine_intrinsics)
-    board_seed = stereo.integer("board_seed", None, 0, 2**32 - 1)
-    board_look = stereo.choice("board_look", BOARD_LOOKS, default.board_look)
-    pattern = stereo.data.get("pattern", list(CHESSBOARD_PATTERN))
-    stereo.has("pattern")
+    tilt, refine = stereo.setting(_TILT), stereo.setting(_REFINE)
+    board_seed, board_look = stereo.setting(_SEED), stereo.setting(_BOARD_LOOK)
+    pattern = stereo.data.get(_PATTERN.name, list(CHESSBOARD_PATTERN))
+    stereo.has(_PATTERN.name)
     if pattern != list(CHESSBOARD_PATTERN):
-        columns, rows = CHESSBOARD_PATTERN
-        raise stereo.fail(
-            "pattern",
-            f"{pattern!r} is not the scene's board",
-            f"[{columns}, {rows}] (the chessboard scene's inner corners)",
-        )
+        raise stereo.fail(_PATTERN.name, f"{pattern!r} is not the scene's board", _PATTERN.allowed)
     stereo.done()
     return {"block": StereoSpec(views, (low, high), tilt, refine, board_seed, board_look)}
-
-
-#: What the scenario keys only it reads mean.
-KEYS: dict[str, str] = {
-    "experiment.stereo": "The calibrated stereo baseline (procedure `stereo`): Zhang's calibration from chessboard views, then each target triangulated at eye angle 0.",
-    "experiment.stereo.views": "Chessboard poses rendered for the calibration (at least 5 must show the whole board).",
-    "experiment.stereo.distance_m": "The board centre's distance from camera 1, [low, high], m.",
-    "experiment.stereo.max_tilt_rad": "The board's largest tilt about its x and y axes, rad.",
-    "experiment.stereo.refine_intrinsics": "stereoCalibrate refines each camera's K, k1, k2 (false: keeps each camera's own calibration).",
-    "experiment.stereo.board_seed": "The board poses' seed (default: the scenario's seed), so that a study can calibrate with the poses it drew before.",
-    "experiment.stereo.board_look": "How each camera finds the board: `full_frame`, or `windowed` (a binned preview, then a window on the board: the same corners).",
-    "experiment.stereo.from": "A stored stereo calibration file (`headsim.stereo.calibration_file`) to triangulate with instead of calibrating (no board keys then).",
-    "experiment.stereo.look": "With `from`: each camera's look for a target, the full frame or `once` (a binned preview, then a window where it shows the target).",
-    "experiment.stereo.pattern": "The board's inner corners, [columns, rows]: the chessboard scene's board, [8, 6].",
-}
 
 
 STEREO = register(
@@ -655,7 +638,7 @@ STEREO = register(
         rows=lambda result, log: result.log_rows(log),
         options=read_options,
         read_scene=targets_reader("stereo", required=False),
-        keys=KEYS,
+        keys=(STEREO_TABLE,),
         rank=80,
     )
 )

@@ -24,7 +24,7 @@ from headsim.runs.outcomes import MeasurementRecord
 from headsim.runs.table import cell, mm
 from headsim.runs.targets import marker_target
 from headsim.scenario.scene import (
-    RANDOM_BOX_KEYS,
+    RANDOM_BOX,
     finite_number,
     random_points_head,
     start_head_to_world,
@@ -41,6 +41,7 @@ from headsim.scenario.spec import (
 )
 from headsim.scenario.tables import MISSING, Context, Table, describe_value
 from headsim.sim import names
+from headsim.sim.declared import Array, Choice, Section, Setting, Text
 from headsim.sim.events import EventSink
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
@@ -160,16 +161,13 @@ def read_moving_scene(table: Table, ctx: Context, settings: HeadSettings, seed: 
 
 def _read_moving(table: Table, ctx: Context, settings: HeadSettings, seed: int) -> MovingTarget:
     """``[scene.moving_target]``: a marker moved along waypoints, explicit or random."""
-    moving = table.table("moving_target")
+    moving = table.section(MOVING)
     if moving is None:
         raise table.fail("moving_target", "missing", "a [scene.moving_target] table")
-    name = moving.string("name", "moving_target", 60)
-    body = moving.choice("body", tuple(MARKER_BODIES), names.MARKERS[0])
-    duration = moving.number("duration_s", 10.0, 0.0, 3600.0, lo_open=True, unit="s")
-    steps = moving.integer("steps", MISSING, 1, 10000)
+    name, body, duration, steps = (moving.setting(d) for d in (_NAME, _BODY, _DURATION, _STEPS))
     allowed = "waypoints_head_m or waypoints_world_m (arrays of [x, y, z], at least 2) or [scene.moving_target.random]"
     given = []
-    for key, frame in (("waypoints_head_m", "head"), ("waypoints_world_m", "world")):
+    for key, frame in ((_IN_HEAD.name, "head"), (_IN_WORLD.name, "world")):
         value = moving.data.get(key, MISSING)
         moving.has(key)
         if value is MISSING:
@@ -186,9 +184,9 @@ def _read_moving(table: Table, ctx: Context, settings: HeadSettings, seed: int) 
             [[finite_number(moving, f"{key}[{i}]", c) for c in p] for i, p in enumerate(value)]
         )
         given.append(start_head_to_world(settings, points) if frame == "head" else points)
-    random_table = moving.table("random")
+    random_table = moving.section(RANDOM)
     if random_table is not None:
-        count = random_table.integer("waypoints", MISSING, 2, 1000)
+        count = random_table.setting(_COUNT)
         rng = np.random.default_rng([seed, STREAM_MOVING])
         given.append(start_head_to_world(settings, random_points_head(random_table, count, rng)))
         random_table.done()
@@ -208,19 +206,17 @@ def _fixations(scenario: Scenario) -> int:
     return scenario.scene.moving.steps if scenario.scene.moving else 0
 
 
-#: What the scenario keys only it reads mean.
-KEYS: dict[str, str] = {
-    "scene.moving_target": "The marker moved along waypoints (procedure `tracking`).",
-    "scene.moving_target.name": "The moving target's name.",
-    "scene.moving_target.body": "The marker body that moves.",
-    "scene.moving_target.duration_s": "Time to pass all waypoints, s.",
-    "scene.moving_target.steps": "Fixations, at equal intervals from t = 0. Required.",
-    "scene.moving_target.waypoints_head_m": "Waypoints [[x, y, z], ...] in H at the start pose, at least 2, passed at equal times, m.",
-    "scene.moving_target.waypoints_world_m": "Waypoints [[x, y, z], ...] in W, at least 2, m.",
-    "scene.moving_target.random": "Random waypoints drawn from the seed instead.",
-    "scene.moving_target.random.waypoints": "Number of random waypoints.",
-    **{f"scene.moving_target.random.{k}": v for k, v in RANDOM_BOX_KEYS.items()},
-}
+#: The scenario tables only it reads.
+_NAME = Text("name", "moving_target", "The moving target's name.", max_length=60)
+_BODY = Choice("body", tuple(MARKER_BODIES), names.MARKERS[0], "The marker body that moves.")  # fmt: skip
+_DURATION = Setting("duration_s", 10.0, 0.0, 3600.0, "s", "Time to pass all waypoints, s.", lo_open=True)  # fmt: skip
+_STEPS = Setting("steps", None, 1, 10000, "", "Fixations, at equal intervals from t = 0. Required.", integer=True, required=True)  # fmt: skip
+_WAYPOINTS = "an array of [x, y, z], at least 2"
+_IN_HEAD = Array("waypoints_head_m", _WAYPOINTS, "Waypoints [[x, y, z], ...] in H at the start pose, at least 2, passed at equal times, m.")  # fmt: skip
+_IN_WORLD = Array("waypoints_world_m", _WAYPOINTS, "Waypoints [[x, y, z], ...] in W, at least 2, m.")  # fmt: skip
+_COUNT = Setting("waypoints", None, 2, 1000, "", "Number of random waypoints.", integer=True, required=True)  # fmt: skip
+MOVING = Section("scene.moving_target", "The marker moved along waypoints (procedure `tracking`).", (_NAME, _BODY, _DURATION, _STEPS, _IN_HEAD, _IN_WORLD))  # fmt: skip
+RANDOM = Section("scene.moving_target.random", "Random waypoints drawn from the seed instead.", (_COUNT, *RANDOM_BOX))  # fmt: skip
 
 
 TRACKING = register(
@@ -233,7 +229,7 @@ TRACKING = register(
         options=read_options,
         read_scene=read_moving_scene,
         fixations=_fixations,
-        keys=KEYS,
+        keys=(MOVING, RANDOM),
         rank=40,
     )
 )

@@ -29,6 +29,7 @@ from headsim.runs.table import format_table
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
 from headsim.sim import names
+from headsim.sim.declared import Section, Setting
 from headsim.sim.simulator import HeadSim
 
 if TYPE_CHECKING:
@@ -156,24 +157,19 @@ def run_zoom_fixed_points(
 
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
     """``[experiment.zoom_fixed_points]``: :class:`ZoomSpec`."""
-    block = table.table("zoom_fixed_points") or Table(
-        {}, table.field("zoom_fixed_points"), table.ctx
-    )
-    default = ZoomSpec()
-    zoom = block.number("zoom", default.zoom, 1.05, 3.0)
-    poses = block.integer("poses", default.poses, 1, 100)
-    board_seed: int | None = block.integer("board_seed", None, 0, 2**32 - 1)
+    block = table.section(ZOOM_TABLE) or Table({}, table.field("zoom_fixed_points"), table.ctx)
+    zoom, poses, board_seed = (block.setting(d) for d in (_ZOOM, _POSES, _SEED))
     block.done()
     return {"block": ZoomSpec(zoom, poses, board_seed)}
 
 
-#: What the scenario keys only it reads mean.
-KEYS: dict[str, str] = {
-    "experiment.zoom_fixed_points": "Each camera's principal point as the fixed point of a zoom (procedure `zoom_fixed_points`): chessboard images at the head's focal lengths and at `zoom` times them; only pixels enter the fit.",
-    "experiment.zoom_fixed_points.zoom": "The focal length ratio of the second images.",
-    "experiment.zoom_fixed_points.poses": "Chessboard poses rendered at both focal lengths.",
-    "experiment.zoom_fixed_points.board_seed": "The seed of the board poses' draws (absent: the scenario's seed).",
-}
+# fmt: off
+_ZOOM = Setting("zoom", ZoomSpec.zoom, 1.05, 3.0, "", "The focal length ratio of the second images.")
+_POSES = Setting("poses", ZoomSpec.poses, 1, 100, "", "Chessboard poses rendered at both focal lengths.", integer=True)
+_SEED = Setting("board_seed", None, 0, 2**32 - 1, "", "The seed of the board poses' draws (absent: the scenario's seed).", integer=True, optional=True)
+#: ``[experiment.zoom_fixed_points]``, the scenario table only it reads.
+ZOOM_TABLE = Section("experiment.zoom_fixed_points", "Each camera's principal point as the fixed point of a zoom (procedure `zoom_fixed_points`): chessboard images at the head's focal lengths and at `zoom` times them; only pixels enter the fit.", (_ZOOM, _POSES, _SEED))
+# fmt: on
 
 
 ZOOM_FIXED_POINTS = register(
@@ -188,7 +184,7 @@ ZOOM_FIXED_POINTS = register(
         rows=lambda result, log: result.log_rows(log),
         options=read_options,
         fixations=lambda scenario: 0,
-        keys=KEYS,
+        keys=(ZOOM_TABLE,),
         rank=90,
     )
 )

@@ -22,6 +22,7 @@ from headsim.scenario.spec import MAX_DEPTH_M, TARGETS_AS, ListedSurfaceTarget, 
 from headsim.scenario.surface_targets import NotOnSurface, on_object, on_surface
 from headsim.scenario.tables import Table
 from headsim.sim import names
+from headsim.sim.declared import Array, Choice, Flag, Section, Setting, Text
 from headsim.sim.textured_scene import (
     SHAPES,
     LightSettings,
@@ -79,12 +80,57 @@ def draw_clutter(
 MAX_MESH_VERTICES, MAX_MESH_M = 1000, 2.0
 
 
+_PI = math.pi
+# fmt: off
+_NAME = Text("name", None, "The object's name, unique (default `item_N`; `clutter_`, `room_` and the scenes' bodies are reserved).", max_length=60, derived=True)
+_SHAPE = Choice("shape", tuple(SHAPES), None, "`box`, `cylinder`, `sphere`, `plane` or `mesh` (its `vertices_m` and `faces`, no `size_m`).", required=True)
+_VERTICES = Array("vertices_m", f"4 to {MAX_MESH_VERTICES} points [x, y, z] in the object's frame, m", "`mesh`: its vertices [[x, y, z], ...] in the object's frame (4-1000, within 2 m of its origin), m.", required=True)
+_FACES = Array("faces", "triangles [i, j, k] of vertex indices, counter-clockwise seen from outside, at least 4, each with an area", "`mesh`: its triangles [[i, j, k], ...] of vertex indices, counter-clockwise seen from outside (each textured by projecting it onto the object-frame plane it faces most).", required=True)
+_SIZE = Setting("size_m", None, 0.0, 5.0, "m", "MuJoCo's sizes, m: a box's half-lengths, a cylinder's radius and half-height (then 0), a sphere's radius (then 0, 0), a plane's half-sides (then 0).", count=3, optional=True)
+_POS = Setting("pos_world_m", None, -MAX_DEPTH_M, MAX_DEPTH_M, "m", "The object's centre in W, m.", count=3, required=True)
+_YAW = Setting("yaw_rad", 0.0, -_PI, _PI, "rad", "Rotation about W's z, rad.")
+_PITCH = Setting("pitch_rad", 0.0, -_PI, _PI, "rad", "Then about the object's own x, rad (a plane at pi/2 stands up facing the head).")
+_TEXTURE = Choice("texture", TEXTURE_KINDS, "pink", "Texture class: `pink`, `grating`, `low` or `repetitive`.")
+_TEXTURE_SEED = Setting("texture_seed", None, 0, 2**31 - 1, "", "Seed of the object's texture; default from the scenario's seed.", integer=True)
+_PERIOD = Setting("period_px", 16.0, 2.0, 256.0, "px", "`grating` and `repetitive`: the period in texture pixels (256 to a tile).")
+_ORIENTATION = Setting("orientation_rad", 0.0, -_PI, _PI, "rad", "`grating` and `repetitive`: direction the pattern varies along, rad from the texture's columns.")
+_CHECKS = Flag("checks", False, "`repetitive`: checks instead of stripes.")
+_TILE = Setting("tile_m", 0.5, 0.0, 10.0, "m", "`plane` and `mesh`: the side of one texture tile on the surface, m.", lo_open=True)
+OBJECTS = Section("scene.room.objects", "Textured objects placed in the room.", (_NAME, _SHAPE, _VERTICES, _FACES, _SIZE, _POS, _YAW, _PITCH, _TEXTURE, _TEXTURE_SEED, _PERIOD, _ORIENTATION, _CHECKS, _TILE), many=100)
+_LIGHT = LightSettings()
+_DIRECTION = Setting("direction_world", _LIGHT.direction_world, -1.0, 1.0, "", "Direction the key light shines along, in W (normalised).", count=3)
+_DIFFUSE = Setting("diffuse", _LIGHT.diffuse, 0.0, 1.0, "", "Key light's diffuse intensity, 0-1.")
+_AMBIENT = Setting("ambient", _LIGHT.ambient, 0.0, 1.0, "", "Ambient light everywhere, 0-1.")
+_SHADOWS = Flag("shadows", _LIGHT.shadows, "Whether the key light casts shadows (a shadow map: dearer renders).")
+LIGHT = Section("scene.room.light", "The key light and the ambient level.", (_DIRECTION, _DIFFUSE, _AMBIENT, _SHADOWS))
+_TARGET_NAME = Text("name", None, "The listed target's name, unique (`surface_` is reserved for drawn ones). Listed targets are measured in file order.", max_length=60, what="the target's name", required=True)
+_TARGET_OBJECT = Text("object", None, "The room object the point lies on (an objects entry, `clutter_N`, `room_floor`, `room_table`, `room_wall_*`).", max_length=60, what="the name of an object of the room")
+_IN_OBJECT = Setting("point_object_m", None, -MAX_DEPTH_M, MAX_DEPTH_M, "m", "The point in the object's frame, m; must lie within 1 mm of its surface.", count=3, optional=True)
+_IN_WORLD = Setting("point_world_m", None, -MAX_DEPTH_M, MAX_DEPTH_M, "m", "Without `object`: the point in W, m; must lie within 1 mm of a surface of the room.", count=3, optional=True)
+TARGETS = Section("scene.room.targets", "Markerless targets (`model2`, `model1`; told by a click in camera 1's image): a count drawn from the seed where the start pose shows both cameras (0: none), or a list.", (_TARGET_NAME, _TARGET_OBJECT, _IN_OBJECT, _IN_WORLD), many=200)
+_COUNT = Setting("targets", 0, 0, 200, "", TARGETS.meaning, integer=True)
+_TARGETS_DEPTH = Setting("targets_depth_m", (0.3, 2.0), 0.2, MAX_DEPTH_M, "m", "Depth range in H of the markerless targets, m (a draw outside is drawn again, counted).", count=2)
+_TARGETS_LATERAL = Setting("targets_lateral", 0.25, 0.0, 1.0, "", "Largest |x_h / z_h| of a markerless target's draw direction (0.25: the shared field).", lo_open=True)
+_TARGETS_VERTICAL = Setting("targets_vertical", 0.1, 0.0, 1.0, "", "Largest |y_h / z_h| of a markerless target's draw direction.", lo_open=True)
+_CLICK = Setting("click_error_px", 0.5, 0.0, 20.0, "px", "Standard deviation of the click that tells the head a markerless target, px per axis.")
+_BAND = Setting("band_px", 10.0, 1.0, 100.0, "px", "Half-height of the band along camera 1's row in which camera 2 searches the clicked point, px (the head knows no focal length).")
+_TARGETS_AS = Choice("targets_as", TARGETS_AS, "surface", "`surface`: each target by correlation; `markers`: an emissive marker put 5 mm out along the surface's normal, found by its colour (the marker twin).")
+_SURFACE = Choice("surface", TEXTURE_KINDS, "pink", "Texture class of the floor, walls and table: `pink` (1/f noise), `grating`, `low` (faint gradient), `repetitive` (stripes).")
+_TABLE_Z = Setting("table_top_z_m", RoomSpec.table_top_z_m, RoomSpec.floor_z_m, RoomSpec.wall_top_z_m, "m", "Height of the table top in W's z, m (the eyes are about 0.2 m up; default -0.35); the clutter rests on it.", lo_open=True, hi_open=True)
+_CLUTTER = Setting("clutter", 8, 0, 40, "", "Objects drawn from the seed (box, cylinder or sphere, 3-8 cm half-size, a texture class each), resting on the table.", integer=True)
+_CLUTTER_DEPTH = Setting("clutter_depth_m", (0.3, 2.0), 0.2, 2.1, "m", "Range of W's y (depth in front of the head) of the clutter's centres, m.", count=2)
+ROOM = Section("scene.room", "A textured room around the head (every procedure): floor, walls and table with generated textures, objects, clutter from the seed, and the light.", (_COUNT, _TARGETS_DEPTH, _TARGETS_LATERAL, _TARGETS_VERTICAL, _CLICK, _BAND, _TARGETS_AS, _SURFACE, _TABLE_Z, _CLUTTER, _CLUTTER_DEPTH))
+#: ``[scene.room]`` and its tables, as the key reference lists them.
+SECTIONS = (ROOM, LIGHT, OBJECTS, TARGETS)
+# fmt: on
+
+
 def _mesh(table: Table) -> tuple[tuple[Vec3, ...], tuple[tuple[int, int, int], ...]]:
     """A ``mesh`` object's ``vertices_m`` and ``faces``, checked: every index a vertex, no
     face without area."""
-    allowed = f"4 to {MAX_MESH_VERTICES} points [x, y, z] in the object's frame, m"
-    raw = table.data.get("vertices_m")
-    table.has("vertices_m")
+    allowed = _VERTICES.allowed
+    raw = table.data.get(_VERTICES.name)
+    table.has(_VERTICES.name)
     if not isinstance(raw, list) or not 4 <= len(raw) <= MAX_MESH_VERTICES:
         raise table.fail(
             "vertices_m", "missing" if raw is None else "wrong length or type", allowed
@@ -105,8 +151,8 @@ def _mesh(table: Table) -> tuple[tuple[Vec3, ...], tuple[tuple[int, int, int], .
         f"triangles [i, j, k] of vertex indices 0-{count - 1}, counter-clockwise seen from "
         "outside, at least 4, each with an area"
     )
-    raw = table.data.get("faces")
-    table.has("faces")
+    raw = table.data.get(_FACES.name)
+    table.has(_FACES.name)
     if not isinstance(raw, list) or not 4 <= len(raw) <= 4 * MAX_MESH_VERTICES:
         raise table.fail("faces", "missing" if raw is None else "wrong length or type", allowed)
     faces = []
@@ -125,14 +171,14 @@ def _mesh(table: Table) -> tuple[tuple[Vec3, ...], tuple[tuple[int, int, int], .
 
 def _object(table: Table, k: int, seed: int) -> SceneObject:
     """One ``[[scene.room.objects]]`` entry."""
-    name = table.string("name", f"item_{k + 1}", 60)
-    shape = table.choice("shape", tuple(SHAPES))
+    name = table.setting(_NAME, f"item_{k + 1}")
+    shape = table.setting(_SHAPE)
     if shape == "mesh":
         vertices, faces = _mesh(table)
         size: tuple[float, ...] | None = (0.0, 0.0, 0.0)
     else:
         vertices, faces = (), ()
-        size = table.numbers("size_m", 3, None, 0.0, 5.0, unit="m")
+        size = table.setting(_SIZE)
     if size is None or (
         shape != "mesh" and min(size[: {"sphere": 1, "cylinder": 2}.get(shape, 2)]) <= 0.0
     ):
@@ -142,17 +188,15 @@ def _object(table: Table, k: int, seed: int) -> SceneObject:
             "[a, b, c] m > 0: a box's half-lengths, a cylinder's radius and half-height, a "
             "sphere's radius (then 0, 0), a plane's half-sides (then 0)",
         )
-    pos = table.numbers("pos_world_m", 3, lo=-MAX_DEPTH_M, hi=MAX_DEPTH_M, unit="m")
-    yaw = table.number("yaw_rad", 0.0, -math.pi, math.pi, unit="rad")
-    pitch = table.number("pitch_rad", 0.0, -math.pi, math.pi, unit="rad")
+    pos, yaw, pitch = table.setting(_POS), table.setting(_YAW), table.setting(_PITCH)
     texture = TextureSpec(
-        table.choice("texture", TEXTURE_KINDS, "pink"),
-        seed=table.integer("texture_seed", seed * 100 + k, 0, 2**31 - 1),
-        period_px=table.number("period_px", 16.0, 2.0, 256.0, unit="px"),
-        orientation_rad=table.number("orientation_rad", 0.0, -math.pi, math.pi, unit="rad"),
-        checks=table.boolean("checks", False),
+        table.setting(_TEXTURE),
+        seed=table.setting(_TEXTURE_SEED, seed * 100 + k),
+        period_px=table.setting(_PERIOD),
+        orientation_rad=table.setting(_ORIENTATION),
+        checks=table.setting(_CHECKS),
     )
-    tile = table.number("tile_m", 0.5, 0.0, 10.0, lo_open=True, unit="m")
+    tile = table.setting(_TILE)
     table.done()
     full = (size[0], size[1], 1.0 if shape == "plane" else size[2])
     return SceneObject(
@@ -174,10 +218,9 @@ def scene_names() -> frozenset[str]:
 
 def _listed(entry: Table) -> ListedSurfaceTarget:
     """One ``[[scene.room.targets]]`` entry (its point checked later, with the room)."""
-    name = entry.string("name", what="the target's name", max_length=60)
-    body = entry.string("object", None, 60, what="the name of an object of the room")
-    in_object = entry.numbers("point_object_m", 3, None, -MAX_DEPTH_M, MAX_DEPTH_M, unit="m")
-    in_world = entry.numbers("point_world_m", 3, None, -MAX_DEPTH_M, MAX_DEPTH_M, unit="m")
+    name, body, in_object, in_world = (
+        entry.setting(d) for d in (_TARGET_NAME, _TARGET_OBJECT, _IN_OBJECT, _IN_WORLD)
+    )
     entry.done()
     if body is not None and (in_object is None or in_world is not None):
         raise entry.fail(
@@ -201,22 +244,20 @@ def _surface_targets(table: Table) -> SurfaceTargetsSpec | None:
     ``[[scene.room.targets]]`` listed; its ``targets_*`` keys, ``click_error_px``,
     ``band_px``); None when there are none."""
     listed: tuple[ListedSurfaceTarget, ...] = ()
-    if isinstance(table.data.get("targets"), list):
+    if isinstance(table.data.get(_COUNT.name), list):
         # TOML gives a key one type: listed targets leave no count to draw.
-        listed = tuple(_listed(t) for t in table.tables("targets", 200))
+        listed = tuple(_listed(t) for t in table.sections(TARGETS))
         count = 0
     else:
-        count = table.integer("targets", 0, 0, 200)
-    near, far = table.numbers("targets_depth_m", 2, (0.3, 2.0), 0.2, MAX_DEPTH_M, unit="m")
+        count = table.setting(_COUNT)
+    near, far = table.setting(_TARGETS_DEPTH)
     if near >= far:
         raise table.fail(
             "targets_depth_m", f"[{near:g}, {far:g}] is empty", "[near, far], near < far"
         )
-    lateral = table.number("targets_lateral", 0.25, 0.0, 1.0, lo_open=True)
-    vertical = table.number("targets_vertical", 0.1, 0.0, 1.0, lo_open=True)
-    click_px = table.number("click_error_px", 0.5, 0.0, 20.0, unit="px")
-    band_px = table.number("band_px", 10.0, 1.0, 100.0, unit="px")
-    targets_as = table.choice("targets_as", TARGETS_AS, "surface")
+    lateral, vertical = table.setting(_TARGETS_LATERAL), table.setting(_TARGETS_VERTICAL)
+    click_px, band_px = table.setting(_CLICK), table.setting(_BAND)
+    targets_as = table.setting(_TARGETS_AS)
     if count == 0 and not listed:
         return None
     return SurfaceTargetsSpec(
@@ -281,35 +322,31 @@ def check_listed(scene: Table, room: RoomSpec, listed: tuple[ListedSurfaceTarget
 def read_room(scene: Table, seed: int) -> tuple[RoomSpec | None, SurfaceTargetsSpec | None]:
     """``[scene.room]``, its ``light`` and ``objects``, and its markerless targets;
     (None, None) without it."""
-    table = scene.table("room")
+    table = scene.section(ROOM)
     if table is None:
         return None, None
     targets = _surface_targets(table)
-    surface = table.choice("surface", TEXTURE_KINDS, "pink")
-    floor, top = RoomSpec.floor_z_m, RoomSpec.wall_top_z_m
-    table_z = table.number(
-        "table_top_z_m", RoomSpec.table_top_z_m, floor, top, lo_open=True, hi_open=True, unit="m"
-    )
-    count = table.integer("clutter", 8, 0, 40)
-    near, far = table.numbers("clutter_depth_m", 2, (0.3, 2.0), 0.2, 2.1, unit="m")
+    surface, table_z = table.setting(_SURFACE), table.setting(_TABLE_Z)
+    count = table.setting(_CLUTTER)
+    near, far = table.setting(_CLUTTER_DEPTH)
     if near >= far:
         raise table.fail(
             "clutter_depth_m", f"[{near:g}, {far:g}] is empty", "[near, far], near < far"
         )
-    light_table = table.table("light")
+    light_table = table.section(LIGHT)
     light = LightSettings()
     if light_table is not None:
-        direction = light_table.numbers("direction_world", 3, light.direction_world, -1.0, 1.0)
+        direction = light_table.setting(_DIRECTION)
         if not any(direction):
             raise light_table.fail("direction_world", "is zero", "a direction [x, y, z] != 0")
         light = LightSettings(
             direction_world=(direction[0], direction[1], direction[2]),
-            diffuse=light_table.number("diffuse", light.diffuse, 0.0, 1.0),
-            ambient=light_table.number("ambient", light.ambient, 0.0, 1.0),
-            shadows=light_table.boolean("shadows", light.shadows),
+            diffuse=light_table.setting(_DIFFUSE),
+            ambient=light_table.setting(_AMBIENT),
+            shadows=light_table.setting(_SHADOWS),
         )
         light_table.done()
-    objects = tuple(_object(t, k, seed) for k, t in enumerate(table.tables("objects", 100)))
+    objects = tuple(_object(t, k, seed) for k, t in enumerate(table.sections(OBJECTS)))
     table.done()
     given = [o.name for o in objects]
     taken = scene_names()

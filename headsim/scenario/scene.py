@@ -28,8 +28,9 @@ from headsim.scenario.reach import (
     target_refusal,
 )
 from headsim.scenario.room import ROOM_HAS_TARGETS, ROOM_OCCLUDERS, read_room, room_occluders
-from headsim.scenario.schema import depth_range
+from headsim.scenario.schema import check_depth_range
 from headsim.scenario.spec import (
+    CALIBRATION_DEPTH,
     MARKER_BODIES,
     MAX_DEPTH_M,
     STREAM_TARGETS,
@@ -39,27 +40,43 @@ from headsim.scenario.spec import (
 )
 from headsim.scenario.tables import MISSING, Context, Table
 from headsim.sim import names
+from headsim.sim.declared import Choice, Section, Setting, Text
 from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadSettings
 
-#: What the keys of a position (:func:`read_position`) mean.
-POSITION_KEYS: dict[str, str] = {
-    "position_head_m": "Position in H at the start pose (neck and eyes at 0), m; or `position_world_m`.",
-    "position_world_m": "Position in W, m; or `position_head_m`.",
-}
+_M = MAX_DEPTH_M
+#: A position's keys (:func:`read_position`): in H at the start pose, or in W.
+POSITION = (
+    Setting("position_head_m", None, -_M, _M, "m", "Position in H at the start pose (neck and eyes at 0), m; or `position_world_m`.", count=3, optional=True),
+    Setting("position_world_m", None, -_M, _M, "m", "Position in W, m; or `position_head_m`.", count=3, optional=True),
+)  # fmt: skip
 
-#: What the keys of a random box (``[scene.random_*]``) mean.
-RANDOM_BOX_KEYS: dict[str, str] = {
-    "depth_m": "Depth range z_h of the drawn points in H, m.",
-    "lateral": "Largest |x_h / z_h| of a drawn point (half the horizontal field, as a ratio).",
-    "vertical": "Largest |y_h / z_h| of a drawn point.",
-}
+
+def position_of(what: str) -> tuple[Setting, ...]:
+    """:data:`POSITION`, its meanings saying whose position it is."""
+    return tuple(
+        replace(d, meaning=f"{what}: {d.meaning[0].lower()}{d.meaning[1:]}") for d in POSITION
+    )
+
+
+#: A random box's keys (``[scene.random_*]``, :func:`random_points_head`).
+DEPTH = replace(CALIBRATION_DEPTH, default=(0.5, 1.2), meaning="Depth range z_h of the drawn points in H, m.")  # fmt: skip
+LATERAL = Setting("lateral", 0.12, 0.0, 1.0, "(|x_h / z_h|)", "Largest |x_h / z_h| of a drawn point (half the horizontal field, as a ratio).")  # fmt: skip
+VERTICAL = Setting("vertical", 0.06, 0.0, 1.0, "(|y_h / z_h|)", "Largest |y_h / z_h| of a drawn point.")  # fmt: skip
+RANDOM_BOX = (DEPTH, LATERAL, VERTICAL)
+_BODY = Choice("body", tuple(MARKER_BODIES), names.MARKERS[0], "The marker body that stands for the target.")  # fmt: skip
+_NAME = Text("name", None, "The target's name, unique (default `target_N`).", max_length=60, derived=True)  # fmt: skip
+TARGETS = Section("scene.targets", "Fixed targets (model2, model1; for calibration: optional check targets).", (_NAME, _BODY, *POSITION), many=1000)  # fmt: skip
+_COUNT = Setting("count", None, 1, 1000, "", "Number of random targets.", integer=True, required=True)  # fmt: skip
+_WITHIN = Choice("within", ("box", "reach"), "box", "`box` refuses a drawn point out of reach and draws again one the scene hides; `reach` draws any refused point again (each redraw counted).")  # fmt: skip
+RANDOM_TARGETS = Section("scene.random_targets", "More targets drawn from the seed, named `random_N`.", (_COUNT, replace(_BODY, meaning="The marker body of every random target."), _WITHIN, *RANDOM_BOX))  # fmt: skip
+#: ``[scene]``'s shared tables, as the key reference lists them.
+SECTIONS = (Section("scene", "What the procedure measures and where it is."), TARGETS, RANDOM_TARGETS)  # fmt: skip
 
 
 def read_position(table: Table, settings: HeadSettings, default: Any = MISSING) -> np.ndarray:
     """``position_head_m`` (H at the start pose) or ``position_world_m``, as a world point."""
-    in_head = table.numbers("position_head_m", 3, None, -MAX_DEPTH_M, MAX_DEPTH_M, unit="m")
-    in_world = table.numbers("position_world_m", 3, None, -MAX_DEPTH_M, MAX_DEPTH_M, unit="m")
+    in_head, in_world = (table.setting(d) for d in POSITION)
     allowed = "position_head_m = [x, y, z] (H at the start pose) or position_world_m, not both"
     if in_head is not None and in_world is not None:
         raise table.fail("position_world_m", "given together with position_head_m", allowed)
@@ -80,9 +97,8 @@ def start_head_to_world(settings: HeadSettings, points_head: np.ndarray) -> np.n
 
 def random_points_head(table: Table, count: int, rng: np.random.Generator) -> np.ndarray:
     """Points (count, 3) in H drawn like ``calibration_layout``: depth, then angles."""
-    near, far = depth_range(table, (0.5, 1.2))
-    lateral = table.number("lateral", 0.12, 0.0, 1.0, unit="(|x_h / z_h|)")
-    vertical = table.number("vertical", 0.06, 0.0, 1.0, unit="(|y_h / z_h|)")
+    near, far = check_depth_range(table, table.setting(DEPTH))
+    lateral, vertical = table.setting(LATERAL), table.setting(VERTICAL)
     return sample_points_head(
         rng, count, (-lateral, lateral), (-vertical, vertical), depth_range_m=(near, far)
     )
@@ -144,23 +160,22 @@ def _read_targets(
     and how they were accepted (the loader's reach check refuses a listed one it cannot
     fixate; ``within = "reach"`` draws a refused random one again, ``"box"`` one that the
     scene hides, each counted)."""
-    bodies = tuple(MARKER_BODIES)
     targets = []
-    for k, table in enumerate(scene.tables("targets")):
-        name = table.string("name", f"target_{k + 1}", 60)
-        body = table.choice("body", bodies, names.MARKERS[0])
+    for k, table in enumerate(scene.sections(TARGETS)):
+        name = table.setting(_NAME, f"target_{k + 1}")
+        body = table.setting(_BODY)
         position = read_position(table, settings)
         table.done()
         targets.append(Placement(name, body, tuple3(position), table.path))
     listed = len(targets)
-    random_table = scene.table("random_targets")
+    random_table = scene.section(RANDOM_TARGETS)
     within: str | None = None
     drawn = 0
     refused: dict[str, int] = {}
     if random_table is not None:
-        count = random_table.integer("count", MISSING, 1, 1000)
-        body = random_table.choice("body", bodies, names.MARKERS[0])
-        within = random_table.choice("within", ("box", "reach"), "box")
+        count = random_table.setting(_COUNT)
+        body = random_table.setting(_BODY)
+        within = random_table.setting(_WITHIN)
         rng = np.random.default_rng([seed, STREAM_TARGETS])
         points = start_head_to_world(settings, random_points_head(random_table, count, rng))
         # What can hide them: the scene as the listed targets leave it.

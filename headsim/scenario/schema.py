@@ -22,6 +22,7 @@ from headsim.procedures import contract as registry
 from headsim.scenario.spec import (
     CALIBRATION_DEPTH,
     CALIBRATION_LINES_OF_SIGHT,
+    CALIBRATION_POSITIONS,
     CALIBRATION_SETTINGS,
     CALIBRATION_SOURCE,
     CALIBRATION_TARGETS,
@@ -135,6 +136,7 @@ HEAD_KEYS: tuple[Declared, ...] = (
 DEFAULT_FROM_OTHER_KEYS: tuple[Declared, ...] = (CAMERA_PRESET, CALIBRATION_LINES_OF_SIGHT)
 #: What each declared table means (a procedure's own table is its ``Procedure.keys``'s).
 TABLE_MEANINGS = {
+    "fast": "Fields merged over the file by `--fast`: tables key by key, other values replaced.",
     "head": "The head's geometry and joints; missing keys come from `head.preset`.",
     "cam1": "One camera's settings; a missing key comes from the camera's preset.",
     "cam2": "One camera's settings; a missing key comes from the camera's preset.",
@@ -161,6 +163,7 @@ def declared_keys() -> tuple[tuple[str, Declared], ...]:
         *(("belief", d) for d in BELIEF_SETTINGS),
         ("experiment", procedure),
         *(("experiment", d) for d in (INTERPOLATE, MIDLINE, REMEDY, GOAL_COLUMNS)),
+        ("experiment.calibration", CALIBRATION_POSITIONS),
         *(("experiment.calibration", d) for d in CALIBRATION_SETTINGS),
         *(("experiment.servo", d) for d in SERVO_SETTINGS),
     )
@@ -264,40 +267,16 @@ def _read_head_model(head: Table, ctx: Context, directory: Path) -> HeadModel:
             "a [head.mapping] table naming its joints and cameras",
         )
     m = mapping_table
-
-    def joint_name(key: str, default: Any = MISSING) -> Any:
-        kind = {"head_body": "body", "version": "actuator", "vergence": "actuator"}
-        what = f"the name of a {kind.get(key, 'joint')} in the head's MJCF file"
-        if default is not MISSING:
-            what += " (or leave it out)"
-        return m.string(key, default, what=what)
-
-    cameras = m._get("cameras")
+    cameras = m._get(heads.CAMERAS.name)
     if not (
         isinstance(cameras, list)
         and len(cameras) == 2
         and all(isinstance(c, str) and c for c in cameras)
     ):
-        raise m.fail(
-            "cameras",
-            "must name two cameras",
-            "an array of two camera names [left (Ca1), right (Ca2)]",
-        )
-    m._note("cameras", "strings", "an array of two camera names [left (Ca1), right (Ca2)]", MISSING)
+        raise m.fail(heads.CAMERAS.name, "must name two cameras", heads.CAMERAS.allowed)
+    parts = {d.name: m.setting(d) for d in heads.MAPPING.keys if d is not heads.CAMERAS}
     try:
-        mapping = heads.HeadMapping(
-            head_body=joint_name("head_body"),
-            neck_yaw=joint_name("neck_yaw", None),
-            neck_pitch=joint_name("neck_pitch"),
-            eyes=m.choice("eyes", heads.EYE_KINDS),
-            left_eye=joint_name("left_eye"),
-            right_eye=joint_name("right_eye"),
-            cameras=(cameras[0], cameras[1]),
-            neck_roll=joint_name("neck_roll", None),
-            eye_tilt=joint_name("eye_tilt", None),
-            version=joint_name("version", None),
-            vergence=joint_name("vergence", None),
-        )
+        mapping = heads.HeadMapping(**parts, cameras=(cameras[0], cameras[1]))
     except heads.HeadError as err:
         raise ctx.error(f"head.mapping.{err.key}", err.problem, err.allowed) from None
     m.done()
@@ -452,7 +431,7 @@ def _read_calibration(table: Table | None, lines_default: bool = False) -> Calib
     for setting in CALIBRATION_SETTINGS:
         values[setting.name] = table.setting(setting, defaults.get(setting.name, MISSING))
         if setting is CALIBRATION_DEPTH:  # an empty range is named before the keys after it
-            _check_depth_range(table, values[setting.name])
+            check_depth_range(table, values[setting.name])
     spec = CalibrationSpec(
         **{k: v for k, v in values.items() if k != CALIBRATION_SOURCE.name},
         source=values[CALIBRATION_SOURCE.name],
@@ -485,12 +464,11 @@ def _read_calibration(table: Table | None, lines_default: bool = False) -> Calib
 
 def _calibration_positions(table: Table) -> tuple[tuple[float, float, float], ...] | None:
     """``positions_world_m``: the calibration ball's positions, given (None: drawn)."""
-    key = "positions_world_m"
+    key, allowed = CALIBRATION_POSITIONS.name, CALIBRATION_POSITIONS.allowed
     value = table.data.get(key)
     table.has(key)
     if value is None:
         return None
-    allowed = "an array of 3 to 1000 [x, y, z] positions in W, m"
     if (
         not isinstance(value, list)
         or not 3 <= len(value) <= 1000
@@ -510,12 +488,7 @@ def _calibration_positions(table: Table) -> tuple[tuple[float, float, float], ..
     )
 
 
-def depth_range(table: Table, default: tuple[float, float]) -> tuple[float, float]:
-    """``depth_m``: a depth range [near, far] in H, m, within the calibration's limits."""
-    return _check_depth_range(table, table.setting(CALIBRATION_DEPTH, default))
-
-
-def _check_depth_range(table: Table, depth_m: tuple[float, float]) -> tuple[float, float]:
+def check_depth_range(table: Table, depth_m: tuple[float, float]) -> tuple[float, float]:
     lo, hi = depth_m
     if not lo < hi:
         raise table.fail("depth_m", f"[{lo:g}, {hi:g}] is empty", "[near, far] with near < far")

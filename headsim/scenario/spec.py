@@ -19,7 +19,7 @@ from headsim import paper
 from headsim.procedures import contract as registry
 from headsim.scenario.calibration_design import LAYOUTS
 from headsim.sim import names
-from headsim.sim.declared import Choice, Flag, Setting, Text
+from headsim.sim.declared import Array, Choice, Flag, Setting, Text
 from headsim.sim.settings import MAX_IMAGE_SIDE, HeadSettings, belief_sources
 from headsim.sim.textured_scene import RoomSpec
 
@@ -116,6 +116,13 @@ CALIBRATION_NEAR_FRACTION = Setting(
     optional=True,
 )
 #: The calibration's declared keys, in the order ``[experiment.calibration]`` reads them.
+#: Read by its own reader, before the settings (their ``targets`` defaults to its length).
+CALIBRATION_POSITIONS = Array(
+    "positions_world_m",
+    "an array of 3 to 1000 [x, y, z] positions in W, m",
+    "The ball positions [[x, y, z], ...] in W, m, given instead of drawn (`targets` is their "
+    "number).",
+)
 CALIBRATION_SETTINGS = (
     CALIBRATION_TARGETS,
     CALIBRATION_DEPTH,

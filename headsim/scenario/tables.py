@@ -3,23 +3,17 @@
 A :class:`Table` wraps one TOML table; each getter checks one key's type and
 range and names the field and what is allowed when it is wrong
 (:class:`ScenarioError`: ``FILE: FIELD: what is wrong (allowed: ...)``);
-:meth:`Table.done` rejects the keys no getter asked for.  Inside
-:func:`collecting_keys` every getter also notes the key it read, its type, what is
-allowed and its default (:class:`KeyUse`): the scenario reference is made from those.
+:meth:`Table.setting` reads a declared key (:mod:`headsim.sim.declared`) with the getter
+its declaration calls for; :meth:`Table.done` rejects the keys no getter asked for.
 """
 
 from __future__ import annotations
 
 import math
-import re
-from collections.abc import Iterator
-from contextlib import contextmanager
-from contextvars import ContextVar
-from dataclasses import dataclass
 from typing import Any
 
 from headsim.errors import BadInput
-from headsim.sim.declared import Choice, Declared, Flag, Setting, Text
+from headsim.sim.declared import Array, Choice, Declared, Flag, Section, Setting, Text
 
 MISSING = object()
 
@@ -74,6 +68,8 @@ def declared_default(decl: Declared) -> Any:
     file must give it, or the caller passes a default derived from other keys)."""
     if isinstance(decl, Flag):
         return decl.default
+    if isinstance(decl, Array):
+        return MISSING if decl.required else decl.default
     if isinstance(decl, Setting):
         return None if decl.optional else MISSING if decl.default is None else decl.default
     return MISSING if decl.required else decl.default
@@ -83,6 +79,8 @@ def declared_use(decl: Declared) -> tuple[str, str]:
     """``decl``'s kind and what it allows, as the getter that reads it says them."""
     if isinstance(decl, Flag):
         return "boolean", "true, false"
+    if isinstance(decl, Array):
+        return "array", decl.allowed
     if isinstance(decl, Choice):
         return "choice", ", ".join(decl.choices)
     if isinstance(decl, Text):
@@ -119,35 +117,6 @@ def _range_text(lo: float | None, hi: float | None, lo_open: bool, hi_open: bool
         parts.append(f"{'<' if hi_open else '<='} {hi:g}")
     text = " and ".join(parts) if parts else "any finite value"
     return f"{text} {unit}".rstrip()
-
-
-@dataclass(frozen=True)
-class KeyUse:
-    """One key as a getter read it: its dotted path (``[]`` for any index), type and limits."""
-
-    path: str
-    kind: str
-    allowed: str
-    default: str  # the default as TOML would write it, or "" when the key is required
-
-
-_COLLECTED: ContextVar[dict[str, KeyUse] | None] = ContextVar("_COLLECTED", default=None)
-
-
-@contextmanager
-def collecting_keys() -> Iterator[dict[str, KeyUse]]:
-    """Note every key the getters read while inside, by normalised path."""
-    seen: dict[str, KeyUse] = {}
-    token = _COLLECTED.set(seen)
-    try:
-        yield seen
-    finally:
-        _COLLECTED.reset(token)
-
-
-def key_path(field_path: str) -> str:
-    """``field_path`` with list indices as ``[]``: ``scene.targets[3].name`` -> ``scene.targets[].name``."""
-    return re.sub(r"\[\d+\]", "[]", field_path)
 
 
 def toml_value(value: Any) -> str:
@@ -202,20 +171,7 @@ class Table:
     def has(self, key: str) -> bool:
         if key not in self.known:
             self.known.append(key)
-        self._note(key, "", "", MISSING, first=True)
         return key in self.data
-
-    def _note(
-        self, key: str, kind: str, allowed: str, default: Any, *, first: bool = False
-    ) -> None:
-        """Record the key's use while :func:`collecting_keys` is active."""
-        seen = _COLLECTED.get()
-        if seen is None:
-            return
-        path = key_path(self.field(key))
-        if first and path in seen:
-            return
-        seen[path] = KeyUse(path, kind, key_path(allowed), toml_value(default))
 
     def _get(self, key: str) -> Any:
         return self.data[key] if self.has(key) else MISSING
@@ -223,16 +179,26 @@ class Table:
     def fail(self, key: str, message: str, allowed: str | None = None) -> ScenarioError:
         return self.ctx.error(self.field(key), message, allowed)
 
-    def setting(self, decl: Declared, default: Any = MISSING, *, hi: float | None = None) -> Any:
+    def setting(
+        self,
+        decl: Declared,
+        default: Any = MISSING,
+        *,
+        hi: float | None = None,
+        choices: tuple[str, ...] | None = None,
+    ) -> Any:
         """``decl``'s key, read and checked as declared (``default``: instead of the
-        declared one, e.g. a preset's; ``hi``: a tighter upper end that depends on other
-        keys, which the declaration's ``unit_note`` says)."""
+        declared one, e.g. a preset's or one from the scenario's seed; ``hi``: a tighter
+        upper end that depends on other keys; ``choices``: those the scene offers, e.g.
+        the room's objects besides the markers)."""
         if default is MISSING:
             default = declared_default(decl)
         if isinstance(decl, Flag):
             return self.boolean(decl.name, default)
+        if isinstance(decl, Array):
+            raise TypeError(f"{decl.name}: an array's reader checks it")
         if isinstance(decl, Choice):
-            return self.choice(decl.name, decl.choices, default)
+            return self.choice(decl.name, choices or decl.choices, default)
         if isinstance(decl, Text):
             return self.string(decl.name, default, decl.max_length, decl.what)
         if decl.integer:
@@ -261,7 +227,6 @@ class Table:
     ) -> float:
         value = self._get(key)
         allowed = f"a number {_range_text(lo, hi, lo_open, hi_open, unit)}"
-        self._note(key, "number", allowed, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", allowed)
@@ -296,7 +261,6 @@ class Table:
     def integer(self, key: str, default: Any = MISSING, lo: int = 0, hi: int = 10**6) -> int:
         value = self._get(key)
         allowed = _integer_allowed(lo, hi)
-        self._note(key, "integer", allowed, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", allowed)
@@ -309,7 +273,6 @@ class Table:
 
     def boolean(self, key: str, default: bool) -> bool:
         value = self._get(key)
-        self._note(key, "boolean", "true, false", default)
         if value is MISSING:
             return default
         if not isinstance(value, bool):
@@ -324,7 +287,6 @@ class Table:
         """A one-line string; ``what`` says what it names (an error's "allowed" text)."""
         value = self._get(key)
         allowed = _text_allowed(max_length, what)
-        self._note(key, "string", allowed, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", allowed)
@@ -338,7 +300,6 @@ class Table:
     def choice(self, key: str, allowed: tuple[str, ...] | list[str], default: Any = MISSING) -> str:
         value = self._get(key)
         text = ", ".join(allowed)
-        self._note(key, "choice", text, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", text)
@@ -364,7 +325,6 @@ class Table:
         value = self._get(key)
         each = _range_text(lo, hi, lo_open, hi_open, unit)
         allowed = _numbers_allowed(length, each)
-        self._note(key, "numbers", allowed, default)
         if value is MISSING:
             if default is MISSING:
                 raise self.fail(key, "missing", allowed)
@@ -378,9 +338,16 @@ class Table:
             for i, v in enumerate(value)
         )
 
+    def section(self, section: Section) -> Table | None:
+        """``section``'s table below this one (None: not given)."""
+        return self.table(section.path.rsplit(".", 1)[-1])
+
+    def sections(self, section: Section) -> list[Table]:
+        """``section``'s array of tables below this one (empty: not given)."""
+        return self.tables(section.path.rsplit(".", 1)[-1], section.many)
+
     def table(self, key: str) -> Table | None:
         value = self._get(key)
-        self._note(key, "table", f"a [{self.field(key)}] table", MISSING)
         if value is MISSING:
             return None
         if not isinstance(value, dict):
@@ -394,7 +361,6 @@ class Table:
         if value is MISSING:
             return []
         allowed = f"an array of tables, [[{self.field(key)}]], at most {max_count}"
-        self._note(key, "tables", allowed, MISSING)
         if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
             raise self.fail(
                 key, f"must be an array of tables, got {describe_value(value)}", allowed

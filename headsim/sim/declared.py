@@ -1,8 +1,8 @@
 """A declared setting: one key's type, range, default, unit and meaning, in one place.
 
-Every scenario key of the head, its cameras, its belief and the experiment is declared
-as one of these (:class:`Setting` a number or an array of numbers, :class:`Flag`,
-:class:`Choice`, :class:`Text`) beside the field it sets; the Python checks (e.g.
+Every scenario key is declared as one of these (:class:`Setting` a number or an array of
+numbers, :class:`Flag`, :class:`Choice`, :class:`Text`, :class:`Array` a list of points its
+reader checks) beside the field it sets, and each table as a :class:`Section` of them; the Python checks (e.g.
 :class:`headsim.sim.settings.CameraSettings`), the scenario loader's getters and
 one-line errors, and the scenario-key reference are all read from the declaration.
 """
@@ -40,6 +40,7 @@ class Setting:
     count: int = 1
     optional: bool = False
     unit_note: str = ""
+    required: bool = False  # with default None: the file must give it (else derived)
 
     @property
     def fixed_default(self) -> float:
@@ -104,7 +105,36 @@ class Text:
     max_length: int = 200
     what: str | None = None
     required: bool = False
+    derived: bool = False  # with default None: the reader derives it (e.g. ``target_N``)
+
+
+@dataclass(frozen=True)
+class Array:
+    """An array of points or pairs that its reader checks itself; ``allowed`` says what it
+    takes (``required``: the file must give it, else it defaults to ``default``)."""
+
+    name: str
+    allowed: str
+    meaning: str
+    required: bool = False
+    default: object = None
 
 
 #: Any declared key.
-Declared = Setting | Flag | Choice | Text
+Declared = Setting | Flag | Choice | Text | Array
+
+
+@dataclass(frozen=True)
+class Section:
+    """A scenario table at ``path`` and its declared keys; ``many`` > 0: an array of at most
+    that many tables (``[[path]]``, its keys at ``path[]``)."""
+
+    path: str
+    meaning: str
+    keys: tuple[Declared, ...] = ()
+    many: int = 0
+
+    @property
+    def key_path(self) -> str:
+        """Where its keys are: ``path``, or ``path[]`` for an array of tables."""
+        return f"{self.path}[]" if self.many else self.path

@@ -22,6 +22,7 @@ import numpy as np
 from headsim.errors import BadInput
 from headsim.geometry.heads import Neck
 from headsim.sim import names
+from headsim.sim.declared import Array, Choice, Section, Text
 from headsim.sim.head_files import DECLARATION, DECLARED, MODELS_DIR, SHIPPED
 
 #: How a head drives its two eye pan joints.
@@ -42,6 +43,37 @@ class HeadError(BadInput, ValueError):
     def __init__(self, key: str, problem: str, allowed: str) -> None:
         super().__init__(f"head.mapping.{key}: {problem} (allowed: {allowed})")
         self.key, self.problem, self.allowed = key, problem, allowed
+
+
+def _part(key: str, kind: str, meaning: str, *, optional: bool = False) -> Text:
+    """A mapping key that names a ``kind`` (joint, body, actuator) of the head's MJCF file."""
+    what = f"the name of a {kind} in the head's MJCF file" + (" (or leave it out)" * optional)
+    return Text(key, None, meaning, what=what, required=not optional)
+
+
+#: ``[head.mapping]``: the names a user's MJCF head declares, one key per
+#: :class:`HeadMapping` field, in the order the loader reads them.
+CAMERAS = Array(
+    "cameras", "an array of two camera names [left (Ca1), right (Ca2)]",
+    "The two eye cameras, [Ca1, Ca2]: left, then right.", required=True,
+)  # fmt: skip
+MAPPING = Section(
+    "head.mapping",
+    "With an MJCF `head.model`: the names of its joints, body H and cameras.",
+    (
+        CAMERAS,
+        _part("head_body", "body", "The body whose frame is H at all joints zero (midway between the optical centres, x right, y down, z forward)."),
+        _part("neck_yaw", "joint", "The neck's yaw joint: about W's +z at the base, or above a pitch at the base (the iCub's); leave out on a head without one (Model 2 only).", optional=True),
+        _part("neck_pitch", "joint", "The neck's pitch joint, about W's +x (above the yaw, or at the base through W's origin), positive looking up."),
+        Choice("eyes", EYE_KINDS, None, "How the eyes are driven: one motor on `left_eye` with `right_eye` following (coupled), a motor each (independent), or version and vergence actuators (version_vergence).", required=True),
+        _part("left_eye", "joint", "The pan joint of the eye carrying Ca1 (at -x in H), positive inward."),
+        _part("right_eye", "joint", "The pan joint of the eye carrying Ca2 (at +x in H), positive inward."),
+        _part("neck_roll", "joint", "The neck's roll joint, held at zero (leave out on a head without one).", optional=True),
+        _part("eye_tilt", "joint", "The eyes' common tilt joint, held at zero (leave out on a head without one).", optional=True),
+        _part("version", "actuator", 'With `eyes = "version_vergence"`: the actuator of length (left - right) / 2.', optional=True),
+        _part("vergence", "actuator", 'With `eyes = "version_vergence"`: the actuator of length left + right.', optional=True),
+    ),
+)  # fmt: skip
 
 
 @dataclass(frozen=True)

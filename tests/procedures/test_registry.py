@@ -31,6 +31,7 @@ from headsim.scenario.scene import targets_reader
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
 from headsim.sim import names
+from headsim.sim.declared import Section, Setting
 
 BODY = sorted(names.MARKER_COLOURS)[0]
 TOOLS = Path(__file__).resolve().parents[2] / "tools"
@@ -43,9 +44,13 @@ class HeightSpec:
     offset_m: float = 0.0
 
 
+OFFSET = Setting("offset_m", 0.0, -1.0, 1.0, "m", "Added to the marker's height, m.")
+BLOCK = Section("experiment.marker_height", "What the height procedure adds.", (OFFSET,))
+
+
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
-    block = table.table("marker_height") or Table({}, table.field("marker_height"), table.ctx)
-    offset_m = block.number("offset_m", 0.0, -1.0, 1.0)
+    block = table.section(BLOCK) or Table({}, BLOCK.path, table.ctx)
+    offset_m = block.setting(OFFSET)
     block.done()
     return {"block": HeightSpec(offset_m)}
 
@@ -84,10 +89,7 @@ HEIGHT = procedures.Procedure(
     options=read_options,
     read_scene=targets_reader("marker_height", required=True),
     fixations=lambda scenario: 0,  # it fixates nothing
-    keys={
-        "experiment.marker_height": "What the height procedure adds.",
-        "experiment.marker_height.offset_m": "Added to the marker's height, m.",
-    },
+    keys=(BLOCK,),
 )
 
 
@@ -149,7 +151,7 @@ def test_a_new_procedure_appears_in_both_generated_references(
     assert "| `body` | the marker measured |" in section
     assert "| `height_m` | its height in W plus the offset, m |" in section
     keys = docs_pages.scenario_keys_page()
-    assert "| `experiment.marker_height.offset_m` |" in keys
+    assert "| `experiment.marker_height.offset_m` | number | a number >= -1 and <= 1 m |" in keys
     assert "Added to the marker's height, m. |" in keys
 
 
