@@ -46,7 +46,8 @@ from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.runs.progress import Status, quiet
 from headsim.studies.jobs import (
     PlannedJob,
-    schedule,
+    job_error,
+    run_plan,
     started_render_pool,
     stop_pool,
     terminate_children,
@@ -253,8 +254,13 @@ def reproduce(
             ),
         ]
 
-        def finished(name: str, data: dict[str, Any] | None, error: str, wall_s: float) -> None:
+        def finished(
+            name: str, data: dict[str, Any] | None, err: BaseException | None, wall_s: float, _: int
+        ) -> None:
             nonlocal calibration
+            error = "" if err is None else job_error(err)
+            if data is not None:
+                ran(name, data)
             if name == "calibration":
                 calibration = data
                 if data is None:
@@ -288,7 +294,7 @@ def reproduce(
                 why = "no calibration to use" if missing == "calibration" else f"no {missing}"
                 outcomes[name] = JobOutcome(name, "error", 0.0, error=why)
 
-        ended = schedule(pool, workers, plan, finished, skipped, ran)
+        ended = run_plan(plan, lambda: pool, finished, workers=workers, skipped=skipped, close=None)
         progress(f"scheduler: {ended}")
         # Every job ended and its files are written: the idle workers are stopped
         # rather than left to tear down their interpreters and GL contexts (~0.5 s).
