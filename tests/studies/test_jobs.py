@@ -210,6 +210,7 @@ def test_a_plan_with_a_need_that_no_job_meets_is_refused() -> None:
         critical_order(plan)
 
 
+@pytest.mark.fast
 def test_a_plan_with_needs_retries_its_jobs_and_skips_what_lost_a_need_after_its_attempts() -> None:
     """The one loop's both halves at once: attempts (a sweep's) and needs (reproduce's)."""
     calls: dict[str, int] = {}
