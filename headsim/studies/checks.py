@@ -1,21 +1,21 @@
-"""The bench's baseline and tolerances, and comparing a run's metrics with them."""
+"""The campaigns' checks, over their rows: the bench's metrics against the stored baseline
+and its tolerances (:func:`compare`), and ``headsim reproduce``'s rows, each with its
+verdict against the paper's figures, against the rows the stored report reproduced
+(:func:`reproduce_problems`)."""
 
 from __future__ import annotations
 
 import json
 import math
-import platform
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from headsim.version import __version__
-
 BENCH_DIR = Path(__file__).resolve().parents[2] / "benchmarks"
 BASELINE = BENCH_DIR / "baseline.json"
 TOLERANCES = BENCH_DIR / "tolerances.json"
+#: The rows of a ``headsim reproduce --fast`` report that CI holds each run to.
+REPRODUCE_BASELINE = BENCH_DIR / "reproduce_baseline.json"
 
 
 Metrics = dict[str, float]
@@ -76,17 +76,38 @@ def format_table(verdicts: list[Verdict]) -> str:
     return "\n".join(lines)
 
 
+def reproduce_problems(report: dict[str, Any], baseline: dict[str, Any]) -> list[str]:
+    """What a reproduce report lost against the baseline, one line each (empty: ok): a run
+    not ok, an experiment of the baseline missing, a row the baseline reproduced no longer
+    reproduced, or a wall ratio whose unit is not the quieter of its two render medians."""
+    found = []
+    if report.get("status") != "ok":
+        found.append(f"status {report.get('status')!r}, not 'ok'")
+    medians = [report.get("render_before_s"), report.get("render_after_s")]
+    if all(isinstance(m, float) for m in medians) and "render_s" in report:
+        unit = min(medians)  # type: ignore[type-var]
+        if report["render_s"] != unit:
+            found.append(f"render unit {report['render_s']} s, not the quieter median {unit} s")
+        elif (
+            abs(report["wall_over_render"] - report["wall_s"] / unit)
+            > 1e-6 * report["wall_s"] / unit
+        ):
+            found.append("wall ratio is not the wall time over the render unit")
+    rows_now = report.get("rows", {})
+    for experiment, rows in baseline.get("rows", {}).items():
+        now = rows_now.get(experiment)
+        if now is None:
+            found.append(f"{experiment}: no result")
+            continue
+        verdicts = {r["quantity"]: r["verdict"] for r in now}
+        for row in rows or []:
+            if not row["verdict"].startswith("reproduced"):
+                continue
+            verdict = verdicts.get(row["quantity"])
+            if verdict is None or not verdict.startswith("reproduced"):
+                found.append(f"{experiment}: {row['quantity']}: {verdict or 'missing'}")
+    return found
+
+
 def load_json(path: Path) -> dict[str, Any]:
     return json.loads(path.read_text()) if path.exists() else {}
-
-
-def environment() -> dict[str, str]:
-    import mujoco
-
-    return {
-        "headsim": __version__,
-        "mujoco": mujoco.__version__,
-        "numpy": np.__version__,
-        "python": platform.python_version(),
-        "machine": platform.machine(),
-    }
