@@ -247,13 +247,8 @@ def map_jobs(
         if on_record is not None:
             on_record(record)
 
-    client = dask_client(scheduler) if scheduler is not None else None
-    try:
-        pool = client.get_executor if client is not None else lambda: local_pool(workers)
-        execute(jobs, pool, keep, None, None, function)
-    finally:
-        if client is not None:
-            client.close()
+    with pools(workers, scheduler) as (make_pool, _):
+        execute(jobs, make_pool, keep, None, None, function)
     return [records[job.id] for job in jobs]
 
 
@@ -379,6 +374,20 @@ def local_pool(workers: int) -> cf.Executor:
     return cf.ProcessPoolExecutor(
         max_workers=workers, mp_context=multiprocessing.get_context("spawn")
     )
+
+
+@contextlib.contextmanager
+def pools(workers: int, scheduler: str | None) -> Iterator[tuple[Callable[[], cf.Executor], int]]:
+    """Pools of ``workers`` local processes, or of a Dask ``scheduler``'s workers (its
+    client closed at the end), and how many jobs they run at once."""
+    if scheduler is None:
+        yield (lambda: local_pool(workers)), workers
+        return
+    client = dask_client(scheduler)
+    try:
+        yield client.get_executor, sum(client.nthreads().values()) or 1
+    finally:
+        client.close()
 
 
 def dask_client(scheduler: str) -> Any:

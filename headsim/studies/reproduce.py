@@ -121,16 +121,6 @@ def reproduce(
     timeline: dict[str, dict[str, float]] = {"render_time": {"pid": os.getpid(), "start": 0.0}}
     timeline["render_time"]["end"] = time.time() - epoch
 
-    def ran(name: str, data: dict[str, Any]) -> None:
-        worker = data.get("worker")
-        if worker:
-            timeline[name] = {
-                "pid": worker["pid"],
-                "start": worker["start"] - epoch,
-                "end": worker["end"] - epoch,
-                "cpu_s": worker["cpu_s"],
-            }
-
     def draw_tables() -> None:
         """The Tables V/VI PNG, once (drawn here, while the other workers run)."""
         tables = outcomes.get(STUDY_JOB)
@@ -259,8 +249,14 @@ def reproduce(
         ) -> None:
             nonlocal calibration
             error = "" if err is None else job_error(err)
-            if data is not None:
-                ran(name, data)
+            if data is not None and data.get("worker"):
+                worker = data["worker"]
+                timeline[name] = {
+                    "pid": worker["pid"],
+                    "start": worker["start"] - epoch,
+                    "end": worker["end"] - epoch,
+                    "cpu_s": worker["cpu_s"],
+                }
             if name == "calibration":
                 calibration = data
                 if data is None:
