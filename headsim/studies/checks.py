@@ -1,6 +1,7 @@
 """The campaigns' checks, over their rows: the bench's metrics against the stored baseline
-and its tolerances (:func:`compare`), and ``headsim reproduce``'s rows, each with its
-verdict against the paper's figures, against the rows the stored report reproduced
+and its tolerances (:func:`compare`); the paper's figures and how close to them counts as
+reproduced (``headsim reproduce``'s verdicts, :mod:`headsim.studies.reproduce_rows`); and a
+reproduce report's rows against those the stored report reproduced
 (:func:`reproduce_problems`)."""
 
 from __future__ import annotations
@@ -11,6 +12,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from headsim import paper
+
 BENCH_DIR = Path(__file__).resolve().parents[2] / "benchmarks"
 BASELINE = BENCH_DIR / "baseline.json"
 TOLERANCES = BENCH_DIR / "tolerances.json"
@@ -19,6 +22,27 @@ REPRODUCE_BASELINE = BENCH_DIR / "reproduce_baseline.json"
 
 
 Metrics = dict[str, float]
+
+#: The paper's figures (Sec. VI, :mod:`headsim.paper`), in mm to the paper's digits.
+PAPER_ALPHA_E = paper.INITIAL_DIRECTIONS_RAD
+PAPER_SIDE_MEAN_MM, PAPER_SIDE_STD_MM, TRUE_SIDE_MM = (
+    round(1e3 * side_m, 6)
+    for side_m in (
+        paper.CHESSBOARD_SIDE_MEAN_M,
+        paper.CHESSBOARD_SIDE_STD_M,
+        paper.CHESSBOARD_SQUARE_M,
+    )
+)
+#: A square side's std agrees with the paper's when ours over the paper's lies in these
+#: bounds: a head several times more precise than the paper's rig does not reproduce it.
+SIDE_STD_RATIO = (0.5, 2.0)
+#: A square side's mean agrees with the paper's when they differ by at most the paper's std
+#: of one side.
+SIDE_MEAN_TOLERANCE_MM = PAPER_SIDE_STD_MM
+#: "Very close to stereovision" (Sec. VI-B) read as: RMS error at most this times stereo's.
+CLOSE_TO_STEREO = 2.0
+#: "Insensitive to the intrinsic parameters" read as: RMS after the zoom at most this times before.
+INSENSITIVE = 2.0
 
 
 @dataclass(frozen=True)

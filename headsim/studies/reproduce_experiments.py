@@ -36,22 +36,9 @@ TABLES_SCOPE = (
 FIXED_POINT_TARGETS = 30
 #: The scenario whose head (and calibration) every experiment uses.
 TABLES_HEAD = "calibration"
-#: Paper's figures (Sec. VI).
-PAPER_ALPHA_E = (0.0578, -0.0254)
-PAPER_SIDE_MEAN_MM, PAPER_SIDE_STD_MM, TRUE_SIDE_MM = 30.3, 0.677, 30.0
-#: A square side's std agrees with the paper's when ours over the paper's lies in these
-#: bounds: a head several times more precise than the paper's rig does not reproduce it.
-SIDE_STD_RATIO = (0.5, 2.0)
-#: A square side's mean agrees with the paper's when they differ by at most the paper's std
-#: of one side.
-SIDE_MEAN_TOLERANCE_MM = PAPER_SIDE_STD_MM
 #: The job that measures the same board on the realistic preset (real tolerances), with the
 #: chessboard scenario's own calibration: beside the paper preset, whose mechanics are ideal.
 REALISTIC_BOARD_JOB = "chessboard_realistic"
-#: "Very close to stereovision" (Sec. VI-B) read as: RMS error at most this times stereo's.
-CLOSE_TO_STEREO = 2.0
-#: "Insensitive to the intrinsic parameters" read as: RMS after the zoom at most this times before.
-INSENSITIVE = 2.0
 
 
 class ReproduceError(BadInput, ValueError):

@@ -1,22 +1,15 @@
-"""What ``headsim reproduce`` runs (studies/reproduce_experiments.py): its experiments exist,
-each has a cost, and its paper figures are paper.py's."""
+"""What ``headsim reproduce`` runs (studies/reproduce_experiments.py): its experiments exist
+and each has a cost."""
 
 from __future__ import annotations
 
-import pytest
-
-from headsim import paper
 from headsim.errors import BadInput, ExitCode
 from headsim.scenario.loading import scenario_files
 from headsim.studies.reproduce_experiments import (
     COSTS,
-    PAPER_ALPHA_E,
-    PAPER_SIDE_MEAN_MM,
-    PAPER_SIDE_STD_MM,
     SCENARIO_JOBS,
     STUDY_JOB,
     TABLES_HEAD,
-    TRUE_SIDE_MM,
     JobOutcome,
     ReproduceError,
 )
@@ -27,13 +20,6 @@ def test_every_experiment_runs_a_shipped_scenario_and_has_a_cost() -> None:
     assert {scenario for scenario, _ in SCENARIO_JOBS.values()} | {TABLES_HEAD} <= shipped
     assert set(SCENARIO_JOBS) | {STUDY_JOB, TABLES_HEAD} <= set(COSTS)
     assert all(cost > 0 for cost in COSTS.values())
-
-
-def test_the_papers_figures_are_paper_py_s() -> None:
-    assert PAPER_ALPHA_E == paper.INITIAL_DIRECTIONS_RAD
-    assert pytest.approx(1000 * paper.CHESSBOARD_SIDE_MEAN_M) == PAPER_SIDE_MEAN_MM
-    assert pytest.approx(1000 * paper.CHESSBOARD_SIDE_STD_M) == PAPER_SIDE_STD_MM
-    assert pytest.approx(1000 * paper.CHESSBOARD_SQUARE_M) == TRUE_SIDE_MM
 
 
 def test_a_reproduce_error_is_bad_input_and_outcomes_do_not_share_their_data() -> None:
