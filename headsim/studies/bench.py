@@ -35,9 +35,9 @@ from headsim.sim.settings import HeadSettings, paper_head, preset
 from headsim.sim.simulator import HeadSim, start_views
 from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
+from headsim.studies.catalogue import SCENARIO_JOBS
 from headsim.studies.checks import Metrics, compare, format_table, load_json
 from headsim.studies.render_clock import RenderClock
-from headsim.studies.reproduce_experiments import SCENARIO_JOBS
 from headsim.studies.scenario_jobs import run_row
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
 from headsim.studies.targets import random_targets_head, visible_vertical_range

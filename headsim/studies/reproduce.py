@@ -44,6 +44,15 @@ from typing import Any
 from headsim.errors import OutputNotWritable
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.runs.progress import Status, quiet
+from headsim.studies.catalogue import (
+    COSTS,
+    REALISTIC_BOARD_JOB,
+    SCENARIO_JOBS,
+    STUDY_JOB,
+    SWEEP_COST,
+    JobOutcome,
+    ReproduceError,
+)
 from headsim.studies.jobs import (
     PlannedJob,
     job_error,
@@ -53,15 +62,6 @@ from headsim.studies.jobs import (
     terminate_children,
 )
 from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
-from headsim.studies.reproduce_experiments import (
-    COSTS,
-    REALISTIC_BOARD_JOB,
-    SCENARIO_JOBS,
-    STUDY_JOB,
-    SWEEP_COST,
-    JobOutcome,
-    ReproduceError,
-)
 from headsim.studies.reproduce_jobs import (
     WORKER_MODULES,
     calibrate_job,
@@ -85,7 +85,7 @@ def reproduce(
     progress: Callable[[str], None] = lambda _: None,
 ) -> dict[str, Any]:
     """Run everything, write DIR/report.md; returns the state (``status``: ok, failed, interrupted)."""
-    from headsim.studies.study_experiments import SWEEPS
+    from headsim.studies.catalogue import SWEEPS
 
     if not isinstance(workers, int) or not 1 <= workers <= 64:
         raise ReproduceError(f"--workers must be an integer from 1 to 64, got {workers!r}")

@@ -7,6 +7,13 @@ import math
 from pathlib import Path
 from typing import Any
 
+from headsim.studies.catalogue import (
+    REALISTIC_BOARD_JOB,
+    SCENARIO_JOBS,
+    STUDY_JOB,
+    TABLES_SCOPE,
+    JobOutcome,
+)
 from headsim.studies.checks import (
     PAPER_ALPHA_E,
     PAPER_SIDE_MEAN_MM,
@@ -14,13 +21,6 @@ from headsim.studies.checks import (
     TRUE_SIDE_MM,
 )
 from headsim.studies.render_clock import CLOCK_RENDERS
-from headsim.studies.reproduce_experiments import (
-    REALISTIC_BOARD_JOB,
-    SCENARIO_JOBS,
-    STUDY_JOB,
-    TABLES_SCOPE,
-    JobOutcome,
-)
 from headsim.studies.reproduce_rows import ROWS, Row, initial_direction_rows
 
 

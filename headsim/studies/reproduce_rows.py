@@ -8,6 +8,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from headsim.studies.catalogue import STUDY_JOB
 from headsim.studies.checks import (
     CLOSE_TO_STEREO,
     INSENSITIVE,
@@ -17,7 +18,6 @@ from headsim.studies.checks import (
     SIDE_MEAN_TOLERANCE_MM,
     SIDE_STD_RATIO,
 )
-from headsim.studies.reproduce_experiments import STUDY_JOB
 
 
 @dataclass(frozen=True)

@@ -12,10 +12,10 @@ import numpy as np
 
 from headsim.files import to_jsonable, write_csv_atomic, write_json_atomic
 from headsim.sim.settings import HeadSettings
+from headsim.studies.catalogue import ExperimentResult, compare_figures
 from headsim.studies.conditions import Condition
 from headsim.studies.methods import METHOD_LABELS
 from headsim.studies.output import write_rows
-from headsim.studies.study_experiments import ExperimentResult, compare_figures
 
 
 def _condition_columns(result: ExperimentResult, c: Condition) -> dict[str, Any]:

@@ -14,6 +14,7 @@ from typing import Any
 
 import pytest
 
+from headsim.studies.catalogue import COSTS, STUDY_JOB, SWEEP_COST
 from headsim.studies.jobs import (
     ATTEMPTS,
     PlannedJob,
@@ -26,7 +27,6 @@ from headsim.studies.jobs import (
     spawn_context,
     start_workers,
 )
-from headsim.studies.reproduce_experiments import COSTS, STUDY_JOB, SWEEP_COST
 
 
 @dataclass(frozen=True)
