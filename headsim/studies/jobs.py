@@ -90,8 +90,7 @@ def run_plan(
     tries = dict.fromkeys(position, 0)
     done: dict[str, dict[str, Any]] = {}
     failed: set[str] = set()
-    pools = [make_pool()]
-    broken = False
+    pool, generation, broken = make_pool(), 0, False
     running: dict[cf.Future[dict[str, Any]], tuple[PlannedJob, float, int]] = {}
     reports: list[tuple[str, dict[str, Any] | None, BaseException | None, float, int]] = []
     finished = 0
@@ -103,9 +102,8 @@ def run_plan(
                 return f"stopped after {stop_after} jobs"
             if broken:
                 if close is not None:
-                    close(pools[-1], True)
-                pools.append(make_pool())
-                broken = False
+                    close(pool, True)
+                pool, generation, broken = make_pool(), generation + 1, False
             for job in list(waiting):
                 lost = next((n for n in job.needs if n in failed), None)
                 if lost is not None:
@@ -118,8 +116,8 @@ def run_plan(
                     waiting.remove(job)
                     tries[job.name] += 1
                     with interrupt_deferred():
-                        future = pools[-1].submit(job.run, *job.args(done))
-                    running[future] = (job, time.perf_counter(), len(pools))
+                        future = pool.submit(job.run, *job.args(done))
+                    running[future] = (job, time.perf_counter(), generation)
             for report in reports:
                 ended(*report)
             finished += len(reports)
@@ -132,7 +130,7 @@ def run_plan(
                 )
             ready, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
             for future in sorted(ready, key=lambda f: order(running[f][0])):
-                job, began, pool = running.pop(future)
+                job, began, made_in = running.pop(future)
                 data: dict[str, Any] | None = None
                 error: BaseException | None = None
                 try:
@@ -140,7 +138,7 @@ def run_plan(
                 except Exception as err:  # the job raised, or its worker died
                     error = err
                     if isinstance(err, cf.process.BrokenProcessPool):
-                        broken = broken or pool == len(pools)
+                        broken = broken or made_in == generation
                         marker = markers / job.name if markers is not None else None
                         if marker is not None and not marker.exists():
                             tries[job.name] -= 1  # a bystander of another job's crash
@@ -161,9 +159,7 @@ def run_plan(
             waiting.sort(key=order)
     finally:
         if close is not None:
-            for made in pools[:-1]:
-                close(made, True)
-            close(pools[-1], broken)
+            close(pool, broken)
 
 
 def execute(
