@@ -55,7 +55,7 @@ def tables_run(seed: int) -> dict[str, Any]:
 def _settings() -> Any:
     """The true head the tables run on (the calibration scenario's paper preset)."""
     from headsim.scenario.loading import load_scenario
-    from headsim.studies.reproduce_experiments import TABLES_HEAD
+    from headsim.studies.catalogue import TABLES_HEAD
 
     return load_scenario(TABLES_HEAD).settings
 

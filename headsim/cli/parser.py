@@ -294,7 +294,7 @@ STUDY_DESCRIPTION = (
 
 def add_study_arguments(study: argparse.ArgumentParser) -> None:
     """``headsim study``'s description and options (loads the study's sweeps for their names)."""
-    from headsim.studies.study_experiments import SWEEPS
+    from headsim.studies.catalogue import SWEEPS
 
     study.description = STUDY_DESCRIPTION
     what = study.add_mutually_exclusive_group(required=True)

@@ -42,7 +42,7 @@ def study_command(args: argparse.Namespace) -> int:
 
 def bench_command(args: argparse.Namespace) -> int:
     from headsim.studies import bench
-    from headsim.studies.bench_compare import BASELINE, TOLERANCES
+    from headsim.studies.checks import BASELINE, TOLERANCES
 
     args.baseline = args.baseline or str(BASELINE)
     args.tolerances = args.tolerances or str(TOLERANCES)

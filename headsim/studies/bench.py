@@ -11,6 +11,7 @@ how far each metric may move, and in which direction is worse.
 from __future__ import annotations
 
 import math
+import platform
 import sys
 import tempfile
 import time
@@ -34,12 +35,26 @@ from headsim.sim.settings import HeadSettings, paper_head, preset
 from headsim.sim.simulator import HeadSim, start_views
 from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
-from headsim.studies.bench_compare import Metrics, compare, environment, format_table, load_json
+from headsim.studies.catalogue import SCENARIO_JOBS
+from headsim.studies.checks import Metrics, compare, format_table, load_json
 from headsim.studies.render_clock import RenderClock
-from headsim.studies.reproduce_experiments import SCENARIO_JOBS
 from headsim.studies.scenario_jobs import run_row
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
 from headsim.studies.targets import random_targets_head, visible_vertical_range
+from headsim.version import __version__
+
+
+def environment() -> dict[str, str]:
+    """What the bench ran on: the versions of headsim, MuJoCo, NumPy and Python, the machine."""
+    import mujoco
+
+    return {
+        "headsim": __version__,
+        "mujoco": mujoco.__version__,
+        "numpy": np.__version__,
+        "python": platform.python_version(),
+        "machine": platform.machine(),
+    }
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from headsim.studies.bench_compare import BENCH_DIR
+from headsim.studies.checks import BENCH_DIR
 
 #: A case's kind: compared with the baseline, figures of minutes, figures of longer.
 KINDS = ("regress", "figures", "long")

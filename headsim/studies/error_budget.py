@@ -34,6 +34,7 @@ and ``error_budget.png`` (bar chart).
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -43,14 +44,11 @@ from typing import Any
 
 import numpy as np
 
-from headsim.files import (
-    write_csv_atomic,
-    write_json_atomic,
-    write_text_atomic,
-)
+from headsim.files import write_text_atomic
 from headsim.geometry.kinematics import world_to_head
 from headsim.runs.accuracy import DEPTH_BANDS_M
 from headsim.sim.settings import HeadSettings
+from headsim.studies.output import write_rows
 
 #: The scenario the budget runs: the realistic head over the whole shared field.
 SCENARIO = "realistic_field"
@@ -352,22 +350,19 @@ def markdown_table(rows: Sequence[dict[str, Any]], fast: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _draw(rows: Sequence[dict[str, Any]], png: Path) -> None:
+    from headsim.studies.plots import plot_budget  # matplotlib loads only for the chart
+
+    plot_budget(rows, png)
+
+
 def write_budget(
     rows: Sequence[dict[str, Any]], out_dir: str | Path, fast: bool
 ) -> dict[str, Path]:
     """Write error_budget.csv, .md, .json and .png to ``out_dir``; their paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    paths = {
-        "csv": out / "error_budget.csv",
-        "md": out / "error_budget.md",
-        "json": out / "error_budget.json",
-        "png": out / "error_budget.png",
-    }
-    write_csv_atomic(paths["csv"], list(rows))
-    write_text_atomic(paths["md"], markdown_table(rows, fast))
-    write_json_atomic(paths["json"], {"scenario": SCENARIO, "fast": fast, "rows": list(rows)})
-    from headsim.studies.plots import plot_budget  # matplotlib loads only for the chart
-
-    plot_budget(rows, paths["png"])
-    return paths
+    md = write_text_atomic(out / "error_budget.md", markdown_table(rows, fast))
+    document = {"scenario": SCENARIO, "fast": fast, "rows": list(rows)}
+    written = write_rows(out, "error_budget", rows, document, functools.partial(_draw, rows))
+    return {"csv": written["csv"], "md": md, "json": written["json"], "png": written["png"]}

@@ -1,12 +1,13 @@
-"""The campaigns' job engine: jobs on spawned local processes or a Dask cluster, each
-retried once and a crashed worker survived (:func:`execute`, :func:`map_jobs`); the log
-a campaign resumes from (:func:`read_log`, :func:`append_record`); jobs with needs, the
-longest path to the end first (:func:`schedule`); and the render workers' pool."""
+"""The campaigns' job engine: one loop (:func:`run_plan`) over a plan of jobs with needs,
+the longest path to the end first, each with its attempts, on a pool that a crashed
+worker breaks and a new one replaces; a sweep is a plan without needs (:func:`execute`,
+:func:`map_jobs`), ``headsim reproduce`` one with needs.  Also the log a campaign resumes
+from (:func:`read_log`, :func:`append_record`) and the render workers' pool."""
 
 from __future__ import annotations
 
 import concurrent.futures as cf
-import concurrent.futures.process  # noqa: F401  execute() reads cf.process; only a process pool loads it
+import concurrent.futures.process  # noqa: F401  run_plan() reads cf.process; only a process pool loads it
 import contextlib
 import functools
 import importlib
@@ -25,8 +26,140 @@ from typing import Any, Protocol, TypeVar
 
 from headsim.errors import EnvironmentProblem
 
-#: Attempts per job: the first and one retry.
+#: Attempts per job of a sweep or study: the first and one retry.
 ATTEMPTS = 2
+
+
+@dataclass(frozen=True)
+class PlannedJob:
+    """A job of a plan: what it runs, the jobs it needs, and its arguments from their data."""
+
+    name: str
+    run: Callable[..., dict[str, Any]]
+    needs: tuple[str, ...]
+    args: Callable[[dict[str, dict[str, Any]]], tuple[Any, ...]]
+    #: What it costs, in any unit common to the plan (``headsim reproduce``: render-times).
+    cost: float
+
+
+#: How a job ended: its name, its data (None when it raised), the error, its wall time from
+#: submission in s, and the attempts it took.
+Ended = Callable[[str, "dict[str, Any] | None", "BaseException | None", float, int], None]
+
+
+def close_pool(pool: cf.Executor, broken: bool) -> None:
+    """Shut ``pool`` down, cancelling what it has not started; a broken pool is not waited for."""
+    try:
+        pool.shutdown(wait=not broken, cancel_futures=True)
+    except TypeError:  # Dask's executor takes no cancel_futures
+        pool.shutdown(wait=not broken)
+
+
+def run_plan(
+    plan: list[PlannedJob],
+    make_pool: Callable[[], cf.Executor],
+    ended: Ended,
+    *,
+    workers: int | None = None,
+    attempts: int = 1,
+    retry: Callable[[dict[str, Any]], bool] = lambda data: False,
+    markers: Path | None = None,
+    stop_after: int | None = None,
+    skipped: Callable[[str, str], None] = lambda name, missing: None,
+    close: Callable[[cf.Executor, bool], None] | None = close_pool,
+) -> str:
+    """Run ``plan`` on pools from ``make_pool``; returns why it ended.
+
+    Of the jobs whose needs are done, the one with the longest path to the end starts
+    first (a pool would otherwise start them in the order they were queued), at most
+    ``workers`` at a time (None: every ready job is queued on the pool at once).  A job
+    runs again, up to ``attempts`` in all, when it raised or ``retry(data)`` is true; a
+    job whose need failed is skipped.  ``ended`` hears of each job once it last ran,
+    after the next jobs started (a report, a figure, must not keep a worker idle).
+
+    A crashed worker breaks a local pool: every job in it fails, a new pool replaces it,
+    and only the jobs whose file in ``markers`` shows they were running (the job writes
+    it; all of them without ``markers``) count an attempt.  ``stop_after``: stop after
+    that many jobs ended.  ``close(pool, broken)`` ends each pool made (None: the
+    caller's pool, left open).
+    """
+    level = critical_order(plan)
+    position = {job.name: i for i, job in enumerate(plan)}
+    order = lambda job: (-level[job.name], position[job.name])  # noqa: E731
+    waiting = sorted(plan, key=order)
+    tries = dict.fromkeys(position, 0)
+    done: dict[str, dict[str, Any]] = {}
+    failed: set[str] = set()
+    pool, generation, broken = make_pool(), 0, False
+    running: dict[cf.Future[dict[str, Any]], tuple[PlannedJob, float, int]] = {}
+    reports: list[tuple[str, dict[str, Any] | None, BaseException | None, float, int]] = []
+    finished = 0
+    try:
+        while True:  # each pass ends a job at least (cf.wait)
+            if stop_after is not None and finished + len(reports) >= stop_after:
+                for report in reports[: stop_after - finished]:
+                    ended(*report)
+                return f"stopped after {stop_after} jobs"
+            if broken:
+                if close is not None:
+                    close(pool, True)
+                pool, generation, broken = make_pool(), generation + 1, False
+            for job in list(waiting):
+                lost = next((n for n in job.needs if n in failed), None)
+                if lost is not None:
+                    waiting.remove(job)
+                    failed.add(job.name)
+                    skipped(job.name, lost)
+                elif (workers is None or len(running) < workers) and all(
+                    n in done for n in job.needs
+                ):
+                    waiting.remove(job)
+                    tries[job.name] += 1
+                    with interrupt_deferred():
+                        future = pool.submit(job.run, *job.args(done))
+                    running[future] = (job, time.perf_counter(), generation)
+            for report in reports:
+                ended(*report)
+            finished += len(reports)
+            reports.clear()
+            if not running:
+                return (
+                    "every job ended"
+                    if not waiting
+                    else f"stuck: {[j.name for j in waiting]} wait for jobs that never ran"
+                )
+            ready, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+            for future in sorted(ready, key=lambda f: order(running[f][0])):
+                job, began, made_in = running.pop(future)
+                data: dict[str, Any] | None = None
+                error: BaseException | None = None
+                try:
+                    data = future.result()
+                except Exception as err:  # the job raised, or its worker died
+                    error = err
+                    if isinstance(err, cf.process.BrokenProcessPool):
+                        broken = broken or made_in == generation
+                        marker = markers / job.name if markers is not None else None
+                        if marker is not None and not marker.exists():
+                            tries[job.name] -= 1  # a bystander of another job's crash
+                            waiting.append(job)
+                            continue
+                        if marker is not None:
+                            marker.unlink(missing_ok=True)
+                if tries[job.name] < attempts and (data is None or retry(data)):
+                    waiting.append(job)
+                    continue
+                if data is None:
+                    failed.add(job.name)
+                else:
+                    done[job.name] = data
+                reports.append(
+                    (job.name, data, error, time.perf_counter() - began, tries[job.name])
+                )
+            waiting.sort(key=order)
+    finally:
+        if close is not None:
+            close(pool, broken)
 
 
 def execute(
@@ -37,67 +170,48 @@ def execute(
     marker_dir: Path | None,
     function: Callable[..., dict[str, Any]],
 ) -> int:
-    """Run ``jobs`` with one retry each; survive a broken pool by building a new one.
+    """Run ``jobs`` (each with an ``id`` and an ``index``), a plan without needs, with one
+    retry each; returns how many ended.
 
-    ``function(job, marker_dir)`` runs one job (e.g. :func:`headsim.studies.sweep.run_job`) and
-    returns its record, a dict with at least ``status``; a job is anything
-    with an ``id`` and an ``index``.
-
-    When a local pool breaks, every job still queued in it fails with it; only
-    those whose marker shows they were running count an attempt.
+    ``function(job, marker_dir)`` runs one job (e.g. :func:`headsim.studies.sweep.run_job`)
+    and returns its record, a dict with at least ``status``: ``error`` or ``crashed`` is
+    retried.  A job that raised, or whose worker died, is recorded as ``crashed``.
     """
-    attempts = dict.fromkeys((job.id for job in jobs), 0)
-    queue = list(jobs)
-    finished = 0
-    while queue:
-        executor = make_executor()
-        broken = False
-        try:
-            futures = {}
-            for job in queue:
-                attempts[job.id] += 1
-                marker = str(marker_dir) if marker_dir is not None else None
-                futures[executor.submit(function, job, marker)] = job
-            queue = []
-            for future in cf.as_completed(futures):
-                job = futures[future]
-                try:
-                    record = future.result()
-                except Exception as err:  # the worker died (BrokenProcessPool, KilledWorker, ...)
-                    if isinstance(err, cf.process.BrokenProcessPool):
-                        broken = True
-                        was_running = True
-                        if marker_dir is not None:
-                            was_running = (marker_dir / job.id).exists()
-                            (marker_dir / job.id).unlink(missing_ok=True)
-                        if not was_running:  # an innocent bystander of another job's crash
-                            attempts[job.id] -= 1
-                            queue.append(job)
-                            continue
-                    record = {
-                        "id": job.id,
-                        "index": job.index,
-                        "params": getattr(job, "params", {}),
-                        "status": "crashed",
-                        "error": f"{type(err).__name__}: {err}",
-                    }
-                if record.get("status") in ("error", "crashed") and attempts[job.id] < ATTEMPTS:
-                    queue.append(job)
-                    continue
-                record["attempts"] = attempts[job.id]
-                on_record(record)
-                finished += 1
-                if stop_after is not None and finished >= stop_after:
-                    for other in futures:
-                        other.cancel()
-                    return finished
-        finally:
-            try:
-                executor.shutdown(wait=not broken, cancel_futures=True)
-            except TypeError:  # Dask's executor takes no cancel_futures
-                executor.shutdown(wait=not broken)
-        queue.sort(key=lambda job: job.index)
-    return finished
+    marker = str(marker_dir) if marker_dir is not None else None
+    by_id = {job.id: job for job in jobs}
+    count = 0
+
+    def record(
+        name: str, data: dict[str, Any] | None, error: Any, wall_s: float, tries: int
+    ) -> None:
+        nonlocal count
+        if data is None:
+            job = by_id[name]
+            data = {
+                "id": job.id,
+                "index": job.index,
+                "params": getattr(job, "params", {}),
+                "status": "crashed",
+                "error": f"{type(error).__name__}: {error}",
+            }
+        data["attempts"] = tries
+        on_record(data)
+        count += 1
+
+    plan = [
+        PlannedJob(job.id, function, (), functools.partial(lambda done, j: (j, marker), j=job), 1.0)
+        for job in jobs
+    ]
+    run_plan(
+        plan,
+        make_executor,
+        record,
+        attempts=ATTEMPTS,
+        retry=lambda data: data.get("status") in ("error", "crashed"),
+        markers=marker_dir,
+        stop_after=stop_after,
+    )
+    return count
 
 
 def map_jobs(
@@ -111,10 +225,9 @@ def map_jobs(
     """Run ``function(job, None)`` for every job; records in job order.
 
     One local worker: in this process, one job after the other (an error is raised, not
-    retried).  More, or a Dask ``scheduler``: the same machinery as
-    :func:`headsim.studies.sweep.run_sweep` (spawned processes, one retry, crash-proof) for
-    any picklable jobs with ``id`` and ``index``, such as the insensitivity study's
-    conditions.
+    retried).  More, or a Dask ``scheduler``: :func:`execute` (spawned processes, one
+    retry, crash-proof) for any picklable jobs with ``id`` and ``index``, such as the
+    insensitivity study's conditions.
     """
     if workers == 1 and scheduler is None:
         done = []
@@ -130,21 +243,8 @@ def map_jobs(
         if on_record is not None:
             on_record(record)
 
-    if scheduler is not None:
-        client = dask_client(scheduler)
-        try:
-            execute(jobs, client.get_executor, keep, None, None, function)
-        finally:
-            client.close()
-    else:
-        execute(
-            jobs,
-            lambda: local_pool(workers),
-            keep,
-            None,
-            None,
-            function,
-        )
+    with pools(workers, scheduler) as (make_pool, _):
+        execute(jobs, make_pool, keep, None, None, function)
     return [records[job.id] for job in jobs]
 
 
@@ -211,22 +311,15 @@ def plain_errors(job: Callable[..., dict[str, Any]]) -> Callable[..., dict[str, 
     return run
 
 
+def job_error(err: BaseException) -> str:
+    """What a job's error says: a :class:`JobError`'s message, else :func:`why`."""
+    return str(err) if isinstance(err, JobError) else why(err)
+
+
 def why(err: BaseException) -> str:
     """The last line of ``err``'s report: its type and message."""
     text = "".join(traceback.format_exception_only(type(err), err)).strip()
     return text.splitlines()[-1] if text else repr(err)
-
-
-@dataclass(frozen=True)
-class PlannedJob:
-    """A job of the run: what it runs, the jobs it needs, and its arguments from their data."""
-
-    name: str
-    run: Callable[..., dict[str, Any]]
-    needs: tuple[str, ...]
-    args: Callable[[dict[str, dict[str, Any]]], tuple[Any, ...]]
-    #: What it costs, in any unit common to the plan (``headsim reproduce``: render-times).
-    cost: float
 
 
 def critical_order(plan: list[PlannedJob]) -> dict[str, float]:
@@ -272,68 +365,25 @@ def interrupt_deferred() -> Iterator[None]:
         raise KeyboardInterrupt
 
 
-def schedule(
-    pool: cf.Executor,
-    workers: int,
-    plan: list[PlannedJob],
-    finished: Callable[[str, dict[str, Any] | None, str, float], None],
-    skipped: Callable[[str, str], None],
-    ran: Callable[[str, dict[str, Any]], None],
-) -> str:
-    """Run ``plan`` on ``pool``, at most ``workers`` jobs at a time: of the jobs whose
-    needs are done, the one with the longest path to the end first (the pool
-    would otherwise start them in the order they were queued, whatever frees
-    first).  A job whose need failed is skipped.  Returns why it ended."""
-    level = critical_order(plan)
-    waiting = sorted(plan, key=lambda j: -level[j.name])
-    done: dict[str, dict[str, Any]] = {}
-    failed: set[str] = set()
-    running: dict[cf.Future[dict[str, Any]], tuple[str, float]] = {}
-    # Ended jobs are reported after the next jobs started: a report (a figure) must
-    # not keep a worker idle.
-    ended: list[tuple[str, dict[str, Any] | None, str, float]] = []
-    for _ in range(2 * len(plan) + 1):  # each pass starts or ends a job at least
-        for job in list(waiting):
-            missing = next((n for n in job.needs if n in failed), None)
-            if missing is not None:
-                waiting.remove(job)
-                failed.add(job.name)
-                skipped(job.name, missing)
-            elif len(running) < workers and all(n in done for n in job.needs):
-                waiting.remove(job)
-                with interrupt_deferred():
-                    future = pool.submit(job.run, *job.args(done))
-                running[future] = (job.name, time.perf_counter())
-        for report in ended:
-            finished(*report)
-        ended.clear()
-        if not running:
-            return (
-                "every job ended"
-                if not waiting
-                else f"stuck: {[j.name for j in waiting]} wait for jobs that never ran"
-            )
-        ready, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
-        for future in ready:
-            name, began = running.pop(future)
-            try:
-                data = future.result()
-            except Exception as err:
-                failed.add(name)
-                error = str(err) if isinstance(err, JobError) else why(err)
-                ended.append((name, None, error, time.perf_counter() - began))
-                continue
-            ran(name, data)
-            done[name] = data
-            ended.append((name, data, "", time.perf_counter() - began))
-    return "stopped: more passes than jobs allow"
-
-
 def local_pool(workers: int) -> cf.Executor:
     """``workers`` local processes, spawned: EGL in forked children hangs."""
     return cf.ProcessPoolExecutor(
         max_workers=workers, mp_context=multiprocessing.get_context("spawn")
     )
+
+
+@contextlib.contextmanager
+def pools(workers: int, scheduler: str | None) -> Iterator[tuple[Callable[[], cf.Executor], int]]:
+    """Pools of ``workers`` local processes, or of a Dask ``scheduler``'s workers (its
+    client closed at the end), and how many jobs they run at once."""
+    if scheduler is None:
+        yield (lambda: local_pool(workers)), workers
+        return
+    client = dask_client(scheduler)
+    try:
+        yield client.get_executor, sum(client.nthreads().values()) or 1
+    finally:
+        client.close()
 
 
 def dask_client(scheduler: str) -> Any:

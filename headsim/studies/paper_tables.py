@@ -45,10 +45,10 @@ from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import start_views
 from headsim.stereo.calibration import StereoCalibration
 from headsim.studies.calibrations import calibration_positions, zhang_stereo, zoom_fixed_points
+from headsim.studies.catalogue import Experiment, ExperimentResult
 from headsim.studies.conditions import Condition, ConditionResult
 from headsim.studies.methods import METHODS, StudyConfig
 from headsim.studies.scenario_runs import calibration_run
-from headsim.studies.study_experiments import Experiment, ExperimentResult
 from headsim.studies.target_errors import (
     TargetError,
     model2_errors,

@@ -33,7 +33,7 @@ from headsim.files import write_bytes_atomic
 from headsim.studies.methods import METHOD_LABELS
 
 if TYPE_CHECKING:
-    from headsim.studies.study_experiments import ExperimentResult
+    from headsim.studies.catalogue import ExperimentResult
 
 #: Colour and marker per method.
 STYLE: dict[str, dict[str, Any]] = {

@@ -44,15 +44,7 @@ from typing import Any
 from headsim.errors import OutputNotWritable
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.runs.progress import Status, quiet
-from headsim.studies.jobs import (
-    PlannedJob,
-    schedule,
-    started_render_pool,
-    stop_pool,
-    terminate_children,
-)
-from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
-from headsim.studies.reproduce_experiments import (
+from headsim.studies.catalogue import (
     COSTS,
     REALISTIC_BOARD_JOB,
     SCENARIO_JOBS,
@@ -61,6 +53,15 @@ from headsim.studies.reproduce_experiments import (
     JobOutcome,
     ReproduceError,
 )
+from headsim.studies.jobs import (
+    PlannedJob,
+    job_error,
+    run_plan,
+    started_render_pool,
+    stop_pool,
+    terminate_children,
+)
+from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
 from headsim.studies.reproduce_jobs import (
     WORKER_MODULES,
     calibrate_job,
@@ -84,7 +85,7 @@ def reproduce(
     progress: Callable[[str], None] = lambda _: None,
 ) -> dict[str, Any]:
     """Run everything, write DIR/report.md; returns the state (``status``: ok, failed, interrupted)."""
-    from headsim.studies.study_experiments import SWEEPS
+    from headsim.studies.catalogue import SWEEPS
 
     if not isinstance(workers, int) or not 1 <= workers <= 64:
         raise ReproduceError(f"--workers must be an integer from 1 to 64, got {workers!r}")
@@ -119,16 +120,6 @@ def reproduce(
     #: Each job's worker, times since the start and CPU time, s: {"pid", "start", "end", "cpu_s"}.
     timeline: dict[str, dict[str, float]] = {"render_time": {"pid": os.getpid(), "start": 0.0}}
     timeline["render_time"]["end"] = time.time() - epoch
-
-    def ran(name: str, data: dict[str, Any]) -> None:
-        worker = data.get("worker")
-        if worker:
-            timeline[name] = {
-                "pid": worker["pid"],
-                "start": worker["start"] - epoch,
-                "end": worker["end"] - epoch,
-                "cpu_s": worker["cpu_s"],
-            }
 
     def draw_tables() -> None:
         """The Tables V/VI PNG, once (drawn here, while the other workers run)."""
@@ -253,8 +244,19 @@ def reproduce(
             ),
         ]
 
-        def finished(name: str, data: dict[str, Any] | None, error: str, wall_s: float) -> None:
+        def finished(
+            name: str, data: dict[str, Any] | None, err: BaseException | None, wall_s: float, _: int
+        ) -> None:
             nonlocal calibration
+            error = "" if err is None else job_error(err)
+            if data is not None and data.get("worker"):
+                worker = data["worker"]
+                timeline[name] = {
+                    "pid": worker["pid"],
+                    "start": worker["start"] - epoch,
+                    "end": worker["end"] - epoch,
+                    "cpu_s": worker["cpu_s"],
+                }
             if name == "calibration":
                 calibration = data
                 if data is None:
@@ -288,7 +290,7 @@ def reproduce(
                 why = "no calibration to use" if missing == "calibration" else f"no {missing}"
                 outcomes[name] = JobOutcome(name, "error", 0.0, error=why)
 
-        ended = schedule(pool, workers, plan, finished, skipped, ran)
+        ended = run_plan(plan, lambda: pool, finished, workers=workers, skipped=skipped, close=None)
         progress(f"scheduler: {ended}")
         # Every job ended and its files are written: the idle workers are stopped
         # rather than left to tear down their interpreters and GL contexts (~0.5 s).

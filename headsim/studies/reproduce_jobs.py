@@ -9,13 +9,13 @@ from pathlib import Path
 from typing import Any
 
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
-from headsim.studies.jobs import plain_errors
-from headsim.studies.reproduce_experiments import (
+from headsim.studies.catalogue import (
     FIXED_POINT_TARGETS,
     REALISTIC_BOARD_JOB,
     SCENARIO_JOBS,
     TABLES_HEAD,
 )
+from headsim.studies.jobs import plain_errors
 from headsim.studies.scenario_jobs import Job
 
 #: What the jobs import, loaded by each worker as it starts (about 1 s), while the parent
@@ -27,7 +27,7 @@ WORKER_MODULES = (
     "headsim.scenario.loading",
     "headsim.active.calibration_file",
     "headsim.studies.paper_tables",
-    "headsim.studies.study_experiments",
+    "headsim.studies.catalogue",
     "headsim.studies.study_output",
 )
 
@@ -186,7 +186,7 @@ def tables_job(
 
 @plain_errors
 def study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, Any]:
-    from headsim.studies.study_experiments import run_experiment, sweep_experiment
+    from headsim.studies.catalogue import run_experiment, sweep_experiment
     from headsim.studies.study_output import experiment_record, write_experiment
 
     config = _study_config(fast, seed)

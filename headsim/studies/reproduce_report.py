@@ -7,18 +7,20 @@ import math
 from pathlib import Path
 from typing import Any
 
-from headsim.studies.render_clock import CLOCK_RENDERS
-from headsim.studies.reproduce_experiments import (
-    PAPER_ALPHA_E,
-    PAPER_SIDE_MEAN_MM,
-    PAPER_SIDE_STD_MM,
+from headsim.studies.catalogue import (
     REALISTIC_BOARD_JOB,
     SCENARIO_JOBS,
     STUDY_JOB,
     TABLES_SCOPE,
-    TRUE_SIDE_MM,
     JobOutcome,
 )
+from headsim.studies.checks import (
+    PAPER_ALPHA_E,
+    PAPER_SIDE_MEAN_MM,
+    PAPER_SIDE_STD_MM,
+    TRUE_SIDE_MM,
+)
+from headsim.studies.render_clock import CLOCK_RENDERS
 from headsim.studies.reproduce_rows import ROWS, Row, initial_direction_rows
 
 

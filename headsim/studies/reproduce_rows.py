@@ -8,7 +8,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from headsim.studies.reproduce_experiments import (
+from headsim.studies.catalogue import STUDY_JOB
+from headsim.studies.checks import (
     CLOSE_TO_STEREO,
     INSENSITIVE,
     PAPER_ALPHA_E,
@@ -16,7 +17,6 @@ from headsim.studies.reproduce_experiments import (
     PAPER_SIDE_STD_MM,
     SIDE_MEAN_TOLERANCE_MM,
     SIDE_STD_RATIO,
-    STUDY_JOB,
 )
 
 

@@ -31,11 +31,11 @@ base head (``"kept"``: the cameras changed after calibration, e.g. a zoom) or
 are calibrated again on this head (``"redone"``).  :func:`headsim.studies.conditions.run_conditions`
 measures every method on every target of every condition.
 
-**Experiments.**  :func:`headsim.studies.study_experiments.compare_experiment`: the six target positions of
+**Experiments.**  :func:`headsim.studies.catalogue.compare_experiment`: the six target positions of
 Tables V and VI, then the same targets after a zoom (1.5x, 0.7x), a
 principal-point shift and a distortion change with the calibrations kept, on
 the paper's cameras and on the paper's cameras with centred principal points.
-:data:`headsim.studies.study_experiments.SWEEPS`: error against depth, focal length, principal-point shift,
+:data:`headsim.studies.catalogue.SWEEPS`: error against depth, focal length, principal-point shift,
 k1, image noise and encoder resolution.  :func:`headsim.studies.study_output.write_experiment` writes
 ``<name>.csv`` (a row per condition and method), ``<name>_targets.csv`` (a
 row per target), ``<name>.json`` and ``<name>.png`` beside ``results.json``,
@@ -60,13 +60,13 @@ import time
 
 from headsim.runs.progress import Progress, Status, quiet
 from headsim.studies.calibrations import CalibrationCache
-from headsim.studies.methods import StudyConfig
-from headsim.studies.study_experiments import (
+from headsim.studies.catalogue import (
     SWEEPS,
     compare_experiment,
     run_experiment,
     sweep_experiment,
 )
+from headsim.studies.methods import StudyConfig
 from headsim.studies.study_output import print_result, write_experiment
 
 #: Printed by the deprecated alias ``python -m headsim.studies.study``.

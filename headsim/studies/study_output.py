@@ -3,6 +3,7 @@ and the results.json index; and its table on stdout."""
 
 from __future__ import annotations
 
+import functools
 import json
 from pathlib import Path
 from typing import Any
@@ -11,9 +12,10 @@ import numpy as np
 
 from headsim.files import to_jsonable, write_csv_atomic, write_json_atomic
 from headsim.sim.settings import HeadSettings
+from headsim.studies.catalogue import ExperimentResult, compare_figures
 from headsim.studies.conditions import Condition
 from headsim.studies.methods import METHOD_LABELS
-from headsim.studies.study_experiments import ExperimentResult, compare_figures
+from headsim.studies.output import write_rows
 
 
 def _condition_columns(result: ExperimentResult, c: Condition) -> dict[str, Any]:
@@ -115,16 +117,14 @@ def write_experiment(
     }
     if result.experiment.kind == "compare":
         payload["figures"] = compare_figures(result)
+    draw = functools.partial(_draw, result) if figure else None
+    written = write_rows(out, name, summaries, payload, draw)
     files = {
-        "csv": write_csv_atomic(out / f"{name}.csv", summaries),
+        "csv": written["csv"],
         "targets_csv": write_csv_atomic(out / f"{name}_targets.csv", payload["targets"]),
-        "json": write_json_atomic(out / f"{name}.json", payload),
+        "json": written["json"],
         "png": out / f"{name}.png",
     }
-    if figure:
-        from headsim.studies import plots  # matplotlib loads only when figures are written
-
-        plots.plot_experiment(result, files["png"])
     index_path = out / "results.json"
     index: dict[str, Any] = {}
     if index_path.exists():
@@ -140,6 +140,12 @@ def write_experiment(
     }
     write_json_atomic(index_path, to_jsonable(index))
     return files
+
+
+def _draw(result: ExperimentResult, png: Path) -> None:
+    from headsim.studies import plots  # matplotlib loads only when figures are written
+
+    plots.plot_experiment(result, png)
 
 
 def _head_description(settings: HeadSettings) -> dict[str, Any]:

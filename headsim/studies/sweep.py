@@ -48,7 +48,7 @@ from typing import Any
 from headsim.errors import BadInput
 from headsim.runs.progress import Counter
 from headsim.scenario.tables import TargetRefused
-from headsim.studies.jobs import append_record, dask_client, execute, local_pool, read_log
+from headsim.studies.jobs import append_record, execute, pools, read_log
 from headsim.studies.scenario_jobs import Job, run_row
 from headsim.studies.sweep_output import write_aggregate
 from headsim.studies.sweep_spec import BatchOptions, SweepSpec
@@ -330,21 +330,15 @@ def run_sweep(
             )
         return execute(remaining, make_executor, on_record, stop_after, markers, job_function)
 
-    if scheduler is not None:
-        client = dask_client(scheduler)
-        try:
-            cores = sum(client.nthreads().values()) or 1
-            ran = run_all(client.get_executor, None, cores)
-        finally:
-            client.close()
-    else:
+    markers = out / ".running" if scheduler is None else None
+    if markers is not None:
         if workers < 1:
             raise ValueError(f"workers must be >= 1, got {workers}")
-        markers = out / ".running"
         markers.mkdir(exist_ok=True)
         for stale in markers.iterdir():
             stale.unlink()
-        ran = run_all(lambda: local_pool(workers), markers, workers)
+    with pools(workers, scheduler) as (make_pool, slots):
+        ran = run_all(make_pool, markers, slots)
     if bar is not None:
         bar.close()
     wall = time.perf_counter() - start

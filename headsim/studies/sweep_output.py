@@ -7,7 +7,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from headsim.files import write_csv_atomic, write_json_atomic
+from headsim.studies.output import write_rows
 from headsim.studies.sweep_spec import SweepSpec
 
 #: Columns of aggregate.csv after the swept fields.
@@ -42,11 +42,8 @@ def write_aggregate(
 ) -> dict[str, Path]:
     """aggregate.csv, aggregate.json and one PNG per numeric swept field."""
     rows = aggregate_rows(spec, records)
-    files = {"csv": out / "aggregate.csv", "json": out / "aggregate.json"}
-    write_csv_atomic(files["csv"], rows)
-    write_json_atomic(
-        files["json"], {"sweep": spec.description, "scenario": spec.scenario, "rows": rows}
-    )
+    document = {"sweep": spec.description, "scenario": spec.scenario, "rows": rows}
+    files = write_rows(out, "aggregate", rows, document)
     for name in spec.fields:
         if name == "seed":  # an error against the seed says nothing
             continue

@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 
 from headsim.studies.bench import PARTS, Faults, suite
-from headsim.studies.bench_compare import BASELINE, TOLERANCES, compare, format_table, load_json
+from headsim.studies.checks import BASELINE, TOLERANCES, compare, format_table, load_json
 
 #: The metrics of the ideal part (``headsim.studies.bench._ideal_part``).
 IDEAL_PREFIXES = ("ideal.", "windows.", "speed.wall_per_point_over_render")

@@ -8,7 +8,7 @@ import pytest
 from headsim.cli import main
 from headsim.studies.bench import PARTS
 from headsim.studies.bench_cases import CASES, KINDS, of_kind
-from headsim.studies.bench_compare import BENCH_DIR
+from headsim.studies.checks import BENCH_DIR
 
 #: Scripts in benchmarks/ that are not benchmarks (none today).
 NOT_CASES: set[str] = set()

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from headsim.studies.calibrations import CalibrationCache
+from headsim.studies.catalogue import run_experiment, sweep_experiment
 from headsim.studies.methods import StudyConfig
-from headsim.studies.study_experiments import run_experiment, sweep_experiment
 
 CONFIG = StudyConfig.quick()
 

@@ -14,18 +14,19 @@ from typing import Any
 
 import pytest
 
+from headsim.studies.catalogue import COSTS, STUDY_JOB, SWEEP_COST
 from headsim.studies.jobs import (
     ATTEMPTS,
     PlannedJob,
     _render_threads,
     critical_order,
     execute,
+    job_error,
     render_pool,
-    schedule,
+    run_plan,
     spawn_context,
     start_workers,
 )
-from headsim.studies.reproduce_experiments import COSTS, STUDY_JOB, SWEEP_COST
 
 
 @dataclass(frozen=True)
@@ -174,16 +175,19 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
     assert level["calibration"] == cost["calibration"] + cost["chessboard"]
     assert level["zhang"] == cost["zhang"] + cost[STUDY_JOB]
     assert level["fixed_point"] == cost["fixed_point"] + cost[STUDY_JOB]
-    finished, skipped, ran = [], [], []
+    finished, skipped = [], []
     with futures.ThreadPoolExecutor(max_workers=1) as pool:
-        ended = schedule(
-            pool,
-            1,
+        ended = run_plan(
             plan,
-            lambda name, data, error, wall: finished.append((name, data is None, error)),
-            lambda name, missing: skipped.append((name, missing)),
-            lambda name, data: ran.append(name),
+            lambda: pool,
+            lambda name, data, error, wall, tries: finished.append(
+                (name, data is None, error and job_error(error))
+            ),
+            workers=1,
+            skipped=lambda name, missing: skipped.append((name, missing)),
+            close=None,
         )
+        ran = [name for name, lost, _ in finished if not lost]
     assert ended == "every job ended"
     # One worker: each time the ready job with the longest path to the end.
     assert log == [
@@ -204,3 +208,39 @@ def test_a_plan_with_a_need_that_no_job_meets_is_refused() -> None:
     plan = [PlannedJob("chessboard", _echo, ("calibration",), lambda done: (), 1.0)]
     with pytest.raises(ValueError, match="unmet or circular needs: \\['chessboard'\\]"):
         critical_order(plan)
+
+
+@pytest.mark.fast
+def test_a_plan_with_needs_retries_its_jobs_and_skips_what_lost_a_need_after_its_attempts() -> None:
+    """The one loop's both halves at once: attempts (a sweep's) and needs (reproduce's)."""
+    calls: dict[str, int] = {}
+
+    def run(name: str) -> dict[str, Any]:
+        calls[name] = calls.get(name, 0) + 1
+        if name == "always" or (name == "once" and calls[name] == 1):
+            raise RuntimeError(f"{name} failed")
+        return {"status": "ok"}
+
+    def make(name: str, needs: tuple[str, ...] = ()) -> PlannedJob:
+        return PlannedJob(name, run, needs, lambda done, n=name: (n,), 1.0)
+
+    ended, skipped = [], []
+    with cf.ThreadPoolExecutor(max_workers=2) as pool:
+        why_ended = run_plan(
+            [
+                make("once"),
+                make("always"),
+                make("after_once", ("once",)),
+                make("lost", ("always",)),
+            ],
+            lambda: pool,
+            lambda name, data, error, wall, tries: ended.append((name, data is None, tries)),
+            workers=2,
+            attempts=2,
+            skipped=lambda name, missing: skipped.append((name, missing)),
+            close=None,
+        )
+    assert why_ended == "every job ended"
+    assert sorted(ended) == [("after_once", False, 1), ("always", True, 2), ("once", False, 2)]
+    assert skipped == [("lost", "always")]
+    assert calls == {"once": 2, "always": 2, "after_once": 1}

@@ -9,11 +9,9 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools"))
-
-from check_reproduce import problems
-
 from headsim.cli import main
+from headsim.studies.checks import REPRODUCE_BASELINE
+from headsim.studies.checks import reproduce_problems as problems
 
 
 def test_the_ci_check_catches_a_row_no_longer_reproduced() -> None:
@@ -99,7 +97,5 @@ def test_the_command_line_ends_a_run_of_workers_cleanly(tmp_path: Path) -> None:
 
 def test_check_reproduce_finds_its_stored_baseline() -> None:
     """CI calls the check without --baseline: its default is the stored file in benchmarks/."""
-    from check_reproduce import BASELINE
-
-    assert BASELINE.is_file(), BASELINE
-    assert json.loads(BASELINE.read_text())["rows"]
+    assert REPRODUCE_BASELINE.is_file(), REPRODUCE_BASELINE
+    assert json.loads(REPRODUCE_BASELINE.read_text())["rows"]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from headsim.studies.reproduce_experiments import JobOutcome
+from headsim.studies.catalogue import JobOutcome
 from headsim.studies.reproduce_report import report_sections, report_text
 
 from .helpers import BOARD, CALIBRATION

@@ -11,8 +11,8 @@ import pytest
 
 from headsim import cli
 from headsim.studies import study
+from headsim.studies.catalogue import sweep_experiment
 from headsim.studies.methods import StudyConfig
-from headsim.studies.study_experiments import sweep_experiment
 from headsim.studies.target_errors import measure_methods
 
 CONFIG = StudyConfig.quick()

@@ -8,8 +8,8 @@ import json
 import cv2
 
 from headsim.studies.calibrations import CalibrationCache
+from headsim.studies.catalogue import run_experiment, sweep_experiment
 from headsim.studies.methods import SWEEP_METHODS, StudyConfig
-from headsim.studies.study_experiments import run_experiment, sweep_experiment
 from headsim.studies.study_output import write_experiment
 
 CONFIG = StudyConfig.quick()

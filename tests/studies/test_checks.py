@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from headsim.studies.bench_compare import BASELINE, TOLERANCES, compare, format_table, load_json
+from headsim.studies.checks import BASELINE, TOLERANCES, compare, format_table, load_json
 
 RULES = {
     "err": {"worse": "higher", "abs": 0.1, "rel": 0.5},

@@ -1,27 +1,38 @@
-"""What ``headsim reproduce`` runs (studies/reproduce_experiments.py): its experiments exist,
-each has a cost, and its paper figures are paper.py's."""
+"""The campaigns' catalogue (studies/catalogue.py): the study's comparison figures are
+ratios of RMS errors; reproduce's experiments run shipped scenarios and each has a cost."""
 
 from __future__ import annotations
 
 import pytest
 
-from headsim import paper
 from headsim.errors import BadInput, ExitCode
 from headsim.scenario.loading import scenario_files
-from headsim.studies.reproduce_experiments import (
+from headsim.studies import head_changes
+from headsim.studies.catalogue import (
     COSTS,
-    PAPER_ALPHA_E,
-    PAPER_SIDE_MEAN_MM,
-    PAPER_SIDE_STD_MM,
     SCENARIO_JOBS,
     STUDY_JOB,
     TABLES_HEAD,
-    TRUE_SIDE_MM,
     JobOutcome,
     ReproduceError,
+    compare_experiment,
 )
+from headsim.studies.methods import METHODS, StudyConfig
+
+CONFIG = StudyConfig.quick()
 
 
+def test_the_comparison_figures_are_ratios_of_rms_errors(calibrations) -> None:
+    experiment = compare_experiment(CONFIG)
+    labels = [(c.group, c.label) for c in experiment.conditions]
+    assert labels[:2] == [("paper", "as calibrated"), ("paper", "zoom 1.5x")]
+    assert experiment.methods == METHODS
+    # Two heads only differ in their principal points.
+    paper, centred = experiment.base.values()
+    assert centred == head_changes.centred(paper)
+
+
+@pytest.mark.fast
 def test_every_experiment_runs_a_shipped_scenario_and_has_a_cost() -> None:
     shipped = {path.stem for path in scenario_files()}
     assert {scenario for scenario, _ in SCENARIO_JOBS.values()} | {TABLES_HEAD} <= shipped
@@ -29,13 +40,7 @@ def test_every_experiment_runs_a_shipped_scenario_and_has_a_cost() -> None:
     assert all(cost > 0 for cost in COSTS.values())
 
 
-def test_the_papers_figures_are_paper_py_s() -> None:
-    assert PAPER_ALPHA_E == paper.INITIAL_DIRECTIONS_RAD
-    assert pytest.approx(1000 * paper.CHESSBOARD_SIDE_MEAN_M) == PAPER_SIDE_MEAN_MM
-    assert pytest.approx(1000 * paper.CHESSBOARD_SIDE_STD_M) == PAPER_SIDE_STD_MM
-    assert pytest.approx(1000 * paper.CHESSBOARD_SQUARE_M) == TRUE_SIDE_MM
-
-
+@pytest.mark.fast
 def test_a_reproduce_error_is_bad_input_and_outcomes_do_not_share_their_data() -> None:
     error = ReproduceError("--workers: 0 is not allowed")
     assert isinstance(error, BadInput) and isinstance(error, ValueError)
