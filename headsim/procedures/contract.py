@@ -23,7 +23,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from headsim.codec import describe
 from headsim.sim.declared import Section
 
 if TYPE_CHECKING:
@@ -152,6 +151,8 @@ class Procedure:
         """What its results.json ``experiment`` keys beside ``procedure`` mean, from its
         result type's declaration (paths relative to ``experiment``: ``a.b``, ``a[].b``,
         ``a.*``, as in :mod:`headsim.runs.results_reference`)."""
+        from headsim.codec import describe  # numpy: not at `import headsim`
+
         out: dict[str, str] = {}
         for kind in self.result if isinstance(self.result, tuple) else (self.result,):
             for path, meaning in describe(kind).items():

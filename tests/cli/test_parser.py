@@ -8,6 +8,7 @@ import sys
 
 import pytest
 
+from headsim.cli.estimate import estimate_command
 from headsim.cli.parser import build_parser, positive_int, preset_name
 from headsim.cli.scenarios import calibrate_command, list_command, run_command
 from headsim.cli.snapshot import snapshot_command
@@ -33,6 +34,7 @@ def test_every_command_reaches_its_function_and_states_the_exit_codes() -> None:
         "sweep": sweep_command,
         "study": study_command,
         "bench": bench_command,
+        "estimate": estimate_command,
     }
     assert set(commands) == set(expected)
     for name, sub in commands.items():
@@ -85,4 +87,6 @@ def test_help_loads_no_numerical_or_rendering_library() -> None:
     assert "usage: headsim" in result.stdout
     loaded = {line.split("|")[-1].strip().split(".")[0] for line in result.stderr.splitlines()}
     assert "headsim" in loaded
-    assert not loaded & {"scipy", "matplotlib", "mujoco", "cv2", "rerun", "dask", "gymnasium"}
+    assert not loaded & {
+        "numpy", "scipy", "matplotlib", "mujoco", "cv2", "rerun", "dask", "gymnasium", "mcap"
+    }  # fmt: skip

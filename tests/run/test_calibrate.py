@@ -22,7 +22,7 @@ def test_the_quick_start_calibrates_within_its_stated_errors() -> None:
     report = calibrate_scenario(scenario)
     assert report.status is Status.OK and report.status_text == "ok"
     assert report.fixated == len(report.positions) == spec.targets
-    assert all(p.failure is None and p.status_text == "ok" for p in report.positions)
+    assert all(p.failure is None and p.status == "ok" for p in report.positions)
     assert report.layout is not None and len(report.layout.positions_world_m) == spec.targets
     assert report.rendered_frames is not None and report.rendered_frames > 0
     assert report.knowledge is not None and report.knowledge.alpha_e_rad is not None
@@ -36,7 +36,7 @@ def test_each_position_outcome_keeps_its_failure() -> None:
     lost = Failure(FailureCause.LOST, "step 1", 2)
     outcomes = position_outcomes([None, lost])
     assert [o.failure for o in outcomes] == [None, lost]
-    assert [o.status_text for o in outcomes] == ["ok", "Ca2 at step 1: target lost"]
+    assert [o.status for o in outcomes] == ["ok", "Ca2 at step 1: target lost"]
 
 
 @pytest.mark.parametrize(
