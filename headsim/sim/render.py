@@ -1,10 +1,12 @@
 """Off-screen rendering of the eye cameras: MuJoCo pinhole render, lens, noise.
 
-One :class:`mujoco.Renderer` (an OpenGL context) per scene (its assets and
-off-screen buffer size, :func:`context_key`) is kept in a small process-wide
-pool and reused by every simulator of that scene, whatever its head, within a
-run and across the jobs of a worker: creating one costs about 0.2 s.  Images are drawn into a viewport of its off-screen buffer, so one
-context serves every canvas size and every window.
+One :class:`mujoco.Renderer` (an OpenGL context) per scene and context state (the
+assets it uploads, :func:`context_key`, and what else it is made with,
+:func:`context_state`: buffer size, multisampling, clip and fog distances, read when an
+image is drawn) is kept in a small process-wide pool and reused by every simulator of
+that scene and state, whatever its head, within a run and across the jobs of a worker:
+creating one costs about 0.2 s.  So an image never depends on what the process drew
+before.
 
 A *window* is a sub-rectangle of a camera's image (for a distorted camera:
 the region of its pinhole canvas that the window's pixels sample), drawn as
@@ -60,13 +62,11 @@ _CONTEXT_ARRAYS = ("mesh_vert", "mesh_face", "mesh_normal", "tex_data", "hfield_
 
 def context_key(scene: str, model: mujoco.MjModel) -> tuple[str, str]:
     """What identifies the OpenGL context a model needs: its scene and a digest of the
-    assets the context uploads.  Heads that differ only in their settings (cameras,
-    baseline, mounts) share one context; its off-screen buffer grows to the largest
-    canvas asked of it."""
+    assets the context uploads (taken when the simulator is built: a texture changed later
+    is uploaded, not a new context).  Heads that differ only in their settings (baseline,
+    mounts, noise) share one context; :func:`context_state` adds what else it is made
+    with."""
     digest = hashlib.sha1()
-    digest.update(f"offsamples={int(model.vis.quality.offsamples)}".encode())
-    # The shadow map's buffer is made with the context: a model with shadows needs its own.
-    digest.update(f"shadowsize={int(model.vis.quality.shadowsize)}".encode())
     for name in _CONTEXT_ARRAYS:
         array = getattr(model, name, None)
         if array is not None:
@@ -75,21 +75,36 @@ def context_key(scene: str, model: mujoco.MjModel) -> tuple[str, str]:
     return (str(scene), digest.hexdigest())
 
 
+def context_state(model: mujoco.MjModel) -> tuple[float, ...]:
+    """What ``mjr_makeContext`` reads from ``model`` besides its assets, read when an image
+    is drawn (a model may change them after it is built, as the Gym env's multisampling):
+    the off-screen buffer's size and samples, the shadow map, the built-in meshes'
+    tessellation, and the clip, fog and shadow distances (``vis.map`` x ``stat.extent``)."""
+    quality, scale = model.vis.quality, model.vis.map
+    return (
+        float(model.vis.global_.offwidth),
+        float(model.vis.global_.offheight),
+        float(quality.offsamples),
+        float(quality.shadowsize),
+        float(quality.numslices),
+        float(quality.numstacks),
+        float(quality.numquads),
+        float(model.stat.extent),
+        *(float(getattr(scale, name)) for name in _MAP_FIELDS),
+    )
+
+
+#: ``vis.map``'s fields that the context scales by the model's extent.
+_MAP_FIELDS = ("znear", "zfar", "fogstart", "fogend", "shadowclip", "shadowscale", "haze")
+
+
 def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
-    """The pooled renderer of ``key``, with a buffer at least ``model``'s off-screen size."""
+    """The pooled renderer of ``key`` (assets and :func:`context_state`), made from ``model``."""
     global created
-    need = (int(model.vis.global_.offwidth), int(model.vis.global_.offheight))
     renderer = _POOL.pop(key, None)
-    if renderer is not None and (renderer.width < need[0] or renderer.height < need[1]):
-        need = (max(need[0], renderer.width), max(need[1], renderer.height))
-        renderer.close()
-        renderer = None
     if renderer is None:
         backend = check_backend()
-        width, height = need
-        saved = (model.vis.global_.offwidth, model.vis.global_.offheight)
-        # The context's buffer is sized from the model it is made with.
-        model.vis.global_.offwidth, model.vis.global_.offheight = width, height
+        width, height = int(model.vis.global_.offwidth), int(model.vis.global_.offheight)
         try:
             renderer = mujoco.Renderer(model, height=height, width=width)
         except ValueError as err:  # larger than the model's off-screen buffer
@@ -99,8 +114,6 @@ def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
                 f"could not create an off-screen OpenGL context with MUJOCO_GL={backend}: {err}. "
                 f"{INSTALL_HINT}"
             ) from err
-        finally:
-            model.vis.global_.offwidth, model.vis.global_.offheight = saved
         check_renderer(renderer)
         created += 1
         for uploaded in [k for k in _UPLOADED if k[0] == key]:
@@ -175,13 +188,14 @@ class EyeRenderer:
         self._textures[texture_id] = next(_versions)
 
     def _renderer(self) -> mujoco.Renderer:
-        renderer = _acquire(self._key, self._mj_model)
+        key = (self._key, context_state(self._mj_model))
+        renderer = _acquire(key, self._mj_model)
         use_model(renderer, self._mj_model)  # the same assets; this model's cameras and bodies
         for texture_id, version in self._textures.items():
-            if _UPLOADED.get((self._key, texture_id)) != version:
+            if _UPLOADED.get((key, texture_id)) != version:
                 make_current(renderer)
                 mujoco.mjr_uploadTexture(self._mj_model, mjr_context(renderer), texture_id)
-                _UPLOADED[(self._key, texture_id)] = version
+                _UPLOADED[(key, texture_id)] = version
         return renderer
 
     def _draw(
@@ -323,9 +337,8 @@ class EyeRenderer:
     def close(self) -> None:
         """Give the OpenGL context back to the pool (closed if it was this renderer's own)."""
         if self._own:
-            renderer = _POOL.pop(self._key, None)
-            if renderer is not None:
-                renderer.close()
+            for key in [k for k in _POOL if isinstance(k, tuple) and k[0] == self._key]:
+                _POOL.pop(key).close()
 
 
 #: What makes the eye renderers of simulators made in this context (None: :class:`EyeRenderer`);

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from headsim.sim.optics import undistort_pixels
+from headsim.sim.render import release_renderers
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
 from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import DetectionStatus
@@ -111,6 +112,27 @@ def test_repeated_renders_are_identical() -> None:
         sim.move(eye=0.05)
         first = sim.render(2)
         np.testing.assert_array_equal(first, sim.render(2))
+
+
+def test_an_image_does_not_depend_on_what_the_process_drew_before() -> None:
+    """A model whose multisampling is set after it is built (as the Gym env's) gets a
+    context made with it, not a pooled one another head made with the default."""
+    small = HeadSettings(cameras=(CAMERA_VARIANTS["small_image"],) * 2)
+
+    def draw(offsamples: int | None) -> np.ndarray:
+        with HeadSim(settings=small) as sim:
+            if offsamples is not None:
+                sim.model.vis.quality.offsamples = offsamples
+            sim.set_body_pose(MARKER, [0.02, 0.6, 0.23])
+            sim.move(eye=0.05)
+            return sim.render(1)
+
+    release_renderers()
+    fresh = draw(0)
+    release_renderers()
+    default = draw(None)  # a context with the default multisampling, pooled
+    assert default.tobytes() != fresh.tobytes()
+    assert draw(0).tobytes() == fresh.tobytes()
 
 
 def test_a_marker_out_of_view_is_reported_lost_and_one_on_the_border_cut() -> None:
