@@ -20,9 +20,9 @@ from headsim.active.failure import Failure, FailureCause
 from headsim.active.servo_types import Detector
 from headsim.estimators import PositionEstimate
 from headsim.estimators.result import Method, Status
+from headsim.head.servo_head import ServoHead, Specified
 from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadBelief, HeadSettings
-from headsim.sim.simulator import HeadSim
 
 #: Centroid precision assumed for covariances, px (measured: ~0.03-0.06 px).
 NOMINAL_PIXEL_SIGMA = 0.05
@@ -53,7 +53,7 @@ class HeadKnowledge:
     belief: HeadBelief | None = None
     los_offset_m: tuple[float, float] | None = None
 
-    def head_belief(self, sim: HeadSim) -> HeadBelief:
+    def head_belief(self, sim: Specified) -> HeadBelief:
         """The geometry the head believes it has."""
         return self.head_belief_of(sim.settings)
 
@@ -61,7 +61,7 @@ class HeadKnowledge:
         """The geometry the head ``settings`` believes it has."""
         return self.belief if self.belief is not None else settings.believed
 
-    def line_of_sight_offsets(self, sim: HeadSim) -> tuple[float, float]:
+    def line_of_sight_offsets(self, sim: Specified) -> tuple[float, float]:
         """(s1, s2), m: calibrated, else the believed side offsets."""
         return self.line_of_sight_offsets_of(sim.settings)
 
@@ -71,7 +71,7 @@ class HeadKnowledge:
             return self.los_offset_m
         return self.head_belief_of(settings).side_offset_m
 
-    def reference(self, sim: HeadSim, camera: int) -> tuple[float, float]:
+    def reference(self, sim: Specified, camera: int) -> tuple[float, float]:
         """(u_i0, v_i0): the servo's goal column and the reference row of camera 1 or 2, px."""
         return self.reference_of(sim.settings, camera)
 
@@ -88,7 +88,7 @@ class Target:
 
     name: str
     detector: Detector
-    truth_world: Callable[[HeadSim], np.ndarray]
+    truth_world: Callable[[ServoHead], np.ndarray]
 
 
 def body_target(name: str, detector: Detector) -> Target:
@@ -156,7 +156,7 @@ def _nan3() -> np.ndarray:
 
 
 def failed_measurement(
-    sim: HeadSim,
+    sim: ServoHead,
     target: Target,
     method: str,
     failure: Failure,
@@ -185,7 +185,7 @@ def failed_measurement(
 
 
 def estimated_measurement(
-    sim: HeadSim,
+    sim: ServoHead,
     target: Target,
     method: str,
     estimate: PositionEstimate,
@@ -229,7 +229,7 @@ def encoder_sigma_rad(resolution_rad: float, interpolate: bool) -> float:
 
 
 def to_world(
-    sim: HeadSim,
+    sim: ServoHead,
     point_head: np.ndarray,
     neck_rad: tuple[float, float] | None = None,
     belief: HeadBelief | None = None,
