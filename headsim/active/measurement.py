@@ -20,7 +20,7 @@ from headsim.active.failure import Failure, FailureCause
 from headsim.active.servo_types import Detector
 from headsim.estimators import PositionEstimate
 from headsim.estimators.result import Method, Status
-from headsim.head.servo_head import ServoHead, Specified
+from headsim.head.servo_head import NoTruth, ServoHead, Specified
 from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadBelief, HeadSettings
 
@@ -155,6 +155,15 @@ def _nan3() -> np.ndarray:
     return np.full(3, np.nan)
 
 
+def _truth(sim: ServoHead, target: Target) -> tuple[np.ndarray, np.ndarray]:
+    """The target's true position in W and in H, m; NaN on a head with no truth (a replay)."""
+    try:
+        truth_world = target.truth_world(sim)
+        return truth_world, sim.truth.transform_points(truth_world, "world", "head")[0]
+    except NoTruth:
+        return _nan3(), _nan3()
+
+
 def failed_measurement(
     sim: ServoHead,
     target: Target,
@@ -165,7 +174,7 @@ def failed_measurement(
     search_renders: int = 0,
     scan_renders: int = 0,
 ) -> Measurement:
-    truth_world = target.truth_world(sim)
+    truth_world, truth_head = _truth(sim, target)
     return Measurement(
         name=target.name,
         method=Method(method),
@@ -175,7 +184,7 @@ def failed_measurement(
         search_renders=search_renders,
         scan_renders=scan_renders,
         estimate_head_m=_nan3(),
-        truth_head_m=sim.truth.transform_points(truth_world, "world", "head")[0],
+        truth_head_m=truth_head,
         estimate_world_m=_nan3(),
         truth_world_m=truth_world,
         covariance_head_m2=np.full((3, 3), np.nan),
@@ -202,7 +211,7 @@ def estimated_measurement(
     if not bool(estimate.valid[0]):
         failure = Failure(FailureCause.ESTIMATOR, "estimate", None, repr(estimate.reasons(0)))
         return failed_measurement(sim, target, method, failure, renders, residuals, search, scan)
-    truth_world = target.truth_world(sim)
+    truth_world, truth_head = _truth(sim, target)
     estimate_head = estimate.positions[0]
     covariance = estimate.covariance
     return Measurement(
@@ -210,7 +219,7 @@ def estimated_measurement(
         method=Method(method),
         status=Status.OK,
         estimate_head_m=estimate_head,
-        truth_head_m=sim.truth.transform_points(truth_world, "world", "head")[0],
+        truth_head_m=truth_head,
         estimate_world_m=to_world(sim, estimate_head, neck_rad, belief),
         truth_world_m=truth_world,
         covariance_head_m2=covariance[0] if covariance is not None else np.full((3, 3), np.nan),

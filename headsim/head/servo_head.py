@@ -32,6 +32,10 @@ if TYPE_CHECKING:
     from headsim.sim.simulator import HeadSim
 
 
+class NoTruth(RuntimeError):
+    """A head without a truth channel (a replay, a robot) was asked for the truth."""
+
+
 class Specified(Protocol):
     """Anything that tells a head's specification (a :class:`ServoHead`, the simulator)."""
 
@@ -129,8 +133,9 @@ class ServoHead(Head, Specified, Protocol):
     # -- the truth channel -------------------------------------------------------------
     @property
     def truth(self) -> HeadSim:
-        """What is truly where: for placing targets and scoring, never for measuring."""
+        """What is truly where: for placing targets and scoring, never for measuring
+        (:class:`NoTruth` on a head that has none)."""
         ...
 
 
-__all__ = ["ServoHead", "Specified"]
+__all__ = ["NoTruth", "ServoHead", "Specified"]
