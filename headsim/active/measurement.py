@@ -84,7 +84,8 @@ class HeadKnowledge:
 
 @dataclass(frozen=True)
 class Target:
-    """Something to measure: a name, how to find it in an image, and where it truly is."""
+    """Something to measure: a name, how to find it in an image, and where it truly is
+    (``truth_world``: read from the head's truth channel, for scoring)."""
 
     name: str
     detector: Detector

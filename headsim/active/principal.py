@@ -23,7 +23,7 @@ with the chessboard's 48 corners, both eyes at angle 0.
 **Servoing to it**: ``HeadKnowledge(u0=columns)`` makes ``measure_model2``
 servo each camera to its column, and ``calibrate_head(..., knowledge=...)``
 calibrates the initial directions on those columns; the simulator's truth
-for them is ``ServoHead.effective_initial_direction(camera, goal_u)``.
+for them is ``HeadSim.effective_initial_direction(camera, goal_u)``.
 """
 
 from __future__ import annotations
