@@ -14,7 +14,7 @@ from headsim.active.calibration_report import CalibrationReport
 from headsim.codec import declared, decode, describe, doc, encode, keys
 from headsim.files import to_jsonable
 from headsim.runs.outcomes import RunRenders
-from headsim.runs.serialise import ResultsDocument
+from headsim.runs.serialise import EstimateDocument, ResultsDocument
 from headsim.sim.events import RenderCounts
 from headsim.stereo.calibration import StereoCalibration
 
@@ -119,7 +119,9 @@ def test_the_reference_lists_every_key_by_its_path() -> None:
     assert list(fields)[:3] == ["state", "colour", "pose"]
 
 
-@pytest.mark.parametrize("cls", [ResultsDocument, CalibrationReport, StereoCalibration])
+@pytest.mark.parametrize(
+    "cls", [ResultsDocument, EstimateDocument, CalibrationReport, StereoCalibration]
+)
 def test_every_key_of_the_result_files_has_a_meaning(cls: type) -> None:
     fields = describe(cls)
     assert len(fields) >= 10 and [path for path, meaning in fields.items() if not meaning] == []

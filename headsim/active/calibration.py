@@ -26,8 +26,8 @@ from headsim.estimators.calibration import (
     calibrate_lines_of_sight,
 )
 from headsim.estimators.vertical import VerticalCalibration, calibrate_vertical_reference
+from headsim.head.servo_head import ServoHead
 from headsim.sim.events import EventSink
-from headsim.sim.simulator import HeadSim
 
 
 class CalibrationError(ValueError):
@@ -101,7 +101,7 @@ def tape_measure(
 
 
 def calibrate_head(
-    sim: HeadSim,
+    sim: ServoHead,
     servo: EyeServo,
     target: Target,
     body: str,
@@ -146,7 +146,7 @@ def calibrate_head(
     configs = (Model2Config(midline_px=0.0), Model2Config())
     for index, position in enumerate(np.atleast_2d(positions_world)):
         sink.emit(FixationStarted(f"calibration {index + 1}"))
-        sim.set_body_pose(body, position)
+        sim.truth.set_body_pose(body, position)
         for config in configs:
             m = measure_model2(sim, servo, target, base, config)
             if m.failure is None or m.failure.cause is not FailureCause.ESTIMATOR:
@@ -162,7 +162,7 @@ def calibrate_head(
         )
         depths.append(measured[2])
         rows.append((measured, m.details))
-    sim.set_body_pose(body, parked)
+    sim.truth.set_body_pose(body, parked)
     baseline = base.head_belief(sim).baseline_m
     total = len(outcomes)
     if len(alpha1) < 2:
@@ -275,7 +275,7 @@ class LineOfSightTruth:
     effective_baseline_m: float
 
 
-def line_of_sight_truth(sim: HeadSim, knowledge: HeadKnowledge) -> LineOfSightTruth:
+def line_of_sight_truth(sim: ServoHead, knowledge: HeadKnowledge) -> LineOfSightTruth:
     """Ground truth for the extended calibration's offsets (scoring only)."""
     believed = knowledge.head_belief(sim).baseline_m
     half_error = 0.5 * (sim.truth.settings.baseline_m - believed)
@@ -290,7 +290,7 @@ def line_of_sight_truth(sim: HeadSim, knowledge: HeadKnowledge) -> LineOfSightTr
 
 
 def _vertical_from_samples(
-    sim: HeadSim,
+    sim: ServoHead,
     rows: list[tuple[np.ndarray, dict[str, float]]],
     alpha_e: tuple[float, float],
     base: HeadKnowledge,

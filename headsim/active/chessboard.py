@@ -10,8 +10,8 @@ import numpy as np
 
 from headsim.active.look import look_once
 from headsim.active.measurement import Target
+from headsim.head.servo_head import ServoHead
 from headsim.sim import names
-from headsim.sim.simulator import HeadSim
 from headsim.stereo.views import CHESSBOARD_PATTERN, CHESSBOARD_SQUARE_M
 from headsim.vision.chessboard import (
     ChessboardDetection,
@@ -84,8 +84,8 @@ def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: flo
     columns, _ = pattern
     i, j = index % columns, index // columns
 
-    def truth(sim: HeadSim) -> np.ndarray:
-        body = sim.data.body(names.CHESSBOARD)
+    def truth(sim: ServoHead) -> np.ndarray:
+        body = sim.truth.data.body(names.CHESSBOARD)
         return body.xpos + body.xmat.reshape(3, 3) @ np.array([i * square_m, j * square_m, 0.0])
 
     return Target(f"corner_{i}_{j}", ChessboardCorner(index, pattern, square_m), truth)
@@ -98,7 +98,7 @@ def chessboard_corner_target(index: int, pattern: tuple[int, int], square_m: flo
 BOARD_PREVIEW_BINNING = 2
 
 
-def look_for_board(sim: HeadSim, camera: int) -> np.ndarray | None:
+def look_for_board(sim: ServoHead, camera: int) -> np.ndarray | None:
     """The scene's board's inner corners (N, 2) px in ``camera``'s next image, in board
     order (as ``headsim.stereo.views.detect_chessboard`` gives them), or None: found in
     the window a binned preview places (:func:`look_once`), else in the full frame."""

@@ -33,8 +33,8 @@ from headsim.active.servo_types import (
     ServoOutcome,
     ServoResult,
 )
+from headsim.head.servo_head import ServoHead
 from headsim.sim.events import EventSink
-from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection, DetectionStatus
 
 
@@ -42,7 +42,7 @@ class EyeServo:
     """Servo the eye motor so that one camera's target column reaches a goal u."""
 
     def __init__(
-        self, sim: HeadSim, config: ServoConfig | None = None, sink: EventSink | None = None
+        self, sim: ServoHead, config: ServoConfig | None = None, sink: EventSink | None = None
     ) -> None:
         self.sim = sim
         self.config = config or ServoConfig()

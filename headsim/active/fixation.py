@@ -16,14 +16,14 @@ from headsim.active.measurement import (
 from headsim.active.neck_servo import NeckServo
 from headsim.estimators import Uncertainty
 from headsim.estimators.fixation import fixation
-from headsim.sim.simulator import HeadSim
+from headsim.head.servo_head import ServoHead
 
 #: The motors a one-step fixation drives, in the order of its servo's steps: the
 #: errors (u1 - u10, u2 - u20, mean v - v0) fall on them one each.
 FIXATION_MOTORS = ("eye", "eye2", "neck_pitch")
 
 
-def fixation_servo(sim: HeadSim, servo: NeckServo | None = None, **kwargs: object) -> NeckServo:
+def fixation_servo(sim: ServoHead, servo: NeckServo | None = None, **kwargs: object) -> NeckServo:
     """The servo of a one-step fixation on ``sim``'s head, which needs independent eyes."""
     if "eye2" not in sim.motors:
         raise ValueError("a one-step fixation needs a head with a motor per eye")
@@ -31,7 +31,7 @@ def fixation_servo(sim: HeadSim, servo: NeckServo | None = None, **kwargs: objec
 
 
 def measure_fixation(
-    sim: HeadSim,
+    sim: ServoHead,
     servo: NeckServo,
     target: Target,
     knowledge: HeadKnowledge | None = None,

@@ -26,9 +26,9 @@ import numpy as np
 
 from headsim.active.events import Detected
 from headsim.active.servo_types import Detector, ServoConfig
+from headsim.head.servo_head import ServoHead
 from headsim.sim.events import EventSink
 from headsim.sim.render import Window
-from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection
 
 #: A blob found in a window placed from an earlier sight counts only if its area is
@@ -171,7 +171,7 @@ class Sight:
 
 def unbinned_px(binned_px: tuple[float, ...] | np.ndarray, binning: int) -> np.ndarray:
     """Full-frame pixel coordinates of coordinates in a preview binned ``binning`` x
-    ``binning`` (``HeadSim.render_preview``): binned pixel i covers pixels
+    ``binning`` (``ServoHead.render_preview``): binned pixel i covers pixels
     b i .. b i + b - 1, so its centre is b i + (b - 1) / 2."""
     return binning * np.asarray(binned_px, dtype=np.float64) + (binning - 1) / 2.0
 
@@ -279,7 +279,7 @@ def reporting(
 
 
 def look_once(
-    sim: HeadSim,
+    sim: ServoHead,
     camera: int,
     detector: Detector,
     config: ServoConfig | None = None,
@@ -316,7 +316,7 @@ class Looker:
 
     def __init__(
         self,
-        sim: HeadSim,
+        sim: ServoHead,
         config: ServoConfig | None = None,
         sink: EventSink | None = None,
         report: bool = True,

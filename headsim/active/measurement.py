@@ -20,9 +20,9 @@ from headsim.active.failure import Failure, FailureCause
 from headsim.active.servo_types import Detector
 from headsim.estimators import PositionEstimate
 from headsim.estimators.result import Method, Status
+from headsim.head.servo_head import NoTruth, ServoHead, Specified
 from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadBelief, HeadSettings
-from headsim.sim.simulator import HeadSim
 
 #: Centroid precision assumed for covariances, px (measured: ~0.03-0.06 px).
 NOMINAL_PIXEL_SIGMA = 0.05
@@ -53,7 +53,7 @@ class HeadKnowledge:
     belief: HeadBelief | None = None
     los_offset_m: tuple[float, float] | None = None
 
-    def head_belief(self, sim: HeadSim) -> HeadBelief:
+    def head_belief(self, sim: Specified) -> HeadBelief:
         """The geometry the head believes it has."""
         return self.head_belief_of(sim.settings)
 
@@ -61,7 +61,7 @@ class HeadKnowledge:
         """The geometry the head ``settings`` believes it has."""
         return self.belief if self.belief is not None else settings.believed
 
-    def line_of_sight_offsets(self, sim: HeadSim) -> tuple[float, float]:
+    def line_of_sight_offsets(self, sim: Specified) -> tuple[float, float]:
         """(s1, s2), m: calibrated, else the believed side offsets."""
         return self.line_of_sight_offsets_of(sim.settings)
 
@@ -71,7 +71,7 @@ class HeadKnowledge:
             return self.los_offset_m
         return self.head_belief_of(settings).side_offset_m
 
-    def reference(self, sim: HeadSim, camera: int) -> tuple[float, float]:
+    def reference(self, sim: Specified, camera: int) -> tuple[float, float]:
         """(u_i0, v_i0): the servo's goal column and the reference row of camera 1 or 2, px."""
         return self.reference_of(sim.settings, camera)
 
@@ -84,11 +84,12 @@ class HeadKnowledge:
 
 @dataclass(frozen=True)
 class Target:
-    """Something to measure: a name, how to find it in an image, and where it truly is."""
+    """Something to measure: a name, how to find it in an image, and where it truly is
+    (``truth_world``: read from the head's truth channel, for scoring)."""
 
     name: str
     detector: Detector
-    truth_world: Callable[[HeadSim], np.ndarray]
+    truth_world: Callable[[ServoHead], np.ndarray]
 
 
 def body_target(name: str, detector: Detector) -> Target:
@@ -155,8 +156,17 @@ def _nan3() -> np.ndarray:
     return np.full(3, np.nan)
 
 
+def _truth(sim: ServoHead, target: Target) -> tuple[np.ndarray, np.ndarray]:
+    """The target's true position in W and in H, m; NaN on a head with no truth (a replay)."""
+    try:
+        truth_world = target.truth_world(sim)
+        return truth_world, sim.truth.transform_points(truth_world, "world", "head")[0]
+    except NoTruth:
+        return _nan3(), _nan3()
+
+
 def failed_measurement(
-    sim: HeadSim,
+    sim: ServoHead,
     target: Target,
     method: str,
     failure: Failure,
@@ -165,7 +175,7 @@ def failed_measurement(
     search_renders: int = 0,
     scan_renders: int = 0,
 ) -> Measurement:
-    truth_world = target.truth_world(sim)
+    truth_world, truth_head = _truth(sim, target)
     return Measurement(
         name=target.name,
         method=Method(method),
@@ -175,7 +185,7 @@ def failed_measurement(
         search_renders=search_renders,
         scan_renders=scan_renders,
         estimate_head_m=_nan3(),
-        truth_head_m=sim.truth.transform_points(truth_world, "world", "head")[0],
+        truth_head_m=truth_head,
         estimate_world_m=_nan3(),
         truth_world_m=truth_world,
         covariance_head_m2=np.full((3, 3), np.nan),
@@ -185,7 +195,7 @@ def failed_measurement(
 
 
 def estimated_measurement(
-    sim: HeadSim,
+    sim: ServoHead,
     target: Target,
     method: str,
     estimate: PositionEstimate,
@@ -202,7 +212,7 @@ def estimated_measurement(
     if not bool(estimate.valid[0]):
         failure = Failure(FailureCause.ESTIMATOR, "estimate", None, repr(estimate.reasons(0)))
         return failed_measurement(sim, target, method, failure, renders, residuals, search, scan)
-    truth_world = target.truth_world(sim)
+    truth_world, truth_head = _truth(sim, target)
     estimate_head = estimate.positions[0]
     covariance = estimate.covariance
     return Measurement(
@@ -210,7 +220,7 @@ def estimated_measurement(
         method=Method(method),
         status=Status.OK,
         estimate_head_m=estimate_head,
-        truth_head_m=sim.truth.transform_points(truth_world, "world", "head")[0],
+        truth_head_m=truth_head,
         estimate_world_m=to_world(sim, estimate_head, neck_rad, belief),
         truth_world_m=truth_world,
         covariance_head_m2=covariance[0] if covariance is not None else np.full((3, 3), np.nan),
@@ -229,7 +239,7 @@ def encoder_sigma_rad(resolution_rad: float, interpolate: bool) -> float:
 
 
 def to_world(
-    sim: HeadSim,
+    sim: ServoHead,
     point_head: np.ndarray,
     neck_rad: tuple[float, float] | None = None,
     belief: HeadBelief | None = None,

@@ -21,11 +21,11 @@ from headsim.active.neck_servo import NeckServo
 from headsim.active.search import find_neck_view, scan_neck
 from headsim.active.servo_types import ServoOutcome
 from headsim.estimators import Uncertainty, model1
-from headsim.sim.simulator import HeadSim
+from headsim.head.servo_head import ServoHead
 
 
 def measure_model1(
-    sim: HeadSim,
+    sim: ServoHead,
     servo: NeckServo,
     target: Target,
     knowledge: HeadKnowledge | None = None,

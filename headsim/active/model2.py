@@ -30,7 +30,7 @@ from headsim.active.measurement import (
 from headsim.active.search import find_view, scan_eyes
 from headsim.active.servo_types import ServoOutcome, ServoResult
 from headsim.estimators import Uncertainty, model2
-from headsim.sim.simulator import HeadSim
+from headsim.head.servo_head import ServoHead
 from headsim.vision.detection import Detection
 
 
@@ -38,7 +38,7 @@ def _observe(servo: EyeServo, camera: int, target: Target) -> Detection:
     return servo.observe(camera, target.detector)
 
 
-def _fixation_angle(sim: HeadSim, result: ServoResult, interpolate: bool) -> float:
+def _fixation_angle(sim: ServoHead, result: ServoResult, interpolate: bool) -> float:
     """Eye angle at fixation, rad: the whole step, or the sub-step interpolated from the image."""
     steps = result.subpixel_steps if interpolate else float(result.steps)
     return steps * sim.settings.encoder_resolution_rad
@@ -104,7 +104,7 @@ class _Failed:
 
 
 def _two_steps(
-    sim: HeadSim,
+    sim: ServoHead,
     servo: EyeServo,
     target: Target,
     goal_u: tuple[float, float],
@@ -162,7 +162,7 @@ def _two_steps(
 
 
 def measure_model2(
-    sim: HeadSim,
+    sim: ServoHead,
     servo: EyeServo,
     target: Target,
     knowledge: HeadKnowledge | None = None,
@@ -249,7 +249,7 @@ def measure_model2(
 
 
 def _near_midline_images(
-    sim: HeadSim,
+    sim: ServoHead,
     servo: EyeServo,
     target: Target,
     step1: ServoResult,
@@ -275,7 +275,7 @@ def _near_midline_images(
 
 
 def measure_points_model2(
-    sim: HeadSim,
+    sim: ServoHead,
     servo: EyeServo,
     targets: Sequence[Target],
     knowledge: HeadKnowledge | None = None,

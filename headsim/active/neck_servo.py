@@ -19,8 +19,8 @@ from headsim.active.servo_types import (
     ServoConfig,
     ServoOutcome,
 )
+from headsim.head.servo_head import ServoHead
 from headsim.sim.events import EventSink
-from headsim.sim.simulator import HeadSim
 from headsim.vision.detection import Detection, DetectionStatus
 
 
@@ -38,7 +38,7 @@ class NeckServo:
 
     def __init__(
         self,
-        sim: HeadSim,
+        sim: ServoHead,
         config: ServoConfig | None = None,
         sink: EventSink | None = None,
         motors: tuple[str, str, str] = JOINTS,

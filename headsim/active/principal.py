@@ -33,9 +33,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from headsim.active.chessboard import look_for_board
+from headsim.head.servo_head import ServoHead
 from headsim.sim import names
 from headsim.sim.settings import HeadSettings
-from headsim.sim.simulator import HeadSim
 from headsim.stereo.views import place_chessboard, sample_board_pose
 
 #: Zoom used to find the principal point when the study needs one (f' = 1.3 f).
@@ -165,8 +165,8 @@ class PrincipalPointRun:
 
 
 def principal_points_by_zoom(
-    before: HeadSim,
-    after: HeadSim,
+    before: ServoHead,
+    after: ServoHead,
     zoom: float = PROBE_ZOOM,
     rng: np.random.Generator | None = None,
     poses: int = 2,
@@ -202,9 +202,9 @@ def principal_points_by_zoom(
         sim.move(eye=0.0, neck_yaw=0.0, neck_pitch=0.0)
     sampler = after if zoom > 1 else before
     for _ in range(poses):
-        head_from_board = sample_board_pose(sampler, rng, distance_range_m, max_tilt_rad=0.4)
+        head_from_board = sample_board_pose(sampler.truth, rng, distance_range_m, max_tilt_rad=0.4)
         for sim in sims:
-            place_chessboard(sim, head_from_board)
+            place_chessboard(sim.truth, head_from_board)
         found_any = False
         for camera in (1, 2):
             corners = [look_for_board(sim, camera) for sim in sims]

@@ -12,9 +12,14 @@ from headsim.runs.outputs import Outputs
 
 def estimate_command(args: argparse.Namespace) -> int:
     from headsim.cli.writing import write_all
-    from headsim.head.offline import estimate_file
+    from headsim.head.offline import estimate_file, read_truth
+    from headsim.runs.serialise import estimate_payload
 
-    document = estimate_file(args.log, args.mapping, args.truth)
+    mapping, estimates, pairs = estimate_file(args.log, args.mapping)
+    truth = None if args.truth is None else read_truth(args.truth)
+    document = estimate_payload(
+        str(args.log), estimates, pairs, mapping.belief, mapping.alpha_e_rad, truth
+    )
     outputs = Outputs()
     try:
         out = outputs.directory(args.out, "--out")
@@ -25,10 +30,11 @@ def estimate_command(args: argparse.Namespace) -> int:
     print(printable(f"{document['stereo_pairs']} stereo pairs in {args.log}"))
     for m in document["measurements"]:
         if m["status"] != "ok":
-            print(printable(f"  {m['name']}: FAILED, {m['failure']}"))
+            print(printable(f"  {m['name']}: FAILED, {m['status']}"))
             continue
         x, y, z = m["estimate_head_m"]
-        line = f"  {m['name']}: ({x:.4f}, {y:.4f}, {z:.4f}) m in H from {m['pairs']} pairs"
+        pairs = round(m["details"]["pairs"])
+        line = f"  {m['name']}: ({x:.4f}, {y:.4f}, {z:.4f}) m in H from {pairs} pairs"
         error = m["error_m"]
         if error is not None and math.isfinite(error):
             line += f"; error {error * 1000:.2f} mm ({m['error_pct_of_depth']:.3f} % of depth)"

@@ -23,6 +23,9 @@ class Method(enum.Enum):
     MODEL2 = "model2"
     #: One-step fixation with independent eyes (:mod:`headsim.estimators.fixation`)
     FIXATION = "fixation"
+    #: Both eyes' images of a recording triangulated where they stood
+    #: (:mod:`headsim.head.stereo_look`, ``headsim estimate``)
+    STEREO_TRIANGULATION = "stereo_triangulation"
 
 
 class Status(enum.Enum):

@@ -27,6 +27,7 @@ from headsim.geometry.kinematics import head_from_camera
 from headsim.head.camera_info import CameraInfo
 from headsim.head.interface import Head, JointReading, StampedImage, StereoFrame
 from headsim.head.ros_messages import msgdef
+from headsim.sim.render import Window
 from headsim.sim.settings import HeadBelief
 
 
@@ -46,6 +47,7 @@ class Topics:
     position_commands: str = "/forward_position_controller/commands"
     velocity_commands: str = "/forward_velocity_controller/commands"
     estimates: str = "/headsim/estimates"
+    phases: str = "/headsim/phase"
     joints: Mapping[str, str] = field(default_factory=dict)
     head_frame: str = "head"
     optical_frames: tuple[str, str] = ("cam1_optical", "cam2_optical")
@@ -126,8 +128,15 @@ class McapRecorder:
             topic, schema, message, log_time=_ns(time_s), sequence=self._sequence
         )
 
-    def image(self, camera: int, stamped: StampedImage) -> None:
-        """Camera ``camera``'s image and its CameraInfo, both stamped with the image's time."""
+    def image(
+        self, camera: int, stamped: StampedImage, window: Window | None = None, binning: int = 1
+    ) -> None:
+        """Camera ``camera``'s image and its CameraInfo, both stamped with the image's time.
+
+        ``window``: the image is only this region of interest of the full frame (the
+        CameraInfo's ``roi``); ``binning``: the whole view binned b x b (its
+        ``binning_x``/``binning_y``).  The CameraInfo's K, D, P stay the full frame's, as
+        ROS has them."""
         image = np.ascontiguousarray(stamped.image, dtype=np.uint8)
         height, width = image.shape[:2]
         header = {
@@ -147,9 +156,15 @@ class McapRecorder:
                 "k": list(info.K),
                 "r": list(info.R),
                 "p": list(info.P),
-                "binning_x": 0,
-                "binning_y": 0,
-                "roi": {"x_offset": 0, "y_offset": 0, "height": 0, "width": 0, "do_rectify": False},
+                "binning_x": binning if binning > 1 else 0,
+                "binning_y": binning if binning > 1 else 0,
+                "roi": {
+                    "x_offset": 0 if window is None else window.x0,
+                    "y_offset": 0 if window is None else window.y0,
+                    "height": 0 if window is None else window.height,
+                    "width": 0 if window is None else window.width,
+                    "do_rectify": False,
+                },
             },
             stamped.time_s,
         )
@@ -233,6 +248,10 @@ class McapRecorder:
             },
             time_s,
         )
+
+    def phase(self, name: str, time_s: float) -> None:
+        """A procedure's phase ("calibration", "measurement") begins: a ``std_msgs/String``."""
+        self._write(self.topics.phases, "std_msgs/String", {"data": name}, time_s)
 
     def close(self) -> None:
         self._writer.finish()
@@ -346,8 +365,11 @@ def _image(message: Any, topic: str) -> np.ndarray:
     return np.ascontiguousarray(image[..., ::-1] if message.encoding == "bgr8" else image)
 
 
-def _messages(path: Path, topics: Sequence[str]) -> Iterator[tuple[str, Any, float]]:
-    """(topic, decoded message, log time in s) of ``topics``, in log-time order."""
+def _messages(
+    path: Path, topics: Sequence[str], in_time_order: bool = True
+) -> Iterator[tuple[str, Any, float]]:
+    """(topic, decoded message, log time in s) of ``topics``, in log-time order (else in
+    the order written)."""
     try:
         from mcap.reader import make_reader
         from mcap_ros2.decoder import DecoderFactory
@@ -361,7 +383,7 @@ def _messages(path: Path, topics: Sequence[str]) -> Iterator[tuple[str, Any, flo
         try:
             reader = make_reader(stream, decoder_factories=[DecoderFactory()])
             for _, channel, message, decoded in reader.iter_decoded_messages(
-                topics=list(topics), log_time_order=True
+                topics=list(topics), log_time_order=in_time_order
             ):
                 yield channel.topic, decoded, message.log_time * 1e-9
         except LogError:
@@ -461,8 +483,62 @@ def read_log(path: str | Path, topics: Topics | None = None) -> HeadLog:
     return HeadLog((images[0], images[1]), joints, tuple(commands), tuple(estimates))
 
 
+@dataclass(frozen=True)
+class Grab:
+    """One image a head took, as recorded: camera 1 or 2, its stamp, the image, its region
+    of interest in the full frame (None: the whole view) and binning (1: none), the
+    joints' positions when it was taken (rad, headsim's names) and the phase under way."""
+
+    camera: int
+    time_s: float
+    image: np.ndarray
+    window: Window | None
+    binning: int
+    positions_rad: Mapping[str, float]
+    phase: str
+
+
+def read_grabs(path: str | Path, topics: Topics | None = None) -> tuple[Grab, ...]:
+    """Every image of a recording in the order taken, windows and previews too, each with
+    its CameraInfo's region of interest and binning and the joint state written before it
+    (a servo's looks, as :class:`~headsim.runs.mcap_run.McapRun` records them)."""
+    topics = topics or Topics()
+    robot_to_ours = {topics.robot_joint(n): n for n in ("neck_yaw", "neck_pitch", "eye", "eye2")}
+    grabs: list[Grab] = []
+    info: list[Any] = [None, None]
+    positions: dict[str, float] = {}
+    phase = ""
+    wanted = (*topics.images, *topics.camera_infos, topics.joint_states, topics.phases)
+    for topic, msg, _ in _messages(Path(path), wanted, in_time_order=False):
+        if topic == topics.phases:
+            phase = str(msg.data)
+        elif topic == topics.joint_states:
+            positions = {
+                robot_to_ours[n]: float(p)
+                for n, p in zip(msg.name, msg.position, strict=False)
+                if n in robot_to_ours
+            }
+        elif topic in topics.camera_infos:
+            info[topics.camera_infos.index(topic)] = msg
+        else:
+            camera = topics.images.index(topic) + 1
+            roi = None if info[camera - 1] is None else info[camera - 1].roi
+            window = (
+                Window(int(roi.x_offset), int(roi.y_offset), int(roi.width), int(roi.height))
+                if roi is not None and roi.width and roi.height
+                else None
+            )
+            binning = 1 if info[camera - 1] is None else max(1, int(info[camera - 1].binning_x))
+            image = _image(msg, topic)
+            grabs.append(
+                Grab(camera, _time(msg.header), image, window, binning, dict(positions), phase)
+            )
+    return tuple(grabs)
+
+
 __all__ = [
     "Command",
+    "Grab",
     "HeadLog",
     "JointTrack",
     "LogError",
@@ -470,5 +546,6 @@ __all__ = [
     "RecordingHead",
     "Topics",
     "believed_head_from_cameras",
+    "read_grabs",
     "read_log",
 ]

@@ -27,7 +27,8 @@ Each stereo pair (Ca1's image with Ca2's nearest in time), with the joints
 interpolated to its time, gives a triangulation of every target found in both
 images (:func:`~headsim.head.stereo_look.estimate_markers`); a target's estimate is
 the median of its pairs'.  With ``--truth`` (a JSON object: name -> [x, y, z] in the
-head frame, m) each estimate is scored.
+head frame, m) each estimate is scored.  results.json is in the run's schema
+(:func:`headsim.runs.serialise.estimate_payload`).
 """
 
 from __future__ import annotations
@@ -209,61 +210,16 @@ def read_truth(path: str | Path) -> dict[str, np.ndarray]:
     return truth
 
 
-def _floats(values: np.ndarray) -> list[float | None]:
-    return [float(v) if math.isfinite(v) else None for v in values]
-
-
-def results_document(
-    log_path: Path,
-    estimates: list[TargetEstimate],
-    pairs: int,
-    truth: Mapping[str, np.ndarray] | None,
-) -> dict[str, Any]:
-    """results.json for an offline estimate: a run's top-level keys that apply, and its
-    measurement fields (name, method, status, estimate/truth/error in H, depth, error %)."""
-    measurements = []
-    for e in estimates:
-        ok = e.pairs > 0
-        true = None if truth is None else truth.get(e.name)
-        error = None if true is None or not ok else e.point_head_m - true
-        depth = float(true[2]) if true is not None else None
-        measurements.append(
-            {
-                "name": e.name,
-                "method": "stereo_triangulation",
-                "status": "ok" if ok else "failed",
-                "failure": None if ok else f"not found in both images of any of {e.seen} pairs",
-                "pairs": e.pairs,
-                "estimate_head_m": _floats(e.point_head_m) if ok else None,
-                "truth_head_m": None if true is None else _floats(true),
-                "error_head_m": None if error is None else _floats(error),
-                "error_m": None if error is None else float(np.linalg.norm(error)),
-                "depth_m": depth,
-                "error_pct_of_depth": None
-                if error is None or not depth
-                else float(100 * np.linalg.norm(error) / depth),
-            }
-        )
-    failures = [f"{m['name']}: {m['failure']}" for m in measurements if m["status"] != "ok"]
-    return {
-        "schema": "headsim-estimate/1",
-        "source": str(log_path),
-        "status": "ok" if not failures else "failed",
-        "failures": failures,
-        "stereo_pairs": pairs,
-        "measurements": measurements,
-    }
-
-
 def estimate_file(
-    log_path: str | Path, mapping_path: str | Path, truth_path: str | Path | None = None
-) -> dict[str, Any]:
-    """``headsim estimate``'s results document for a recording and its mapping."""
+    log_path: str | Path, mapping_path: str | Path
+) -> tuple[LogMapping, list[TargetEstimate], int]:
+    """A recording estimated as its mapping says: the mapping, each target's estimate and
+    the stereo pairs used (``headsim estimate``; results.json is
+    :func:`headsim.runs.serialise.estimate_payload`'s)."""
     mapping = read_mapping(mapping_path)
     log = read_log(log_path, mapping.topics)
-    truth = None if truth_path is None else read_truth(truth_path)
     estimates, pairs = estimate_log(log, mapping)
-    return results_document(Path(log_path), estimates, pairs, truth)
+    return mapping, estimates, pairs
 
 
 __all__ = [
@@ -273,5 +229,4 @@ __all__ = [
     "estimate_log",
     "read_mapping",
     "read_truth",
-    "results_document",
 ]

@@ -1,5 +1,7 @@
-"""The simulator as a :class:`~headsim.head.interface.Head`: :class:`SimHead` over a
-:class:`~headsim.sim.simulator.HeadSim`.
+"""The simulator as a :class:`~headsim.head.interface.Head` and a
+:class:`~headsim.head.servo_head.ServoHead`: :class:`SimHead` over a
+:class:`~headsim.sim.simulator.HeadSim`.  The servo-level calls pass straight to the
+simulator (the same calls in the same order: a run through it is the simulator's run).
 
 Its clock is MuJoCo's time plus what commanded motions and grabs took: a position
 command settles at once (kinematic settling) or by the physics' steps, a velocity
@@ -12,10 +14,14 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
+import numpy as np
+
 from headsim.head.camera_info import CameraInfo, camera_info_of
 from headsim.head.interface import JointReading, StampedImage, StereoFrame
-from headsim.sim.settings import HeadBelief, SettingsError
-from headsim.sim.simulator import HeadSim
+from headsim.sim.events import EventSink
+from headsim.sim.render import Window
+from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
+from headsim.sim.simulator import HeadSim, SettleResult
 
 #: The frame period of :meth:`SimHead.grab_stereo`, s (30 frames a second).
 FRAME_PERIOD_S = 1.0 / 30.0
@@ -26,18 +32,15 @@ class SimHead:
 
     ``camera_infos``: each eye's camera as the head believes it (its calibration);
     default: its cameras' own intrinsics, as a Zhang calibration gives them to within
-    its error.  ``sim.truth`` stays on the simulator, out of this interface.
+    its error, read through the truth channel when first asked for).  :attr:`truth` is
+    the simulator's truth channel, for placing and scoring.
     """
 
     def __init__(
         self, sim: HeadSim, camera_infos: tuple[CameraInfo, CameraInfo] | None = None
     ) -> None:
         self.sim = sim
-        cameras = sim.names.cameras
-        self._camera_infos = camera_infos or (
-            camera_info_of(sim.settings.cameras[0].pinhole(), cameras[0]),
-            camera_info_of(sim.settings.cameras[1].pinhole(), cameras[1]),
-        )
+        self._camera_infos = camera_infos
         self._elapsed_s = 0.0
 
     @property
@@ -54,6 +57,12 @@ class SimHead:
         return self.sim.belief
 
     def camera_infos(self) -> tuple[CameraInfo, CameraInfo]:
+        if self._camera_infos is None:
+            cameras, names = self.sim.truth.settings.cameras, self.sim.names.cameras
+            self._camera_infos = (
+                camera_info_of(cameras[0].pinhole(), names[0]),
+                camera_info_of(cameras[1].pinhole(), names[1]),
+            )
         return self._camera_infos
 
     def now(self) -> float:
@@ -94,13 +103,80 @@ class SimHead:
     def grab_stereo(self) -> StereoFrame:
         """Both eyes' next full images, taken at one instant; then one frame period passes."""
         time_s = self.now()
-        left, right = self._camera_infos
+        left, right = self.camera_infos()
         frame = StereoFrame(
             StampedImage(time_s, self.sim.render(1), left),
             StampedImage(time_s, self.sim.render(2), right),
         )
         self._elapsed_s += FRAME_PERIOD_S
         return frame
+
+    # -- the servo level (ServoHead): the simulator's own calls ------------------------
+    @property
+    def settings(self) -> HeadSettings:
+        return self.sim.settings
+
+    @property
+    def sink(self) -> EventSink:
+        return self.sim.sink
+
+    @property
+    def motors(self) -> tuple[str, ...]:
+        return self.sim.motors
+
+    @property
+    def render_count(self) -> int:
+        return self.sim.render_count
+
+    @property
+    def truth(self) -> HeadSim:
+        return self.sim.truth
+
+    def camera_settings(self, camera: int) -> CameraSettings:
+        return self.sim.camera_settings(camera)
+
+    def joint_range(self, motor: str) -> tuple[float, float]:
+        return self.sim.joint_range(motor)
+
+    def eye_encoder_steps(self) -> int:
+        return self.sim.eye_encoder_steps()
+
+    def encoder_steps(self, motor: str) -> int:
+        return self.sim.encoder_steps(motor)
+
+    def neck_encoders(self) -> tuple[float, float]:
+        return self.sim.neck_encoders()
+
+    def command(
+        self,
+        *,
+        neck_yaw: float | None = None,
+        neck_pitch: float | None = None,
+        eye: float | None = None,
+        eye2: float | None = None,
+    ) -> None:
+        self.sim.command(neck_yaw=neck_yaw, neck_pitch=neck_pitch, eye=eye, eye2=eye2)
+
+    def command_eye_steps(self, steps: int) -> None:
+        self.sim.command_eye_steps(steps)
+
+    def settle(self) -> SettleResult:
+        return self.sim.settle()
+
+    def move(self, **targets: float) -> SettleResult:
+        return self.sim.move(**targets)
+
+    def render(self, camera: int) -> np.ndarray:
+        return self.sim.render(camera)
+
+    def retake(self, camera: int) -> np.ndarray:
+        return self.sim.retake(camera)
+
+    def render_window(self, camera: int, window: Window, retake: bool = False) -> np.ndarray:
+        return self.sim.render_window(camera, window, retake=retake)
+
+    def render_preview(self, camera: int, binning: int) -> np.ndarray:
+        return self.sim.render_preview(camera, binning)
 
 
 __all__ = ["FRAME_PERIOD_S", "SimHead"]

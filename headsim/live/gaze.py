@@ -25,6 +25,7 @@ from headsim.active.look import foveal_detector
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import Detector
+from headsim.head.sim_head import SimHead
 from headsim.live.estimator import GazeEstimator
 from headsim.live.head import Frame, LiveHead
 from headsim.live.motors import MotorDriver, bang_bang_duration, min_jerk_duration
@@ -333,7 +334,8 @@ def acquire(
     at-rest procedures.
     """
     sim = live.sim
-    if servo.sim is not sim:
+    driven = servo.sim.sim if isinstance(servo.sim, SimHead) else servo.sim
+    if driven is not sim:
         raise ValueError("acquire: servo must drive the live head's simulator (live.sim)")
     knowledge = knowledge or HeadKnowledge()
     goals = (knowledge.reference(sim, 1), knowledge.reference(sim, 2))

@@ -14,6 +14,7 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import Model2Config, measure_model2
 from headsim.codec import declared, doc
+from headsim.head.sim_head import SimHead
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import (
     PAPER,
@@ -158,7 +159,7 @@ def measure_chessboard(
     for k in indices:
         corner = chessboard_corner_target(k, pattern, square_m)
         sink.emit(FixationStarted(corner.name))
-        measured[k] = measure_model2(sim, servo, corner, knowledge, config)
+        measured[k] = measure_model2(SimHead(sim), servo, corner, knowledge, config)
         sink.emit(MeasurementDone(measured[k]))
     widths: list[float] = []
     heights: list[float] = []
@@ -220,7 +221,7 @@ def run_chessboard(
         hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
         run = measure_chessboard(
             sim,
-            EyeServo(sim, servo_config(scenario)),
+            EyeServo(SimHead(sim), servo_config(scenario)),
             knowledge,
             model2_config(scenario),
             CHESSBOARD_PATTERN,

@@ -10,12 +10,12 @@ import numpy as np
 
 from headsim.active.events import PhaseStarted
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
-from headsim.runs.context import record_measurement, simulator
+from headsim.head.servo_head import ServoHead
+from headsim.runs.context import head, record_measurement
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord
 from headsim.runs.targets import marker_target
 from headsim.scenario.spec import Scenario
-from headsim.sim.simulator import HeadSim
 
 S = TypeVar("S")
 
@@ -25,8 +25,8 @@ def measure_each_target(
     hub: Hub,
     knowledge: HeadKnowledge,
     passes: Sequence[tuple[HeadKnowledge, str]],
-    servo: Callable[[HeadSim], S],
-    measure: Callable[[HeadSim, S, Target, HeadKnowledge], Measurement],
+    servo: Callable[[ServoHead], S],
+    measure: Callable[[ServoHead, S, Target, HeadKnowledge], Measurement],
 ) -> list[MeasurementRecord]:
     """Each target measured once per pass (what the head knows, its label), in target order.
 
@@ -34,15 +34,15 @@ def measure_each_target(
     servo every measurement shares (its gains carry over); ``measure`` measures a target.
     """
     records = []
-    with simulator(hub, "default", scenario) as sim:
+    with head(hub, "default", scenario) as sim:
         targets = scenario.scene.targets
         truth = {t.name: np.array(t.position_world_m) for t in targets}
-        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
+        hub.emit(PhaseStarted("measurement", sim.truth, knowledge, truth))
         shared = servo(sim)
         for placement in targets:
             for known, known_label in passes:
                 step = hub.begin(placement.name)
-                sim.set_body_pose(placement.body, np.array(placement.position_world_m))
+                sim.truth.set_body_pose(placement.body, np.array(placement.position_world_m))
                 target = marker_target(placement.name, placement.body)
                 m = measure(sim, shared, target, known)
                 records.append(record_measurement(hub, m, known_label, step))

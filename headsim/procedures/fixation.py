@@ -11,6 +11,7 @@ from headsim.active.fixation import fixation_servo, measure_fixation
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.neck_servo import NeckServo
 from headsim.codec import declared
+from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.runs.context import servo_config
@@ -21,7 +22,6 @@ from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
-from headsim.sim.simulator import HeadSim
 
 
 @declared
@@ -36,11 +36,11 @@ def run_fixation(
     interpolate = scenario.experiment.interpolate
 
     def measure(
-        sim: HeadSim, servo: NeckServo, target: Target, known: HeadKnowledge
+        sim: ServoHead, servo: NeckServo, target: Target, known: HeadKnowledge
     ) -> Measurement:
         return measure_fixation(sim, servo, target, known, interpolate)
 
-    def servo(sim: HeadSim) -> NeckServo:
+    def servo(sim: ServoHead) -> NeckServo:
         return fixation_servo(sim, config=servo_config(scenario))
 
     if scenario.scene.surface_targets is not None:

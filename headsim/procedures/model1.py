@@ -8,6 +8,7 @@ from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
 from headsim.codec import declared
+from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.runs.context import servo_config
@@ -18,7 +19,6 @@ from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
-from headsim.sim.simulator import HeadSim
 
 
 @declared
@@ -33,7 +33,7 @@ def run_model1(
     interpolate = scenario.experiment.interpolate
 
     def measure(
-        sim: HeadSim, servo: NeckServo, target: Target, known: HeadKnowledge
+        sim: ServoHead, servo: NeckServo, target: Target, known: HeadKnowledge
     ) -> Measurement:
         return measure_model1(sim, servo, target, known, interpolate)
 

@@ -8,6 +8,7 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model2 import measure_model2
 from headsim.codec import declared
+from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_each_target
 from headsim.runs.context import model2_config, servo_config
@@ -18,7 +19,6 @@ from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
-from headsim.sim.simulator import HeadSim
 
 
 @declared
@@ -32,7 +32,9 @@ def run_model2(
     """Model 2 on each target in turn, one eye servo for all."""
     config = model2_config(scenario)
 
-    def measure(sim: HeadSim, servo: EyeServo, target: Target, known: HeadKnowledge) -> Measurement:
+    def measure(
+        sim: ServoHead, servo: EyeServo, target: Target, known: HeadKnowledge
+    ) -> Measurement:
         return measure_model2(sim, servo, target, known, config)
 
     if scenario.scene.surface_targets is not None:

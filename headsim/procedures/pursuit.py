@@ -33,6 +33,7 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import Detector, ServoConfig
 from headsim.codec import declared, doc
+from headsim.head.sim_head import SimHead
 from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
 from headsim.procedures.contract import Procedure, register
@@ -271,7 +272,9 @@ def run_pursuit(
         )
         # Whole frames, no windows or previews: the acquisition as it has always run (a
         # markerless pair still correlates only its foveal window).
-        estimator = acquire(live, NeckServo(sim, ServoConfig(windows=False)), detector, knowledge)
+        estimator = acquire(
+            live, NeckServo(SimHead(sim), ServoConfig(windows=False)), detector, knowledge
+        )
         if estimator is None:
             return [], PursuitResult(described, failures=(f"{spec.name}: not acquired at rest",))
 

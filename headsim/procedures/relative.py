@@ -21,6 +21,7 @@ from headsim.estimators.areas import (
     areas_from_pixels,
     compare_areas,
 )
+from headsim.head.sim_head import SimHead
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import (
     PAPER,
@@ -253,7 +254,7 @@ def relative_positioning(
     knowledge = knowledge or HeadKnowledge()
     start = sim.render_count
     sink.emit(FixationStarted(reference.name))
-    ref = measure_model2(sim, servo, reference, knowledge, Model2Config(midline_px=0.0))
+    ref = measure_model2(SimHead(sim), servo, reference, knowledge, Model2Config(midline_px=0.0))
     sink.emit(MeasurementDone(ref))
     if not ref.ok:
         return RelativeRun(ref, {}, {}, {}, tuple(objects), None, sim.render_count - start)
@@ -342,7 +343,7 @@ def run_relative(
         cross = cast(Detector, find_cross_point)
         reference = Target(names.BLOCKS, cross, lambda s: s.truth.position(names.BLOCKS))
         run = relative_positioning(
-            sim, EyeServo(sim, servo_config(scenario)), reference, colours, knowledge
+            sim, EyeServo(SimHead(sim), servo_config(scenario)), reference, colours, knowledge
         )  # the reference's fixation is the phase's one step
         (step,) = hub.steps
         positions_head = {o.body: sim.truth.position(o.body, "head") for o in scene.objects}

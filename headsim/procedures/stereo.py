@@ -52,6 +52,7 @@ from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge
 from headsim.codec import declared, doc
 from headsim.geometry.transforms import frame_deviation
+from headsim.head.sim_head import SimHead
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import simulator
 from headsim.runs.events import Hub
@@ -444,7 +445,9 @@ def calibrate(
         np.random.default_rng(seed if spec.board_seed is None else spec.board_seed),
         spec.distance_m,
         spec.max_tilt_rad,
-        look=look_for_board if spec.board_look == "windowed" else None,
+        look=(lambda sim, camera: look_for_board(SimHead(sim), camera))
+        if spec.board_look == "windowed"
+        else None,
     )
     return zhang_calibration(sim, views, spec.refine_intrinsics), views
 
@@ -518,7 +521,11 @@ def run_stereo(
     spec = scenario.experiment.block
     if isinstance(spec, StoredStereoSpec):
         stored = read_stereo_calibration(spec.source)
-        look = look_once if spec.look == "once" else None
+        look = (
+            (lambda sim, camera, detector: look_once(SimHead(sim), camera, detector))
+            if spec.look == "once"
+            else None
+        )
         rows, summary, renders = measure_targets(scenario, hub, knowledge, stored, look)
         return [], StoredStereoResult(spec.source, summary, rows, renders)
     assert isinstance(spec, StereoSpec)

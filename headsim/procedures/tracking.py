@@ -13,6 +13,7 @@ from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
 from headsim.codec import declared, doc
+from headsim.head.sim_head import SimHead
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import (
     record_measurement,
@@ -109,7 +110,7 @@ def track_moving_target(
     for k, t in enumerate(times_s):
         sink.emit(FixationStarted(f"{target.name} {k + 1}"))
         sim.set_body_pose(body, trajectory(float(t)))
-        m = measure_model1(sim, servo, target, knowledge, last_seen=fixations[-2:])
+        m = measure_model1(SimHead(sim), servo, target, knowledge, last_seen=fixations[-2:])
         sink.emit(MeasurementDone(m, float(t)))
         measurements.append(m)
         if m.ok:
@@ -130,7 +131,7 @@ def run_tracking(
         target = marker_target(moving.name, moving.body)
         run = track_moving_target(
             sim,
-            NeckServo(sim, servo_config(scenario)),
+            NeckServo(SimHead(sim), servo_config(scenario)),
             target,
             moving.body,
             moving.position,

@@ -21,6 +21,7 @@ from headsim.active.principal import (
     zoomed,
 )
 from headsim.codec import declared, doc
+from headsim.head.sim_head import SimHead
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import simulator
 from headsim.runs.events import Hub
@@ -148,7 +149,7 @@ def run_zoom_fixed_points(
         hub.emit(PhaseStarted("board views", before, knowledge, {}))
         try:
             run = principal_points_by_zoom(
-                before, after, spec.zoom, np.random.default_rng(seed), spec.poses
+                SimHead(before), SimHead(after), spec.zoom, np.random.default_rng(seed), spec.poses
             )
         except PrincipalPointError as error:
             return [], NotFound(str(error))

@@ -28,11 +28,12 @@ from headsim.active.failure import Failure
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.placement import calibration_layout
 from headsim.estimators.result import Status
+from headsim.head.servo_head import ServoHead
 from headsim.runs.context import (
     PAPER,
     PARKED_WORLD_M,
+    head,
     servo_config,
-    simulator,
     told,
 )
 from headsim.runs.events import CalibrationDone, Hub
@@ -41,7 +42,6 @@ from headsim.scenario.calibration_design import near_far_depths, near_fraction
 from headsim.scenario.spec import STREAM_CALIBRATION, STREAM_DEPTH_NOISE, Scenario
 from headsim.sim import names
 from headsim.sim.events import RenderCounts
-from headsim.sim.simulator import HeadSim
 
 
 def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, CalibrationReport]:
@@ -52,11 +52,11 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
     start = hub.renders  # every image this phase draws is one of its renders
     near_far = spec.layout == "near_far"
     config, known = servo_config(scenario), told(scenario)
-    with simulator(hub, "default", scenario) as sim:
+    with head(hub, "default", scenario) as sim:
         # The ball alone in the scene, as on a bench: the markers where the scene's XML
         # puts them stand among the ball's positions and would hide some of them.
         for marker in names.MARKERS:
-            sim.set_body_pose(marker, np.array(PARKED_WORLD_M))
+            sim.truth.set_body_pose(marker, np.array(PARKED_WORLD_M))
         try:
             depths_m = (
                 near_far_depths(spec.targets, spec.depth_m, spec.near_fraction)
@@ -89,7 +89,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
             hub.emit(CalibrationDone(report))
             return None, report
         truth = {f"calibration {k + 1}": p for k, p in enumerate(positions)}
-        hub.emit(PhaseStarted("calibration", sim, HeadKnowledge(), truth))
+        hub.emit(PhaseStarted("calibration", sim.truth, HeadKnowledge(), truth))
         ball = marker_target(names.CALIBRATION_BALL, names.CALIBRATION_BALL)
         # At the servo's goal columns, as the fit's error is (the image centres by default).
         truth_alpha_e = [
@@ -187,7 +187,7 @@ def position_outcomes(outcomes: Sequence[Failure | None]) -> tuple[PositionOutco
     return tuple(PositionOutcome(o) for o in outcomes)
 
 
-def _lines_fit(run: CalibrationRun, sim: HeadSim) -> LinesOfSightFit:
+def _lines_fit(run: CalibrationRun, sim: ServoHead) -> LinesOfSightFit:
     """The extended line-of-sight fit beside the truth."""
     lines = run.lines
     assert lines is not None

@@ -4,6 +4,8 @@ where unused bodies park, the paper's figures, and each measurement's record."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import asdict
 from typing import Any
 
@@ -11,6 +13,7 @@ from headsim import paper
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import Model2Config
 from headsim.active.servo_types import ServoConfig
+from headsim.head.sim_head import SimHead
 from headsim.runs.events import Hub, MeasurementRecorded
 from headsim.runs.outcomes import FixationScore, MeasurementRecord
 from headsim.scenario.spec import Scenario
@@ -52,6 +55,15 @@ def simulator(hub: Hub, scene: str, scenario: Scenario) -> HeadSim:
     )
 
 
+@contextmanager
+def head(hub: Hub, scene: str, scenario: Scenario) -> Iterator[SimHead]:
+    """The scenario's simulator in ``scene`` as the head the servos and procedures drive
+    (:class:`~headsim.head.servo_head.ServoHead`; its truth channel for placing and
+    scoring), reporting to ``hub``; closed on leaving."""
+    with simulator(hub, scene, scenario) as sim:
+        yield SimHead(sim)
+
+
 def told(scenario: Scenario) -> HeadKnowledge:
     """What the scenario tells the head before any calibration: its goal columns, if given."""
     goals = scenario.experiment.goal_columns_px
@@ -74,6 +86,7 @@ def record_measurement(
 __all__ = [
     "PAPER",
     "PARKED_WORLD_M",
+    "head",
     "model2_config",
     "record_measurement",
     "servo_config",

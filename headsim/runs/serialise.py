@@ -11,6 +11,7 @@ The ``calibration`` block, which a calibration file (head.json) holds too, is a
 from __future__ import annotations
 
 import platform
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from importlib import metadata
 from typing import Any
@@ -20,14 +21,16 @@ import mujoco
 import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
-from headsim.active.failure import Failure
+from headsim.active.failure import Failure, FailureCause
+from headsim.active.measurement import Measurement
 from headsim.codec import declared, describe, doc, encode, keys
-from headsim.estimators.result import Method
+from headsim.estimators.result import Method, Status
+from headsim.head.offline import TargetEstimate
 from headsim.runs.accuracy import MeasurementSummary, summaries
 from headsim.runs.outcomes import FixationScore, MeasurementRecord, RunOutcome, RunRenders
 from headsim.scenario.spec import experiment_record
 from headsim.sim.events import RenderCounts
-from headsim.sim.settings import settings_record
+from headsim.sim.settings import HeadBelief, settings_record
 from headsim.version import __version__
 
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
@@ -63,7 +66,9 @@ class MeasurementEntry:
     name: str = doc(
         "the target (`corner_i_j` for chessboard corners, `blocks` for the cross point)"
     )
-    method: Method = doc("`model2`, `model1` or `fixation`")
+    method: Method = doc(
+        "`model2`, `model1`, `fixation`, or `stereo_triangulation` (`headsim estimate`)"
+    )
     status: str = doc(
         '`"ok"`, or why it failed (`"Ca2 at step 1: target lost (and at 12 eye angles searched)"`, ...)'
     )
@@ -301,6 +306,103 @@ def results_document(result: RunOutcome) -> ResultsDocument:
     )
 
 
+# -- an offline estimate's (``headsim estimate``) ----------------------------------------
+
+
+@declared
+class EstimateDocument:
+    """results.json of ``headsim estimate``: the run's keys that a recording has, in the
+    run's order (``source`` in place of ``scenario``), its measurements the run's entries."""
+
+    schema: str = doc("the run's schema (`results.json`'s `schema`)")
+    source: str = doc("the recording estimated from")
+    status: str = doc('`"ok"` or `"failed"`')
+    failures: tuple[str, ...] = doc("one line per target not found in both images of any pair")
+    software: dict[str, str] = doc(
+        "versions of headsim, Python, MuJoCo, NumPy, SciPy, OpenCV, rerun-sdk"
+    )
+    belief: dict[str, Any] = doc(
+        "what the mapping's `[head]` says the head is (`baseline_m`, `neck_d1_m`, `neck_a2_m`, `nodal_offset_m`, `side_offset_m`), and `alpha_e_rad`, each eye's initial direction"
+    )
+    stereo_pairs: int = doc("Ca1's images, each paired with Ca2's nearest in time")
+    measurements: tuple[MeasurementEntry, ...] = doc(
+        "one entry per target of the mapping, in order: the median of its pairs' triangulations "
+        "(`details.pairs`: how many; `details.seen`: pairs it was looked for in); truth and "
+        "errors only with `--truth` (in H; nothing in W: a recording has no world)"
+    )
+    summary: dict[str, MeasurementSummary] = doc(
+        "the measurements' statistics, per knowledge",
+        each='one knowledge (`"none"`; `"calibrated"`: the mapping gives initial directions)',
+    )
+
+
+def estimate_records(
+    estimates: Sequence[TargetEstimate],
+    truth: Mapping[str, np.ndarray] | None,
+    calibrated: bool,
+) -> list[MeasurementRecord]:
+    """Each target's offline estimate as a run's measurement record (truth in H, if given)."""
+    records = []
+    nan3 = np.full(3, np.nan)
+    for step, e in enumerate(estimates):
+        ok = e.pairs > 0
+        failure = (
+            None
+            if ok
+            else Failure(
+                FailureCause.LOST, "estimate", None, f"not in both images of any of {e.seen} pairs"
+            )
+        )
+        true = None if truth is None else truth.get(e.name)
+        m = Measurement(
+            name=e.name,
+            method=Method.STEREO_TRIANGULATION,
+            status=Status.OK if ok else Status.FAILED,
+            estimate_head_m=e.point_head_m if ok else nan3,
+            truth_head_m=nan3 if true is None else np.asarray(true, dtype=float),
+            estimate_world_m=nan3,
+            truth_world_m=nan3,
+            covariance_head_m2=np.full((3, 3), np.nan),
+            renders=0,
+            servo_residual_px=(),
+            details={"pairs": float(e.pairs), "seen": float(e.seen)},
+            failure=failure,
+            detail="" if failure is None else failure.message,
+        )
+        records.append(MeasurementRecord(m, "calibrated" if calibrated else "none", step))
+    return records
+
+
+def estimate_payload(
+    source: str,
+    estimates: Sequence[TargetEstimate],
+    pairs: int,
+    belief: HeadBelief,
+    alpha_e_rad: tuple[float, float],
+    truth: Mapping[str, np.ndarray] | None = None,
+) -> dict[str, Any]:
+    """``headsim estimate``'s results.json (plain data) for a recording's estimates."""
+    records = estimate_records(estimates, truth, alpha_e_rad != (0.0, 0.0))
+    failures = tuple(
+        f"{r.measurement.name}: {r.measurement.status_text}"
+        for r in records
+        if not r.measurement.ok
+    )
+    document = EstimateDocument(
+        schema=RESULTS_SCHEMA,
+        source=source,
+        status="ok" if not failures else "failed",
+        failures=failures,
+        software=software_versions(),
+        belief={**asdict(belief), "alpha_e_rad": list(alpha_e_rad)},
+        stereo_pairs=pairs,
+        measurements=tuple(MeasurementEntry.of(r) for r in records),
+        summary=summaries(records),
+    )
+    payload: dict[str, Any] = encode(document)
+    return payload
+
+
 def results_payload(result: RunOutcome) -> dict[str, Any]:
     """The results.json document (plain data; :func:`headsim.files.write_json_atomic` writes it)."""
     payload: dict[str, Any] = encode(results_document(result))
@@ -311,9 +413,12 @@ __all__ = [
     "MEASUREMENT_KEYS",
     "RESULTS_KEYS",
     "RESULTS_SCHEMA",
+    "EstimateDocument",
     "MeasurementEntry",
     "ResultsDocument",
     "ScenarioRecord",
+    "estimate_payload",
+    "estimate_records",
     "experiment_block",
     "results_document",
     "results_payload",

@@ -26,6 +26,8 @@ import numpy as np
 from headsim.active.events import Detected, PhaseStarted
 from headsim.active.markerless import MarkerlessPair
 from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.head.servo_head import ServoHead
+from headsim.head.sim_head import SimHead
 from headsim.runs.context import PARKED_WORLD_M, record_measurement, simulator
 from headsim.runs.events import Hub, Stamp
 from headsim.runs.landing import Landing, fixation_error, landing, vergence_error_deg
@@ -276,8 +278,8 @@ def measure_surface_targets(
     hub: Hub,
     knowledge: HeadKnowledge,
     label: str,
-    servo: Callable[[HeadSim], S],
-    measure: Callable[[HeadSim, S, Target, HeadKnowledge], Measurement],
+    servo: Callable[[ServoHead], S],
+    measure: Callable[[ServoHead, S, Target, HeadKnowledge], Measurement],
     both_views: bool = False,
 ) -> tuple[list[MeasurementRecord], SurfaceDraw]:
     """Each of ``[scene.room] targets`` measured in turn from the start pose: listed or
@@ -311,7 +313,8 @@ def measure_surface_targets(
         log = LandingLog(sim, goal_u)
         hub.subscribers.append(log)
         try:
-            shared = servo(sim)
+            head = SimHead(sim)  # what the servo and the measurement drive
+            shared = servo(head)
             clicks = np.random.default_rng([scenario.seed, STREAM_CLICKS])
             band_for = row_band_for(knowledge, sim, spec.band_px)
             for placed, marker_at in zip(drawn.targets, markers_at, strict=True):
@@ -341,7 +344,7 @@ def measure_surface_targets(
                 # Depth at the start pose (a failure leaves the head wherever it gave up).
                 truth_head = sim.truth.transform_points(where, "world", "head")[0]
                 depth = float(truth_head[2])
-                m = measure(sim, shared, target, knowledge)
+                m = measure(head, shared, target, knowledge)
                 if not m.ok:
                     m = replace(m, truth_head_m=truth_head)
                 match = None
@@ -415,8 +418,8 @@ def _clicked_point(sim: HeadSim, told: Click, placed: SurfaceTarget) -> Callable
     return lambda: point_world(sim, hit.body, local)
 
 
-def _true_point(placed: SurfaceTarget) -> Callable[[HeadSim], np.ndarray]:
-    return lambda sim: point_world(sim, placed.body, placed.point_body_m)
+def _true_point(placed: SurfaceTarget) -> Callable[[ServoHead], np.ndarray]:
+    return lambda head: point_world(head.truth, placed.body, placed.point_body_m)
 
 
 def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int, both_views: bool) -> SurfaceDraw:

@@ -10,7 +10,14 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
+from headsim.codec import keys
 from headsim.head.offline import estimate_file
+from headsim.runs.serialise import (
+    MEASUREMENT_KEYS,
+    RESULTS_SCHEMA,
+    EstimateDocument,
+    ResultsDocument,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLE = ROOT / "examples" / "recording"
@@ -36,10 +43,18 @@ def test_the_shipped_recording_is_estimated_and_scored(
     assert main(_estimate(tmp_path, "--truth", str(SAMPLE / "truth.json"))) == 0
     document = json.loads((tmp_path / "out" / "results.json").read_text())
     assert document["status"] == "ok" and document["stereo_pairs"] == 4
+    # the run's schema: its keys where a recording has them, its measurement entries
+    assert document["schema"] == RESULTS_SCHEMA
+    assert tuple(document) == keys(EstimateDocument)
+    assert [k for k in keys(ResultsDocument) if k in document] == [
+        k for k in document if k in keys(ResultsDocument)
+    ]
+    assert set(document["summary"]) == {"calibrated"}
     names = [m["name"] for m in document["measurements"]]
     assert names == ["marker_red", "marker_green", "marker_blue"]
     for m in document["measurements"]:
-        assert m["pairs"] == 4
+        assert list(m) == list(MEASUREMENT_KEYS)
+        assert m["method"] == "stereo_triangulation" and m["details"]["pairs"] == 4
         # the paper's cameras, no noise, a calibration exact to the mount yaws: sub-mm
         assert m["error_m"] < 0.0005, m
     assert "error" in capsys.readouterr().out
@@ -54,9 +69,11 @@ def test_the_shipped_recording_is_what_the_tool_makes(tmp_path: Path) -> None:
     made = sample.make(tmp_path / "made")
     assert (made / "mapping.toml").read_text() == (SAMPLE / "mapping.toml").read_text()
     assert (made / "truth.json").read_text() == (SAMPLE / "truth.json").read_text()
-    ours = estimate_file(made / "markers.mcap", made / "mapping.toml")["measurements"]
-    shipped = estimate_file(SAMPLE / "markers.mcap", SAMPLE / "mapping.toml")["measurements"]
-    assert ours == shipped
+    _, ours, _ = estimate_file(made / "markers.mcap", made / "mapping.toml")
+    _, shipped, _ = estimate_file(SAMPLE / "markers.mcap", SAMPLE / "mapping.toml")
+    assert [(e.name, e.point_head_m.tolist(), e.pairs) for e in ours] == [
+        (e.name, e.point_head_m.tolist(), e.pairs) for e in shipped
+    ]
 
 
 @pytest.mark.fast

@@ -73,7 +73,7 @@ def _full_report() -> CalibrationReport:
 
 
 def test_the_enums_write_the_strings_results_json_always_had() -> None:
-    assert [m.value for m in Method] == ["model1", "model2", "fixation"]
+    assert [m.value for m in Method] == ["model1", "model2", "fixation", "stereo_triangulation"]
     assert [s.value for s in Status] == ["ok", "failed"]
     assert to_jsonable([Method.MODEL1, Status.FAILED]) == ["model1", "failed"]
 
