@@ -1,5 +1,6 @@
 """The campaigns' one catalogue of experiments: the study's (the Tables V/VI comparison and
-the sweeps as conditions, running one, the comparison's done-when ratios) and what
+the sweeps, described in ``study_experiments.toml`` and made into conditions here, running
+one, the comparison's done-when ratios) and what
 ``headsim reproduce`` runs (its scenario jobs, Tables V/VI, the realistic board, each
 job's cost in render-times, and an experiment's outcome).  The bench's paper scenarios
 are reproduce's (:data:`SCENARIO_JOBS`)."""
@@ -7,28 +8,27 @@ are reproduce's (:data:`SCENARIO_JOBS`)."""
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+import tomllib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from headsim.active.principal import zoomed
 from headsim.errors import BadInput
 from headsim.runs.progress import Progress, quiet
 from headsim.sim.settings import HeadSettings, preset
 from headsim.studies.calibrations import CalibrationCache, Calibrations
 from headsim.studies.conditions import Condition, ConditionResult, run_conditions
 from headsim.studies.head_changes import (
-    CHANGES,
+    HEAD_CHANGES,
+    HeadChange,
     centred,
     image_centre_directions,
-    k1_changed,
-    principal_shifted,
-    with_encoder,
-    with_noise,
 )
 from headsim.studies.methods import METHODS, SWEEP_METHODS, StudyConfig
+from headsim.studies.sweep_spec import SweepError
 from headsim.studies.target_errors import Summary
 from headsim.studies.targets import depth_targets, table_targets
 
@@ -52,96 +52,149 @@ class Experiment:
     log_x: bool = False
 
 
-def compare_experiment(config: StudyConfig) -> Experiment:
-    """Tables V/VI and the changes after calibration, on the preset and on it with centred principal points."""
-    head = preset(config.preset, seed=config.seed)
-    targets = table_targets(config.table_targets)
-    base = {config.preset: head, f"{config.preset} with centred principal points": centred(head)}
-    changes = CHANGES if not config.fast else dict(list(CHANGES.items())[:1])
-    conditions = []
-    for group, settings in base.items():
-        conditions.append(Condition(group, "as calibrated", 0.0, settings, "kept", targets))
-        for label, (value, change) in changes.items():
-            conditions.append(Condition(group, label, value, change(settings), "kept", targets))
-    return Experiment(
-        name="compare",
-        title="Tables V/VI, then the cameras change after calibration",
-        kind="compare",
-        parameter="condition",
-        base=base,
-        conditions=tuple(conditions),
-        methods=METHODS,
-    )
-
-
 @dataclass(frozen=True)
 class Sweep:
-    """One sweep: values, how each changes the head, and the calibration modes.
+    """One sweep: values, how each changes the head, the calibration modes, the targets.
 
-    ``change(head, value)``: the head at that value; ``modes``: "kept"
-    (calibrated on the preset, changed after) and/or "redone".
+    ``change(head, value)``: the head at that value; ``modes``: "kept" (calibrated on the
+    preset, changed after) and/or "redone"; ``targets``: "table" or "depth".
     """
 
     name: str
     parameter: str
     values: tuple[float, ...]
     fast_values: tuple[float, ...]
-    change: Callable[[HeadSettings, float], HeadSettings]
+    change: HeadChange
     modes: tuple[str, ...]
     log_x: bool = False
+    targets: str = "table"
+    methods: tuple[str, ...] = SWEEP_METHODS
 
 
-SWEEPS: dict[str, Sweep] = {
-    "depth": Sweep(
-        "depth",
-        "target depth z_h, m",
-        (0.3, 0.45, 0.6, 0.8, 1.0, 1.25, 1.5, 2.0),
-        (0.4, 1.5),
-        lambda head, _: head,
-        ("kept",),
-    ),
-    "focal": Sweep(
-        "focal",
-        "focal length / calibrated focal length",
-        (0.7, 0.85, 1.0, 1.2, 1.5),
-        (1.0, 1.5),
-        zoomed,
-        ("kept", "redone"),
-    ),
-    "principal": Sweep(
-        "principal",
-        "principal point shift, px (Ca1 u +, Ca2 u -, both v +)",
-        (-10.0, -5.0, -2.0, 0.0, 2.0, 5.0, 10.0),
-        (0.0, 5.0),
-        principal_shifted,
-        ("kept", "redone"),
-    ),
-    "k1": Sweep(
-        "k1",
-        "change of k1 (both cameras)",
-        (-0.1, -0.05, 0.0, 0.05, 0.1, 0.2),
-        (0.0, 0.1),
-        k1_changed,
-        ("kept", "redone"),
-    ),
-    "noise": Sweep(
-        "noise",
-        "image noise, grey levels (std)",
-        (0.0, 2.0, 4.0, 8.0),
-        (0.0, 4.0),
-        with_noise,
-        ("redone",),
-    ),
-    "encoder": Sweep(
-        "encoder",
-        "eye encoder, steps per turn",
-        (3200.0, 6400.0, 12800.0, 25600.0, 102400.0),
-        (6400.0, 25600.0),
-        with_encoder,
-        ("redone",),
-        log_x=True,
-    ),
+@dataclass(frozen=True)
+class Change:
+    """One change after calibration of the comparison: its label, x value and hook."""
+
+    label: str
+    value: float
+    change: HeadChange
+
+
+@dataclass(frozen=True)
+class StudyExperiments:
+    """A checked study experiment file: the comparison's title and changes, the sweeps."""
+
+    compare_title: str
+    changes: tuple[Change, ...]
+    sweeps: dict[str, Sweep]
+
+
+#: The study's experiments, as a file.
+STUDY_FILE = Path(__file__).with_name("study_experiments.toml")
+_SWEEP_KEYS = {
+    "parameter",
+    "values",
+    "fast_values",
+    "change",
+    "modes",
+    "log_x",
+    "targets",
+    "methods",
 }
+_CHOICES = {"modes": ("kept", "redone"), "targets": ("table", "depth"), "methods": ("sweep", "all")}
+
+
+def _take(
+    source: str, where: str, table: dict[str, Any], key: str, kind: type, default: Any = None
+) -> Any:
+    """``table[key]`` (or ``default``): a ``kind`` or a non-empty list of them (for a list
+    ``kind``, the list itself), one of the allowed names where the key has a choice."""
+    value = table.get(key, default)
+    if value is None:
+        raise SweepError(source, f"{where}.{key}", "is missing")
+    items = value if isinstance(value, list) and kind is not list else [value]
+    if not items or not all(isinstance(v, kind) for v in items):
+        raise SweepError(source, f"{where}.{key}", f"must be {kind.__name__}, got {value!r}")
+    allowed = HEAD_CHANGES if key == "change" else _CHOICES.get(key)
+    if allowed is not None and not set(items) <= set(allowed):
+        raise SweepError(source, f"{where}.{key}", f"unknown {value!r}", ", ".join(allowed))
+    return value
+
+
+def _floats(source: str, where: str, table: dict[str, Any], key: str) -> tuple[float, ...]:
+    """``table[key]``: a number or a non-empty list of numbers, as floats."""
+    value = table.get(key)
+    items: list[Any] = value if isinstance(value, list) else [value]
+    if not items or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in items):
+        raise SweepError(source, f"{where}.{key}", f"must be numbers, got {value!r}")
+    return tuple(float(v) for v in items)
+
+
+def read_study_experiments(path: Path = STUDY_FILE) -> StudyExperiments:
+    """Read and check a study experiment file (:class:`SweepError` naming the field)."""
+    source = str(path)
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    compare = data.get("compare", {})
+    changes = tuple(
+        Change(
+            _take(source, f"compare.changes[{i}]", entry, "label", str),
+            _floats(source, f"compare.changes[{i}]", entry, "value")[0],
+            HEAD_CHANGES[_take(source, f"compare.changes[{i}]", entry, "change", str)],
+        )
+        for i, entry in enumerate(_take(source, "compare", compare, "changes", list))
+    )
+    sweeps = {}
+    for name, table in data.get("sweep", {}).items():
+        where = f"sweep.{name}"
+        unknown = set(table) - _SWEEP_KEYS
+        if unknown:
+            raise SweepError(
+                source,
+                f"{where}.{min(unknown)}",
+                "unknown key",
+                ", ".join(sorted(_SWEEP_KEYS)),
+            )
+        methods = _take(source, where, table, "methods", str, "sweep")
+        sweeps[name] = Sweep(
+            name=name,
+            parameter=_take(source, where, table, "parameter", str),
+            values=_floats(source, where, table, "values"),
+            fast_values=_floats(source, where, table, "fast_values"),
+            change=HEAD_CHANGES[_take(source, where, table, "change", str)],
+            modes=tuple(_take(source, where, table, "modes", str)),
+            log_x=_take(source, where, table, "log_x", bool, False),
+            targets=_take(source, where, table, "targets", str, "table"),
+            methods=METHODS if methods == "all" else SWEEP_METHODS,
+        )
+    return StudyExperiments(_take(source, "compare", compare, "title", str), changes, sweeps)
+
+
+STUDY = read_study_experiments()
+SWEEPS: dict[str, Sweep] = STUDY.sweeps
+
+
+def compare_experiment(config: StudyConfig) -> Experiment:
+    """Tables V/VI and the changes after calibration, on the preset and on it with centred principal points."""
+    head = preset(config.preset, seed=config.seed)
+    targets = table_targets(config.table_targets)
+    base = {config.preset: head, f"{config.preset} with centred principal points": centred(head)}
+    changes = STUDY.changes[:1] if config.fast else STUDY.changes
+    conditions = []
+    for group, settings in base.items():
+        conditions.append(Condition(group, "as calibrated", 0.0, settings, "kept", targets))
+        for c in changes:
+            conditions.append(
+                Condition(group, c.label, c.value, c.change(settings, c.value), "kept", targets)
+            )
+    return Experiment(
+        name="compare",
+        title=STUDY.compare_title,
+        kind="compare",
+        parameter="condition",
+        base=base,
+        conditions=tuple(conditions),
+        methods=METHODS,
+    )
 
 
 def sweep_experiment(name: str, config: StudyConfig) -> Experiment:
@@ -154,7 +207,7 @@ def sweep_experiment(name: str, config: StudyConfig) -> Experiment:
     rng = np.random.default_rng(config.seed + 10)
     conditions = []
     for value in values:
-        if name == "depth":
+        if sweep.targets == "depth":
             targets = depth_targets(head, value, config.targets_per_depth, rng)
         else:
             targets = table_targets(config.table_targets)
@@ -168,7 +221,7 @@ def sweep_experiment(name: str, config: StudyConfig) -> Experiment:
         parameter=sweep.parameter,
         base={config.preset: head},
         conditions=tuple(conditions),
-        methods=METHODS if name == "principal" else SWEEP_METHODS,
+        methods=sweep.methods,
         log_x=sweep.log_x,
     )
 

@@ -1,23 +1,29 @@
-"""The campaigns' catalogue (studies/catalogue.py): the study's comparison figures are
-ratios of RMS errors; reproduce's experiments run shipped scenarios and each has a cost."""
+"""The campaigns' catalogue (studies/catalogue.py): the study's experiment file is read
+into hooks and refused naming the field; the comparison figures are ratios of RMS errors;
+reproduce's experiments run shipped scenarios and each has a cost."""
 
 from __future__ import annotations
 
 import pytest
 
+from headsim.active.principal import zoomed
 from headsim.errors import BadInput, ExitCode
 from headsim.scenario.loading import scenario_files
 from headsim.studies import head_changes
 from headsim.studies.catalogue import (
     COSTS,
     SCENARIO_JOBS,
+    STUDY,
     STUDY_JOB,
+    SWEEPS,
     TABLES_HEAD,
     JobOutcome,
     ReproduceError,
     compare_experiment,
+    read_study_experiments,
 )
-from headsim.studies.methods import METHODS, StudyConfig
+from headsim.studies.methods import METHODS, SWEEP_METHODS, StudyConfig
+from headsim.studies.sweep_spec import SweepError
 
 CONFIG = StudyConfig.quick()
 
@@ -30,6 +36,62 @@ def test_the_comparison_figures_are_ratios_of_rms_errors(calibrations) -> None:
     # Two heads only differ in their principal points.
     paper, centred = experiment.base.values()
     assert centred == head_changes.centred(paper)
+
+
+@pytest.mark.fast
+def test_the_study_file_names_its_hooks_and_choices() -> None:
+    assert list(SWEEPS) == ["depth", "focal", "principal", "k1", "noise", "encoder"]
+    assert SWEEPS["focal"].change is zoomed and SWEEPS["focal"].modes == ("kept", "redone")
+    assert SWEEPS["depth"].targets == "depth" and SWEEPS["k1"].targets == "table"
+    assert SWEEPS["principal"].methods == METHODS and SWEEPS["noise"].methods == SWEEP_METHODS
+    assert SWEEPS["encoder"].log_x and SWEEPS["depth"].fast_values == (0.4, 1.5)
+    assert [c.label for c in STUDY.changes][:1] == ["zoom 1.5x"]
+    assert all(c.change in head_changes.HEAD_CHANGES.values() for c in STUDY.changes)
+
+
+_GOOD_SWEEP = """
+[compare]
+title = "t"
+changes = [{ label = "z", value = 1, change = "zoom" }]
+[sweep.s]
+parameter = "p"
+values = [1, 2.5]
+fast_values = [1]
+change = "zoom"
+modes = ["kept"]
+"""
+
+
+@pytest.mark.fast
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (
+            ('zoom"\nmodes', 'nope"\nmodes'),
+            r"sweep\.s\.change: unknown 'nope' \(allowed: zoom, none,",
+        ),
+        (
+            ('["kept"]', '["later"]'),
+            r"sweep\.s\.modes: unknown \['later'\] \(allowed: kept, redone\)",
+        ),
+        (("values = [1, 2.5]", "values = []"), r"sweep\.s\.values: must be numbers, got \[\]"),
+        (('parameter = "p"', "parameter = 3"), r"sweep\.s\.parameter: must be str, got 3"),
+        (('title = "t"', 'titel = "t"'), r"compare\.title: is missing"),
+        (
+            ("modes = [", "colour = 1\nmodes = ["),
+            r"sweep\.s\.colour: unknown key \(allowed: change,",
+        ),
+    ],
+)
+def test_a_bad_study_file_is_refused_naming_the_field(tmp_path, edit, message) -> None:
+    path = tmp_path / "study.toml"
+    path.write_text(_GOOD_SWEEP)
+    good = read_study_experiments(path)
+    assert good.sweeps["s"].values == (1.0, 2.5) and good.changes[0].value == 1.0
+    path.write_text(_GOOD_SWEEP.replace(*edit))
+    with pytest.raises(SweepError, match=f"^{path}: " + message) as refused:
+        read_study_experiments(path)
+    assert refused.value.exit_code == ExitCode.BAD_INPUT
 
 
 @pytest.mark.fast
