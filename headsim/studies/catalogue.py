@@ -1,8 +1,8 @@
 """The campaigns' one catalogue of experiments: the study's (the Tables V/VI comparison and
 the sweeps, described in ``study_experiments.toml`` and made into conditions here, running
-one, the comparison's done-when ratios) and what
-``headsim reproduce`` runs (its scenario jobs, Tables V/VI, the realistic board, each
-job's cost in render-times, and an experiment's outcome).  The bench's paper scenarios
+one, the comparison's done-when ratios) and what ``headsim reproduce`` runs (its jobs,
+described in ``reproduce_experiments.toml``: their hooks, order and cost in render-times;
+Tables V/VI's scope and an experiment's outcome).  The bench's paper scenarios
 are reproduce's (:data:`SCENARIO_JOBS`)."""
 
 from __future__ import annotations
@@ -310,15 +310,69 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
 
 # -- headsim reproduce ---------------------------------------------------------------
 
-#: The scenarios run with the one calibration, and what each reproduces.
+
+@dataclass(frozen=True)
+class ReproduceJob:
+    """One job of ``headsim reproduce`` as its file describes it: the hook that runs it, the
+    jobs it comes after, its cost in render-times and, for a scenario job, the scenario, its
+    overrides and what it reproduces."""
+
+    name: str
+    hook: str
+    after: tuple[str, ...]
+    cost: float
+    scenario: str = ""
+    overrides: dict[str, Any] = field(default_factory=dict)
+    reproduces: str = ""
+
+
+@dataclass(frozen=True)
+class ReproduceExperiments:
+    """A checked reproduce experiment file: its jobs in planned order, a sweep's cost."""
+
+    jobs: dict[str, ReproduceJob]
+    sweep_cost: float
+
+
+#: Reproduce's experiments, as a file.
+REPRODUCE_FILE = Path(__file__).with_name("reproduce_experiments.toml")
+_JOB_KEYS = ("hook", "after", "cost", "scenario", "overrides", "reproduces")
+
+
+def read_reproduce_experiments(path: Path = REPRODUCE_FILE) -> ReproduceExperiments:
+    """Read and check a reproduce experiment file (:class:`SweepError` naming the field); a
+    job comes after jobs planned before it."""
+    source = str(path)
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    jobs: dict[str, ReproduceJob] = {}
+    for name, table in data.get("job", {}).items():
+        where = f"job.{name}"
+        unknown = set(table) - set(_JOB_KEYS)
+        if unknown:
+            raise SweepError(source, f"{where}.{min(unknown)}", "unknown key", ", ".join(_JOB_KEYS))
+        after = tuple(table.get("after", ()))
+        if not set(after) <= set(jobs):
+            raise SweepError(
+                source, f"{where}.after", f"{list(after)!r} names no earlier job", ", ".join(jobs)
+            )
+        scenario = _take(source, where, table, "scenario", str, "")
+        overrides = _take(source, where, table, "overrides", dict, {})
+        jobs[name] = ReproduceJob(
+            name=name,
+            hook=_take(source, where, table, "hook", str),
+            after=after,
+            cost=_floats(source, where, table, "cost")[0],
+            scenario=scenario,
+            overrides=overrides,
+            reproduces=_take(source, where, table, "reproduces", str, ""),
+        )
+    return ReproduceExperiments(jobs, _floats(source, "", data, "sweep_cost")[0])
+
+
+REPRODUCE = read_reproduce_experiments()
+#: The scenario jobs that reproduce a part of the paper: name -> (scenario, what).
 SCENARIO_JOBS = {
-    "initial_directions": ("calibration", "Sec. V, Fig. 8: initial directions"),
-    "chessboard": ("chessboard", "Sec. VI-A, Tables III-IV, Fig. 10: chessboard"),
-    "relative_positioning": (
-        "relative_positioning",
-        "Sec. VI-C, Table VII, Fig. 12: relative positioning",
-    ),
-    "tracking": ("tracking", "Tracking with the neck (Model 1), beyond the paper"),
+    name: (job.scenario, job.reproduces) for name, job in REPRODUCE.jobs.items() if job.reproduces
 }
 STUDY_JOB = "tables_v_vi"
 #: What the Tables V/VI experiment measures here, and what it leaves to the study.
@@ -338,8 +392,7 @@ TABLES_SCOPE = (
 FIXED_POINT_TARGETS = 30
 #: The scenario whose head (and calibration) every experiment uses.
 TABLES_HEAD = "calibration"
-#: The job that measures the same board on the realistic preset (real tolerances), with the
-#: chessboard scenario's own calibration: beside the paper preset, whose mechanics are ideal.
+#: The job that measures the board on the realistic preset, beside the paper preset's.
 REALISTIC_BOARD_JOB = "chessboard_realistic"
 
 
@@ -358,20 +411,6 @@ class JobOutcome:
     error: str = ""
 
 
-#: What each job costs, in 640x480 render-times at full size (its CPU time over the
-#: run's render, medians of 3 runs of ``headsim reproduce --workers 2`` on this
-#: machine, Dec 2026): the scheduler starts the ready job with the longest path to the
-#: end first.  Sweeps are the longest.
-COSTS = {
-    "calibration": 185.0,
-    "zhang": 120.0,
-    "fixed_point": 130.0,
-    "initial_directions": 12.0,
-    "chessboard": 140.0,
-    # Its CPU time 1.8x the chessboard job's (one run, Dec 2026), scaled from that job's cost.
-    REALISTIC_BOARD_JOB: 250.0,
-    "relative_positioning": 45.0,
-    "tracking": 50.0,
-    STUDY_JOB: 80.0,
-}
-SWEEP_COST = 1000.0
+#: What each job costs, in render-times (the file's ``cost``).
+COSTS = {name: job.cost for name, job in REPRODUCE.jobs.items()}
+SWEEP_COST = REPRODUCE.sweep_cost

@@ -45,11 +45,8 @@ from headsim.errors import OutputNotWritable
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.runs.progress import Status, quiet
 from headsim.studies.catalogue import (
-    COSTS,
-    REALISTIC_BOARD_JOB,
-    SCENARIO_JOBS,
+    REPRODUCE,
     STUDY_JOB,
-    SWEEP_COST,
     JobOutcome,
     ReproduceError,
 )
@@ -62,16 +59,7 @@ from headsim.studies.jobs import (
     terminate_children,
 )
 from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
-from headsim.studies.reproduce_jobs import (
-    WORKER_MODULES,
-    calibrate_job,
-    fixed_point_job,
-    realistic_board_job,
-    scenario_job,
-    study_job,
-    tables_job,
-    zhang_job,
-)
+from headsim.studies.reproduce_jobs import JOB_HOOKS, WORKER_MODULES, study_job
 from headsim.studies.reproduce_report import main_figure, report_sections, report_text
 
 
@@ -185,63 +173,23 @@ def reproduce(
         threading.Thread(
             target=importlib.import_module, args=("headsim.studies.plots",), daemon=True
         ).start()
-        path = str(out)
-        head = lambda done: done["calibration"]["path"]  # noqa: E731
+        path, sweep_cost = str(out), REPRODUCE.sweep_cost
+
+        def args(done: dict[str, Any], name: str, after: tuple[str, ...]) -> tuple[Any, ...]:
+            return (name, path, fast, seed, {job: done[job] for job in after})
+
         plan = [
             PlannedJob(
-                "calibration",
-                calibrate_job,
-                (),
-                lambda done: (path, fast, seed),
-                COSTS["calibration"],
-            ),
-            PlannedJob("zhang", zhang_job, (), lambda done: (fast, seed), COSTS["zhang"]),
-            PlannedJob(
-                "fixed_point", fixed_point_job, (), lambda done: (fast, seed), COSTS["fixed_point"]
-            ),
-            PlannedJob(
-                REALISTIC_BOARD_JOB,
-                realistic_board_job,
-                (),
-                lambda done: (path, fast, seed),
-                COSTS[REALISTIC_BOARD_JOB],
-            ),
-            *(
-                PlannedJob(
-                    name,
-                    scenario_job,
-                    ("calibration",),
-                    functools.partial(
-                        lambda done, name: (name, path, fast, seed, head(done)), name=name
-                    ),
-                    COSTS[name],
-                )
-                for name in SCENARIO_JOBS
-            ),
-            PlannedJob(
-                STUDY_JOB,
-                tables_job,
-                ("calibration", "zhang", "fixed_point"),
-                lambda done: (
-                    path,
-                    fast,
-                    seed,
-                    head(done),
-                    done["zhang"],
-                    done["fixed_point"],
-                ),
-                COSTS[STUDY_JOB],
-            ),
-            *(
-                PlannedJob(
-                    name,
-                    study_job,
-                    (),
-                    functools.partial(lambda d, n: (n, path, fast, seed), n=name),
-                    SWEEP_COST,
-                )
-                for name in state["sweeps"]
-            ),
+                name,
+                JOB_HOOKS[job.hook],
+                job.after,
+                functools.partial(args, name=name, after=job.after),
+                job.cost,
+            )
+            for name, job in REPRODUCE.jobs.items()
+        ] + [
+            PlannedJob(n, study_job, (), functools.partial(args, name=n, after=()), sweep_cost)
+            for n in state["sweeps"]
         ]
 
         def finished(

@@ -12,6 +12,7 @@ from headsim.scenario.loading import scenario_files
 from headsim.studies import head_changes
 from headsim.studies.catalogue import (
     COSTS,
+    REPRODUCE,
     SCENARIO_JOBS,
     STUDY,
     STUDY_JOB,
@@ -20,9 +21,11 @@ from headsim.studies.catalogue import (
     JobOutcome,
     ReproduceError,
     compare_experiment,
+    read_reproduce_experiments,
     read_study_experiments,
 )
 from headsim.studies.methods import METHODS, SWEEP_METHODS, StudyConfig
+from headsim.studies.reproduce_jobs import JOB_HOOKS
 from headsim.studies.sweep_spec import SweepError
 
 CONFIG = StudyConfig.quick()
@@ -100,6 +103,45 @@ def test_every_experiment_runs_a_shipped_scenario_and_has_a_cost() -> None:
     assert {scenario for scenario, _ in SCENARIO_JOBS.values()} | {TABLES_HEAD} <= shipped
     assert set(SCENARIO_JOBS) | {STUDY_JOB, TABLES_HEAD} <= set(COSTS)
     assert all(cost > 0 for cost in COSTS.values())
+
+
+@pytest.mark.fast
+def test_reproduce_s_file_names_registered_hooks_in_planned_order() -> None:
+    assert list(REPRODUCE.jobs)[:3] == ["calibration", "zhang", "fixed_point"]
+    assert {job.hook for job in REPRODUCE.jobs.values()} <= set(JOB_HOOKS)
+    assert REPRODUCE.jobs[STUDY_JOB].after == ("calibration", "zhang", "fixed_point")
+    # The realistic board uses its own calibration, so it reproduces no section itself.
+    board = REPRODUCE.jobs["chessboard_realistic"]
+    assert board.overrides == {"head.preset": "realistic"} and board.after == ()
+    assert list(SCENARIO_JOBS) == [
+        "initial_directions",
+        "chessboard",
+        "relative_positioning",
+        "tracking",
+    ]
+    assert REPRODUCE.sweep_cost > max(COSTS.values())
+
+
+@pytest.mark.fast
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            '[job.a]\nhook = "h"\ncost = 1\nafter = ["b"]',
+            r"job\.a\.after: \['b'\] names no earlier job",
+        ),
+        ('[job.a]\nhook = "h"\ncost = "x"', r"job\.a\.cost: must be numbers, got 'x'"),
+        ('[job.a]\nhook = "h"\ncost = 1\nwhen = 2', r"job\.a\.when: unknown key \(allowed: hook,"),
+        ("[job.a]\ncost = 1", r"job\.a\.hook: is missing"),
+    ],
+)
+def test_a_bad_reproduce_file_is_refused_naming_the_field(tmp_path, text, message) -> None:
+    path = tmp_path / "reproduce.toml"
+    path.write_text('sweep_cost = 10\n[job.b]\nhook = "h"\ncost = 2\n')
+    assert read_reproduce_experiments(path).jobs["b"].cost == 2.0
+    path.write_text("sweep_cost = 10\n" + text)
+    with pytest.raises(SweepError, match=f"^{path}: " + message):
+        read_reproduce_experiments(path)
 
 
 @pytest.mark.fast
