@@ -2,22 +2,10 @@
 
 One head (the scenarios' ``paper`` head) is calibrated once (Sec. V, the
 ``calibration`` scenario's targets) into ``DIR/head.json``; then, spread over
-``--workers`` processes, each experiment runs with that calibration:
-
-- ``initial_directions``: the calibration's check targets, before and after
-  (Sec. V, Fig. 8), beside the calibrated directions;
-- ``chessboard``: every cross point of a 30 mm board (Sec. VI-A, Tables III-IV);
-  beside it ``chessboard_realistic``, the same board on the realistic preset with the
-  scenario's own calibration (the paper's rig had real tolerances; the paper head's
-  mechanics are ideal);
-- ``relative_positioning``: the cross point and six objects' areas (Sec. VI-C, Table VII);
-- ``tracking``: the moving target with the neck (beyond Sec. VI's static tests);
-- ``tables_v_vi``: calibrated stereo against the active method (Sec. VI-B,
-  Tables V-VI, Fig. 11), then the cameras zoomed 1.5x with every calibration
-  kept (the changed focal length), on the same head with the same Sec. V
-  calibration (head.json), one Zhang stereo calibration and one zoom
-  fixed-point calibration (:mod:`headsim.studies.paper_tables`; the study's other
-  heads and changes are left to ``headsim study``).
+``--workers`` processes, each experiment runs with that calibration.  The jobs, what
+each reproduces and what each needs are described in ``reproduce_experiments.toml``
+(the Tables V/VI job: :mod:`headsim.studies.paper_tables`; the study's other heads and
+changes are left to ``headsim study``).
 
 The head's calibration, Zhang's and the fixed points' run first, side by
 side; then the longest experiments first, so that the workers finish together.
