@@ -91,17 +91,19 @@ class StudyExperiments:
 
 #: The study's experiments, as a file.
 STUDY_FILE = Path(__file__).with_name("study_experiments.toml")
-_SWEEP_KEYS = {
-    "parameter",
-    "values",
-    "fast_values",
-    "change",
-    "modes",
-    "log_x",
-    "targets",
-    "methods",
-}
+_SWEEP_KEYS = ("parameter", "values", "fast_values", "change", "modes", "log_x", "targets")
+_SWEEP_KEYS_ALL = (*_SWEEP_KEYS, "methods")
 _CHOICES = {"modes": ("kept", "redone"), "targets": ("table", "depth"), "methods": ("sweep", "all")}
+
+
+def _table(source: str, where: str, table: Any, keys: Sequence[str]) -> dict[str, Any]:
+    """``table`` if it is a TOML table of only ``keys``."""
+    if not isinstance(table, dict):
+        raise SweepError(source, where, f"must be a table, got {table!r}")
+    unknown = set(table) - set(keys)
+    if unknown:
+        raise SweepError(source, f"{where}.{min(unknown)}", "unknown key", ", ".join(keys))
+    return table
 
 
 def _take(
@@ -135,25 +137,17 @@ def read_study_experiments(path: Path = STUDY_FILE) -> StudyExperiments:
     source = str(path)
     data = tomllib.loads(path.read_text(encoding="utf-8"))
     compare = data.get("compare", {})
-    changes = tuple(
-        Change(
-            _take(source, f"compare.changes[{i}]", entry, "label", str),
-            _floats(source, f"compare.changes[{i}]", entry, "value")[0],
-            HEAD_CHANGES[_take(source, f"compare.changes[{i}]", entry, "change", str)],
-        )
-        for i, entry in enumerate(_take(source, "compare", compare, "changes", list))
-    )
+    changes = []
+    for i, entry in enumerate(_take(source, "compare", compare, "changes", list)):
+        where = f"compare.changes[{i}]"
+        entry = _table(source, where, entry, ("label", "value", "change"))
+        change = HEAD_CHANGES[_take(source, where, entry, "change", str)]
+        value = _floats(source, where, entry, "value")[0]
+        changes.append(Change(_take(source, where, entry, "label", str), value, change))
     sweeps = {}
     for name, table in data.get("sweep", {}).items():
         where = f"sweep.{name}"
-        unknown = set(table) - _SWEEP_KEYS
-        if unknown:
-            raise SweepError(
-                source,
-                f"{where}.{min(unknown)}",
-                "unknown key",
-                ", ".join(sorted(_SWEEP_KEYS)),
-            )
+        table = _table(source, where, table, _SWEEP_KEYS_ALL)
         methods = _take(source, where, table, "methods", str, "sweep")
         sweeps[name] = Sweep(
             name=name,
@@ -166,7 +160,8 @@ def read_study_experiments(path: Path = STUDY_FILE) -> StudyExperiments:
             targets=_take(source, where, table, "targets", str, "table"),
             methods=METHODS if methods == "all" else SWEEP_METHODS,
         )
-    return StudyExperiments(_take(source, "compare", compare, "title", str), changes, sweeps)
+    title = _take(source, "compare", compare, "title", str)
+    return StudyExperiments(title, tuple(changes), sweeps)
 
 
 STUDY = read_study_experiments()
@@ -347,9 +342,7 @@ def read_reproduce_experiments(path: Path = REPRODUCE_FILE) -> ReproduceExperime
     jobs: dict[str, ReproduceJob] = {}
     for name, table in data.get("job", {}).items():
         where = f"job.{name}"
-        unknown = set(table) - set(_JOB_KEYS)
-        if unknown:
-            raise SweepError(source, f"{where}.{min(unknown)}", "unknown key", ", ".join(_JOB_KEYS))
+        table = _table(source, where, table, _JOB_KEYS)
         after = tuple(table.get("after", ()))
         if not set(after) <= set(jobs):
             raise SweepError(

@@ -80,9 +80,10 @@ modes = ["kept"]
         (("values = [1, 2.5]", "values = []"), r"sweep\.s\.values: must be numbers, got \[\]"),
         (('parameter = "p"', "parameter = 3"), r"sweep\.s\.parameter: must be str, got 3"),
         (('title = "t"', 'titel = "t"'), r"compare\.title: is missing"),
+        (("[{ label", "[3, { label"), r"compare\.changes\[0\]: must be a table, got 3"),
         (
             ("modes = [", "colour = 1\nmodes = ["),
-            r"sweep\.s\.colour: unknown key \(allowed: change,",
+            r"sweep\.s\.colour: unknown key \(allowed: parameter, values,",
         ),
     ],
 )
