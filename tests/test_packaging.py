@@ -84,6 +84,13 @@ def test_package_data_covers_every_model_and_scenario_file() -> None:
             )
 
 
+def test_package_data_covers_the_campaigns_experiment_files() -> None:
+    patterns: list[str] = SETUPTOOLS["package-data"]["headsim.studies"]
+    files = sorted((REPO / "headsim" / "studies").glob("*.toml"))
+    assert [p.name for p in files] == ["reproduce_experiments.toml", "study_experiments.toml"]
+    assert all(any(fnmatch(p.name, pattern) for pattern in patterns) for p in files)
+
+
 def test_the_installed_package_finds_the_checkouts_models_and_scenarios() -> None:
     # The suite runs on an editable install (make setup); a stale one (installed
     # before pyproject.toml changed) fails here: run `make setup` again.

@@ -37,6 +37,7 @@ CENTRE, V_KNOWN, EXTENDED, FIXED, STEREO = (
 def tables_run(seed: int) -> dict[str, Any]:
     """The Tables V/VI experiment at ``seed``, full size: ``result`` (the experiment's
     per-target errors) and ``summary`` (its rows)."""
+    from headsim.studies.catalogue import STUDY_JOB
     from headsim.studies.reproduce_jobs import (
         calibrate_job,
         fixed_point_job,
@@ -46,10 +47,12 @@ def tables_run(seed: int) -> dict[str, Any]:
 
     with tempfile.TemporaryDirectory(prefix="figures-findings-") as out:
         fast = not FULL
-        calibration = calibrate_job(out, fast, seed)
-        zhang = zhang_job(fast, seed)
-        fixed = fixed_point_job(fast, seed)
-        return tables_job(out, fast, seed, calibration["path"], zhang, fixed)
+        after = {
+            "calibration": calibrate_job("calibration", out, fast, seed, {}),
+            "zhang": zhang_job("zhang", out, fast, seed, {}),
+            "fixed_point": fixed_point_job("fixed_point", out, fast, seed, {}),
+        }
+        return tables_job(STUDY_JOB, out, fast, seed, after)
 
 
 def _settings() -> Any:

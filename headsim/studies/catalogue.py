@@ -1,34 +1,34 @@
 """The campaigns' one catalogue of experiments: the study's (the Tables V/VI comparison and
-the sweeps as conditions, running one, the comparison's done-when ratios) and what
-``headsim reproduce`` runs (its scenario jobs, Tables V/VI, the realistic board, each
-job's cost in render-times, and an experiment's outcome).  The bench's paper scenarios
+the sweeps, described in ``study_experiments.toml`` and made into conditions here, running
+one, the comparison's done-when ratios) and what ``headsim reproduce`` runs (its jobs,
+described in ``reproduce_experiments.toml``: their hooks, order and cost in render-times;
+Tables V/VI's scope and an experiment's outcome).  The bench's paper scenarios
 are reproduce's (:data:`SCENARIO_JOBS`)."""
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+import tomllib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from headsim.active.principal import zoomed
 from headsim.errors import BadInput
 from headsim.runs.progress import Progress, quiet
 from headsim.sim.settings import HeadSettings, preset
 from headsim.studies.calibrations import CalibrationCache, Calibrations
 from headsim.studies.conditions import Condition, ConditionResult, run_conditions
 from headsim.studies.head_changes import (
-    CHANGES,
+    HEAD_CHANGES,
+    HeadChange,
     centred,
     image_centre_directions,
-    k1_changed,
-    principal_shifted,
-    with_encoder,
-    with_noise,
 )
 from headsim.studies.methods import METHODS, SWEEP_METHODS, StudyConfig
+from headsim.studies.sweep_spec import SweepError
 from headsim.studies.target_errors import Summary
 from headsim.studies.targets import depth_targets, table_targets
 
@@ -52,96 +52,144 @@ class Experiment:
     log_x: bool = False
 
 
-def compare_experiment(config: StudyConfig) -> Experiment:
-    """Tables V/VI and the changes after calibration, on the preset and on it with centred principal points."""
-    head = preset(config.preset, seed=config.seed)
-    targets = table_targets(config.table_targets)
-    base = {config.preset: head, f"{config.preset} with centred principal points": centred(head)}
-    changes = CHANGES if not config.fast else dict(list(CHANGES.items())[:1])
-    conditions = []
-    for group, settings in base.items():
-        conditions.append(Condition(group, "as calibrated", 0.0, settings, "kept", targets))
-        for label, (value, change) in changes.items():
-            conditions.append(Condition(group, label, value, change(settings), "kept", targets))
-    return Experiment(
-        name="compare",
-        title="Tables V/VI, then the cameras change after calibration",
-        kind="compare",
-        parameter="condition",
-        base=base,
-        conditions=tuple(conditions),
-        methods=METHODS,
-    )
-
-
 @dataclass(frozen=True)
 class Sweep:
-    """One sweep: values, how each changes the head, and the calibration modes.
+    """One sweep: values, how each changes the head, the calibration modes, the targets.
 
-    ``change(head, value)``: the head at that value; ``modes``: "kept"
-    (calibrated on the preset, changed after) and/or "redone".
+    ``change(head, value)``: the head at that value; ``modes``: "kept" (calibrated on the
+    preset, changed after) and/or "redone"; ``targets``: "table" or "depth".
     """
 
     name: str
     parameter: str
     values: tuple[float, ...]
     fast_values: tuple[float, ...]
-    change: Callable[[HeadSettings, float], HeadSettings]
+    change: HeadChange
     modes: tuple[str, ...]
     log_x: bool = False
+    targets: str = "table"
+    methods: tuple[str, ...] = SWEEP_METHODS
 
 
-SWEEPS: dict[str, Sweep] = {
-    "depth": Sweep(
-        "depth",
-        "target depth z_h, m",
-        (0.3, 0.45, 0.6, 0.8, 1.0, 1.25, 1.5, 2.0),
-        (0.4, 1.5),
-        lambda head, _: head,
-        ("kept",),
-    ),
-    "focal": Sweep(
-        "focal",
-        "focal length / calibrated focal length",
-        (0.7, 0.85, 1.0, 1.2, 1.5),
-        (1.0, 1.5),
-        zoomed,
-        ("kept", "redone"),
-    ),
-    "principal": Sweep(
-        "principal",
-        "principal point shift, px (Ca1 u +, Ca2 u -, both v +)",
-        (-10.0, -5.0, -2.0, 0.0, 2.0, 5.0, 10.0),
-        (0.0, 5.0),
-        principal_shifted,
-        ("kept", "redone"),
-    ),
-    "k1": Sweep(
-        "k1",
-        "change of k1 (both cameras)",
-        (-0.1, -0.05, 0.0, 0.05, 0.1, 0.2),
-        (0.0, 0.1),
-        k1_changed,
-        ("kept", "redone"),
-    ),
-    "noise": Sweep(
-        "noise",
-        "image noise, grey levels (std)",
-        (0.0, 2.0, 4.0, 8.0),
-        (0.0, 4.0),
-        with_noise,
-        ("redone",),
-    ),
-    "encoder": Sweep(
-        "encoder",
-        "eye encoder, steps per turn",
-        (3200.0, 6400.0, 12800.0, 25600.0, 102400.0),
-        (6400.0, 25600.0),
-        with_encoder,
-        ("redone",),
-        log_x=True,
-    ),
-}
+@dataclass(frozen=True)
+class Change:
+    """One change after calibration of the comparison: its label, x value and hook."""
+
+    label: str
+    value: float
+    change: HeadChange
+
+
+@dataclass(frozen=True)
+class StudyExperiments:
+    """A checked study experiment file: the comparison's title and changes, the sweeps."""
+
+    compare_title: str
+    changes: tuple[Change, ...]
+    sweeps: dict[str, Sweep]
+
+
+#: The study's experiments, as a file.
+STUDY_FILE = Path(__file__).with_name("study_experiments.toml")
+_SWEEP_KEYS = ("parameter", "values", "fast_values", "change", "modes", "log_x", "targets")
+_SWEEP_KEYS_ALL = (*_SWEEP_KEYS, "methods")
+_CHOICES = {"modes": ("kept", "redone"), "targets": ("table", "depth"), "methods": ("sweep", "all")}
+
+
+def _table(source: str, where: str, table: Any, keys: Sequence[str]) -> dict[str, Any]:
+    """``table`` if it is a TOML table of only ``keys``."""
+    if not isinstance(table, dict):
+        raise SweepError(source, where, f"must be a table, got {table!r}")
+    unknown = set(table) - set(keys)
+    if unknown:
+        raise SweepError(source, f"{where}.{min(unknown)}", "unknown key", ", ".join(keys))
+    return table
+
+
+def _take(
+    source: str, where: str, table: dict[str, Any], key: str, kind: type, default: Any = None
+) -> Any:
+    """``table[key]`` (or ``default``): a ``kind`` or a non-empty list of them (for a list
+    ``kind``, the list itself), one of the allowed names where the key has a choice."""
+    value = table.get(key, default)
+    if value is None:
+        raise SweepError(source, f"{where}.{key}", "is missing")
+    items = value if isinstance(value, list) and kind is not list else [value]
+    if not items or not all(isinstance(v, kind) for v in items):
+        raise SweepError(source, f"{where}.{key}", f"must be {kind.__name__}, got {value!r}")
+    allowed = HEAD_CHANGES if key == "change" else _CHOICES.get(key)
+    if allowed is not None and not set(items) <= set(allowed):
+        raise SweepError(source, f"{where}.{key}", f"unknown {value!r}", ", ".join(allowed))
+    return value
+
+
+def _floats(source: str, where: str, table: dict[str, Any], key: str) -> tuple[float, ...]:
+    """``table[key]``: a number or a non-empty list of numbers, as floats."""
+    value = table.get(key)
+    items: list[Any] = value if isinstance(value, list) else [value]
+    if not items or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in items):
+        raise SweepError(source, f"{where}.{key}", f"must be numbers, got {value!r}")
+    return tuple(float(v) for v in items)
+
+
+def read_study_experiments(path: Path = STUDY_FILE) -> StudyExperiments:
+    """Read and check a study experiment file (:class:`SweepError` naming the field)."""
+    source = str(path)
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    compare = data.get("compare", {})
+    changes = []
+    for i, entry in enumerate(_take(source, "compare", compare, "changes", list)):
+        where = f"compare.changes[{i}]"
+        entry = _table(source, where, entry, ("label", "value", "change"))
+        change = HEAD_CHANGES[_take(source, where, entry, "change", str)]
+        value = _floats(source, where, entry, "value")[0]
+        changes.append(Change(_take(source, where, entry, "label", str), value, change))
+    sweeps = {}
+    for name, table in data.get("sweep", {}).items():
+        where = f"sweep.{name}"
+        table = _table(source, where, table, _SWEEP_KEYS_ALL)
+        methods = _take(source, where, table, "methods", str, "sweep")
+        sweeps[name] = Sweep(
+            name=name,
+            parameter=_take(source, where, table, "parameter", str),
+            values=_floats(source, where, table, "values"),
+            fast_values=_floats(source, where, table, "fast_values"),
+            change=HEAD_CHANGES[_take(source, where, table, "change", str)],
+            modes=tuple(_take(source, where, table, "modes", str)),
+            log_x=_take(source, where, table, "log_x", bool, False),
+            targets=_take(source, where, table, "targets", str, "table"),
+            methods=METHODS if methods == "all" else SWEEP_METHODS,
+        )
+    title = _take(source, "compare", compare, "title", str)
+    return StudyExperiments(title, tuple(changes), sweeps)
+
+
+STUDY = read_study_experiments()
+SWEEPS: dict[str, Sweep] = STUDY.sweeps
+
+
+def compare_experiment(config: StudyConfig) -> Experiment:
+    """Tables V/VI and the changes after calibration, on the preset and on it with centred principal points."""
+    head = preset(config.preset, seed=config.seed)
+    targets = table_targets(config.table_targets)
+    base = {config.preset: head, f"{config.preset} with centred principal points": centred(head)}
+    changes = STUDY.changes[:1] if config.fast else STUDY.changes
+    conditions = []
+    for group, settings in base.items():
+        conditions.append(Condition(group, "as calibrated", 0.0, settings, "kept", targets))
+        for c in changes:
+            conditions.append(
+                Condition(group, c.label, c.value, c.change(settings, c.value), "kept", targets)
+            )
+    return Experiment(
+        name="compare",
+        title=STUDY.compare_title,
+        kind="compare",
+        parameter="condition",
+        base=base,
+        conditions=tuple(conditions),
+        methods=METHODS,
+    )
 
 
 def sweep_experiment(name: str, config: StudyConfig) -> Experiment:
@@ -154,7 +202,7 @@ def sweep_experiment(name: str, config: StudyConfig) -> Experiment:
     rng = np.random.default_rng(config.seed + 10)
     conditions = []
     for value in values:
-        if name == "depth":
+        if sweep.targets == "depth":
             targets = depth_targets(head, value, config.targets_per_depth, rng)
         else:
             targets = table_targets(config.table_targets)
@@ -168,7 +216,7 @@ def sweep_experiment(name: str, config: StudyConfig) -> Experiment:
         parameter=sweep.parameter,
         base={config.preset: head},
         conditions=tuple(conditions),
-        methods=METHODS if name == "principal" else SWEEP_METHODS,
+        methods=sweep.methods,
         log_x=sweep.log_x,
     )
 
@@ -257,15 +305,67 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
 
 # -- headsim reproduce ---------------------------------------------------------------
 
-#: The scenarios run with the one calibration, and what each reproduces.
+
+@dataclass(frozen=True)
+class ReproduceJob:
+    """One job of ``headsim reproduce`` as its file describes it: the hook that runs it, the
+    jobs it comes after, its cost in render-times and, for a scenario job, the scenario, its
+    overrides and what it reproduces."""
+
+    name: str
+    hook: str
+    after: tuple[str, ...]
+    cost: float
+    scenario: str = ""
+    overrides: dict[str, Any] = field(default_factory=dict)
+    reproduces: str = ""
+
+
+@dataclass(frozen=True)
+class ReproduceExperiments:
+    """A checked reproduce experiment file: its jobs in planned order, a sweep's cost."""
+
+    jobs: dict[str, ReproduceJob]
+    sweep_cost: float
+
+
+#: Reproduce's experiments, as a file.
+REPRODUCE_FILE = Path(__file__).with_name("reproduce_experiments.toml")
+_JOB_KEYS = ("hook", "after", "cost", "scenario", "overrides", "reproduces")
+
+
+def read_reproduce_experiments(path: Path = REPRODUCE_FILE) -> ReproduceExperiments:
+    """Read and check a reproduce experiment file (:class:`SweepError` naming the field); a
+    job comes after jobs planned before it."""
+    source = str(path)
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    jobs: dict[str, ReproduceJob] = {}
+    for name, table in data.get("job", {}).items():
+        where = f"job.{name}"
+        table = _table(source, where, table, _JOB_KEYS)
+        after = tuple(table.get("after", ()))
+        if not set(after) <= set(jobs):
+            raise SweepError(
+                source, f"{where}.after", f"{list(after)!r} names no earlier job", ", ".join(jobs)
+            )
+        scenario = _take(source, where, table, "scenario", str, "")
+        overrides = _take(source, where, table, "overrides", dict, {})
+        jobs[name] = ReproduceJob(
+            name=name,
+            hook=_take(source, where, table, "hook", str),
+            after=after,
+            cost=_floats(source, where, table, "cost")[0],
+            scenario=scenario,
+            overrides=overrides,
+            reproduces=_take(source, where, table, "reproduces", str, ""),
+        )
+    return ReproduceExperiments(jobs, _floats(source, "", data, "sweep_cost")[0])
+
+
+REPRODUCE = read_reproduce_experiments()
+#: The scenario jobs that reproduce a part of the paper: name -> (scenario, what).
 SCENARIO_JOBS = {
-    "initial_directions": ("calibration", "Sec. V, Fig. 8: initial directions"),
-    "chessboard": ("chessboard", "Sec. VI-A, Tables III-IV, Fig. 10: chessboard"),
-    "relative_positioning": (
-        "relative_positioning",
-        "Sec. VI-C, Table VII, Fig. 12: relative positioning",
-    ),
-    "tracking": ("tracking", "Tracking with the neck (Model 1), beyond the paper"),
+    name: (job.scenario, job.reproduces) for name, job in REPRODUCE.jobs.items() if job.reproduces
 }
 STUDY_JOB = "tables_v_vi"
 #: What the Tables V/VI experiment measures here, and what it leaves to the study.
@@ -285,8 +385,7 @@ TABLES_SCOPE = (
 FIXED_POINT_TARGETS = 30
 #: The scenario whose head (and calibration) every experiment uses.
 TABLES_HEAD = "calibration"
-#: The job that measures the same board on the realistic preset (real tolerances), with the
-#: chessboard scenario's own calibration: beside the paper preset, whose mechanics are ideal.
+#: The job that measures the board on the realistic preset, beside the paper preset's.
 REALISTIC_BOARD_JOB = "chessboard_realistic"
 
 
@@ -305,20 +404,6 @@ class JobOutcome:
     error: str = ""
 
 
-#: What each job costs, in 640x480 render-times at full size (its CPU time over the
-#: run's render, medians of 3 runs of ``headsim reproduce --workers 2`` on this
-#: machine, Dec 2026): the scheduler starts the ready job with the longest path to the
-#: end first.  Sweeps are the longest.
-COSTS = {
-    "calibration": 185.0,
-    "zhang": 120.0,
-    "fixed_point": 130.0,
-    "initial_directions": 12.0,
-    "chessboard": 140.0,
-    # Its CPU time 1.8x the chessboard job's (one run, Dec 2026), scaled from that job's cost.
-    REALISTIC_BOARD_JOB: 250.0,
-    "relative_positioning": 45.0,
-    "tracking": 50.0,
-    STUDY_JOB: 80.0,
-}
-SWEEP_COST = 1000.0
+#: What each job costs, in render-times (the file's ``cost``).
+COSTS = {name: job.cost for name, job in REPRODUCE.jobs.items()}
+SWEEP_COST = REPRODUCE.sweep_cost

@@ -1,5 +1,6 @@
 """Heads the study measures on: the cameras changed after calibration (zoom, principal
-point, k1, noise, encoder) and each eye's true image-centre direction, rad."""
+point, k1, noise, encoder), registered by name as the hooks the study's experiment file
+(``study_experiments.toml``) names, and each eye's true image-centre direction, rad."""
 
 from __future__ import annotations
 
@@ -11,6 +12,30 @@ from headsim.active.principal import zoomed
 from headsim.sim.forward import effective_directions
 from headsim.sim.settings import HeadSettings
 
+#: A change of the head to one value of an experiment.
+HeadChange = Callable[[HeadSettings, float], HeadSettings]
+#: The hooks an experiment file names: name -> change.
+HEAD_CHANGES: dict[str, HeadChange] = {}
+
+
+def head_change(name: str) -> Callable[[HeadChange], HeadChange]:
+    """Register a change under ``name``, the name experiment files use."""
+
+    def register(change: HeadChange) -> HeadChange:
+        HEAD_CHANGES[name] = change
+        return change
+
+    return register
+
+
+head_change("zoom")(zoomed)
+
+
+@head_change("none")
+def unchanged(settings: HeadSettings, _value: float) -> HeadSettings:
+    """The head as it is (a sweep of the targets, not the head)."""
+    return settings
+
 
 def centred(settings: HeadSettings) -> HeadSettings:
     """The same head with both principal points at the image centre."""
@@ -18,6 +43,7 @@ def centred(settings: HeadSettings) -> HeadSettings:
     return replace(settings, cameras=(cam1, cam2))
 
 
+@head_change("principal_shift_px")
 def principal_shifted(settings: HeadSettings, shift_px: float) -> HeadSettings:
     """Principal points moved ``shift_px``: Ca1's u by +shift, Ca2's u by -shift, both v by +shift.
 
@@ -32,30 +58,24 @@ def principal_shifted(settings: HeadSettings, shift_px: float) -> HeadSettings:
     return replace(settings, cameras=(cams[0], cams[1]))
 
 
+@head_change("k1_change")
 def k1_changed(settings: HeadSettings, change: float) -> HeadSettings:
     """Both cameras' k1 changed by ``change`` (positive: less barrel distortion)."""
     cam1, cam2 = (replace(c, k1=c.k1 + change) for c in settings.cameras)
     return replace(settings, cameras=(cam1, cam2))
 
 
+@head_change("noise_std")
 def with_noise(settings: HeadSettings, noise_std: float) -> HeadSettings:
     """Both cameras with Gaussian image noise of ``noise_std`` grey levels."""
     cam1, cam2 = (replace(c, noise_std=noise_std) for c in settings.cameras)
     return replace(settings, cameras=(cam1, cam2))
 
 
+@head_change("encoder_steps_per_turn")
 def with_encoder(settings: HeadSettings, steps_per_turn: float) -> HeadSettings:
     """The eye encoder with ``steps_per_turn`` steps per revolution."""
     return replace(settings, encoder_resolution_rad=2 * math.pi / steps_per_turn)
-
-
-#: The changes after calibration of the comparison: label -> (x value, change).
-CHANGES: dict[str, tuple[float, Callable[[HeadSettings], HeadSettings]]] = {
-    "zoom 1.5x": (1.5, lambda s: zoomed(s, 1.5)),
-    "zoom 0.7x": (0.7, lambda s: zoomed(s, 0.7)),
-    "principal point moved 5 px": (5.0, lambda s: principal_shifted(s, 5.0)),
-    "k1 + 0.1": (0.1, lambda s: k1_changed(s, 0.1)),
-}
 
 
 def image_centre_directions(settings: HeadSettings) -> tuple[float, float]:

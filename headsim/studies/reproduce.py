@@ -2,22 +2,10 @@
 
 One head (the scenarios' ``paper`` head) is calibrated once (Sec. V, the
 ``calibration`` scenario's targets) into ``DIR/head.json``; then, spread over
-``--workers`` processes, each experiment runs with that calibration:
-
-- ``initial_directions``: the calibration's check targets, before and after
-  (Sec. V, Fig. 8), beside the calibrated directions;
-- ``chessboard``: every cross point of a 30 mm board (Sec. VI-A, Tables III-IV);
-  beside it ``chessboard_realistic``, the same board on the realistic preset with the
-  scenario's own calibration (the paper's rig had real tolerances; the paper head's
-  mechanics are ideal);
-- ``relative_positioning``: the cross point and six objects' areas (Sec. VI-C, Table VII);
-- ``tracking``: the moving target with the neck (beyond Sec. VI's static tests);
-- ``tables_v_vi``: calibrated stereo against the active method (Sec. VI-B,
-  Tables V-VI, Fig. 11), then the cameras zoomed 1.5x with every calibration
-  kept (the changed focal length), on the same head with the same Sec. V
-  calibration (head.json), one Zhang stereo calibration and one zoom
-  fixed-point calibration (:mod:`headsim.studies.paper_tables`; the study's other
-  heads and changes are left to ``headsim study``).
+``--workers`` processes, each experiment runs with that calibration.  The jobs, what
+each reproduces and what each needs are described in ``reproduce_experiments.toml``
+(the Tables V/VI job: :mod:`headsim.studies.paper_tables`; the study's other heads and
+changes are left to ``headsim study``).
 
 The head's calibration, Zhang's and the fixed points' run first, side by
 side; then the longest experiments first, so that the workers finish together.
@@ -45,11 +33,8 @@ from headsim.errors import OutputNotWritable
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.runs.progress import Status, quiet
 from headsim.studies.catalogue import (
-    COSTS,
-    REALISTIC_BOARD_JOB,
-    SCENARIO_JOBS,
+    REPRODUCE,
     STUDY_JOB,
-    SWEEP_COST,
     JobOutcome,
     ReproduceError,
 )
@@ -62,16 +47,7 @@ from headsim.studies.jobs import (
     terminate_children,
 )
 from headsim.studies.render_clock import CLOCK_RENDERS, RenderClock, cpu_s
-from headsim.studies.reproduce_jobs import (
-    WORKER_MODULES,
-    calibrate_job,
-    fixed_point_job,
-    realistic_board_job,
-    scenario_job,
-    study_job,
-    tables_job,
-    zhang_job,
-)
+from headsim.studies.reproduce_jobs import JOB_HOOKS, WORKER_MODULES, study_job
 from headsim.studies.reproduce_report import main_figure, report_sections, report_text
 
 
@@ -185,63 +161,23 @@ def reproduce(
         threading.Thread(
             target=importlib.import_module, args=("headsim.studies.plots",), daemon=True
         ).start()
-        path = str(out)
-        head = lambda done: done["calibration"]["path"]  # noqa: E731
+        path, sweep_cost = str(out), REPRODUCE.sweep_cost
+
+        def args(done: dict[str, Any], name: str, after: tuple[str, ...]) -> tuple[Any, ...]:
+            return (name, path, fast, seed, {job: done[job] for job in after})
+
         plan = [
             PlannedJob(
-                "calibration",
-                calibrate_job,
-                (),
-                lambda done: (path, fast, seed),
-                COSTS["calibration"],
-            ),
-            PlannedJob("zhang", zhang_job, (), lambda done: (fast, seed), COSTS["zhang"]),
-            PlannedJob(
-                "fixed_point", fixed_point_job, (), lambda done: (fast, seed), COSTS["fixed_point"]
-            ),
-            PlannedJob(
-                REALISTIC_BOARD_JOB,
-                realistic_board_job,
-                (),
-                lambda done: (path, fast, seed),
-                COSTS[REALISTIC_BOARD_JOB],
-            ),
-            *(
-                PlannedJob(
-                    name,
-                    scenario_job,
-                    ("calibration",),
-                    functools.partial(
-                        lambda done, name: (name, path, fast, seed, head(done)), name=name
-                    ),
-                    COSTS[name],
-                )
-                for name in SCENARIO_JOBS
-            ),
-            PlannedJob(
-                STUDY_JOB,
-                tables_job,
-                ("calibration", "zhang", "fixed_point"),
-                lambda done: (
-                    path,
-                    fast,
-                    seed,
-                    head(done),
-                    done["zhang"],
-                    done["fixed_point"],
-                ),
-                COSTS[STUDY_JOB],
-            ),
-            *(
-                PlannedJob(
-                    name,
-                    study_job,
-                    (),
-                    functools.partial(lambda d, n: (n, path, fast, seed), n=name),
-                    SWEEP_COST,
-                )
-                for name in state["sweeps"]
-            ),
+                name,
+                JOB_HOOKS[job.hook],
+                job.after,
+                functools.partial(args, name=name, after=job.after),
+                job.cost,
+            )
+            for name, job in REPRODUCE.jobs.items()
+        ] + [
+            PlannedJob(n, study_job, (), functools.partial(args, name=n, after=()), sweep_cost)
+            for n in state["sweeps"]
         ]
 
         def finished(

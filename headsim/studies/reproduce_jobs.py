@@ -1,20 +1,19 @@
 """The jobs of ``headsim reproduce``, run in worker processes (module-level, so they pickle):
-the head's calibration, Zhang's, the fixed points', the scenarios, Tables V/VI, the sweeps."""
+the head's calibration, Zhang's, the fixed points', the scenarios, Tables V/VI, the sweeps;
+registered by the names ``reproduce_experiments.toml`` gives as hooks (:data:`JOB_HOOKS`).
+Each takes the job's name, the output directory, ``--fast``, ``--seed`` and the data of the
+jobs it comes after."""
 
 from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
-from headsim.studies.catalogue import (
-    FIXED_POINT_TARGETS,
-    REALISTIC_BOARD_JOB,
-    SCENARIO_JOBS,
-    TABLES_HEAD,
-)
+from headsim.studies.catalogue import FIXED_POINT_TARGETS, REPRODUCE, TABLES_HEAD
 from headsim.studies.jobs import plain_errors
 from headsim.studies.scenario_jobs import Job
 
@@ -31,9 +30,28 @@ WORKER_MODULES = (
     "headsim.studies.study_output",
 )
 
+#: A reproduce job: (name, out, fast, seed, the data of the jobs it comes after) -> data.
+JobHook = Callable[[str, str, bool, "int | None", dict[str, Any]], dict[str, Any]]
+#: The hooks a reproduce experiment file names: name -> job.
+JOB_HOOKS: dict[str, JobHook] = {}
 
+
+def job_hook(name: str) -> Callable[[JobHook], JobHook]:
+    """Register a job under ``name``, the name experiment files use."""
+
+    def register(job: JobHook) -> JobHook:
+        JOB_HOOKS[name] = job
+        return job
+
+    return register
+
+
+@job_hook("calibrate")
 @plain_errors
-def calibrate_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
+def calibrate_job(
+    _name: str, out: str, fast: bool, seed: int | None, _after: dict[str, Any]
+) -> dict[str, Any]:
+    """The head's one Sec. V calibration, written to ``out/head.json``."""
     from headsim.active.calibration_file import head_hash, write_calibration
     from headsim.codec import encode
     from headsim.runs.runner import calibrate_scenario
@@ -81,21 +99,19 @@ def _scenario_run(job: Job, directory: Path) -> dict[str, Any]:
     }
 
 
+@job_hook("scenario")
 @plain_errors
-def scenario_job(name: str, out: str, fast: bool, seed: int | None, head: str) -> dict[str, Any]:
-    scenario_name, _ = SCENARIO_JOBS[name]
-    params = {"experiment.calibration.from": head, "seed": seed}
-    return _scenario_run(Job(0, name, scenario_name, fast, params), Path(out) / name)
-
-
-@plain_errors
-def realistic_board_job(out: str, fast: bool, seed: int | None) -> dict[str, Any]:
-    """The chessboard on the realistic preset, calibrated by the scenario itself: the
-    paper's rig had real tolerances, which the paper preset's ideal mechanics lack."""
-    scenario_name, _ = SCENARIO_JOBS["chessboard"]
-    params = {"head.preset": "realistic", "seed": seed}
-    job = Job(0, REALISTIC_BOARD_JOB, scenario_name, fast, params)
-    return _scenario_run(job, Path(out) / REALISTIC_BOARD_JOB)
+def scenario_job(
+    name: str, out: str, fast: bool, seed: int | None, after: dict[str, Any]
+) -> dict[str, Any]:
+    """The file's scenario with its overrides; with head.json when it comes after the
+    calibration, else with the scenario's own calibration."""
+    spec = REPRODUCE.jobs[name]
+    params = dict(spec.overrides)
+    if "calibration" in after:
+        params["experiment.calibration.from"] = after["calibration"]["path"]
+    params["seed"] = seed
+    return _scenario_run(Job(0, name, spec.scenario, fast, params), Path(out) / name)
 
 
 def _study_config(fast: bool, seed: int | None) -> Any:
@@ -105,8 +121,11 @@ def _study_config(fast: bool, seed: int | None) -> Any:
     return make(seed=seed or 0)
 
 
+@job_hook("zhang")
 @plain_errors
-def zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
+def zhang_job(
+    _name: str, _out: str, fast: bool, seed: int | None, _after: dict[str, Any]
+) -> dict[str, Any]:
     """Zhang's stereo calibration of the one head, once (it needs no head.json)."""
     from headsim.scenario.loading import load_scenario
     from headsim.studies.paper_tables import zhang_calibration
@@ -117,8 +136,11 @@ def zhang_job(fast: bool, seed: int | None) -> dict[str, Any]:
     return {"calibration": calibration, "renders": renders, "wall_s": time.perf_counter() - start}
 
 
+@job_hook("fixed_point")
 @plain_errors
-def fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
+def fixed_point_job(
+    _name: str, _out: str, fast: bool, seed: int | None, _after: dict[str, Any]
+) -> dict[str, Any]:
     """The zoom fixed points and the Sec. V calibration on their columns, once (beyond the
     paper: the active method that the focal length's change does not move)."""
     from headsim.scenario.loading import load_scenario
@@ -134,14 +156,10 @@ def fixed_point_job(fast: bool, seed: int | None) -> dict[str, Any]:
     return {"fixed": fixed, "targets": targets, "wall_s": time.perf_counter() - start}
 
 
+@job_hook("tables")
 @plain_errors
 def tables_job(
-    out: str,
-    fast: bool,
-    seed: int | None,
-    head: str,
-    zhang: dict[str, Any],
-    fixed: dict[str, Any],
+    _name: str, out: str, fast: bool, seed: int | None, after: dict[str, Any]
 ) -> dict[str, Any]:
     """Tables V/VI and the changed focal length with the one calibration and Zhang's."""
     from headsim.active.calibration_file import read_calibration
@@ -149,6 +167,7 @@ def tables_job(
     from headsim.studies import paper_tables
     from headsim.studies.study_output import experiment_record, write_experiment
 
+    head, zhang, fixed = after["calibration"]["path"], after["zhang"], after["fixed_point"]
     settings = load_scenario(TABLES_HEAD, fast=fast, seed=seed).settings
     stored = read_calibration(head, settings).knowledge
     calibration = zhang["calibration"]
@@ -185,7 +204,10 @@ def tables_job(
 
 
 @plain_errors
-def study_job(name: str, out: str, fast: bool, seed: int | None) -> dict[str, Any]:
+def study_job(
+    name: str, out: str, fast: bool, seed: int | None, _after: dict[str, Any]
+) -> dict[str, Any]:
+    """One of the study's sweeps (``sweep_<name>``, with ``--sweeps``)."""
     from headsim.studies.catalogue import run_experiment, sweep_experiment
     from headsim.studies.study_output import experiment_record, write_experiment
 

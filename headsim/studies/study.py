@@ -31,12 +31,10 @@ base head (``"kept"``: the cameras changed after calibration, e.g. a zoom) or
 are calibrated again on this head (``"redone"``).  :func:`headsim.studies.conditions.run_conditions`
 measures every method on every target of every condition.
 
-**Experiments.**  :func:`headsim.studies.catalogue.compare_experiment`: the six target positions of
-Tables V and VI, then the same targets after a zoom (1.5x, 0.7x), a
-principal-point shift and a distortion change with the calibrations kept, on
-the paper's cameras and on the paper's cameras with centred principal points.
-:data:`headsim.studies.catalogue.SWEEPS`: error against depth, focal length, principal-point shift,
-k1, image noise and encoder resolution.  :func:`headsim.studies.study_output.write_experiment` writes
+**Experiments** are described in ``study_experiments.toml`` (read by
+:mod:`headsim.studies.catalogue`): the comparison (the six target positions of Tables V
+and VI, then the same targets after the changes it lists, with the calibrations kept, on
+the paper's cameras and with centred principal points) and the sweeps.  :func:`headsim.studies.study_output.write_experiment` writes
 ``<name>.csv`` (a row per condition and method), ``<name>_targets.csv`` (a
 row per target), ``<name>.json`` and ``<name>.png`` beside ``results.json``,
 which indexes every experiment written to the directory.  The realistic

@@ -16,7 +16,8 @@ def test_a_failing_job_says_why_and_leaves_the_pool_working(tmp_path: Path) -> N
     pool = render_pool(1)
     try:
         for _ in range(2):
-            job = pool.submit(scenario_job, "chessboard", str(tmp_path), True, None, missing)
+            after = {"calibration": {"path": missing}}
+            job = pool.submit(scenario_job, "chessboard", str(tmp_path), True, None, after)
             with pytest.raises(JobError, match=r"ScenarioError: .*cannot read"):
                 job.result(timeout=300)
     finally:
@@ -24,10 +25,10 @@ def test_a_failing_job_says_why_and_leaves_the_pool_working(tmp_path: Path) -> N
 
 
 def test_the_realistic_board_is_the_same_board_on_the_realistic_preset(tmp_path: Path) -> None:
-    from headsim.studies.reproduce_jobs import realistic_board_job
+    from headsim.studies.catalogue import REALISTIC_BOARD_JOB
     from headsim.studies.reproduce_rows import chessboard_rows
 
-    data = realistic_board_job(str(tmp_path), True, None)
+    data = scenario_job(REALISTIC_BOARD_JOB, str(tmp_path), True, None, {})
     results = data["results"]
     assert results["scenario"]["preset"] == "realistic"
     experiment = results["experiment"]
