@@ -20,6 +20,7 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
+from headsim.head.sim_head import SimHead
 from headsim.procedures.chessboard import measure_chessboard
 from headsim.procedures.tracking import track_moving_target
 from headsim.sim import names
@@ -147,7 +148,8 @@ def test_calibration_reports_each_position_and_tracking_each_time() -> None:
         def path(t: float) -> np.ndarray:
             return np.array([0.05 * t, 0.7, 0.25])
 
-        tracked = track_moving_target(sim, NeckServo(sim), RED, "marker_red", path, [0.0, 0.5])
+        head = SimHead(sim)
+        tracked = track_moving_target(head, NeckServo(head), RED, "marker_red", path, [0.0, 0.5])
     assert [e.label for e in sink.of(FixationStarted)] == ["marker_red 1", "marker_red 2"]
     done = sink.of(MeasurementDone)
     assert [d.time_s for d in done] == [0.0, 0.5]
