@@ -112,7 +112,8 @@ def test_procedures_report_each_fixation_with_its_label_and_result() -> None:
     sink = ListSink()
     with HeadSim("chessboard", sink=sink) as sim:
         sim.set_body_pose(names.CHESSBOARD, [-0.105, 0.8, 0.285])
-        run = measure_chessboard(sim, EyeServo(sim), corners=[9, 10])
+        head = SimHead(sim)
+        run = measure_chessboard(head, EyeServo(head), corners=[9, 10])
     labels = [e.label for e in sink.of(FixationStarted)]
     assert labels == ["corner_1_1", "corner_2_1"]
     done = sink.of(MeasurementDone)
