@@ -14,14 +14,14 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge, Measurement
 from headsim.active.model2 import Model2Config, measure_model2
 from headsim.codec import declared, doc
-from headsim.head.sim_head import SimHead
+from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import (
     PAPER,
+    head,
     model2_config,
     record_measurement,
     servo_config,
-    simulator,
 )
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord
@@ -47,7 +47,6 @@ from headsim.sim import names
 from headsim.sim.declared import Array, Section
 from headsim.sim.events import EventSink
 from headsim.sim.settings import HeadSettings
-from headsim.sim.simulator import HeadSim
 
 
 @declared
@@ -138,7 +137,7 @@ class ChessboardRun:
 
 
 def measure_chessboard(
-    sim: HeadSim,
+    head: ServoHead,
     servo: EyeServo,
     knowledge: HeadKnowledge | None = None,
     config: Model2Config | None = None,
@@ -150,16 +149,16 @@ def measure_chessboard(
     """Measure the chessboard's cross points (all, or ``corners``) and its squares' sides.
 
     ``sink``: where each corner's fixation ("corner_i_j") and measurement is
-    reported (None: the simulator's sink).
+    reported (None: the head's sink).
     """
-    sink = sim.sink if sink is None else sink
+    sink = head.sink if sink is None else sink
     columns, rows = pattern
     indices = list(range(columns * rows)) if corners is None else list(corners)
     measured: dict[int, Measurement] = {}
     for k in indices:
         corner = chessboard_corner_target(k, pattern, square_m)
         sink.emit(FixationStarted(corner.name))
-        measured[k] = measure_model2(SimHead(sim), servo, corner, knowledge, config)
+        measured[k] = measure_model2(head, servo, corner, knowledge, config)
         sink.emit(MeasurementDone(measured[k]))
     widths: list[float] = []
     heights: list[float] = []
@@ -206,9 +205,9 @@ def run_chessboard(
         if scene.corners is not None
         else list(range(columns * CHESSBOARD_PATTERN[1]))
     )
-    with simulator(hub, "chessboard", scenario) as sim:
-        sim.set_body_pose(names.CHESSBOARD, np.array(scene.chessboard.position_world_m))
-        body = sim.data.body(names.CHESSBOARD)
+    with head(hub, "chessboard", scenario) as sim:
+        sim.truth.set_body_pose(names.CHESSBOARD, np.array(scene.chessboard.position_world_m))
+        body = sim.truth.data.body(names.CHESSBOARD)
         rotation = body.xmat.reshape(3, 3)
         truth = {
             f"corner_{k % columns}_{k // columns}": body.xpos
@@ -218,10 +217,10 @@ def run_chessboard(
             )
             for k in indices
         }
-        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
+        hub.emit(PhaseStarted("measurement", sim.truth, knowledge, truth))
         run = measure_chessboard(
             sim,
-            EyeServo(SimHead(sim), servo_config(scenario)),
+            EyeServo(sim, servo_config(scenario)),
             knowledge,
             model2_config(scenario),
             CHESSBOARD_PATTERN,

@@ -21,14 +21,14 @@ from headsim.estimators.areas import (
     areas_from_pixels,
     compare_areas,
 )
-from headsim.head.sim_head import SimHead
+from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import (
     PAPER,
     PARKED_WORLD_M,
+    head,
     record_measurement,
     servo_config,
-    simulator,
 )
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord
@@ -50,7 +50,6 @@ from headsim.sim.declared import Choice, Section, Setting
 from headsim.sim.events import EventSink
 from headsim.sim.model import neck_of
 from headsim.sim.settings import HeadSettings
-from headsim.sim.simulator import HeadSim
 from headsim.vision.crosses import find_cross_point
 from headsim.vision.detection import Detection
 from headsim.vision.markers import find_markers
@@ -234,7 +233,7 @@ def _touching_blobs(found: dict[str, Detection], gap_px: float = 1.5) -> set[str
 
 
 def relative_positioning(
-    sim: HeadSim,
+    head: ServoHead,
     servo: EyeServo,
     reference: Target,
     objects: dict[str, str],
@@ -248,17 +247,17 @@ def relative_positioning(
     whose blob touches another's in any image (one partly hides the other)
     counts as not seen: its centroid would be biased.
     ``sink``: where the reference's fixation and measurement are reported (None:
-    the simulator's sink).
+    the head's sink).
     """
-    sink = sim.sink if sink is None else sink
+    sink = head.sink if sink is None else sink
     knowledge = knowledge or HeadKnowledge()
-    start = sim.render_count
+    start = head.render_count
     sink.emit(FixationStarted(reference.name))
-    ref = measure_model2(SimHead(sim), servo, reference, knowledge, Model2Config(midline_px=0.0))
+    ref = measure_model2(head, servo, reference, knowledge, Model2Config(midline_px=0.0))
     sink.emit(MeasurementDone(ref))
     if not ref.ok:
-        return RelativeRun(ref, {}, {}, {}, tuple(objects), None, sim.render_count - start)
-    resolution = sim.settings.encoder_resolution_rad
+        return RelativeRun(ref, {}, {}, {}, tuple(objects), None, head.render_count - start)
+    resolution = head.settings.encoder_resolution_rad
     # The lines L11..L22 are the cameras' lines of sight at the two fixations
     # (not where a search took a y image).
     steps = (
@@ -268,17 +267,17 @@ def relative_positioning(
     columns: dict[str, list[float]] = {name: [math.nan] * 4 for name in objects}
     # Order of the four columns: u11 (Ca1, step 1), u12 (Ca1, step 2), u21, u22.
     for step_index, step in enumerate(steps):
-        sim.command_eye_steps(step)
-        sim.settle()
+        head.command_eye_steps(step)
+        head.settle()
         for camera in (1, 2):
-            found = find_markers(sim.render(camera), objects)
+            found = find_markers(head.render(camera), objects)
             touching = _touching_blobs(found)
             for name, detection in found.items():
                 if detection.found and detection.uv is not None and name not in touching:
                     columns[name][2 * (camera - 1) + step_index] = detection.uv[0]
     seen = [name for name in objects if np.all(np.isfinite(columns[name]))]
     missing = tuple(name for name in objects if name not in seen)
-    (u10, _), (u20, _) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+    (u10, _), (u20, _) = knowledge.reference(head, 1), knowledge.reference(head, 2)
     alpha1, alpha2 = steps[0] * resolution, steps[1] * resolution
     areas: dict[str, int] = dict.fromkeys(objects, 0)
     true_areas: dict[str, int] = dict.fromkeys(objects, 0)
@@ -288,13 +287,13 @@ def relative_positioning(
         cols = np.array([columns[name] for name in seen])
         u11, u12, u21, u22 = cols.T
         pixel_areas = areas_from_pixels(u11, u12, u21, u22, u10, u20, alpha1=alpha1, alpha2=alpha2)
-        truth_h = np.array([sim.truth.position(name, "head") for name in seen])
+        truth_h = np.array([head.truth.position(name, "head") for name in seen])
         effective = (
-            sim.truth.effective_initial_direction(1),
-            sim.truth.effective_initial_direction(2),
+            head.truth.effective_initial_direction(1),
+            head.truth.effective_initial_direction(2),
         )
         truth = areas_from_geometry(
-            truth_h, alpha1, alpha2, sim.truth.settings.baseline_m, effective
+            truth_h, alpha1, alpha2, head.truth.settings.baseline_m, effective
         )
         comparison = compare_areas(pixel_areas, truth, u11, u12, u21, u22, u10, u20)
         areas.update(zip(seen, (int(a) for a in pixel_areas), strict=True))
@@ -318,7 +317,7 @@ def relative_positioning(
         columns={name: (c[0], c[1], c[2], c[3]) for name, c in columns.items()},
         missing=missing,
         comparison=comparison,
-        renders=sim.render_count - start,
+        renders=head.render_count - start,
         gain_areas=gain_areas,
         gain_comparison=gain_comparison,
     )
@@ -331,19 +330,19 @@ def run_relative(
     scene = scenario.scene
     assert scene.blocks is not None
     colours = {o.body: names.RELATIVE_OBJECT_COLOURS[o.body] for o in scene.objects}
-    with simulator(hub, "blocks", scenario) as sim:
+    with head(hub, "blocks", scenario) as sim:
         for placement in (scene.blocks, *scene.objects):
-            sim.set_body_pose(placement.body, np.array(placement.position_world_m))
+            sim.truth.set_body_pose(placement.body, np.array(placement.position_world_m))
         for body in scene.parked:
-            sim.set_body_pose(body, np.array(PARKED_WORLD_M))
+            sim.truth.set_body_pose(body, np.array(PARKED_WORLD_M))
         truth = {p.name: np.array(p.position_world_m) for p in (scene.blocks, *scene.objects)}
-        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
+        hub.emit(PhaseStarted("measurement", sim.truth, knowledge, truth))
         # A cross point's detection has the status and uv the servo reads; it is never
         # windowed (only blob detectors are), so it stands in for a Detection.
         cross = cast(Detector, find_cross_point)
         reference = Target(names.BLOCKS, cross, lambda s: s.truth.position(names.BLOCKS))
         run = relative_positioning(
-            sim, EyeServo(SimHead(sim), servo_config(scenario)), reference, colours, knowledge
+            sim, EyeServo(sim, servo_config(scenario)), reference, colours, knowledge
         )  # the reference's fixation is the phase's one step
         (step,) = hub.steps
         positions_head = {o.body: sim.truth.position(o.body, "head") for o in scene.objects}

@@ -13,12 +13,12 @@ from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
 from headsim.codec import declared, doc
-from headsim.head.sim_head import SimHead
+from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
 from headsim.runs.context import (
+    head,
     record_measurement,
     servo_config,
-    simulator,
 )
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord
@@ -45,7 +45,6 @@ from headsim.sim import names
 from headsim.sim.declared import Array, Choice, Section, Setting, Text
 from headsim.sim.events import EventSink
 from headsim.sim.settings import HeadSettings
-from headsim.sim.simulator import HeadSim
 
 
 @declared
@@ -86,7 +85,7 @@ class TrackingRun:
 
 
 def track_moving_target(
-    sim: HeadSim,
+    head: ServoHead,
     servo: NeckServo,
     target: Target,
     body: str,
@@ -102,15 +101,15 @@ def track_moving_target(
     target that left both views since is searched for around the last
     fixation (:func:`headsim.active.search.find_neck_view`), then from the start pose.
     ``sink``: where each fixation ("<target> 1", ...) and measurement is reported
-    (None: the simulator's sink).
+    (None: the head's sink).
     """
-    sink = sim.sink if sink is None else sink
+    sink = head.sink if sink is None else sink
     measurements = []
     fixations: list[tuple[int, int, int]] = []  # where the target was seen, in steps
     for k, t in enumerate(times_s):
         sink.emit(FixationStarted(f"{target.name} {k + 1}"))
-        sim.set_body_pose(body, trajectory(float(t)))
-        m = measure_model1(SimHead(sim), servo, target, knowledge, last_seen=fixations[-2:])
+        head.truth.set_body_pose(body, trajectory(float(t)))
+        m = measure_model1(head, servo, target, knowledge, last_seen=fixations[-2:])
         sink.emit(MeasurementDone(m, float(t)))
         measurements.append(m)
         if m.ok:
@@ -125,13 +124,13 @@ def run_tracking(
     moving = scenario.scene.moving
     assert moving is not None
     times = moving.times_s
-    with simulator(hub, "default", scenario) as sim:
+    with head(hub, "default", scenario) as sim:
         truth = {f"{moving.name} {k + 1}": moving.position(float(t)) for k, t in enumerate(times)}
-        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
+        hub.emit(PhaseStarted("measurement", sim.truth, knowledge, truth))
         target = marker_target(moving.name, moving.body)
         run = track_moving_target(
             sim,
-            NeckServo(SimHead(sim), servo_config(scenario)),
+            NeckServo(sim, servo_config(scenario)),
             target,
             moving.body,
             moving.position,

@@ -6,7 +6,7 @@ enter the fit; each fixed point is reported beside the simulator's principal poi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -21,9 +21,8 @@ from headsim.active.principal import (
     zoomed,
 )
 from headsim.codec import declared, doc
-from headsim.head.sim_head import SimHead
 from headsim.procedures.contract import Procedure, register
-from headsim.runs.context import simulator
+from headsim.runs.context import head
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord
 from headsim.runs.table import format_table
@@ -31,7 +30,6 @@ from headsim.scenario.spec import CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
 from headsim.sim import names
 from headsim.sim.declared import Section, Setting
-from headsim.sim.simulator import HeadSim
 
 if TYPE_CHECKING:
     from headsim.runs.recording import Recorder
@@ -141,15 +139,15 @@ def run_zoom_fixed_points(
     spec = scenario.experiment.block
     assert isinstance(spec, ZoomSpec)
     seed = scenario.seed if spec.board_seed is None else spec.board_seed
-    zoomed_head = zoomed(scenario.settings, spec.zoom)
+    twin = replace(scenario, settings=zoomed(scenario.settings, spec.zoom))
     with (
-        simulator(hub, "chessboard", scenario) as before,
-        HeadSim("chessboard", zoomed_head, settle_mode=scenario.settle_mode, sink=hub) as after,
+        head(hub, "chessboard", scenario) as before,
+        head(hub, "chessboard", twin) as after,
     ):
-        hub.emit(PhaseStarted("board views", before, knowledge, {}))
+        hub.emit(PhaseStarted("board views", before.truth, knowledge, {}))
         try:
             run = principal_points_by_zoom(
-                SimHead(before), SimHead(after), spec.zoom, np.random.default_rng(seed), spec.poses
+                before, after, spec.zoom, np.random.default_rng(seed), spec.poses
             )
         except PrincipalPointError as error:
             return [], NotFound(str(error))

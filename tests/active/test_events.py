@@ -20,6 +20,7 @@ from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
+from headsim.head.sim_head import SimHead
 from headsim.procedures.chessboard import measure_chessboard
 from headsim.procedures.tracking import track_moving_target
 from headsim.sim import names
@@ -111,7 +112,8 @@ def test_procedures_report_each_fixation_with_its_label_and_result() -> None:
     sink = ListSink()
     with HeadSim("chessboard", sink=sink) as sim:
         sim.set_body_pose(names.CHESSBOARD, [-0.105, 0.8, 0.285])
-        run = measure_chessboard(sim, EyeServo(sim), corners=[9, 10])
+        head = SimHead(sim)
+        run = measure_chessboard(head, EyeServo(head), corners=[9, 10])
     labels = [e.label for e in sink.of(FixationStarted)]
     assert labels == ["corner_1_1", "corner_2_1"]
     done = sink.of(MeasurementDone)
@@ -147,7 +149,8 @@ def test_calibration_reports_each_position_and_tracking_each_time() -> None:
         def path(t: float) -> np.ndarray:
             return np.array([0.05 * t, 0.7, 0.25])
 
-        tracked = track_moving_target(sim, NeckServo(sim), RED, "marker_red", path, [0.0, 0.5])
+        head = SimHead(sim)
+        tracked = track_moving_target(head, NeckServo(head), RED, "marker_red", path, [0.0, 0.5])
     assert [e.label for e in sink.of(FixationStarted)] == ["marker_red 1", "marker_red 2"]
     done = sink.of(MeasurementDone)
     assert [d.time_s for d in done] == [0.0, 0.5]

@@ -28,19 +28,17 @@ SIMULATOR = "headsim.sim.simulator"
 PACKAGE = Path(headsim.__file__).resolve().parent
 
 #: The modules of the servos and procedures that still import the simulator, and why.
-#: The quick start's (Model 2, Model 1, fixation, the calibration procedure, every servo)
-#: are not among them.
+#: The quick start's (Model 2, Model 1, fixation, the calibration procedure, every servo),
+#: the chessboard's, relative positioning's, tracking's and zoom_fixed_points' are not
+#: among them.
 STILL_IMPORTING = {
     # PhaseStarted carries the simulator to the recording: the truth channel, for drawing.
     "headsim.active.events",
-    # These build or stage their scenes on the simulator themselves (boards, blocks, moving
-    # targets, a zoomed twin) and hand their servos a SimHead over it.
-    "headsim.procedures.chessboard",
+    # Pursuit runs the live head (headsim.live), which steps the simulator's physics in time.
     "headsim.procedures.pursuit",
-    "headsim.procedures.relative",
+    # Zhang's calibration and the triangulation (headsim.stereo) take the simulator: they
+    # pose the board per view and score against the cameras' true poses.
     "headsim.procedures.stereo",
-    "headsim.procedures.tracking",
-    "headsim.procedures.zoom_fixed_points",
 }
 
 
@@ -117,3 +115,36 @@ def test_the_quick_start_runs_through_the_servo_head_alone(
         assert isinstance(head, ServoHead) and isinstance(head, Head)
     with pytest.raises(AssertionError, match="reached the simulator behind the head"):
         _ = heads[0].sim
+
+
+@pytest.mark.render
+@pytest.mark.parametrize(
+    ("name", "heads_built"),
+    # The calibration's head and the procedure's; zoom_fixed_points: the head and its twin.
+    [("tracking", 2), ("chessboard", 2), ("relative_positioning", 2), ("zoom_fixed_points", 2)],
+)
+def test_the_staging_procedures_run_on_the_head_the_runner_builds(
+    monkeypatch: pytest.MonkeyPatch, name: str, heads_built: int
+) -> None:
+    # They place their boards, blocks and moving targets through the truth channel and
+    # measure on the sealed head: the same results as on the plain one.
+    scenario = load_scenario(name, fast=True)
+    plain = run_scenario(scenario)
+    heads: list[SealedSimHead] = []
+
+    def sealed(sim: Any) -> SealedSimHead:
+        heads.append(SealedSimHead(sim))
+        return heads[-1]
+
+    monkeypatch.setattr(context, "HeadSim", GuardedSim)
+    monkeypatch.setattr(context, "SimHead", sealed)
+    sealed_run = run_scenario(scenario)
+    assert len(heads) == heads_built
+    assert sealed_run.failures == plain.failures == ()
+    assert len(sealed_run.records) == len(plain.records)
+    for a, b in zip(plain.records, sealed_run.records, strict=True):
+        assert np.array_equal(a.measurement.estimate_head_m, b.measurement.estimate_head_m)
+        assert a.measurement.renders == b.measurement.renders
+    assert repr(sealed_run.experiment) == repr(plain.experiment)
+    assert sealed_run.renders == plain.renders
+    assert all(head.render_count > 0 for head in heads)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
+from headsim.head.sim_head import SimHead
 from headsim.procedures.relative import relative_positioning
 from headsim.sim import names
 from headsim.sim.simulator import HeadSim
@@ -13,7 +14,7 @@ from headsim.vision.crosses import find_cross_point
 def test_relative_positioning_places_every_object_in_its_true_area() -> None:
     with HeadSim("blocks") as sim:
         run = relative_positioning(
-            sim,
+            SimHead(sim),
             EyeServo(sim),
             body_target(names.BLOCKS, find_cross_point),
             names.RELATIVE_OBJECT_COLOURS,

@@ -8,6 +8,7 @@ import numpy as np
 
 from headsim.active.measurement import body_target
 from headsim.active.neck_servo import NeckServo
+from headsim.head.sim_head import SimHead
 from headsim.procedures.tracking import track_moving_target
 from headsim.sim.settings import HeadSettings
 from headsim.sim.simulator import HeadSim
@@ -22,7 +23,8 @@ def test_tracking_follows_a_moving_target_with_fewer_renders_after_the_first() -
         def path(t: float) -> np.ndarray:
             return np.array([0.1 * np.sin(t), 0.8, 0.25 + 0.05 * t])
 
-        run = track_moving_target(sim, NeckServo(sim), RED, "marker_red", path, [0.0, 0.3, 0.6])
+        head = SimHead(sim)
+        run = track_moving_target(head, NeckServo(head), RED, "marker_red", path, [0.0, 0.3, 0.6])
         assert all(m.ok for m in run.measurements)
         assert np.all(run.errors_world_m < 0.006)
         renders = [m.renders for m in run.measurements]
@@ -41,8 +43,10 @@ def test_tracking_searches_around_its_last_fixation_for_a_target_that_left_both_
             return np.array([0.25 * t, 0.8, 0.3])
 
         assert not sim.stereo_view().sees_whole(path(1.0)[None], 0.01)[0]  # not from the start pose
-        servo = NeckServo(sim)
-        run = track_moving_target(sim, servo, RED, "marker_red", path, [0.0, 1.0, 2.0, 2.6])
+        head = SimHead(sim)
+        run = track_moving_target(
+            head, NeckServo(head), RED, "marker_red", path, [0.0, 1.0, 2.0, 2.6]
+        )
     assert all(m.ok for m in run.measurements), [m.status for m in run.measurements]
     searched = [m.search_renders for m in run.measurements]
     assert searched[0] == 0 and searched[1] > 0

@@ -7,6 +7,7 @@ import pytest
 
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import body_target
+from headsim.head.sim_head import SimHead
 from headsim.procedures.relative import relative_positioning
 from headsim.runs.context import PARKED_WORLD_M
 from headsim.scenario.area_layouts import area_layout, reference_angles
@@ -34,7 +35,10 @@ def test_objects_placed_in_the_magnitude_areas_are_classified_by_both_tests() ->
             sim.set_body_pose(body, sim.transform_points(p, "head", "world")[0])
         servo = EyeServo(sim)
         run = relative_positioning(
-            sim, servo, body_target(names.BLOCKS, find_cross_point), names.RELATIVE_OBJECT_COLOURS
+            SimHead(sim),
+            servo,
+            body_target(names.BLOCKS, find_cross_point),
+            names.RELATIVE_OBJECT_COLOURS,
         )
     assert run.reference.ok and run.missing == ()
     # The layout put each object where it was wanted (the fixations' whole steps
@@ -106,7 +110,7 @@ def test_a_ball_partly_hidden_by_another_counts_as_not_seen_not_as_a_biased_area
             )
         colours = {b: names.RELATIVE_OBJECT_COLOURS[b] for b in placed}
         run = relative_positioning(
-            sim, EyeServo(sim), body_target(names.BLOCKS, find_cross_point), colours
+            SimHead(sim), EyeServo(sim), body_target(names.BLOCKS, find_cross_point), colours
         )
     assert run.reference.ok
     # The half-hidden ball reads OCCLUDED (not a biased centroid); the whole one in

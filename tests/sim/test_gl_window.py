@@ -12,6 +12,7 @@ from headsim.active.model1 import measure_model1
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import ServoConfig
+from headsim.head.sim_head import SimHead
 from headsim.sim import gl_window, render
 from headsim.sim.render import Window
 from headsim.sim.settings import CameraSettings, HeadSettings, paper_head
@@ -300,7 +301,7 @@ def test_windows_change_no_chessboard_corner() -> None:
                 names.CHESSBOARD, sim.transform_points([-0.105, -0.075, 0.85], "head", "world")[0]
             )
             servo = LoggingServo(sim, ServoConfig(windows=windows))
-            run = measure_chessboard(sim, servo, HeadKnowledge(), corners=corners)
+            run = measure_chessboard(SimHead(sim), servo, HeadKnowledge(), corners=corners)
             runs[windows] = (run, sim.rendered_frames, sim.render_count, servo)
     (plain, plain_frames, plain_renders, plain_servo) = runs[False]
     (windowed, frames, renders, servo) = runs[True]
