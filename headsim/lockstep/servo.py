@@ -1,0 +1,432 @@
+"""The eye servo and Model 2 over heads in lockstep (:class:`~headsim.lockstep.settled.SettledHeads`).
+
+Every head runs the classic servo's law (:class:`headsim.active.eye_servo.EyeServo`: the
+probe, secant gains, the pixel-locking stop, retreats at half the move) on its own
+target; each round every head still servoing makes its move, then all of them settle in
+one batch call, one camera of all of them is drawn through one context and the markers
+are found over the stack (:func:`~headsim.lockstep.detect.find_markers_stacked`).  A
+head stops when it converges (or fails); the round goes on with the rest.  Model 2
+(:func:`headsim.active.model2.measure_model2`) runs its two steps, y images and
+near-midline remedy the same way, and estimates every head's point in one call of the
+pure estimator.  The classic path stays the reference (tests/lockstep compares them).
+
+What lockstep does not do: scanning the eye range for a target camera 1 does not see
+at the start, and searching for one camera 2 does not see where camera 1 fixates
+(:mod:`headsim.active.search`).  Such a head ends ``needs_classic`` with the reason, for a
+caller to measure on the classic path.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from headsim.active.failure import detection_failure, servo_failure
+from headsim.active.measurement import NOMINAL_PIXEL_SIGMA, HeadKnowledge
+from headsim.active.model2 import Model2Config, _nearest_seen
+from headsim.active.servo_types import ServoConfig, ServoOutcome, ServoResult
+from headsim.estimators import Uncertainty, model2
+from headsim.geometry.transforms import apply_transform
+from headsim.vision.detection import Detection, DetectionStatus
+
+from .detect import find_markers_stacked
+from .settled import SettledHeads
+
+
+@dataclass(frozen=True)
+class LockstepTarget:
+    """A marker a head measures: its name, colour, mocap body and true position (W, m)."""
+
+    name: str
+    colour: str
+    body: str
+    position_world_m: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class HeadEstimate:
+    """One head's Model 2 measurement: ``status`` "ok", "failed" or "needs_classic"
+    (``detail`` says why); estimate and truth in H, m; images taken; servo residuals, px."""
+
+    name: str
+    status: str
+    estimate_head_m: np.ndarray
+    truth_head_m: np.ndarray
+    renders: int
+    residuals_px: tuple[float, ...]
+    detail: str = ""
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def error_pct_of_depth(self) -> float:
+        """|estimate - truth| as a percentage of the true depth (NaN unless ok)."""
+        error = np.linalg.norm(self.estimate_head_m - self.truth_head_m)
+        return float(100.0 * error / self.truth_head_m[2])
+
+
+def observe(
+    heads: SettledHeads, ids: Sequence[int], camera: int, colours: Sequence[str]
+) -> list[Detection]:
+    """Camera ``camera``'s detection of each head's marker (``colours[row]``) now."""
+    if not len(ids):
+        return []
+    images = heads.render(np.asarray(ids, np.int64), camera)
+    out: list[Detection] = [Detection(DetectionStatus.LOST, None, 0.0)] * len(ids)
+    colour_of = np.array(colours)
+    for colour in dict.fromkeys(colours):
+        rows = np.flatnonzero(colour_of == colour)
+        for row, found in zip(rows, find_markers_stacked(images[rows], colour), strict=True):
+            out[row] = found
+    return out
+
+
+@dataclass
+class _Servo:
+    """One head's servo: the classic ``EyeServo._servo``'s state between moves."""
+
+    head: int
+    colour: str
+    goal: float
+    steps: int
+    uv: tuple[float, float]
+    gain: float | None
+    renders: int
+    probe: int
+    damping: float = 1.0
+    iteration: int = 1
+    retreats: int = 0
+    visited: dict[int, tuple[float, float]] = field(default_factory=dict)
+    path: list[tuple[int, float, float]] = field(default_factory=list)
+    move: int = 0
+    result: ServoResult | None = None
+
+    def finish(
+        self,
+        outcome: ServoOutcome,
+        steps: int,
+        uv: tuple[float, float] | None,
+        iterations: int,
+        lost: DetectionStatus | None = None,
+    ) -> None:
+        residual = math.nan if uv is None else uv[0] - self.goal
+        gain = self.gain
+        subpixel = float(steps) if gain is None or uv is None else steps - residual / gain
+        self.result = ServoResult(
+            outcome, steps, uv, residual, gain, subpixel, self.renders, iterations, lost,
+            tuple(self.path), self.retreats,
+        )  # fmt: skip
+
+
+def servo_heads(
+    heads: SettledHeads,
+    ids: Sequence[int],
+    camera: int,
+    colours: Sequence[str],
+    goals_u: Sequence[float],
+    gains: Sequence[float | None],
+    config: ServoConfig,
+    first: Sequence[Detection] | None = None,
+) -> list[ServoResult]:
+    """Drive each head's eye until ``camera`` sees its marker at its goal column, all in
+    lockstep; each head's result as :meth:`EyeServo.run`'s (no fixation averaging).
+    ``gains``: each head's gain to start from (None: probe); ``first``: detections already
+    made at the heads' eyes (saves a render)."""
+    low, high = heads.step_range
+    steps0 = heads.eye_steps(ids)
+    renders0 = 0
+    if first is None:
+        first = observe(heads, ids, camera, colours)
+        renders0 = 1
+    states = []
+    for row, head in enumerate(ids):
+        s = _Servo(
+            int(head), colours[row], float(goals_u[row]), int(steps0[row]),
+            (math.nan, math.nan), gains[row], renders0, config.probe_steps,
+        )  # fmt: skip
+        seen = first[row]
+        if not seen.found or seen.uv is None:
+            s.finish(ServoOutcome.TARGET_LOST, s.steps, None, 0, lost=seen.status)
+        else:
+            s.uv = seen.uv
+            s.visited[s.steps] = seen.uv
+            s.path.append((s.steps, *seen.uv))
+        states.append(s)
+    active = [s for s in states if s.result is None]
+    while active:
+        moving, settle_only = _decide(active, config, (low, high))
+        heads.command_eye_steps(
+            np.array([s.head for s, _ in settle_only], np.int64),
+            np.array([step for _, step in settle_only], np.int64),
+        )
+        targets = np.array([s.steps + s.move for s in moving], np.int64)
+        heads.command_eye_steps(np.array([s.head for s in moving], np.int64), targets)
+        images = observe(heads, [s.head for s in moving], camera, [s.colour for s in moving])
+        back = [
+            s
+            for s, target, d in zip(moving, targets, images, strict=True)
+            if _moved(s, int(target), d, config)
+        ]
+        heads.command_eye_steps(
+            np.array([s.head for s in back], np.int64), np.array([s.steps for s in back], np.int64)
+        )
+        active = [s for s in active if s.result is None]
+    return [s.result for s in states if s.result is not None]
+
+
+def _decide(
+    active: list[_Servo], cfg: ServoConfig, limits: tuple[int, int]
+) -> tuple[list[_Servo], list[tuple[_Servo, int]]]:
+    """Each head's next move (the classic loop's head): the heads that move, and those that
+    stop at a visited step they must go back to."""
+    moving, settle_only = [], []
+    for s in active:
+        iteration, gain, uv, steps = s.iteration, s.gain, s.uv, s.steps
+        error = uv[0] - s.goal
+        if gain is not None and abs(error) <= max(cfg.tolerance_px, 0.5 * abs(gain)):
+            s.finish(ServoOutcome.CONVERGED, steps, uv, iteration - 1)
+            continue
+        if gain is None:
+            move = s.probe if steps + s.probe <= limits[1] else -s.probe
+            move = round(move * s.damping) or (1 if move > 0 else -1)
+        else:
+            move = round(-s.damping * error / gain) or (-1 if error / gain > 0 else 1)
+        target = steps + move
+        if not limits[0] <= target <= limits[1]:
+            s.finish(ServoOutcome.JOINT_LIMIT, steps, uv, iteration - 1)
+            continue
+        if target in s.visited:
+            best = min(s.visited, key=lambda k: abs(s.visited[k][0] - s.goal))
+            if best != steps:
+                settle_only.append((s, best))
+            s.finish(ServoOutcome.CONVERGED, best, s.visited[best], iteration)
+            continue
+        s.move = move
+        moving.append(s)
+    return moving, settle_only
+
+
+def _moved(s: _Servo, target: int, detection: Detection, cfg: ServoConfig) -> bool:
+    """Take in a move's image (the classic loop's body); True when the move is undone."""
+    s.renders += 1
+    iteration, move = s.iteration, s.move
+    if not detection.found or detection.uv is None:
+        if s.retreats >= cfg.max_retreats or abs(move) <= 1:
+            s.finish(ServoOutcome.TARGET_LOST, target, None, iteration, lost=detection.status)
+            return False
+        s.retreats += 1
+        s.damping *= 0.5
+        s.iteration += 1
+        _out_of_moves(s, cfg)
+        return True
+    change = detection.uv[0] - s.uv[0]
+    if s.gain is None:
+        if abs(change) >= cfg.min_probe_px:
+            s.gain = change / move
+        else:
+            s.probe *= 4
+    elif abs(move) >= cfg.min_secant_steps and change != 0.0:
+        s.gain = change / move
+    s.steps, s.uv = target, detection.uv
+    s.visited[target] = detection.uv
+    s.path.append((target, *detection.uv))
+    s.iteration += 1
+    _out_of_moves(s, cfg)
+    return False
+
+
+def _out_of_moves(s: _Servo, cfg: ServoConfig) -> None:
+    """After the last move the classic loop allows: converged if within tolerance."""
+    if s.iteration <= cfg.max_iterations or s.result is not None:
+        return
+    done = s.gain is not None and abs(s.uv[0] - s.goal) <= max(cfg.tolerance_px, 0.5 * abs(s.gain))
+    outcome = ServoOutcome.CONVERGED if done else ServoOutcome.ITERATION_LIMIT
+    s.finish(outcome, s.steps, s.uv, cfg.max_iterations)
+
+
+def measure_model2_heads(
+    heads: SettledHeads,
+    targets: Sequence[LockstepTarget],
+    knowledge: HeadKnowledge,
+    config: Model2Config,
+    servo: ServoConfig,
+) -> list[HeadEstimate]:
+    """Model 2 on ``targets[i]`` by head i, every head in lockstep (see the module)."""
+    n = len(targets)
+    if n > heads.n:
+        raise ValueError(f"{n} targets for {heads.n} heads: at most one target a head")
+    settings = heads.settings
+    (u10, v10), (u20, v20) = (
+        knowledge.reference_of(settings, 1),
+        knowledge.reference_of(settings, 2),
+    )
+    colours = [t.colour for t in targets]
+    ids = list(range(n))
+    renders = np.zeros(n, np.int64)
+    ends: dict[int, tuple[str, str, tuple[float, ...]]] = {}
+
+    def end(head: int, status: str, detail: str, residuals: tuple[float, ...]) -> None:
+        ends[head] = (status, detail, residuals)
+
+    step1 = servo_heads(heads, ids, 1, colours, [u10] * n, [None] * n, servo)
+    for head, r in zip(ids, step1, strict=True):
+        renders[head] += r.renders
+        if r.outcome is ServoOutcome.TARGET_LOST and r.iterations == 0:
+            end(head, "needs_classic", "camera 1 does not see it at the start: a scan", ())
+        elif not r.converged:
+            end(head, "failed", servo_failure(r, "step 1", 1).message, (r.residual_px,))
+    go = [h for h in ids if h not in ends]
+    seen2 = observe(heads, go, 2, [colours[h] for h in go])
+    renders[go] += 1
+    for head, d in zip(go, seen2, strict=True):
+        if not d.found or d.uv is None:
+            end(
+                head,
+                "needs_classic",
+                "camera 2 does not see it where camera 1 fixates: a search",
+                (),
+            )
+    first2 = {h: d for h, d in zip(go, seen2, strict=True)}
+    go = [h for h in go if h not in ends]
+    gains2: list[float | None] = [None] * len(go)  # camera 2's gain: not learnt yet
+    step2_list = servo_heads(
+        heads, go, 2, [colours[h] for h in go], [u20] * len(go), gains2, servo,
+        first=[first2[h] for h in go],
+    )  # fmt: skip
+    step2 = dict(zip(go, step2_list, strict=True))
+    for head, r in step2.items():
+        renders[head] += r.renders
+        if not r.converged:
+            residuals = (step1[head].residual_px, r.residual_px)
+            end(head, "failed", servo_failure(r, "step 2", 2).message, residuals)
+    go = [h for h in go if h not in ends]
+    seen1 = observe(heads, go, 1, [colours[h] for h in go])
+    renders[go] += 1
+    uv1: dict[int, np.ndarray] = {}
+    gamma1: dict[int, int] = {}
+    for head, d in zip(go, seen1, strict=True):
+        if d.found and d.uv is not None:
+            uv1[head], gamma1[head] = np.array(d.uv), step2[head].steps
+            continue
+        memory = _nearest_seen(step1[head].seen, step2[head].steps, u10, config.midline_px)
+        if memory is None:
+            residuals = (step1[head].residual_px, step2[head].residual_px)
+            end(head, "failed", detection_failure(d, "step 2", 1).message, residuals)
+        else:
+            uv1[head], gamma1[head] = np.array(memory[1:]), memory[0]
+    go = [h for h in go if h not in ends]
+    uv2 = {h: np.array(first2[h].uv) for h in go}
+    gamma2 = {h: step1[h].steps for h in go}
+    _remedy(heads, go, colours, step1, step2, (u10, u20), config, uv1, uv2, gamma1, gamma2, renders)
+    resolution = heads.resolution_rad
+    estimates: dict[int, np.ndarray] = {}
+    if go:
+
+        def angle(r: ServoResult) -> float:
+            return (r.subpixel_steps if config.interpolate else float(r.steps)) * resolution
+
+        gain = min(min(abs(r.gain_px_per_step or 1.0) for r in (step1[h], step2[h])) for h in go)
+        sigma = (
+            resolution * NOMINAL_PIXEL_SIGMA / gain
+            if config.interpolate
+            else resolution / math.sqrt(12.0)
+        )
+        # The estimator's covariances are not compared here; one sigma serves every row.
+        estimate = model2(
+            [angle(step1[h]) for h in go],
+            [angle(step2[h]) for h in go],
+            np.array([uv1[h] for h in go]),
+            np.array([uv2[h] for h in go]),
+            knowledge.head_belief_of(settings).baseline_m,
+            uv10=(u10, v10),
+            uv20=(u20, v20),
+            alpha_e=knowledge.alpha_e,
+            gamma1=[gamma1[h] * resolution for h in go],
+            gamma2=[gamma2[h] * resolution for h in go],
+            kx_over_ky=knowledge.kx_over_ky,
+            uncertainty=Uncertainty(encoder=sigma, pixel=NOMINAL_PIXEL_SIGMA),
+            los_offset_m=knowledge.line_of_sight_offsets_of(settings),
+        )
+        for row, head in enumerate(go):
+            residuals = (step1[head].residual_px, step2[head].residual_px)
+            if bool(estimate.valid[row]):
+                estimates[head] = estimate.positions[row]
+                end(head, "ok", "", residuals)
+            else:
+                end(head, "failed", f"estimate: {estimate.reasons(row)!r}", residuals)
+    out = []
+    for head, target in enumerate(targets):
+        status, detail, spent = ends[head]
+        truth = apply_transform(heads.head_from_world(head), np.array(target.position_world_m))
+        truth = np.asarray(truth).reshape(3)
+        out.append(
+            HeadEstimate(
+                target.name,
+                status,
+                estimates.get(head, np.full(3, np.nan)),
+                truth,
+                int(renders[head]),
+                spent,
+                detail,
+            )
+        )
+    return out
+
+
+def _remedy(
+    heads: SettledHeads,
+    go: list[int],
+    colours: Sequence[str],
+    step1: Sequence[ServoResult],
+    step2: dict[int, ServoResult],
+    goals_u: tuple[float, float],
+    config: Model2Config,
+    uv1: dict[int, np.ndarray],
+    uv2: dict[int, np.ndarray],
+    gamma1: dict[int, int],
+    gamma2: dict[int, int],
+    renders: np.ndarray,
+) -> None:
+    """The near-midline remedy (``measure_model2``'s) for the heads that need it: both
+    cameras' images at an eye angle ``remedy_px`` of image motion off the fixations,
+    taken in place of a y image that lies farther from its goal column."""
+    u10, u20 = goals_u
+    low, high = heads.step_range
+    need, poses = [], []
+    for h in go:
+        if min(abs(uv1[h][0] - u10), abs(uv2[h][0] - u20)) >= config.midline_px:
+            continue
+        gain = max(abs(step1[h].gain_px_per_step or 0.0), abs(step2[h].gain_px_per_step or 0.0))
+        if gain == 0.0:
+            continue
+        offset = round(config.remedy_px / gain)
+        middle = (step1[h].steps + step2[h].steps) / 2
+        pose = round(middle - offset) if middle - offset >= low else round(middle + offset)
+        if low <= pose <= high:
+            need.append(h)
+            poses.append(pose)
+    if not need:
+        return
+    heads.command_eye_steps(np.array(need, np.int64), np.array(poses, np.int64))
+    seen = [observe(heads, need, camera, [colours[h] for h in need]) for camera in (1, 2)]
+    renders[need] += 2
+    for row, (h, pose) in enumerate(zip(need, poses, strict=True)):
+        r1, r2 = (s[row].uv if s[row].found else None for s in seen)
+        if r1 is not None and abs(r1[0] - u10) > abs(uv1[h][0] - u10):
+            uv1[h], gamma1[h] = np.array(r1), pose
+        if r2 is not None and abs(r2[0] - u20) > abs(uv2[h][0] - u20):
+            uv2[h], gamma2[h] = np.array(r2), pose
+
+
+__all__ = [
+    "HeadEstimate",
+    "LockstepTarget",
+    "measure_model2_heads",
+    "observe",
+    "servo_heads",
+]
