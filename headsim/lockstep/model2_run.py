@@ -15,7 +15,7 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.runs.context import model2_config, servo_config
 from headsim.scenario.spec import MARKER_BODIES, Scenario
 
-from .servo import HeadEstimate, LockstepTarget, measure_model2_heads
+from .servo import HeadEstimate, HeadJob, LockstepTarget, measure_model2_heads
 from .settled import SettledHeads
 
 
@@ -39,14 +39,13 @@ def run_model2_lockstep(scenario: Scenario, knowledge: HeadKnowledge) -> list[He
             "lockstep heads settle kinematically in the default scene; allowed: "
             "settle_mode = 'kinematic', no room"
         )
-    targets = scenario_targets(scenario)
-    with SettledHeads(len(targets), scenario.settings) as heads:
-        for head in range(len(targets)):
+    model2, servo = model2_config(scenario), servo_config(scenario)
+    jobs = [HeadJob(t, knowledge, model2, servo) for t in scenario_targets(scenario)]
+    with SettledHeads([scenario.settings] * len(jobs)) as heads:
+        for head in range(len(jobs)):
             for placed in scenario.scene.targets[: head + 1]:
                 heads.place(head, placed.body, np.array(placed.position_world_m))
-        return measure_model2_heads(
-            heads, targets, knowledge, model2_config(scenario), servo_config(scenario)
-        )
+        return measure_model2_heads(heads, jobs)
 
 
 __all__ = ["run_model2_lockstep", "scenario_targets"]

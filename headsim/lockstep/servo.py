@@ -78,10 +78,12 @@ def observe(
         return []
     images = heads.render(np.asarray(ids, np.int64), camera)
     out: list[Detection] = [Detection(DetectionStatus.LOST, None, 0.0)] * len(ids)
-    colour_of = np.array(colours)
-    for colour in dict.fromkeys(colours):
-        rows = np.flatnonzero(colour_of == colour)
-        for row, found in zip(rows, find_markers_stacked(images[rows], colour), strict=True):
+    groups: dict[tuple[str, tuple[int, ...]], list[int]] = {}
+    for row, (colour, image) in enumerate(zip(colours, images, strict=True)):
+        groups.setdefault((colour, image.shape), []).append(row)
+    for (colour, _), rows in groups.items():
+        stack = np.stack([images[row] for row in rows])
+        for row, found in zip(rows, find_markers_stacked(stack, colour), strict=True):
             out[row] = found
     return out
 
@@ -92,6 +94,7 @@ class _Servo:
 
     head: int
     colour: str
+    cfg: ServoConfig
     goal: float
     steps: int
     uv: tuple[float, float]
@@ -130,13 +133,13 @@ def servo_heads(
     colours: Sequence[str],
     goals_u: Sequence[float],
     gains: Sequence[float | None],
-    config: ServoConfig,
+    configs: Sequence[ServoConfig],
     first: Sequence[Detection] | None = None,
 ) -> list[ServoResult]:
     """Drive each head's eye until ``camera`` sees its marker at its goal column, all in
     lockstep; each head's result as :meth:`EyeServo.run`'s (no fixation averaging).
     ``gains``: each head's gain to start from (None: probe); ``first``: detections already
-    made at the heads' eyes (saves a render)."""
+    made at the heads' eyes (saves a render); ``configs``: each head's servo settings."""
     low, high = heads.step_range
     steps0 = heads.eye_steps(ids)
     renders0 = 0
@@ -145,9 +148,10 @@ def servo_heads(
         renders0 = 1
     states = []
     for row, head in enumerate(ids):
+        cfg = configs[row]
         s = _Servo(
-            int(head), colours[row], float(goals_u[row]), int(steps0[row]),
-            (math.nan, math.nan), gains[row], renders0, config.probe_steps,
+            int(head), colours[row], cfg, float(goals_u[row]), int(steps0[row]),
+            (math.nan, math.nan), gains[row], renders0, cfg.probe_steps,
         )  # fmt: skip
         seen = first[row]
         if not seen.found or seen.uv is None:
@@ -159,7 +163,7 @@ def servo_heads(
         states.append(s)
     active = [s for s in states if s.result is None]
     while active:
-        moving, settle_only = _decide(active, config, (low, high))
+        moving, settle_only = _decide(active, (low, high))
         heads.command_eye_steps(
             np.array([s.head for s, _ in settle_only], np.int64),
             np.array([step for _, step in settle_only], np.int64),
@@ -170,7 +174,7 @@ def servo_heads(
         back = [
             s
             for s, target, d in zip(moving, targets, images, strict=True)
-            if _moved(s, int(target), d, config)
+            if _moved(s, int(target), d)
         ]
         heads.command_eye_steps(
             np.array([s.head for s in back], np.int64), np.array([s.steps for s in back], np.int64)
@@ -180,13 +184,13 @@ def servo_heads(
 
 
 def _decide(
-    active: list[_Servo], cfg: ServoConfig, limits: tuple[int, int]
+    active: list[_Servo], limits: tuple[int, int]
 ) -> tuple[list[_Servo], list[tuple[_Servo, int]]]:
     """Each head's next move (the classic loop's head): the heads that move, and those that
     stop at a visited step they must go back to."""
     moving, settle_only = [], []
     for s in active:
-        iteration, gain, uv, steps = s.iteration, s.gain, s.uv, s.steps
+        cfg, iteration, gain, uv, steps = s.cfg, s.iteration, s.gain, s.uv, s.steps
         error = uv[0] - s.goal
         if gain is not None and abs(error) <= max(cfg.tolerance_px, 0.5 * abs(gain)):
             s.finish(ServoOutcome.CONVERGED, steps, uv, iteration - 1)
@@ -211,8 +215,9 @@ def _decide(
     return moving, settle_only
 
 
-def _moved(s: _Servo, target: int, detection: Detection, cfg: ServoConfig) -> bool:
+def _moved(s: _Servo, target: int, detection: Detection) -> bool:
     """Take in a move's image (the classic loop's body); True when the move is undone."""
+    cfg = s.cfg
     s.renders += 1
     iteration, move = s.iteration, s.move
     if not detection.found or detection.uv is None:
@@ -222,7 +227,7 @@ def _moved(s: _Servo, target: int, detection: Detection, cfg: ServoConfig) -> bo
         s.retreats += 1
         s.damping *= 0.5
         s.iteration += 1
-        _out_of_moves(s, cfg)
+        _out_of_moves(s)
         return True
     change = detection.uv[0] - s.uv[0]
     if s.gain is None:
@@ -236,12 +241,13 @@ def _moved(s: _Servo, target: int, detection: Detection, cfg: ServoConfig) -> bo
     s.visited[target] = detection.uv
     s.path.append((target, *detection.uv))
     s.iteration += 1
-    _out_of_moves(s, cfg)
+    _out_of_moves(s)
     return False
 
 
-def _out_of_moves(s: _Servo, cfg: ServoConfig) -> None:
+def _out_of_moves(s: _Servo) -> None:
     """After the last move the classic loop allows: converged if within tolerance."""
+    cfg = s.cfg
     if s.iteration <= cfg.max_iterations or s.result is not None:
         return
     done = s.gain is not None and abs(s.uv[0] - s.goal) <= max(cfg.tolerance_px, 0.5 * abs(s.gain))
@@ -249,23 +255,31 @@ def _out_of_moves(s: _Servo, cfg: ServoConfig) -> None:
     s.finish(outcome, s.steps, s.uv, cfg.max_iterations)
 
 
-def measure_model2_heads(
-    heads: SettledHeads,
-    targets: Sequence[LockstepTarget],
-    knowledge: HeadKnowledge,
-    config: Model2Config,
-    servo: ServoConfig,
-) -> list[HeadEstimate]:
-    """Model 2 on ``targets[i]`` by head i, every head in lockstep (see the module)."""
-    n = len(targets)
+@dataclass(frozen=True)
+class HeadJob:
+    """What one head measures with: its target, what it knows, its Model 2 and servo
+    settings."""
+
+    target: LockstepTarget
+    knowledge: HeadKnowledge
+    model2: Model2Config
+    servo: ServoConfig
+
+
+def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[HeadEstimate]:
+    """Model 2 on ``jobs[i].target`` by head i, every head in lockstep (see the module)."""
+    n = len(jobs)
     if n > heads.n:
         raise ValueError(f"{n} targets for {heads.n} heads: at most one target a head")
-    settings = heads.settings
-    (u10, v10), (u20, v20) = (
-        knowledge.reference_of(settings, 1),
-        knowledge.reference_of(settings, 2),
-    )
-    colours = [t.colour for t in targets]
+    refs = [
+        (
+            j.knowledge.reference_of(heads.settings[h], 1),
+            j.knowledge.reference_of(heads.settings[h], 2),
+        )
+        for h, j in enumerate(jobs)
+    ]
+    colours = [j.target.colour for j in jobs]
+    servos = [j.servo for j in jobs]
     ids = list(range(n))
     renders = np.zeros(n, np.int64)
     ends: dict[int, tuple[str, str, tuple[float, ...]]] = {}
@@ -273,108 +287,179 @@ def measure_model2_heads(
     def end(head: int, status: str, detail: str, residuals: tuple[float, ...]) -> None:
         ends[head] = (status, detail, residuals)
 
-    step1 = servo_heads(heads, ids, 1, colours, [u10] * n, [None] * n, servo)
+    def pick(rows: list[int]) -> tuple[list[str], list[ServoConfig]]:
+        return [colours[h] for h in rows], [servos[h] for h in rows]
+
+    goals1 = [refs[h][0][0] for h in ids]
+    step1 = servo_heads(heads, ids, 1, colours, goals1, [None] * n, servos)
     for head, r in zip(ids, step1, strict=True):
         renders[head] += r.renders
         if r.outcome is ServoOutcome.TARGET_LOST and r.iterations == 0:
-            end(head, "needs_classic", "camera 1 does not see it at the start: a scan", ())
+            end(head, NEEDS_CLASSIC, "camera 1 does not see it at the start: a scan", ())
         elif not r.converged:
             end(head, "failed", servo_failure(r, "step 1", 1).message, (r.residual_px,))
     go = [h for h in ids if h not in ends]
-    seen2 = observe(heads, go, 2, [colours[h] for h in go])
+    seen2 = observe(heads, go, 2, pick(go)[0])
     renders[go] += 1
     for head, d in zip(go, seen2, strict=True):
         if not d.found or d.uv is None:
-            end(
-                head,
-                "needs_classic",
-                "camera 2 does not see it where camera 1 fixates: a search",
-                (),
-            )
-    first2 = {h: d for h, d in zip(go, seen2, strict=True)}
+            why = "camera 2 does not see it where camera 1 fixates: a search"
+            end(head, NEEDS_CLASSIC, why, ())
+    first2 = dict(zip(go, seen2, strict=True))
     go = [h for h in go if h not in ends]
-    gains2: list[float | None] = [None] * len(go)  # camera 2's gain: not learnt yet
-    step2_list = servo_heads(
-        heads, go, 2, [colours[h] for h in go], [u20] * len(go), gains2, servo,
-        first=[first2[h] for h in go],
-    )  # fmt: skip
-    step2 = dict(zip(go, step2_list, strict=True))
+    step2 = dict(
+        zip(
+            go,
+            servo_heads(
+                heads,
+                go,
+                2,
+                pick(go)[0],
+                [refs[h][1][0] for h in go],
+                [None] * len(go),
+                pick(go)[1],
+                first=[first2[h] for h in go],
+            ),
+            strict=True,
+        )
+    )
     for head, r in step2.items():
         renders[head] += r.renders
         if not r.converged:
             residuals = (step1[head].residual_px, r.residual_px)
             end(head, "failed", servo_failure(r, "step 2", 2).message, residuals)
     go = [h for h in go if h not in ends]
-    seen1 = observe(heads, go, 1, [colours[h] for h in go])
+    seen1 = observe(heads, go, 1, pick(go)[0])
     renders[go] += 1
-    uv1: dict[int, np.ndarray] = {}
-    gamma1: dict[int, int] = {}
+    images = _Images(
+        {}, {h: np.array(first2[h].uv) for h in go}, {}, {h: step1[h].steps for h in go}
+    )
     for head, d in zip(go, seen1, strict=True):
         if d.found and d.uv is not None:
-            uv1[head], gamma1[head] = np.array(d.uv), step2[head].steps
+            images.uv1[head], images.gamma1[head] = np.array(d.uv), step2[head].steps
             continue
-        memory = _nearest_seen(step1[head].seen, step2[head].steps, u10, config.midline_px)
+        memory = _nearest_seen(
+            step1[head].seen, step2[head].steps, refs[head][0][0], jobs[head].model2.midline_px
+        )
         if memory is None:
             residuals = (step1[head].residual_px, step2[head].residual_px)
             end(head, "failed", detection_failure(d, "step 2", 1).message, residuals)
         else:
-            uv1[head], gamma1[head] = np.array(memory[1:]), memory[0]
+            images.uv1[head], images.gamma1[head] = np.array(memory[1:]), memory[0]
     go = [h for h in go if h not in ends]
-    uv2 = {h: np.array(first2[h].uv) for h in go}
-    gamma2 = {h: step1[h].steps for h in go}
-    _remedy(heads, go, colours, step1, step2, (u10, u20), config, uv1, uv2, gamma1, gamma2, renders)
-    resolution = heads.resolution_rad
-    estimates: dict[int, np.ndarray] = {}
-    if go:
-
-        def angle(r: ServoResult) -> float:
-            return (r.subpixel_steps if config.interpolate else float(r.steps)) * resolution
-
-        gain = min(min(abs(r.gain_px_per_step or 1.0) for r in (step1[h], step2[h])) for h in go)
-        sigma = (
-            resolution * NOMINAL_PIXEL_SIGMA / gain
-            if config.interpolate
-            else resolution / math.sqrt(12.0)
-        )
-        # The estimator's covariances are not compared here; one sigma serves every row.
-        estimate = model2(
-            [angle(step1[h]) for h in go],
-            [angle(step2[h]) for h in go],
-            np.array([uv1[h] for h in go]),
-            np.array([uv2[h] for h in go]),
-            knowledge.head_belief_of(settings).baseline_m,
-            uv10=(u10, v10),
-            uv20=(u20, v20),
-            alpha_e=knowledge.alpha_e,
-            gamma1=[gamma1[h] * resolution for h in go],
-            gamma2=[gamma2[h] * resolution for h in go],
-            kx_over_ky=knowledge.kx_over_ky,
-            uncertainty=Uncertainty(encoder=sigma, pixel=NOMINAL_PIXEL_SIGMA),
-            los_offset_m=knowledge.line_of_sight_offsets_of(settings),
-        )
-        for row, head in enumerate(go):
-            residuals = (step1[head].residual_px, step2[head].residual_px)
-            if bool(estimate.valid[row]):
-                estimates[head] = estimate.positions[row]
-                end(head, "ok", "", residuals)
-            else:
-                end(head, "failed", f"estimate: {estimate.reasons(row)!r}", residuals)
+    _remedy(heads, go, colours, step1, step2, refs, jobs, images, renders)
+    estimates = _estimate(heads, go, jobs, refs, step1, step2, images)
+    for head in go:
+        residuals = (step1[head].residual_px, step2[head].residual_px)
+        found = estimates[head]
+        if isinstance(found, str):
+            end(head, "failed", found, residuals)
+        else:
+            end(head, "ok", "", residuals)
     out = []
-    for head, target in enumerate(targets):
+    for head, job in enumerate(jobs):
         status, detail, spent = ends[head]
-        truth = apply_transform(heads.head_from_world(head), np.array(target.position_world_m))
-        truth = np.asarray(truth).reshape(3)
+        truth = apply_transform(heads.head_from_world(head), np.array(job.target.position_world_m))
+        estimate = estimates.get(head)
         out.append(
             HeadEstimate(
-                target.name,
+                job.target.name,
                 status,
-                estimates.get(head, np.full(3, np.nan)),
-                truth,
+                estimate if isinstance(estimate, np.ndarray) else np.full(3, np.nan),
+                np.asarray(truth).reshape(3),
                 int(renders[head]),
                 spent,
                 detail,
             )
         )
+    return out
+
+
+#: A head's status when lockstep stops short of what the classic path would do next.
+NEEDS_CLASSIC = "needs_classic"
+
+
+@dataclass
+class _Images:
+    """Each head's y images (px) and the eye steps they were taken at."""
+
+    uv1: dict[int, np.ndarray]
+    uv2: dict[int, np.ndarray]
+    gamma1: dict[int, int]
+    gamma2: dict[int, int]
+
+
+#: What the estimator is told, shared by the heads estimated in one call.
+_Key = tuple[
+    float,
+    tuple[tuple[float, float], tuple[float, float]],
+    tuple[float, float],
+    tuple[float, float],
+    tuple[float, float],
+    float,
+    bool,
+    float,
+]
+
+
+def _estimate(
+    heads: SettledHeads,
+    go: list[int],
+    jobs: Sequence[HeadJob],
+    refs: Sequence[tuple[tuple[float, float], tuple[float, float]]],
+    step1: Sequence[ServoResult],
+    step2: dict[int, ServoResult],
+    images: _Images,
+) -> dict[int, np.ndarray | str]:
+    """Each head's point in H (or why the estimator refused it): one call of the pure
+    estimator for all the heads that share what it is told (``measure_model2``'s inputs)."""
+    groups: dict[_Key, list[int]] = {}
+    for h in go:
+        knowledge, config = jobs[h].knowledge, jobs[h].model2
+        resolution = float(heads.resolution_rad[h])
+        gain = min(abs(r.gain_px_per_step or 1.0) for r in (step1[h], step2[h]))
+        sigma = (
+            resolution * NOMINAL_PIXEL_SIGMA / gain
+            if config.interpolate
+            else resolution / math.sqrt(12.0)
+        )
+        settings = heads.settings[h]
+        key: _Key = (
+            knowledge.head_belief_of(settings).baseline_m,
+            refs[h],
+            knowledge.alpha_e,
+            knowledge.kx_over_ky,
+            knowledge.line_of_sight_offsets_of(settings),
+            sigma,
+            config.interpolate,
+            resolution,
+        )
+        groups.setdefault(key, []).append(h)
+    out: dict[int, np.ndarray | str] = {}
+    for key, rows in groups.items():
+        baseline, ref, alpha_e, kx_over_ky, los, sigma, interpolate, resolution = key
+
+        def angle(r: ServoResult, interpolate: bool = interpolate) -> float:
+            return (r.subpixel_steps if interpolate else float(r.steps)) * resolution  # noqa: B023
+
+        estimate = model2(
+            [angle(step1[h]) for h in rows],
+            [angle(step2[h]) for h in rows],
+            np.array([images.uv1[h] for h in rows]),
+            np.array([images.uv2[h] for h in rows]),
+            baseline,
+            uv10=ref[0],
+            uv20=ref[1],
+            alpha_e=alpha_e,
+            gamma1=[images.gamma1[h] * resolution for h in rows],
+            gamma2=[images.gamma2[h] * resolution for h in rows],
+            kx_over_ky=kx_over_ky,
+            uncertainty=Uncertainty(encoder=sigma, pixel=NOMINAL_PIXEL_SIGMA),
+            los_offset_m=los,
+        )
+        for row, h in enumerate(rows):
+            valid = bool(estimate.valid[row])
+            out[h] = estimate.positions[row] if valid else f"estimate: {estimate.reasons(row)!r}"
     return out
 
 
@@ -384,22 +469,20 @@ def _remedy(
     colours: Sequence[str],
     step1: Sequence[ServoResult],
     step2: dict[int, ServoResult],
-    goals_u: tuple[float, float],
-    config: Model2Config,
-    uv1: dict[int, np.ndarray],
-    uv2: dict[int, np.ndarray],
-    gamma1: dict[int, int],
-    gamma2: dict[int, int],
+    refs: Sequence[tuple[tuple[float, float], tuple[float, float]]],
+    jobs: Sequence[HeadJob],
+    images: _Images,
     renders: np.ndarray,
 ) -> None:
     """The near-midline remedy (``measure_model2``'s) for the heads that need it: both
     cameras' images at an eye angle ``remedy_px`` of image motion off the fixations,
     taken in place of a y image that lies farther from its goal column."""
-    u10, u20 = goals_u
     low, high = heads.step_range
     need, poses = [], []
     for h in go:
-        if min(abs(uv1[h][0] - u10), abs(uv2[h][0] - u20)) >= config.midline_px:
+        (u10, _), (u20, _) = refs[h]
+        config = jobs[h].model2
+        if min(abs(images.uv1[h][0] - u10), abs(images.uv2[h][0] - u20)) >= config.midline_px:
             continue
         gain = max(abs(step1[h].gain_px_per_step or 0.0), abs(step2[h].gain_px_per_step or 0.0))
         if gain == 0.0:
@@ -416,15 +499,18 @@ def _remedy(
     seen = [observe(heads, need, camera, [colours[h] for h in need]) for camera in (1, 2)]
     renders[need] += 2
     for row, (h, pose) in enumerate(zip(need, poses, strict=True)):
+        (u10, _), (u20, _) = refs[h]
         r1, r2 = (s[row].uv if s[row].found else None for s in seen)
-        if r1 is not None and abs(r1[0] - u10) > abs(uv1[h][0] - u10):
-            uv1[h], gamma1[h] = np.array(r1), pose
-        if r2 is not None and abs(r2[0] - u20) > abs(uv2[h][0] - u20):
-            uv2[h], gamma2[h] = np.array(r2), pose
+        if r1 is not None and abs(r1[0] - u10) > abs(images.uv1[h][0] - u10):
+            images.uv1[h], images.gamma1[h] = np.array(r1), pose
+        if r2 is not None and abs(r2[0] - u20) > abs(images.uv2[h][0] - u20):
+            images.uv2[h], images.gamma2[h] = np.array(r2), pose
 
 
 __all__ = [
+    "NEEDS_CLASSIC",
     "HeadEstimate",
+    "HeadJob",
     "LockstepTarget",
     "measure_model2_heads",
     "observe",

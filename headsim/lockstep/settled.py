@@ -24,7 +24,7 @@ from headsim.geometry.transforms import homogeneous, invert_transform
 from headsim.sim import imperfections, names
 from headsim.sim.heads import eye_motor_range
 from headsim.sim.joints import Commands, true_targets
-from headsim.sim.model import HEAD_PREFIX, build_model
+from headsim.sim.model import HEAD_PREFIX, BuiltModel, build_model
 from headsim.sim.settings import HeadSettings, SettingsError
 
 from .heads import _given
@@ -32,47 +32,63 @@ from .opengl import EyeView, ViewRenderer
 
 
 class SettledHeads:
-    """``n`` heads of ``settings`` at rest in ``scene``; the eye motor commanded in whole
-    encoder steps (the neck stays home).  Image k of camera c of head i carries noise from
-    the stream ((seed, i), c, k): each head's own, apart from the classic simulator's."""
+    """Heads at rest in ``scene``, one per entry of ``settings`` (each its own cameras,
+    tolerances, noise; one kind of head); the eye motor commanded in whole encoder steps
+    (the neck stays home).  Image k of camera c of head i carries noise from the stream
+    ((seed, i), c, k): each head's own, apart from the classic simulator's."""
 
-    def __init__(self, n: int, settings: HeadSettings, scene: str = "default") -> None:
-        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-            raise SettingsError(f"n must be a whole number >= 1, got {n!r}")
-        if len({(c.width, c.height) for c in settings.cameras}) != 1:
-            raise SettingsError("lockstep heads need both cameras of one image size")
-        self.n, self.settings = n, settings
-        self.built = build_model(scene, settings)
-        self.model = model = self.built.model
-        self.names = mapping = self.built.names
+    def __init__(self, settings: Sequence[HeadSettings], scene: str = "default") -> None:
+        if not settings:
+            raise SettingsError("settled lockstep heads need at least one head's settings")
+        self.n = len(settings)
+        self.settings = list(settings)
+        builds: dict[HeadSettings, BuiltModel] = {}
+        for s in settings:
+            if s not in builds:
+                builds[s] = build_model(scene, s)
+        self.built = [builds[s] for s in settings]
+        first = self.built[0]
+        self.names = mapping = first.names
         if mapping.independent or mapping.version is not None:
             raise SettingsError(
                 "settled lockstep heads drive one eye motor (coupled eyes); "
                 "allowed: a head whose eyes share one motor"
             )
-        home_name = names.HOME if settings.head.is_paper else HEAD_PREFIX + names.HOME
-        home = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, home_name)
-        self.batch = mj_batch.Batch(model, n, nthread=1, persistent=True)
-        self.batch.reset(keyframe=home)
+        if len({b.names for b in builds.values()}) != 1:
+            raise SettingsError("settled lockstep heads must be one kind of head")
+        model = first.model
+        home_name = names.HOME if settings[0].head.is_paper else HEAD_PREFIX + names.HOME
+        homes = [mujoco.mj_name2id(b.model, mujoco.mjtObj.mjOBJ_KEY, home_name) for b in self.built]
+        self.batch = mj_batch.Batch(model, self.n, nthread=1, persistent=True)
+        if len(builds) > 1:
+            self.batch.set_models([b.model for b in self.built])
+        self.batch.reset(keyframe=np.array(homes))
         self._qpos = self.batch.bind("qpos")
         self._mocap_pos = self.batch.bind("mocap_pos")
         self._eyes = np.array(
             [int(model.joint(j).qposadr[0]) for j in (mapping.left_eye, mapping.right_eye)]
         )
-        self._data = [mujoco.MjData(model) for _ in range(n)]
-        self._commands = [Commands() for _ in range(n)]
-        self.resolution_rad = settings.encoder_resolution_rad
-        low, high = eye_motor_range(model, mapping)
+        self._data = [mujoco.MjData(b.model) for b in self.built]
+        self._commands = [Commands() for _ in range(self.n)]
+        #: Each head's encoder resolution, rad.
+        self.resolution_rad = np.array([s.encoder_resolution_rad for s in settings])
+        ranges = set()
+        for b, resolution in zip(self.built, self.resolution_rad, strict=True):
+            low, high = eye_motor_range(b.model, mapping)
+            ranges.add((math.ceil(low / resolution), math.floor(high / resolution)))
+        if len(ranges) != 1:
+            raise SettingsError(f"settled lockstep heads must share one eye range, got {ranges}")
         #: The eye motor's range, whole encoder steps.
-        self.step_range = (
-            math.ceil(low / self.resolution_rad),
-            math.floor(high / self.resolution_rad),
-        )
-        self._stages = tuple(
-            imperfections.prepare(c, canvas)
-            for c, canvas in zip(settings.cameras, self.built.canvases, strict=True)
-        )
-        self._taken = np.zeros((n, 2), np.int64)
+        self.step_range: tuple[int, int] = ranges.pop()
+        stages: dict[HeadSettings, tuple[imperfections.Stages, imperfections.Stages]] = {
+            s: (
+                imperfections.prepare(s.cameras[0], b.canvases[0]),
+                imperfections.prepare(s.cameras[1], b.canvases[1]),
+            )
+            for s, b in builds.items()
+        }
+        self._stages = [stages[s] for s in settings]
+        self._taken = np.zeros((self.n, 2), np.int64)
         self._renderer: ViewRenderer | None = None
         #: Eye images drawn, and the heads' kinematic updates.
         self.images = 0
@@ -81,8 +97,9 @@ class SettledHeads:
     # -- the scene ---------------------------------------------------------------
     def place(self, head: int, body: str, position_world_m: np.ndarray) -> None:
         """Put mocap body ``body`` of head ``head``'s scene at ``position_world_m``."""
-        body_id = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, body)
-        mocap = int(self.model.body_mocapid[body_id]) if body_id >= 0 else -1
+        model = self.built[head].model
+        body_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body)
+        mocap = int(model.body_mocapid[body_id]) if body_id >= 0 else -1
         if mocap < 0:
             raise SettingsError(f"{body!r} is not a movable (mocap) body in this scene")
         self._mocap_pos[head, mocap] = position_world_m
@@ -103,11 +120,11 @@ class SettledHeads:
         angles = np.empty((len(ids), 2))
         for row, (head, step) in enumerate(zip(ids, steps, strict=True)):
             commands = self._commands[head]
-            angle = int(step) * self.resolution_rad
+            angle = int(step) * float(self.resolution_rad[head])
             if angle != commands.eye:
                 commands.approach["eye"] = 1.0 if angle > commands.eye else -1.0
             commands.eye = angle
-            true = true_targets(self.settings, commands, ("eye",))["eye"]
+            true = true_targets(self.settings[head], commands, ("eye",))["eye"]
             angles[row] = true  # coupled: Ca2's eye follows the one motor
         self._qpos[ids[:, None], self._eyes] = angles
         self.batch.forward(ids)
@@ -117,46 +134,55 @@ class SettledHeads:
         """``heads``' eye encoders, whole steps: the command with joint errors (they lie
         beyond the motor's shaft), else the joint, as the classic simulator reads them."""
         ids = np.asarray(heads, np.int64)
-        if self.settings.joint_errors:
-            read = np.array([self._commands[h].eye for h in ids])
-        else:
-            read = self._qpos[ids, self._eyes[0]]
-        return np.round(read / self.resolution_rad).astype(np.int64)
+        joint = self._qpos[ids, self._eyes[0]]
+        read = np.array(
+            [
+                self._commands[h].eye if self.settings[h].joint_errors else joint[row]
+                for row, h in enumerate(ids)
+            ]
+        )
+        return np.round(read / self.resolution_rad[ids]).astype(np.int64)
 
     # -- images ------------------------------------------------------------------
-    def render(self, heads: Sequence[int] | np.ndarray, camera: int) -> np.ndarray:
-        """Camera ``camera`` (1 or 2) of each of ``heads``: (m, H, W, 3) uint8, full frames
+    def render(self, heads: Sequence[int] | np.ndarray, camera: int) -> list[np.ndarray]:
+        """Camera ``camera`` (1 or 2) of each of ``heads``: (H, W, 3) uint8 each, full frames
         drawn through one context, each finished with its head's own noise."""
         ids = np.asarray(heads, np.int64)
         index = camera - 1
-        canvas = self.built.canvases[index]
-        cam_name = self.names.cameras[index]
-        k = self.settings.render.supersample
-        views = [
-            EyeView(
-                self.model, self.batch.get_data(int(h), self._data[h]), cam_name, canvas.size, k
+        views = []
+        for h in ids:
+            built, k = self.built[h], self.settings[h].render.supersample
+            data = self.batch.get_data(int(h), self._data[h])
+            views.append(
+                EyeView(
+                    built.model, data, built.names.cameras[index], built.canvases[index].size, k
+                )
             )
-            for h in ids
-        ]
-        if self._renderer is None:
-            largest = (
-                max(c.size[0] for c in self.built.canvases),
-                max(c.size[1] for c in self.built.canvases),
-            )
-            self._renderer = ViewRenderer(self.model, (k * largest[0], k * largest[1]))
-        canvases = self._renderer.draw(views) if views else []
-        size = (self.settings.cameras[index].width, self.settings.cameras[index].height)
+        if not views:
+            return []
+        need = (
+            max(v.supersample * v.canvas_px[0] for v in views),
+            max(v.supersample * v.canvas_px[1] for v in views),
+        )
+        renderer = self._renderer
+        if renderer is not None and (
+            renderer.largest_px[0] < need[0] or renderer.largest_px[1] < need[1]
+        ):
+            renderer.close()
+            renderer = None
+        if renderer is None:
+            renderer = self._renderer = ViewRenderer(views[0].model, need)
         images = []
-        for head, drawn in zip(ids, canvases, strict=True):
+        for head, drawn in zip(ids, renderer.draw(views), strict=True):
+            camera_settings = self.settings[head].cameras[index]
+            size = (camera_settings.width, camera_settings.height)
             shot = imperfections.Shot(
-                (self.settings.seed, int(head)), int(self._taken[head, index]), size
+                (self.settings[head].seed, int(head)), int(self._taken[head, index]), size
             )
             self._taken[head, index] += 1
-            images.append(imperfections.finish(_given(drawn), self._stages[index], shot))
+            images.append(imperfections.finish(_given(drawn), self._stages[head][index], shot))
         self.images += len(images)
-        if not images:
-            return np.empty((0, size[1], size[0], 3), np.uint8)
-        return np.stack(images)
+        return images
 
     @property
     def opengl_cpu_s(self) -> float:
