@@ -65,9 +65,19 @@ class SettledHeads:
         self.batch.reset(keyframe=np.array(homes))
         self._qpos = self.batch.bind("qpos")
         self._mocap_pos = self.batch.bind("mocap_pos")
-        self._eyes = np.array(
-            [int(model.joint(j).qposadr[0]) for j in (mapping.left_eye, mapping.right_eye)]
-        )
+        # The motors HeadSim settles, and the joints each one moves (Ca2's eye with Ca1's).
+        self._motors = tuple(
+            motor
+            for motor, joint in (("neck_yaw", mapping.neck_yaw), ("neck_pitch", mapping.neck_pitch))
+            if joint is not None
+        ) + ("eye",)
+        joints = [
+            j
+            for j in (mapping.neck_yaw, mapping.neck_pitch, mapping.left_eye, mapping.right_eye)
+            if j is not None
+        ]
+        self._joints = np.array([int(model.joint(j).qposadr[0]) for j in joints])
+        self._eyes = self._joints[-2:]
         self._data = [mujoco.MjData(b.model) for b in self.built]
         self._commands = [Commands() for _ in range(self.n)]
         #: Each head's encoder resolution, rad.
@@ -113,20 +123,22 @@ class SettledHeads:
 
     # -- motors and encoders -----------------------------------------------------
     def command_eye_steps(self, heads: np.ndarray, steps: np.ndarray) -> None:
-        """Command ``heads``' eye motors to ``steps`` and settle them (one batch call)."""
+        """Command ``heads``' eye motors to ``steps`` and settle every motor as the classic
+        simulator does (each joint where it truly settles: the neck's too), in one batch call."""
         ids = np.asarray(heads, np.int64)
         if ids.size == 0:
             return
-        angles = np.empty((len(ids), 2))
+        angles = np.empty((len(ids), len(self._joints)))
         for row, (head, step) in enumerate(zip(ids, steps, strict=True)):
             commands = self._commands[head]
             angle = int(step) * float(self.resolution_rad[head])
             if angle != commands.eye:
                 commands.approach["eye"] = 1.0 if angle > commands.eye else -1.0
             commands.eye = angle
-            true = true_targets(self.settings[head], commands, ("eye",))["eye"]
-            angles[row] = true  # coupled: Ca2's eye follows the one motor
-        self._qpos[ids[:, None], self._eyes] = angles
+            true = true_targets(self.settings[head], commands, self._motors)
+            # Coupled: Ca2's eye follows the one motor.
+            angles[row] = [true[m] for m in self._motors] + [true["eye"]]
+        self._qpos[ids[:, None], self._joints] = angles
         self.batch.forward(ids)
         self.settles += len(ids)
 
