@@ -59,6 +59,7 @@ def compare(fast: bool, seed: int) -> list[dict[str, Any]]:
                 "variant": "fast" if fast else "full",
                 "seed": seed,
                 "target": m.name,
+                "first": c is classic[0],
                 "depth_m": depth,
                 "classic_ok": m.ok,
                 "lockstep_status": lk.status,
@@ -113,6 +114,14 @@ def main() -> None:
         "lockstep_vs_classic_pct": spread(
             [r["lockstep_vs_classic_pct"] for r in rows if r["lockstep_vs_classic_pct"] is not None]
         ),
+        # The first target: both paths start alike (home, no gain learnt).
+        "lockstep_vs_classic_first_target_pct": spread(
+            [
+                r["lockstep_vs_classic_pct"]
+                for r in rows
+                if r["first"] and r["lockstep_vs_classic_pct"] is not None
+            ]
+        ),
         "classic_reseeded_vs_classic_pct": spread(
             [
                 r["classic_reseeded_vs_classic_pct"]
@@ -122,9 +131,12 @@ def main() -> None:
         ),
     }
     write_json_atomic(out / "figures.json", figures)
-    print(f"targets {figures['targets']}: lockstep ok {figures['lockstep_ok']}, classic ok "
-          f"{figures['classic_ok']}")
+    print(
+        f"targets {figures['targets']}: lockstep ok {figures['lockstep_ok']}, classic ok "
+        f"{figures['classic_ok']}"
+    )
     print(f"|lockstep - classic|, % of depth: {figures['lockstep_vs_classic_pct']}")
+    print(f"  first targets (same start): {figures['lockstep_vs_classic_first_target_pct']}")
     print(f"|classic reseeded - classic|, % of depth: {figures['classic_reseeded_vs_classic_pct']}")
     print(f"figures: {out / 'figures.json'}")
 

@@ -24,10 +24,13 @@ from headsim.scenario.loading import load_scenario
 from headsim.sim.settings import HeadSettings, SettingsError
 
 #: Largest |lockstep - classic| of one target's estimate, % of depth.  Measured on the
-#: quick start (benchmarks/lockstep_model2.py, 6 seeds): up to 0.31 %, while the classic
-#: path against itself at another noise seed reaches 0.19 %; the two start each target
-#: differently (lockstep: from home, no gain; classic: where the last target left it).
-AGREEMENT_PCT = 0.5
+#: quick start (benchmarks/lockstep_model2.py, 6 seeds, fast and full: 48 targets): up to
+#: 0.49 %, while the classic path against itself at another noise seed reaches 0.57 %;
+#: the two start each target differently (lockstep: from home, no gain; classic: where
+#: the last target left it, with its gains).
+AGREEMENT_PCT = 0.6
+#: The same for the first target, where both start alike (measured: at most 0.002 %).
+SAME_START_PCT = 0.01
 
 
 def test_model2_in_lockstep_measures_the_quick_starts_targets_as_the_classic_path() -> None:
@@ -41,7 +44,8 @@ def test_model2_in_lockstep_measures_the_quick_starts_targets_as_the_classic_pat
         assert m.ok and estimate.ok, (m.status_text, estimate.detail)
         np.testing.assert_allclose(estimate.truth_head_m, m.truth_head_m, atol=1e-9)
         apart_pct = 100 * np.linalg.norm(estimate.estimate_head_m - m.estimate_head_m) / m.depth_m
-        assert apart_pct < AGREEMENT_PCT, (m.name, apart_pct)
+        bound = SAME_START_PCT if record is classic[0] else AGREEMENT_PCT
+        assert apart_pct < bound, (m.name, apart_pct)
         assert estimate.renders >= 4  # at least the two steps' first images and two y images
 
 
