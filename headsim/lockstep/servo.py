@@ -25,12 +25,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from headsim.active.failure import detection_failure, servo_failure
+from headsim.active.look import expected_window, stands_for_frame
 from headsim.active.measurement import NOMINAL_PIXEL_SIGMA, HeadKnowledge
 from headsim.active.model2 import Model2Config, _nearest_seen
 from headsim.active.servo_types import ServoConfig, ServoOutcome, ServoResult
 from headsim.estimators import Uncertainty, model2
 from headsim.geometry.transforms import apply_transform
+from headsim.sim.gl_window import Window
 from headsim.vision.detection import Detection, DetectionStatus
+from headsim.vision.markers import find_marker
 
 from .detect import find_markers_stacked
 from .settled import SettledHeads
@@ -70,22 +73,71 @@ class HeadEstimate:
         return float(100.0 * error / self.truth_head_m[2])
 
 
+@dataclass(frozen=True)
+class Expected:
+    """Where a head expects its marker (full-frame px), its area (px) and the image
+    motion since it was seen (px): what places a window (:func:`expected_window`)."""
+
+    uv_px: tuple[float, float]
+    area_px: float
+    motion_px: float
+    margin_px: float
+
+
 def observe(
-    heads: SettledHeads, ids: Sequence[int], camera: int, colours: Sequence[str]
-) -> list[Detection]:
-    """Camera ``camera``'s detection of each head's marker (``colours[row]``) now."""
-    if not len(ids):
-        return []
-    images = heads.render(np.asarray(ids, np.int64), camera)
-    out: list[Detection] = [Detection(DetectionStatus.LOST, None, 0.0)] * len(ids)
-    groups: dict[tuple[str, tuple[int, ...]], list[int]] = {}
-    for row, (colour, image) in enumerate(zip(colours, images, strict=True)):
-        groups.setdefault((colour, image.shape), []).append(row)
-    for (colour, _), rows in groups.items():
-        stack = np.stack([images[row] for row in rows])
-        for row, found in zip(rows, find_markers_stacked(stack, colour), strict=True):
+    heads: SettledHeads,
+    ids: Sequence[int],
+    camera: int,
+    colours: Sequence[str],
+    expected: Sequence[Expected | None] | None = None,
+) -> tuple[list[Detection], list[int]]:
+    """Camera ``camera``'s detection of each head's marker (``colours[row]``) now, and the
+    images each took.  Where ``expected`` places a window, only it is drawn, and its
+    detection kept if the full frame would give the same answer (:func:`stands_for_frame`,
+    the classic looker's rule); a miss is looked for again in the full frame."""
+    n = len(ids)
+    if not n:
+        return [], []
+    size = heads.image_size_px
+    windows: list[Window | None] = [
+        None if e is None else expected_window(size, e.uv_px, e.area_px, e.motion_px, e.margin_px)
+        for e in (expected or [None] * n)
+    ]
+    images = heads.render(np.asarray(ids, np.int64), camera, windows)
+    out: list[Detection | None] = [None] * n
+    takes = [1] * n
+    for row, window in enumerate(windows):
+        if window is not None:
+            seen = find_marker(images[row], colours[row])
+            placed = None if expected is None else expected[row]
+            area = None if placed is None else placed.area_px
+            out[row] = stands_for_frame(seen, window, size, area)
+    _detect_whole(images, colours, [r for r in range(n) if windows[r] is None], out)
+    missed = [r for r in range(n) if out[r] is None]
+    if missed:
+        again = heads.render(np.asarray([ids[r] for r in missed], np.int64), camera)
+        found: list[Detection | None] = [None] * len(missed)
+        _detect_whole(again, [colours[r] for r in missed], list(range(len(missed))), found)
+        for r, d in zip(missed, found, strict=True):
+            out[r], takes[r] = d, 2
+    return [d if d is not None else Detection(DetectionStatus.LOST, None, 0.0) for d in out], takes
+
+
+def _detect_whole(
+    images: Sequence[np.ndarray],
+    colours: Sequence[str],
+    rows: Sequence[int],
+    out: list[Detection | None],
+) -> None:
+    """``out[row]``: the marker of ``colours[row]`` in whole frame ``images[row]``, found
+    over the stack of each colour's frames."""
+    groups: dict[str, list[int]] = {}
+    for row in rows:
+        groups.setdefault(colours[row], []).append(row)
+    for colour, members in groups.items():
+        stack = np.stack([images[row] for row in members])
+        for row, found in zip(members, find_markers_stacked(stack, colour), strict=True):
             out[row] = found
-    return out
 
 
 @dataclass
@@ -107,6 +159,8 @@ class _Servo:
     visited: dict[int, tuple[float, float]] = field(default_factory=dict)
     path: list[tuple[int, float, float]] = field(default_factory=list)
     move: int = 0
+    area: float = 0.0
+    bound: float = 0.0
     result: ServoResult | None = None
 
     def finish(
@@ -142,22 +196,22 @@ def servo_heads(
     made at the heads' eyes (saves a render); ``configs``: each head's servo settings."""
     low, high = heads.step_range
     steps0 = heads.eye_steps(ids)
-    renders0 = 0
+    taken = [0] * len(ids)
     if first is None:
-        first = observe(heads, ids, camera, colours)
-        renders0 = 1
+        first, taken = observe(heads, ids, camera, colours)
     states = []
     for row, head in enumerate(ids):
         cfg = configs[row]
         s = _Servo(
             int(head), colours[row], cfg, float(goals_u[row]), int(steps0[row]),
-            (math.nan, math.nan), gains[row], renders0, cfg.probe_steps,
+            (math.nan, math.nan), gains[row], taken[row], cfg.probe_steps,
         )  # fmt: skip
+        s.bound = heads.gain_bound(int(head), camera)
         seen = first[row]
         if not seen.found or seen.uv is None:
             s.finish(ServoOutcome.TARGET_LOST, s.steps, None, 0, lost=seen.status)
         else:
-            s.uv = seen.uv
+            s.uv, s.area = seen.uv, seen.area_px
             s.visited[s.steps] = seen.uv
             s.path.append((s.steps, *seen.uv))
         states.append(s)
@@ -170,11 +224,17 @@ def servo_heads(
         )
         targets = np.array([s.steps + s.move for s in moving], np.int64)
         heads.command_eye_steps(np.array([s.head for s in moving], np.int64), targets)
-        images = observe(heads, [s.head for s in moving], camera, [s.colour for s in moving])
+        found, takes = observe(
+            heads,
+            [s.head for s in moving],
+            camera,
+            [s.colour for s in moving],
+            [_expected(s) for s in moving],
+        )
         back = [
             s
-            for s, target, d in zip(moving, targets, images, strict=True)
-            if _moved(s, int(target), d)
+            for s, target, d, take in zip(moving, targets, found, takes, strict=True)
+            if _moved(s, int(target), d, take)
         ]
         heads.command_eye_steps(
             np.array([s.head for s in back], np.int64), np.array([s.steps for s in back], np.int64)
@@ -215,10 +275,23 @@ def _decide(
     return moving, settle_only
 
 
-def _moved(s: _Servo, target: int, detection: Detection) -> bool:
-    """Take in a move's image (the classic loop's body); True when the move is undone."""
+def _expected(s: _Servo) -> Expected | None:
+    """Where the head's next image should show its marker (the classic looker's window
+    after a move): predicted by the gain, or before one is learnt, a window wide enough
+    for ``bound`` px a step either way; None: the full frame."""
+    if not s.cfg.windows or s.area <= 0:
+        return None
+    if s.gain is None:  # expected_window grows by a quarter of the motion
+        return Expected(s.uv, s.area, 4.0 * s.bound * abs(s.move), s.cfg.window_margin_px)
+    motion = s.gain * s.move
+    return Expected((s.uv[0] + motion, s.uv[1]), s.area, motion, s.cfg.window_margin_px)
+
+
+def _moved(s: _Servo, target: int, detection: Detection, take: int) -> bool:
+    """Take in a move's image (the classic loop's body; ``take`` images drawn for it); True
+    when the move is undone."""
     cfg = s.cfg
-    s.renders += 1
+    s.renders += take
     iteration, move = s.iteration, s.move
     if not detection.found or detection.uv is None:
         if s.retreats >= cfg.max_retreats or abs(move) <= 1:
@@ -237,7 +310,7 @@ def _moved(s: _Servo, target: int, detection: Detection) -> bool:
             s.probe *= 4
     elif abs(move) >= cfg.min_secant_steps and change != 0.0:
         s.gain = change / move
-    s.steps, s.uv = target, detection.uv
+    s.steps, s.uv, s.area = target, detection.uv, detection.area_px
     s.visited[target] = detection.uv
     s.path.append((target, *detection.uv))
     s.iteration += 1
@@ -299,8 +372,8 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
         elif not r.converged:
             end(head, "failed", servo_failure(r, "step 1", 1).message, (r.residual_px,))
     go = [h for h in ids if h not in ends]
-    seen2 = observe(heads, go, 2, pick(go)[0])
-    renders[go] += 1
+    seen2, takes = observe(heads, go, 2, pick(go)[0])
+    renders[go] += takes
     for head, d in zip(go, seen2, strict=True):
         if not d.found or d.uv is None:
             why = "camera 2 does not see it where camera 1 fixates: a search"
@@ -329,8 +402,15 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
             residuals = (step1[head].residual_px, r.residual_px)
             end(head, "failed", servo_failure(r, "step 2", 2).message, residuals)
     go = [h for h in go if h not in ends]
-    seen1 = observe(heads, go, 1, pick(go)[0])
-    renders[go] += 1
+    # Camera 1 last saw it where step 1 ended: its window follows step 2's move.
+    seen1, takes = observe(
+        heads,
+        go,
+        1,
+        pick(go)[0],
+        [_after_step2(step1[h], step2[h], first2[h].area_px, servos[h]) for h in go],
+    )
+    renders[go] += takes
     images = _Images(
         {}, {h: np.array(first2[h].uv) for h in go}, {}, {h: step1[h].steps for h in go}
     )
@@ -373,6 +453,18 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
             )
         )
     return out
+
+
+def _after_step2(
+    step1: ServoResult, step2: ServoResult, area_px: float, cfg: ServoConfig
+) -> Expected | None:
+    """Where camera 1 should see the marker after step 2: step 1's last sight moved by its
+    gain over step 2's move (``area_px``: camera 2's sight, a like size)."""
+    if step1.uv is None or step1.gain_px_per_step is None or not cfg.windows:
+        return None
+    motion = step1.gain_px_per_step * (step2.steps - step1.steps)
+    u, v = step1.uv
+    return Expected((u + motion, v), area_px, motion, cfg.window_margin_px)
 
 
 #: A head's status when lockstep stops short of what the classic path would do next.
@@ -496,8 +588,11 @@ def _remedy(
     if not need:
         return
     heads.command_eye_steps(np.array(need, np.int64), np.array(poses, np.int64))
-    seen = [observe(heads, need, camera, [colours[h] for h in need]) for camera in (1, 2)]
-    renders[need] += 2
+    seen = []
+    for camera in (1, 2):
+        found, takes = observe(heads, need, camera, [colours[h] for h in need])
+        seen.append(found)
+        renders[need] += takes
     for row, (h, pose) in enumerate(zip(need, poses, strict=True)):
         (u10, _), (u20, _) = refs[h]
         r1, r2 = (s[row].uv if s[row].found else None for s in seen)
@@ -509,6 +604,7 @@ def _remedy(
 
 __all__ = [
     "NEEDS_CLASSIC",
+    "Expected",
     "HeadEstimate",
     "HeadJob",
     "LockstepTarget",

@@ -22,6 +22,7 @@ from mujoco import batch as mj_batch
 
 from headsim.geometry.transforms import homogeneous, invert_transform
 from headsim.sim import imperfections, names
+from headsim.sim.gl_window import Window
 from headsim.sim.heads import eye_motor_range
 from headsim.sim.joints import Commands, true_targets
 from headsim.sim.model import HEAD_PREFIX, BuiltModel, build_model
@@ -66,11 +67,8 @@ class SettledHeads:
         self._qpos = self.batch.bind("qpos")
         self._mocap_pos = self.batch.bind("mocap_pos")
         # The motors HeadSim settles, and the joints each one moves (Ca2's eye with Ca1's).
-        self._motors = tuple(
-            motor
-            for motor, joint in (("neck_yaw", mapping.neck_yaw), ("neck_pitch", mapping.neck_pitch))
-            if joint is not None
-        ) + ("eye",)
+        neck = (("neck_yaw", mapping.neck_yaw), ("neck_pitch", mapping.neck_pitch))
+        self._motors = (*(motor for motor, joint in neck if joint is not None), "eye")
         joints = [
             j
             for j in (mapping.neck_yaw, mapping.neck_pitch, mapping.left_eye, mapping.right_eye)
@@ -88,6 +86,11 @@ class SettledHeads:
             ranges.add((math.ceil(low / resolution), math.floor(high / resolution)))
         if len(ranges) != 1:
             raise SettingsError(f"settled lockstep heads must share one eye range, got {ranges}")
+        sizes = {(c.width, c.height) for s in settings for c in s.cameras}
+        if len(sizes) != 1:
+            raise SettingsError(f"settled lockstep heads must share one image size, got {sizes}")
+        #: Every camera's image size (width, height), px.
+        self.image_size_px: tuple[int, int] = sizes.pop()
         #: The eye motor's range, whole encoder steps.
         self.step_range: tuple[int, int] = ranges.pop()
         stages: dict[HeadSettings, tuple[imperfections.Stages, imperfections.Stages]] = {
@@ -103,6 +106,12 @@ class SettledHeads:
         #: Eye images drawn, and the heads' kinematic updates.
         self.images = 0
         self.settles = 0
+
+    def gain_bound(self, head: int, camera: int) -> float:
+        """A bound on camera ``camera``'s image motion per eye step of head ``head``, px:
+        1.5 x its focal length times the encoder step (where a probe's window is placed;
+        a window that misses costs a full frame, never another answer)."""
+        return 1.5 * self.settings[head].cameras[camera - 1].kx * float(self.resolution_rad[head])
 
     # -- the scene ---------------------------------------------------------------
     def place(self, head: int, body: str, position_world_m: np.ndarray) -> None:
@@ -156,10 +165,17 @@ class SettledHeads:
         return np.round(read / self.resolution_rad[ids]).astype(np.int64)
 
     # -- images ------------------------------------------------------------------
-    def render(self, heads: Sequence[int] | np.ndarray, camera: int) -> list[np.ndarray]:
-        """Camera ``camera`` (1 or 2) of each of ``heads``: (H, W, 3) uint8 each, full frames
-        drawn through one context, each finished with its head's own noise."""
+    def render(
+        self,
+        heads: Sequence[int] | np.ndarray,
+        camera: int,
+        windows: Sequence[Window | None] | None = None,
+    ) -> list[np.ndarray]:
+        """Camera ``camera`` (1 or 2) of each of ``heads``: (H, W, 3) uint8 each, drawn
+        through one context, each finished with its head's own noise; where ``windows``
+        gives one, only that window of the frame (its crop, (h, w, 3))."""
         ids = np.asarray(heads, np.int64)
+        wanted = [None] * len(ids) if windows is None else list(windows)
         index = camera - 1
         views = []
         for h in ids:
@@ -184,15 +200,27 @@ class SettledHeads:
             renderer = None
         if renderer is None:
             renderer = self._renderer = ViewRenderer(views[0].model, need)
+        whole = [row for row, window in enumerate(wanted) if window is None]
+        frames = dict(zip(whole, renderer.draw([views[row] for row in whole]), strict=True))
         images = []
-        for head, drawn in zip(ids, renderer.draw(views), strict=True):
+        for row, head in enumerate(ids):
             camera_settings = self.settings[head].cameras[index]
             size = (camera_settings.width, camera_settings.height)
             shot = imperfections.Shot(
                 (self.settings[head].seed, int(head)), int(self._taken[head, index]), size
             )
             self._taken[head, index] += 1
-            images.append(imperfections.finish(_given(drawn), self._stages[head][index], shot))
+            stages, window = self._stages[head][index], wanted[row]
+            if window is None:
+                images.append(imperfections.finish(_given(frames[row]), stages, shot))
+                continue
+
+            def draw(rect: Window | None, view: EyeView = views[row]) -> np.ndarray:
+                if rect is None or (rect.width, rect.height) == view.canvas_px:
+                    return renderer.draw([view])[0]
+                return renderer.draw_window(view, rect)
+
+            images.append(imperfections.finish(draw, stages, shot, window))
         self.images += len(images)
         return images
 
