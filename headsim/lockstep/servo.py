@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from headsim.active.failure import detection_failure, servo_failure
+from headsim.active.failure import Failure, FailureCause, detection_failure, servo_failure
 from headsim.active.look import expected_window, stands_for_frame
 from headsim.active.measurement import NOMINAL_PIXEL_SIGMA, HeadKnowledge
 from headsim.active.model2 import Model2Config, _nearest_seen
@@ -61,6 +61,7 @@ class HeadEstimate:
     renders: int
     residuals_px: tuple[float, ...]
     detail: str = ""
+    failure: Failure | None = None
 
     @property
     def ok(self) -> bool:
@@ -355,10 +356,12 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
     servos = [j.servo for j in jobs]
     ids = list(range(n))
     renders = np.zeros(n, np.int64)
-    ends: dict[int, tuple[str, str, tuple[float, ...]]] = {}
+    ends: dict[int, tuple[str, Failure | str | None, tuple[float, ...]]] = {}
 
-    def end(head: int, status: str, detail: str, residuals: tuple[float, ...]) -> None:
-        ends[head] = (status, detail, residuals)
+    def end(
+        head: int, status: str, why: Failure | str | None, residuals: tuple[float, ...]
+    ) -> None:
+        ends[head] = (status, why, residuals)
 
     def pick(rows: list[int]) -> tuple[list[str], list[ServoConfig]]:
         return [colours[h] for h in rows], [servos[h] for h in rows]
@@ -370,14 +373,14 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
         if r.outcome is ServoOutcome.TARGET_LOST and r.iterations == 0:
             end(head, NEEDS_CLASSIC, "camera 1 does not see it at the start: a scan", ())
         elif not r.converged:
-            end(head, "failed", servo_failure(r, "step 1", 1).message, (r.residual_px,))
+            end(head, "failed", servo_failure(r, "step 1", 1), (r.residual_px,))
     go = [h for h in ids if h not in ends]
     seen2, takes = observe(heads, go, 2, pick(go)[0])
     renders[go] += takes
     for head, d in zip(go, seen2, strict=True):
         if not d.found or d.uv is None:
-            why = "camera 2 does not see it where camera 1 fixates: a search"
-            end(head, NEEDS_CLASSIC, why, ())
+            reason = "camera 2 does not see it where camera 1 fixates: a search"
+            end(head, NEEDS_CLASSIC, reason, ())
     first2 = dict(zip(go, seen2, strict=True))
     go = [h for h in go if h not in ends]
     step2 = dict(
@@ -400,7 +403,7 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
         renders[head] += r.renders
         if not r.converged:
             residuals = (step1[head].residual_px, r.residual_px)
-            end(head, "failed", servo_failure(r, "step 2", 2).message, residuals)
+            end(head, "failed", servo_failure(r, "step 2", 2), residuals)
     go = [h for h in go if h not in ends]
     # Camera 1 last saw it where step 1 ended: its window follows step 2's move.
     seen1, takes = observe(
@@ -423,7 +426,7 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
         )
         if memory is None:
             residuals = (step1[head].residual_px, step2[head].residual_px)
-            end(head, "failed", detection_failure(d, "step 2", 1).message, residuals)
+            end(head, "failed", detection_failure(d, "step 2", 1), residuals)
         else:
             images.uv1[head], images.gamma1[head] = np.array(memory[1:]), memory[0]
     go = [h for h in go if h not in ends]
@@ -433,12 +436,12 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
         residuals = (step1[head].residual_px, step2[head].residual_px)
         found = estimates[head]
         if isinstance(found, str):
-            end(head, "failed", found, residuals)
+            end(head, "failed", Failure(FailureCause.ESTIMATOR, "estimate", None, found), residuals)
         else:
-            end(head, "ok", "", residuals)
+            end(head, "ok", None, residuals)
     out = []
     for head, job in enumerate(jobs):
-        status, detail, spent = ends[head]
+        status, why, spent = ends[head]
         truth = apply_transform(heads.head_from_world(head), np.array(job.target.position_world_m))
         estimate = estimates.get(head)
         out.append(
@@ -449,7 +452,8 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
                 np.asarray(truth).reshape(3),
                 int(renders[head]),
                 spent,
-                detail,
+                why.message if isinstance(why, Failure) else why or "",
+                why if isinstance(why, Failure) else None,
             )
         )
     return out
@@ -551,7 +555,7 @@ def _estimate(
         )
         for row, h in enumerate(rows):
             valid = bool(estimate.valid[row])
-            out[h] = estimate.positions[row] if valid else f"estimate: {estimate.reasons(row)!r}"
+            out[h] = estimate.positions[row] if valid else repr(estimate.reasons(row))
     return out
 
 
