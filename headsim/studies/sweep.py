@@ -17,14 +17,15 @@ A sweep file (TOML) names a scenario and the fields to vary::
     "head.baseline_m" = [0.10, 0.20]   # uniform in [low, high]
 
 Each job is one scenario run with those fields set (``seed`` sets the run's
-seed).  ``backend = "batch"`` runs the jobs in lockstep batches instead, each batch's
-images rendered together by MuJoCo Warp (``headsim[batch]``)::
+seed).  ``backend = "batch"`` runs the jobs in chunks instead, each chunk's Model 2
+measurements in lockstep (:mod:`headsim.lockstep.runs`: every target of every job a head,
+advanced together, drawn through one OpenGL context); each job's calibration, and a job
+lockstep does not run (another procedure, a room, a target the classic scan or search
+must find), go the classic way, the job's record saying why (``classic_because``)::
 
     backend = "batch"
     [batch]
-    worlds = 32                      # heads per batch (default 32)
-    samples_per_pixel = 1            # Warp's sub-pixel samples per axis (default: the head's)
-    device = "cpu"                   # or "cuda"
+    worlds = 32                      # jobs per chunk (default 32)
 
 Jobs are appended to ``DIR/jobs.jsonl`` as they finish, so an interrupted sweep
 resumes where it stopped; a job that fails or crashes its process is retried once,
@@ -42,7 +43,7 @@ import os
 import signal
 import time
 import traceback
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -90,8 +91,10 @@ class Batch:
 
 
 def run_batch(batch: Batch, marker_dir: str | None, options: BatchOptions) -> dict[str, Any]:
-    """Run ``batch``'s jobs in lockstep in this process: its record, with each job's under
-    ``records`` and what the session rendered under ``rendered``; never raises."""
+    """Run ``batch``'s jobs in this process, their Model 2 measurements in lockstep
+    (:func:`headsim.lockstep.runs.run_scenarios`; a job lockstep cannot run goes the
+    classic way, its record saying why): its record, with each job's under ``records``
+    and what lockstep drew under ``rendered``; never raises."""
     marker = Path(marker_dir) / batch.id if marker_dir else None
     if marker is not None:
         marker.touch()
@@ -101,14 +104,32 @@ def run_batch(batch: Batch, marker_dir: str | None, options: BatchOptions) -> di
     start = time.perf_counter()
     record: dict[str, Any] = {"id": batch.id, "index": batch.index}
     try:
-        from headsim.sim.batch import BatchSession
+        from headsim.lockstep.runs import run_scenarios
 
-        session = BatchSession(options.device, options.samples_per_pixel)
-        records = session.run([functools.partial(_run_job, job) for job in batch.jobs])
-        for job_record in records:
-            job_record["backend"] = "batch"
-        record.update(status="ok", records=records, rendered=asdict(session.stats))
-    except Exception as err:  # Warp failed: the batch's jobs are recorded as errors
+        loaded: dict[int, Any] = {}
+        for row, job in enumerate(batch.jobs):
+            try:
+                loaded[row] = _load(job)
+            except Exception:  # the classic path records its refusal or error
+                continue
+        runs, stats = run_scenarios(list(loaded.values()))
+        by_row = dict(zip(loaded, runs, strict=True))
+        records = []
+        for row, job in enumerate(batch.jobs):
+            ran = by_row.get(row)
+            if ran is None or isinstance(ran, str):
+                job_record = _run_job(job)
+                job_record.update(backend="classic", classic_because=ran or "")
+            else:
+                job_record = {"id": job.id, "index": job.index, "params": job.params}
+                _record_result(job_record, ran)
+                job_record.update(backend="batch", wall_s=ran.timing_s.get("total", 0.0))
+            records.append(job_record)
+        rendered = {"images": stats.images, "calls": 1, "largest": stats.heads}
+        record.update(
+            status="ok", records=records, rendered={**rendered, "render_s": stats.render_s}
+        )
+    except Exception as err:  # the lockstep chunk failed: its jobs are recorded as errors
         record.update(status="error", error=f"{type(err).__name__}: {err}")
     finally:
         if marker is not None:
@@ -217,12 +238,8 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
     record: dict[str, Any] = {"id": job.id, "index": job.index, "params": job.params}
     try:
         from headsim.runs.runner import run_scenario
-        from headsim.scenario.loading import load_scenario
 
-        overrides = {k: v for k, v in job.params.items() if k != "seed"}
-        scenario = load_scenario(
-            job.scenario, fast=job.fast, seed=job.params.get("seed"), overrides=overrides
-        )
+        scenario = _load(job)
         if recording is not None:
             from headsim.runs.recording import Recorder
             from headsim.runs.rerun_cli import job_target
@@ -233,33 +250,7 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
                 result = run_scenario(scenario, [recorder])
         else:
             result = run_scenario(scenario)
-        calibrated = result.calibration is not None
-        acceptance = result.scenario.scene.acceptance
-        ok = [r.measurement for r in result.records if r.measurement.ok]
-        used = [
-            r.measurement
-            for r in result.records
-            if r.measurement.ok and (r.knowledge != "none" or not calibrated)
-        ]
-        errors_mm = [1000 * float(np.linalg.norm(m.error_head_m)) for m in used]
-        pct = [m.error_pct_of_depth for m in used]
-        record.update(
-            status="ok" if result.ok else "failed",
-            failures=len(result.failures),
-            failure_reasons=list(result.failures),
-            measurements_ok=len(ok),
-            measurements=len(result.records),
-            rms_error_pct_depth=float(np.sqrt(np.mean(np.square(pct)))) if pct else None,
-            mean_error_mm=float(np.mean(errors_mm)) if errors_mm else None,
-            max_error_mm=float(np.max(errors_mm)) if errors_mm else None,
-            renders=result.renders.overall.total,
-            targets_redrawn=acceptance.refused_total if acceptance is not None else 0,
-            calibration_max_error_rad=float(
-                np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
-            )
-            if result.calibration is not None and result.calibration.layout is not None
-            else None,
-        )
+        _record_result(record, result)
     except TargetRefused as err:  # this job's values: its failure, not the sweep file's
         record.update(
             status="refused",
@@ -276,6 +267,47 @@ def _run_job(job: Job, recording: Any = None) -> dict[str, Any]:
         )
     record["wall_s"] = time.perf_counter() - start
     return record
+
+
+def _load(job: Job) -> Any:
+    """``job``'s scenario with its values (raises its refusal or error)."""
+    from headsim.scenario.loading import load_scenario
+
+    overrides = {k: v for k, v in job.params.items() if k != "seed"}
+    return load_scenario(
+        job.scenario, fast=job.fast, seed=job.params.get("seed"), overrides=overrides
+    )
+
+
+def _record_result(record: dict[str, Any], result: Any) -> None:
+    """A finished run's figures into its job's ``record``."""
+    calibrated = result.calibration is not None
+    acceptance = result.scenario.scene.acceptance
+    ok = [r.measurement for r in result.records if r.measurement.ok]
+    used = [
+        r.measurement
+        for r in result.records
+        if r.measurement.ok and (r.knowledge != "none" or not calibrated)
+    ]
+    errors_mm = [1000 * float(np.linalg.norm(m.error_head_m)) for m in used]
+    pct = [m.error_pct_of_depth for m in used]
+    record.update(
+        status="ok" if result.ok else "failed",
+        failures=len(result.failures),
+        failure_reasons=list(result.failures),
+        measurements_ok=len(ok),
+        measurements=len(result.records),
+        rms_error_pct_depth=float(np.sqrt(np.mean(np.square(pct)))) if pct else None,
+        mean_error_mm=float(np.mean(errors_mm)) if errors_mm else None,
+        max_error_mm=float(np.max(errors_mm)) if errors_mm else None,
+        renders=result.renders.overall.total,
+        targets_redrawn=acceptance.refused_total if acceptance is not None else 0,
+        calibration_max_error_rad=float(
+            np.max(np.abs(np.asarray(result.calibration.alpha_e_error_rad)))
+        )
+        if result.calibration is not None and result.calibration.layout is not None
+        else None,
+    )
 
 
 @dataclass
@@ -371,7 +403,10 @@ def run_sweep(
         _append(log, record)
         done[record["id"]] = record
         if bar is not None:
-            bar.update(note="" if record.get("status") == "ok" else "(this one failed)")
+            note = "" if record.get("status") == "ok" else "(this one failed)"
+            if record.get("classic_because"):  # the batch back-end ran it the classic way
+                note = f"{note} (classic path: {record['classic_because']})".strip()
+            bar.update(note=note)
 
     rendered: dict[str, float] = {}
 
