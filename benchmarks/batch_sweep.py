@@ -97,15 +97,17 @@ def main() -> None:
         raise SystemExit("scenarios/quickstart.toml changed: update this benchmark's edit")
     reach = quickstart.replace(marker, marker + 'within = "reach"\n')
     (out / "quickstart_reach.toml").write_text(reach, encoding="utf-8")
+    share = -(-args.count // args.rounds)
+    # Each round's share in one chunk per worker: a round's jobs keep every worker busy.
+    worlds = max(1, min(args.worlds, -(-share // args.workers)))
     specs = {}
     for name, backend in (
         ("classic", ""),
-        ("batch", f'backend = "batch"\n[batch]\nworlds = {args.worlds}\ndevice = "{args.device}"'),
+        ("batch", f'backend = "batch"\n[batch]\nworlds = {worlds}\ndevice = "{args.device}"'),
     ):
         path = out / f"{name}.toml"
         path.write_text(SWEEP.format(count=args.count, backend=backend), encoding="utf-8")
         specs[name] = load_sweep(path)
-    share = -(-args.count // args.rounds)
     walls = {name: 0.0 for name in specs}
     drawn: dict[str, float] = {}  # what lockstep drew, over the rounds
     for _ in range(args.rounds):
