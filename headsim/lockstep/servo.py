@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from headsim.active.failure import Failure, FailureCause, detection_failure, servo_failure
-from headsim.active.look import expected_window, stands_for_frame
+from headsim.active.look import expected_window, stands_for_frame, unbinned_px
 from headsim.active.measurement import NOMINAL_PIXEL_SIGMA, HeadKnowledge
 from headsim.active.model2 import Model2Config, _nearest_seen
 from headsim.active.servo_types import ServoConfig, ServoOutcome, ServoResult
@@ -91,11 +91,15 @@ def observe(
     camera: int,
     colours: Sequence[str],
     expected: Sequence[Expected | None] | None = None,
+    previews: Sequence[int] | None = None,
+    margins: Sequence[float] = (),
 ) -> tuple[list[Detection], list[int]]:
     """Camera ``camera``'s detection of each head's marker (``colours[row]``) now, and the
     images each took.  Where ``expected`` places a window, only it is drawn, and its
     detection kept if the full frame would give the same answer (:func:`stands_for_frame`,
-    the classic looker's rule); a miss is looked for again in the full frame."""
+    the classic looker's rule); a miss is looked for again in the full frame.  Where a
+    row has no expectation and ``previews`` gives a binning b > 1, a binned preview
+    places the window first (``margins``: each row's window margin, px)."""
     n = len(ids)
     if not n:
         return [], []
@@ -104,9 +108,18 @@ def observe(
         None if e is None else expected_window(size, e.uv_px, e.area_px, e.motion_px, e.margin_px)
         for e in (expected or [None] * n)
     ]
+    takes = [1] * n
+    for row, b in enumerate(previews or [0] * n):
+        if windows[row] is None and b > 1:  # the classic looker's preview, then its window
+            takes[row] += 1
+            seen = find_marker(heads.preview(ids[row], camera, b), colours[row])
+            if seen.found and seen.uv is not None:
+                u, v = unbinned_px(seen.uv, b)
+                windows[row] = expected_window(
+                    size, (float(u), float(v)), b * b * seen.area_px, 4.0 * b, margins[row]
+                )
     images = heads.render(np.asarray(ids, np.int64), camera, windows)
     out: list[Detection | None] = [None] * n
-    takes = [1] * n
     for row, window in enumerate(windows):
         if window is not None:
             seen = find_marker(images[row], colours[row])
@@ -120,7 +133,8 @@ def observe(
         found: list[Detection | None] = [None] * len(missed)
         _detect_whole(again, [colours[r] for r in missed], list(range(len(missed))), found)
         for r, d in zip(missed, found, strict=True):
-            out[r], takes[r] = d, 2
+            out[r] = d
+            takes[r] += 1
     return [d if d is not None else Detection(DetectionStatus.LOST, None, 0.0) for d in out], takes
 
 
@@ -199,7 +213,7 @@ def servo_heads(
     steps0 = heads.eye_steps(ids)
     taken = [0] * len(ids)
     if first is None:
-        first, taken = observe(heads, ids, camera, colours)
+        first, taken = observe(heads, ids, camera, colours, None, *_previews(configs))
     states = []
     for row, head in enumerate(ids):
         cfg = configs[row]
@@ -274,6 +288,14 @@ def _decide(
         s.move = move
         moving.append(s)
     return moving, settle_only
+
+
+def _previews(configs: Sequence[ServoConfig]) -> tuple[list[int], list[float]]:
+    """Each head's preview binning (0: none, as without windows) and window margin."""
+    return (
+        [c.preview_binning if c.windows else 0 for c in configs],
+        [c.window_margin_px for c in configs],
+    )
 
 
 def _expected(s: _Servo) -> Expected | None:
@@ -375,7 +397,7 @@ def measure_model2_heads(heads: SettledHeads, jobs: Sequence[HeadJob]) -> list[H
         elif not r.converged:
             end(head, "failed", servo_failure(r, "step 1", 1), (r.residual_px,))
     go = [h for h in ids if h not in ends]
-    seen2, takes = observe(heads, go, 2, pick(go)[0])
+    seen2, takes = observe(heads, go, 2, pick(go)[0], None, *_previews(pick(go)[1]))
     renders[go] += takes
     for head, d in zip(go, seen2, strict=True):
         if not d.found or d.uv is None:

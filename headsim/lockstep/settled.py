@@ -26,6 +26,7 @@ from headsim.sim.gl_window import Window
 from headsim.sim.heads import eye_motor_range
 from headsim.sim.joints import Commands, true_targets
 from headsim.sim.model import HEAD_PREFIX, BuiltModel, build_model
+from headsim.sim.render import EyeRenderer, context_key
 from headsim.sim.settings import HeadSettings, SettingsError
 
 from .heads import _given
@@ -101,6 +102,9 @@ class SettledHeads:
             for s, b in builds.items()
         }
         self._stages = [stages[s] for s in settings]
+        self._scene = scene
+        # Previews through the classic renderer itself (its binned camera), one a build.
+        self._previewers: dict[int, EyeRenderer] = {}
         self._taken = np.zeros((self.n, 2), np.int64)
         self._renderer: ViewRenderer | None = None
         #: Eye images drawn, and the heads' kinematic updates.
@@ -223,6 +227,26 @@ class SettledHeads:
             images.append(imperfections.finish(draw, stages, shot, window))
         self.images += len(images)
         return images
+
+    def preview(self, head: int, camera: int, binning: int) -> np.ndarray:
+        """Camera ``camera``'s whole view of head ``head`` binned ``binning`` x ``binning``:
+        the classic renderer's preview (:meth:`EyeRenderer.render_preview`), (H/b, W/b, 3)."""
+        built, settings = self.built[head], self.settings[head]
+        renderer = self._previewers.get(id(built))
+        if renderer is None:
+            renderer = EyeRenderer(
+                built.model,
+                settings.cameras,
+                built.canvases,
+                seed=settings.seed,
+                key=context_key(self._scene, built.model),
+                supersample=settings.render.supersample,
+                camera_names=built.names.cameras,
+            )
+            self._previewers[id(built)] = renderer
+        data = self.batch.get_data(int(head), self._data[head])
+        self.images += 1
+        return renderer.render_preview(data, camera - 1, binning)
 
     @property
     def opengl_cpu_s(self) -> float:
