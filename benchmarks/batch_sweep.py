@@ -17,6 +17,7 @@ again (each job's ``results.json`` counts them) rather than refusing the seed.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -110,11 +111,12 @@ def main() -> None:
         specs[name] = load_sweep(path)
     walls = {name: 0.0 for name in specs}
     drawn: dict[str, float] = {}  # what lockstep drew, over the rounds
-    for _ in range(args.rounds):
+    for r in range(args.rounds):
         for name, spec in specs.items():
-            outcomes[name] = run_sweep(
-                spec, out / name, workers=args.workers, stop_after=share, progress=False
-            )
+            # This round's share of the jobs (not stop_after: a pool finishes the chunks
+            # it already took, work that a later round would redo).
+            part = dataclasses.replace(spec, jobs=spec.jobs[r * share : (r + 1) * share])
+            outcomes[name] = run_sweep(part, out / name, workers=args.workers, progress=False)
             walls[name] += outcomes[name].wall_s
             for key, value in (outcomes[name].rendered or {}).items():
                 drawn[key] = (
