@@ -118,9 +118,12 @@ def sweep_command(args: argparse.Namespace) -> int:
         f"{rate:.1f} jobs/min; {len(outcome.failed)} failed"
     )
     if batch is not None and outcome.rendered:
-        from headsim.sim.batch import BatchStats
-
-        print(f"batch back-end: {BatchStats.of(outcome.rendered).describe(batch.device)}")
+        drawn = outcome.rendered
+        print(
+            "batch back-end: lockstep heads, classic OpenGL renderer on the CPU: "
+            f"{int(drawn.get('images', 0))} images, at most {int(drawn.get('largest', 0))} "
+            "heads at once"
+        )
     for kind, path in outcome.files.items():
         print(f"  {kind:18s} {path}")
     return 1 if outcome.failed else 0

@@ -21,6 +21,7 @@ import numpy as np
 
 from headsim.sim import names
 from headsim.sim.backend import INSTALL_HINT, RenderBackendError, check_backend
+from headsim.sim.gl_window import Window, draw_window
 from headsim.sim.mujoco_renderer import check_renderer, make_current, mjr_context, use_model
 
 
@@ -101,6 +102,24 @@ class ViewRenderer:
             canvases = cv2.resize(canvases, size, interpolation=cv2.INTER_AREA)
         upright = canvases.reshape(len(views), canvas_px[1], canvas_px[0], 3)[:, ::-1]
         return list(np.ascontiguousarray(upright))
+
+    def draw_window(self, view: EyeView, rect: Window) -> np.ndarray:
+        """The canvas pixels of ``rect`` of ``view``, uint8 (h, w, 3): drawn as the classic
+        renderer draws a window (the whole frame's projection, clipped to it:
+        :func:`~headsim.sim.gl_window.draw_window`), so they are the frame's crop."""
+        renderer, k = self._renderer, view.supersample
+        full = (k * view.canvas_px[0], k * view.canvas_px[1])
+        use_model(renderer, view.model)
+        renderer.update_scene(view.data, camera=view.camera, scene_option=self._option)
+        make_current(renderer)
+        start = time.process_time()
+        pixels = draw_window(renderer, rect, k, full)
+        self.opengl_cpu_s += time.process_time() - start
+        self.views += 1
+        pixels = np.ascontiguousarray(pixels[::-1])  # OpenGL's rows run bottom-up
+        if k > 1:
+            pixels = cv2.resize(pixels, (rect.width, rect.height), interpolation=cv2.INTER_AREA)
+        return pixels
 
     def close(self) -> None:
         """Free the OpenGL context."""

@@ -1,33 +1,16 @@
-"""Many heads at once: their eye images rendered in batches by MuJoCo Warp's ray caster.
+"""Eye images of many worlds at once through MuJoCo Warp's ray caster, and the one adapter
+to ``mujoco_warp`` and ``warp`` (the ``batch`` extra: ``pip install 'headsim[batch]'``).
 
-A :class:`BatchSession` runs N calls in lockstep (scenario runs, environment steps), each
-on a thread of its own with its own :class:`~headsim.sim.simulator.HeadSim`: its own
-settings (cameras, mounts, tolerances, belief), targets, commands and noise streams.
-Every head moves, settles and reads its encoders on the CPU as it does alone (MuJoCo,
-microseconds a head); only the images, where the time goes, are batched.  A simulator
-made inside a session renders through a :class:`BatchEyeRenderer`: each image it asks
-for waits until every head still running has asked for one (or finished), and then
-all are ray-cast in one Warp call per kind of world.  A head that converges ends its
-call; the batch ends when the last one does.
-
-Each image is then finished exactly as the classic renderer finishes its own
-(:class:`~headsim.sim.render.EyeRenderer`): every registered imperfection
-(:func:`headsim.sim.imperfections.finish`: the lens by remap, the camera's noise from
-the same stream), the same counts.  A window casts only its own pixels' rays (a camera
-whose intrinsics cover just that rectangle, :func:`window_intrinsic`, on a size rounded
-up to a power of two), a preview one ray per binned pixel.  Anti-aliasing:
-``samples_per_pixel`` x ``samples_per_pixel`` rays per pixel on a regular grid, averaged,
-by default the head's ``render.supersample`` (the classic path's supersampling, without
-its MSAA).
-
-Worlds share one Warp call when they share the scene, the cast size and the samples:
-each casts from its own eye's pose and intrinsics (focal length, principal point) in
-one camera slot, through Warp's per-world camera parameters, so heads of other cameras
-and lenses share a call.
-
-This module is the one adapter to ``mujoco_warp`` and ``warp`` (the ``batch`` extra:
-``pip install 'headsim[batch]'``); they are imported only when a session is made.
-Warp runs on the CPU by default, on a GPU with ``device="cuda"`` where it finds one.
+:class:`BatchRenderer` casts both eye cameras of ``nworld`` copies of one head at given
+joint positions in one Warp call per camera and finishes each image as the classic
+renderer finishes its own (:func:`headsim.sim.imperfections.finish`: the lens by remap,
+the camera's noise from a stream of its own).  Anti-aliasing: ``samples_per_pixel`` x
+``samples_per_pixel`` rays per pixel on a regular grid, averaged (the classic path's
+supersampling, without its MSAA); each world casts from its own eye's pose and
+intrinsics in one camera slot, through Warp's per-world camera parameters.
+Heads that move, servo and measure together are :mod:`headsim.lockstep`'s (its device
+path reaches Warp through :func:`check_device`).  Warp is imported only when asked
+for; it runs on the CPU by default, on a GPU with ``device="cuda"`` where it finds one.
 """
 
 from __future__ import annotations
@@ -37,30 +20,24 @@ import ctypes.util
 import hashlib
 import importlib
 import os
-import threading
-import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any, TypeVar
 
 import cv2
 import mujoco
 import numpy as np
 
 from headsim.errors import BadInput
-from headsim.sim import imperfections, render
-from headsim.sim.gl_window import Window
+from headsim.sim import imperfections
 from headsim.sim.simulator import HeadSim
 
-#: The devices a batch session runs on.
+#: The devices Warp runs on here.
 DEVICES = ("cpu", "cuda")
 #: The noise stream of :class:`BatchRenderer`'s images, apart from the classic renderer's.
 BATCH_STREAM = 0xBA7C
-#: The most sub-pixel samples per axis a session takes.
+#: The most sub-pixel samples per axis a Warp cast takes.
 MAX_SAMPLES_PER_PIXEL = 8
-
-T = TypeVar("T")
 
 
 class BatchError(BadInput, ValueError):
@@ -267,16 +244,6 @@ def window_intrinsic(
     return np.array([fx_w, fy_w, cx_w, cy_w], np.float32)
 
 
-#: Windows are cast on sizes rounded up to a power of two, at least this many pixels, so
-#: that heads whose windows differ share a Warp call (and its kernel); the extra pixels
-#: are cut off.
-WINDOW_MIN_PX = 32
-
-
-def _cast_side(n: int) -> int:
-    return max(WINDOW_MIN_PX, 1 << (n - 1).bit_length())
-
-
 @dataclass(frozen=True)
 class _Kind:
     """What worlds rendered together share: the scene, the image's size, the samples (each
@@ -287,7 +254,7 @@ class _Kind:
     samples: int
 
 
-@dataclass
+@dataclass(frozen=True)
 class _Request:
     model: mujoco.MjModel
     kind: _Kind
@@ -296,8 +263,6 @@ class _Request:
     fovy: float
     intrinsic: np.ndarray
     keep: tuple[int, int]
-    image: np.ndarray | None = None
-    error: BaseException | None = None
 
 
 class _Scene:
@@ -376,130 +341,18 @@ class _Scene:
         return images
 
 
-@dataclass
-class BatchStats:
-    """What a session rendered: Warp calls, images, the most worlds in one call, seconds."""
-
-    calls: int = 0
-    images: int = 0
-    largest: int = 0
-    render_s: float = 0.0
-    scenes: int = 0
-
-    @property
-    def mean_batch(self) -> float:
-        return self.images / self.calls if self.calls else 0.0
-
-    @classmethod
-    def of(cls, totals: dict[str, float]) -> BatchStats:
-        """The stats of ``totals`` (a sweep's sums over its batches)."""
-        return cls(
-            calls=int(totals.get("calls", 0)),
-            images=int(totals.get("images", 0)),
-            largest=int(totals.get("largest", 0)),
-            render_s=float(totals.get("render_s", 0.0)),
-        )
-
-    def describe(self, device: str) -> str:
-        """What was rendered on ``device``, in words."""
-        return (
-            f"MuJoCo Warp on {device}: {self.images} images in {self.calls} batches "
-            f"(mean {self.mean_batch:.1f}, largest {self.largest}), "
-            f"{self.render_s:.1f} s rendering"
-        )
-
-
-class BatchSession:
-    """N heads in lockstep, their images rendered together through MuJoCo Warp.
-
-    ``device``: ``"cpu"`` or ``"cuda"``.  ``samples_per_pixel``: Warp's sub-pixel samples
-    per axis (None: each head's ``render.supersample``).  :meth:`run` calls its functions
-    in lockstep; a simulator made inside one renders through this session.
-    """
+class _Caster:
+    """Pinhole canvases of many worlds cast by MuJoCo Warp: one call per kind of world
+    (scene, size, samples), on Warp scenes kept for reuse.  ``device``: ``"cpu"`` or
+    ``"cuda"``; ``samples_per_pixel``: sub-pixel samples per axis (None: the caller's)."""
 
     def __init__(self, device: str = "cpu", samples_per_pixel: int | None = None) -> None:
         self._warp = check_device(device)
         _check_samples(samples_per_pixel)
         self.device = device
         self.samples_per_pixel = samples_per_pixel
-        self.stats = BatchStats()
-        self._cond = threading.Condition()
-        self._live = 0
-        self._pending: list[_Request] = []
         self._scenes: dict[tuple[_Kind, int], _Scene] = {}
         self._digests: dict[int, tuple[mujoco.MjModel, str]] = {}
-
-    def describe(self) -> str:
-        """Which device ran and what it rendered, in words."""
-        return self.stats.describe(self.device)
-
-    # -- lockstep --------------------------------------------------------------
-    def run(self, calls: Sequence[Callable[[], T]]) -> list[T]:
-        """Each of ``calls`` on a thread of its own, their images rendered in batches; their
-        results in order (the first call to raise is raised, once all have ended)."""
-        results: list[Any] = [None] * len(calls)
-        errors: list[BaseException | None] = [None] * len(calls)
-        with self._cond:
-            self._live += len(calls)
-
-        def work(index: int) -> None:
-            token = render.renderer_factory.set(self._renderer)
-            try:
-                results[index] = calls[index]()
-            except BaseException as err:  # raised in the caller's thread below
-                errors[index] = err
-            finally:
-                render.renderer_factory.reset(token)
-                self._leave()
-
-        threads = [
-            threading.Thread(target=work, args=(i,), name=f"headsim-batch-{i}", daemon=True)
-            for i in range(len(calls))
-        ]
-        for thread in threads:
-            thread.start()
-        for thread in threads:
-            thread.join()
-        for error in errors:
-            if error is not None:
-                raise error
-        return results
-
-    def _renderer(self, *args: Any, **kwargs: Any) -> render.EyeRenderer:
-        return BatchEyeRenderer(self, *args, **kwargs)
-
-    def _leave(self) -> None:
-        with self._cond:
-            self._live -= 1
-            if self._pending and len(self._pending) >= self._live:
-                self._flush()
-
-    def draw(
-        self,
-        model: mujoco.MjModel,
-        data: mujoco.MjData,
-        camera: int,
-        canvas_size: tuple[int, int],
-        rect: Window,
-        size: tuple[int, int],
-        samples: int,
-    ) -> np.ndarray:
-        """Camera ``camera``'s pinhole canvas (of ``canvas_size``) within ``rect``, as an
-        image of ``size`` cast with ``samples`` x ``samples`` rays a pixel: uint8 (h, w, 3).
-        Rendered once every head still running has asked for an image (at once outside
-        :meth:`run`)."""
-        pose = _Pose.of(model, data)
-        request = self._request(model, pose, camera, canvas_size, rect, size, samples)
-        with self._cond:
-            self._pending.append(request)
-            if len(self._pending) >= self._live:
-                self._flush()
-            while request.image is None and request.error is None:
-                self._cond.wait()
-        if request.error is not None:
-            raise request.error
-        assert request.image is not None
-        return request.image
 
     def cast(
         self,
@@ -510,53 +363,30 @@ class BatchSession:
         supersample: int = 1,
     ) -> list[np.ndarray]:
         """Camera ``camera``'s pinhole canvas of ``size`` in each of ``data`` (one model's
-        worlds), uint8 (h, w, 3), in one Warp call now."""
-        full = Window(0, 0, *size)
-        samples = self.samples_per_pixel or supersample
-        requests = [
-            self._request(model, _Pose.of(model, d), camera, size, full, size, samples)
-            for d in data
-        ]
-        with self._cond:
-            self._pending.extend(requests)
-            self._flush()
-        for request in requests:
-            if request.error is not None:
-                raise request.error
-        return [r.image for r in requests if r.image is not None]
-
-    def _request(
-        self,
-        model: mujoco.MjModel,
-        pose: _Pose,
-        camera: int,
-        canvas_size: tuple[int, int],
-        rect: Window,
-        size: tuple[int, int],
-        samples: int,
-    ) -> _Request:
+        worlds), uint8 (h, w, 3), in one Warp call."""
         sensor = model.cam_sensorsize[camera]
         if sensor[1] <= 0:
             raise BatchError(
                 f"camera {camera} has no sensor size: the batch renderer casts from a camera's "
                 "intrinsics (MJCF sensorsize and focal or focalpixel)"
             )
-        cast = size
-        if (rect.width, rect.height) != canvas_size:  # a window: on a rounded-up size
-            cast = (_cast_side(size[0]), _cast_side(size[1]))
-        scale_x, scale_y = rect.width / size[0], rect.height / size[1]  # canvas px per px
-        corners = (
-            float(rect.x0),
-            float(rect.y0),
-            rect.x0 + cast[0] * scale_x,
-            rect.y0 + cast[1] * scale_y,
-        )
+        samples = self.samples_per_pixel or supersample
+        corners = (0.0, 0.0, float(size[0]), float(size[1]))
         intrinsic = window_intrinsic(
-            model.cam_intrinsic[camera], sensor, canvas_size, corners, cast, CAST_SENSOR
+            model.cam_intrinsic[camera], sensor, size, corners, size, CAST_SENSOR
         )
-        kind = _Kind(self._digest(model), cast, samples)
+        kind = _Kind(self._digest(model), size, samples)
         fovy = float(model.cam_fovy[camera])
-        return _Request(model, kind, pose, int(camera), fovy, intrinsic, size)
+        requests = [
+            _Request(model, kind, _Pose.of(model, d), int(camera), fovy, intrinsic, size)
+            for d in data
+        ]
+        nworld = 1 << max(len(requests) - 1, 0).bit_length()
+        scene = self._scenes.get((kind, nworld))
+        if scene is None:
+            scene = _Scene(self._warp, self.device, model, kind, nworld)
+            self._scenes[(kind, nworld)] = scene
+        return scene.render(requests)
 
     def _digest(self, model: mujoco.MjModel) -> str:
         known = self._digests.get(id(model))
@@ -564,72 +394,6 @@ class BatchSession:
             known = (model, _scene_digest(model))
             self._digests[id(model)] = known
         return known[1]
-
-    def _flush(self) -> None:
-        """Render every pending request, one Warp call per kind (the lock held)."""
-        pending, self._pending = self._pending, []
-        start = time.perf_counter()
-        try:
-            kinds: dict[_Kind, list[_Request]] = {}
-            for request in pending:
-                kinds.setdefault(request.kind, []).append(request)
-            for kind, requests in kinds.items():
-                images = self._scene(kind, requests[0].model, len(requests)).render(requests)
-                for request, image in zip(requests, images, strict=True):
-                    request.image = image
-                self.stats.calls += 1
-                self.stats.images += len(requests)
-                self.stats.largest = max(self.stats.largest, len(requests))
-        except Exception as err:  # every waiting head hears of it
-            for request in pending:
-                if request.image is None:
-                    request.error = err
-        finally:
-            self.stats.render_s += time.perf_counter() - start
-            self._cond.notify_all()
-
-    def _scene(self, kind: _Kind, model: mujoco.MjModel, n: int) -> _Scene:
-        """The scene of ``kind`` for the fewest worlds, a power of two, that hold ``n``."""
-        nworld = 1 << max(n - 1, 0).bit_length()
-        scene = self._scenes.get((kind, nworld))
-        if scene is None:
-            scene = _Scene(self._warp, self.device, model, kind, nworld)
-            self._scenes[(kind, nworld)] = scene
-            self.stats.scenes += 1
-        return scene
-
-
-class BatchEyeRenderer(render.EyeRenderer):
-    """The classic renderer's images with the pinhole canvas ray-cast by a batch session:
-    the lens, noise and counts are :class:`~headsim.sim.render.EyeRenderer`'s own."""
-
-    def __init__(self, session: BatchSession, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        self._session = session
-
-    def _draw(
-        self, data: mujoco.MjData, index: int, rect: Window | None, binning: int = 1
-    ) -> np.ndarray:
-        """As the classic renderer: a window only its pixels' rays, a preview the camera at
-        1/b of the resolution (one ray a pixel)."""
-        width, height = self._canvases[index].size
-        samples = self._session.samples_per_pixel or self._supersample
-        if binning > 1:
-            rect = Window(0, 0, width - width % binning, height - height % binning)
-            size, samples = (rect.width // binning, rect.height // binning), 1
-        elif rect is None:
-            rect = Window(0, 0, width, height)
-            size = (width, height)
-        else:
-            size = (rect.width, rect.height)
-        image = self._session.draw(
-            self._mj_model, data, self._cam_ids[index], (width, height), rect, size, samples
-        )
-        self.rendered_frames += (size[0] * size[1]) / (width * height)
-        return image
-
-    def close(self) -> None:
-        """Nothing to free: the session holds the Warp scenes."""
 
 
 class BatchRenderer:
@@ -652,7 +416,7 @@ class BatchRenderer:
     ) -> None:
         if not (isinstance(nworld, int) and nworld >= 1):
             raise BatchError(f"nworld must be a whole number >= 1, got {nworld!r}")
-        self._session = BatchSession(device, samples_per_pixel)
+        self._caster = _Caster(device, samples_per_pixel)
         self.device, self.nworld = device, nworld
         self.model: mujoco.MjModel = sim.model
         self._cameras = [int(self.model.camera(name).id) for name in sim.names.cameras]
@@ -685,7 +449,7 @@ class BatchRenderer:
             mujoco.mj_camlight(self.model, data)
             worlds.append(data)
         images = [
-            self._session.cast(self.model, worlds, self._cameras[c], self._canvases[c].size)
+            self._caster.cast(self.model, worlds, self._cameras[c], self._canvases[c].size)
             for c in range(2)
         ]
         out = np.stack(
@@ -707,10 +471,7 @@ class BatchRenderer:
 __all__ = [
     "DEVICES",
     "BatchError",
-    "BatchEyeRenderer",
     "BatchRenderer",
-    "BatchSession",
-    "BatchStats",
     "check_device",
     "cuda_available",
 ]

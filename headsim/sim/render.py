@@ -27,8 +27,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 from collections import OrderedDict
-from collections.abc import Callable, Hashable
-from contextvars import ContextVar
+from collections.abc import Hashable
 from typing import Any
 
 import cv2
@@ -341,17 +340,9 @@ class EyeRenderer:
                 _POOL.pop(key).close()
 
 
-#: What makes the eye renderers of simulators made in this context (None: :class:`EyeRenderer`);
-#: a batch session (:mod:`headsim.sim.batch`) sets it in each of its threads.
-renderer_factory: ContextVar[Callable[..., EyeRenderer] | None] = ContextVar(
-    "headsim_renderer_factory", default=None
-)
-
-
 def make_eye_renderer(*args: Any, **kwargs: Any) -> EyeRenderer:
-    """An :class:`EyeRenderer` (arguments as its), or the batch session's in one's thread."""
-    factory = renderer_factory.get()
-    return EyeRenderer(*args, **kwargs) if factory is None else factory(*args, **kwargs)
+    """An :class:`EyeRenderer` (arguments as its)."""
+    return EyeRenderer(*args, **kwargs)
 
 
 #: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.

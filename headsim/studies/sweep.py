@@ -17,14 +17,15 @@ A sweep file (TOML) names a scenario and the fields to vary::
     "head.baseline_m" = [0.10, 0.20]   # uniform in [low, high]
 
 Each job is one scenario run with those fields set (``seed`` sets the run's
-seed).  ``backend = "batch"`` runs the jobs in lockstep batches instead, each batch's
-images rendered together by MuJoCo Warp (``headsim[batch]``)::
+seed).  ``backend = "batch"`` runs the jobs in chunks instead, each chunk's Model 2
+measurements in lockstep (:mod:`headsim.lockstep.runs`: every target of every job a head,
+advanced together, drawn through one OpenGL context); each job's calibration, and a job
+lockstep does not run (another procedure, a room, a target the classic scan or search
+must find), go the classic way, the job's record saying why (``classic_because``)::
 
     backend = "batch"
     [batch]
-    worlds = 32                      # heads per batch (default 32)
-    samples_per_pixel = 1            # Warp's sub-pixel samples per axis (default: the head's)
-    device = "cpu"                   # or "cuda"
+    worlds = 32                      # jobs per chunk (default 32)
 
 Jobs are appended to ``DIR/jobs.jsonl`` as they finish, so an interrupted sweep
 resumes where it stopped; a job that fails or crashes its process is retried once,
@@ -41,7 +42,7 @@ import os
 import signal
 import time
 import traceback
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -88,8 +89,10 @@ class Batch:
 
 
 def run_batch(batch: Batch, marker_dir: str | None, options: BatchOptions) -> dict[str, Any]:
-    """Run ``batch``'s jobs in lockstep in this process: its record, with each job's under
-    ``records`` and what the session rendered under ``rendered``; never raises."""
+    """Run ``batch``'s jobs in this process, their Model 2 measurements in lockstep
+    (:func:`headsim.lockstep.runs.run_scenarios`; a job lockstep cannot run goes the
+    classic way, its record saying why): its record, with each job's under ``records``
+    and what lockstep drew under ``rendered``; never raises."""
     marker = Path(marker_dir) / batch.id if marker_dir else None
     if marker is not None:
         marker.touch()
@@ -99,14 +102,32 @@ def run_batch(batch: Batch, marker_dir: str | None, options: BatchOptions) -> di
     start = time.perf_counter()
     record: dict[str, Any] = {"id": batch.id, "index": batch.index}
     try:
-        from headsim.sim.batch import BatchSession
+        from headsim.lockstep.runs import run_scenarios
 
-        session = BatchSession(options.device, options.samples_per_pixel)
-        records = session.run([functools.partial(_run_job, job) for job in batch.jobs])
-        for job_record in records:
-            job_record["backend"] = "batch"
-        record.update(status="ok", records=records, rendered=asdict(session.stats))
-    except Exception as err:  # Warp failed: the batch's jobs are recorded as errors
+        loaded: dict[int, Any] = {}
+        for row, job in enumerate(batch.jobs):
+            try:
+                loaded[row] = job.load()
+            except Exception:  # the classic path records its refusal or error
+                continue
+        runs, stats = run_scenarios(list(loaded.values()))
+        by_row = dict(zip(loaded, runs, strict=True))
+        records = []
+        for row, job in enumerate(batch.jobs):
+            ran = by_row.get(row)
+            if ran is None or isinstance(ran, str):
+                job_record = _run_job(job)
+                job_record.update(backend="classic", classic_because=ran or "")
+            else:
+                job_record = {"id": job.id, "index": job.index, "params": job.params}
+                job_record.update(run_row(ran))
+                job_record.update(backend="batch", wall_s=ran.timing_s.get("total", 0.0))
+            records.append(job_record)
+        rendered = {"images": stats.images, "calls": 1, "largest": stats.heads}
+        record.update(
+            status="ok", records=records, rendered={**rendered, "render_s": stats.render_s}
+        )
+    except Exception as err:  # the lockstep chunk failed: its jobs are recorded as errors
         record.update(status="error", error=f"{type(err).__name__}: {err}")
     finally:
         if marker is not None:
@@ -194,8 +215,8 @@ def _execute_batches(
 
 def batch_options(spec: SweepSpec, device: str | None = None) -> BatchOptions | None:
     """The batch back-end's options, with ``device`` in place of the file's where given,
-    once Warp and that device are known to run here; None on the classic back-end (which
-    takes no device)."""
+    once that device is known to run here (a GPU: Warp must find one); None on the
+    classic back-end (which takes no device)."""
     if spec.backend != "batch":
         if device is not None:
             raise BadInput(
@@ -206,7 +227,8 @@ def batch_options(spec: SweepSpec, device: str | None = None) -> BatchOptions | 
     from headsim.sim.batch import check_device
 
     options = spec.batch if device is None else replace(spec.batch, device=device)
-    check_device(options.device)
+    if options.device != "cpu":  # lockstep needs Warp only to say whether a GPU is here
+        check_device(options.device)
     return options
 
 
@@ -312,7 +334,10 @@ def run_sweep(
         append_record(log, record)
         done[record["id"]] = record
         if bar is not None:
-            bar.update(note="" if record.get("status") == "ok" else "(this one failed)")
+            note = "" if record.get("status") == "ok" else "(this one failed)"
+            if record.get("classic_because"):  # the batch back-end ran it the classic way
+                note = f"{note} (classic path: {record['classic_because']})".strip()
+            bar.update(note=note)
 
     rendered: dict[str, float] = {}
 

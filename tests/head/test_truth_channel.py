@@ -6,6 +6,7 @@ a head's specification gives (encoder resolution, image sizes, its model and bel
 from __future__ import annotations
 
 import inspect
+import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -13,7 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from headsim.procedures import pursuit, zoom_fixed_points
+from headsim.procedures import pursuit
 from headsim.runs import context
 from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
@@ -147,8 +148,16 @@ def test_a_run_reads_truth_only_through_the_channel(
 ) -> None:
     scenario = load_scenario(name, fast=True)
     plain = run_scenario(scenario)
-    # every place a run builds a simulator
-    for module in (context, zoom_fixed_points, pursuit):
+    # every place a run builds a simulator: each loaded module that names HeadSim
+    builders = [
+        module
+        for name, module in list(sys.modules.items())
+        if name.startswith("headsim.")
+        and name != "headsim.sim.simulator"
+        and getattr(module, "HeadSim", None) is HeadSim
+    ]
+    assert context in builders and pursuit in builders
+    for module in builders:
         monkeypatch.setattr(module, "HeadSim", GuardedSim)
     guarded = run_scenario(scenario)
     assert guarded.failures == plain.failures

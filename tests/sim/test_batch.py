@@ -4,7 +4,6 @@ per world, and its refusals."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -13,12 +12,10 @@ import pytest
 from headsim.sim.batch import (
     BatchError,
     BatchRenderer,
-    BatchSession,
     cuda_available,
     window_intrinsic,
 )
-from headsim.sim.gl_window import Window
-from headsim.sim.settings import HeadSettings, preset
+from headsim.sim.settings import preset
 from headsim.sim.simulator import HeadSim
 from headsim.vision.markers import find_marker
 
@@ -100,91 +97,6 @@ def test_the_cuda_path_runs_where_warp_finds_a_device_and_is_refused_elsewhere(
         assert np.hypot(*np.subtract(found.uv, classic[0][0].uv)) <= CENTROID_TOLERANCE_PX
 
 
-def _kx(settings_name: str, kx: float) -> HeadSettings:
-    settings = preset(settings_name)
-    return replace(settings, cameras=tuple(replace(c, kx=kx, ky=kx) for c in settings.cameras))
-
-
-def _look(sim: HeadSim, eyes: list[float]) -> list[tuple[float, float]]:
-    """The red marker's centroid in Ca1 at each eye angle (one image each)."""
-    found = []
-    for eye in eyes:
-        sim.move(eye=eye)
-        uv = find_marker(sim.render(1), "red").uv
-        assert uv is not None
-        found.append(uv)
-    return found
-
-
-def test_heads_in_lockstep_render_together_and_each_sees_what_it_sees_alone() -> None:
-    """Three heads of three focal lengths, a different number of images each: at one sample
-    per pixel they share one Warp scene (Warp's per-world camera parameters), the batch
-    shrinks as heads finish, and every centroid is the classic renderer's."""
-    focals, eyes = (700.0, 835.0, 1000.0), [[0.0, 0.04, 0.08], [0.02, 0.06], [0.05]]
-    sims = [HeadSim(settings=_kx("ideal", kx)) for kx in focals]
-    classic = [_look(sim, e) for sim, e in zip(sims, eyes, strict=True)]
-    for sim in sims:
-        sim.close()
-    session = BatchSession(samples_per_pixel=1)
-
-    def head(kx: float, angles: list[float]) -> Callable[[], list[tuple[float, float]]]:
-        return lambda: _look(HeadSim(settings=_kx("ideal", kx)), angles)
-
-    batch = session.run([head(kx, e) for kx, e in zip(focals, eyes, strict=True)])
-    offsets = [
-        float(np.hypot(*np.subtract(b, c)))
-        for bs, cs in zip(batch, classic, strict=True)
-        for b, c in zip(bs, cs, strict=True)
-    ]
-    assert max(offsets) <= CENTROID_TOLERANCE_PX, offsets
-    # The focal length moved the marker: kx 700 and 1000 differ by tens of pixels at eye 0.05.
-    assert abs(batch[0][2][0] - batch[2][0][0]) > 5
-    stats = session.stats
-    # Every head renders in one call per step while it runs: 3 + 2 + 1 images in 3 calls.
-    assert (stats.images, stats.calls, stats.largest) == (6, 3, 3), stats
-    assert "MuJoCo Warp on cpu: 6 images in 3 batches" in session.describe()
-
-
-def test_with_sub_pixel_samples_heads_of_two_focal_lengths_still_share_a_call() -> None:
-    """Two samples per axis (rays on a grid twice as fine, averaged): the classic renderer's
-    supersampling, and each world still casts from its own focal length."""
-    focals = (700.0, 900.0)
-    classic = []
-    for kx in focals:
-        with HeadSim(settings=_kx("ideal", kx)) as sim:
-            classic.append(_look(sim, [0.03]))
-    session = BatchSession(samples_per_pixel=2)
-    batch = session.run(
-        [lambda kx=kx: _look(HeadSim(settings=_kx("ideal", kx)), [0.03]) for kx in focals]
-    )
-    assert (session.stats.images, session.stats.calls, session.stats.largest) == (2, 1, 2)
-    for (b,), (c,) in zip(batch, classic, strict=True):
-        assert np.hypot(*np.subtract(b, c)) <= CENTROID_TOLERANCE_PX
-
-
-def test_an_error_in_one_head_is_raised_once_the_others_end() -> None:
-    session = BatchSession(samples_per_pixel=1)
-    ended = []
-
-    def fine() -> None:
-        _look(HeadSim(settings=preset("ideal")), [0.0, 0.05])
-        ended.append(True)
-
-    def broken() -> None:
-        raise RuntimeError("this head broke")
-
-    with pytest.raises(RuntimeError, match="this head broke"):
-        session.run([fine, broken])
-    assert ended == [True]  # the healthy head was not left waiting for the broken one
-
-
-def test_bad_sessions_name_what_is_allowed() -> None:
-    with pytest.raises(BatchError, match="samples_per_pixel must be a whole number from 1 to 8"):
-        BatchSession(samples_per_pixel=0)
-    with pytest.raises(BatchError, match="device must be one of cpu, cuda, got 'gpu'"):
-        BatchSession(device="gpu")
-
-
 def test_a_window_camera_covers_exactly_its_rectangle_of_the_canvas() -> None:
     """Exact geometry: the whole canvas gives back the camera; a window's edges are the
     canvas's pixel edges there (rays through the same points at unit depth)."""
@@ -221,38 +133,6 @@ def test_a_window_camera_covers_exactly_its_rectangle_of_the_canvas() -> None:
         full[2] + (full[3] - full[2]) * y1 / 568,
     ]
     assert np.allclose(window, expected, rtol=1e-5)
-
-
-@pytest.mark.parametrize("name", ["ideal", "paper"])
-def test_windows_and_previews_are_what_the_classic_renderer_takes(name: str) -> None:
-    """Only a window's rays are cast, on a rounded-up size; its marker lies where the
-    classic window puts it, and a binned preview finds the marker where the classic one does."""
-    with HeadSim(settings=preset(name)) as sim:
-        sim.move(eye=0.04)
-        full = find_marker(sim.render(1), "red").uv
-        assert full is not None
-        cam = sim.settings.cameras[0]
-        window = Window.around(full, 20.5, (cam.width, cam.height))
-        classic = find_marker(sim.render_window(1, window), "red").uv
-        preview = find_marker(sim.render_preview(1, 4), "red").uv
-        qpos = sim.data.qpos.copy()
-
-    def batch() -> tuple:
-        with HeadSim(settings=preset(name)) as head:
-            head.data.qpos[:] = qpos
-            head.move(eye=0.04)
-            return (
-                find_marker(head.render_window(1, window), "red").uv,
-                find_marker(head.render_preview(1, 4), "red").uv,
-                head.rendered_frames,
-            )
-
-    session = BatchSession()
-    ((win, prev, frames),) = session.run([batch])
-    assert win is not None and classic is not None and prev is not None and preview is not None
-    assert np.hypot(*np.subtract(win, classic)) <= CENTROID_TOLERANCE_PX
-    assert np.hypot(*np.subtract(prev, preview)) <= CENTROID_TOLERANCE_PX
-    assert frames < 0.2  # a 41 px window and a 1/16 preview: a small share of one frame
 
 
 def test_warp_starts_without_a_cuda_warning_on_a_machine_without_the_driver() -> None:

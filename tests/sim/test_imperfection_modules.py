@@ -120,7 +120,7 @@ def test_an_imperfection_from_a_test_module_reaches_the_batch_renderer(ramp: Row
     if importlib.util.find_spec("mujoco_warp") is None:
         print("batch: mujoco_warp is not installed; the batch renderer's part did not run")
         return
-    from headsim.sim.batch import BatchRenderer, BatchSession
+    from headsim.sim.batch import BatchRenderer
 
     out = {}
     for grey in (0.0, RAMP_GREY):
@@ -128,19 +128,6 @@ def test_an_imperfection_from_a_test_module_reaches_the_batch_renderer(ramp: Row
             _pose(sim)
             out[grey] = BatchRenderer(sim, 1).render(sim.data.qpos[None, :].copy())[0, 0]
     _assert_ramp(out[RAMP_GREY], out[0.0], np.arange(480))
-
-    window = Window(100, 50, 160, 120)
-
-    def take(grey: float) -> Any:
-        def run() -> np.ndarray:
-            with HeadSim("default", _head(grey)) as sim:
-                _pose(sim)
-                return sim.render_window(1, window)
-
-        return run
-
-    off, on = BatchSession().run([take(0.0), take(RAMP_GREY)])
-    _assert_ramp(on, off, np.arange(window.y0, window.y1))
 
 
 def test_an_imperfections_setting_is_a_scenario_key_with_its_range_and_meaning(

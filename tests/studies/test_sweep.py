@@ -98,19 +98,19 @@ def _batched(grid: Path, worlds: int) -> Path:
 def test_a_batch_sweep_gives_the_classic_outputs_and_resumes(
     grid: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """Two batches of two heads on MuJoCo Warp (CPU): the first, then a resume for the
-    second; the aggregate has the classic sweep's rows, columns and plots, and each job's
-    error is the classic job's within the servo's noise."""
+    """Two chunks of two heads in lockstep: the first, then a resume for the second; the
+    aggregate has the classic sweep's rows, columns and plots, and each job's error is
+    the classic job's within the servo's noise."""
     classic = run_sweep(load_sweep(grid), tmp_path / "classic", progress=False)
     spec = load_sweep(_batched(grid, 2))
     assert spec.backend == "batch" and spec.batch.worlds == 2
     out = tmp_path / "batch"
     first = run_sweep(spec, out, progress=False, stop_after=2)
     assert first.ran == 2 and first.rendered is not None
-    assert first.rendered["largest"] == 2  # both heads of the batch in one Warp call
+    assert first.rendered["largest"] == 2  # both jobs' heads in lockstep
     assert main(["sweep", str(spec.path), "--out", str(out), "--no-progress"]) == 0
     printed = capsys.readouterr().out
-    assert "batch back-end: MuJoCo Warp on cpu" in printed
+    assert "batch back-end: lockstep heads, classic OpenGL renderer on the CPU" in printed
     assert "2 jobs run (2 already done)" in printed
     rows, expected = _rows(out / "aggregate.csv"), _rows(tmp_path / "classic" / "aggregate.csv")
     assert list(rows[0]) == list(expected[0])
@@ -122,6 +122,27 @@ def test_a_batch_sweep_gives_the_classic_outputs_and_resumes(
     assert {r["backend"] for r in read_log(out / "jobs.jsonl").values()} == {"batch"}
     assert (out / "error_vs_head_baseline_m.png").stat().st_size > 1000
     assert not classic.failed
+
+
+def test_a_batch_sweep_runs_a_procedure_lockstep_lacks_the_classic_way_and_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    base = (DATA / "sweep_base.toml").read_text()
+    (tmp_path / "model1.toml").write_text(
+        base.replace('procedure = "model2"', 'procedure = "model1"')
+    )
+    sweep = tmp_path / "model1_sweep.toml"
+    sweep.write_text(
+        'description = "Model 1: not in lockstep"\nscenario = "model1.toml"\n'
+        'backend = "batch"\n[batch]\nworlds = 2\n[grid]\n"head.baseline_m" = [0.12, 0.18]\n'
+    )
+    outcome = run_sweep(load_sweep(sweep), tmp_path / "out", progress=True)
+    records = read_log(tmp_path / "out" / "jobs.jsonl").values()
+    assert {r["status"] for r in records} == {"ok"}
+    assert {r["backend"] for r in records} == {"classic"}
+    assert {r["classic_because"] for r in records} == {"procedure 'model1' (lockstep runs model2)"}
+    assert "classic path: procedure 'model1'" in capsys.readouterr().err
+    assert not outcome.failed
 
 
 def test_a_crashing_job_in_a_batch_takes_no_other_job_down(
