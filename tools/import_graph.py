@@ -40,6 +40,10 @@ LAYERS = (
     "scenario",
     "runs",
     "procedures",
+    # Lockstep's scenario jobs: a sweep's chunk of scenarios run as heads over arrays (they
+    # read scenarios, calibrate and return the runner's results, so above procedures).
+    "lockstep.model2_run",
+    "lockstep.runs",
     "studies",
     "envs",
     "cli",

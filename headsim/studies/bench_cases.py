@@ -85,6 +85,8 @@ CASES: dict[str, BenchCase] = {
         BenchCase("search_cases", "long", "search_cases.py"),
         BenchCase("batch_sweep", "long", "batch_sweep.py"),
         BenchCase("batch_device", "long", "batch_device.py"),
+        BenchCase("lockstep_model2", "long", "lockstep_model2.py"),
+        BenchCase("lockstep_servo_host", "long", "lockstep_servo_host.py"),
         BenchCase("render_fidelity", "long", "render_fidelity.py"),
         BenchCase("relative_areas", "long", "relative_areas.py"),
         BenchCase("reach_and_zoom", "long", "reach_and_zoom.py"),
