@@ -108,7 +108,7 @@ def test_a_declared_keys_error_says_what_its_reference_entry_allows(
     says is allowed (the principal point's upper end is the image's, tighter than any
     image's)."""
     entry = keys[path]
-    assert descriptions()[path] == decl.meaning and decl.meaning
+    assert entry.description == decl.meaning and decl.meaning
     with pytest.raises(ScenarioError) as refused:
         load_scenario("quickstart", overrides={path: _outside(decl)})
     message = str(refused.value)
