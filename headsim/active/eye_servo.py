@@ -57,21 +57,6 @@ class EyeServo:
         self.looker = Looker(sim, self.config, self.sink)
 
     @property
-    def previews(self) -> int:
-        """Binned previews rendered to place a window."""
-        return self.looker.counts.previews
-
-    @property
-    def window_renders(self) -> int:
-        """Windows rendered."""
-        return self.looker.counts.window_renders
-
-    @property
-    def window_misses(self) -> int:
-        """Windows that missed the target (a preview's window, or a full frame, followed)."""
-        return self.looker.counts.window_misses
-
-    @property
     def step_range(self) -> tuple[int, int]:
         """Eye-motor range, whole encoder steps."""
         return self._step_range

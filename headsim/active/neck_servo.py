@@ -124,21 +124,6 @@ class NeckServo:
             return Anew(self._key)
         return Whole()
 
-    @property
-    def previews(self) -> int:
-        """Binned previews rendered to place a window."""
-        return self.looker.counts.previews
-
-    @property
-    def window_renders(self) -> int:
-        """Windows rendered."""
-        return self.looker.counts.window_renders
-
-    @property
-    def window_misses(self) -> int:
-        """Windows that missed the target (a preview's window, or a full frame, followed)."""
-        return self.looker.counts.window_misses
-
     def _in_range(self, steps: np.ndarray) -> bool:
         return all(lo <= s <= hi for s, (lo, hi) in zip(steps, self._ranges, strict=True))
 

@@ -28,7 +28,6 @@ import hashlib
 import itertools
 from collections import OrderedDict
 from collections.abc import Hashable
-from typing import Any
 
 import cv2
 import mujoco
@@ -338,11 +337,6 @@ class EyeRenderer:
         if self._own:
             for key in [k for k in _POOL if isinstance(k, tuple) and k[0] == self._key]:
                 _POOL.pop(key).close()
-
-
-def make_eye_renderer(*args: Any, **kwargs: Any) -> EyeRenderer:
-    """An :class:`EyeRenderer` (arguments as its)."""
-    return EyeRenderer(*args, **kwargs)
 
 
 #: The noise stream of previews (``EyeRenderer.render_preview``), beside each camera's own.

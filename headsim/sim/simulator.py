@@ -39,7 +39,7 @@ from headsim.sim.joints import (
 )
 from headsim.sim.model import CV_FROM_MJCAM, HEAD_PREFIX, BuiltModel, build_model
 from headsim.sim.optics import camera_matrix, dist_coeffs, project_points
-from headsim.sim.render import Window, context_key, make_eye_renderer
+from headsim.sim.render import EyeRenderer, Window, context_key
 from headsim.sim.settings import CameraSettings, HeadBelief, HeadSettings, SettingsError
 from headsim.sim.textured_scene import RoomSpec
 
@@ -113,7 +113,7 @@ class HeadSim:
         self._commands = Commands()
         #: Bodies placed so far (targets moved: earlier images are out of date).
         self.placements = 0
-        self._renderer = make_eye_renderer(
+        self._renderer = EyeRenderer(
             self.model,
             self.settings.cameras,
             self.built.canvases,

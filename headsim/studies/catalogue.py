@@ -18,6 +18,7 @@ import numpy as np
 
 from headsim.errors import BadInput
 from headsim.runs.progress import Progress, quiet
+from headsim.sim.forward import effective_directions
 from headsim.sim.settings import HeadSettings, preset
 from headsim.studies.calibrations import CalibrationCache, Calibrations
 from headsim.studies.conditions import Condition, ConditionResult, run_conditions
@@ -25,7 +26,6 @@ from headsim.studies.head_changes import (
     HEAD_CHANGES,
     HeadChange,
     centred,
-    image_centre_directions,
 )
 from headsim.studies.methods import METHODS, SWEEP_METHODS, StudyConfig
 from headsim.studies.sweep_spec import SweepError
@@ -287,7 +287,7 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
     # How far each change turned the image centre's rays (the plain method's offsets).
     turns = {}
     for c in exp.conditions:
-        before, after = (image_centre_directions(h) for h in (exp.base[c.group], c.head))
+        before, after = (effective_directions(h) for h in (exp.base[c.group], c.head))
         turns[f"{c.group}: {c.label}"] = [1e3 * (a - b) for a, b in zip(after, before, strict=True)]
     figures["image_centre_ray_turn_mrad"] = turns
     labels = {c.label for c in exp.conditions}

@@ -9,7 +9,6 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from headsim.active.principal import zoomed
-from headsim.sim.forward import effective_directions
 from headsim.sim.settings import HeadSettings
 
 #: A change of the head to one value of an experiment.
@@ -76,13 +75,3 @@ def with_noise(settings: HeadSettings, noise_std: float) -> HeadSettings:
 def with_encoder(settings: HeadSettings, steps_per_turn: float) -> HeadSettings:
     """The eye encoder with ``steps_per_turn`` steps per revolution."""
     return replace(settings, encoder_resolution_rad=2 * math.pi / steps_per_turn)
-
-
-def image_centre_directions(settings: HeadSettings) -> tuple[float, float]:
-    """Each eye's true effective initial direction, rad: mount yaw plus the image centre's ray.
-
-    What the Sec. V calibration with the servo on the image centre finds
-    (``HeadSim.effective_initial_direction`` without mount pitch or roll);
-    for explaining the errors, never given to a method.
-    """
-    return effective_directions(settings)

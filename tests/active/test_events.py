@@ -59,7 +59,7 @@ def test_a_sink_sees_every_image_and_detection_and_changes_no_measurement() -> N
             first = measure_model2(sim, servo, RED)
             _at(sim, "marker_red", [-0.04, 0.02, 0.7])  # windows and previews from here on
             second = measure_model2(sim, servo, RED)
-            measured.append((first, second, sim.render_count, servo.window_misses))
+            measured.append((first, second, sim.render_count, servo.looker.counts.window_misses))
     assert sink is not None
     (a1, a2, renders, misses), (b1, b2, renders_b, misses_b) = measured
     for a, b in ((a1, b1), (a2, b2)):

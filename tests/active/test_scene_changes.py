@@ -83,7 +83,7 @@ def test_a_target_moved_far_is_found_again_in_a_preview() -> None:
     # Camera 1 looks where it last saw the target (a window: nothing there), finds it in
     # a preview and takes the window it places of the same instant.
     assert kinds[:3] == [ImageKind.WINDOW, ImageKind.PREVIEW, ImageKind.RETAKE]
-    assert servo.window_misses >= 1
+    assert servo.looker.counts.window_misses >= 1
     assert moved.ok and moved.error_pct_of_depth < 0.1
     np.testing.assert_allclose(moved.truth_head_m, [-0.06, 0.04, 0.6], atol=1e-12)
     assert moved.renders == len(kinds)
@@ -93,7 +93,7 @@ def test_a_target_moved_a_little_is_seen_in_the_old_window() -> None:
     moved, kinds, servo = _measure_then_move(_told, far=False)
     # No preview, no miss: every look is a window where the last sight put the target.
     assert ImageKind.PREVIEW not in kinds and ImageKind.RETAKE not in kinds
-    assert kinds[0] is ImageKind.WINDOW and servo.window_misses == 0
+    assert kinds[0] is ImageKind.WINDOW and servo.looker.counts.window_misses == 0
     assert moved.ok and moved.error_pct_of_depth < 0.1
     np.testing.assert_allclose(moved.truth_head_m, [0.082, -0.03, 0.9], atol=1e-12)
 
@@ -116,7 +116,7 @@ def test_a_blob_much_smaller_than_last_seen_is_not_trusted_in_the_old_window() -
         sink.kinds.clear()
         seen = servo.observe(1, RED.detector)
         assert sink.kinds == [ImageKind.WINDOW, ImageKind.PREVIEW, ImageKind.RETAKE]
-        assert servo.window_misses == 1
+        assert servo.looker.counts.window_misses == 1
         assert seen.area_px == pytest.approx(first.area_px / 4, rel=0.1)
         _told(plain, far)
         plain.command_eye_steps(sim.eye_encoder_steps())
@@ -149,7 +149,7 @@ def test_the_neck_servo_finds_a_moved_target_from_its_images() -> None:
                 result = servo.run(RED.detector)
                 assert result.converged and result.residual_px < 0.5
                 kinds.append(list(sink.kinds))
-            runs.append((kinds, servo.window_misses))
+            runs.append((kinds, servo.looker.counts.window_misses))
     (near, far), misses = runs[0]
     assert runs[1] == runs[0]
     assert ImageKind.PREVIEW not in near and near[0] is ImageKind.WINDOW

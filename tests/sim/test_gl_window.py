@@ -210,10 +210,11 @@ def test_windows_change_no_measurement(head: str) -> None:
     # (a new target), and where the last sight's window missed (the target was moved:
     # at most once per point and camera) a preview and the image it places, of the same
     # instant; far fewer pixels rendered.
-    assert renders == plain_renders + servo.previews + servo.window_misses
-    assert 0 < servo.window_misses <= 2 * len(points)
-    assert 0 < servo.previews <= servo.window_renders
-    assert servo.window_renders > renders / 2
+    counts = servo.looker.counts
+    assert renders == plain_renders + counts.previews + counts.window_misses
+    assert 0 < counts.window_misses <= 2 * len(points)
+    assert 0 < counts.previews <= counts.window_renders
+    assert counts.window_renders > renders / 2
     assert frames < 0.5 * plain_frames
 
 
@@ -251,10 +252,11 @@ def test_windows_change_no_fixation_with_the_neck() -> None:
         assert (a_uv is None) == (b_uv is None)
         if a_uv is not None and b_uv is not None:
             assert np.max(np.abs(np.subtract(a_uv, b_uv))) <= 0.01
-    assert renders == plain_renders + servo.previews + servo.window_misses
+    counts = servo.looker.counts
+    assert renders == plain_renders + counts.previews + counts.window_misses
     # A miss where the last fixation's window no longer holds the moved target: at
     # most once per point and camera.
-    assert servo.window_renders > 0 and servo.window_misses <= 2 * len(points)
+    assert counts.window_renders > 0 and counts.window_misses <= 2 * len(points)
     assert frames < 0.7 * plain_frames
 
 
@@ -280,8 +282,9 @@ def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
                 measured.append(measure_model2(sim, servo, experiments.RED, HeadKnowledge()))
             runs[windows] = (measured, sim.render_count, servo)
     (plain, plain_renders, plain_servo), (missed, renders, servo) = runs[False], runs[True]
-    assert servo.window_misses == servo.window_renders > 0
-    assert renders == plain_renders + servo.window_misses + servo.previews
+    counts = servo.looker.counts
+    assert counts.window_misses == counts.window_renders > 0
+    assert renders == plain_renders + counts.window_misses + counts.previews
     assert servo.seen == plain_servo.seen
     for a, b in zip(plain, missed, strict=True):
         np.testing.assert_array_equal(a.estimate_head_m, b.estimate_head_m)
@@ -314,9 +317,10 @@ def test_windows_change_no_chessboard_corner() -> None:
         if a_uv is not None and b_uv is not None:
             assert np.max(np.abs(np.subtract(a_uv, b_uv))) <= 0.01
     # Each corner is looked for in the board's window: no preview, no miss, no extra render.
-    assert servo.previews == 0 and renders == plain_renders
-    assert servo.window_misses == 0
-    assert servo.window_renders > plain_renders / 2
+    counts = servo.looker.counts
+    assert counts.previews == 0 and renders == plain_renders
+    assert counts.window_misses == 0
+    assert counts.window_renders > plain_renders / 2
     assert frames < 0.7 * plain_frames
 
 
