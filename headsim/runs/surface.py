@@ -17,7 +17,7 @@ correspondence (eye 2), counted, not hidden.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TypeVar
 
@@ -473,18 +473,12 @@ def _draw(sim: HeadSim, spec: SurfaceTargetsSpec, seed: int, both_views: bool) -
     )
 
 
-def fixation_scores(records: Sequence[MeasurementRecord]) -> list[FixationScore]:
-    """The records' fixation scores (markerless targets only)."""
-    return [r.fixation for r in records if r.fixation is not None]
-
-
 __all__ = [
     "MARKER_OFFSET_M",
     "TWIN_MARKER",
     "LandingLog",
     "Look",
     "false_fixation_limit_m",
-    "fixation_scores",
     "measure_surface_targets",
     "row_band_for",
     "score_fixation",

@@ -158,16 +158,6 @@ class GaussianNoise:
         return noisy.reshape(image.shape)
 
 
-def add_noise(image: np.ndarray, std: float, rng: np.random.Generator) -> np.ndarray:
-    """Add zero-mean Gaussian noise of ``std`` grey levels to an 8-bit image.
-
-    The same law as :class:`GaussianNoise`, seeded from ``rng``; for many
-    images of one camera use :class:`GaussianNoise` (tables built once).
-    """
-    seed = int(rng.integers(0, 2**63))
-    return GaussianNoise.of(std).apply(image, (seed,), 0)
-
-
 class Noise(Imperfection):
     """Zero-mean Gaussian noise of ``noise_std`` grey levels on every image."""
 
