@@ -1,5 +1,5 @@
-"""What Model 2, Model 1 and the calibration procedure share: one servo measuring each of
-the scenario's targets in turn, in the default scene."""
+"""What Model 2, Model 1, the one-step fixation and the calibration procedure share: one
+servo measuring each of the scenario's targets in turn, in the default scene."""
 
 from __future__ import annotations
 
@@ -13,11 +13,13 @@ from headsim.active.measurement import HeadKnowledge, Measurement, Target
 from headsim.head.servo_head import ServoHead
 from headsim.runs.context import head, record_measurement
 from headsim.runs.events import Hub
-from headsim.runs.outcomes import MeasurementRecord
+from headsim.runs.outcomes import MeasurementRecord, SurfaceResult
+from headsim.runs.surface import measure_surface_targets
 from headsim.runs.targets import marker_target
 from headsim.scenario.spec import Scenario
 
 S = TypeVar("S")
+R = TypeVar("R", bound=SurfaceResult)
 
 
 def measure_each_target(
@@ -49,4 +51,26 @@ def measure_each_target(
     return records
 
 
-__all__ = ["measure_each_target"]
+def measure_targets(
+    scenario: Scenario,
+    hub: Hub,
+    knowledge: HeadKnowledge,
+    label: str,
+    servo: Callable[[ServoHead], S],
+    measure: Callable[[ServoHead, S, Target, HeadKnowledge], Measurement],
+    result: type[R],
+    both_views: bool = False,
+) -> tuple[list[MeasurementRecord], R]:
+    """Each target once through one shared ``servo``: ``[scene.room] targets``, where the
+    scene has them (:func:`~headsim.runs.surface.measure_surface_targets`, their draw in
+    ``result``), else the marker targets (:func:`measure_each_target`, ``result`` empty)."""
+    if scenario.scene.surface_targets is not None:
+        scored, drawn = measure_surface_targets(
+            scenario, hub, knowledge, label, servo, measure, both_views
+        )
+        return scored, result.of(drawn)
+    records = measure_each_target(scenario, hub, knowledge, [(knowledge, label)], servo, measure)
+    return records, result()
+
+
+__all__ = ["measure_each_target", "measure_targets"]

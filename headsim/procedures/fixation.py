@@ -13,11 +13,10 @@ from headsim.active.neck_servo import NeckServo
 from headsim.codec import declared
 from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
-from headsim.procedures.each_target import measure_each_target
+from headsim.procedures.each_target import measure_targets
 from headsim.runs.context import servo_config
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord, SurfaceResult
-from headsim.runs.surface import measure_surface_targets
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
 from headsim.scenario.spec import CalibrationSpec, Scenario
@@ -43,14 +42,10 @@ def run_fixation(
     def servo(sim: ServoHead) -> NeckServo:
         return fixation_servo(sim, config=servo_config(scenario))
 
-    if scenario.scene.surface_targets is not None:
-        # The servo's first look is with both cameras: points both start images show.
-        scored, drawn = measure_surface_targets(
-            scenario, hub, knowledge, label, servo, measure, both_views=True
-        )
-        return scored, FixationResult.of(drawn)
-    records = measure_each_target(scenario, hub, knowledge, [(knowledge, label)], servo, measure)
-    return records, FixationResult()
+    # The servo's first look is with both cameras: points both start images show.
+    return measure_targets(
+        scenario, hub, knowledge, label, servo, measure, FixationResult, both_views=True
+    )
 
 
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:

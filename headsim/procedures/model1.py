@@ -10,11 +10,10 @@ from headsim.active.neck_servo import NeckServo
 from headsim.codec import declared
 from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
-from headsim.procedures.each_target import measure_each_target
+from headsim.procedures.each_target import measure_targets
 from headsim.runs.context import servo_config
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord, SurfaceResult
-from headsim.runs.surface import measure_surface_targets
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option
 from headsim.scenario.spec import CalibrationSpec, Scenario
@@ -37,26 +36,16 @@ def run_model1(
     ) -> Measurement:
         return measure_model1(sim, servo, target, known, interpolate)
 
-    if scenario.scene.surface_targets is not None:
-        scored, drawn = measure_surface_targets(
-            scenario,
-            hub,
-            knowledge,
-            label,
-            lambda sim: NeckServo(sim, servo_config(scenario)),
-            measure,
-            both_views=True,  # the neck servo's first look is with both cameras
-        )
-        return scored, Model1Result.of(drawn)
-    records = measure_each_target(
+    return measure_targets(
         scenario,
         hub,
         knowledge,
-        [(knowledge, label)],
+        label,
         lambda sim: NeckServo(sim, servo_config(scenario)),
         measure,
+        Model1Result,
+        both_views=True,  # the neck servo's first look is with both cameras
     )
-    return records, Model1Result()
 
 
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:

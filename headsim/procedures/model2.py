@@ -10,11 +10,10 @@ from headsim.active.model2 import measure_model2
 from headsim.codec import declared
 from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
-from headsim.procedures.each_target import measure_each_target
+from headsim.procedures.each_target import measure_targets
 from headsim.runs.context import model2_config, servo_config
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord, SurfaceResult
-from headsim.runs.surface import measure_surface_targets
 from headsim.scenario.scene import targets_reader
 from headsim.scenario.schema import interpolate_option, near_midline_options
 from headsim.scenario.spec import CalibrationSpec, Scenario
@@ -37,25 +36,15 @@ def run_model2(
     ) -> Measurement:
         return measure_model2(sim, servo, target, known, config)
 
-    if scenario.scene.surface_targets is not None:
-        scored, drawn = measure_surface_targets(
-            scenario,
-            hub,
-            knowledge,
-            label,
-            lambda sim: EyeServo(sim, servo_config(scenario)),
-            measure,
-        )
-        return scored, Model2Result.of(drawn)
-    records = measure_each_target(
+    return measure_targets(
         scenario,
         hub,
         knowledge,
-        [(knowledge, label)],
+        label,
         lambda sim: EyeServo(sim, servo_config(scenario)),
         measure,
+        Model2Result,
     )
-    return records, Model2Result()
 
 
 def read_options(table: Table, calibration: CalibrationSpec | None) -> dict[str, Any]:
