@@ -7,6 +7,8 @@ beside ours for its head; lengths in mm, errors in % of depth.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from headsim.active.calibration_report import CalibrationReport
@@ -56,64 +58,32 @@ def _calibration_lines(report: CalibrationReport, paper: bool) -> list[str]:
                 *([_cell(paper_e[k], ".4f")] if paper else []),
             ]
         )
-    vertical = report.vertical_reference
+
+    def extended(label: str, fmts: str, *columns: Sequence[float], scale: float = 1.0) -> None:
+        """A row per camera (``{k}`` in ``label``: its number) of ``columns`` ours, its standard
+        error and the truth, then ours minus the truth, each times ``scale``, as ``fmts``."""
+        for k, (ours, std, truth) in enumerate(zip(*columns, strict=True), start=1):
+            cells = (scale * ours, scale * std, scale * truth, scale * (ours - truth))
+            texts = [_cell(c, f) for c, f in zip(cells, fmts.split(), strict=True)]
+            rows.append([label.format(k=k), *texts, *(["-"] if paper else [])])
+
+    vertical, los = report.vertical_reference, report.lines_of_sight
     if vertical:
-        for k in range(2):
-            rows.append(
-                [
-                    f"v{k + 1}0 (px, extended)",
-                    _cell(vertical.v0_px[k], ".2f"),
-                    _cell(vertical.v0_std_px[k], ".2f"),
-                    _cell(vertical.v0_truth_px[k], ".2f"),
-                    _cell(vertical.v0_px[k] - vertical.v0_truth_px[k], "+.2f"),
-                    *(["-"] if paper else []),
-                ]
-            )
-        for k in range(2):
-            rows.append(
-                [
-                    f"kx{k + 1}/ky{k + 1} (extended)",
-                    _cell(vertical.kx_over_ky[k], ".4f"),
-                    _cell(vertical.kx_over_ky_std[k], ".4f"),
-                    _cell(vertical.kx_over_ky_truth[k], ".4f"),
-                    _cell(vertical.kx_over_ky[k] - vertical.kx_over_ky_truth[k], "+.4f"),
-                    *(["-"] if paper else []),
-                ]
-            )
-    los = report.lines_of_sight
+        v = vertical
+        extended("v{k}0 (px, extended)", ".2f .2f .2f +.2f", v.v0_px, v.v0_std_px, v.v0_truth_px)
+        ratios = (v.kx_over_ky, v.kx_over_ky_std, v.kx_over_ky_truth)
+        extended("kx{k}/ky{k} (extended)", ".4f .4f .4f +.4f", *ratios)
     if los:
-        for k in range(2):
-            rows.append(
-                [
-                    f"alpha_e{k + 1} (rad, extended)",
-                    _cell(los.alpha_e_rad[k], ".5f"),
-                    _cell(los.std_errors_alpha_e_rad[k], ".1e"),
-                    _cell(truth_e[k], ".5f"),
-                    _cell(los.alpha_e_rad[k] - truth_e[k], "+.1e"),
-                    *(["-"] if paper else []),
-                ]
-            )
-        for k in range(2):
-            rows.append(
-                [
-                    f"s{k + 1} (mm, extended)",
-                    _cell(1e3 * los.offset_m[k], ".3f"),
-                    _cell(1e3 * los.std_errors_offset_m[k], ".3f"),
-                    _cell(1e3 * los.offset_truth_m[k], ".3f"),
-                    _cell(1e3 * (los.offset_m[k] - los.offset_truth_m[k]), "+.3f"),
-                    *(["-"] if paper else []),
-                ]
-            )
-        rows.append(
-            [
-                "D effective (mm)",
-                _cell(1e3 * los.effective_baseline_m, ".3f"),
-                _cell(1e3 * los.effective_baseline_std_m, ".3f"),
-                _cell(1e3 * los.effective_baseline_truth_m, ".3f"),
-                _cell(1e3 * (los.effective_baseline_m - los.effective_baseline_truth_m), "+.3f"),
-                *(["-"] if paper else []),
-            ]
+        angles = (los.alpha_e_rad, los.std_errors_alpha_e_rad, truth_e)
+        extended("alpha_e{k} (rad, extended)", ".5f .1e .5f +.1e", *angles)
+        offsets = (los.offset_m, los.std_errors_offset_m, los.offset_truth_m)
+        extended("s{k} (mm, extended)", ".3f .3f .3f +.3f", *offsets, scale=1e3)
+        baseline = (
+            los.effective_baseline_m,
+            los.effective_baseline_std_m,
+            los.effective_baseline_truth_m,
         )
+        extended("D effective (mm)", ".3f .3f .3f +.3f", *([b] for b in baseline), scale=1e3)
     out = lines + format_table(headers, rows)
     if los and not los.separable:
         out.append(f"  line-of-sight offsets: {los.message}")

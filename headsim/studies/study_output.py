@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from headsim.codec import encode
 from headsim.files import to_jsonable, write_csv_atomic, write_json_atomic
 from headsim.sim.settings import HeadSettings
 from headsim.studies.catalogue import ExperimentResult, compare_figures
@@ -31,24 +32,11 @@ def _condition_columns(result: ExperimentResult, c: Condition) -> dict[str, Any]
 
 def summary_rows(result: ExperimentResult) -> list[dict[str, Any]]:
     """A row per condition and method."""
-    rows = []
-    for r in result.results:
-        c = r.condition
-        for s in r.summaries:
-            rows.append(
-                {
-                    **_condition_columns(result, c),
-                    "method": s.method,
-                    "ok": s.ok,
-                    "failed": s.failed,
-                    "rms_mm": s.rms_mm,
-                    "rms_pct_depth": s.rms_pct_depth,
-                    "rms_xz_pct_depth": s.rms_xz_pct_depth,
-                    "rms_y_pct_depth": s.rms_y_pct_depth,
-                    "max_pct_depth": s.max_pct_depth,
-                }
-            )
-    return rows
+    return [
+        {**_condition_columns(result, r.condition), **encode(s)}
+        for r in result.results
+        for s in r.summaries
+    ]
 
 
 def target_rows(result: ExperimentResult) -> list[dict[str, Any]]:
