@@ -61,14 +61,6 @@ class Failure:
         )
         return f"{where}: {what}" + (f" ({self.detail})" if self.detail else "")
 
-    def as_dict(self) -> dict[str, object]:
-        return {
-            "cause": self.cause.value,
-            "stage": self.stage,
-            "camera": self.camera,
-            "detail": self.detail,
-        }
-
 
 def detection_failure(detection: Detection, stage: str, camera: int, detail: str = "") -> Failure:
     """The failure of a detection that did not find the target."""

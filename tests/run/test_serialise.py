@@ -28,6 +28,14 @@ from headsim.sim.events import RenderCounts
 
 from .helpers import LOST, measurement
 
+#: How results.json writes helpers.LOST.
+LOST_WRITTEN = {
+    "cause": "lost",
+    "stage": "step 1",
+    "camera": 2,
+    "detail": "and at 12 eye angles searched",
+}
+
 
 def _full_report() -> CalibrationReport:
     return CalibrationReport(
@@ -85,12 +93,7 @@ def test_a_measurement_writes_its_method_status_and_failure_as_documented() -> N
     assert ok["error_m"] == pytest.approx(0.003)
     lost = encode(MeasurementEntry.of(MeasurementRecord(measurement(0.0, 0.5, LOST), "none", 1)))
     assert lost["status"] == "Ca2 at step 1: target lost (and at 12 eye angles searched)"
-    assert lost["failure"] == {
-        "cause": "lost",
-        "stage": "step 1",
-        "camera": 2,
-        "detail": "and at 12 eye angles searched",
-    }
+    assert lost["failure"] == LOST_WRITTEN
 
 
 def test_a_calibration_that_could_not_lay_out_its_positions_writes_five_keys() -> None:
@@ -118,7 +121,7 @@ def test_a_calibration_block_reads_back_to_the_same_report_and_bytes() -> None:
         "total": 40,
     }
     assert list(block)[-2:] == ["positions", "rendered_frames"]
-    assert block["positions"][1] == {"status": LOST.message, "failure": LOST.as_dict()}
+    assert block["positions"][1] == {"status": LOST.message, "failure": LOST_WRITTEN}
     assert decode(CalibrationReport, block) == report
     source = CalibrationSource("/tmp/head.json", "quickstart", 0, "abc", report.renders)
     stored = decode(CalibrationReport, block, renders=RenderCounts(), source=source)
