@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 
 from headsim.geometry import kinematics
 from headsim.geometry.synthetic import StereoHead, fixation_angles
-from headsim.geometry.transforms import homogeneous
+from headsim.geometry.transforms import homogeneous, points3
 
 __all__ = [
     "NECK_ORDERS",
@@ -145,7 +145,7 @@ def fixating_eye_angles(
     plane.  NaN where a point is not in front of the baseline or an eye would turn to
     +-pi/2 or beyond.
     """
-    p = _points(points_eyes, "points_eyes")
+    p = points3(points_eyes, "points_eyes")
     e1, e2 = _pair(alpha_e_rad, "alpha_e_rad")
     s1, s2 = _pair(los_offset_m, "los_offset_m")
     head = StereoHead(_baseline(baseline_m), alpha_e1=e1, alpha_e2=e2, side1=s1, side2=s2)
@@ -188,7 +188,7 @@ def tilt_to_plane(points_h: ArrayLike, tilt_axis_h_m: ArrayLike = (0.0, 0.0, 0.0
     on which P stays ahead of the tilt axis.  NaN where the point is within |t_y| of
     the tilt axis.
     """
-    p = _points(points_h, "points_h")
+    p = points3(points_h, "points_h")
     t = np.asarray(tilt_axis_h_m, float)
     if t.shape != (3,) or not np.isfinite(t).all():
         raise ValueError(f"tilt_axis_h_m must be a finite point (3,) in metres, got {t!r}")
@@ -362,7 +362,7 @@ class Neck:
         """Points (..., 3) from H to W."""
         if self.order == "yaw_pitch":
             return kinematics.head_to_world(points_h, theta1, theta2, d1, a2)
-        p = _points(points_h, "points_h")
+        p = points3(points_h, "points_h")
         t = self.world_from_head(theta1, theta2, d1, a2)
         return np.einsum("...ij,...j->...i", t[..., :3, :3], p) + t[..., :3, 3]
 
@@ -372,7 +372,7 @@ class Neck:
         """Points (..., 3) from W to H, the inverse of :meth:`head_to_world`."""
         if self.order == "yaw_pitch":
             return kinematics.world_to_head(points_w, theta1, theta2, d1, a2)
-        p = _points(points_w, "points_w")
+        p = points3(points_w, "points_w")
         t = self.world_from_head(theta1, theta2, d1, a2)
         return np.einsum("...ji,...j->...i", t[..., :3, :3], p - t[..., :3, 3])
 
@@ -553,13 +553,6 @@ def _pair(values: tuple[float, float], name: str) -> tuple[float, float]:
     if not (math.isfinite(a) and math.isfinite(b)):
         raise ValueError(f"{name} must be two finite numbers, got {values!r}")
     return a, b
-
-
-def _points(points: ArrayLike, name: str) -> np.ndarray:
-    p = np.asarray(points, dtype=float)
-    if p.ndim == 0 or p.shape[-1] != 3:
-        raise ValueError(f"{name} must have shape (..., 3), got {p.shape}")
-    return p
 
 
 def _direction(v: ArrayLike, name: str) -> np.ndarray:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from headsim.geometry.transforms import rotation_x, rotation_y, rotation_z
+from headsim.geometry.transforms import points3, rotation_x, rotation_y, rotation_z
 from headsim.paper import ENCODER_RESOLUTION_RAD
 
 __all__ = [
@@ -52,7 +52,7 @@ def head_to_world(
     points_h: ArrayLike, theta1: ArrayLike, theta2: ArrayLike, d1: float, a2: float
 ) -> np.ndarray:
     """Map points (..., 3) from H to W through eq. (3); angles broadcast with the points' lead."""
-    p = _points(points_h, "points_h")
+    p = points3(points_h, "points_h")
     t = world_from_head(theta1, theta2, d1, a2)
     return np.einsum("...ij,...j->...i", t[..., :3, :3], p) + t[..., :3, 3]
 
@@ -61,7 +61,7 @@ def world_to_head(
     points_w: ArrayLike, theta1: ArrayLike, theta2: ArrayLike, d1: float, a2: float
 ) -> np.ndarray:
     """Map points (..., 3) from W to H, the inverse of :func:`head_to_world`."""
-    p = _points(points_w, "points_w")
+    p = points3(points_w, "points_w")
     t = world_from_head(theta1, theta2, d1, a2)
     return np.einsum("...ji,...j->...i", t[..., :3, :3], p - t[..., :3, 3])
 
@@ -125,7 +125,7 @@ def head_to_camera(
     (no 4 x 4 per point): rotate ``p - A_i`` about y by ``-yaw`` (Ca1) or ``+yaw``
     (Ca2), A_i the yaw axis, then subtract the optical centre's offset (side, 0, nodal).
     """
-    p = _points(points_h, "points_h")
+    p = points3(points_h, "points_h")
     sign = _camera_sign(camera)
     psi = -sign * np.asarray(yaw, float)
     c, s = np.cos(psi), np.sin(psi)
@@ -139,10 +139,3 @@ def _camera_sign(camera: int) -> float:
     if camera not in (1, 2):
         raise ValueError(f"camera must be 1 or 2, got {camera!r}")
     return -1.0 if camera == 1 else 1.0
-
-
-def _points(points: ArrayLike, name: str) -> np.ndarray:
-    p = np.asarray(points, dtype=float)
-    if p.ndim == 0 or p.shape[-1] != 3:
-        raise ValueError(f"{name} must have shape (..., 3), got {p.shape}")
-    return p

@@ -10,17 +10,27 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = [
     "apply_transform",
     "frame_deviation",
     "homogeneous",
     "invert_transform",
+    "points3",
     "rotation_angle",
     "rotation_x",
     "rotation_y",
     "rotation_z",
 ]
+
+
+def points3(points: ArrayLike, name: str) -> np.ndarray:
+    """``points`` as floats of shape (..., 3), else ValueError naming them ``name``."""
+    p = np.asarray(points, dtype=float)
+    if p.ndim == 0 or p.shape[-1] != 3:
+        raise ValueError(f"{name} must have shape (..., 3), got {p.shape}")
+    return p
 
 
 def homogeneous(rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
