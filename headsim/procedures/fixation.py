@@ -5,10 +5,11 @@ one-motor design gives up."""
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any
 
 from headsim.active.fixation import fixation_servo, measure_fixation
-from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.codec import declared
 from headsim.head.servo_head import ServoHead
@@ -32,19 +33,20 @@ def run_fixation(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
 ) -> tuple[list[MeasurementRecord], FixationResult]:
     """Each target in turn, one servo of both eyes and the neck pitch for all."""
-    interpolate = scenario.experiment.interpolate
-
-    def measure(
-        sim: ServoHead, servo: NeckServo, target: Target, known: HeadKnowledge
-    ) -> Measurement:
-        return measure_fixation(sim, servo, target, known, interpolate)
 
     def servo(sim: ServoHead) -> NeckServo:
         return fixation_servo(sim, config=servo_config(scenario))
 
     # The servo's first look is with both cameras: points both start images show.
     return measure_targets(
-        scenario, hub, knowledge, label, servo, measure, FixationResult, both_views=True
+        scenario,
+        hub,
+        knowledge,
+        label,
+        servo,
+        partial(measure_fixation, interpolate=scenario.experiment.interpolate),
+        FixationResult,
+        both_views=True,
     )
 
 

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any
 
-from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.active.measurement import HeadKnowledge
 from headsim.active.model1 import measure_model1
 from headsim.active.neck_servo import NeckServo
 from headsim.codec import declared
-from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_targets
 from headsim.runs.context import servo_config
@@ -29,20 +29,13 @@ def run_model1(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
 ) -> tuple[list[MeasurementRecord], Model1Result]:
     """Model 1 on each target in turn, one neck servo for all."""
-    interpolate = scenario.experiment.interpolate
-
-    def measure(
-        sim: ServoHead, servo: NeckServo, target: Target, known: HeadKnowledge
-    ) -> Measurement:
-        return measure_model1(sim, servo, target, known, interpolate)
-
     return measure_targets(
         scenario,
         hub,
         knowledge,
         label,
         lambda sim: NeckServo(sim, servo_config(scenario)),
-        measure,
+        partial(measure_model1, interpolate=scenario.experiment.interpolate),
         Model1Result,
         both_views=True,  # the neck servo's first look is with both cameras
     )

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any
 
 from headsim.active.eye_servo import EyeServo
-from headsim.active.measurement import HeadKnowledge, Measurement, Target
+from headsim.active.measurement import HeadKnowledge
 from headsim.active.model2 import measure_model2
 from headsim.codec import declared
-from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
 from headsim.procedures.each_target import measure_targets
 from headsim.runs.context import model2_config, servo_config
@@ -29,20 +29,13 @@ def run_model2(
     scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
 ) -> tuple[list[MeasurementRecord], Model2Result]:
     """Model 2 on each target in turn, one eye servo for all."""
-    config = model2_config(scenario)
-
-    def measure(
-        sim: ServoHead, servo: EyeServo, target: Target, known: HeadKnowledge
-    ) -> Measurement:
-        return measure_model2(sim, servo, target, known, config)
-
     return measure_targets(
         scenario,
         hub,
         knowledge,
         label,
         lambda sim: EyeServo(sim, servo_config(scenario)),
-        measure,
+        partial(measure_model2, config=model2_config(scenario)),
         Model2Result,
     )
 
