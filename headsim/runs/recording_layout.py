@@ -94,11 +94,26 @@ def blueprint(scenario: Scenario | None = None) -> rrb.Blueprint:
     """
     if scenario is not None and scenario.scene.room is not None:
         return room_blueprint(scenario)
+    return _layout(
+        scenario,
+        "head, scene and targets (W)",
+        rrb.Horizontal(
+            rrb.TimeSeriesView(origin="/servo", name="servo error, px"),
+            rrb.TimeSeriesView(origin="/joints", name="joint encoders, rad"),
+            rrb.TimeSeriesView(origin="/measurements", name="measurements"),
+        ),
+        rrb.Tabs(*text_views(), active_tab=2),
+    )
+
+
+def _layout(scenario: Scenario | None, world: str, *below: rrb.Container) -> rrb.Blueprint:
+    """The 3-D view named ``world`` on the left; on the right both cameras above the
+    containers ``below`` (the cameras' row 3 shares, each of them 2)."""
     return rrb.Blueprint(
         rrb.Horizontal(
             rrb.Spatial3DView(
                 origin="/world",
-                name="head, scene and targets (W)",
+                name=world,
                 eye_controls=eye_controls(scenario),
                 defaults=mjcf_rerun.view_defaults(),
             ),
@@ -107,13 +122,8 @@ def blueprint(scenario: Scenario | None = None) -> rrb.Blueprint:
                     rrb.Spatial2DView(origin="/world/head/cam1", name="camera 1"),
                     rrb.Spatial2DView(origin="/world/head/cam2", name="camera 2"),
                 ),
-                rrb.Horizontal(
-                    rrb.TimeSeriesView(origin="/servo", name="servo error, px"),
-                    rrb.TimeSeriesView(origin="/joints", name="joint encoders, rad"),
-                    rrb.TimeSeriesView(origin="/measurements", name="measurements"),
-                ),
-                rrb.Tabs(*text_views(), active_tab=2),
-                row_shares=[3, 2, 2],
+                *below,
+                row_shares=[3, *(2 for _ in below)],
             ),
             column_shares=[2, 3],
         ),
@@ -141,42 +151,26 @@ def room_blueprint(scenario: Scenario) -> rrb.Blueprint:
             visual_bounds=bounds,
         )
 
-    return rrb.Blueprint(
+    return _layout(
+        scenario,
+        "room, head and where the eyes landed (W)",
         rrb.Horizontal(
-            rrb.Spatial3DView(
-                origin="/world",
-                name="room, head and where the eyes landed (W)",
-                eye_controls=eye_controls(scenario),
-                defaults=mjcf_rerun.view_defaults(),
-            ),
-            rrb.Vertical(
-                rrb.Horizontal(
-                    rrb.Spatial2DView(origin="/world/head/cam1", name="camera 1"),
-                    rrb.Spatial2DView(origin="/world/head/cam2", name="camera 2"),
-                ),
-                rrb.Horizontal(
-                    fovea("cam1", "fovea 1"),
-                    rrb.Spatial2DView(origin="/fovea/cam1/template", name="template 1"),
-                    fovea("cam2", "fovea 2"),
-                    rrb.Spatial2DView(origin="/fovea/cam2/patch", name="found in 2"),
-                ),
-                rrb.Horizontal(
-                    rrb.TimeSeriesView(origin="/correlation", name="match score, ambiguity"),
-                    rrb.TextLogView(origin="/correlation/status", name="match status"),
-                    rrb.TimeSeriesView(origin="/servo", name="servo error, px"),
-                ),
-                rrb.Tabs(
-                    *text_views(),
-                    rrb.TimeSeriesView(origin="/measurements", name="measurements"),
-                    rrb.TimeSeriesView(origin="/joints", name="joint encoders, rad"),
-                    active_tab=2,
-                ),
-                row_shares=[3, 2, 2, 2],
-            ),
-            column_shares=[2, 3],
+            fovea("cam1", "fovea 1"),
+            rrb.Spatial2DView(origin="/fovea/cam1/template", name="template 1"),
+            fovea("cam2", "fovea 2"),
+            rrb.Spatial2DView(origin="/fovea/cam2/patch", name="found in 2"),
         ),
-        rrb.TimePanel(timeline="frame", state="collapsed"),
-        collapse_panels=True,
+        rrb.Horizontal(
+            rrb.TimeSeriesView(origin="/correlation", name="match score, ambiguity"),
+            rrb.TextLogView(origin="/correlation/status", name="match status"),
+            rrb.TimeSeriesView(origin="/servo", name="servo error, px"),
+        ),
+        rrb.Tabs(
+            *text_views(),
+            rrb.TimeSeriesView(origin="/measurements", name="measurements"),
+            rrb.TimeSeriesView(origin="/joints", name="joint encoders, rad"),
+            active_tab=2,
+        ),
     )
 
 
