@@ -422,7 +422,7 @@ class FixateEnv(gymnasium.Env):
             else:
                 self._sim = for_settings(settings, scene="base", room=self._room)
             self._settings = settings
-            self._prepare_model(self._sim)
+            self.prepare_model(self._sim.model)
         sim = self._sim
         sim.reset()
         if self._room is not None:
@@ -477,9 +477,6 @@ class FixateEnv(gymnasium.Env):
         """The ranges an episode's fields are drawn from: the defaults, the env's
         ``randomise``, then ``options["randomise"]``."""
         return {**self.defaults, **self.randomise, **_check_ranges(options.get("randomise", {}))}
-
-    def _prepare_model(self, sim: HeadSim) -> None:
-        self.prepare_model(sim.model)
 
     def prepare_model(self, model: mujoco.MjModel) -> None:
         """This env's own model: its target's size and the renderer's multisampling."""
