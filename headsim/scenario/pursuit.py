@@ -129,31 +129,11 @@ SECTIONS = (PURSUIT, PATH, LIVE, GAZE)
 # fmt: on
 
 
-def _points(table: Table, decl: Array, minimum: int) -> tuple[tuple[float, float, float], ...]:
-    key, value = decl.name, table.data.get(decl.name)
-    table.has(key)
-    allowed = decl.allowed
-    if not isinstance(value, list) or len(value) < minimum or len(value) > 1000:
-        raise table.fail(key, "missing" if value is None else "wrong length or type", allowed)
-    points: list[tuple[float, float, float]] = []
-    for i, p in enumerate(value):
-        if not (isinstance(p, list) and len(p) == 3):
-            raise table.fail(f"{key}[{i}]", "must be [x, y, z]", allowed)
-        x, y, z = (
-            table._check_number(
-                f"{key}[{i}]", c, -MAX_COORDINATE_M, MAX_COORDINATE_M, False, False, allowed
-            )
-            for c in p
-        )
-        points.append((x, y, z))
-    return tuple(points)
-
-
 def _path(table: Table, seed: int, duration_s: float) -> tuple[str, Path, Visibility]:
     kind = table.setting(KIND)
     path: Path
     if kind == "waypoints":
-        points = _points(table, POINTS, 2)
+        points = table.points(POINTS, 2, 1000, MAX_COORDINATE_M)
         speeds = table.data.get(SPEEDS.name)
         table.has(SPEEDS.name)
         allowed = f"an array of {len(points) - 1} speeds > 0 m/s, one per leg"

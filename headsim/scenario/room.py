@@ -128,24 +128,7 @@ SECTIONS = (ROOM, LIGHT, OBJECTS, TARGETS)
 def _mesh(table: Table) -> tuple[tuple[Vec3, ...], tuple[tuple[int, int, int], ...]]:
     """A ``mesh`` object's ``vertices_m`` and ``faces``, checked: every index a vertex, no
     face without area."""
-    allowed = _VERTICES.allowed
-    raw = table.data.get(_VERTICES.name)
-    table.has(_VERTICES.name)
-    if not isinstance(raw, list) or not 4 <= len(raw) <= MAX_MESH_VERTICES:
-        raise table.fail(
-            "vertices_m", "missing" if raw is None else "wrong length or type", allowed
-        )
-    vertices = []
-    for i, p in enumerate(raw):
-        if not (isinstance(p, list) and len(p) == 3):
-            raise table.fail(f"vertices_m[{i}]", "must be [x, y, z]", allowed)
-        x, y, z = (
-            table._check_number(
-                f"vertices_m[{i}]", c, -MAX_MESH_M, MAX_MESH_M, False, False, allowed
-            )
-            for c in p
-        )
-        vertices.append((x, y, z))
+    vertices = table.points(_VERTICES, 4, MAX_MESH_VERTICES, MAX_MESH_M)
     count = len(vertices)
     allowed = (
         f"triangles [i, j, k] of vertex indices 0-{count - 1}, counter-clockwise seen from "

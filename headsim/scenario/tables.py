@@ -258,6 +258,26 @@ class Table:
             raise self.fail(key, f"{value:g} is out of range", allowed)
         return value + 0.0  # -0.0 is 0: a range [-x, x] of it must not come out reversed
 
+    def points(
+        self, decl: Array, minimum: int, maximum: int, bound_m: float
+    ) -> tuple[tuple[float, float, float], ...]:
+        """``decl``'s array of ``minimum`` to ``maximum`` points [x, y, z], each coordinate
+        within +-``bound_m``, m."""
+        key, value, allowed = decl.name, self.data.get(decl.name), decl.allowed
+        self.has(key)
+        if not isinstance(value, list) or not minimum <= len(value) <= maximum:
+            raise self.fail(key, "missing" if value is None else "wrong length or type", allowed)
+        points: list[tuple[float, float, float]] = []
+        for i, p in enumerate(value):
+            if not (isinstance(p, list) and len(p) == 3):
+                raise self.fail(f"{key}[{i}]", "must be [x, y, z]", allowed)
+            x, y, z = (
+                self._check_number(f"{key}[{i}]", c, -bound_m, bound_m, False, False, allowed)
+                for c in p
+            )
+            points.append((x, y, z))
+        return tuple(points)
+
     def integer(self, key: str, default: Any = MISSING, lo: int = 0, hi: int = 10**6) -> int:
         value = self._get(key)
         allowed = _integer_allowed(lo, hi)
