@@ -12,7 +12,7 @@ near the midline the y images are taken again at an intermediate eye angle
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -274,15 +274,4 @@ def _near_midline_images(
     return gamma_steps * sim.settings.encoder_resolution_rad, uv[0], uv[1]
 
 
-def measure_points_model2(
-    sim: ServoHead,
-    servo: EyeServo,
-    targets: Sequence[Target],
-    knowledge: HeadKnowledge | None = None,
-    config: Model2Config | None = None,
-) -> list[Measurement]:
-    """Model 2 on several targets in turn (the servo's gains carry over)."""
-    return [measure_model2(sim, servo, t, knowledge, config) for t in targets]
-
-
-__all__ = ["Model2Config", "measure_model2", "measure_points_model2"]
+__all__ = ["Model2Config", "measure_model2"]

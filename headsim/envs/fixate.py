@@ -131,7 +131,6 @@ TARGET_FIELDS = ("depth_m", "bearing_rad", "speed_m_s")
 PLANE_FIELDS = ("plane_depth_m",)
 #: What the eyes look at: a marker ball, or a textured plane filling the view.
 SCENES = ("marker", "textured_plane")
-REWARDS = ("offsets", "position", "vergence")
 #: The rewards each scene offers; the first is its default.
 SCENE_REWARDS = {"marker": ("offsets", "position"), "textured_plane": ("vergence", "position")}
 #: The plane's body, geom and texture (``<name>_texture``).
