@@ -439,9 +439,8 @@ def model1_refusal(
     return _occlusion(head, p_world, what, radius_m, occluders, poses)
 
 
-@lru_cache(maxsize=8)
-def _head_of(settings: HeadSettings) -> ReachHead:
-    return ReachHead.of(settings)
+#: The reach check's head for settings, made once per head.
+_head_of = lru_cache(maxsize=8)(ReachHead.of)
 
 
 def target_refusal(
