@@ -10,7 +10,6 @@ from pathlib import Path
 import pytest
 
 from headsim.cli import main
-from headsim.sim import imperfections, settings
 from headsim.runs.results_reference import (
     MARKERLESS_ONLY,
     RESULTS_FIELDS,
@@ -18,6 +17,7 @@ from headsim.runs.results_reference import (
     experiment_fields,
     undocumented,
 )
+from headsim.sim import imperfections, settings
 
 TOOLS = Path(__file__).resolve().parents[2] / "tools"
 
