@@ -29,13 +29,11 @@ PACKAGE = Path(headsim.__file__).resolve().parent
 
 #: The modules of the servos and procedures that still import the simulator, and why.
 #: The quick start's (Model 2, Model 1, fixation, the calibration procedure, every servo),
-#: the chessboard's, relative positioning's, tracking's and zoom_fixed_points' are not
-#: among them.
+#: the chessboard's, relative positioning's, tracking's, zoom_fixed_points' and pursuit's
+#: are not among them.
 STILL_IMPORTING = {
     # PhaseStarted carries the simulator to the recording: the truth channel, for drawing.
     "headsim.active.events",
-    # Pursuit runs the live head (headsim.live), which steps the simulator's physics in time.
-    "headsim.procedures.pursuit",
     # Zhang's calibration and the triangulation (headsim.stereo) take the simulator: they
     # pose the board per view and score against the cameras' true poses.
     "headsim.procedures.stereo",
@@ -120,14 +118,23 @@ def test_the_quick_start_runs_through_the_servo_head_alone(
 @pytest.mark.render
 @pytest.mark.parametrize(
     ("name", "heads_built"),
-    # The calibration's head and the procedure's; zoom_fixed_points: the head and its twin.
-    [("tracking", 2), ("chessboard", 2), ("relative_positioning", 2), ("zoom_fixed_points", 2)],
+    # The calibration's head and the procedure's; zoom_fixed_points: the head and its twin;
+    # pursuit (no calibration): the live head's.
+    [
+        ("tracking", 2),
+        ("chessboard", 2),
+        ("relative_positioning", 2),
+        ("zoom_fixed_points", 2),
+        ("pursuit", 1),
+        ("pursuit_textured", 1),
+    ],
 )
 def test_the_staging_procedures_run_on_the_head_the_runner_builds(
     monkeypatch: pytest.MonkeyPatch, name: str, heads_built: int
 ) -> None:
     # They place their boards, blocks and moving targets through the truth channel and
-    # measure on the sealed head: the same results as on the plain one.
+    # measure on the sealed head (pursuit: the live head over it, stepping the physics
+    # its truth channel holds): the same results as on the plain one.
     scenario = load_scenario(name, fast=True)
     plain = run_scenario(scenario)
     heads: list[SealedSimHead] = []

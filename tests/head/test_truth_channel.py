@@ -14,7 +14,6 @@ from typing import Any
 import numpy as np
 import pytest
 
-from headsim.procedures import pursuit
 from headsim.runs import context
 from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
@@ -141,7 +140,16 @@ for _name in TRUTH_METHODS:
 
 @pytest.mark.render
 @pytest.mark.parametrize(
-    "name", ["quickstart", "relative_positioning", "stereo", "zoom_fixed_points", "natural_field"]
+    "name",
+    [
+        "quickstart",
+        "relative_positioning",
+        "stereo",
+        "zoom_fixed_points",
+        "natural_field",
+        "pursuit",
+        "pursuit_textured",
+    ],
 )
 def test_a_run_reads_truth_only_through_the_channel(
     name: str, monkeypatch: pytest.MonkeyPatch
@@ -156,7 +164,7 @@ def test_a_run_reads_truth_only_through_the_channel(
         and name != "headsim.sim.simulator"
         and getattr(module, "HeadSim", None) is HeadSim
     ]
-    assert context in builders and pursuit in builders
+    assert context in builders
     for module in builders:
         monkeypatch.setattr(module, "HeadSim", GuardedSim)
     guarded = run_scenario(scenario)
@@ -169,6 +177,7 @@ def test_a_run_reads_truth_only_through_the_channel(
         assert guarded.calibration is not None
         assert plain.calibration.alpha_e_rad == guarded.calibration.alpha_e_rad
     assert all(np.isfinite(r.measurement.truth_head_m).all() for r in guarded.records)
+    assert repr(guarded.experiment) == repr(plain.experiment)
 
 
 @pytest.mark.render
