@@ -24,6 +24,8 @@ is shown escaped and never acts on the user's terminal.
 from __future__ import annotations
 
 import errno
+import os
+import select
 import sys
 import traceback
 from collections.abc import Callable
@@ -202,16 +204,41 @@ def guarded(body: Callable[[], int], *, debug: bool = False, stream: TextIO | No
         return code
     except SystemExit:
         raise
+    except BrokenPipeError as err:
+        if not _stdout_gone():
+            return _report(err, debug, stream)
+        return int(ExitCode.OK)  # its reader stopped reading (``headsim list | head``)
     except BaseException as err:
-        code, message = exit_code_for(err)
-        if debug:
-            traceback.print_exception(err, file=stream)
-        try:
-            print(
-                f"headsim: {'' if code == ExitCode.INTERRUPTED else 'error: '}{printable(message)}",
-                file=stream,
-            )
-            stream.flush()
-        except (OSError, ValueError):  # stderr itself is gone
-            pass
-        return int(code)
+        return _report(err, debug, stream)
+
+
+def _stdout_gone() -> bool:
+    """Whether standard output's reader has gone (a pipe with no reader polls as an
+    error); if so, later writes go nowhere, so that the interpreter's last flush is quiet."""
+    try:
+        fd = sys.stdout.fileno()
+        poller = select.poll()
+        poller.register(fd, select.POLLOUT)
+        if not any(events & select.POLLERR for _, events in poller.poll(0)):
+            return False
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, fd)
+        return True
+    except (OSError, ValueError, AttributeError):  # no file behind it: not a pipe's end
+        return False
+
+
+def _report(err: BaseException, debug: bool, stream: TextIO) -> int:
+    """Print ``err`` as one line (its traceback too with ``debug``); its exit code."""
+    code, message = exit_code_for(err)
+    if debug:
+        traceback.print_exception(err, file=stream)
+    try:
+        print(
+            f"headsim: {'' if code == ExitCode.INTERRUPTED else 'error: '}{printable(message)}",
+            file=stream,
+        )
+        stream.flush()
+    except (OSError, ValueError):  # stderr itself is gone
+        pass
+    return int(code)

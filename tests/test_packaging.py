@@ -87,7 +87,11 @@ def test_package_data_covers_every_model_and_scenario_file() -> None:
 def test_package_data_covers_the_campaigns_experiment_files() -> None:
     patterns: list[str] = SETUPTOOLS["package-data"]["headsim.studies"]
     files = sorted((REPO / "headsim" / "studies").glob("*.toml"))
-    assert [p.name for p in files] == ["reproduce_experiments.toml", "study_experiments.toml"]
+    assert [p.name for p in files] == [
+        "bench_cases.toml",
+        "reproduce_experiments.toml",
+        "study_experiments.toml",
+    ]
     assert all(any(fnmatch(p.name, pattern) for pattern in patterns) for p in files)
 
 

@@ -27,7 +27,11 @@ from mkdocs.structure.files import File, Files
 from headsim import __version__
 from headsim.cli.parser import build_parser
 from headsim.errors import EXIT_MEANINGS, ExitCode
-from headsim.runs.results_reference import RESULTS_FIELDS, experiment_fields
+from headsim.runs.results_reference import (
+    CALIBRATION_FILE_FIELDS,
+    RESULTS_FIELDS,
+    experiment_fields,
+)
 from headsim.scenario.key_reference import accepted_keys
 from headsim.scenario.loading import load_scenario, scenario_files
 from headsim.sim.heads import REGISTRY, SHIPPED
@@ -115,6 +119,12 @@ def results_json_page() -> str:
             continue
         out.append("| key | meaning |\n|---|---|")
         out.extend(f"| `{key}` | {_cell(text)} |" for key, text in fields.items())
+    out.append(
+        "\n## The calibration file (`head.json`)\n\n`headsim calibrate SCENARIO --out "
+        "head.json` writes it and `[experiment.calibration] from` reads it (`.` separates a "
+        "table's keys):\n\n| key | meaning |\n|---|---|"
+    )
+    out.extend(f"| `{key}` | {_cell(text)} |" for key, text in CALIBRATION_FILE_FIELDS.items())
     return "\n".join(out) + "\n"
 
 

@@ -28,7 +28,7 @@ from headsim.active.calibration_report import (
     KnowledgeReport,
 )
 from headsim.active.measurement import HeadKnowledge
-from headsim.codec import decode
+from headsim.codec import declared, decode, doc, encode
 from headsim.files import to_jsonable, write_json_atomic
 from headsim.sim.events import RenderCounts
 from headsim.sim.settings import HeadSettings, settings_record
@@ -89,25 +89,60 @@ def knowledge_from_block(block: dict[str, Any]) -> HeadKnowledge:
     return decode(KnowledgeReport, block["knowledge"]).head_knowledge()
 
 
-def write_calibration(
-    path: str | Path, settings: HeadSettings, block: dict[str, Any], scenario: str, seed: int
-) -> Path:
-    """Write a successful calibration ``block`` (results.json form) for the head ``settings``."""
-    if block.get("knowledge") is None:
-        raise CalibrationFileError(
-            f"calibration did not succeed ({block.get('status')}): nothing to write"
-        )
-    path = Path(path)
-    write_json_atomic(
-        path,
-        {
-            "format": FORMAT,
-            "scenario": scenario,
-            "seed": seed,
-            "head": {"hash": head_hash(settings), "settings": head_fields(settings)},
-            "calibration": block,
-        },
+@declared
+class CalibrationHead:
+    """The head a calibration file holds for."""
+
+    hash: str = doc("SHA-256 of `settings` as JSON (keys sorted, no spaces)")
+    settings: dict[str, Any] = doc(
+        "every setting of the true head by dotted name (`cam1.kx`), but the seed and the "
+        "cameras' image noise (they change the images, not the head); `head_model` for a "
+        "head other than the paper's",
+        whole=True,
     )
+
+
+@declared
+class CalibrationDocument:
+    """A calibration file (``head.json``): its keys in the order written."""
+
+    format: str = doc(f'`"{FORMAT}"`')
+    scenario: str = doc("the scenario that calibrated (`told`: a knowledge given, not measured)")
+    seed: int = doc("its seed")
+    head: CalibrationHead = doc(
+        "the head it holds for: a scenario whose head differs is refused, naming each setting"
+    )
+    calibration: dict[str, Any] = doc(
+        "what the head learnt: results.json's `calibration` block (for a knowledge told: "
+        "`status`, `targets` 0, `fixated` 0, `positions` and `knowledge` only)",
+        whole=True,
+    )
+
+
+def write_calibration(
+    path: str | Path,
+    settings: HeadSettings,
+    learnt: CalibrationReport | HeadKnowledge,
+    scenario: str,
+    seed: int,
+) -> Path:
+    """Write what the head ``settings`` learnt: a successful calibration's report, or a
+    knowledge told to it (no layout, no fit; it must hold no belief of the head's geometry,
+    which the file does not keep)."""
+    if isinstance(learnt, HeadKnowledge):
+        if learnt.belief is not None:
+            raise ValueError("a calibration file holds no belief of the head's geometry")
+        told = {"status": "ok", "targets": 0, "fixated": 0, "positions": []}
+        block = {**told, "knowledge": encode(KnowledgeReport.of(learnt))}
+    elif learnt.knowledge is None:
+        raise CalibrationFileError(
+            f"calibration did not succeed ({learnt.status_text}): nothing to write"
+        )
+    else:
+        block = encode(learnt)
+    path = Path(path)
+    head = CalibrationHead(hash=head_hash(settings), settings=head_fields(settings))
+    write_json_atomic(path, encode(CalibrationDocument(FORMAT, scenario, seed, head, block)))
     return path
 
 

@@ -78,6 +78,18 @@ class KnowledgeReport:
     u0_px: list[float | None] = doc("", default_factory=lambda: [None, None])
     los_offset_m: list[float] | None = None
 
+    @classmethod
+    def of(cls, knowledge: HeadKnowledge) -> KnowledgeReport:
+        """``knowledge`` as numbers (the inverse of :meth:`head_knowledge`)."""
+        offsets = knowledge.los_offset_m
+        return cls(
+            alpha_e_rad=list(knowledge.alpha_e),
+            v0_px=list(knowledge.v0),
+            kx_over_ky=list(knowledge.kx_over_ky),
+            u0_px=list(knowledge.u0),
+            los_offset_m=None if offsets is None else list(offsets),
+        )
+
     def head_knowledge(self) -> HeadKnowledge:
         """The :class:`HeadKnowledge` these numbers are."""
         a1, a2 = (float(a) for a in self.alpha_e_rad)

@@ -159,7 +159,6 @@ def progress_observer(args: argparse.Namespace, total: int, unit: str) -> Any:
 
 def calibrate_command(args: argparse.Namespace) -> int:
     from headsim.active.calibration_file import head_hash, write_calibration
-    from headsim.codec import encode
     from headsim.runs.runner import calibrate_scenario
     from headsim.scenario.loading import load_scenario
     from headsim.scenario.tables import ScenarioError
@@ -198,7 +197,7 @@ def calibrate_command(args: argparse.Namespace) -> int:
         )
         return 1
     try:
-        write_calibration(out, scenario.settings, encode(report), scenario.name, scenario.seed)
+        write_calibration(out, scenario.settings, report, scenario.name, scenario.seed)
     except OSError as err:
         raise OutputNotWritable(f"cannot write {out}: {err.strerror or err}") from err
     alpha, std = report.alpha_e_rad, report.alpha_e_std_rad

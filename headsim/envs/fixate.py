@@ -86,6 +86,7 @@ from gymnasium import spaces
 
 from headsim.active.measurement import HeadKnowledge
 from headsim.estimators.model1 import model1
+from headsim.head.sim_head import SimHead
 from headsim.live.head import EYE_LIMITS, NECK_LIMITS, Frame, LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
 from headsim.runs.landing import landing, vergence_error_deg
@@ -426,14 +427,14 @@ class FixateEnv(gymnasium.Env):
         sim.reset()
         if self._room is not None:
             self._place_plane(sim, _draw(self.np_random, ranges, "plane_depth_m"))
-            self._live = LiveHead(sim, self.live_config)
+            self._live = LiveHead(SimHead(sim), self.live_config)
             self._steps = 0
             self._frame = self._live.capture()
             return self._observation(), self._info(self._measure())
         path = draw_marker_path(
             self.np_random, settings, ranges, options, self.max_steps * self.period_s
         )
-        self._live = LiveHead(sim, self.live_config, target_body=TARGET_BODY, path=path)
+        self._live = LiveHead(SimHead(sim), self.live_config, target_body=TARGET_BODY, path=path)
         self._steps = 0
         self._frame = self._live.capture()
         return self._observation(), self._info(self._measure())

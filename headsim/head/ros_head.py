@@ -8,8 +8,12 @@ forward position and velocity controllers' ``~/commands`` (values in
 ``joint_names`` order, each dimension labelled with the joint's name).  A position
 command returns once the joint states are within ``tolerance_rad`` of it; a grab
 waits for a pair of images that arrived after the last command settled (Ca1's with
-Ca2's nearest in time).  Topic and joint names: a :class:`~headsim.head.mcap_log.Topics`
-(the mapping file's).  Installing: see docs/how-to/real-head.md.
+Ca2's nearest in time).  The servos' grabs of one eye (:class:`~headsim.head.servo_head.ServoHead`'s
+``render``, ``render_window``, ``render_preview``, ``retake``) take that eye's next such
+image and crop its region of interest or bin it on the host, as for a camera driver
+without hardware ROI or binning.  Topic and joint names: a
+:class:`~headsim.head.mcap_log.Topics` (the mapping file's).  Installing: see
+docs/how-to/real-head.md.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from headsim.errors import EnvironmentProblem, JobFailed
 from headsim.head.camera_info import CameraInfo
 from headsim.head.interface import JointReading, StampedImage, StereoFrame
 from headsim.head.mcap_log import Topics
+from headsim.sim.render import Window
 from headsim.sim.settings import HeadBelief
 
 
@@ -85,6 +90,16 @@ def camera_info_from_msg(msg: Any) -> CameraInfo:
     )
 
 
+def binned(image: np.ndarray, binning: int) -> np.ndarray:
+    """``image`` (H, W, 3) uint8 binned ``binning`` x ``binning``: each pixel the rounded
+    mean of its block, (H/b, W/b, 3) uint8."""
+    height, width = image.shape[:2]
+    if binning < 1 or height % binning or width % binning:
+        raise ValueError(f"binning {binning} must divide the {width}x{height} image")
+    blocks = image.reshape(height // binning, binning, width // binning, binning, -1)
+    return np.rint(blocks.mean(axis=(1, 3))).astype(np.uint8)
+
+
 def command_msg(values: Mapping[str, float], topics: Topics) -> Any:
     """A ``Float64MultiArray`` of ``values``, each dimension labelled with the robot's name."""
     std = ros_modules()[2]
@@ -135,10 +150,13 @@ class RosHead:
         self._changed = threading.Condition()
         self._arrivals = 0
         #: The stamp of the joint state that ended the last command, and the arrival
-        #: number of the last image grabbed: a grab takes images stamped at or after the
-        #: one, arrived after the other.
+        #: number of each eye's last image grabbed: a grab takes images stamped at or after
+        #: the one, arrived after the other.
         self._settled_s = -np.inf
-        self._grabbed = 0
+        self._grabbed = [0, 0]
+        #: Each eye's image last grabbed (a retake's), and the grabs so far.
+        self._taken: list[np.ndarray | None] = [None, None]
+        self._grabs = 0
         #: Each eye's latest images: (arrival number, stamp in s, image).
         self._images: list[list[tuple[int, float, np.ndarray]]] = [[], []]
         self._infos: list[CameraInfo | None] = [None, None]
@@ -264,27 +282,72 @@ class RosHead:
             assert self._joints is not None
             self._settled_s = self._joints.time_s
 
+    def _fresh(self, index: int) -> list[tuple[int, float, np.ndarray]]:
+        """Eye ``index``'s images taken since the last command settled (stamped at or after
+        the joint state that ended it) and arrived after its last grab."""
+        return [
+            image
+            for image in self._images[index]
+            if image[0] > self._grabbed[index] and image[1] >= self._settled_s
+        ]
+
     def grab_stereo(self) -> StereoFrame:
-        """The newest left image taken since the last command settled (stamped at or after
-        the joint state that ended it) and not grabbed before, with the right image nearest
-        it in time (waiting for one from each eye)."""
-
-        def fresh(index: int) -> list[tuple[int, float, np.ndarray]]:
-            return [
-                image
-                for image in self._images[index]
-                if image[0] > self._grabbed and image[1] >= self._settled_s
-            ]
-
+        """The newest fresh left image, with the fresh right image nearest it in time
+        (waiting for one from each eye)."""
         left_info, right_info = self.camera_infos()
-        self._wait(lambda: bool(fresh(0)) and bool(fresh(1)), "new images from both eyes")
+        self._wait(
+            lambda: bool(self._fresh(0)) and bool(self._fresh(1)), "new images from both eyes"
+        )
         with self._changed:
-            _, left_s, left = fresh(0)[-1]
-            _, right_s, right = min(fresh(1), key=lambda image: abs(image[1] - left_s))
-            self._grabbed = self._arrivals
+            _, left_s, left = self._fresh(0)[-1]
+            _, right_s, right = min(self._fresh(1), key=lambda image: abs(image[1] - left_s))
+            self._grabbed = [self._arrivals, self._arrivals]
+        self._taken, self._grabs = [left, right], self._grabs + 2
         return StereoFrame(
             StampedImage(left_s, left, left_info), StampedImage(right_s, right, right_info)
         )
+
+    # -- the servos' grabs of one eye (ServoHead's) --------------------------------------
+    @property
+    def render_count(self) -> int:
+        """Images grabbed so far: each eye's of a stereo grab, frames, windows, retakes and
+        previews, each one."""
+        return self._grabs
+
+    def _grab(self, camera: int) -> np.ndarray:
+        """Camera 1 or 2's newest fresh image (waiting for one)."""
+        index = camera - 1
+        self._wait(lambda: bool(self._fresh(index)), f"a new image from camera {camera}")
+        with self._changed:
+            arrival, _, image = self._fresh(index)[-1]
+            self._grabbed[index] = arrival
+        self._taken[index], self._grabs = image, self._grabs + 1
+        return image
+
+    def _retaken(self, camera: int) -> np.ndarray:
+        image = self._taken[camera - 1]
+        if image is None:
+            raise JobFailed(f"the ROS 2 head: nothing grabbed from camera {camera} to retake")
+        self._grabs += 1
+        return image
+
+    def render(self, camera: int) -> np.ndarray:
+        """Camera 1 or 2's next whole image, (H, W, 3) uint8 RGB."""
+        return self._grab(camera)
+
+    def retake(self, camera: int) -> np.ndarray:
+        """The whole image camera 1 or 2 last gave (the same exposure)."""
+        return self._retaken(camera)
+
+    def render_window(self, camera: int, window: Window, retake: bool = False) -> np.ndarray:
+        """Only ``window`` of camera 1 or 2's next image (``retake``: of its last), cropped
+        here, (h, w, 3) uint8."""
+        image = self._retaken(camera) if retake else self._grab(camera)
+        return np.ascontiguousarray(image[window.y0 : window.y1, window.x0 : window.x1])
+
+    def render_preview(self, camera: int, binning: int) -> np.ndarray:
+        """Camera 1 or 2's next image binned ``binning`` x ``binning`` here (:func:`binned`)."""
+        return binned(self._grab(camera), binning)
 
     def close(self) -> None:
         rclpy = ros_modules()[0]
@@ -294,4 +357,4 @@ class RosHead:
             rclpy.shutdown()
 
 
-__all__ = ["RosHead", "command_msg", "command_values", "image_array", "ros_modules"]
+__all__ = ["RosHead", "binned", "command_msg", "command_values", "image_array", "ros_modules"]

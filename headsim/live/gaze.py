@@ -9,7 +9,9 @@ predictor the goal moves on at ``q*``'s estimated velocity, which makes up for
 the latency.  A saccade (minimum-jerk or bang-bang, within the motor limits)
 is made when the target is newly seen or the offset is large.  A target not
 seen is coasted after on the prediction for ``coast_frames`` frames; then the
-gaze holds.  Truth is read only to score the run.
+gaze holds.  They see the live head only through its frames (images and encoders), the
+commands they send it and its :attr:`~headsim.live.head.LiveHead.head` (the at-rest
+servo's, with the head's specification and belief); a frame's truth only scores the run.
 """
 
 from __future__ import annotations
@@ -25,7 +27,6 @@ from headsim.active.look import foveal_detector
 from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import Detector
-from headsim.head.sim_head import SimHead
 from headsim.live.estimator import GazeEstimator
 from headsim.live.head import Frame, LiveHead
 from headsim.live.motors import MotorDriver, bang_bang_duration, min_jerk_duration
@@ -323,7 +324,7 @@ def acquire(
     knowledge: HeadKnowledge | None = None,
 ) -> GazeEstimator | None:
     """Fixate the target at rest with ``servo`` (the paper's Model 1 servo on the live
-    head's simulator) and keep its image Jacobian.
+    head's :attr:`~LiveHead.head`) and keep its image Jacobian.
 
     The head is at rest (the target held where it is at the present time);
     the servo's probes and moves settle kinematically, as the at-rest
@@ -333,22 +334,21 @@ def acquire(
     specification (counts per turn), known to the head exactly, as in the
     at-rest procedures.
     """
-    sim = live.sim
-    driven = servo.sim.sim if isinstance(servo.sim, SimHead) else servo.sim
-    if driven is not sim:
-        raise ValueError("acquire: servo must drive the live head's simulator (live.sim)")
+    head = live.head
+    if servo.sim is not head:
+        raise ValueError("acquire: servo must drive the live head's head (live.head)")
     knowledge = knowledge or HeadKnowledge()
-    goals = (knowledge.reference(sim, 1), knowledge.reference(sim, 2))
+    goals = (knowledge.reference(head, 1), knowledge.reference(head, 2))
     result = servo.run(detector, goals=(goals[0][0], goals[1][0], (goals[0][1] + goals[1][1]) / 2))
     if not result.converged or servo.jacobian is None:
         return None
     live.motors.sync()
     return GazeEstimator(
         servo.jacobian,
-        sim.settings.encoder_resolution_rad,  # a spec, not an imperfection (see above)
+        head.settings.encoder_resolution_rad,  # a spec, not an imperfection (see above)
         goals,
-        knowledge.head_belief(sim),
+        knowledge.head_belief(head),
         knowledge,
-        knowledge.line_of_sight_offsets(sim),
-        neck_of(sim.settings.head),
+        knowledge.line_of_sight_offsets(head),
+        neck_of(head.settings.head),
     )

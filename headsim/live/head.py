@@ -14,6 +14,13 @@ taken while the eyes move sees them where the physics put them, and each
 encoder reads its joint to the count (no backlash on the live head).  The target
 is a mocap body (a marker, or a room's textured object) moved along its path at every
 physics step.
+
+The live head is the simulator run in time over a :class:`~headsim.head.sim_head.SimHead`:
+it grabs its images from the head and reads the encoders' specification there; the
+physics it steps, the motors it drives and the target it moves are the simulator's
+world, reached through the head's truth channel (placing is the simulator's job).  What
+measures on it (:mod:`headsim.live.gaze`) takes its frames, sends it commands and drives
+:attr:`LiveHead.head`; only a frame's ``truth_*`` fields carry the truth, for scoring.
 """
 
 from __future__ import annotations
@@ -25,10 +32,10 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from headsim.head.sim_head import SimHead
 from headsim.live.motors import MotorDriver, MotorLimits, motor_joints
 from headsim.live.paths import Path, Visibility
 from headsim.sim.settings import SettingsError
-from headsim.sim.simulator import HeadSim
 
 #: Where a target that is not present is parked (world, m): under the table, out of view.
 PARKED_WORLD_M = np.array([0.0, 0.5, -5.0])
@@ -114,11 +121,11 @@ class _Queued:
 
 
 class LiveHead:
-    """A :class:`HeadSim` run in time: motors, a moving target, frames at a rate."""
+    """A :class:`SimHead`'s simulator run in time: motors, a moving target, frames at a rate."""
 
     def __init__(
         self,
-        sim: HeadSim,
+        head: SimHead,
         config: LiveConfig | None = None,
         target_body: str | None = None,
         path: Path | None = None,
@@ -127,19 +134,22 @@ class LiveHead:
     ) -> None:
         """``point_offset_m``: the scored point's offset from the moved body's centre, W, m
         (a textured object's clicked surface point; the path moves the centre)."""
-        self.sim = sim
+        #: The head it grabs from (and the at-rest servo drives, :func:`headsim.live.gaze.acquire`).
+        self.head = head
+        world = head.truth  # the physics, the motors' actuators and the target's body
+        self._model, self._data = world.model, world.data
         self.point_offset_m = None if point_offset_m is None else np.asarray(point_offset_m)
         self.config = config or LiveConfig()
-        self.dt = float(sim.model.opt.timestep)
+        self.dt = float(self._model.opt.timestep)
         limits = (self.config.neck_limits, self.config.neck_limits, self.config.eye_limits)
         self.motors = MotorDriver(
-            sim.model, sim.data, limits, self.config.servo_bandwidth_hz, sim.names
+            self._model, self._data, limits, self.config.servo_bandwidth_hz, world.names
         )
-        self._qadr = [int(sim.model.joint(j).qposadr[0]) for j in motor_joints(sim.names)]
+        self._qadr = [int(self._model.joint(j).qposadr[0]) for j in motor_joints(world.names)]
         self._mocap = -1
         if target_body is not None:
-            body_id = mujoco.mj_name2id(sim.model, mujoco.mjtObj.mjOBJ_BODY, target_body)
-            self._mocap = int(sim.model.body_mocapid[body_id]) if body_id >= 0 else -1
+            body_id = mujoco.mj_name2id(self._model, mujoco.mjtObj.mjOBJ_BODY, target_body)
+            self._mocap = int(self._model.body_mocapid[body_id]) if body_id >= 0 else -1
             if self._mocap < 0:
                 raise SettingsError(f"{target_body!r} is not a movable (mocap) body in this scene")
         self.path = path
@@ -149,7 +159,7 @@ class LiveHead:
         self._queue: list[_Queued] = []
         self._order = 0
         self._place_target()
-        mujoco.mj_forward(sim.model, sim.data)
+        mujoco.mj_forward(self._model, self._data)
         self.motors.sync()
 
     # -- time ----------------------------------------------------------------
@@ -173,7 +183,7 @@ class LiveHead:
             return
         present = self.visibility.visible(self.time_s)
         centre = self.path.position(self.time_s) if present else PARKED_WORLD_M
-        self.sim.data.mocap_pos[self._mocap] = centre
+        self._data.mocap_pos[self._mocap] = centre
 
     def advance_to(self, time_s: float) -> None:
         """Step the physics, motors and target until ``time_s`` (rounded to a physics step)."""
@@ -183,10 +193,10 @@ class LiveHead:
             while self._queue and self._queue[0].due_s <= now + 1e-12:
                 self._queue.pop(0).command(self.motors, now)
             self.motors.advance(now, self.dt)
-            mujoco.mj_step(self.sim.model, self.sim.data)
+            mujoco.mj_step(self._model, self._data)
             self.step_count += 1
             self._place_target()
-        mujoco.mj_forward(self.sim.model, self.sim.data)
+        mujoco.mj_forward(self._model, self._data)
 
     def send(self, command: Command, frame: Frame) -> None:
         """Queue ``command(motors, time_s)`` to act ``latency_frames`` periods after ``frame`` ended."""
@@ -207,11 +217,13 @@ class LiveHead:
         always).  The at-rest readings (``sim.neck_encoders``) would give the last at-rest
         command on a head with joint errors.  Backlash is not modelled here.
         """
-        resolution = self.sim.settings.encoder_resolution_rad
+        resolution = self.head.settings.encoder_resolution_rad
         return np.round(self.true_joints() / resolution) * resolution
 
     def true_joints(self) -> np.ndarray:
-        return np.array([float(self.sim.data.qpos[a]) for a in self._qadr])
+        """(neck yaw, neck pitch, eye) as the physics has them now, rad (truth: for the
+        encoders' model and for scoring)."""
+        return np.array([float(self._data.qpos[a]) for a in self._qadr])
 
     def capture(self) -> Frame:
         """Advance to the next frame's exposure and take it (both cameras)."""
@@ -228,7 +240,7 @@ class LiveHead:
             for i in range(n):
                 self.advance_to(start + (i + 0.5) * cfg.exposure_s / n)
                 for cam in range(2):
-                    image = self.sim.render(cam + 1).astype(np.float32)
+                    image = self.head.render(cam + 1).astype(np.float32)
                     total = sums[cam]
                     sums[cam] = image if total is None else total + image
                 if self._steps_at(middle) <= self.step_count and encoders is None:
@@ -243,7 +255,7 @@ class LiveHead:
             self.advance_to(end)
         else:
             self.advance_to(middle)
-            images = (self.sim.render(1), self.sim.render(2))
+            images = (self.head.render(1), self.head.render(2))
             encoders, joints, truth = self.encoders(), self.true_joints(), self.target_truth(middle)
         frame = Frame(
             self.frame_index,

@@ -33,11 +33,12 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.active.servo_types import Detector, ServoConfig
 from headsim.codec import declared, doc
-from headsim.head.sim_head import SimHead
+from headsim.head.servo_head import ServoHead
 from headsim.live.gaze import FrameRecord, PursuitFrame, PursuitRun, acquire, pursue
 from headsim.live.head import LiveHead
 from headsim.procedures.contract import Procedure, register
-from headsim.runs.context import PARKED_WORLD_M
+from headsim.runs.context import PARKED_WORLD_M, head
+from headsim.runs.events import Hub
 from headsim.runs.landing import landing, vergence_error_deg
 from headsim.runs.outcomes import MeasurementRecord
 from headsim.runs.surface import row_band_for
@@ -46,8 +47,6 @@ from headsim.scenario.pursuit import SECTIONS, PursuitSpec, describe
 from headsim.scenario.scene import read_pursuit_scene
 from headsim.scenario.spec import MARKER_BODIES, STREAM_CLICKS, Scenario
 from headsim.scenario.surface_targets import Click, camera_centre, cast, click
-from headsim.sim.events import EventSink
-from headsim.sim.simulator import HeadSim
 from headsim.vision.correspondence import MatchConfig
 
 if TYPE_CHECKING:
@@ -171,14 +170,14 @@ def figures(
 
 
 def _vergence_deg(
-    sim: HeadSim, goals: tuple[tuple[float, float], ...], marker_world_m: np.ndarray | None
+    head: ServoHead, goals: tuple[tuple[float, float], ...], marker_world_m: np.ndarray | None
 ) -> float:
     """The vergence error now, degrees (truth, for scoring): eye 2's goal ray against the
     direction to the point eye 1 fixates: where its ray landed on a surface, or, for a
     marker (``marker_world_m``, its centre), its ray's point nearest the centre (a 4 mm
     sphere's front, or the wall behind when the ray passes beside it, is not what the eyes
     converge on); NaN when eye 1's met nothing."""
-    one, two = landing(sim, 1, goals[0]), landing(sim, 2, goals[1])
+    one, two = landing(head.truth, 1, goals[0]), landing(head.truth, 2, goals[1])
     fixated = one.point_world_m
     if marker_world_m is not None:
         along = float(one.direction_world @ (marker_world_m - one.origin_world_m))
@@ -210,11 +209,13 @@ def _per_frame(records: tuple[FrameRecord, ...], vergence_deg: list[float]) -> d
 
 
 def run_pursuit(
-    scenario: Scenario, sink: EventSink, knowledge: HeadKnowledge, label: str
+    scenario: Scenario, hub: Hub, knowledge: HeadKnowledge, label: str
 ) -> tuple[list[MeasurementRecord], PursuitResult]:
-    """Acquire at rest, then pursue: no point records, and the pursuit's result.
+    """Acquire at rest, then pursue on the head the runner builds: no point records, and
+    the pursuit's result.  The target is moved, and the run scored, through the head's
+    truth channel.
 
-    ``sink``: where the run's events go; ``label``: unused (the procedures' common signature).
+    ``hub``: where the run's events go; ``label``: unused (the procedures' common signature).
     """
     spec = scenario.scene.pursuit
     assert spec is not None  # the reader sets it for this procedure
@@ -227,10 +228,10 @@ def run_pursuit(
                 replace(o, movable=True) if o.name == spec.body else o for o in room.objects
             ),
         )
-    with HeadSim(
-        "default", scenario.settings, settle_mode=scenario.settle_mode, sink=sink, room=room
-    ) as sim:
-        live = LiveHead(sim, spec.live, spec.body, spec.path, spec.visibility)
+    staged = replace(scenario, scene=replace(scenario.scene, room=room))
+    with head(hub, "default", staged) as sim_head:
+        truth = sim_head.truth  # placing the target and scoring only
+        live = LiveHead(sim_head, spec.live, spec.body, spec.path, spec.visibility)
         first = next(
             (
                 float(t)
@@ -241,54 +242,54 @@ def run_pursuit(
         )
         described = describe(spec)
         if first is None:
-            sink.emit(PhaseStarted("measurement", sim, knowledge, {}))
+            hub.emit(PhaseStarted("measurement", truth, knowledge, {}))
             return [], PursuitResult(
                 described, failures=(f"{spec.name}: never present in the run",)
             )
         told: Click | None = None
         if textured:
             for body in MARKER_BODIES:  # markers play no part: out of every view
-                sim.set_body_pose(body, np.array(PARKED_WORLD_M))
+                truth.set_body_pose(body, np.array(PARKED_WORLD_M))
             live.advance_to(first)
-            told, offset = _click_object(sim, spec, scenario.seed)
+            told, offset = _click_object(sim_head, spec, scenario.seed)
             if told is None:
-                sink.emit(PhaseStarted("measurement", sim, knowledge, {}))
+                hub.emit(PhaseStarted("measurement", truth, knowledge, {}))
                 failure = "not in camera 1's first image (hidden or out of view)"
                 return [], PursuitResult(described, failures=(f"{spec.name}: {failure}",))
             live.point_offset_m = offset
         else:
             live.advance_to(first)
-        truth = live.target_truth(first)
-        assert truth is not None
-        sink.emit(PhaseStarted("measurement", sim, knowledge, {spec.name: truth}))
+        present = live.target_truth(first)
+        assert present is not None
+        hub.emit(PhaseStarted("measurement", truth, knowledge, {spec.name: present}))
         detector: Detector = (
             marker_target(spec.name, spec.body).detector
             if told is None
             # Camera 1's first image, clicked: camera 1 tracks that fovea, camera 2
             # finds it by correlation along the believed row.
             else MarkerlessPair(
-                sim.render(1), told.clicked_uv, row_band_for(knowledge, sim, spec.band_px)
+                sim_head.render(1), told.clicked_uv, row_band_for(knowledge, sim_head, spec.band_px)
             )
         )
         # Whole frames, no windows or previews: the acquisition as it has always run (a
         # markerless pair still correlates only its foveal window).
         estimator = acquire(
-            live, NeckServo(SimHead(sim), ServoConfig(windows=False)), detector, knowledge
+            live, NeckServo(sim_head, ServoConfig(windows=False)), detector, knowledge
         )
         if estimator is None:
             return [], PursuitResult(described, failures=(f"{spec.name}: not acquired at rest",))
 
         # The servo's goal pixels: each camera's goal column on the mean goal row.
-        (u1, v1), (u2, v2) = knowledge.reference(sim, 1), knowledge.reference(sim, 2)
+        (u1, v1), (u2, v2) = knowledge.reference(sim_head, 1), knowledge.reference(sim_head, 2)
         goals = ((u1, (v1 + v2) / 2), (u2, (v1 + v2) / 2))
         vergence: list[float] = []
 
         def on_frame(record: FrameRecord) -> None:
             # At the pose the frame was taken at; a marker's centre is what the eyes fixate.
             centre = record.truth_world_m if told is None else None
-            vergence.append(_vergence_deg(sim, goals, centre))
-            sink.emit(FixationStarted(f"{spec.name} t={record.time_s:.3f}s"))  # a step per frame
-            sink.emit(PursuitFrame(record))
+            vergence.append(_vergence_deg(sim_head, goals, centre))
+            hub.emit(FixationStarted(f"{spec.name} t={record.time_s:.3f}s"))  # a step per frame
+            hub.emit(PursuitFrame(record))
 
         run = pursue(live, detector, estimator, spec.duration_s, spec.gaze, on_frame)
     return [], PursuitResult(
@@ -300,20 +301,21 @@ def run_pursuit(
     )
 
 
-def _click_object(sim: HeadSim, spec: PursuitSpec, seed: int) -> tuple[Click | None, np.ndarray]:
+def _click_object(head: ServoHead, spec: PursuitSpec, seed: int) -> tuple[Click | None, np.ndarray]:
     """The user's click on the room object ``spec.body`` in camera 1's image now, and the
-    clicked surface point's offset from the object's centre (truth, for placing the click
-    and scoring).  The point: where camera 1's line of sight to the object's centre first
+    clicked surface point's offset from the object's centre (truth through ``head``'s
+    channel, for placing the click and scoring; the image's size is the specification's).  The point: where camera 1's line of sight to the object's centre first
     meets the object; None where that is another object, or too near the image's edge
     for a template."""
-    centre = sim.data.xpos[sim.model.body(spec.body).id].copy()
-    origin = camera_centre(sim, 1)
-    hit, _, geom = cast(sim.model, sim.data, origin, centre - origin)
+    world = head.truth
+    centre = world.data.xpos[world.model.body(spec.body).id].copy()
+    origin = camera_centre(world, 1)
+    hit, _, geom = cast(world.model, world.data, origin, centre - origin)
     none = np.zeros(3)
-    if hit is None or sim.model.body(int(sim.model.geom_bodyid[geom])).name != spec.body:
+    if hit is None or world.model.body(int(world.model.geom_bodyid[geom])).name != spec.body:
         return None, none
-    told = click(sim, hit, np.random.default_rng([seed, STREAM_CLICKS]), spec.click_error_px)
-    size = sim.camera_settings(1)
+    told = click(world, hit, np.random.default_rng([seed, STREAM_CLICKS]), spec.click_error_px)
+    size = head.camera_settings(1)
     half = MatchConfig().half_px + 2
     u, v = told.clicked_uv
     if not (half <= u <= size.width - 1 - half and half <= v <= size.height - 1 - half):

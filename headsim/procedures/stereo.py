@@ -52,9 +52,9 @@ from headsim.active.look import look_once
 from headsim.active.measurement import HeadKnowledge
 from headsim.codec import declared, doc
 from headsim.geometry.transforms import frame_deviation
-from headsim.head.sim_head import SimHead
+from headsim.head.servo_head import ServoHead
 from headsim.procedures.contract import Procedure, register
-from headsim.runs.context import simulator
+from headsim.runs.context import head
 from headsim.runs.events import Hub
 from headsim.runs.outcomes import MeasurementRecord
 from headsim.runs.table import cell, format_table, mm
@@ -62,7 +62,6 @@ from headsim.scenario.scene import targets_reader
 from headsim.scenario.spec import WHEN_GIVEN, CalibrationSpec, Scenario
 from headsim.scenario.tables import Table
 from headsim.sim.declared import Array, Choice, Flag, Section, Setting, Text
-from headsim.sim.simulator import HeadSim
 from headsim.stereo.calibration import MIN_VIEWS, CameraCalibration, StereoCalibration
 from headsim.stereo.calibration import calibrate_stereo as zhang_calibration
 from headsim.stereo.calibration_file import StereoCalibrationFileError, read_stereo_calibration
@@ -393,16 +392,18 @@ def camera_parameters(calib: StereoCalibration) -> tuple[dict[str, Parameter], .
     return tuple(tables)
 
 
-def head_frames(sim: HeadSim, calib: StereoCalibration) -> dict[str, np.ndarray]:
+def head_frames(sim_head: ServoHead, calib: StereoCalibration) -> dict[str, np.ndarray]:
     """Ways to place camera 1 in H (:data:`HEAD_FRAMES`): from the extrinsics, and the
     paper's eye-geometry ones, which turn camera 1 about H's y by the true mount yaw; the
     true effective initial direction (what a perfect Sec. V calibration returns); that
-    minus the calibrated centre-ray angle; and 0 (cameras parallel to H)."""
-    baseline = sim.truth.settings.baseline_m
-    effective = sim.truth.effective_initial_direction(1)
+    minus the calibrated centre-ray angle; and 0 (cameras parallel to H).  The true
+    geometry is read through the head's truth channel: these score, they do not measure."""
+    truth = sim_head.truth
+    baseline = truth.settings.baseline_m
+    effective = truth.effective_initial_direction(1)
     frames = (
         calib.head_from_cam1,
-        head_from_cam1_from_eye(sim.truth.settings.cameras[0].mount_yaw_rad, baseline),
+        head_from_cam1_from_eye(truth.settings.cameras[0].mount_yaw_rad, baseline),
         head_from_cam1_from_eye(effective, baseline),
         head_from_cam1_from_eye(effective - calib.cam1.centre_ray_yaw_rad, baseline),
         head_from_cam1_from_eye(0.0, baseline),
@@ -435,21 +436,19 @@ def head_frame(
 
 
 def calibrate(
-    sim: HeadSim, spec: StereoSpec, seed: int
+    sim_head: ServoHead, spec: StereoSpec, seed: int
 ) -> tuple[StereoCalibration, ChessboardViews]:
-    """Zhang's calibration from ``spec.views`` seeded board poses in ``sim`` (the chessboard
-    scene); the calibration and its views."""
+    """Zhang's calibration from ``spec.views`` seeded board poses shown to ``sim_head``
+    (the chessboard scene); the calibration and its views."""
     views = chessboard_views(
-        sim,
+        sim_head,
         spec.views,
         np.random.default_rng(seed if spec.board_seed is None else spec.board_seed),
         spec.distance_m,
         spec.max_tilt_rad,
-        look=(lambda sim, camera: look_for_board(SimHead(sim), camera))
-        if spec.board_look == "windowed"
-        else None,
+        look=look_for_board if spec.board_look == "windowed" else None,
     )
-    return zhang_calibration(sim, views, spec.refine_intrinsics), views
+    return zhang_calibration(sim_head, views, spec.refine_intrinsics), views
 
 
 def measure_targets(
@@ -468,29 +467,30 @@ def measure_targets(
     rows: list[StereoTarget] = []
     renders: list[int] = []
     frame_errors: dict[str, list[tuple[float, float]]] = {name: [] for name in HEAD_FRAMES}
-    with simulator(hub, "default", scenario) as sim:
+    with head(hub, "default", scenario) as sim_head:
+        world = sim_head.truth  # placing the targets and scoring only
         truth = {t.name: np.array(t.position_world_m) for t in targets}
-        hub.emit(PhaseStarted("measurement", sim, knowledge, truth))
-        sim.move(eye=0.0)
-        world_from_head = sim.truth.world_from_head()
-        frames = head_frames(sim, calib)
+        hub.emit(PhaseStarted("measurement", world, knowledge, truth))
+        sim_head.move(eye=0.0)
+        world_from_head = world.world_from_head()
+        frames = head_frames(sim_head, calib)
         for placement in targets:
             hub.begin(placement.name)
-            sim.set_body_pose(placement.body, np.array(placement.position_world_m))
-            start = sim.render_count
+            world.set_body_pose(placement.body, np.array(placement.position_world_m))
+            start = sim_head.render_count
             try:
-                m = measure_point_stereo(sim, calib, placement.body, look=look)
+                m = measure_point_stereo(sim_head, calib, placement.body, look=look)
             except StereoError as missed:
-                renders.append(sim.render_count - start)
+                renders.append(sim_head.render_count - start)
                 unknown = np.full(3, np.nan)
-                truth_head = sim.truth.position(placement.body, "head")
+                truth_head = world.position(placement.body, "head")
                 rows.append(
                     StereoTarget(
                         placement.name, str(missed), truth_head, unknown, unknown, None, None
                     )
                 )
                 continue
-            renders.append(sim.render_count - start)
+            renders.append(sim_head.render_count - start)
             for name, head_from_cam1 in frames.items():
                 p_head = triangulate(calib, np.array([m.uv1]), np.array([m.uv2]), head_from_cam1)
                 error_m = float(np.linalg.norm(p_head[0] - m.true_p_head))
@@ -521,18 +521,14 @@ def run_stereo(
     spec = scenario.experiment.block
     if isinstance(spec, StoredStereoSpec):
         stored = read_stereo_calibration(spec.source)
-        look = (
-            (lambda sim, camera, detector: look_once(SimHead(sim), camera, detector))
-            if spec.look == "once"
-            else None
-        )
+        look: Look | None = look_once if spec.look == "once" else None
         rows, summary, renders = measure_targets(scenario, hub, knowledge, stored, look)
         return [], StoredStereoResult(spec.source, summary, rows, renders)
     assert isinstance(spec, StereoSpec)
-    with simulator(hub, "chessboard", scenario) as sim:
-        hub.emit(PhaseStarted("board views", sim, knowledge, {}))
+    with head(hub, "chessboard", scenario) as sim_head:
+        hub.emit(PhaseStarted("board views", sim_head.truth, knowledge, {}))
         try:
-            calib, views = calibrate(sim, spec, scenario.seed)
+            calib, views = calibrate(sim_head, spec, scenario.seed)
         except StereoError as error:
             return [], NotCalibrated(spec.views, str(error))
     rows, summary, _ = measure_targets(scenario, hub, knowledge, calib)

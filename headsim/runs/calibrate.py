@@ -170,13 +170,7 @@ def calibrate(scenario: Scenario, hub: Hub) -> tuple[CalibrationRun | None, Cali
             kx_over_ky_truth=truth_ratio,
         ),
         lines_of_sight=None if run.lines is None else _lines_fit(run, sim),
-        knowledge=KnowledgeReport(
-            alpha_e_rad=list(knowledge.alpha_e),
-            v0_px=list(knowledge.v0),
-            kx_over_ky=list(knowledge.kx_over_ky),
-            u0_px=list(knowledge.u0),
-            los_offset_m=None if knowledge.los_offset_m is None else list(knowledge.los_offset_m),
-        ),
+        knowledge=KnowledgeReport.of(knowledge),
     )
     hub.emit(CalibrationDone(report))
     return run, report

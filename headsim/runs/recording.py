@@ -175,6 +175,7 @@ class Recorder:
         self.truth: dict[str, np.ndarray] = {}
         self.estimates: dict[str, tuple[np.ndarray, np.ndarray, bool]] = {}
         self._labels: dict[str, str] = {}
+        self._measured: set[tuple[str, float | None, str]] = set()
         self.knowledge = HeadKnowledge()
         self.effective_alpha_e = (0.0, 0.0)
         self.world_from_head_start = np.eye(4)
@@ -382,8 +383,10 @@ class Recorder:
         label = m.name
         if record.time_s is not None:
             label += f" t={record.time_s:g}s"
-        if self.scenario.experiment.procedure == "calibration":
+        seen = {k for n, t, k in self._measured if (n, t) == (m.name, record.time_s)}
+        if seen - {record.knowledge}:  # measured again knowing more (before and after)
             label += f" ({record.knowledge})"
+        self._measured.add((m.name, record.time_s, record.knowledge))
         self.estimates[f"{record.step}"] = (m.estimate_world_m, m.truth_world_m, m.ok)
         self._labels[f"{record.step}"] = label
         done = [(k, e, t) for k, (e, t, ok) in self.estimates.items() if ok]

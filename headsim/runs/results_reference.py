@@ -5,6 +5,7 @@ of :class:`~headsim.runs.serialise.ResultsDocument`): ``a.b`` a key of a
 table, ``a[].b`` a key of each entry of a list, ``a.*`` each key of a table
 whose keys are data (a knowledge, a phase).  A path listed without any of its
 children is described as a whole (its keys are not listed one by one).
+:data:`CALIBRATION_FILE_FIELDS` does the same for a calibration file.
 :func:`experiment_fields` gives each procedure's ``experiment`` keys the same
 way, relative to ``experiment``, from its declaration (``Procedure.results``).
 :func:`undocumented` and :func:`documented_paths` compare a real results.json
@@ -17,6 +18,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping
 from typing import Any
 
+from headsim.active.calibration_file import CalibrationDocument
 from headsim.codec import describe
 from headsim.procedures.contract import procedures
 from headsim.runs.outcomes import SurfaceResult
@@ -25,6 +27,9 @@ from headsim.runs.serialise import ResultsDocument
 #: Every key of results.json outside ``experiment``'s procedure keys, in the order written:
 #: read from the declarations of the document's types.
 RESULTS_FIELDS: dict[str, str] = describe(ResultsDocument)
+
+#: Every key of a calibration file (``headsim calibrate``'s ``head.json``), in the order written.
+CALIBRATION_FILE_FIELDS: dict[str, str] = describe(CalibrationDocument)
 
 #: ``experiment`` keys a procedure writes only when it failed.
 FAILED_ONLY = frozenset({"reason"})
@@ -90,6 +95,7 @@ def documented_paths(results: Mapping[str, Any]) -> set[str]:
 
 
 __all__ = [
+    "CALIBRATION_FILE_FIELDS",
     "FAILED_ONLY",
     "MARKERLESS_ONLY",
     "RESULTS_FIELDS",

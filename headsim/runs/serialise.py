@@ -28,9 +28,15 @@ from headsim.estimators.result import Method, Status
 from headsim.head.offline import TargetEstimate
 from headsim.runs.accuracy import MeasurementSummary, summaries
 from headsim.runs.outcomes import FixationScore, MeasurementRecord, RunOutcome, RunRenders
+from headsim.scenario.schema import SETTLE
 from headsim.scenario.spec import experiment_record
 from headsim.sim.events import RenderCounts
-from headsim.sim.settings import HeadBelief, settings_record
+from headsim.sim.settings import (
+    HeadBelief,
+    belief_meanings,
+    record_meanings,
+    settings_record,
+)
 from headsim.version import __version__
 
 #: Version of the results.json layout; bumped when a key changes meaning or goes.
@@ -202,32 +208,12 @@ class ResultsDocument:
     )
     settings: dict[str, Any] = doc(
         "the true head",
-        parts={
-            "baseline_m": "the baseline, m",
-            "neck_d1_m": "the neck's d1, m",
-            "neck_a2_m": "the neck's a2, m",
-            "encoder_resolution_rad": "one encoder count, rad",
-            "cameras": "each camera's settings (`kx`, `ky`, `cx`, `cy`, `width`, `height`, `k1`, `k2`, `noise_std`, `mount_yaw_rad`, `mount_pitch_rad`, `mount_roll_rad`, `nodal_offset_m`, `side_offset_m`, `eye_axis_tilt_rad`)",
-            "seed": "the seed of the head's own draws",
-            "belief": "what the head was told it is, as given (`null`: the truth)",
-            "backlash_rad": "play of every joint's gearing, rad",
-            "count_error": "whether the true angle lies anywhere within the count read, not on it",
-            "render": "the rendering fidelity: `offsamples`, `supersample`",
-            "head": "the head, only when it is not the paper's (absent: the paper's head)",
-            "head.name": "its name: a shipped head's, or the MJCF file's stem",
-            "head.path": "its MJCF file: `models/NAME.xml` for a shipped head (the same on every checkout), a user's file by its path",
-            "head.mapping": "the names headsim uses in it (the scenario's `[head.mapping]`): `head_body`, `neck_yaw`, `neck_pitch`, `eyes`, `left_eye`, `right_eye`, `cameras`, `neck_roll`, `eye_tilt`, `version`, `vergence` (`null`: none)",
-            "settle_mode": "how the servo waits for the joints to settle",
-        },
+        parts={**record_meanings(), "settle_mode": SETTLE.meaning.removesuffix(".")},
     )
     belief: dict[str, Any] = doc(
         "what the head believed and measured with",
         parts={
-            "baseline_m": "the believed baseline, m",
-            "neck_d1_m": "the believed neck d1, m",
-            "neck_a2_m": "the believed neck a2, m",
-            "nodal_offset_m": "the believed nodal offset, m (recorded; no estimate uses it, since it acts only through the goal column's angle off the optical axis)",
-            "side_offset_m": "the believed side offset, m",
+            **belief_meanings(),
             "sources": "where each believed quantity above came from: `design` (the head's design), `preset` (the realistic preset's own belief), `file` (the scenario's `[belief]`), `given` (a `HeadBelief` given in Python), or `truth` (equal to the true head's, which the scenario changed in `[head]` and the belief followed)",
         },
     )

@@ -250,13 +250,13 @@ def score_fixation(
 
 
 def row_band_for(
-    knowledge: HeadKnowledge, sim: HeadSim, band_px: float
+    knowledge: HeadKnowledge, head: ServoHead, band_px: float
 ) -> Callable[[tuple[float, float]], Callable[[], Band]]:
     """The band camera 2 searches for camera 1's point at (u, v): camera 1's row shifted
     by the believed reference rows' difference, +- ``band_px``, across camera 2's width
     (the head's belief only; the image size is the image's)."""
-    v_shift = knowledge.reference(sim, 2)[1] - knowledge.reference(sim, 1)[1]
-    width = sim.camera_settings(2).width
+    v_shift = knowledge.reference(head, 2)[1] - knowledge.reference(head, 1)[1]
+    width = head.camera_settings(2).width
 
     def band_for(uv1: tuple[float, float]) -> Callable[[], Band]:
         band = row_band(uv1[1] + v_shift, width, band_px)
@@ -316,7 +316,7 @@ def measure_surface_targets(
             head = SimHead(sim)  # what the servo and the measurement drive
             shared = servo(head)
             clicks = np.random.default_rng([scenario.seed, STREAM_CLICKS])
-            band_for = row_band_for(knowledge, sim, spec.band_px)
+            band_for = row_band_for(knowledge, head, spec.band_px)
             for placed, marker_at in zip(drawn.targets, markers_at, strict=True):
                 step = hub.begin(placed.name)
                 _start_pose(sim)

@@ -19,7 +19,7 @@ from headsim.geometry.synthetic import mount_yaw_for_direction
 from headsim.paper import BASELINE_M, ENCODER_RESOLUTION_RAD, INITIAL_DIRECTIONS_RAD, INTRINSICS
 from headsim.sim import imperfections
 from headsim.sim.declared import Choice, Flag, Setting
-from headsim.sim.heads import MODELS_DIR, PAPER, HeadModel
+from headsim.sim.heads import MODELS_DIR, PAPER, HeadMapping, HeadModel
 from headsim.sim.imperfections.distortion import K1, K2
 from headsim.sim.imperfections.noise import NOISE_STD
 from headsim.sim.tolerances import REALISTIC_BUDGET
@@ -554,6 +554,65 @@ def settings_record(settings: HeadSettings) -> dict[str, Any]:
     if not settings.head.is_paper:
         record["head"] = {**head, "path": _model_path(settings.head.path)}
     return record
+
+
+def _said(meaning: str) -> str:
+    """A declaration's meaning as a reference cell says it: no closing full stop."""
+    return meaning.removesuffix(".")
+
+
+def record_meanings() -> dict[str, str]:
+    """What each key of :func:`settings_record`'s table means (paths relative to it, as
+    :func:`headsim.codec.describe` lists a table's parts), read from the declarations
+    above and the imperfections': the results reference's ``settings`` rows."""
+    own = {s.name: s for s in CAMERA_SETTINGS}
+    camera = {
+        f"cameras[].{f.name}": _said((own.get(f.name) or imperfections.setting(f.name)).meaning)
+        for f in fields(CameraSettings)
+        if f.name != "extra"
+    }
+    camera["cameras[].extra"] = (
+        "the settings of imperfections registered beyond the fields above, as (name, value) "
+        "pairs (absent while there are none)"
+    )
+    render = {f"render.{s.name.removeprefix('render_')}": _said(s.meaning) for s in RENDER_SETTINGS}
+    head = {
+        "head.name": "its name: a shipped head's, or the MJCF file's stem",
+        "head.path": "its MJCF file: `models/NAME.xml` for a shipped head (the same on every "
+        "checkout), a user's file by its path",
+        "head.mapping": "the names headsim uses in it (the scenario's `[head.mapping]`: "
+        f"{', '.join(f'`{f.name}`' for f in fields(HeadMapping))}; `null`: none)",
+    }
+    declared = {s.name: _said(s.meaning) for s in (*HEAD_SETTINGS, COUNT_ERROR)}
+    undeclared = {  # the record's tables, and the fields no scenario key sets
+        "cameras": ("each camera's settings, Ca1's then Ca2's", camera),
+        "seed": ("the seed of the head's own draws", {}),
+        "belief": (
+            "what the head was told it is, as given (`null`: the truth)",
+            {f"belief.{key}": meaning for key, meaning in belief_meanings().items()},
+        ),
+        "render": ("the rendering fidelity", render),
+        "head": ("the head, only when it is not the paper's (absent: the paper's head)", head),
+    }
+    out: dict[str, str] = {}
+    for f in fields(HeadSettings):
+        if f.name in declared:
+            out[f.name] = declared[f.name]
+        else:
+            out[f.name], parts = undeclared[f.name]
+            out.update(parts)
+    return out
+
+
+def belief_meanings() -> dict[str, str]:
+    """What each key of a record of :class:`HeadBelief` means, from the declarations of
+    the believed quantities (paths relative to it)."""
+    declared = {s.name: _said(s.meaning) for s in BELIEF_SETTINGS}
+    declared["nodal_offset_m"] = (
+        "Believed nodal offset per camera, m (recorded; no estimate uses it, since it acts "
+        "only through the goal column's angle off the optical axis)"
+    )
+    return {key: declared[key] for key in BELIEF_KEYS}
 
 
 def _model_path(path: Path | None) -> str:

@@ -16,7 +16,7 @@ import numpy as np
 
 from headsim.codec import declared, doc
 from headsim.geometry.transforms import invert_transform, rotation_angle
-from headsim.sim.simulator import HeadSim
+from headsim.head.servo_head import ServoHead
 from headsim.stereo.frames import head_from_cam1_from_extrinsics
 from headsim.stereo.views import ChessboardViews, StereoError
 
@@ -174,26 +174,26 @@ def _calibrate_camera(
 
 
 def calibrate_stereo(
-    sim: HeadSim, views: ChessboardViews, refine_intrinsics: bool = True
+    head: ServoHead, views: ChessboardViews, refine_intrinsics: bool = True
 ) -> StereoCalibration:
-    """Calibrate each camera, then the pair, from ``views``; truth read from ``sim``.
+    """Calibrate each camera, then the pair, from ``views``; the truth beside it read
+    through ``head``'s truth channel.
 
     With ``refine_intrinsics`` (default, as OpenCV's stereo sample does),
     ``stereoCalibrate`` starts from the per-camera K, k1, k2 and refines them
     with the extrinsics; otherwise it keeps them fixed.  Same distortion model
     throughout (``CALIBRATION_FLAGS``).  The truth is the simulator's at eye
-    angle 0 (``sim``'s eyes are moved there).
+    angle 0 (``head``'s eyes are moved there).
     """
     if views.count < MIN_VIEWS:
         raise StereoError(
             f"need at least {MIN_VIEWS} views with the board found in both cameras, got "
             f"{views.count} of {views.poses_tried} poses; render more poses"
         )
-    sim.move(eye=0.0)
+    head.move(eye=0.0)
+    truth = head.truth  # scoring only
     mono = [
-        _calibrate_camera(
-            views, index, sim.truth.camera_matrix(index), sim.truth.dist_coeffs(index)
-        )
+        _calibrate_camera(views, index, truth.camera_matrix(index), truth.dist_coeffs(index))
         for index in (1, 2)
     ]
     flags = CALIBRATION_FLAGS | (
@@ -226,9 +226,7 @@ def calibrate_stereo(
     cam2_from_cam1 = np.eye(4)
     cam2_from_cam1[:3, :3] = R
     cam2_from_cam1[:3, 3] = np.asarray(T, dtype=float).ravel()
-    true_cam2_from_cam1 = invert_transform(
-        sim.truth.world_from_camera(2)
-    ) @ sim.truth.world_from_camera(1)
+    true_cam2_from_cam1 = invert_transform(truth.world_from_camera(2)) @ truth.world_from_camera(1)
     return StereoCalibration(
         mono1=mono[0],
         mono2=mono[1],
@@ -237,7 +235,7 @@ def calibrate_stereo(
         stereo_rms_px=float(rms),
         cam2_from_cam1=cam2_from_cam1,
         true_cam2_from_cam1=true_cam2_from_cam1,
-        true_head_from_cam1=sim.truth.head_from_camera(1),
+        true_head_from_cam1=truth.head_from_camera(1),
         views=views.count,
         refined=refine_intrinsics,
     )

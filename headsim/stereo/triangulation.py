@@ -3,7 +3,8 @@
 Step 3 of the baseline (:func:`triangulate`): undistort detected pixels with
 the calibration, ``cv2.triangulatePoints`` in camera 1's frame, then map into
 the head frame H (:mod:`headsim.stereo.frames`).  :func:`measure_point_stereo`
-runs it on a body of the scene, scored against the simulator's truth.
+runs it on a body of the scene: found in the head's images (:func:`detect_pair`), scored
+against the simulator's truth (through the head's truth channel).
 Units: m, px.
 """
 
@@ -15,8 +16,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from headsim.head.servo_head import ServoHead
 from headsim.sim import names
-from headsim.sim.simulator import HeadSim
 from headsim.stereo.calibration import StereoCalibration, undistort_normalized_points
 from headsim.stereo.views import StereoError
 from headsim.vision.detection import Detection
@@ -89,41 +90,52 @@ def marker_detector(target: str) -> Detector:
     return lambda image: find_marker(image, colour)
 
 
-#: How a camera's next image is detected in: ``look(sim, camera, detector)``.
-Look = Callable[[HeadSim, int, Detector], Detection]
+#: How a camera's next image is detected in: ``look(head, camera, detector)``.
+Look = Callable[[ServoHead, int, Detector], Detection]
 
 
-def full_frame(sim: HeadSim, camera: int, detector: Detector) -> Detection:
+def full_frame(head: ServoHead, camera: int, detector: Detector) -> Detection:
     """``detector`` on ``camera``'s next image, the full frame."""
-    return detector(sim.render(camera))
+    return detector(head.render(camera))
+
+
+def detect_pair(
+    head: ServoHead, target: str, detector: Detector | None = None, look: Look | None = None
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The body ``target``'s pixel in each eye's next image (camera 1's, camera 2's) at
+    eye angle 0, px: the head's images alone.
+
+    ``detector`` defaults to :func:`marker_detector` of ``target``.  ``look(head,
+    camera, detector)`` detects in the camera's next image (default: the full frame;
+    ``headsim.active.look.look_once`` grabs only where a preview shows the target).
+    :class:`StereoError` when either camera misses it.
+    """
+    detect = detector or marker_detector(target)
+    look = look or full_frame
+    head.move(eye=0.0)
+    uvs = []
+    for index in (1, 2):
+        detection = look(head, index, detect)
+        if not detection.found or detection.uv is None:
+            raise StereoError(
+                f"{target!r} not found in {names.CAMERAS[index - 1]}: {detection.status.value}"
+            )
+        uvs.append(detection.uv)
+    return uvs[0], uvs[1]
 
 
 def measure_point_stereo(
-    sim: HeadSim,
+    head: ServoHead,
     calib: StereoCalibration,
     target: str,
     detector: Detector | None = None,
     head_from_cam1: np.ndarray | None = None,
     look: Look | None = None,
 ) -> StereoMeasurement:
-    """Measure the body ``target`` in H: eye angle 0, render both cameras, detect, triangulate.
-
-    ``detector`` defaults to :func:`marker_detector` of ``target``.  ``look(sim,
-    camera, detector)`` detects in the camera's next image (default: the full frame;
-    ``headsim.active.look.look_once`` renders only where a preview shows the target).
-    """
-    detect = detector or marker_detector(target)
-    look = look or full_frame
-    sim.move(eye=0.0)
-    uvs = []
-    for index in (1, 2):
-        detection = look(sim, index, detect)
-        if not detection.found or detection.uv is None:
-            raise StereoError(
-                f"{target!r} not found in {names.CAMERAS[index - 1]}: {detection.status.value}"
-            )
-        uvs.append(detection.uv)
-    p_head = triangulate(calib, np.array([uvs[0]]), np.array([uvs[1]]), head_from_cam1)[0]
+    """Measure the body ``target`` in H (:func:`detect_pair`, then :func:`triangulate`),
+    scored against its truth through ``head``'s truth channel."""
+    uv1, uv2 = detect_pair(head, target, detector, look)
+    p_head = triangulate(calib, np.array([uv1]), np.array([uv2]), head_from_cam1)[0]
     return StereoMeasurement(
-        uv1=uvs[0], uv2=uvs[1], p_head=p_head, true_p_head=sim.truth.position(target, "head")
+        uv1=uv1, uv2=uv2, p_head=p_head, true_p_head=head.truth.position(target, "head")
     )

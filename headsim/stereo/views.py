@@ -4,6 +4,9 @@ Step 1 of the baseline (:func:`chessboard_views`): the scene's chessboard in
 seeded random poses (:func:`sample_board_pose`, every pose fully in both
 images), both eyes rendered at eye angle 0, inner corners detected with
 OpenCV (:func:`detect_chessboard`).  Poses in the head frame H, m; pixels px.
+The board is placed, and its true corners projected, through the head's truth
+channel (the simulator's job); the corners are measured in the head's images alone
+(:func:`board_view`).
 :class:`StereoError` is what every step of the baseline raises when it
 cannot proceed.
 """
@@ -17,6 +20,7 @@ import mujoco
 import numpy as np
 
 from headsim.geometry.transforms import rotation_x, rotation_y, rotation_z
+from headsim.head.servo_head import ServoHead
 from headsim.sim import names
 from headsim.sim.optics import project_points, undistort_pixels
 from headsim.sim.simulator import HeadSim
@@ -196,52 +200,65 @@ def detect_chessboard(image: np.ndarray) -> np.ndarray | None:
     return detection.corners.astype(float)
 
 
-#: How a camera's next image gives the board's corners: ``look(sim, camera)``, (N, 2)
+#: How a camera's next image gives the board's corners: ``look(head, camera)``, (N, 2)
 #: px in board order, or None.
-BoardLook = Callable[[HeadSim, int], "np.ndarray | None"]
+BoardLook = Callable[[ServoHead, int], "np.ndarray | None"]
 
 
-def full_frame_board(sim: HeadSim, camera: int) -> np.ndarray | None:
+def full_frame_board(head: ServoHead, camera: int) -> np.ndarray | None:
     """:func:`detect_chessboard` on ``camera``'s next image, the full frame."""
-    return detect_chessboard(sim.render(camera))
+    return detect_chessboard(head.render(camera))
+
+
+def board_view(head: ServoHead, look: BoardLook) -> tuple[np.ndarray, np.ndarray] | None:
+    """The board's corners (N, 2) px in each eye's next image (camera 1's, camera 2's),
+    through ``look``; None when either misses it."""
+    detected = [look(head, camera) for camera in (1, 2)]
+    if detected[0] is None or detected[1] is None:
+        return None
+    return detected[0], detected[1]
 
 
 def chessboard_views(
-    sim: HeadSim,
+    head: ServoHead,
     n_poses: int,
     rng: np.random.Generator,
     distance_range_m: tuple[float, float] = (0.4, 1.0),
     max_tilt_rad: float = 0.6,
     look: BoardLook | None = None,
 ) -> ChessboardViews:
-    """Render the chessboard in ``n_poses`` random poses at eye angle 0 and detect its corners.
+    """Show ``head`` the chessboard in ``n_poses`` random poses at eye angle 0 and detect
+    its corners.
 
-    ``sim`` must hold the chessboard scene.  The neck and eyes are moved to 0.
-    Views where either camera misses the board are dropped.  ``look(sim, camera)``
-    gives the corners of the camera's next image (default: :func:`detect_chessboard`
-    on the full frame; ``headsim.active.chessboard.look_for_board`` renders less).
+    ``head`` must see the chessboard scene.  The neck and eyes are moved to 0.  Each pose
+    is drawn and the board placed through the head's truth channel; the corners come from
+    the head's images (:func:`board_view`).  Views where either camera misses the board
+    are dropped.  ``look(head, camera)`` gives the corners of the camera's next image
+    (default: :func:`detect_chessboard` on the full frame;
+    ``headsim.active.chessboard.look_for_board`` renders less).
     """
     look = look or full_frame_board
     if n_poses < 1:
         raise StereoError(f"n_poses must be >= 1, got {n_poses}")
-    sim.move(eye=0.0, neck_yaw=0.0, neck_pitch=0.0)
-    world_from_head = sim.truth.world_from_head()
+    head.move(eye=0.0, neck_yaw=0.0, neck_pitch=0.0)
+    world = head.truth  # placing the board and scoring its corners only
+    world_from_head = world.world_from_head()
     object_points = chessboard_object_points()
-    renders_before = sim.render_count
+    renders_before = head.render_count
     kept: list[tuple[np.ndarray, ...]] = []
     for _ in range(n_poses):
-        head_from_board = sample_board_pose(sim, rng, distance_range_m, max_tilt_rad)
+        head_from_board = sample_board_pose(world, rng, distance_range_m, max_tilt_rad)
         world_from_board = world_from_head @ head_from_board
-        sim.set_body_pose(
+        world.set_body_pose(
             names.CHESSBOARD, world_from_board[:3, 3], _quat_from_rotation(world_from_board[:3, :3])
         )
-        detected = [look(sim, camera) for camera in (1, 2)]
-        if detected[0] is None or detected[1] is None:
+        detected = board_view(head, look)
+        if detected is None:
             continue
         points_world = object_points @ world_from_board[:3, :3].T + world_from_board[:3, 3]
-        truth = [sim.truth.project(points_world, camera) for camera in (1, 2)]
+        truth = [world.project(points_world, camera) for camera in (1, 2)]
         kept.append((detected[0], detected[1], truth[0], truth[1], head_from_board))
-    sizes = tuple((c.width, c.height) for c in sim.settings.cameras)
+    sizes = tuple((c.width, c.height) for c in head.settings.cameras)
     empty = np.zeros((0, len(object_points), 2))
     stacked = [np.array([k[i] for k in kept]) if kept else empty for i in range(4)]
     return ChessboardViews(
@@ -253,5 +270,5 @@ def chessboard_views(
         head_from_board=np.array([k[4] for k in kept]) if kept else np.zeros((0, 4, 4)),
         image_sizes=(sizes[0], sizes[1]),
         poses_tried=n_poses,
-        renders=sim.render_count - renders_before,
+        renders=head.render_count - renders_before,
     )

@@ -15,6 +15,7 @@ import platform
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -164,9 +165,24 @@ def _measure_points(
     return measured, render_s, frames, watches[0].seen, min(w.wall_s for w in watches)
 
 
-#: The suite's parts, in order (the regression cases of :mod:`headsim.studies.bench_cases`);
-#: ``suite(parts=...)`` runs a subset (tests and ``headsim bench --case`` do).
+#: The suite's parts, in the order they run: the regression cases of
+#: ``bench_cases.toml``; ``suite(parts=...)`` runs a subset (tests and ``headsim bench
+#: --case`` do).
 PARTS = tuple(c.name for c in of_kind("regress"))
+
+Part = Callable[[int, Faults, Progress], Metrics]
+#: Each part's function, by its case's name (:func:`part`).
+PART_RUNS: dict[str, Part] = {}
+
+
+def part(name: str) -> Callable[[Part], Part]:
+    """Register the function that runs the regression case ``name``."""
+
+    def register(run: Part) -> Part:
+        PART_RUNS[name] = run
+        return run
+
+    return register
 
 
 def suite(
@@ -181,25 +197,33 @@ def suite(
         raise ValueError(f"unknown bench parts {sorted(unknown)}; allowed: {', '.join(PARTS)}")
     faults = faults or Faults()
     metrics: Metrics = {}
-    if "ideal" in parts:
-        metrics.update(_ideal_part(seed, faults, progress))
-    if "paper" in parts:
-        metrics.update(_paper_part(seed, faults, progress))
-    if "realistic" in parts:
-        metrics.update(_realistic_part(seed, faults, progress))
-    if "scenarios" in parts:
-        for name in PAPER_SCENARIOS:
-            progress(f"scenario {name} (fast)")
-            metrics.update(scenario_metrics(name))
-    if "speed" in parts:
-        progress("estimator throughput")
-        speed = estimator_throughput(200_000, repeats=3, seed=seed)
-        metrics["speed.model2_over_numpy"] = speed["model2_over_numpy_eq4_11"]
-        progress("quick start, full size")
-        metrics["speed.quickstart_over_render"] = _quickstart_over_render()
+    for name in PARTS:
+        if name in parts:
+            metrics.update(PART_RUNS[name](seed, faults, progress))
     return metrics
 
 
+@part("scenarios")
+def _scenarios_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
+    metrics: Metrics = {}
+    for name in PAPER_SCENARIOS:
+        progress(f"scenario {name} (fast)")
+        metrics.update(scenario_metrics(name))
+    return metrics
+
+
+@part("speed")
+def _speed_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
+    progress("estimator throughput")
+    speed = estimator_throughput(200_000, repeats=3, seed=seed)
+    progress("quick start, full size")
+    return {
+        "speed.model2_over_numpy": speed["model2_over_numpy_eq4_11"],
+        "speed.quickstart_over_render": _quickstart_over_render(),
+    }
+
+
+@part("ideal")
 def _ideal_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     rng = np.random.default_rng(seed)
     metrics: Metrics = {}
@@ -269,6 +293,7 @@ def _quickstart_over_render() -> float:
     return wall / ((before + after) / 2)
 
 
+@part("paper")
 def _paper_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     rng = np.random.default_rng(seed + 1)
     metrics: Metrics = {}
@@ -328,6 +353,7 @@ def _paper_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     return metrics
 
 
+@part("realistic")
 def _realistic_part(seed: int, faults: Faults, progress: Progress) -> Metrics:
     """The realistic preset over the whole shared field after the extended calibration."""
     rng = np.random.default_rng(seed + 2)

@@ -1,11 +1,12 @@
-"""Every benchmark as a case of ``headsim bench``: one registry, one command, one listing.
+"""Every benchmark as a case of ``headsim bench``: one file, one command, one listing.
 
 A :class:`BenchCase` is either a part of the regression suite
 (:data:`headsim.studies.bench.PARTS`: machine-independent metrics compared
 with ``benchmarks/baseline.json`` within ``benchmarks/tolerances.json``; CI
 runs them through ``make regress``) or a figures case: a script in
 ``benchmarks/`` that prints its figures (minutes to hours, not compared with
-anything).  ``headsim bench`` runs the regression cases; ``--case NAME`` any
+anything).  The cases are declared in ``bench_cases.toml`` beside this module.
+``headsim bench`` runs the regression cases; ``--case NAME`` any
 case (a figures case takes its script's own arguments after ``--``);
 ``--all`` the regression cases, then every figures case that takes minutes
 (the ``long`` ones run only by name); ``--list`` shows them all.
@@ -16,6 +17,7 @@ from __future__ import annotations
 import ast
 import subprocess
 import sys
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -52,49 +54,31 @@ class BenchCase:
         return doc.splitlines()[0] if doc else ""
 
 
-#: Every case, the regression suite's parts first (in :data:`headsim.studies.bench.PARTS`'
-#: order), then the figures scripts, then the long ones.
-CASES: dict[str, BenchCase] = {
-    case.name: case
-    for case in (
-        BenchCase("ideal", "regress", summary="Model 2 on ideal cameras, with and without windows"),
-        BenchCase(
-            "paper",
-            "regress",
-            summary="the paper's cameras: Sec. V calibration, Model 2, chessboard, areas",
-        ),
-        BenchCase(
-            "realistic",
-            "regress",
-            summary="the realistic head: extended calibration, Model 2 over the whole field",
-        ),
-        BenchCase("scenarios", "regress", summary="the paper scenarios' fast variants"),
-        BenchCase(
-            "speed", "regress", summary="estimator throughput, the quick start over one render"
-        ),
-        BenchCase("render_speed", "figures", "render_speed.py"),
-        BenchCase("estimators_throughput", "figures", "estimators_throughput.py"),
-        BenchCase("vision_speed", "figures", "vision_speed.py"),
-        BenchCase("stereo_calibration", "figures", "stereo_calibration.py"),
-        BenchCase("procedures_accuracy", "figures", "procedures_accuracy.py"),
-        BenchCase("live_gaze", "figures", "live_gaze.py"),
-        BenchCase("gym_env", "figures", "gym_env.py"),
-        BenchCase("batch_render", "figures", "batch_render.py"),
-        BenchCase("batch_env", "figures", "batch_env.py"),
-        BenchCase("scene_cost", "figures", "scene_cost.py"),
-        BenchCase("search_cases", "long", "search_cases.py"),
-        BenchCase("batch_sweep", "long", "batch_sweep.py"),
-        BenchCase("batch_device", "long", "batch_device.py"),
-        BenchCase("lockstep_model2", "long", "lockstep_model2.py"),
-        BenchCase("lockstep_servo_host", "long", "lockstep_servo_host.py"),
-        BenchCase("render_fidelity", "long", "render_fidelity.py"),
-        BenchCase("relative_areas", "long", "relative_areas.py"),
-        BenchCase("reach_and_zoom", "long", "reach_and_zoom.py"),
-        BenchCase("realistic_head", "long", "realistic_head.py"),
-        BenchCase("insensitivity_study", "long", "insensitivity_study.py"),
-        BenchCase("heads", "long", "heads.py"),
-    )
-}
+#: The file that declares every case (see its header).
+CASES_FILE = Path(__file__).with_name("bench_cases.toml")
+
+
+def _load(path: Path) -> dict[str, BenchCase]:
+    """The cases ``path`` declares, in its order: a regression case's value is its
+    summary, a figures or long case's its script in ``benchmarks/``."""
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    unknown = set(data) - set(KINDS)
+    if unknown:
+        raise ValueError(f"{path.name}: unknown tables {sorted(unknown)}; allowed: {KINDS}")
+    return {
+        name: (
+            BenchCase(name, kind, summary=value)
+            if kind == "regress"
+            else BenchCase(name, kind, script=value)
+        )
+        for kind in KINDS
+        for name, value in data.get(kind, {}).items()
+    }
+
+
+#: Every case, the regression suite's parts first (in the order they run), then the
+#: figures scripts, then the long ones.
+CASES: dict[str, BenchCase] = _load(CASES_FILE)
 
 
 def case(name: str) -> BenchCase:

@@ -63,13 +63,12 @@ def calibrate_job(
     wall = time.perf_counter() - start
     if not report.ok:
         raise RuntimeError(f"calibration failed: {report.status_text}")
-    block = encode(report)
     path = write_calibration(
-        (Path(out) / "head.json").resolve(), scenario.settings, block, "calibration", scenario.seed
+        (Path(out) / "head.json").resolve(), scenario.settings, report, "calibration", scenario.seed
     )
     return {
         "path": str(path),
-        "block": block,
+        "block": encode(report),
         "head_hash": head_hash(scenario.settings),
         "seed": scenario.seed,
         "wall_s": wall,

@@ -96,24 +96,7 @@ def knowledge_file(path: Path, settings: HeadSettings, knowledge: HeadKnowledge)
     ``experiment.calibration.from`` reads.  A knowledge with its own ``belief``
     cannot be written (the file holds no head geometry).
     """
-    if knowledge.belief is not None:
-        raise ValueError("a calibration file holds no belief of the head's geometry")
-    block = {
-        "status": "ok",
-        "targets": 0,
-        "fixated": 0,
-        "positions": [],
-        "knowledge": {
-            "alpha_e_rad": list(knowledge.alpha_e),
-            "v0_px": list(knowledge.v0),
-            "kx_over_ky": list(knowledge.kx_over_ky),
-            "u0_px": list(knowledge.u0),
-            "los_offset_m": None
-            if knowledge.los_offset_m is None
-            else list(knowledge.los_offset_m),
-        },
-    }
-    return write_calibration(path, settings, block, "told", settings.seed)
+    return write_calibration(path, settings, knowledge, "told", settings.seed)
 
 
 def calibration_run(

@@ -16,12 +16,14 @@ from headsim.active.calibration_file import (
     write_calibration,
 )
 from headsim.active.calibration_report import CalibrationReport
+from headsim.active.measurement import HeadKnowledge
 from headsim.cli import main
-from headsim.codec import decode, encode
+from headsim.codec import decode
+from headsim.runs.results_reference import CALIBRATION_FILE_FIELDS
 from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.tables import ScenarioError
-from headsim.sim.settings import HeadSettings, paper_head
+from headsim.sim.settings import HeadBelief, HeadSettings, paper_head
 
 SCENARIO = """description = "measure with a stored calibration"
 [head]
@@ -60,6 +62,9 @@ def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
     assert "alpha_e1" in capsys.readouterr().out
     stored = json.loads(head_file.read_text())
     assert stored["format"] == "headsim-calibration/1"
+    # Every key written is in the reference, and every key of the reference is written.
+    written = [*stored, *(f"head.{key}" for key in stored["head"])]
+    assert sorted(written) == sorted(CALIBRATION_FILE_FIELDS)
     assert stored["head"]["hash"] == head_hash(load_scenario("quickstart").settings)
     block = stored["calibration"]
     assert block["status"] == "ok" and block["render_counts"]["previews"] > 0
@@ -68,7 +73,7 @@ def test_calibrate_once_then_measure_with_it(tmp_path: Path, capsys) -> None:
     again = write_calibration(
         tmp_path / "again.json",
         load_scenario("quickstart").settings,
-        encode(decode(CalibrationReport, block)),
+        decode(CalibrationReport, block),
         stored["scenario"],
         stored["seed"],
     )
@@ -142,3 +147,14 @@ def test_calibrate_refuses_bad_input(tmp_path: Path, capsys) -> None:
     assert "experiment.calibration" in capsys.readouterr().err
     assert main(["calibrate", "quickstart", "--fast", "--out", str(tmp_path)]) == 2
     assert "is a directory" in capsys.readouterr().err
+
+
+def test_a_told_knowledge_is_written_and_read_back_but_not_a_belief(tmp_path: Path) -> None:
+    settings = load_scenario("quickstart").settings
+    told = HeadKnowledge(alpha_e=(0.05, -0.02), v0=(240.5, None), los_offset_m=(0.001, 0.0))
+    path = write_calibration(tmp_path / "told.json", settings, told, "told", 3)
+    stored = read_calibration(path, settings)
+    assert (stored.knowledge, stored.scenario, stored.seed) == (told, "told", 3)
+    believing = HeadKnowledge(belief=HeadBelief(baseline_m=0.16))
+    with pytest.raises(ValueError, match="holds no belief"):
+        write_calibration(tmp_path / "no.json", settings, believing, "told", 3)

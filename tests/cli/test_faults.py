@@ -243,3 +243,18 @@ def test_interrupt_mid_run_is_130_and_leaves_no_empty_folder(tmp_path: Path) -> 
     assert "Traceback" not in stderr
     assert "interrupted: nothing written" in stderr
     assert not out.exists()
+
+
+@pytest.mark.parametrize("args", [("list",), ("bench", "--list")])
+def test_a_reader_that_stops_reading_ends_the_command_quietly(args: tuple[str, ...]) -> None:
+    """``headsim list | head -1``: the reader has gone before the listing is written; the
+    command stops with exit 0 and prints nothing, rather than an error about the pipe."""
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        proc = subprocess.run(
+            [*CLI, *args], stdout=write_end, stderr=subprocess.PIPE, env=_env(), timeout=120
+        )
+    finally:
+        os.close(write_end)
+    assert (proc.returncode, proc.stderr.decode()) == (0, "")

@@ -16,9 +16,11 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
+from headsim.head.ros_head import binned
 from headsim.head.sim_head import SimHead
 from headsim.head.stereo_look import look_and_estimate
 from headsim.sim.names import MARKER_COLOURS
+from headsim.sim.render import Window
 from headsim.sim.settings import paper_head
 from headsim.sim.simulator import HeadSim
 
@@ -31,6 +33,8 @@ pytestmark = [
 ]
 
 POSES = ({"eye": 0.0}, {"eye": 0.06}, {"eye": 0.1})
+#: A region of interest of camera 1's 640 x 480 image.
+WINDOW = Window(200, 150, 64, 48)
 
 NODE = textwrap.dedent(
     """
@@ -90,6 +94,16 @@ def test_a_procedure_through_ros2_matches_the_simulator(ros_env: dict[str, str])
             before = head.read_joints().positions_rad["eye"]
             head.command_velocity({"eye": -0.1}, 0.3)
             after = head.read_joints().positions_rad["eye"]
+            # The servos' grabs of one eye: a window of the pair just grabbed, its whole
+            # image again, then each eye's next image (the node's resend of the same pair)
+            # binned and windowed, cropped and binned here.
+            grabs = head.render_count
+            frame = head.grab_stereo()
+            retaken = head.render_window(1, WINDOW, retake=True)
+            whole = head.retake(2)
+            preview = head.render_preview(2, 4)
+            window = head.render_window(1, WINDOW)
+            grabs = head.render_count - grabs
         finally:
             head.close()
     finally:
@@ -101,6 +115,22 @@ def test_a_procedure_through_ros2_matches_the_simulator(ros_env: dict[str, str])
     for a, b in zip(direct, through_ros, strict=True):
         assert a.name == b.name and a.status == b.status == "ok" and a.uv_px == b.uv_px
         assert a.point_head_m.tobytes() == b.point_head_m.tobytes()
+    crop = frame.left.image[WINDOW.y0 : WINDOW.y1, WINDOW.x0 : WINDOW.x1]
+    assert retaken.shape == (WINDOW.height, WINDOW.width, 3)
+    assert np.array_equal(retaken, crop) and np.array_equal(window, crop)
+    assert np.array_equal(whole, frame.right.image)
+    assert preview.shape == (120, 160, 3) and np.array_equal(preview, binned(whole, 4))
+    assert grabs == 6  # the pair's two images, then one each
     # 0.1 rad/s for 0.3 s of wall clock, turned on the node's 20 ms timer
     assert -0.06 < after - before < -0.01
     assert np.isfinite(after)
+
+
+def test_binning_averages_each_block_and_refuses_a_size_it_does_not_divide() -> None:
+    image = np.arange(4 * 6 * 3, dtype=np.uint8).reshape(4, 6, 3)
+    preview = binned(image, 2)
+    assert preview.shape == (2, 3, 3) and preview.dtype == np.uint8
+    block = image[2:4, 2:4].astype(float).mean(axis=(0, 1))
+    assert np.array_equal(preview[1, 1], np.rint(block).astype(np.uint8))
+    with pytest.raises(ValueError, match="binning 4 must divide the 6x4 image"):
+        binned(image, 4)

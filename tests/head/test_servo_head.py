@@ -27,18 +27,17 @@ from .test_truth_channel import GuardedSim
 SIMULATOR = "headsim.sim.simulator"
 PACKAGE = Path(headsim.__file__).resolve().parent
 
-#: The modules of the servos and procedures that still import the simulator, and why.
+#: The modules of the servos, the live head, the stereo baseline and the procedures that
+#: still import the simulator, and why.
 #: The quick start's (Model 2, Model 1, fixation, the calibration procedure, every servo),
-#: the chessboard's, relative positioning's, tracking's and zoom_fixed_points' are not
-#: among them.
+#: the chessboard's, relative positioning's, tracking's, zoom_fixed_points', pursuit's and
+#: the stereo baseline's are not among them.
 STILL_IMPORTING = {
     # PhaseStarted carries the simulator to the recording: the truth channel, for drawing.
     "headsim.active.events",
-    # Pursuit runs the live head (headsim.live), which steps the simulator's physics in time.
-    "headsim.procedures.pursuit",
-    # Zhang's calibration and the triangulation (headsim.stereo) take the simulator: they
-    # pose the board per view and score against the cameras' true poses.
-    "headsim.procedures.stereo",
+    # sample_board_pose and place_chessboard place the board (the simulator's job); the
+    # corners are measured on the head (board_view).
+    "headsim.stereo.views",
 }
 
 
@@ -54,10 +53,10 @@ def _imports(path: Path) -> set[str]:
 
 
 @pytest.mark.fast
-def test_only_the_listed_servo_and_procedure_modules_import_the_simulator() -> None:
+def test_only_the_listed_measuring_and_procedure_modules_import_the_simulator() -> None:
     importing = {
         f"headsim.{package}.{path.stem}"
-        for package in ("active", "procedures")
+        for package in ("active", "live", "stereo", "procedures")
         for path in sorted((PACKAGE / package).glob("*.py"))
         if SIMULATOR in _imports(path)
     }
@@ -120,14 +119,24 @@ def test_the_quick_start_runs_through_the_servo_head_alone(
 @pytest.mark.render
 @pytest.mark.parametrize(
     ("name", "heads_built"),
-    # The calibration's head and the procedure's; zoom_fixed_points: the head and its twin.
-    [("tracking", 2), ("chessboard", 2), ("relative_positioning", 2), ("zoom_fixed_points", 2)],
+    # The calibration's head and the procedure's; zoom_fixed_points: the head and its twin;
+    # pursuit (no calibration): the live head's; stereo: the board's head and the targets'.
+    [
+        ("tracking", 2),
+        ("chessboard", 2),
+        ("relative_positioning", 2),
+        ("zoom_fixed_points", 2),
+        ("pursuit", 1),
+        ("pursuit_textured", 1),
+        ("stereo", 2),
+    ],
 )
 def test_the_staging_procedures_run_on_the_head_the_runner_builds(
     monkeypatch: pytest.MonkeyPatch, name: str, heads_built: int
 ) -> None:
     # They place their boards, blocks and moving targets through the truth channel and
-    # measure on the sealed head: the same results as on the plain one.
+    # measure on the sealed head (pursuit: the live head over it, stepping the physics
+    # its truth channel holds): the same results as on the plain one.
     scenario = load_scenario(name, fast=True)
     plain = run_scenario(scenario)
     heads: list[SealedSimHead] = []

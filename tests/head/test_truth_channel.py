@@ -1,7 +1,8 @@
 """The measurement path never reads the truth: it reaches truth only through ``HeadSim.truth``
 (for placing and scoring), shown by running scenarios on a simulator whose truth methods
-raise when asked directly, and whose settings show code outside the simulator only what
-a head's specification gives (encoder resolution, image sizes, its model and belief)."""
+raise when asked directly, whose settings show code outside the simulator only what
+a head's specification gives (encoder resolution, image sizes, its model and belief), and
+whose truth channel refuses the functions that measure (:data:`MEASURING`)."""
 
 from __future__ import annotations
 
@@ -14,11 +15,12 @@ from typing import Any
 import numpy as np
 import pytest
 
-from headsim.procedures import pursuit
+from headsim.head.sim_head import SimHead
 from headsim.runs import context
 from headsim.runs.runner import run_scenario
 from headsim.scenario.loading import load_scenario
 from headsim.sim.simulator import HeadSim
+from headsim.stereo.views import full_frame_board
 
 #: HeadSim's truth methods: what is truly where (the ``Truth`` channel and its helpers).
 TRUTH_METHODS = (
@@ -65,6 +67,39 @@ class _Specification:
         return getattr(self._settings, name)
 
 
+#: The functions that measure, by module (``"*"``: every function of the module): none may
+#: ask a head or the simulator for the truth channel.  The live gaze, the servos it acquires
+#: with, and the stereo baseline's corner, marker and triangulation steps.
+MEASURING: dict[str, tuple[str, ...]] = {
+    "headsim.live.gaze": ("*",),
+    "headsim.live.estimator": ("*",),
+    "headsim.active.neck_servo": ("*",),
+    "headsim.active.look": ("*",),
+    "headsim.active.markerless": ("*",),
+    "headsim.stereo.views": ("board_view", "full_frame_board", "detect_chessboard"),
+    "headsim.stereo.triangulation": (
+        "detect_pair",
+        "full_frame",
+        "triangulate",
+        "triangulate_cam1",
+    ),
+}
+
+
+def _measuring_caller() -> str | None:
+    """The measuring function (:data:`MEASURING`) that asked for the truth channel, if one
+    did: the first of the package's frames up the stack outside the head's own code."""
+    frame = inspect.currentframe()
+    while frame is not None:
+        module = frame.f_globals.get("__name__", "")
+        if module.startswith("headsim.") and module != "headsim.head.sim_head":
+            function = frame.f_code.co_name
+            listed = MEASURING.get(module, ())
+            return f"{module}.{function}" if "*" in listed or function in listed else None
+        frame = frame.f_back
+    return None
+
+
 def _inside_simulator(depth: int = 2) -> bool:
     """Whether the caller ``depth`` frames up is the simulator's own code."""
     frame = inspect.currentframe()
@@ -106,6 +141,9 @@ class GuardedSim(HeadSim):
 
     @property
     def truth(self) -> Any:
+        measuring = _measuring_caller()
+        if measuring is not None:
+            raise TruthRead(f"{measuring} asked for the truth channel")
         sim = self
 
         class _Channel:
@@ -141,7 +179,16 @@ for _name in TRUTH_METHODS:
 
 @pytest.mark.render
 @pytest.mark.parametrize(
-    "name", ["quickstart", "relative_positioning", "stereo", "zoom_fixed_points", "natural_field"]
+    "name",
+    [
+        "quickstart",
+        "relative_positioning",
+        "stereo",
+        "zoom_fixed_points",
+        "natural_field",
+        "pursuit",
+        "pursuit_textured",
+    ],
 )
 def test_a_run_reads_truth_only_through_the_channel(
     name: str, monkeypatch: pytest.MonkeyPatch
@@ -156,7 +203,7 @@ def test_a_run_reads_truth_only_through_the_channel(
         and name != "headsim.sim.simulator"
         and getattr(module, "HeadSim", None) is HeadSim
     ]
-    assert context in builders and pursuit in builders
+    assert context in builders
     for module in builders:
         monkeypatch.setattr(module, "HeadSim", GuardedSim)
     guarded = run_scenario(scenario)
@@ -169,6 +216,7 @@ def test_a_run_reads_truth_only_through_the_channel(
         assert guarded.calibration is not None
         assert plain.calibration.alpha_e_rad == guarded.calibration.alpha_e_rad
     assert all(np.isfinite(r.measurement.truth_head_m).all() for r in guarded.records)
+    assert repr(guarded.experiment) == repr(plain.experiment)
 
 
 @pytest.mark.render
@@ -185,3 +233,20 @@ def test_the_guard_catches_a_direct_read() -> None:
         assert sim.settings.cameras[0].width == 640
         assert sim.truth.settings.baseline_m == 0.15
         assert sim.truth.camera_settings(1).k1 == sim.truth.settings.cameras[0].k1
+
+
+@pytest.mark.render
+def test_the_guard_refuses_the_channel_to_a_function_that_measures() -> None:
+    class Peeking(SimHead):
+        """A head whose grab asks for the truth: charged to the function grabbing."""
+
+        def render(self, camera: int) -> np.ndarray:
+            _ = self.truth
+            return super().render(camera)
+
+    with GuardedSim("chessboard") as sim:
+        with pytest.raises(TruthRead, match=r"stereo\.views\.full_frame_board asked"):
+            full_frame_board(Peeking(sim), 1)
+        corners = full_frame_board(SimHead(sim), 1)  # a plain head measures
+        assert corners is None or corners.shape == (48, 2)
+        assert SimHead(sim).truth.settings.baseline_m == 0.15  # placing and scoring may ask

@@ -11,6 +11,7 @@ from headsim.active.measurement import HeadKnowledge
 from headsim.active.neck_servo import NeckServo
 from headsim.estimators import model2
 from headsim.geometry.kinematics import head_to_world
+from headsim.head.sim_head import SimHead
 from headsim.live import Jump, LiveConfig, LiveHead, RandomWalk, Static, Visibility, Waypoints
 from headsim.live.estimator import GazeEstimator
 from headsim.live.gaze import GazeConfig, acquire, pursue
@@ -23,8 +24,8 @@ from .helpers import RED, small_head
 def pursuit_run(seed: int, predictor: bool = True, duration_s: float = 0.6):
     with HeadSim(settings=small_head()) as sim:
         path = RandomWalk((0.0, 0.8, 0.3), max_speed_m_s=0.3, duration_s=2.0, seed=seed)
-        live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path)
-        estimator = acquire(live, NeckServo(sim), RED)
+        live = LiveHead(SimHead(sim), LiveConfig(latency_frames=1), "marker_red", path)
+        estimator = acquire(live, NeckServo(live.head), RED)
         assert estimator is not None
         run = pursue(live, RED, estimator, duration_s, GazeConfig(predictor=predictor))
         return run, live.capture().images
@@ -65,8 +66,10 @@ def test_losses_reacquisitions_and_a_target_that_disappears_and_reappears_elsewh
     runs = {}
     for name, path, visibility in (("lost", lost_path, None), ("jump", jump, windows)):
         with HeadSim(settings=small_head()) as sim:
-            live = LiveHead(sim, LiveConfig(latency_frames=1), "marker_red", path, visibility)
-            estimator = acquire(live, NeckServo(sim), RED)
+            live = LiveHead(
+                SimHead(sim), LiveConfig(latency_frames=1), "marker_red", path, visibility
+            )
+            estimator = acquire(live, NeckServo(live.head), RED)
             assert estimator is not None
             runs[name] = pursue(live, RED, estimator, 1.0)
     lost, jumped = runs["lost"], runs["jump"]
@@ -93,8 +96,8 @@ def test_acquiring_with_the_servos_windows_off_looks_at_whole_frames_only() -> N
     for windows in (True, False):
         sink = Sink()
         with HeadSim(settings=small_head(), sink=sink) as sim:
-            live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.28)))
-            estimator = acquire(live, NeckServo(sim, ServoConfig(windows=windows)), RED)
+            live = LiveHead(SimHead(sim), LiveConfig(), "marker_red", Static((0.03, 0.8, 0.28)))
+            estimator = acquire(live, NeckServo(live.head, ServoConfig(windows=windows)), RED)
             assert estimator is not None
         kinds[windows] = sink.kinds
     assert set(kinds[False]) == {ImageKind.FULL}
@@ -112,8 +115,8 @@ def test_the_live_estimate_measures_with_the_heads_belief_not_its_true_geometry(
         ("wider", truth, HeadKnowledge(belief=wider)),  # the knowledge's own belief
     ):
         with HeadSim(settings=settings) as sim:
-            live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.24)))
-            estimator = acquire(live, NeckServo(sim), RED, knowledge)
+            live = LiveHead(SimHead(sim), LiveConfig(), "marker_red", Static((0.03, 0.8, 0.24)))
+            estimator = acquire(live, NeckServo(live.head), RED, knowledge)
             assert estimator is not None
             frame = live.capture()
             uv = tuple(RED(image).uv for image in frame.images)
@@ -160,8 +163,8 @@ def test_the_live_lines_of_sight_cross_where_model_2s_do_offsets_included() -> N
     np.testing.assert_allclose(estimate[[0, 2]], rest.positions[0][[0, 2]], rtol=1e-12)
 
 
-def test_acquire_refuses_a_servo_on_another_simulator() -> None:
+def test_acquire_refuses_a_servo_on_another_head() -> None:
     with HeadSim(settings=small_head()) as sim, HeadSim(settings=small_head()) as other:
-        live = LiveHead(sim, LiveConfig(), "marker_red", Static((0.03, 0.8, 0.28)))
-        with pytest.raises(ValueError, match=r"servo must drive the live head's simulator"):
-            acquire(live, NeckServo(other), RED)
+        live = LiveHead(SimHead(sim), LiveConfig(), "marker_red", Static((0.03, 0.8, 0.28)))
+        with pytest.raises(ValueError, match=r"servo must drive the live head's head"):
+            acquire(live, NeckServo(SimHead(other)), RED)

@@ -8,6 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from headsim.head.sim_head import SimHead
 from headsim.live import LiveConfig, LiveHead, MotorLimits, Static, Waypoints
 from headsim.sim.settings import SettingsError
 from headsim.sim.simulator import HeadSim
@@ -32,7 +33,7 @@ def test_motion_blur_centroid_and_streak_match_the_forward_model() -> None:
     path = Waypoints(((-0.1, 0.6, 0.21), (0.3, 0.6, 0.21)), (speed,))
     config = LiveConfig(frame_rate_hz=30.0, exposure_s=1 / 60, blur_subframes=9, latency_frames=0)
     with HeadSim(settings=small_head()) as sim:
-        live = LiveHead(sim, config, "marker_red", path)
+        live = LiveHead(SimHead(sim), config, "marker_red", path)
         frame = live.capture()
         dt, n = live.dt, config.blur_subframes
         instants = [round((i + 0.5) * config.exposure_s / n / dt) * dt for i in range(n)]
@@ -60,7 +61,7 @@ def test_an_image_is_taken_at_mid_exposure() -> None:
     path = Waypoints(((-0.1, 0.6, 0.21), (0.3, 0.6, 0.21)), (1.5,))
     config = LiveConfig(frame_rate_hz=30.0, exposure_s=exposure, latency_frames=0)
     with HeadSim(settings=small_head()) as sim:
-        live = LiveHead(sim, config, "marker_red", path)
+        live = LiveHead(SimHead(sim), config, "marker_red", path)
         live.capture()
         frame = live.capture()
         start = config.period_s
@@ -78,7 +79,7 @@ def test_an_image_is_taken_at_mid_exposure() -> None:
 def test_a_command_acts_the_latency_after_its_frame_ended() -> None:
     config = LiveConfig(frame_rate_hz=30.0, exposure_s=0.01, latency_frames=2)
     with HeadSim(settings=small_head()) as sim:
-        live = LiveHead(sim, config, "marker_red", Static((0.0, 0.6, 0.21)))
+        live = LiveHead(SimHead(sim), config, "marker_red", Static((0.0, 0.6, 0.21)))
         frame = live.capture()
         acted: list[float] = []
 
@@ -112,7 +113,9 @@ def test_encoders_follow_the_moving_joints_to_the_count_on_a_head_with_joint_err
     settings = replace(small_head(), count_error=True, backlash_rad=2.9e-4)
     resolution = settings.encoder_resolution_rad
     with HeadSim(settings=settings) as sim:
-        live = LiveHead(sim, LiveConfig(latency_frames=0), "marker_red", Static((0, 0.8, 0.2)))
+        live = LiveHead(
+            SimHead(sim), LiveConfig(latency_frames=0), "marker_red", Static((0, 0.8, 0.2))
+        )
         live.now(lambda motors, now: motors.set_velocity(0, 0.5))  # neck yaw at 0.5 rad/s
         frames = [live.capture() for _ in range(4)]
     for frame in frames:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from headsim.head.sim_head import SimHead
 from headsim.live import LiveConfig, LiveHead, MotorLimits, Static
 from headsim.live.motors import bang_bang_duration, min_jerk, min_jerk_duration
 from headsim.sim.simulator import HeadSim
@@ -16,7 +17,7 @@ def test_motors_keep_their_limits_and_images_see_the_eyes_where_they_are() -> No
     limits = MotorLimits(max_speed=2.0, max_accel=40.0)
     config = LiveConfig(latency_frames=0, eye_limits=limits, neck_limits=limits)
     with HeadSim(settings=small_head()) as sim:
-        live = LiveHead(sim, config, "marker_red", Static((0.0, 0.7, 0.21)))
+        live = LiveHead(SimHead(sim), config, "marker_red", Static((0.0, 0.7, 0.21)))
         live.now(lambda motors, now: motors.track(2, 0.3, 0.0, now))
         live.now(lambda motors, now: motors.track(0, -0.2, 0.0, now))
         speeds, refs, steps = [], [], []

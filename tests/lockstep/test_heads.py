@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from headsim.envs.fixate import TARGET_BODY, FixateEnv
+from headsim.head.sim_head import SimHead
 from headsim.live.head import LiveConfig, LiveHead
 from headsim.live.paths import Static, Waypoints
 from headsim.lockstep import LockstepHeads
@@ -61,7 +62,7 @@ def test_lockstep_heads_see_and_move_as_classic_heads_do(latency_frames: int) ->
     for head in range(3):
         sim = for_settings(settings[head])
         env.prepare_model(sim.model)
-        live = LiveHead(sim, config, target_body=TARGET_BODY, path=paths[head])
+        live = LiveHead(SimHead(sim), config, target_body=TARGET_BODY, path=paths[head])
         classic = [live.capture()]
         for step in range(STEPS):
 
@@ -121,7 +122,7 @@ def test_the_quick_starts_heads_at_its_targets_see_what_the_classic_heads_see() 
     assert min(seen) > 0  # every eye sees its head's target: the images are not empty views
     for head in range(n):
         with for_settings(settings) as sim:
-            live = LiveHead(sim, config, target_body="marker_red", path=targets[head])
+            live = LiveHead(SimHead(sim), config, target_body="marker_red", path=targets[head])
             classic = [live.capture()]
 
             def command(motors, _now, s=speeds[head]) -> None:

@@ -14,6 +14,7 @@ from rerun.chunk import RrdReader
 
 from headsim.cli import main
 from headsim.errors import ExitCode
+from headsim.head.sim_head import SimHead
 from headsim.procedures.stereo import FOCAL_BOUND, HEAD_FRAMES, RMS_BOUND_PX, StereoSpec, calibrate
 from headsim.scenario.loading import load_scenario
 from headsim.scenario.spec import experiment_record
@@ -184,7 +185,7 @@ def test_a_run_without_targets_calibrates_from_the_board_poses_it_is_given(
 def stored(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A Zhang calibration of the ideal head from eight real board views, as a file."""
     with HeadSim("chessboard", ideal_head()) as sim:
-        calibration, _ = calibrate(sim, StereoSpec(views=8), seed=0)
+        calibration, _ = calibrate(SimHead(sim), StereoSpec(views=8), seed=0)
     return write_stereo_calibration(tmp_path_factory.mktemp("zhang") / "zhang.json", calibration)
 
 

@@ -4,6 +4,7 @@ sent as columns."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import signal
@@ -289,3 +290,24 @@ def test_one_entity_keeps_one_archetype_and_instance_count() -> None:
     kept.add("/s", 0, 0, rr.Scalars, scalars=1.0)
     with pytest.raises(ValueError, match="/s"):
         kept.add("/s", 1, 0, rr.Transform3D, translation=[0.0, 0.0, 0.0])
+
+
+def test_a_target_measured_again_knowing_more_is_labelled_with_what_it_knew(
+    tmp_path: Path,
+) -> None:
+    """The calibration procedure measures each check target before and after calibrating:
+    the second estimate's label says so (found from the records, not the procedure's name)."""
+    from headsim.cli import main
+
+    rrd = tmp_path / "calibration.rrd"
+    argv = ["run", "calibration", "--fast", "--out", str(tmp_path), "--rrd", str(rrd)]
+    assert main([*argv, "--no-progress"]) == 0
+    measurements = json.loads((tmp_path / "results.json").read_text())["measurements"]
+    labels = rows(rrd, "/world/estimate", "Points3D:labels")[-1]["value"]
+    ok = [m for m in measurements if m["status"] == "ok"]
+    assert len(labels) == len(ok) >= 2
+    first = {m["name"] for m in ok if m["knowledge"] == "none"}
+    assert {m["name"] for m in ok if m["knowledge"] == "calibrated"} & first
+    for m, label in zip(ok, labels, strict=True):
+        again = m["knowledge"] == "calibrated" and m["name"] in first
+        assert label == (f"{m['name']} (calibrated)" if again else m["name"])

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sys
+from dataclasses import fields
 from pathlib import Path
 
 import pytest
@@ -16,6 +17,7 @@ from headsim.runs.results_reference import (
     experiment_fields,
     undocumented,
 )
+from headsim.sim import imperfections, settings
 
 TOOLS = Path(__file__).resolve().parents[2] / "tools"
 
@@ -37,8 +39,9 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, dict]:
 
 def test_every_meaning_names_a_key_that_a_real_run_writes(runs: dict[str, dict]) -> None:
     held = set().union(*(documented_paths(r) for r in runs.values()))
-    # Written only by `headsim calibrate` and for a stored calibration (tests/run/test_serialise.py).
-    elsewhere = {"calibration.rendered_frames", "calibration.from"}
+    # Written only by `headsim calibrate` and for a stored calibration (tests/run/test_serialise.py),
+    # and only with an imperfection registered beyond the camera's fields (none is shipped).
+    elsewhere = {"calibration.rendered_frames", "calibration.from", "settings.cameras[].extra"}
     assert [p for p in RESULTS_FIELDS if p not in held | elsewhere] == []
     assert all(undocumented(r) == [] for r in runs.values())
     assert {p for p in held if p.startswith("experiment.")} == {
@@ -73,3 +76,22 @@ def test_the_generated_page_lists_every_key_under_its_table() -> None:
     assert "### `relative_positioning`\n" in page and "| `objects[].margin_px` |" in page
     for path in RESULTS_FIELDS:
         assert f"| `{path.rpartition('.')[2]}` |" in page, path
+
+
+def test_the_settings_rows_are_the_settings_declarations() -> None:
+    """The ``settings`` block's meanings are the declared settings' own (sim/settings.py and
+    each imperfection's module), one row per field of the records, in the order written."""
+    declared = {s.name: s for s in (*settings.CAMERA_SETTINGS, *imperfections.all_settings())}
+    for f in fields(settings.CameraSettings):
+        if f.name != "extra":
+            row = RESULTS_FIELDS[f"settings.cameras[].{f.name}"]
+            assert row == declared[f.name].meaning.removesuffix(".")
+    for setting in settings.HEAD_SETTINGS:
+        assert RESULTS_FIELDS[f"settings.{setting.name}"] == setting.meaning.removesuffix(".")
+    for setting in settings.BELIEF_SETTINGS:
+        meaning = setting.meaning.removesuffix(".")
+        assert RESULTS_FIELDS[f"belief.{setting.name}"] == meaning
+        assert RESULTS_FIELDS[f"settings.belief.{setting.name}"] == meaning
+    top = [p.removeprefix("settings.") for p in RESULTS_FIELDS if p.count(".") == 1]
+    top = [p for p in top if p in {f.name for f in fields(settings.HeadSettings)}]
+    assert top == [f.name for f in fields(settings.HeadSettings)]

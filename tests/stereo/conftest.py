@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from headsim.head.sim_head import SimHead
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.calibration import (
     StereoCalibration,
@@ -18,6 +19,7 @@ from .helpers import PRESETS, TEST_POSES
 @pytest.fixture(scope="package", params=sorted(PRESETS))
 def calibrated(request) -> tuple[str, ChessboardViews, StereoCalibration]:
     with HeadSim("chessboard", PRESETS[request.param]()) as sim:
-        views = chessboard_views(sim, TEST_POSES, np.random.default_rng(3))
-        calib = calibrate_stereo(sim, views)
+        head = SimHead(sim)
+        views = chessboard_views(head, TEST_POSES, np.random.default_rng(3))
+        calib = calibrate_stereo(head, views)
     return request.param, views, calib

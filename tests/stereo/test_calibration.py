@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from headsim.geometry.transforms import frame_deviation
+from headsim.head.sim_head import SimHead
 from headsim.sim.optics import camera_matrix, dist_coeffs
 from headsim.sim.settings import ideal_head, paper_head
 from headsim.sim.simulator import HeadSim
@@ -42,10 +43,10 @@ def test_calibration_reaches_the_reprojection_and_focal_length_bounds(calibrated
 @pytest.mark.render
 def test_too_few_views_is_a_clear_error() -> None:
     with HeadSim("chessboard", ideal_head()) as sim:
-        views = chessboard_views(sim, 3, np.random.default_rng(0))
+        views = chessboard_views(SimHead(sim), 3, np.random.default_rng(0))
         assert views.renders == 6
         with pytest.raises(StereoError, match=r"need at least 5 views .* got 3 of 3 poses"):
-            calibrate_stereo(sim, views)
+            calibrate_stereo(SimHead(sim), views)
 
 
 def test_undistortion_converges_over_the_whole_image_where_opencv_defaults_do_not() -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from headsim.head.sim_head import SimHead
 from headsim.sim import names
 from headsim.sim.settings import ideal_head, paper_head
 from headsim.sim.simulator import HeadSim
@@ -25,7 +26,7 @@ def test_stereo_error_at_a_known_depth_is_below_half_a_percent(calibrated) -> No
         for p_head in ([0.0, 0.0, 0.8], [0.06, -0.04, 0.6]):
             p_world = world_from_head[:3, :3] @ p_head + world_from_head[:3, 3]
             sim.set_body_pose(names.MARKERS[0], p_world)
-            measured = measure_point_stereo(sim, calib, names.MARKERS[0])
+            measured = measure_point_stereo(SimHead(sim), calib, names.MARKERS[0])
             np.testing.assert_allclose(measured.true_p_head, p_head, atol=1e-12)
             assert measured.error_rel_depth < 0.005, (name, p_head, measured.error_m)
             assert abs(measured.error_m[2]) < 0.005 * p_head[2]
@@ -37,7 +38,7 @@ def test_a_target_that_is_not_seen_is_a_clear_error(calibrated) -> None:
     with HeadSim("default", ideal_head()) as sim:
         sim.set_body_pose(names.MARKERS[0], [0.0, -1.0, 0.2])  # behind the head
         with pytest.raises(StereoError, match="'marker_red' not found in cam1: lost"):
-            measure_point_stereo(sim, calib, names.MARKERS[0])
+            measure_point_stereo(SimHead(sim), calib, names.MARKERS[0])
 
 
 def test_triangulation_with_the_true_calibration_recovers_points_exactly(rng) -> None:

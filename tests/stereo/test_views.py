@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from headsim.head.sim_head import SimHead
 from headsim.sim.settings import ideal_head
 from headsim.sim.simulator import HeadSim
 from headsim.stereo.views import StereoError, chessboard_views, sample_board_pose
@@ -41,6 +42,6 @@ def test_same_seed_gives_the_same_views() -> None:
     results = []
     for _ in range(2):
         with HeadSim("chessboard", settings) as sim:
-            results.append(chessboard_views(sim, 2, np.random.default_rng(5)))
+            results.append(chessboard_views(SimHead(sim), 2, np.random.default_rng(5)))
     np.testing.assert_array_equal(results[0].image_points1, results[1].image_points1)
     np.testing.assert_array_equal(results[0].head_from_board, results[1].head_from_board)

@@ -1,4 +1,4 @@
-"""Every benchmark is a case of ``headsim bench``: the registry in step with benchmarks/,
+"""Every benchmark is a case of ``headsim bench``: the cases file in step with benchmarks/,
 and the command's listing, case choice and refusals."""
 
 from __future__ import annotations
@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 
 from headsim.cli import main
-from headsim.studies.bench import PARTS
-from headsim.studies.bench_cases import CASES, KINDS, of_kind
+from headsim.studies.bench import PART_RUNS, PARTS
+from headsim.studies.bench_cases import CASES, KINDS, _load, of_kind
 from headsim.studies.checks import BENCH_DIR
 
 #: Scripts in benchmarks/ that are not benchmarks (none today).
@@ -21,9 +21,17 @@ def test_every_benchmark_script_is_a_case_and_every_case_script_exists() -> None
     assert all((c.script is None) == (c.kind == "regress") for c in CASES.values())
 
 
-def test_the_regression_cases_are_the_suites_parts() -> None:
+def test_each_regression_case_has_its_part_and_each_part_its_case() -> None:
     assert tuple(c.name for c in of_kind("regress")) == PARTS
-    assert PARTS == ("ideal", "paper", "realistic", "scenarios", "speed")
+    assert set(PART_RUNS) == set(PARTS)
+    assert {"ideal", "paper", "realistic", "scenarios", "speed"} <= set(PARTS)
+
+
+def test_a_cases_file_with_an_unknown_table_is_refused(tmp_path) -> None:
+    path = tmp_path / "cases.toml"
+    path.write_text('[regress]\nideal = "x"\n[slow]\nsome = "some.py"\n')
+    with pytest.raises(ValueError, match=r"unknown tables \['slow'\]"):
+        _load(path)
 
 
 def test_list_names_every_case_with_its_scripts_first_docstring_line(capsys) -> None:
