@@ -304,9 +304,10 @@ def run_pursuit(
 def _click_object(head: ServoHead, spec: PursuitSpec, seed: int) -> tuple[Click | None, np.ndarray]:
     """The user's click on the room object ``spec.body`` in camera 1's image now, and the
     clicked surface point's offset from the object's centre (truth through ``head``'s
-    channel, for placing the click and scoring; the image's size is the specification's).  The point: where camera 1's line of sight to the object's centre first
-    meets the object; None where that is another object, or too near the image's edge
-    for a template."""
+    channel, for placing the click and scoring; the image's size is the specification's).
+    The point: where camera 1's line of sight to the object's centre first meets the
+    object; None where that is another object, or too near the image's edge for a
+    template."""
     world = head.truth
     centre = world.data.xpos[world.model.body(spec.body).id].copy()
     origin = camera_centre(world, 1)

@@ -267,6 +267,7 @@ def test_the_tracker_and_the_correspondence_see_only_images() -> None:
         tree = ast.parse((SOURCE / module).read_text(encoding="utf-8"))
         assert _scene_reads(tree) == set(), module
     assert _scene_reads(_function(SOURCE / "live" / "gaze.py", "detect")) == set()
-    # The check can see a read: the textured pursuit's click, truth for placing it.
+    # The check can see a read: the textured pursuit's click, truth (through the head's
+    # channel) for placing it.
     clicked = _function(SOURCE / "procedures" / "pursuit.py", "_click_object")
-    assert {"sim", "data", "xpos"} <= _scene_reads(clicked)
+    assert {"model", "data", "xpos"} <= _scene_reads(clicked)
