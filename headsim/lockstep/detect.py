@@ -60,12 +60,14 @@ def find_markers_stacked(
     inked = weight > threshold * 255.0
     rows: np.ndarray = np.any(inked, axis=2)
     columns: np.ndarray = np.any(inked, axis=1)
+    # Each image's first and last inked row and column, for the whole stack at once.
+    top, bottom = rows.argmax(axis=1), height - 1 - rows[:, ::-1].argmax(axis=1)
+    left, right = columns.argmax(axis=1), width - 1 - columns[:, ::-1].argmax(axis=1)
     out = [Detection(DetectionStatus.LOST, None, 0.0)] * count
-    for image in np.flatnonzero(rows.any(axis=1)):
-        ys, xs = np.flatnonzero(rows[image]), np.flatnonzero(columns[image])
+    for image in np.flatnonzero(rows.any(axis=1)).tolist():
         # Every piece of the colour, and a pixel around them for the rim.
-        y0, y1 = max(int(ys[0]) - 1, 0), min(int(ys[-1]) + 2, height)
-        x0, x1 = max(int(xs[0]) - 1, 0), min(int(xs[-1]) + 2, width)
+        y0, y1 = max(int(top[image]) - 1, 0), min(int(bottom[image]) + 2, height)
+        x0, x1 = max(int(left[image]) - 1, 0), min(int(right[image]) + 2, width)
         binary = inked[image, y0:y1, x0:x1].astype(np.uint8)
         pieces, _, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
         if pieces > 2:

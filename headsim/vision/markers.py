@@ -138,7 +138,7 @@ def asymmetry(weights: np.ndarray, u: float, v: float) -> float:
     """
     h, w = weights.shape
     inked = weights[weights > 0.02]
-    partial = float(np.mean((inked > 0.1) & (inked < 0.9))) if inked.size else 0.0
+    partial = np.count_nonzero((inked > 0.1) & (inked < 0.9)) / inked.size if inked.size else 0.0
     soften = _SOFTEN_HARD_EDGE_PX if partial < _HARD_EDGE_SHARE else _SOFTEN_PX
     pad = 4  # room for the softening and the moves: the blob stays inside
     padded = cv2.copyMakeBorder(
