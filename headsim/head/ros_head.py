@@ -354,8 +354,11 @@ class RosHead(RosServo):
         )
 
     def close(self) -> None:
+        """Stop spinning (the spinner thread ended: one left running aborts the
+        interpreter's exit) and destroy the node."""
         rclpy = ros_modules()[0]
         self._executor.shutdown()
+        self._spinner.join(timeout=self.timeout_s)
         self.node.destroy_node()
         if self._own_context and rclpy.ok():
             rclpy.shutdown()

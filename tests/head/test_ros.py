@@ -237,6 +237,22 @@ def test_model2_through_ros2_measures_what_it_measures_on_the_simulator(sim_node
     assert asked == grabbed
 
 
+def test_a_script_that_grabs_and_closes_exits_cleanly(
+    sim_node: None, ros_env: dict[str, str]
+) -> None:
+    """close() ends the spinner thread: one left spinning aborts the interpreter's exit."""
+    script = (
+        "from headsim.head.ros_head import RosHead\n"
+        "head = RosHead(('neck_yaw', 'neck_pitch', 'eye'), timeout_s=60.0)\n"
+        "print(head.grab_stereo().left.image.shape)\n"
+        "head.close()\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], env=ros_env, capture_output=True, text=True, timeout=120
+    )
+    assert (done.returncode, done.stdout, done.stderr) == (0, "(480, 640, 3)\n", "")
+
+
 def test_a_ros2_head_says_what_it_lacks(ros_env: dict[str, str]) -> None:
     """No robot on the topics, no encoder resolution, limits for the eye only."""
     from headsim.head.ros_head import RosHead
