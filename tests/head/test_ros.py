@@ -1,8 +1,8 @@
 """The ROS 2 head end to end on the loopback: a real ROS 2 node (another process) serves
 the simulator's images, camera infos and joint states and takes forward-controller
-commands; the marker procedure and Model 2 (the eye servo's windows and previews) run
-through :class:`RosHead` and get the estimates they get on the simulator directly, bit
-for bit.  Needs the ``ros`` extra: without rclpy the test says it did not run."""
+commands; the marker procedure, Model 2 (the eye servo's windows and previews) and
+Model 1 (the neck servo) run through :class:`RosHead` and get the estimates they get on
+the simulator directly, bit for bit.  Needs the ``ros`` extra: without rclpy the test says it did not run."""
 
 from __future__ import annotations
 
@@ -19,7 +19,9 @@ import pytest
 
 from headsim.active.eye_servo import EyeServo
 from headsim.active.measurement import HeadKnowledge
+from headsim.active.model1 import measure_model1
 from headsim.active.model2 import measure_model2
+from headsim.active.neck_servo import NeckServo
 from headsim.errors import JobFailed
 from headsim.head.ros_head import binned
 from headsim.head.servo_head import NoTruth, ServoHead
@@ -235,6 +237,41 @@ def test_model2_through_ros2_measures_what_it_measures_on_the_simulator(sim_node
     # The truth was asked once per target, by the scoring after its last image (and
     # found none); measuring never asked it (NoTruth would have ended the run).
     assert asked == grabbed
+
+
+def test_model1_through_ros2_moves_the_neck_as_on_the_simulator(sim_node: None) -> None:
+    """Model 1 (the neck servo: neck yaw, neck pitch and the eye together) on each marker
+    through RosHead and on the simulator directly: bit for bit, in H and, through the
+    neck encoders, in W."""
+    from headsim.head.ros_head import RosHead
+
+    settings = paper_head()
+    knowledge = HeadKnowledge(alpha_e=INITIAL_DIRECTIONS_RAD)
+    targets = [marker_target(body, body) for body in MARKER_COLOURS]
+    with HeadSim("default", settings) as sim:
+        direct_head = SimHead(sim)
+        limits = {motor: direct_head.joint_range(motor) for motor in direct_head.motors}
+        servo = NeckServo(direct_head)
+        direct = [measure_model1(direct_head, servo, t, knowledge) for t in targets]
+    head = RosHead(
+        ("neck_yaw", "neck_pitch", "eye"),
+        belief=settings.believed,
+        limits=limits,
+        timeout_s=60.0,
+        encoder_resolution_rad=settings.encoder_resolution_rad,
+    )
+    try:
+        servo = NeckServo(head)
+        through_ros = [measure_model1(head, servo, t, knowledge) for t in targets]
+        neck = head.neck_encoders()
+    finally:
+        head.close()
+    assert neck != (0.0, 0.0)  # the neck turned
+    assert [m.ok for m in direct] == [m.ok for m in through_ros] == [True] * 3
+    for a, b in zip(direct, through_ros, strict=True):
+        assert a.estimate_head_m.tobytes() == b.estimate_head_m.tobytes()
+        assert a.estimate_world_m.tobytes() == b.estimate_world_m.tobytes()
+        assert a.details == b.details and a.renders == b.renders
 
 
 def test_a_script_that_grabs_and_closes_exits_cleanly(
