@@ -1,19 +1,18 @@
 """A live head over ROS 2 (the ``ros`` extra): :class:`RosHead` is the
-:class:`~headsim.head.interface.Head` interface on a robot's topics and its
+:class:`~headsim.head.interface.Head` interface, and the
+:class:`~headsim.head.servo_head.ServoHead` the servos and procedures drive
+(:class:`~headsim.head.ros_servo.RosServo`), on a robot's topics and its
 ``ros2_control`` forward controllers.
 
 It subscribes to each eye's ``sensor_msgs/Image`` (rgb8 or bgr8) and ``CameraInfo``
 and to ``JointState``; it commands through ``std_msgs/Float64MultiArray`` on the
 forward position and velocity controllers' ``~/commands`` (values in
 ``joint_names`` order, each dimension labelled with the joint's name).  A position
-command returns once the joint states are within ``tolerance_rad`` of it; a grab
-waits for a pair of images that arrived after the last command settled (Ca1's with
-Ca2's nearest in time).  The servos' grabs of one eye (:class:`~headsim.head.servo_head.ServoHead`'s
-``render``, ``render_window``, ``render_preview``, ``retake``) take that eye's next such
-image and crop its region of interest or bin it on the host, as for a camera driver
-without hardware ROI or binning.  Topic and joint names: a
-:class:`~headsim.head.mcap_log.Topics` (the mapping file's).  Installing: see
-docs/how-to/real-head.md.
+command ends with the first joint state stamped after it that has every named joint
+within ``tolerance_rad`` of it; a grab waits for images stamped at or after that state
+(a stereo pair: Ca1's with Ca2's nearest in time; one eye's: its next).  Topic and
+joint names: a :class:`~headsim.head.mcap_log.Topics` (the mapping file's).
+Installing: see docs/how-to/real-head.md.
 """
 
 from __future__ import annotations
@@ -29,7 +28,9 @@ from headsim.errors import EnvironmentProblem, JobFailed
 from headsim.head.camera_info import CameraInfo
 from headsim.head.interface import JointReading, StampedImage, StereoFrame
 from headsim.head.mcap_log import Topics
-from headsim.sim.render import Window
+from headsim.head.ros_servo import RosServo, binned
+from headsim.sim.events import NO_EVENTS, EventSink, ImageKind
+from headsim.sim.heads import PAPER, HeadModel
 from headsim.sim.settings import HeadBelief
 
 
@@ -90,16 +91,6 @@ def camera_info_from_msg(msg: Any) -> CameraInfo:
     )
 
 
-def binned(image: np.ndarray, binning: int) -> np.ndarray:
-    """``image`` (H, W, 3) uint8 binned ``binning`` x ``binning``: each pixel the rounded
-    mean of its block, (H/b, W/b, 3) uint8."""
-    height, width = image.shape[:2]
-    if binning < 1 or height % binning or width % binning:
-        raise ValueError(f"binning {binning} must divide the {width}x{height} image")
-    blocks = image.reshape(height // binning, binning, width // binning, binning, -1)
-    return np.rint(blocks.mean(axis=(1, 3))).astype(np.uint8)
-
-
 def command_msg(values: Mapping[str, float], topics: Topics) -> Any:
     """A ``Float64MultiArray`` of ``values``, each dimension labelled with the robot's name."""
     std = ros_modules()[2]
@@ -123,8 +114,17 @@ def command_values(msg: Any, topics: Topics, joint_names: Sequence[str]) -> dict
     return {ours[label]: float(v) for label, v in zip(labels, msg.data, strict=True)}
 
 
-class RosHead:
-    """A head on ROS 2 topics (see the module docstring); spins its node on a thread."""
+class RosHead(RosServo):
+    """A head on ROS 2 topics (see the module docstring); spins its node on a thread.
+
+    ``belief``: what the head believes of its geometry; ``limits``: each joint's (low,
+    high) range, rad; ``tolerance_rad``: how near its command a joint must be for a
+    command to have ended, rad (default: half an encoder step with
+    ``encoder_resolution_rad``, else 2e-3).  For the servos
+    (:class:`~headsim.head.servo_head.ServoHead`): ``encoder_resolution_rad``, one
+    encoder step of its joints, rad; ``model``: the head's model (its neck); ``sink``:
+    where its grabs are reported.
+    """
 
     def __init__(
         self,
@@ -132,15 +132,21 @@ class RosHead:
         topics: Topics | None = None,
         belief: HeadBelief | None = None,
         limits: Mapping[str, tuple[float, float]] | None = None,
-        tolerance_rad: float = 2e-3,
+        tolerance_rad: float | None = None,
         timeout_s: float = 30.0,
         node_name: str = "headsim_head",
+        *,
+        encoder_resolution_rad: float | None = None,
+        model: HeadModel = PAPER,
+        sink: EventSink = NO_EVENTS,
     ) -> None:
         rclpy, sensor, std, _ = ros_modules()
         self.topics = topics or Topics()
         self._names = tuple(joint_names)
         self._belief = belief or HeadBelief()
-        self._limits = dict(limits or {})
+        self._init_servo(encoder_resolution_rad, limits or {}, model, sink)
+        if tolerance_rad is None:
+            tolerance_rad = 2e-3 if encoder_resolution_rad is None else encoder_resolution_rad / 2
         self.tolerance_rad = tolerance_rad
         self.timeout_s = timeout_s
         self._own_context = not rclpy.ok()
@@ -154,9 +160,9 @@ class RosHead:
         #: the one, arrived after the other.
         self._settled_s = -np.inf
         self._grabbed = [0, 0]
-        #: Each eye's image last grabbed (a retake's), and the grabs so far.
-        self._taken: list[np.ndarray | None] = [None, None]
-        self._grabs = 0
+        #: The stamp of the newest joint state when the last command was published: the
+        #: state that ends it is a later one.
+        self._commanded_s = -np.inf
         #: Each eye's latest images: (arrival number, stamp in s, image).
         self._images: list[list[tuple[int, float, np.ndarray]]] = [[], []]
         self._infos: list[CameraInfo | None] = [None, None]
@@ -252,23 +258,52 @@ class RosHead:
         assert self._joints is not None
         return self._joints
 
-    def command_position(self, positions_rad: Mapping[str, float]) -> None:
-        """Publish the command and wait until every named joint is within tolerance of it."""
+    def _publish_position(self, positions_rad: Mapping[str, float]) -> None:
+        """Publish a position command, without waiting."""
         with self._changed:
-            self._joints = None
+            self._commanded_s = -np.inf if self._joints is None else self._joints.time_s
         self._position.publish(command_msg(positions_rad, self.topics))
 
-        def there() -> bool:
-            j = self._joints
-            return j is not None and all(
-                abs(j.positions_rad.get(n, np.inf) - v) <= self.tolerance_rad
-                for n, v in positions_rad.items()
-            )
+    def _await_position(self, positions_rad: Mapping[str, float]) -> JointReading:
+        """Wait for a joint state stamped after the last command with every named joint
+        within ``tolerance_rad`` of ``positions_rad``; grabs then take images stamped at
+        or after it."""
 
-        self._wait(there, f"joints reaching {dict(positions_rad)}")
+        def off(reading: JointReading) -> list[str]:
+            """The named joints not within tolerance, each with where it is."""
+            at = reading.positions_rad
+            return [
+                f"{n} at {at[n]!r} rad" if n in at else f"{n} not in the joint states"
+                for n, v in positions_rad.items()
+                if not abs(at.get(n, np.inf) - v) <= self.tolerance_rad
+            ]
+
+        def new() -> JointReading | None:
+            j = self._joints
+            return j if j is not None and j.time_s > self._commanded_s else None
+
         with self._changed:
+            if not self._changed.wait_for(
+                lambda: (j := new()) is not None and not off(j), timeout=self.timeout_s
+            ):
+                latest = new()
+                why = (
+                    f"no joint state on {self.topics.joint_states} since the command"
+                    if latest is None
+                    else "; ".join(off(latest))
+                )
+                raise JobFailed(
+                    f"the ROS 2 head: not within {self.tolerance_rad:g} rad of "
+                    f"{dict(positions_rad)} after {self.timeout_s} s: {why}"
+                )
             assert self._joints is not None
             self._settled_s = self._joints.time_s
+            return self._joints
+
+    def command_position(self, positions_rad: Mapping[str, float]) -> None:
+        """Publish the command and wait until every named joint is within tolerance of it."""
+        self._publish_position(positions_rad)
+        self._await_position(positions_rad)
 
     def command_velocity(self, velocities_rad_s: Mapping[str, float], duration_s: float) -> None:
         """Publish the rates, wait ``duration_s`` (wall clock), then publish zeros."""
@@ -291,6 +326,15 @@ class RosHead:
             if image[0] > self._grabbed[index] and image[1] >= self._settled_s
         ]
 
+    def _next_image(self, camera: int) -> np.ndarray:
+        """Camera 1 or 2's newest fresh image (waiting for one)."""
+        index = camera - 1
+        self._wait(lambda: bool(self._fresh(index)), f"a new image from camera {camera}")
+        with self._changed:
+            arrival, _, image = self._fresh(index)[-1]
+            self._grabbed[index] = arrival
+        return image
+
     def grab_stereo(self) -> StereoFrame:
         """The newest fresh left image, with the fresh right image nearest it in time
         (waiting for one from each eye)."""
@@ -302,56 +346,19 @@ class RosHead:
             _, left_s, left = self._fresh(0)[-1]
             _, right_s, right = min(self._fresh(1), key=lambda image: abs(image[1] - left_s))
             self._grabbed = [self._arrivals, self._arrivals]
-        self._taken, self._grabs = [left, right], self._grabs + 2
+        self._taken = [left, right]
+        self._taken_image(1, left, ImageKind.FULL)
+        self._taken_image(2, right, ImageKind.FULL)
         return StereoFrame(
             StampedImage(left_s, left, left_info), StampedImage(right_s, right, right_info)
         )
 
-    # -- the servos' grabs of one eye (ServoHead's) --------------------------------------
-    @property
-    def render_count(self) -> int:
-        """Images grabbed so far: each eye's of a stereo grab, frames, windows, retakes and
-        previews, each one."""
-        return self._grabs
-
-    def _grab(self, camera: int) -> np.ndarray:
-        """Camera 1 or 2's newest fresh image (waiting for one)."""
-        index = camera - 1
-        self._wait(lambda: bool(self._fresh(index)), f"a new image from camera {camera}")
-        with self._changed:
-            arrival, _, image = self._fresh(index)[-1]
-            self._grabbed[index] = arrival
-        self._taken[index], self._grabs = image, self._grabs + 1
-        return image
-
-    def _retaken(self, camera: int) -> np.ndarray:
-        image = self._taken[camera - 1]
-        if image is None:
-            raise JobFailed(f"the ROS 2 head: nothing grabbed from camera {camera} to retake")
-        self._grabs += 1
-        return image
-
-    def render(self, camera: int) -> np.ndarray:
-        """Camera 1 or 2's next whole image, (H, W, 3) uint8 RGB."""
-        return self._grab(camera)
-
-    def retake(self, camera: int) -> np.ndarray:
-        """The whole image camera 1 or 2 last gave (the same exposure)."""
-        return self._retaken(camera)
-
-    def render_window(self, camera: int, window: Window, retake: bool = False) -> np.ndarray:
-        """Only ``window`` of camera 1 or 2's next image (``retake``: of its last), cropped
-        here, (h, w, 3) uint8."""
-        image = self._retaken(camera) if retake else self._grab(camera)
-        return np.ascontiguousarray(image[window.y0 : window.y1, window.x0 : window.x1])
-
-    def render_preview(self, camera: int, binning: int) -> np.ndarray:
-        """Camera 1 or 2's next image binned ``binning`` x ``binning`` here (:func:`binned`)."""
-        return binned(self._grab(camera), binning)
-
     def close(self) -> None:
+        """Stop spinning (the spinner thread ended: one left running aborts the
+        interpreter's exit) and destroy the node."""
         rclpy = ros_modules()[0]
         self._executor.shutdown()
+        self._spinner.join(timeout=self.timeout_s)
         self.node.destroy_node()
         if self._own_context and rclpy.ok():
             rclpy.shutdown()
