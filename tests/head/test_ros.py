@@ -230,8 +230,15 @@ def test_model2_through_ros2_measures_what_it_measures_on_the_simulator(sim_node
         assert np.isnan(b.truth_head_m).all() and np.isfinite(a.truth_head_m).all()
     # The same looks: windows placed by previews, as on the simulator.
     assert counts.total == head.render_count == direct_renders
-    assert counts.windows == servo.window_renders == direct_servo.window_renders > 0
-    assert counts.previews == servo.previews == direct_servo.previews > 0
+    assert (
+        counts.windows
+        == servo.looker.counts.window_renders
+        == direct_servo.looker.counts.window_renders
+        > 0
+    )
+    assert (
+        counts.previews == servo.looker.counts.previews == direct_servo.looker.counts.previews > 0
+    )
     assert len(taken.images) == counts.total  # each reported to the head's sink
     assert sum(e.kind is ImageKind.PREVIEW for e in taken.images) == counts.previews
     # The truth was asked once per target, by the scoring after its last image (and
