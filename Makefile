@@ -24,19 +24,19 @@ test: setup
 	$(BIN)/ruff check headsim tests benchmarks tools
 	$(BIN)/ruff format --check headsim tests benchmarks tools
 	$(BIN)/mypy
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto
 
 # The suite's tiers (pytest markers, assigned in tests/conftest.py; README "Tests" gives
 # their times): fast (pure math, estimators, scenario checks; under a minute), render
 # (components with real MuJoCo renders), e2e (the command line, procedures, studies, docs).
 test-fast: setup
-	$(BIN)/python -m pytest -q -m fast
+	$(BIN)/python -m pytest -q -n auto -m fast
 
 test-render: setup
-	$(BIN)/python -m pytest -q -m render
+	$(BIN)/python -m pytest -q -n auto -m render
 
 test-e2e: setup
-	$(BIN)/python -m pytest -q -m e2e
+	$(BIN)/python -m pytest -q -n auto -m e2e
 
 # The regression suite CI runs after the tests: exits 1 on a regression.
 regress: setup

@@ -17,6 +17,7 @@ from __future__ import annotations
 import signal
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -113,6 +114,32 @@ def shipped_fast_run(tmp_path_factory: pytest.TempPathFactory) -> Callable[[str]
         return runs[name]
 
     return run
+
+
+@pytest.fixture
+def did_not_run(request: pytest.FixtureRequest) -> Callable[[str], None]:
+    """Say that a path cannot run here (a GPU, a driver, an extra not installed): the
+    sentences are listed at the end of the run, also when workers run the tests."""
+
+    def say(sentence: str) -> None:
+        request.node.user_properties.append(("did_not_run", sentence))
+
+    return say
+
+
+def pytest_terminal_summary(terminalreporter: Any) -> None:
+    """List every path that said it did not run (:func:`did_not_run`)."""
+    said = {
+        value
+        for reports in terminalreporter.stats.values()
+        for report in reports
+        for key, value in getattr(report, "user_properties", ())
+        if key == "did_not_run"
+    }
+    if said:
+        terminalreporter.section("did not run here")
+        for sentence in sorted(said):
+            terminalreporter.line(sentence)
 
 
 @pytest.fixture

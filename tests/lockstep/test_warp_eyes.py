@@ -6,6 +6,8 @@ without one that path says it did not run."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -63,12 +65,14 @@ def test_warp_casts_every_head_in_one_call_where_opengl_draws_them() -> None:
     heads.close()
 
 
-def test_the_gpu_path_runs_where_warp_finds_cuda_and_says_so_elsewhere() -> None:
+def test_the_gpu_path_runs_where_warp_finds_cuda_and_says_so_elsewhere(
+    did_not_run: Callable[[str], None],
+) -> None:
     heads, _ = _stepped_heads(1)
     cam = heads.settings(0).cameras[0]
     names = heads.camera_names(0)
     if not cuda_available():
-        print("GPU path did not run: Warp finds no CUDA device here")
+        did_not_run("lockstep: Warp finds no CUDA device here; the GPU path did not run")
         with pytest.raises(BatchError, match="Warp finds no CUDA device here; allowed: cpu"):
             WarpEyes(heads.model(0), names, (cam.width, cam.height), 1, device="cuda")
         heads.close()

@@ -4,6 +4,7 @@ per world, and its refusals."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -81,14 +82,13 @@ def test_bad_requests_name_what_is_allowed() -> None:
 
 
 def test_the_cuda_path_runs_where_warp_finds_a_device_and_is_refused_elsewhere(
-    capsys: pytest.CaptureFixture[str],
+    did_not_run: Callable[[str], None],
 ) -> None:
     with HeadSim() as sim:
         if not cuda_available():
             with pytest.raises(BatchError, match="Warp finds no CUDA device here"):
                 BatchRenderer(sim, 1, device="cuda")
-            with capsys.disabled():
-                print("\nbatch: no CUDA device here; the CUDA render path did not run")
+            did_not_run("batch: no CUDA device here; the CUDA render path did not run")
             return
         qpos, classic = _poses(sim, np.array([0.05]))
         images = BatchRenderer(sim, 1, device="cuda").render(qpos)
@@ -135,7 +135,9 @@ def test_a_window_camera_covers_exactly_its_rectangle_of_the_canvas() -> None:
     assert np.allclose(window, expected, rtol=1e-5)
 
 
-def test_warp_starts_without_a_cuda_warning_on_a_machine_without_the_driver() -> None:
+def test_warp_starts_without_a_cuda_warning_on_a_machine_without_the_driver(
+    did_not_run: Callable[[str], None],
+) -> None:
     """Warp's native start-up complains about a missing libcuda; users here asked for no GPU."""
     import ctypes.util
     import subprocess
@@ -144,7 +146,7 @@ def test_warp_starts_without_a_cuda_warning_on_a_machine_without_the_driver() ->
     code = "from headsim.sim.batch import cuda_available; print(cuda_available())"
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     if ctypes.util.find_library("cuda") is not None:
-        print("\nbatch: a CUDA driver is installed here; the quiet start-up did not run")
+        did_not_run("batch: a CUDA driver is installed here; the quiet start-up did not run")
         assert done.stdout.strip() in {"True", "False"}
         return
     assert done.stdout.strip() == "False"

@@ -8,7 +8,7 @@ Real renders (MuJoCo; MuJoCo Warp on the CPU for the batch renderer).
 from __future__ import annotations
 
 import importlib.util
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
@@ -116,9 +116,11 @@ def test_an_imperfection_from_a_test_module_reaches_the_classic_renderer_windows
     _assert_ramp(preview_on, preview_off, 4 * np.arange(120) + 1.5)
 
 
-def test_an_imperfection_from_a_test_module_reaches_the_batch_renderer(ramp: RowRamp) -> None:
+def test_an_imperfection_from_a_test_module_reaches_the_batch_renderer(
+    ramp: RowRamp, did_not_run: Callable[[str], None]
+) -> None:
     if importlib.util.find_spec("mujoco_warp") is None:
-        print("batch: mujoco_warp is not installed; the batch renderer's part did not run")
+        did_not_run("batch: mujoco_warp is not installed; the batch renderer's part did not run")
         return
     from headsim.sim.batch import BatchRenderer
 
