@@ -38,7 +38,9 @@ class LogError(BadInput, ValueError):
 @dataclass(frozen=True)
 class Topics:
     """Where a recording keeps each stream, and the robot's names of the head's joints
-    (``joints``: headsim's name -> the robot's, e.g. ``{"eye": "l_eye_pan"}``)."""
+    (``joints``: headsim's name -> the robot's, e.g. ``{"eye": "l_eye_pan"}``) and their
+    senses (``signs``: headsim's name -> 1 or -1, the robot's angle times it is headsim's,
+    positive inward)."""
 
     images: tuple[str, str] = ("/cam1/image_raw", "/cam2/image_raw")
     camera_infos: tuple[str, str] = ("/cam1/camera_info", "/cam2/camera_info")
@@ -51,10 +53,15 @@ class Topics:
     joints: Mapping[str, str] = field(default_factory=dict)
     head_frame: str = "head"
     optical_frames: tuple[str, str] = ("cam1_optical", "cam2_optical")
+    signs: Mapping[str, float] = field(default_factory=dict)
 
     def robot_joint(self, joint: str) -> str:
         """The robot's name of headsim's joint ``joint``."""
         return self.joints.get(joint, joint)
+
+    def sign(self, joint: str) -> float:
+        """1 or -1: headsim's angle of ``joint`` is the robot's times it (and the reverse)."""
+        return self.signs.get(joint, 1.0)
 
 
 def _stamp(time_s: float) -> dict[str, int]:
@@ -192,8 +199,10 @@ class McapRecorder:
             {
                 "header": {"stamp": _stamp(reading.time_s), "frame_id": ""},
                 "name": [self.topics.robot_joint(n) for n in names],
-                "position": [reading.positions_rad[n] for n in names],
-                "velocity": [reading.velocities_rad_s.get(n, 0.0) for n in names],
+                "position": [reading.positions_rad[n] * self.topics.sign(n) for n in names],
+                "velocity": [
+                    reading.velocities_rad_s.get(n, 0.0) * self.topics.sign(n) for n in names
+                ],
                 "effort": [],
             },
             reading.time_s,
@@ -231,7 +240,7 @@ class McapRecorder:
                     ],
                     "data_offset": 0,
                 },
-                "data": [float(values[n]) for n in names],
+                "data": [float(values[n]) * self.topics.sign(n) for n in names],
             },
             time_s,
         )
@@ -400,7 +409,8 @@ def _info_at(infos: Sequence[tuple[float, CameraInfo]], time_s: float) -> Camera
 
 def read_log(path: str | Path, topics: Topics | None = None) -> HeadLog:
     """A recording's images (each with its camera's latest CameraInfo at or before it),
-    joint states (by headsim's joint names), commands and estimates."""
+    joint states and commands (by headsim's joint names and senses: ``topics``' names
+    and signs), and estimates."""
     topics = topics or Topics()
     robot_to_ours = {topics.robot_joint(n): n for n in ("neck_yaw", "neck_pitch", "eye", "eye2")}
     infos: tuple[list[tuple[float, CameraInfo]], ...] = ([], [])
@@ -440,7 +450,7 @@ def read_log(path: str | Path, topics: Topics | None = None) -> HeadLog:
                 (
                     _time(msg.header),
                     {
-                        robot_to_ours[n]: float(p)
+                        robot_to_ours[n]: float(p) * topics.sign(robot_to_ours[n])
                         for n, p in zip(msg.name, msg.position, strict=False)
                         if n in robot_to_ours
                     },
@@ -453,10 +463,8 @@ def read_log(path: str | Path, topics: Topics | None = None) -> HeadLog:
         else:
             kind = "position" if topic == topics.position_commands else "velocity"
             labels = [d.label for d in msg.layout.dim]
-            values = {
-                robot_to_ours.get(label, label): float(v)
-                for label, v in zip(labels, msg.data, strict=False)
-            }
+            ours = [robot_to_ours.get(label, label) for label in labels]
+            values = {n: float(v) * topics.sign(n) for n, v in zip(ours, msg.data, strict=False)}
             commands.append(Command(log_time_s, kind, values))
     images: list[tuple[StampedImage, ...]] = []
     for index in (0, 1):

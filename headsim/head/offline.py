@@ -69,7 +69,6 @@ class LogMapping:
     """A mapping file, read: topics and joint names, signs, belief, initial directions, targets."""
 
     topics: Topics
-    signs: Mapping[str, float]
     belief: HeadBelief
     alpha_e_rad: tuple[float, float]
     targets: Mapping[str, str]
@@ -156,7 +155,7 @@ def read_mapping(path: str | Path) -> LogMapping:
             raise MappingError(
                 f"targets.{name} must be a marker colour ({', '.join(COLOURS)}), got {colour!r}"
             )
-    return LogMapping(Topics(**fields), signs, belief, alpha, dict(targets))
+    return LogMapping(Topics(**fields, signs=signs), belief, alpha, dict(targets))
 
 
 @dataclass(frozen=True)
@@ -175,11 +174,7 @@ def estimate_log(log: HeadLog, mapping: LogMapping) -> tuple[list[TargetEstimate
     pairs = pair_by_stamp(*log.images)
     per_target: dict[str, list[StereoEstimate]] = {name: [] for name in mapping.targets}
     for frame in pairs:
-        positions = {
-            name: value * mapping.signs.get(name, 1.0)
-            for name, value in log.joints.at(frame.time_s).items()
-        }
-        reading = JointReading(frame.time_s, positions, {})
+        reading = JointReading(frame.time_s, dict(log.joints.at(frame.time_s)), {})
         for estimate in estimate_markers(
             frame, reading, mapping.belief, mapping.targets, mapping.alpha_e_rad
         ):

@@ -67,8 +67,11 @@ class SimBridge:
         msg = sensor.JointState()
         set_stamp(msg.header, reading.time_s)
         msg.name = [self.topics.robot_joint(n) for n in reading.positions_rad]
-        msg.position = [float(v) for v in reading.positions_rad.values()]
-        msg.velocity = [float(reading.velocities_rad_s.get(n, 0.0)) for n in reading.positions_rad]
+        sign = self.topics.sign
+        msg.position = [float(v) * sign(n) for n, v in reading.positions_rad.items()]
+        msg.velocity = [
+            float(reading.velocities_rad_s.get(n, 0.0)) * sign(n) for n in reading.positions_rad
+        ]
         return msg
 
     def _publish_frame(self, frame: StereoFrame) -> None:

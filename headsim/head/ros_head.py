@@ -98,7 +98,7 @@ def command_msg(values: Mapping[str, float], topics: Topics) -> Any:
     msg.layout.dim = [
         std.MultiArrayDimension(label=topics.robot_joint(n), size=1, stride=1) for n in values
     ]
-    msg.data = [float(v) for v in values.values()]
+    msg.data = [float(v) * topics.sign(n) for n, v in values.items()]
     return msg
 
 
@@ -111,7 +111,10 @@ def command_values(msg: Any, topics: Topics, joint_names: Sequence[str]) -> dict
     unknown = [label for label in labels if label not in ours]
     if unknown:
         raise JobFailed(f"a command names unknown joint {unknown[0]!r}")
-    return {ours[label]: float(v) for label, v in zip(labels, msg.data, strict=True)}
+    return {
+        ours[label]: float(v) * topics.sign(ours[label])
+        for label, v in zip(labels, msg.data, strict=True)
+    }
 
 
 class RosHead(RosServo):
@@ -215,11 +218,16 @@ class RosHead(RosServo):
 
     def _on_joints(self, msg: Any) -> None:
         ours = {self.topics.robot_joint(n): n for n in self._names}
+        sign = self.topics.sign
         positions = {
-            ours[n]: float(p) for n, p in zip(msg.name, msg.position, strict=False) if n in ours
+            ours[n]: float(p) * sign(ours[n])
+            for n, p in zip(msg.name, msg.position, strict=False)
+            if n in ours
         }
         velocities = {
-            ours[n]: float(v) for n, v in zip(msg.name, msg.velocity, strict=False) if n in ours
+            ours[n]: float(v) * sign(ours[n])
+            for n, v in zip(msg.name, msg.velocity, strict=False)
+            if n in ours
         }
         with self._changed:
             self._joints = JointReading(stamp_s(msg.header), positions, velocities)

@@ -20,6 +20,7 @@ from headsim.head.mcap_log import (
     JointTrack,
     McapRecorder,
     RecordingHead,
+    Topics,
     read_log,
 )
 from headsim.head.replay import ReplayDiverged, ReplayHead, pair_by_stamp
@@ -213,3 +214,26 @@ def test_the_simulator_is_a_head() -> None:
         assert head.now() == pytest.approx(0.5 + FRAME_PERIOD_S)
         with pytest.raises(SettingsError, match="no motor 'eye2'"):
             head.command_velocity({"eye2": 0.1}, 0.1)
+
+
+def test_a_robot_whose_eye_turns_the_other_way_is_read_in_headsims_sense(tmp_path: Path) -> None:
+    """``Topics.signs``: the recorder writes the robot's names and senses, and the reader
+    gives headsim's back; read without the signs, the eye's angles come back negated."""
+    robot = Topics(joints={"eye": "l_eye_pan"}, signs={"eye": -1.0})
+    path = tmp_path / "robot.mcap"
+    sent = [JointReading(0.1 * k, {"neck_yaw": 0.01 * k, "eye": 0.02 * k}, {}) for k in range(4)]
+    with HeadSim("default", ideal_head()) as sim, McapRecorder(path, robot) as recorder:
+        frame = SimHead(sim).grab_stereo()
+        recorder.image(1, frame.left)
+        recorder.image(2, frame.right)
+        for reading in sent:
+            recorder.joints(reading)
+        recorder.command("position", {"eye": 0.03}, 0.5)
+    ours = read_log(path, robot)
+    assert [ours.joints.at(r.time_s)["eye"] for r in sent] == [r.positions_rad["eye"] for r in sent]
+    assert ours.commands[-1].values == {"eye": 0.03}
+    as_sent = read_log(path, Topics(joints={"eye": "l_eye_pan"}))
+    assert [as_sent.joints.at(r.time_s)["eye"] for r in sent] == [
+        -r.positions_rad["eye"] for r in sent
+    ]
+    assert as_sent.commands[-1].values == {"eye": -0.03}

@@ -11,6 +11,7 @@ import random
 import subprocess
 import sys
 import textwrap
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import replace
 
@@ -92,11 +93,9 @@ def ros_env() -> Iterator[dict[str, str]]:
             os.environ[key] = value
 
 
-@pytest.fixture()
-def sim_node(ros_env: dict[str, str]) -> Iterator[None]:
-    """The simulated paper head served as a ROS 2 node (:data:`NODE`) in another process."""
+def _serve(ros_env: dict[str, str], node_code: str) -> Iterator[None]:
     node = subprocess.Popen(
-        [sys.executable, "-c", NODE], env=ros_env, stdout=subprocess.PIPE, text=True
+        [sys.executable, "-c", node_code], env=ros_env, stdout=subprocess.PIPE, text=True
     )
     try:
         assert node.stdout is not None and node.stdout.readline().strip() == "ready"
@@ -106,6 +105,62 @@ def sim_node(ros_env: dict[str, str]) -> Iterator[None]:
         node.wait(timeout=30)
         assert node.stdout is not None
         node.stdout.close()
+
+
+@pytest.fixture()
+def sim_node(ros_env: dict[str, str]) -> Iterator[None]:
+    """The simulated paper head served as a ROS 2 node (:data:`NODE`) in another process."""
+    yield from _serve(ros_env, NODE)
+
+
+#: A robot whose eye joint has its own name and turns the other way (positive outward).
+ROBOT_TOPICS = 'Topics(joints={"eye": "l_eye_pan"}, signs={"eye": -1.0})'
+
+
+@pytest.fixture()
+def robot_node(ros_env: dict[str, str]) -> Iterator[None]:
+    """The same node, publishing and taking the eye as :data:`ROBOT_TOPICS`' robot does."""
+    code = NODE.replace(
+        "SimBridge(SimHead(sim), resend_s=0.2)",
+        f"SimBridge(SimHead(sim), {ROBOT_TOPICS}, resend_s=0.2)",
+    ).replace("import rclpy\n", "import rclpy\nfrom headsim.head.mcap_log import Topics\n")
+    assert ROBOT_TOPICS in code and "import Topics" in code
+    yield from _serve(ros_env, code)
+
+
+def test_a_robot_whose_eye_turns_the_other_way_is_driven_in_headsims_sense(
+    robot_node: None,
+) -> None:
+    """The mapping's names and signs (``Topics``): the robot's ``l_eye_pan`` is headsim's
+    eye reversed; through them the marker procedure measures what it measures on the
+    simulator, bit for bit, and a head told no sign reads the eye negated."""
+    from headsim.head.mcap_log import Topics
+    from headsim.head.ros_head import RosHead
+
+    with HeadSim("default", paper_head()) as sim:
+        direct = look_and_estimate(SimHead(sim), POSES, MARKER_COLOURS)
+    topics = Topics(joints={"eye": "l_eye_pan"}, signs={"eye": -1.0})
+    head = RosHead(("neck_yaw", "neck_pitch", "eye"), topics, timeout_s=60.0)
+    unsigned = RosHead(
+        ("neck_yaw", "neck_pitch", "eye"),
+        Topics(joints={"eye": "l_eye_pan"}),
+        timeout_s=60.0,
+        node_name="headsim_unsigned",
+    )
+    try:
+        through_ros = look_and_estimate(head, POSES, MARKER_COLOURS)
+        eye = head.read_joints().positions_rad["eye"]
+        assert eye == pytest.approx(POSES[-1]["eye"], abs=2e-3)
+        deadline = time.monotonic() + 10.0  # its spinner may be a message behind
+        while unsigned.read_joints().positions_rad["eye"] != -eye:
+            assert time.monotonic() < deadline, "the unsigned head never read -eye"
+            time.sleep(0.01)
+    finally:
+        unsigned.close()
+        head.close()
+    for a, b in zip(direct, through_ros, strict=True):
+        assert a.name == b.name
+        assert a.point_head_m.tobytes() == b.point_head_m.tobytes()
 
 
 def test_a_procedure_through_ros2_matches_the_simulator(sim_node: None) -> None:
