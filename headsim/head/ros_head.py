@@ -123,7 +123,8 @@ class RosHead(RosServo):
     ``belief``: what the head believes of its geometry; ``limits``: each joint's (low,
     high) range, rad; ``tolerance_rad``: how near its command a joint must be for a
     command to have ended, rad (default: half an encoder step with
-    ``encoder_resolution_rad``, else 2e-3).  For the servos
+    ``encoder_resolution_rad``, else 2e-3), and ``still_rad_s`` how slowly it must turn
+    where the joint states give its rate.  For the servos
     (:class:`~headsim.head.servo_head.ServoHead`): ``encoder_resolution_rad``, one
     encoder step of its joints, rad; ``model``: the head's model (its neck); ``sink``:
     where its grabs are reported.
@@ -139,6 +140,7 @@ class RosHead(RosServo):
         timeout_s: float = 30.0,
         node_name: str = "headsim_head",
         *,
+        still_rad_s: float = 0.05,
         encoder_resolution_rad: float | None = None,
         model: HeadModel = PAPER,
         sink: EventSink = NO_EVENTS,
@@ -151,6 +153,7 @@ class RosHead(RosServo):
         if tolerance_rad is None:
             tolerance_rad = 2e-3 if encoder_resolution_rad is None else encoder_resolution_rad / 2
         self.tolerance_rad = tolerance_rad
+        self.still_rad_s = still_rad_s
         self.timeout_s = timeout_s
         self._own_context = not rclpy.ok()
         if self._own_context:
@@ -278,13 +281,20 @@ class RosHead(RosServo):
         or after it."""
 
         def off(reading: JointReading) -> list[str]:
-            """The named joints not within tolerance, each with where it is."""
-            at = reading.positions_rad
-            return [
+            """The named joints not within tolerance, or still turning faster than
+            ``still_rad_s`` (where the joint states give rates), each with where it is."""
+            at, rate = reading.positions_rad, reading.velocities_rad_s
+            away = [
                 f"{n} at {at[n]!r} rad" if n in at else f"{n} not in the joint states"
                 for n, v in positions_rad.items()
                 if not abs(at.get(n, np.inf) - v) <= self.tolerance_rad
             ]
+            moving = [
+                f"{n} still turning at {rate[n]!r} rad/s"
+                for n in positions_rad
+                if n in rate and not abs(rate[n]) <= self.still_rad_s
+            ]
+            return away + moving
 
         def new() -> JointReading | None:
             j = self._joints
@@ -302,7 +312,7 @@ class RosHead(RosServo):
                 )
                 raise JobFailed(
                     f"the ROS 2 head: not within {self.tolerance_rad:g} rad of "
-                    f"{dict(positions_rad)} after {self.timeout_s} s: {why}"
+                    f"{dict(positions_rad)} and still after {self.timeout_s} s: {why}"
                 )
             assert self._joints is not None
             self._settled_s = self._joints.time_s

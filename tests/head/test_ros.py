@@ -386,3 +386,38 @@ def test_binning_averages_each_block_and_refuses_a_size_it_does_not_divide() -> 
     assert np.array_equal(preview[1, 1], np.rint(block).astype(np.uint8))
     with pytest.raises(ValueError, match="binning 4 must divide the 6x4 image"):
         binned(image, 4)
+
+
+def test_a_command_ends_only_once_the_joint_has_stopped(ros_env: dict[str, str]) -> None:
+    """A joint state at the command but still turning (a robot overshooting) does not end
+    it: settle names the rate, and the next state, at rest, ends it."""
+    import rclpy
+
+    from headsim.head.ros_head import RosHead, latched_qos, ros_modules, set_stamp
+
+    sensor = ros_modules()[1]
+    head = RosHead(("eye",), limits={"eye": (-0.7, 0.7)}, timeout_s=10.0)
+    robot = rclpy.create_node("headsim_test_robot_eye")
+    states = robot.create_publisher(sensor.JointState, "/joint_states", latched_qos())
+
+    def publish(time_s: float, position_rad: float, rate_rad_s: float) -> None:
+        msg = sensor.JointState()
+        set_stamp(msg.header, time_s)
+        msg.name, msg.position, msg.velocity = ["eye"], [position_rad], [rate_rad_s]
+        states.publish(msg)
+
+    try:
+        publish(1.0, 0.0, 0.0)
+        assert head.read_joints().time_s == 1.0
+        head.command(eye=0.1)
+        publish(2.0, 0.1, 0.3)
+        head.timeout_s = 1.0
+        with pytest.raises(JobFailed, match=r"after 1.0 s: eye still turning at 0\.3 rad/s$"):
+            head.settle()
+        head.timeout_s = 10.0
+        publish(3.0, 0.1, 0.0)
+        reading = head.settle()
+        assert (reading.time_s, reading.velocities_rad_s["eye"]) == (3.0, 0.0)
+    finally:
+        robot.destroy_node()
+        head.close()
