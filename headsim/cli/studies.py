@@ -81,10 +81,9 @@ def sweep_command(args: argparse.Namespace) -> int:
         )
         batch = sweep.batch_options(spec, args.device)  # refused before it is announced
         if batch is not None:
-            samples = batch.samples_per_pixel or "the head's"
             where += (
-                f", batch back-end: MuJoCo Warp on {batch.device}, up to {batch.worlds} heads "
-                f"per batch, sub-pixel samples per axis: {samples}"
+                f", batch back-end: up to {batch.worlds} heads per batch in lockstep, drawn "
+                "through one OpenGL context at each head's own render fidelity"
             )
         print(f"  running on {where}; log {Path(args.out) / 'jobs.jsonl'}", flush=True)
         with sigterm_interrupts():
@@ -120,7 +119,7 @@ def sweep_command(args: argparse.Namespace) -> int:
     if batch is not None and outcome.rendered:
         drawn = outcome.rendered
         print(
-            "batch back-end: lockstep heads, classic OpenGL renderer on the CPU: "
+            "batch back-end: lockstep heads through one OpenGL context: "
             f"{int(drawn.get('images', 0))} images, at most {int(drawn.get('largest', 0))} "
             "heads at once"
         )

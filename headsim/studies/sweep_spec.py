@@ -27,7 +27,7 @@ class SweepError(BadInput, ValueError):
 
 
 #: How a sweep's jobs run: one scenario run at a time per process, or in lockstep batches
-#: whose images MuJoCo Warp renders together (``headsim[batch]``).
+#: (:mod:`headsim.lockstep.runs`: every target of a batch a head, drawn through one context).
 BACKENDS = ("classic", "batch")
 #: The most heads one batch holds.
 MAX_WORLDS = 4096
@@ -35,11 +35,11 @@ MAX_WORLDS = 4096
 
 @dataclass(frozen=True)
 class BatchOptions:
-    """A ``[batch]`` table: heads per batch, Warp's sub-pixel samples per axis (None: each
-    head's ``render.supersample``) and the device."""
+    """A ``[batch]`` table: heads per batch, and the device checked before any job runs
+    (lockstep draws every head through one OpenGL context, at each head's own
+    ``render`` fidelity)."""
 
     worlds: int = 32
-    samples_per_pixel: int | None = None
     device: str = "cpu"
 
 
@@ -140,15 +140,21 @@ def load_sweep(path: str | Path) -> SweepSpec:
 
 
 def _batch_options(source: str, table: Any) -> BatchOptions:
-    from headsim.sim.batch import DEVICES, MAX_SAMPLES_PER_PIXEL
+    from headsim.sim.batch import DEVICES
 
     if not isinstance(table, dict):
-        raise SweepError(source, "batch", "must be a table", "worlds, samples_per_pixel, device")
+        raise SweepError(source, "batch", "must be a table", "worlds, device")
+    if "samples_per_pixel" in table:  # Warp's, which the batch back-end no longer uses
+        raise SweepError(
+            source,
+            "batch.samples_per_pixel",
+            "is not used: lockstep draws each head at its own fidelity (set the head's "
+            "render_supersample in the scenario or the grid instead)",
+            "worlds, device",
+        )
     for key in table:
-        if key not in ("worlds", "samples_per_pixel", "device"):
-            raise SweepError(
-                source, f"batch.{key}", "unknown key", "worlds, samples_per_pixel, device"
-            )
+        if key not in ("worlds", "device"):
+            raise SweepError(source, f"batch.{key}", "unknown key", "worlds, device")
 
     def whole(key: str, high: int) -> Any:
         value = table[key]
@@ -161,10 +167,6 @@ def _batch_options(source: str, table: Any) -> BatchOptions:
     options = BatchOptions()
     if "worlds" in table:
         options = replace(options, worlds=whole("worlds", MAX_WORLDS))
-    if "samples_per_pixel" in table:
-        options = replace(
-            options, samples_per_pixel=whole("samples_per_pixel", MAX_SAMPLES_PER_PIXEL)
-        )
     if "device" in table:
         if table["device"] not in DEVICES:
             raise SweepError(

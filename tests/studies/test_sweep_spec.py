@@ -78,8 +78,8 @@ def test_random_sample_is_seeded(tmp_path: Path) -> None:
             r"batch.worlds: 0 is not allowed \(allowed: an integer from 1 to 4096\)",
         ),
         (
-            'description = "x"\nscenario = "sweep_base.toml"\nbackend = "batch"\n[batch]\nsamples_per_pixel = 9\n[grid]\nseed = [1]\n',
-            r"batch.samples_per_pixel: 9 is not allowed \(allowed: an integer from 1 to 8\)",
+            'description = "x"\nscenario = "sweep_base.toml"\nbackend = "batch"\n[batch]\nsamples_per_pixel = 2\n[grid]\nseed = [1]\n',
+            r"batch.samples_per_pixel: is not used: lockstep draws each head at its own fidelity .*\(allowed: worlds, device\)",
         ),
         (
             'description = "x"\nscenario = "sweep_base.toml"\nbackend = "batch"\n[batch]\ndevice = "tpu"\n[grid]\nseed = [1]\n',
