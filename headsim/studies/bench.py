@@ -38,6 +38,7 @@ from headsim.studies import experiments
 from headsim.studies.bench_cases import BenchCase, case, listing, of_kind, run_script
 from headsim.studies.catalogue import SCENARIO_JOBS
 from headsim.studies.checks import Metrics, compare, format_table, load_json
+from headsim.studies.hooks import registrar
 from headsim.studies.render_clock import RenderClock
 from headsim.studies.scenario_jobs import run_row
 from headsim.studies.scenario_runs import calibration_run, knowledge_file, preset_of
@@ -173,16 +174,8 @@ PARTS = tuple(c.name for c in of_kind("regress"))
 Part = Callable[[int, Faults, Progress], Metrics]
 #: Each part's function, by its case's name (:func:`part`).
 PART_RUNS: dict[str, Part] = {}
-
-
-def part(name: str) -> Callable[[Part], Part]:
-    """Register the function that runs the regression case ``name``."""
-
-    def register(run: Part) -> Part:
-        PART_RUNS[name] = run
-        return run
-
-    return register
+#: ``@part("name")``: register the function that runs the regression case ``name``.
+part = registrar(PART_RUNS)
 
 
 def suite(

@@ -10,21 +10,14 @@ from dataclasses import replace
 
 from headsim.active.principal import zoomed
 from headsim.sim.settings import HeadSettings
+from headsim.studies.hooks import registrar
 
 #: A change of the head to one value of an experiment.
 HeadChange = Callable[[HeadSettings, float], HeadSettings]
 #: The hooks an experiment file names: name -> change.
 HEAD_CHANGES: dict[str, HeadChange] = {}
-
-
-def head_change(name: str) -> Callable[[HeadChange], HeadChange]:
-    """Register a change under ``name``, the name experiment files use."""
-
-    def register(change: HeadChange) -> HeadChange:
-        HEAD_CHANGES[name] = change
-        return change
-
-    return register
+#: ``@head_change("name")``: register a change under the name experiment files use.
+head_change = registrar(HEAD_CHANGES)
 
 
 head_change("zoom")(zoomed)

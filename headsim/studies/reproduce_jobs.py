@@ -14,6 +14,7 @@ from typing import Any
 
 from headsim.files import to_jsonable, write_json_atomic, write_text_atomic
 from headsim.studies.catalogue import FIXED_POINT_TARGETS, REPRODUCE, TABLES_HEAD
+from headsim.studies.hooks import registrar
 from headsim.studies.jobs import plain_errors
 from headsim.studies.scenario_jobs import Job
 
@@ -34,16 +35,8 @@ WORKER_MODULES = (
 JobHook = Callable[[str, str, bool, "int | None", dict[str, Any]], dict[str, Any]]
 #: The hooks a reproduce experiment file names: name -> job.
 JOB_HOOKS: dict[str, JobHook] = {}
-
-
-def job_hook(name: str) -> Callable[[JobHook], JobHook]:
-    """Register a job under ``name``, the name experiment files use."""
-
-    def register(job: JobHook) -> JobHook:
-        JOB_HOOKS[name] = job
-        return job
-
-    return register
+#: ``@job_hook("name")``: register a job under the name experiment files use.
+job_hook = registrar(JOB_HOOKS)
 
 
 @job_hook("calibrate")
