@@ -14,6 +14,7 @@ import textwrap
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 import pytest
@@ -24,7 +25,7 @@ from headsim.active.model1 import measure_model1
 from headsim.active.model2 import measure_model2
 from headsim.active.neck_servo import NeckServo
 from headsim.errors import JobFailed
-from headsim.head.ros_head import binned
+from headsim.head.ros_head import RosHead, binned
 from headsim.head.servo_head import NoTruth, ServoHead
 from headsim.head.sim_head import SimHead
 from headsim.head.stereo_look import look_and_estimate
@@ -34,7 +35,7 @@ from headsim.sim.events import ImageKind, ImageTaken, RenderCounts
 from headsim.sim.joints import JointLimitError
 from headsim.sim.names import MARKER_COLOURS
 from headsim.sim.render import Window
-from headsim.sim.settings import SettingsError, paper_head
+from headsim.sim.settings import HeadSettings, SettingsError, paper_head
 from headsim.sim.simulator import HeadSim
 
 pytestmark = [
@@ -135,7 +136,6 @@ def test_a_robot_whose_eye_turns_the_other_way_is_driven_in_headsims_sense(
     eye reversed; through them the marker procedure measures what it measures on the
     simulator, bit for bit, and a head told no sign reads the eye negated."""
     from headsim.head.mcap_log import Topics
-    from headsim.head.ros_head import RosHead
 
     with HeadSim("default", paper_head()) as sim:
         direct = look_and_estimate(SimHead(sim), POSES, MARKER_COLOURS)
@@ -164,8 +164,6 @@ def test_a_robot_whose_eye_turns_the_other_way_is_driven_in_headsims_sense(
 
 
 def test_a_procedure_through_ros2_matches_the_simulator(sim_node: None) -> None:
-    from headsim.head.ros_head import RosHead
-
     with HeadSim("default", paper_head()) as sim:
         direct = look_and_estimate(SimHead(sim), POSES, MARKER_COLOURS)
     head = RosHead(("neck_yaw", "neck_pitch", "eye"), timeout_s=60.0)
@@ -213,6 +211,21 @@ class _Taken:
             self.images.append(event)
 
 
+def _servo_head(
+    settings: HeadSettings, limits: dict[str, tuple[float, float]], **options: Any
+) -> RosHead:
+    """A RosHead on the node's topics, given what the simulated head's owner would give:
+    its belief, its joints' limits and its encoder resolution."""
+    return RosHead(
+        ("neck_yaw", "neck_pitch", "eye"),
+        belief=settings.believed,
+        limits=limits,
+        timeout_s=60.0,
+        encoder_resolution_rad=settings.encoder_resolution_rad,
+        **options,
+    )
+
+
 def test_model2_through_ros2_measures_what_it_measures_on_the_simulator(sim_node: None) -> None:
     """Model 2 on each marker through RosHead, a ServoHead from what the robot publishes
     (CameraInfo, joint states) and what its owner gives (encoder resolution, limits,
@@ -223,8 +236,6 @@ def test_model2_through_ros2_measures_what_it_measures_on_the_simulator(sim_node
     (the paper head has no image noise, whose frame counter would differ: the node takes
     both eyes' frames after every command).  The previews are not (binned here, a
     low-resolution readout there) but only place the windows."""
-    from headsim.head.ros_head import RosHead
-
     settings = paper_head()
     knowledge = HeadKnowledge(alpha_e=INITIAL_DIRECTIONS_RAD)
     with HeadSim("default", settings) as sim:
@@ -237,14 +248,7 @@ def test_model2_through_ros2_measures_what_it_measures_on_the_simulator(sim_node
     missing = [name for name in dir(ServoHead) if name[0] != "_" and not hasattr(RosHead, name)]
     assert not missing  # the whole ServoHead interface
     taken = _Taken()
-    head = RosHead(
-        ("neck_yaw", "neck_pitch", "eye"),
-        belief=settings.believed,
-        limits=limits,
-        timeout_s=60.0,
-        encoder_resolution_rad=settings.encoder_resolution_rad,
-        sink=taken,
-    )
+    head = _servo_head(settings, limits, sink=taken)
     # The scoring asks the target's truth of the head: record when (in images grabbed).
     asked: list[tuple[str, int]] = []
 
@@ -305,7 +309,6 @@ def test_model1_through_ros2_moves_the_neck_as_on_the_simulator(sim_node: None) 
     """Model 1 (the neck servo: neck yaw, neck pitch and the eye together) on each marker
     through RosHead and on the simulator directly: bit for bit, in H and, through the
     neck encoders, in W."""
-    from headsim.head.ros_head import RosHead
 
     settings = paper_head()
     knowledge = HeadKnowledge(alpha_e=INITIAL_DIRECTIONS_RAD)
@@ -315,13 +318,7 @@ def test_model1_through_ros2_moves_the_neck_as_on_the_simulator(sim_node: None) 
         limits = {motor: direct_head.joint_range(motor) for motor in direct_head.motors}
         servo = NeckServo(direct_head)
         direct = [measure_model1(direct_head, servo, t, knowledge) for t in targets]
-    head = RosHead(
-        ("neck_yaw", "neck_pitch", "eye"),
-        belief=settings.believed,
-        limits=limits,
-        timeout_s=60.0,
-        encoder_resolution_rad=settings.encoder_resolution_rad,
-    )
+    head = _servo_head(settings, limits)
     try:
         servo = NeckServo(head)
         through_ros = [measure_model1(head, servo, t, knowledge) for t in targets]
@@ -354,8 +351,6 @@ def test_a_script_that_grabs_and_closes_exits_cleanly(
 
 def test_a_ros2_head_says_what_it_lacks(ros_env: dict[str, str]) -> None:
     """No robot on the topics, no encoder resolution, limits for the eye only."""
-    from headsim.head.ros_head import RosHead
-
     head = RosHead(("neck_pitch", "eye"), limits={"eye": (-0.7, 0.7)}, timeout_s=0.3)
     try:
         with pytest.raises(SettingsError, match="needs its encoder_resolution_rad"):
@@ -393,7 +388,7 @@ def test_a_command_ends_only_once_the_joint_has_stopped(ros_env: dict[str, str])
     it: settle names the rate, and the next state, at rest, ends it."""
     import rclpy
 
-    from headsim.head.ros_head import RosHead, latched_qos, ros_modules, set_stamp
+    from headsim.head.ros_head import latched_qos, ros_modules, set_stamp
 
     sensor = ros_modules()[1]
     head = RosHead(("eye",), limits={"eye": (-0.7, 0.7)}, timeout_s=10.0)
