@@ -218,6 +218,32 @@ def expected_window(
     return window
 
 
+#: A band's rows reach this fraction of the image width above and below the blob's
+#: last sight (besides 3 blob radii and the margin): how far a blob may drift across
+#: the rows while an eye's yaw of unknown image motion carries it along them (the
+#: lens bends its path).  A blob outside the band is a miss, looked for again.
+BAND_DRIFT = 0.05
+
+
+def band_window(
+    image_size_px: tuple[int, int],
+    seen_uv_px: tuple[float, float],
+    area_px: float,
+    margin_px: float,
+) -> Window | None:
+    """The window to look for a blob of ``area_px`` last seen at ``seen_uv_px`` after an
+    eye move of unknown image motion (no gain learnt yet): every column of the rows
+    within 3 blob radii + margin + :data:`BAND_DRIFT` of the width of the sight's row.
+    None where it would be barely cheaper than the frame."""
+    width, height = image_size_px
+    half = 3.0 * math.sqrt(area_px / math.pi) + margin_px + BAND_DRIFT * width
+    side = min(height, 2 * math.ceil(half) + 1)
+    if side >= 0.5 * height:
+        return None
+    y0 = min(max(round(seen_uv_px[1] - side / 2), 0), height - side)
+    return Window(0, int(y0), int(width), int(side))
+
+
 def stands_for_frame(
     seen: Detection,
     window: Window,
@@ -508,8 +534,10 @@ class Looker:
         window is rendered: around where the head expects the target from that sight and
         the eye steps moved since (u + gain * steps), of half-side 3 blob radii plus the
         margin and a quarter of the predicted motion (blob detectors), or the pattern's
-        box so grown.  A blob's miss is looked for again in a preview, then in the same
-        instant's full frame.  A new blob is first found in a binned preview;
+        box so grown.  With no gain known yet (the servo's probe), a blob's window is the
+        band of rows around that sight (:func:`band_window`): a window's pixels are the
+        frame's crop, so it gives the frame's answer at a fraction of its cost.  A blob's
+        miss is looked for again in a preview, then in the same instant's full frame.  A new blob is first found in a binned preview;
         ``preview=False`` renders the full frame instead (a search's look)."""
         key = detector if hint.key is None else hint.key
         sim, cfg, counts = self.sim, self.config, self.counts
@@ -581,18 +609,23 @@ class Looker:
         gain_px_per_step: float | None,
     ) -> Window | None:
         """Where to look for ``key``'s target in ``camera`` (None: the full frame): around
-        where the last sight puts it, the whole pattern's box for a pattern."""
+        where the last sight puts it, the whole pattern's box for a pattern; with no gain
+        learnt yet, a blob's band of rows (:func:`band_window`)."""
         cfg, memory = self.config, self._memory
         seen = memory.sight.get(camera)
-        if not cfg.windows or seen is None or gain_px_per_step is None:
+        if not cfg.windows or seen is None:
             return None
         if seen.key != key or seen.neck_rad != neck_rad:
             return None
         size_px = self.image_sizes_px[camera]
+        extent_px = memory.extent_px.get(camera)
+        if gain_px_per_step is None:  # the eyes moved by an image motion not known yet
+            if extent_px is not None:
+                return None
+            return band_window(size_px, seen.uv_px, seen.area_px, cfg.window_margin_px)
         motion_px = gain_px_per_step * (eye_steps - seen.eye_steps)
         expected_uv_px = (seen.uv_px[0] + motion_px, seen.uv_px[1])
         margin_px = cfg.window_margin_px
-        extent_px = memory.extent_px.get(camera)
         if extent_px is not None:  # a pattern: the whole of it
             return pattern_window(size_px, expected_uv_px, extent_px, motion_px, margin_px)
         return expected_window(size_px, expected_uv_px, seen.area_px, motion_px, margin_px)
@@ -612,6 +645,7 @@ __all__ = [
     "Sight",
     "Since",
     "Whole",
+    "band_window",
     "expected_window",
     "finds_blob",
     "foveal_detector",
