@@ -15,7 +15,9 @@ from headsim.active.look import (
     Anew,
     Around,
     Looker,
+    Since,
     Whole,
+    band_window,
     expected_window,
     finds_blob,
     pattern_feature,
@@ -68,6 +70,36 @@ def test_a_blobs_window_is_three_radii_the_margin_and_a_quarter_of_the_motion() 
     # At the image's corner it is moved inside; as large as half the frame it is refused.
     assert expected_window(SIZE, (0.0, 0.0), math.pi * 16, 8.0, 8.0) == Window(0, 0, 45, 45)
     assert expected_window(SIZE, (320.0, 240.0), math.pi * 100**2, 0.0, 8.0) is None
+
+
+def test_a_blobs_band_is_every_column_of_the_rows_around_its_last_sight() -> None:
+    # Radius 4 px: half-height 12 + 8 + 0.05 * 640 = 52 px, 105 rows around row 240.
+    assert band_window(SIZE, (320.0, 240.0), math.pi * 16, 8.0) == Window(0, 188, 640, 105)
+    # Wherever the blob was along the row, and moved inside the image at its top.
+    assert band_window(SIZE, (5.0, 240.0), math.pi * 16, 8.0) == Window(0, 188, 640, 105)
+    assert band_window(SIZE, (320.0, 3.0), math.pi * 16, 8.0) == Window(0, 0, 640, 105)
+    # A band of half the frame or more is no saving: the full frame.
+    assert band_window(SIZE, (320.0, 240.0), math.pi * 80**2, 8.0) is None
+
+
+def test_after_an_eye_move_of_unknown_gain_a_band_gives_the_full_frames_answer() -> None:
+    taken = Collect()
+    with HeadSim("default", sink=taken) as sim:
+        looker = Looker(sim)
+        first = looker.look(1, RED, Since(None))  # no sight yet: a preview, then its window
+        sim.command_eye_steps(sim.eye_encoder_steps() + 16)  # the servo's probe
+        sim.settle()
+        band = looker.look(1, RED, Since(None))
+        full = RED(sim.retake(1))
+    assert first.found and band.found and full.found and band.uv is not None
+    np.testing.assert_allclose(band.uv, full.uv, rtol=0, atol=0.02)
+    assert band.uv != first.uv  # the eyes moved the blob
+    images = [e for e in taken.events if isinstance(e, ImageTaken)]
+    kinds = [e.kind for e in images]
+    assert kinds == [ImageKind.PREVIEW, ImageKind.WINDOW, ImageKind.WINDOW, ImageKind.RETAKE]
+    window = images[2].window
+    assert window is not None and (window.x0, window.width) == (0, SIZE[0])
+    assert window.y0 <= first.uv[1] < window.y1 and window.height < SIZE[1] / 2
 
 
 def test_a_patterns_window_is_its_extent_grown_and_clipped_to_the_image() -> None:
