@@ -16,7 +16,8 @@ window is rasterised.  Every vertex lands where it does in the frame, less the
 window's offset, so the window's pixels are the full frame's crop (a window
 drawn as a camera of its own, with a shifted principal point, rounds its
 projection otherwise and flips an MSAA sample now and then).  Noise included:
-the noise of image k of a camera is drawn for the whole frame and cropped.  The
+a window gets the noise of image k of its camera's whole frame there, drawn for
+the window's rows only.  The
 head's own geoms (group ``names.HEAD_VISUAL_GROUP``) are hidden from the eye
 cameras.  Every image is
 one render and is counted, with its pixels in full-frame equivalents.

@@ -45,11 +45,14 @@ def test_samples_follow_the_law_with_the_stated_spread(std: float) -> None:
     assert unclipped.size > 0.9999 * n
     assert abs(samples.std() - expected_std) < 0.003 * expected_std
     assert abs(samples.mean()) < 5 * std / math.sqrt(n)
+    # Each count against the sampler's own law (the rounded Gaussian to 2**-16 each, which
+    # is 56 of these 3.7 M samples: a rare outcome's count is judged against its table's).
+    law = noise.probabilities()
     values, counts = np.unique(samples, return_counts=True)
     for k, count in zip(values, counts, strict=True):
         if not -128 < k < 127:
             continue  # saturated at black or white
-        p = _rounded_gaussian(std, int(k))
+        p = law.get(int(k), 0.0)
         assert abs(count - n * p) <= 6 * math.sqrt(n * p * (1 - p)) + 3, k
 
 
@@ -83,3 +86,20 @@ def test_noise_follows_the_seed_and_saturates_like_clipping() -> None:
     expected = np.clip(image.astype(int) + _offsets(noise, (7, 0), 5), 0, 255)
     np.testing.assert_array_equal(noise.apply(image, (7, 0), 5), expected)
     assert GaussianNoise.of(0.0).apply(image, (7, 0), 5) is image
+
+
+@pytest.mark.parametrize("std", [3.0, 30.0])
+@pytest.mark.parametrize("full_size", [(640, 480), (203, 97)])
+def test_a_windows_noise_is_the_full_frames_crop(std: float, full_size: tuple[int, int]) -> None:
+    # Drawn for the window's rows only, from any corner, in colour and in grey: exactly
+    # the noise of the full frame there (a width whose rows do not fill whole blocks too).
+    noise = GaussianNoise.of(std)
+    width, height = full_size
+    rng = np.random.default_rng(2)
+    for shape in ((height, width, 3), (height, width)):
+        image = rng.integers(0, 256, shape, dtype=np.uint8)
+        full = noise.apply(image, (5, 1), 9)
+        for x0, y0, w, h in ((0, 0, width, height), (17, 3, 40, 31), (width - 1, height - 1, 1, 1)):
+            part = np.ascontiguousarray(image[y0 : y0 + h, x0 : x0 + w])
+            window = noise.apply(part, (5, 1), 9, crop=(x0, y0, width, height))
+            np.testing.assert_array_equal(window, full[y0 : y0 + h, x0 : x0 + w])

@@ -1,6 +1,7 @@
 """Gaussian image noise: every image gets its own, seeded by its stream and number.
 
-A window of an image gets the full frame's noise, cropped (:meth:`GaussianNoise.apply`).
+A window of an image gets the full frame's noise, cropped, drawn for the window's rows
+only (:meth:`GaussianNoise.apply`).
 """
 
 from __future__ import annotations
@@ -29,6 +30,10 @@ NOISE_STD = Setting(
 _BUCKETS = 256
 #: Outcomes whose rounded-Gaussian probability is below this are folded into their neighbours.
 _TAIL_PROBABILITY = 2.0**-20
+#: Bytes of random bits per draw of the generator (PCG64DXSM: one 64-bit word): each row
+#: of a frame's random bits starts on a draw, so that a window's first row is reached by
+#: advancing the generator (:func:`_rows`).
+_WORD_BYTES = 8
 
 
 def _rounded_gaussian(std: float) -> tuple[np.ndarray, np.ndarray]:
@@ -57,11 +62,14 @@ class GaussianNoise:
     saturated to [0, 255] in one pass
     (what ``clip(rint(image + std * z))`` gives).  Probabilities are exact to
     2**-16 (each); the outcomes too rare for that (beyond about 4 std, a tail
-    of less than 1e-4) are folded into the extreme values.  Noise of image number ``frame`` of a stream ``key`` is
-    drawn from its own generator, seeded by ``(*key, frame)``: the same for a
-    given seed, camera and image count, and independent between images,
-    pixels and colour channels.  Up to 127 outcomes on each side (std <= 25);
-    larger noise falls back to float samples with the same law.
+    of less than 1e-4) are folded into the extreme values.  Noise of image number
+    ``frame`` of a stream ``key`` is drawn from its own generator (PCG64DXSM), seeded
+    by ``(*key, frame)``: the same for a given seed, camera and image count, and
+    independent between images, pixels and colour channels.  A window's rows are
+    drawn by advancing the generator to its first row (a jump, not a draw): a window
+    costs its rows, not the frame.  Up to 127
+    outcomes on each side (std <= 25); larger noise falls back to Box-Muller samples
+    (two 32-bit uniforms per value) with the same law.
     """
 
     std: float
@@ -136,26 +144,38 @@ class GaussianNoise:
         height, width = image.shape[:2]
         x0, y0, full_w, full_h = (0, 0, width, height) if crop is None else crop
         channels = image.shape[2] if image.ndim == 3 else 1
-        full_shape = (full_h, full_w * channels)
-        rows = slice(y0, y0 + height)
+        values = full_w * channels  # per row of the full frame
         columns = slice(x0 * channels, (x0 + width) * channels)
-        bits = np.random.SFC64(np.random.SeedSequence([*key, frame]))
         flat = np.ascontiguousarray(image).reshape(height, width * channels)
-        if self.tables is None:
-            z = np.random.Generator(bits).standard_normal(size=full_shape, dtype=np.float32)
-            noisy = flat.astype(np.float32) + np.float32(self.std) * z[rows, columns]
+        bits = np.random.PCG64DXSM(np.random.SeedSequence([*key, frame]))
+        if self.tables is None:  # a 64-bit word per value
+            words = _rows(bits, y0, height, 8 * values).view(np.uint64)[:, columns]
+            halves = words.view(np.uint32).reshape(*words.shape, 2).astype(np.float32)
+            u1 = (halves[..., 0] + np.float32(1.0)) * np.float32(2.0**-32)  # (0, 1]
+            angle = halves[..., 1] * np.float32(2.0 * np.pi * 2.0**-32)
+            z = np.sqrt(np.float32(-2.0) * np.log(u1)) * np.cos(angle)
+            noisy = flat.astype(np.float32) + np.float32(self.std) * z
             return np.clip(np.rint(noisy), 0, 255).astype(np.uint8).reshape(image.shape)
         alias, threshold, k_max = self.tables
-        size = full_shape[0] * full_shape[1]
-        raw = bits.random_raw((2 * size + 7) // 8).view(np.uint8)
-        bucket = raw[:size].reshape(full_shape)[rows, columns]
-        within = raw[size : 2 * size].reshape(full_shape)[rows, columns]
+        # Two planes of a byte per value, one after the other: the frame's rows of
+        # buckets, then its rows of decisions within them.
+        bucket = _rows(bits, y0, height, values)[:, columns]
+        within = _rows(bits, full_h - height, height, values)[:, columns]
         # Outcome index: the bucket itself (Vose's primary) or its alias; offset = index - k_max.
         outcome = cv2.LUT(bucket, alias)
         cv2.copyTo(bucket, cv2.compare(within, cv2.LUT(bucket, threshold), cv2.CMP_LT), outcome)
         # One saturating pass: image + outcome - k_max, exact integers in float, to [0, 255].
         noisy = cv2.addWeighted(flat, 1.0, outcome, 1.0, -float(k_max), dtype=cv2.CV_8U)
         return noisy.reshape(image.shape)
+
+
+def _rows(bits: np.random.PCG64DXSM, skip: int, height: int, row_bytes: int) -> np.ndarray:
+    """The next ``height`` rows of ``row_bytes`` random bytes from ``bits``, (height,
+    row_bytes) uint8, after jumping over ``skip`` rows (each row starts on a draw)."""
+    words = -(-row_bytes // _WORD_BYTES)
+    bits.advance(skip * words)
+    raw = bits.random_raw(height * words).view(np.uint8).reshape(height, words * _WORD_BYTES)
+    return raw[:, :row_bytes]
 
 
 class Noise(Imperfection):
