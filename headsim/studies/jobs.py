@@ -333,15 +333,18 @@ def critical_order(plan: list[PlannedJob]) -> dict[str, float]:
 
 
 def _topological(plan: list[PlannedJob]) -> list[PlannedJob]:
+    """``plan`` with every job after the jobs it needs (an empty plan: nothing to order)."""
     order: list[PlannedJob] = []
     placed: set[str] = set()
     for _ in range(len(plan)):  # bounded: one job placed per pass at least
+        if len(order) == len(plan):
+            break
         for job in plan:
             if job.name not in placed and all(n in placed for n in job.needs):
                 order.append(job)
                 placed.add(job.name)
-        if len(order) == len(plan):
-            return order
+    if len(order) == len(plan):
+        return order
     raise ValueError(
         f"jobs with unmet or circular needs: {sorted({j.name for j in plan} - placed)}"
     )

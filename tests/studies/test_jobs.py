@@ -204,6 +204,17 @@ def test_the_scheduler_starts_the_longest_path_first_and_skips_what_lost_a_need(
     assert "relative_positioning" not in ran and len(finished) == 7
 
 
+def test_an_empty_plan_runs_nothing_and_ends() -> None:
+    # A sweep run again once every job is done plans nothing.
+    assert critical_order([]) == {}
+    finished: list[str] = []
+    with cf.ThreadPoolExecutor(max_workers=1) as pool:
+        ended = run_plan(
+            [], lambda: pool, lambda name, *_: finished.append(name), workers=1, close=None
+        )
+    assert ended == "every job ended" and finished == []
+
+
 def test_a_plan_with_a_need_that_no_job_meets_is_refused() -> None:
     plan = [PlannedJob("chessboard", _echo, ("calibration",), lambda done: (), 1.0)]
     with pytest.raises(ValueError, match="unmet or circular needs: \\['chessboard'\\]"):

@@ -70,6 +70,21 @@ def test_an_interrupted_sweep_resumes_without_redoing_jobs(grid: Path, tmp_path:
     assert len(_rows(out / "aggregate.csv")) == 4
 
 
+def test_a_finished_sweep_run_again_redoes_nothing_and_rewrites_its_aggregate(
+    grid: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "out"
+    argv = ["sweep", str(grid), "--out", str(out), "--workers", "1", "--no-progress"]
+    assert main(argv) == 0
+    log, aggregate = (out / "jobs.jsonl").read_text(), (out / "aggregate.csv").read_text()
+    (out / "aggregate.csv").unlink()
+    capsys.readouterr()
+    assert main(argv) == 0
+    assert "0 jobs run (4 already done)" in capsys.readouterr().out
+    assert (out / "jobs.jsonl").read_text() == log
+    assert (out / "aggregate.csv").read_text() == aggregate
+
+
 def test_a_crashing_job_is_retried_once_reported_and_the_rest_complete(
     grid: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
