@@ -2,11 +2,12 @@
 
 One :class:`mujoco.Renderer` (an OpenGL context) per scene and context state (the
 assets it uploads, :func:`context_key`, and what else it is made with,
-:func:`context_state`: buffer size, multisampling, clip and fog distances, read when an
-image is drawn) is kept in a small process-wide pool and reused by every simulator of
-that scene and state, whatever its head, within a run and across the jobs of a worker:
-creating one costs about 0.2 s.  So an image never depends on what the process drew
-before.
+:func:`context_state`: multisampling, clip and fog distances, read when an image is
+drawn) is kept in a small process-wide pool and reused by every simulator of that scene
+and state, whatever its head, within a run and across the jobs of a worker: creating one
+costs 0.08-0.2 s.  Its off-screen buffer is at least as large as every model it drew
+needed (one whose lens needs a larger canvas grows it once), and an image is drawn in
+its corner at its own size, so an image never depends on what the process drew before.
 
 A *window* is a sub-rectangle of a camera's image (for a distorted camera:
 the region of its pinhole canvas that the window's pixels sample), drawn as
@@ -75,14 +76,13 @@ def context_key(scene: str, model: mujoco.MjModel) -> tuple[str, str]:
 
 
 def context_state(model: mujoco.MjModel) -> tuple[float, ...]:
-    """What ``mjr_makeContext`` reads from ``model`` besides its assets, read when an image
-    is drawn (a model may change them after it is built, as the Gym env's multisampling):
-    the off-screen buffer's size and samples, the shadow map, the built-in meshes'
-    tessellation, and the clip, fog and shadow distances (``vis.map`` x ``stat.extent``)."""
+    """What ``mjr_makeContext`` reads from ``model`` besides its assets and the off-screen
+    buffer's size, read when an image is drawn (a model may change them after it is
+    built, as the Gym env's multisampling): the buffer's samples, the shadow map, the
+    built-in meshes' tessellation, and the clip, fog and shadow distances (``vis.map`` x
+    ``stat.extent``)."""
     quality, scale = model.vis.quality, model.vis.map
     return (
-        float(model.vis.global_.offwidth),
-        float(model.vis.global_.offheight),
         float(quality.offsamples),
         float(quality.shadowsize),
         float(quality.numslices),
@@ -98,12 +98,22 @@ _MAP_FIELDS = ("znear", "zfar", "fogstart", "fogend", "shadowclip", "shadowscale
 
 
 def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
-    """The pooled renderer of ``key`` (assets and :func:`context_state`), made from ``model``."""
+    """The pooled renderer of ``key`` (assets and :func:`context_state`), made from
+    ``model``, its off-screen buffer at least ``model``'s (a pooled one too small is made
+    again at the larger of both sizes)."""
     global created
+    width, height = int(model.vis.global_.offwidth), int(model.vis.global_.offheight)
     renderer = _POOL.pop(key, None)
+    if renderer is not None:
+        context = mjr_context(renderer)
+        if context.offWidth < width or context.offHeight < height:
+            width, height = max(width, context.offWidth), max(height, context.offHeight)
+            renderer.close()
+            renderer = None
     if renderer is None:
         backend = check_backend()
-        width, height = int(model.vis.global_.offwidth), int(model.vis.global_.offheight)
+        saved = (model.vis.global_.offwidth, model.vis.global_.offheight)
+        model.vis.global_.offwidth, model.vis.global_.offheight = width, height
         try:
             renderer = mujoco.Renderer(model, height=height, width=width)
         except ValueError as err:  # larger than the model's off-screen buffer
@@ -113,6 +123,8 @@ def _acquire(key: Hashable, model: mujoco.MjModel) -> mujoco.Renderer:
                 f"could not create an off-screen OpenGL context with MUJOCO_GL={backend}: {err}. "
                 f"{INSTALL_HINT}"
             ) from err
+        finally:
+            model.vis.global_.offwidth, model.vis.global_.offheight = saved
         check_renderer(renderer)
         created += 1
         for uploaded in [k for k in _UPLOADED if k[0] == key]:

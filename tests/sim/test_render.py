@@ -135,6 +135,36 @@ def test_an_image_does_not_depend_on_what_the_process_drew_before() -> None:
     assert draw(0).tobytes() == fresh.tobytes()
 
 
+def test_heads_whose_canvases_differ_share_one_context_grown_once_and_render_alike() -> None:
+    """A lens that needs a larger pinhole canvas grows the pooled context's buffer once;
+    a smaller head drawn after it, in the corner of that buffer, gets the pixels of a
+    context of its own size."""
+    from headsim.sim import render
+
+    plain = HeadSettings(seed=5, cameras=(CameraSettings(noise_std=2.0),) * 2)
+    barrel = HeadSettings(seed=5, cameras=(CameraSettings(k1=-0.4, noise_std=2.0),) * 2)
+
+    def draw(settings: HeadSettings) -> tuple[np.ndarray, tuple[int, int]]:
+        with HeadSim(settings=settings) as sim:
+            sim.set_body_pose(MARKER, [0.02, 0.6, 0.23])
+            sim.move(eye=0.05)
+            size = (int(sim.model.vis.global_.offwidth), int(sim.model.vis.global_.offheight))
+            return sim.render(1), size
+
+    release_renderers()
+    alone, plain_size = draw(plain)
+    before = render.created
+    bent, barrel_size = draw(barrel)
+    assert barrel_size[0] > plain_size[0] and barrel_size[1] > plain_size[1]
+    assert render.created == before + 1  # grown to the barrel lens's canvas
+    again, _ = draw(plain)
+    assert render.created == before + 1  # drawn in the grown buffer's corner
+    assert len(render._POOL) == 1  # one context serves both heads
+    np.testing.assert_array_equal(again, alone)
+    release_renderers()
+    assert np.array_equal(draw(barrel)[0], bent)
+
+
 def test_a_marker_out_of_view_is_reported_lost_and_one_on_the_border_cut() -> None:
     with HeadSim("default") as sim:
         sim.set_body_pose(MARKER, [0.0, -1.0, 0.21])  # behind the head
