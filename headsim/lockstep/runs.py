@@ -31,10 +31,14 @@ from headsim.runs.outcomes import MeasurementRecord, RunRenders
 from headsim.runs.result import RunResult
 from headsim.scenario.spec import Placement, Scenario
 from headsim.sim.events import RenderCounts
+from headsim.sim.model import BuiltModel, build_model
 
 from .model2_run import scenario_targets
 from .servo import NEEDS_CLASSIC, HeadEstimate, HeadJob, measure_model2_heads
 from .settled import SettledHeads
+
+#: The scene lockstep heads stand in (the default one: no room).
+LOCKSTEP_SCENE = "default"
 
 
 def classic_reason(scenario: Scenario) -> str:
@@ -66,6 +70,7 @@ class _Pending:
     calibration: CalibrationReport | None
     renders: RenderCounts
     timing_s: dict[str, float]
+    built: BuiltModel
 
 
 @dataclass(frozen=True)
@@ -103,20 +108,26 @@ def run_scenarios(
                 )
                 continue
             knowledge, label = run.knowledge, "calibrated"
-        pending.append(_Pending(row, scenario, knowledge, label, calibration, renders, timing))
+        # Built now, while the lens's canvas the calibration made is still cached.
+        built = build_model(LOCKSTEP_SCENE, scenario.settings)
+        pending.append(
+            _Pending(row, scenario, knowledge, label, calibration, renders, timing, built)
+        )
     jobs: list[HeadJob] = []
     owners: list[int] = []
     settings = []
+    builds = []
     for index, p in enumerate(pending):
         model2, servo = model2_config(p.scenario), servo_config(p.scenario)
         for target in scenario_targets(p.scenario):
             jobs.append(HeadJob(target, p.knowledge, model2, servo))
             owners.append(index)
             settings.append(p.scenario.settings)
+            builds.append(p.built)
     if not jobs:
         return out, LockstepStats(0, 0, 0, 0.0)
     start = time.perf_counter()
-    with SettledHeads(settings) as heads:
+    with SettledHeads(settings, LOCKSTEP_SCENE, builds) as heads:
         head = 0
         for p in pending:
             placed = p.scenario.scene.targets

@@ -39,15 +39,23 @@ class SettledHeads:
     (the neck stays home).  Image k of camera c of head i carries noise from the stream
     ((seed, i), c, k): each head's own, apart from the classic simulator's."""
 
-    def __init__(self, settings: Sequence[HeadSettings], scene: str = "default") -> None:
+    def __init__(
+        self,
+        settings: Sequence[HeadSettings],
+        scene: str = "default",
+        built: Sequence[BuiltModel | None] = (),
+    ) -> None:
+        """``built``: the models of ``scene`` some heads' settings were already built into
+        (None, or a shorter list: built here); a lens's canvas costs about 30 ms to make."""
         if not settings:
             raise SettingsError("settled lockstep heads need at least one head's settings")
         self.n = len(settings)
         self.settings = list(settings)
         builds: dict[HeadSettings, BuiltModel] = {}
-        for s in settings:
+        given = list(built) + [None] * (self.n - len(built))
+        for s, model in zip(settings, given, strict=True):
             if s not in builds:
-                builds[s] = build_model(scene, s)
+                builds[s] = model if model is not None else build_model(scene, s)
         self.built = [builds[s] for s in settings]
         first = self.built[0]
         self.names = mapping = first.names
