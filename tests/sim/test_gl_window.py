@@ -270,10 +270,14 @@ def test_a_missed_window_costs_a_frame_of_the_same_instant(monkeypatch) -> None:
     def far_away(image_size_px, expected_uv_px, area_px, motion_px, margin_px):  # type: ignore[no-untyped-def]
         return Window(0, 0, 24, 24) if expected_uv_px[0] > 100 else Window(600, 440, 24, 24)
 
+    def band_far_away(image_size_px, seen_uv_px, area_px, margin_px):  # type: ignore[no-untyped-def]
+        return far_away(image_size_px, seen_uv_px, area_px, 0.0, margin_px)
+
     runs = {}
     for windows in (False, True):
         if windows:
             monkeypatch.setattr(look, "expected_window", far_away)
+            monkeypatch.setattr(look, "band_window", band_far_away)
         with HeadSim("default", settings) as sim:
             servo = LoggingServo(sim, ServoConfig(windows=windows))
             measured = []
