@@ -155,10 +155,8 @@ def _load(
     overrides: dict[str, Any] | None,
 ) -> Scenario:
     source = str(path)
-    if seed is not None and not (isinstance(seed, int) and 0 <= seed < 2**32):
-        raise ScenarioError(
-            source, "seed", f"{seed!r} is out of range", "an integer from 0 to 2**32 - 1"
-        )
+    if seed is not None:  # checked as the file's own seed is
+        Table({SEED.name: seed}, "", Context(source, None)).setting(SEED)
     for dotted, value in (overrides or {}).items():
         try:
             doc = set_field(doc, dotted, value)

@@ -13,6 +13,7 @@ from scenario.helpers import MINIMAL, write_scenario
 from headsim.cli import main
 from headsim.cli.scenarios import progress_observer
 from headsim.scenario.loading import load_scenario, scenario_files
+from headsim.scenario.tables import ScenarioError
 
 FILES = scenario_files()
 
@@ -29,6 +30,24 @@ def test_run_with_a_bad_file_exits_2_and_writes_nothing(
     assert main(["run", "quickstart", "--seed", "-3", "--out", str(out)]) == 2
     assert "seed: -3 is out of range" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("seed", "said"),
+    [
+        ("a", "seed: must be an integer, got string 'a'"),
+        (True, "seed: must be an integer, got boolean True"),
+        (2**32, "seed: 4294967296 is out of range"),
+    ],
+)
+def test_a_seed_given_from_outside_the_file_is_checked_as_the_files_own(
+    seed: object, said: str
+) -> None:
+    # --seed, a sweep's seed field, load_scenario(seed=...): one declaration's message.
+    with pytest.raises(ScenarioError) as caught:
+        load_scenario("quickstart", seed=seed)  # type: ignore[arg-type]
+    assert said in str(caught.value)
+    assert str(caught.value).endswith("(allowed: an integer from 0 to 4294967295)")
 
 
 def test_list_shows_every_scenario_with_its_head_and_description(
