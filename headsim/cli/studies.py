@@ -112,9 +112,10 @@ def sweep_command(args: argparse.Namespace) -> int:
         why = "; ".join(reasons[:2]) + more
         print(printable(f"  job {record['index']} {record.get('status', '?')}: {why}"))
     rate = 60 * outcome.ran / outcome.wall_s if outcome.wall_s > 0 else 0.0
+    speed = f" in {outcome.wall_s:.1f} s, {rate:.1f} jobs/min" if outcome.ran else ""
     print(
-        f"{outcome.ran} jobs run ({outcome.skipped} already done) in {outcome.wall_s:.1f} s, "
-        f"{rate:.1f} jobs/min; {len(outcome.failed)} failed"
+        f"{outcome.ran} jobs run ({outcome.skipped} already done){speed}; "
+        f"{len(outcome.failed)} failed"
     )
     if batch is not None and outcome.rendered:
         drawn = outcome.rendered

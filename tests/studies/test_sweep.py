@@ -80,7 +80,7 @@ def test_a_finished_sweep_run_again_redoes_nothing_and_rewrites_its_aggregate(
     (out / "aggregate.csv").unlink()
     capsys.readouterr()
     assert main(argv) == 0
-    assert "0 jobs run (4 already done)" in capsys.readouterr().out
+    assert "0 jobs run (4 already done); 0 failed" in capsys.readouterr().out
     assert (out / "jobs.jsonl").read_text() == log
     assert (out / "aggregate.csv").read_text() == aggregate
 
