@@ -35,10 +35,7 @@ from headsim.sim.model import BuiltModel, build_model
 
 from .model2_run import scenario_targets
 from .servo import NEEDS_CLASSIC, HeadEstimate, HeadJob, measure_model2_heads
-from .settled import SettledHeads
-
-#: The scene lockstep heads stand in (the default one: no room).
-LOCKSTEP_SCENE = "default"
+from .settled import DEFAULT_SCENE, SettledHeads
 
 
 def classic_reason(scenario: Scenario) -> str:
@@ -109,7 +106,7 @@ def run_scenarios(
                 continue
             knowledge, label = run.knowledge, "calibrated"
         # Built now, while the lens's canvas the calibration made is still cached.
-        built = build_model(LOCKSTEP_SCENE, scenario.settings)
+        built = build_model(DEFAULT_SCENE, scenario.settings)
         pending.append(
             _Pending(row, scenario, knowledge, label, calibration, renders, timing, built)
         )
@@ -127,7 +124,7 @@ def run_scenarios(
     if not jobs:
         return out, LockstepStats(0, 0, 0, 0.0)
     start = time.perf_counter()
-    with SettledHeads(settings, LOCKSTEP_SCENE, builds) as heads:
+    with SettledHeads(settings, built=builds) as heads:
         head = 0
         for p in pending:
             placed = p.scenario.scene.targets

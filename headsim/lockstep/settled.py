@@ -32,6 +32,9 @@ from headsim.sim.settings import HeadSettings, SettingsError
 from .heads import _given
 from .opengl import EyeView, ViewRenderer
 
+#: The scene settled heads stand in unless told otherwise (the default one: no room).
+DEFAULT_SCENE = "default"
+
 
 class SettledHeads:
     """Heads at rest in ``scene``, one per entry of ``settings`` (each its own cameras,
@@ -42,7 +45,7 @@ class SettledHeads:
     def __init__(
         self,
         settings: Sequence[HeadSettings],
-        scene: str = "default",
+        scene: str = DEFAULT_SCENE,
         built: Sequence[BuiltModel | None] = (),
     ) -> None:
         """``built``: the models of ``scene`` some heads' settings were already built into
@@ -274,4 +277,4 @@ class SettledHeads:
         self.close()
 
 
-__all__ = ["SettledHeads"]
+__all__ = ["DEFAULT_SCENE", "SettledHeads"]
