@@ -97,14 +97,31 @@ def reproduce(
     timeline: dict[str, dict[str, float]] = {"render_time": {"pid": os.getpid(), "start": 0.0}}
     timeline["render_time"]["end"] = time.time() - epoch
 
+    drawing: list[threading.Thread] = []  # the Tables V/VI figure, once its job ends
+
     def draw_tables() -> None:
-        """The Tables V/VI PNG, once (drawn here, while the other workers run)."""
+        """The Tables V/VI PNG, once, on a thread of this process: drawing it (~0.3 s)
+        must not hold back the job that another worker is ready to start."""
         tables = outcomes.get(STUDY_JOB)
         if tables is not None and "result" in tables.data:
-            from headsim.studies import plots
-
             result = tables.data.pop("result")
-            plots.plot_experiment(result, Path(tables.data["files"]["png"]))
+            png = Path(tables.data["files"]["png"])
+
+            def draw() -> None:
+                from headsim.studies import plots
+
+                try:
+                    plots.plot_experiment(result, png)
+                except Exception as err:  # a figure must not hide the numbers
+                    progress(f"figure not drawn: {err!r}")
+
+            drawing.append(threading.Thread(target=draw, daemon=True))
+            drawing[-1].start()
+
+    def tables_drawn() -> None:
+        """Wait for the Tables V/VI figure (pyplot's figures are one thread's at a time)."""
+        for thread in drawing:
+            thread.join()
 
     def write_report(figure: bool = True) -> None:
         """report.md and report.json; the main figure (matplotlib, ~1 s) only when asked:
@@ -112,8 +129,9 @@ def reproduce(
         drawn = None
         if figure:
             try:
-                drawn = main_figure(outcomes, calibration, out / "figures" / "main.png")
                 draw_tables()
+                tables_drawn()
+                drawn = main_figure(outcomes, calibration, out / "figures" / "main.png")
             except Exception as err:  # a figure must not hide the numbers
                 progress(f"figure not drawn: {err!r}")
         state["wall_s"] = time.perf_counter() - start
@@ -215,10 +233,7 @@ def reproduce(
                 )
             progress(f"{name}: {outcomes[name].status}")
             if name == STUDY_JOB:
-                try:
-                    draw_tables()
-                except Exception as err:  # a figure must not hide the numbers
-                    progress(f"figure not drawn: {err!r}")
+                draw_tables()
             write_report(figure=False)
 
         def skipped(name: str, missing: str) -> None:

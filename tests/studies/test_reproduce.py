@@ -93,6 +93,9 @@ def test_the_command_line_ends_a_run_of_workers_cleanly(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert "Warning" not in done.stderr and "leaked" not in done.stderr, done.stderr
     assert json.loads((out / "report.json").read_text())["status"] == "ok"
+    # Both figures, the Tables V/VI one drawn on a thread while the workers ran on.
+    for figure in (out / "figures" / "main.png", out / "study" / "tables_v_vi.png"):
+        assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", figure
 
 
 def test_check_reproduce_finds_its_stored_baseline() -> None:
