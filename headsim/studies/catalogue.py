@@ -125,7 +125,9 @@ def _take(
 
 def _floats(source: str, where: str, table: dict[str, Any], key: str) -> tuple[float, ...]:
     """``table[key]``: a number or a non-empty list of numbers, as floats."""
-    value = table.get(key)
+    if key not in table:
+        raise SweepError(source, f"{where}.{key}", "is missing")
+    value = table[key]
     items: list[Any] = value if isinstance(value, list) else [value]
     if not items or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in items):
         raise SweepError(source, f"{where}.{key}", f"must be numbers, got {value!r}")
@@ -309,16 +311,21 @@ def compare_figures(result: ExperimentResult) -> dict[str, Any]:
 @dataclass(frozen=True)
 class ReproduceJob:
     """One job of ``headsim reproduce`` as its file describes it: the hook that runs it, the
-    jobs it comes after, its cost in render-times and, for a scenario job, the scenario, its
-    overrides and what it reproduces."""
+    jobs it comes after, its cost in render-times in the full and the ``--fast`` run and, for
+    a scenario job, the scenario, its overrides and what it reproduces."""
 
     name: str
     hook: str
     after: tuple[str, ...]
     cost: float
+    fast_cost: float
     scenario: str = ""
     overrides: dict[str, Any] = field(default_factory=dict)
     reproduces: str = ""
+
+    def cost_of(self, fast: bool) -> float:
+        """Its cost in the run asked for (render-times)."""
+        return self.fast_cost if fast else self.cost
 
 
 @dataclass(frozen=True)
@@ -331,7 +338,7 @@ class ReproduceExperiments:
 
 #: Reproduce's experiments, as a file.
 REPRODUCE_FILE = Path(__file__).with_name("reproduce_experiments.toml")
-_JOB_KEYS = ("hook", "after", "cost", "scenario", "overrides", "reproduces")
+_JOB_KEYS = ("hook", "after", "cost", "fast_cost", "scenario", "overrides", "reproduces")
 
 
 def read_reproduce_experiments(path: Path = REPRODUCE_FILE) -> ReproduceExperiments:
@@ -355,6 +362,7 @@ def read_reproduce_experiments(path: Path = REPRODUCE_FILE) -> ReproduceExperime
             hook=_take(source, where, table, "hook", str),
             after=after,
             cost=_floats(source, where, table, "cost")[0],
+            fast_cost=_floats(source, where, table, "fast_cost")[0],
             scenario=scenario,
             overrides=overrides,
             reproduces=_take(source, where, table, "reproduces", str, ""),

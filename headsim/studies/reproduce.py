@@ -190,7 +190,7 @@ def reproduce(
                 JOB_HOOKS[job.hook],
                 job.after,
                 functools.partial(args, name=name, after=job.after),
-                job.cost,
+                job.cost_of(fast),
             )
             for name, job in REPRODUCE.jobs.items()
         ] + [

@@ -104,6 +104,11 @@ def test_every_experiment_runs_a_shipped_scenario_and_has_a_cost() -> None:
     assert {scenario for scenario, _ in SCENARIO_JOBS.values()} | {TABLES_HEAD} <= shipped
     assert set(SCENARIO_JOBS) | {STUDY_JOB, TABLES_HEAD} <= set(COSTS)
     assert all(cost > 0 for cost in COSTS.values())
+    # --fast is a smaller run of every job: the scheduler plans it with its own costs.
+    assert all(0 < job.fast_cost <= job.cost for job in REPRODUCE.jobs.values())
+    assert [job.cost_of(True) for job in REPRODUCE.jobs.values()] != [
+        job.cost_of(False) for job in REPRODUCE.jobs.values()
+    ]
 
 
 @pytest.mark.fast
@@ -128,18 +133,26 @@ def test_reproduce_s_file_names_registered_hooks_in_planned_order() -> None:
     ("text", "message"),
     [
         (
-            '[job.a]\nhook = "h"\ncost = 1\nafter = ["b"]',
+            '[job.a]\nhook = "h"\ncost = 1\nfast_cost = 1\nafter = ["b"]',
             r"job\.a\.after: \['b'\] names no earlier job",
         ),
-        ('[job.a]\nhook = "h"\ncost = "x"', r"job\.a\.cost: must be numbers, got 'x'"),
-        ('[job.a]\nhook = "h"\ncost = 1\nwhen = 2', r"job\.a\.when: unknown key \(allowed: hook,"),
-        ("[job.a]\ncost = 1", r"job\.a\.hook: is missing"),
+        (
+            '[job.a]\nhook = "h"\ncost = "x"\nfast_cost = 1',
+            r"job\.a\.cost: must be numbers, got 'x'",
+        ),
+        ('[job.a]\nhook = "h"\ncost = 1', r"job\.a\.fast_cost: is missing"),
+        (
+            '[job.a]\nhook = "h"\ncost = 1\nfast_cost = 1\nwhen = 2',
+            r"job\.a\.when: unknown key \(allowed: hook,",
+        ),
+        ("[job.a]\ncost = 1\nfast_cost = 1", r"job\.a\.hook: is missing"),
     ],
 )
 def test_a_bad_reproduce_file_is_refused_naming_the_field(tmp_path, text, message) -> None:
     path = tmp_path / "reproduce.toml"
-    path.write_text('sweep_cost = 10\n[job.b]\nhook = "h"\ncost = 2\n')
-    assert read_reproduce_experiments(path).jobs["b"].cost == 2.0
+    path.write_text('sweep_cost = 10\n[job.b]\nhook = "h"\ncost = 2\nfast_cost = 0.5\n')
+    job = read_reproduce_experiments(path).jobs["b"]
+    assert (job.cost_of(False), job.cost_of(True)) == (2.0, 0.5)
     path.write_text("sweep_cost = 10\n" + text)
     with pytest.raises(SweepError, match=f"^{path}: " + message):
         read_reproduce_experiments(path)
