@@ -67,43 +67,24 @@ def find_markers_stacked(
     out = [Detection(DetectionStatus.LOST, None, 0.0)] * count
     with serial_opencv():  # each image's blob window: a few hundred pixels
         for image in np.flatnonzero(rows.any(axis=1)).tolist():
-            out[image] = _one(
-                images[image],
-                weight[image],
-                inked[image],
-                colour,
-                threshold,
-                (int(top[image]), int(bottom[image]), int(left[image]), int(right[image])),
-            )
+            # Every piece of the colour, and a pixel around them for the rim.
+            y0, y1 = max(int(top[image]) - 1, 0), min(int(bottom[image]) + 2, height)
+            x0, x1 = max(int(left[image]) - 1, 0), min(int(right[image]) + 2, width)
+            binary = inked[image, y0:y1, x0:x1].astype(np.uint8)
+            pieces, _, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
+            if pieces > 2:
+                out[image] = find_marker(images[image], colour, threshold)
+                continue
+            x, y, w, h = (int(stats[1, k]) for k in range(4))
+            x, y = x + x0, y + y0
+            if x == 0 or y == 0 or x + w >= width or y + h >= height:
+                area = float(stats[1, cv2.CC_STAT_AREA])
+                out[image] = Detection(DetectionStatus.CUT, None, area)
+                continue
+            rim = cv2.dilate(binary, _RIM, borderType=cv2.BORDER_CONSTANT, borderValue=0)
+            rimmed = np.where(rim > 0, weight[image, y0:y1, x0:x1], 0)
+            out[image] = _single(rimmed, x - 1 - x0, y - 1 - y0, (x0, y0), (w + 2, h + 2))
     return out
-
-
-def _one(
-    image: np.ndarray,
-    weight: np.ndarray,
-    inked: np.ndarray,
-    colour: str,
-    threshold: float,
-    bounds: tuple[int, int, int, int],
-) -> Detection:
-    """One image's detection from its colour weight, inked pixels and their bounds (first
-    and last row, first and last column)."""
-    height, width = weight.shape
-    top, bottom, left, right = bounds
-    # Every piece of the colour, and a pixel around them for the rim.
-    y0, y1 = max(top - 1, 0), min(bottom + 2, height)
-    x0, x1 = max(left - 1, 0), min(right + 2, width)
-    binary = inked[y0:y1, x0:x1].astype(np.uint8)
-    pieces, _, stats, _ = cv2.connectedComponentsWithStats(binary, connectivity=8)
-    if pieces > 2:
-        return find_marker(image, colour, threshold)
-    x, y, w, h = (int(stats[1, k]) for k in range(4))
-    x, y = x + x0, y + y0
-    if x == 0 or y == 0 or x + w >= width or y + h >= height:
-        return Detection(DetectionStatus.CUT, None, float(stats[1, cv2.CC_STAT_AREA]))
-    rim = cv2.dilate(binary, _RIM, borderType=cv2.BORDER_CONSTANT, borderValue=0)
-    rimmed = np.where(rim > 0, weight[y0:y1, x0:x1], 0)
-    return _single(rimmed, x - 1 - x0, y - 1 - y0, (x0, y0), (w + 2, h + 2))
 
 
 def _single(
