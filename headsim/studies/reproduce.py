@@ -97,11 +97,12 @@ def reproduce(
     timeline: dict[str, dict[str, float]] = {"render_time": {"pid": os.getpid(), "start": 0.0}}
     timeline["render_time"]["end"] = time.time() - epoch
 
-    drawing: list[threading.Thread] = []  # the Tables V/VI figure, once its job ends
+    drawing: threading.Thread | None = None  # the Tables V/VI figure, once its job ends
 
     def draw_tables() -> None:
         """The Tables V/VI PNG, once, on a thread of this process: drawing it (~0.3 s)
         must not hold back the job that another worker is ready to start."""
+        nonlocal drawing
         tables = outcomes.get(STUDY_JOB)
         if tables is not None and "result" in tables.data:
             result = tables.data.pop("result")
@@ -115,13 +116,8 @@ def reproduce(
                 except Exception as err:  # a figure must not hide the numbers
                     progress(f"figure not drawn: {err!r}")
 
-            drawing.append(threading.Thread(target=draw, daemon=True))
-            drawing[-1].start()
-
-    def tables_drawn() -> None:
-        """Wait for the Tables V/VI figure (pyplot's figures are one thread's at a time)."""
-        for thread in drawing:
-            thread.join()
+            drawing = threading.Thread(target=draw, daemon=True)
+            drawing.start()
 
     def write_report(figure: bool = True) -> None:
         """report.md and report.json; the main figure (matplotlib, ~1 s) only when asked:
@@ -130,7 +126,8 @@ def reproduce(
         if figure:
             try:
                 draw_tables()
-                tables_drawn()
+                if drawing is not None:  # pyplot's figures are one thread's at a time
+                    drawing.join()
                 drawn = main_figure(outcomes, calibration, out / "figures" / "main.png")
             except Exception as err:  # a figure must not hide the numbers
                 progress(f"figure not drawn: {err!r}")
