@@ -12,7 +12,7 @@ import numpy as np
 
 from headsim.active.events import ServoKind, ServoStep
 from headsim.active.eye_servo import pixel_period_steps
-from headsim.active.look import Anew, Around, Hint, Looker, Whole, finds_blob
+from headsim.active.look import Anew, Around, Hint, Looker, finds_blob
 from headsim.active.servo_types import (
     Detector,
     NeckServoResult,
@@ -107,12 +107,14 @@ class NeckServo:
 
     def _look(self, camera: int, detector: Detector) -> Detection:
         """Detect in ``camera``: in a window around where the last images and the
-        Jacobian put the target (same target, blob detector), a new target in a
-        preview's window, else in the full frame (see :class:`~headsim.active.look.Looker`)."""
+        Jacobian put the target (same target, blob detector), else (a new target, or no
+        Jacobian yet: its probes) in a preview's window, the full frame where that window
+        misses (see :class:`~headsim.active.look.Looker`)."""
         return self.looker.look(camera, detector, self._hint(camera))
 
     def _hint(self, camera: int) -> Hint:
-        """Where the last images and the Jacobian put the target in ``camera``, if they do."""
+        """Where the last images and the Jacobian put the target in ``camera``, if they do;
+        else a look anew."""
         seen, jac = self._seen, self._current
         if self.config.windows and seen is not None and jac is not None and seen[0] is self._key:
             move = self._steps() - np.array(seen[1])
@@ -120,9 +122,7 @@ class NeckServo:
             (u, v), area = seen[2][camera - 1]
             du = du1 if camera == 1 else du2
             return Around(self._key, (u + du, v + dv), area, max(abs(du), abs(dv)))
-        if seen is None or seen[0] is not self._key:
-            return Anew(self._key)
-        return Whole()
+        return Anew(self._key)
 
     def _in_range(self, steps: np.ndarray) -> bool:
         return all(lo <= s <= hi for s, (lo, hi) in zip(steps, self._ranges, strict=True))
