@@ -537,8 +537,9 @@ class Looker:
         box so grown.  With no gain known yet (the servo's probe), a blob's window is the
         band of rows around that sight (:func:`band_window`): a window's pixels are the
         frame's crop, so it gives the frame's answer at a fraction of its cost.  A blob's
-        miss is looked for again in a preview, then in the same instant's full frame.  A new blob is first found in a binned preview;
-        ``preview=False`` renders the full frame instead (a search's look)."""
+        miss is looked for again in a preview, then in the same instant's full frame.  A
+        new blob is first found in a binned preview; ``preview=False`` renders the full
+        frame instead (a search's look)."""
         key = detector if hint.key is None else hint.key
         sim, cfg, counts = self.sim, self.config, self.counts
         eye_steps, neck_rad = sim.eye_encoder_steps(), sim.neck_encoders()

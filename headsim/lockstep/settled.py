@@ -46,16 +46,16 @@ class SettledHeads:
         self,
         settings: Sequence[HeadSettings],
         scene: str = DEFAULT_SCENE,
-        built: Sequence[BuiltModel | None] = (),
+        built: Sequence[BuiltModel] = (),
     ) -> None:
-        """``built``: the models of ``scene`` some heads' settings were already built into
-        (None, or a shorter list: built here); a lens's canvas costs about 30 ms to make."""
+        """``built``: each head's model of ``scene``, already built (empty: built here); a
+        lens's canvas costs about 30 ms to make."""
         if not settings:
             raise SettingsError("settled lockstep heads need at least one head's settings")
         self.n = len(settings)
         self.settings = list(settings)
         builds: dict[HeadSettings, BuiltModel] = {}
-        given = list(built) + [None] * (self.n - len(built))
+        given: Sequence[BuiltModel | None] = built or [None] * self.n
         for s, model in zip(settings, given, strict=True):
             if s not in builds:
                 builds[s] = model if model is not None else build_model(scene, s)
